@@ -1,0 +1,182 @@
+//! The contract every solver crate implements.
+//!
+//! A [`Scene`] says *what*; [`Settings`] say *how finely*; a [`Backend`] turns the two into
+//! results. Backends never see each other.
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::results::{ModalResult, RunResult, StaticResult};
+use crate::scene::Scene;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BackendKind {
+    Fem,
+    Fdm,
+    Modal,
+}
+
+impl BackendKind {
+    pub const ALL: [BackendKind; 3] = [BackendKind::Fem, BackendKind::Fdm, BackendKind::Modal];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            BackendKind::Fem => "fem",
+            BackendKind::Fdm => "fdm",
+            BackendKind::Modal => "modal",
+        }
+    }
+}
+
+impl std::fmt::Display for BackendKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Assumed-mode basis of the modal backend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Basis {
+    /// x², x³, x⁴, … (seed 000 eq. 49).
+    Poly,
+    /// Clamped-free cantilever eigenfunctions.
+    ClampedFree,
+    /// Eigenfunctions of the cantilever with the scene's tip mass/inertia.
+    TipMass,
+    /// Free-free beam eigenfunctions (rocket).
+    FreeFree,
+}
+
+impl Basis {
+    pub fn name(self) -> &'static str {
+        match self {
+            Basis::Poly => "poly",
+            Basis::ClampedFree => "clamped-free",
+            Basis::TipMass => "tip-mass",
+            Basis::FreeFree => "free-free",
+        }
+    }
+}
+
+/// How finely space is discretized. Each backend reads the field it understands and uses its
+/// documented default when the field is absent.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Discretization {
+    /// FEM: elements per link.
+    pub elements: Option<usize>,
+    /// FDM: stations per link (including both ends).
+    pub stations: Option<usize>,
+    /// Modal: assumed modes per link (per field).
+    pub modes: Option<usize>,
+    pub basis: Option<Basis>,
+}
+
+/// How time is integrated.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TimeStepping {
+    /// Fixed step (or initial step of an adaptive method).
+    pub dt: Option<f64>,
+    /// Overrides the scene's end time.
+    pub t_end: Option<f64>,
+    /// Backend-specific method name (e.g. `generalized-alpha`, `central-difference`, `dopri5`).
+    pub method: Option<String>,
+    /// Relative / absolute error tolerances of adaptive methods.
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    /// Multiplier (≤ 1) applied to a stability bound when the backend picks the step itself.
+    pub safety_factor: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    pub discretization: Discretization,
+    pub time: TimeStepping,
+}
+
+/// Degrees of freedom a backend would build for a scene: a table of (what, count).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct DofPlan {
+    pub groups: Vec<DofGroup>,
+    /// Physics the backend builds for this scene, in words (e.g. "foreshortening stiffening").
+    pub builds: Vec<String>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DofGroup {
+    pub what: String,
+    pub count: usize,
+}
+
+impl DofPlan {
+    pub fn total(&self) -> usize {
+        self.groups.iter().map(|g| g.count).sum()
+    }
+    pub fn add(&mut self, what: impl Into<String>, count: usize) {
+        if count > 0 {
+            self.groups.push(DofGroup {
+                what: what.into(),
+                count,
+            });
+        }
+    }
+}
+
+/// Errors a backend may return instead of a result.
+#[derive(Debug, Clone, PartialEq, Error, Serialize, Deserialize)]
+pub enum BackendError {
+    /// The backend does not implement what the scene or the request needs.
+    #[error("unsupported: {0}")]
+    Unsupported(String),
+    /// A setting is out of range for this scene.
+    #[error("invalid setting `{field}`: {message}")]
+    InvalidSettings { field: String, message: String },
+    /// A user-forced step is above an explicit scheme's stability bound.
+    #[error(
+        "time step {dt:.3e} exceeds the {bound_kind} stability bound {bound:.3e} at {location} \
+         (t = {t:.6e}); use --dt {bound:.3e} or smaller, or omit --dt to let the scheme choose"
+    )]
+    StabilityBound {
+        t: f64,
+        dt: f64,
+        bound: f64,
+        bound_kind: String,
+        location: String,
+    },
+    /// A numerical failure that has no partial result worth keeping (e.g. singular mass matrix
+    /// at set-up).
+    #[error("numerical failure at t = {t:.6e}: {message}")]
+    Numerical { t: f64, message: String },
+}
+
+impl BackendError {
+    pub fn unsupported(what: impl Into<String>) -> Self {
+        BackendError::Unsupported(what.into())
+    }
+}
+
+/// A discretization of scenes: finite elements, finite differences or assumed modes.
+///
+/// `simulate` returns `Ok` also when the run stops early: the result then carries a
+/// [`crate::StabilityVerdict::Stopped`] diagnostic and the output up to that time.
+pub trait Backend: Sync {
+    fn kind(&self) -> BackendKind;
+
+    /// The degrees of freedom and physics this backend would build for the scene.
+    fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError>;
+
+    /// Natural frequencies (Hz) and shapes, linearized about the scene's reference state.
+    fn modes(
+        &self,
+        scene: &Scene,
+        settings: &Settings,
+        count: usize,
+    ) -> Result<ModalResult, BackendError>;
+
+    /// Linear static response to the scene's `[statics]` loads.
+    fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError>;
+
+    /// Dynamic response over [0, t_end].
+    fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError>;
+}

@@ -1,0 +1,33 @@
+//! # data — what a problem is and what an answer looks like
+//!
+//! Shared by the three independent solver crates (`fem`, `fdm`, `modal`) and by `verify`:
+//! * [`scene`] — the typed scene model (planar link chains, the variable-mass rocket, the 3-D
+//!   payload link, the mobile manipulator);
+//! * [`reader`] / [`validate`] — TOML → validated scene, errors with file, line, column, field;
+//! * [`catalog`] — the embedded catalog of `data/scenes/*.toml`;
+//! * [`results`] — observables, energy ledger, events, cost counters, stability verdict;
+//! * [`backend`] — the [`Backend`] trait every solver implements.
+//!
+//! No physics lives here: agreement between backends must mean something.
+
+pub mod backend;
+pub mod catalog;
+pub mod error;
+pub mod locate;
+pub mod reader;
+pub mod results;
+pub mod scene;
+pub mod validate;
+
+pub use backend::{
+    Backend, BackendError, BackendKind, Basis, Discretization, DofGroup, DofPlan, Settings,
+    TimeStepping,
+};
+pub use catalog::{CATALOG, catalog_names, catalog_scene, load_scene};
+pub use error::{LoadError, SceneError};
+pub use reader::parse_scene;
+pub use results::{
+    Channel, Cost, Diagnostic, EnergyLedger, EnergyTerm, Event, ModalResult, ModeShape,
+    Observables, RunResult, StabilityVerdict, StaticResult, channel,
+};
+pub use scene::{Family, Scene};

@@ -1,0 +1,378 @@
+//! What a backend returns (verification.md, "What every backend run returns").
+//!
+//! Backends fill these types; `verify` compares them. Observables are addressed by name (see
+//! [`channel`]) so that backends are compared through physical quantities, never raw DOF vectors.
+
+use serde::{Deserialize, Serialize};
+
+use crate::backend::{BackendKind, Settings};
+
+/// Standard observable channel names. Link and joint indices are 1-based, as in the papers.
+pub mod channel {
+    /// Joint angle θᵢ (frame angle of link i relative to its parent) [rad].
+    pub fn joint_angle(i: usize) -> String {
+        format!("joint{i}.angle")
+    }
+    /// Joint rate θ̇ᵢ.
+    pub fn joint_rate(i: usize) -> String {
+        format!("joint{i}.rate")
+    }
+    /// Total torque the joint actuator applies (applied law, or what prescribed motion needed).
+    pub fn joint_torque(i: usize) -> String {
+        format!("joint{i}.torque")
+    }
+    /// Tip position of link i in inertial coordinates.
+    pub fn tip_x(i: usize) -> String {
+        format!("link{i}.tip_x")
+    }
+    pub fn tip_y(i: usize) -> String {
+        format!("link{i}.tip_y")
+    }
+    /// Transverse tip deflection of link i in its own floating frame.
+    pub fn tip_deflection(i: usize) -> String {
+        format!("link{i}.tip_deflection")
+    }
+    /// Axial tip displacement of link i in its floating frame (extensible links).
+    pub fn tip_axial(i: usize) -> String {
+        format!("link{i}.tip_axial")
+    }
+    /// Transverse deflection of link i at field station k (of `simulation.field_stations`).
+    pub fn field_deflection(i: usize, k: usize) -> String {
+        format!("link{i}.v@{k}")
+    }
+    /// Contact phase of contact c: 0 free, 1 constrained (sliding/sticking).
+    pub fn contact_phase(c: usize) -> String {
+        format!("contact{c}.phase")
+    }
+    /// Normal force of contact c (positive pushes the tip to the free side).
+    pub fn contact_normal_force(c: usize) -> String {
+        format!("contact{c}.normal_force")
+    }
+    /// Time step in use (variable-step schemes).
+    pub const STEP_SIZE: &str = "step_size";
+    /// Stability bound on the step in force at that time (explicit schemes).
+    pub const STABILITY_BOUND: &str = "stability_bound";
+}
+
+/// Sampled time series of named channels on a common time grid.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Observables {
+    pub time: Vec<f64>,
+    pub channels: Vec<Channel>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Channel {
+    pub name: String,
+    pub unit: String,
+    pub values: Vec<f64>,
+}
+
+impl Observables {
+    /// Creates empty channels with the given names and units.
+    pub fn with_channels(specs: &[(String, &str)]) -> Self {
+        Observables {
+            time: Vec::new(),
+            channels: specs
+                .iter()
+                .map(|(name, unit)| Channel {
+                    name: name.clone(),
+                    unit: (*unit).to_string(),
+                    values: Vec::new(),
+                })
+                .collect(),
+        }
+    }
+
+    /// Appends one sample; `values` in channel order.
+    pub fn push(&mut self, t: f64, values: &[f64]) {
+        debug_assert_eq!(values.len(), self.channels.len());
+        self.time.push(t);
+        for (c, v) in self.channels.iter_mut().zip(values) {
+            c.values.push(*v);
+        }
+    }
+
+    pub fn get(&self, name: &str) -> Option<&Channel> {
+        self.channels.iter().find(|c| c.name == name)
+    }
+
+    /// Linear interpolation of a channel at time t (None outside the sampled range).
+    pub fn value_at(&self, name: &str, t: f64) -> Option<f64> {
+        let c = self.get(name)?;
+        interpolate(&self.time, &c.values, t)
+    }
+
+    /// First non-finite sample, if any: (channel, time).
+    pub fn first_non_finite(&self) -> Option<(String, f64)> {
+        for c in &self.channels {
+            if let Some(k) = c.values.iter().position(|v| !v.is_finite()) {
+                return Some((c.name.clone(), self.time[k]));
+            }
+        }
+        None
+    }
+}
+
+/// Piecewise-linear interpolation on a sorted grid.
+pub fn interpolate(time: &[f64], values: &[f64], t: f64) -> Option<f64> {
+    if time.is_empty() || t < time[0] - 1e-12 * time[0].abs().max(1.0) {
+        return None;
+    }
+    let last = *time.last()?;
+    if t > last + 1e-12 * last.abs().max(1.0) {
+        return None;
+    }
+    let k = time.partition_point(|&s| s <= t);
+    if k == 0 {
+        return Some(values[0]);
+    }
+    if k >= time.len() {
+        return Some(values[time.len() - 1]);
+    }
+    let (t0, t1) = (time[k - 1], time[k]);
+    let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+    Some(values[k - 1] * (1.0 - w) + values[k] * w)
+}
+
+/// One named energy contribution sampled at the ledger times.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EnergyTerm {
+    pub name: String,
+    pub values: Vec<f64>,
+}
+
+/// The energy ledger: stored energies, cumulative input work and cumulative dissipation.
+///
+/// Closure: E(t) − E(0) − W_in(t) + W_diss(t) = 0, where E is the sum of `stored`.
+/// Standard names — stored: `kinetic`, `strain`, `gravity`, `joint_spring`, `discrete_spring`;
+/// inputs: `applied_torque`, `prescribed_motion`, `thrust`, `pressure`; dissipation:
+/// `joint_damper`, `kelvin_voigt`, `friction`, `impact`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct EnergyLedger {
+    pub time: Vec<f64>,
+    pub stored: Vec<EnergyTerm>,
+    pub inputs: Vec<EnergyTerm>,
+    pub dissipation: Vec<EnergyTerm>,
+}
+
+impl EnergyLedger {
+    pub fn new(stored: &[&str], inputs: &[&str], dissipation: &[&str]) -> Self {
+        let mk = |names: &[&str]| {
+            names
+                .iter()
+                .map(|n| EnergyTerm {
+                    name: (*n).to_string(),
+                    values: Vec::new(),
+                })
+                .collect()
+        };
+        EnergyLedger {
+            time: Vec::new(),
+            stored: mk(stored),
+            inputs: mk(inputs),
+            dissipation: mk(dissipation),
+        }
+    }
+
+    /// Appends one sample; each slice in the order given to [`EnergyLedger::new`].
+    pub fn push(&mut self, t: f64, stored: &[f64], inputs: &[f64], dissipation: &[f64]) {
+        self.time.push(t);
+        for (term, v) in self.stored.iter_mut().zip(stored) {
+            term.values.push(*v);
+        }
+        for (term, v) in self.inputs.iter_mut().zip(inputs) {
+            term.values.push(*v);
+        }
+        for (term, v) in self.dissipation.iter_mut().zip(dissipation) {
+            term.values.push(*v);
+        }
+    }
+
+    fn sum(terms: &[EnergyTerm], k: usize) -> f64 {
+        terms.iter().map(|t| t.values[k]).sum()
+    }
+
+    /// Total stored energy E at sample k.
+    pub fn total(&self, k: usize) -> f64 {
+        Self::sum(&self.stored, k)
+    }
+
+    /// E(t_k) − E(0) − W_in(t_k) + W_diss(t_k).
+    pub fn residual(&self, k: usize) -> f64 {
+        self.total(k) - self.total(0) - Self::sum(&self.inputs, k) + Self::sum(&self.dissipation, k)
+    }
+
+    /// max_k |residual| / scale, with scale = max over the run of |E|, |W_in| and |W_diss|
+    /// (so that a driven run starting from rest is measured against the energy that flowed).
+    pub fn relative_closure(&self) -> f64 {
+        let n = self.time.len();
+        if n == 0 {
+            return 0.0;
+        }
+        let mut scale = 0.0f64;
+        let mut worst = 0.0f64;
+        for k in 0..n {
+            scale = scale
+                .max(self.total(k).abs())
+                .max(Self::sum(&self.inputs, k).abs())
+                .max(Self::sum(&self.dissipation, k).abs());
+            worst = worst.max(self.residual(k).abs());
+        }
+        if scale > 0.0 { worst / scale } else { worst }
+    }
+}
+
+/// Something that happened at a definite time during a run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Event {
+    /// The gap function of a contact crossed zero (located to `time_tolerance`).
+    ContactStart {
+        t: f64,
+        contact: usize,
+        time_tolerance: f64,
+    },
+    /// Generalized impulse–momentum jump M(q̇⁺ − q̇⁻) = Gᵀ Λ with G q̇⁺ = 0.
+    Impact {
+        t: f64,
+        contact: usize,
+        velocity_before: Vec<f64>,
+        velocity_after: Vec<f64>,
+        impulse: f64,
+        /// ‖M(q̇⁺ − q̇⁻) − GᵀΛ‖ / ‖M(q̇⁺ − q̇⁻)‖.
+        momentum_residual: f64,
+        /// Normal tip velocity after the jump.
+        normal_velocity_after: f64,
+        kinetic_energy_lost: f64,
+    },
+    /// The normal force crossed zero: the tip leaves the surface.
+    Release {
+        t: f64,
+        contact: usize,
+        normal_force: f64,
+        time_tolerance: f64,
+    },
+    /// Friction state change.
+    StickSlip { t: f64, contact: usize, sticking: bool },
+    /// The step size changed for a stated reason (e.g. a stability bound moved).
+    StepSizeChange {
+        t: f64,
+        from: f64,
+        to: f64,
+        reason: String,
+    },
+    /// The integrator rejected a step.
+    StepRejected { t: f64, dt: f64, reason: String },
+}
+
+impl Event {
+    pub fn time(&self) -> f64 {
+        match self {
+            Event::ContactStart { t, .. }
+            | Event::Impact { t, .. }
+            | Event::Release { t, .. }
+            | Event::StickSlip { t, .. }
+            | Event::StepSizeChange { t, .. }
+            | Event::StepRejected { t, .. } => *t,
+        }
+    }
+}
+
+/// Work counters reported with every result.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Cost {
+    pub wall_time_s: f64,
+    pub dofs: usize,
+    pub steps: usize,
+    pub rejected_steps: usize,
+    pub rhs_evaluations: usize,
+    pub jacobian_evaluations: usize,
+    pub factorizations: usize,
+    pub newton_iterations: usize,
+}
+
+/// A backend's own account of why it stopped early.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Diagnostic {
+    /// Simulation time at which the problem was detected.
+    pub t: f64,
+    /// What went wrong (e.g. "transverse displacement grew without bound").
+    pub what: String,
+    /// Where (DOF, station, link), if it is localized.
+    pub location: Option<String>,
+    /// Why, as far as the backend can tell.
+    pub why: String,
+    /// What the user can change.
+    pub remedy: String,
+}
+
+impl std::fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "at t = {:.6e}: {}", self.t, self.what)?;
+        if let Some(loc) = &self.location {
+            write!(f, " ({loc})")?;
+        }
+        write!(f, "; why: {}; remedy: {}", self.why, self.remedy)
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "verdict", rename_all = "kebab-case")]
+pub enum StabilityVerdict {
+    /// Reached t_end with finite, bounded output.
+    Completed,
+    /// Stopped early with a diagnostic; output up to `diagnostic.t` is kept.
+    Stopped { diagnostic: Diagnostic },
+}
+
+/// Result of a dynamic run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunResult {
+    pub backend: BackendKind,
+    pub scene: String,
+    pub settings: Settings,
+    pub observables: Observables,
+    pub ledger: EnergyLedger,
+    pub events: Vec<Event>,
+    pub cost: Cost,
+    pub verdict: StabilityVerdict,
+}
+
+/// A natural mode sampled at common stations.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModeShape {
+    /// Link index (1-based) and station coordinate x along it.
+    pub link: usize,
+    pub x: Vec<f64>,
+    /// Transverse component (normalized to unit maximum magnitude).
+    pub transverse: Vec<f64>,
+}
+
+/// Result of a modal analysis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModalResult {
+    pub backend: BackendKind,
+    pub scene: String,
+    pub settings: Settings,
+    /// Natural frequencies in Hz, ascending.
+    pub frequencies_hz: Vec<f64>,
+    /// What kind of motion each mode is ("bending", "axial", "shear", ...), when known.
+    pub kinds: Vec<String>,
+    pub shapes: Vec<ModeShape>,
+    pub cost: Cost,
+}
+
+/// Result of a linear static analysis of the scene's `[statics]` loads.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StaticResult {
+    pub backend: BackendKind,
+    pub scene: String,
+    pub settings: Settings,
+    /// Transverse tip deflection of the last link.
+    pub tip_deflection: f64,
+    /// Tip slope (rotation) of the last link.
+    pub tip_rotation: f64,
+    pub cost: Cost,
+}

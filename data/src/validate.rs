@@ -1,0 +1,521 @@
+//! Semantic validation: what TOML syntax and serde types cannot express.
+//!
+//! Each problem names the field and the form it should take. Limits on sizes are stated here
+//! (and in the README) so that absurd inputs fail early with a message instead of exhausting
+//! memory.
+
+use crate::locate::FieldPath;
+use crate::scene::{
+    Contact, InitialShape, Joint, Link, PrescribedMotion, Rocket, Scene, Surface, TorqueLaw,
+};
+
+/// Largest accepted scene file.
+pub const MAX_FILE_BYTES: usize = 1 << 20;
+/// Largest number of links in a planar chain.
+pub const MAX_LINKS: usize = 8;
+pub const MAX_CONTACTS: usize = 8;
+pub const MAX_STAGES: usize = 4;
+pub const MAX_DISCRETE_MASSES: usize = 32;
+/// Largest number of field stations sampled per link.
+pub const MAX_FIELD_STATIONS: usize = 1001;
+/// Largest number of output samples t_end / output_interval.
+pub const MAX_OUTPUT_SAMPLES: f64 = 1.0e6;
+
+/// One semantic problem.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Issue {
+    pub path: FieldPath,
+    pub message: String,
+    pub expected: String,
+}
+
+struct Checker {
+    issues: Vec<Issue>,
+}
+
+impl Checker {
+    fn fail(&mut self, path: FieldPath, message: impl Into<String>, expected: impl Into<String>) {
+        self.issues.push(Issue {
+            path,
+            message: message.into(),
+            expected: expected.into(),
+        });
+    }
+
+    fn positive(&mut self, path: FieldPath, v: f64) {
+        if !v.is_finite() || v <= 0.0 {
+            self.fail(path, format!("{v} is not positive"), "a finite number > 0");
+        }
+    }
+
+    fn non_negative(&mut self, path: FieldPath, v: f64) {
+        if !v.is_finite() || v < 0.0 {
+            self.fail(path, format!("{v} is negative"), "a finite number ≥ 0");
+        }
+    }
+
+    fn finite(&mut self, path: FieldPath, v: f64) {
+        if !v.is_finite() {
+            self.fail(path, format!("{v} is not finite"), "a finite number");
+        }
+    }
+
+    fn opt_positive(&mut self, path: FieldPath, v: Option<f64>) {
+        if let Some(v) = v {
+            self.positive(path, v);
+        }
+    }
+}
+
+/// All semantic problems of a scene, in document order as far as possible.
+pub fn validate(scene: &Scene) -> Vec<Issue> {
+    let mut c = Checker { issues: Vec::new() };
+    let root = FieldPath::root();
+
+    if scene.name.trim().is_empty()
+        || !scene
+            .name
+            .chars()
+            .all(|ch| ch.is_ascii_lowercase() || ch.is_ascii_digit() || ch == '-')
+    {
+        c.fail(
+            root.key("name"),
+            format!("`{}` is not a kebab-case identifier", scene.name),
+            "lower-case letters, digits and `-`, e.g. \"my-beam\"",
+        );
+    }
+    if scene.description.trim().is_empty() {
+        c.fail(root.key("description"), "is empty", "a one-line description");
+    }
+
+    let sim = root.key("simulation");
+    c.positive(sim.key("t_end"), scene.simulation.t_end);
+    c.positive(sim.key("output_interval"), scene.simulation.output_interval);
+    if scene.simulation.t_end.is_finite()
+        && scene.simulation.output_interval > 0.0
+        && scene.simulation.t_end / scene.simulation.output_interval > MAX_OUTPUT_SAMPLES
+    {
+        c.fail(
+            sim.key("output_interval"),
+            format!(
+                "t_end / output_interval = {:.3e} output samples is above the limit {MAX_OUTPUT_SAMPLES:.0e}",
+                scene.simulation.t_end / scene.simulation.output_interval
+            ),
+            "a larger output_interval",
+        );
+    }
+    let fs = scene.simulation.field_stations;
+    if !(2..=MAX_FIELD_STATIONS).contains(&fs) {
+        c.fail(
+            sim.key("field_stations"),
+            format!("{fs} stations is outside the supported range"),
+            format!("an integer from 2 to {MAX_FIELD_STATIONS}"),
+        );
+    }
+
+    let families = [
+        ("link", !scene.links.is_empty()),
+        ("rocket", scene.rocket.is_some()),
+        ("payload_link", scene.payload_link.is_some()),
+        ("mobile_manipulator", scene.mobile_manipulator.is_some()),
+    ];
+    let present: Vec<&str> = families.iter().filter(|f| f.1).map(|f| f.0).collect();
+    match present.len() {
+        0 => c.fail(
+            root,
+            "the scene defines no model",
+            "one of: [[link]] tables, [rocket], [payload_link] or [mobile_manipulator]",
+        ),
+        1 => {}
+        _ => c.fail(
+            root.key(present[1]),
+            format!(
+                "contradictory model families: {} together",
+                present.join(" and ")
+            ),
+            "exactly one model family per scene file",
+        ),
+    }
+    let planar = present == ["link"];
+    if !planar {
+        for (key, on) in [
+            ("gravity", scene.gravity.is_some()),
+            ("contact", !scene.contacts.is_empty()),
+            ("statics", scene.statics.is_some()),
+            ("studies", scene.studies.is_some()),
+        ] {
+            if on {
+                c.fail(
+                    FieldPath::root().key(key),
+                    format!("`{key}` applies only to planar link chains"),
+                    "remove it, or use the family's own fields (e.g. rocket.gravity)",
+                );
+            }
+        }
+    }
+
+    if scene.links.len() > MAX_LINKS {
+        c.fail(
+            FieldPath::root().key("link"),
+            format!("{} links is above the limit", scene.links.len()),
+            format!("at most {MAX_LINKS} links"),
+        );
+    }
+    for (i, link) in scene.links.iter().enumerate() {
+        let p = FieldPath::root().key("link").index(i);
+        if scene.links[..i].iter().any(|l| l.name == link.name) {
+            c.fail(
+                p.key("name"),
+                format!("duplicate link name `{}`", link.name),
+                "a unique name per link",
+            );
+        }
+        check_link(&mut c, &p, link);
+    }
+
+    if let Some(g) = &scene.gravity {
+        c.finite(FieldPath::root().key("gravity").key("vector").index(0), g.vector[0]);
+        c.finite(FieldPath::root().key("gravity").key("vector").index(1), g.vector[1]);
+    }
+
+    if scene.contacts.len() > MAX_CONTACTS {
+        c.fail(
+            FieldPath::root().key("contact"),
+            format!("{} contacts is above the limit", scene.contacts.len()),
+            format!("at most {MAX_CONTACTS} contacts"),
+        );
+    }
+    for (i, contact) in scene.contacts.iter().enumerate() {
+        check_contact(&mut c, &FieldPath::root().key("contact").index(i), contact, scene);
+    }
+
+    if let Some(st) = &scene.statics {
+        let p = FieldPath::root().key("statics");
+        if let Some(f) = st.tip_force {
+            c.finite(p.key("tip_force"), f);
+        }
+        if let Some(q) = st.distributed_load {
+            c.finite(p.key("distributed_load"), q);
+        }
+        for (k, lp) in st.elastica_load_parameters.iter().enumerate() {
+            let pp = p.key("elastica_load_parameters").index(k);
+            if !(lp.is_finite() && *lp > 0.0 && *lp <= 100.0) {
+                c.fail(pp, format!("{lp} is out of range"), "a load parameter PL²/EI in (0, 100]");
+            }
+        }
+    }
+    if let Some(st) = &scene.studies {
+        for (k, l) in st.rotation_speeds.iter().enumerate() {
+            c.non_negative(
+                FieldPath::root().key("studies").key("rotation_speeds").index(k),
+                *l,
+            );
+        }
+    }
+
+    if let Some(r) = &scene.rocket {
+        check_rocket(&mut c, &FieldPath::root().key("rocket"), r);
+    }
+    if let Some(p) = &scene.payload_link {
+        let b = FieldPath::root().key("payload_link");
+        for (k, v) in [
+            ("length", p.length),
+            ("radius", p.radius),
+            ("youngs_modulus", p.youngs_modulus),
+            ("shear_modulus", p.shear_modulus),
+            ("density", p.density),
+            ("payload_mass", p.payload_mass),
+            ("base_inertia", p.base_inertia),
+        ] {
+            c.positive(b.key(k), v);
+        }
+        c.non_negative(b.key("payload_offset"), p.payload_offset);
+        c.non_negative(b.key("motor_friction"), p.motor_friction);
+        for (k, v) in p.payload_inertia.iter().enumerate() {
+            c.positive(b.key("payload_inertia").index(k), *v);
+        }
+        for (k, v) in p.kelvin_voigt.iter().enumerate() {
+            c.non_negative(b.key("kelvin_voigt").index(k), *v);
+        }
+        for (k, v) in p.gravity.iter().enumerate() {
+            c.finite(b.key("gravity").index(k), *v);
+        }
+    }
+    if let Some(m) = &scene.mobile_manipulator {
+        let b = FieldPath::root().key("mobile_manipulator");
+        for k in 0..3 {
+            c.positive(b.key("link_lengths").index(k), m.link_lengths[k]);
+            c.positive(b.key("link_masses").index(k), m.link_masses[k]);
+        }
+        for (k, v) in [
+            ("gripper_mass", m.gripper_mass),
+            ("base_disc_mass", m.base_disc_mass),
+            ("base_disc_radius", m.base_disc_radius),
+            ("platform_mass", m.platform_mass),
+            ("wheel_mass", m.wheel_mass),
+            ("wheel_radius", m.wheel_radius),
+            ("half_track", m.half_track),
+            ("arm_torque_period", m.arm_torque_period),
+        ] {
+            c.positive(b.key(k), v);
+        }
+        c.finite(b.key("initial_heading"), m.initial_heading);
+        c.finite(b.key("arm_torque_amplitude"), m.arm_torque_amplitude);
+        c.finite(b.key("platform_torque"), m.platform_torque);
+        if m.wheel_count == 0 || m.wheel_count % 2 != 0 || m.wheel_count > 16 {
+            c.fail(
+                b.key("wheel_count"),
+                format!("{} wheels cannot form a skid-steer platform", m.wheel_count),
+                "an even number of wheels from 2 to 16",
+            );
+        }
+        c.opt_positive(
+            b.key("flexible_link2_bending_stiffness"),
+            m.flexible_link2_bending_stiffness,
+        );
+    }
+    c.issues
+}
+
+fn check_link(c: &mut Checker, p: &FieldPath, l: &Link) {
+    if l.name.trim().is_empty() {
+        c.fail(p.key("name"), "is empty", "a non-empty link name");
+    }
+    c.positive(p.key("length"), l.length);
+    c.positive(p.key("mass_per_length"), l.mass_per_length);
+    c.positive(p.key("bending_stiffness"), l.bending_stiffness);
+    c.opt_positive(p.key("axial_stiffness"), l.axial_stiffness);
+    c.opt_positive(p.key("shear_stiffness"), l.shear_stiffness);
+    c.opt_positive(p.key("rotary_inertia_per_length"), l.rotary_inertia_per_length);
+    c.opt_positive(p.key("kelvin_voigt"), l.kelvin_voigt);
+    c.opt_positive(p.key("tip_mass"), l.tip_mass);
+    c.opt_positive(p.key("tip_inertia"), l.tip_inertia);
+    if l.axial && l.foreshortening {
+        c.fail(
+            p.key("foreshortening"),
+            "contradictory flags: `axial` (extensible, strain u' + ½v'²) and `foreshortening` \
+             (inextensible) are both on",
+            "at most one of `axial = true` and `foreshortening = true`",
+        );
+    }
+    if l.axial && l.axial_stiffness.is_none() {
+        c.fail(
+            p.key("axial_stiffness"),
+            "`axial = true` needs the axial stiffness EA, which is missing",
+            "axial_stiffness = <EA > 0>",
+        );
+    }
+    if l.shear && l.shear_stiffness.is_none() {
+        c.fail(
+            p.key("shear_stiffness"),
+            "`shear = true` needs the shear stiffness κGA, which is missing",
+            "shear_stiffness = <κGA > 0>",
+        );
+    }
+    if l.rotary_inertia && l.rotary_inertia_per_length.is_none() {
+        c.fail(
+            p.key("rotary_inertia_per_length"),
+            "`rotary_inertia = true` needs ρI, which is missing",
+            "rotary_inertia_per_length = <ρI > 0>",
+        );
+    }
+    check_joint(c, &p.key("joint"), &l.joint);
+}
+
+fn check_joint(c: &mut Checker, p: &FieldPath, j: &Joint) {
+    c.opt_positive(p.key("hub_inertia"), j.hub_inertia);
+    if let Some(k) = j.stiffness {
+        c.non_negative(p.key("stiffness"), k);
+    }
+    if let Some(d) = j.damping {
+        c.non_negative(p.key("damping"), d);
+    }
+    if let Some(s) = j.set_point {
+        c.finite(p.key("set_point"), s);
+        if j.stiffness.is_none() {
+            c.fail(
+                p.key("set_point"),
+                "a spring set-point without a spring",
+                "`stiffness = K` alongside `set_point`, or no `set_point`",
+            );
+        }
+    }
+    c.finite(p.key("initial_angle"), j.initial_angle);
+    c.finite(p.key("initial_rate"), j.initial_rate);
+    if let Some(pm) = &j.prescribed {
+        for (key, on) in [
+            ("torque", j.torque.is_some()),
+            ("stiffness", j.stiffness.is_some()),
+            ("damping", j.damping.is_some()),
+        ] {
+            if on {
+                c.fail(
+                    p.key(key),
+                    format!(
+                        "contradictory: the joint motion is prescribed, so `{key}` cannot act on it"
+                    ),
+                    "either `prescribed` or spring/damper/torque, not both",
+                );
+            }
+        }
+        let pp = p.key("prescribed");
+        match *pm {
+            PrescribedMotion::SpinUp { omega_s, t_s } => {
+                c.finite(pp.key("omega_s"), omega_s);
+                c.positive(pp.key("t_s"), t_s);
+            }
+            PrescribedMotion::ConstantRate { rate } => c.finite(pp.key("rate"), rate),
+            PrescribedMotion::Fixed => {}
+        }
+        if j.initial_rate != 0.0 {
+            c.fail(
+                p.key("initial_rate"),
+                "the initial rate of a prescribed joint follows from the law",
+                "no `initial_rate` when `prescribed` is set",
+            );
+        }
+    }
+    if let Some(t) = &j.torque {
+        let tp = p.key("torque");
+        match *t {
+            TorqueLaw::Constant { value, until } => {
+                c.finite(tp.key("value"), value);
+                c.opt_positive(tp.key("until"), until);
+            }
+            TorqueLaw::BangBang {
+                amplitude,
+                switch,
+                off,
+            } => {
+                c.finite(tp.key("amplitude"), amplitude);
+                c.positive(tp.key("switch"), switch);
+                if !(off.is_finite() && off > switch) {
+                    c.fail(
+                        tp.key("off"),
+                        format!("off = {off} is not after switch = {switch}"),
+                        "a time `off` > `switch`",
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn check_contact(c: &mut Checker, p: &FieldPath, ct: &Contact, scene: &Scene) {
+    if scene.link_index(&ct.link).is_none() {
+        let names: Vec<&str> = scene.links.iter().map(|l| l.name.as_str()).collect();
+        c.fail(
+            p.key("link"),
+            format!("no link is named `{}`", ct.link),
+            format!("one of the link names: {}", names.join(", ")),
+        );
+    }
+    c.non_negative(p.key("friction"), ct.friction);
+    let sp = p.key("surface");
+    match ct.surface {
+        Surface::Line { point, normal } => {
+            c.finite(sp.key("point").index(0), point[0]);
+            c.finite(sp.key("point").index(1), point[1]);
+            if !(normal[0].is_finite() && normal[1].is_finite()) || normal[0].hypot(normal[1]) == 0.0
+            {
+                c.fail(sp.key("normal"), "the normal is zero or not finite", "a non-zero vector [nx, ny]");
+            }
+        }
+        Surface::Circle { center, radius } => {
+            c.finite(sp.key("center").index(0), center[0]);
+            c.finite(sp.key("center").index(1), center[1]);
+            c.positive(sp.key("radius"), radius);
+        }
+    }
+}
+
+fn check_rocket(c: &mut Checker, p: &FieldPath, r: &Rocket) {
+    c.positive(p.key("gravity"), r.gravity);
+    c.positive(p.key("youngs_modulus"), r.youngs_modulus);
+    c.non_negative(p.key("exhaust_velocity"), r.exhaust_velocity);
+    c.non_negative(p.key("chamber_pressure"), r.chamber_pressure);
+    c.non_negative(p.key("exit_pressure"), r.exit_pressure);
+    c.non_negative(p.key("port_area"), r.port_area);
+    c.finite(p.key("nozzle_angle_deg"), r.nozzle_angle_deg);
+    if !(r.launch_angle_deg.is_finite() && (-180.0..=180.0).contains(&r.launch_angle_deg)) {
+        c.fail(
+            p.key("launch_angle_deg"),
+            format!("{} is not an angle in degrees", r.launch_angle_deg),
+            "a number of degrees in [-180, 180]",
+        );
+    }
+    if r.stages.is_empty() || r.stages.len() > MAX_STAGES {
+        c.fail(
+            p.key("stage"),
+            format!("{} stages", r.stages.len()),
+            format!("1 to {MAX_STAGES} [[rocket.stage]] tables"),
+        );
+    }
+    for (i, s) in r.stages.iter().enumerate() {
+        let sp = p.key("stage").index(i);
+        c.positive(sp.key("length"), s.length);
+        c.positive(sp.key("area"), s.area);
+        c.positive(sp.key("inertia"), s.inertia);
+        c.positive(sp.key("weight_per_length"), s.weight_per_length);
+        c.non_negative(sp.key("burn_rate"), s.burn_rate);
+        if let Some(cw) = s.casing_weight_per_length {
+            c.positive(sp.key("casing_weight_per_length"), cw);
+            if cw > s.weight_per_length {
+                c.fail(
+                    sp.key("casing_weight_per_length"),
+                    format!("casing weight {cw} exceeds the total weight {}", s.weight_per_length),
+                    "casing_weight_per_length ≤ weight_per_length",
+                );
+            }
+        }
+        if s.burn_rate > 0.0 && s.casing_weight_per_length.is_none() {
+            c.fail(
+                sp.key("casing_weight_per_length"),
+                "a burning stage needs the weight that cannot burn",
+                "casing_weight_per_length = <w > 0>",
+            );
+        }
+    }
+    let length = r.length();
+    if r.discrete_masses.len() > MAX_DISCRETE_MASSES {
+        c.fail(
+            p.key("discrete_mass"),
+            format!("{} discrete masses", r.discrete_masses.len()),
+            format!("at most {MAX_DISCRETE_MASSES}"),
+        );
+    }
+    for (i, m) in r.discrete_masses.iter().enumerate() {
+        let mp = p.key("discrete_mass").index(i);
+        if !(m.position.is_finite() && m.position >= 0.0 && m.position <= length) {
+            c.fail(
+                mp.key("position"),
+                format!("x = {} is outside the body", m.position),
+                format!("a station in [0, {length}]"),
+            );
+        }
+        c.positive(mp.key("weight"), m.weight);
+        c.non_negative(mp.key("axial_stiffness"), m.axial_stiffness);
+        c.non_negative(mp.key("transverse_stiffness"), m.transverse_stiffness);
+        c.non_negative(mp.key("axial_damping"), m.axial_damping);
+        c.non_negative(mp.key("transverse_damping"), m.transverse_damping);
+    }
+    for (i, s) in r.springs.iter().enumerate() {
+        let sp = p.key("spring").index(i);
+        let n = r.discrete_masses.len();
+        if s.between[0] >= n || s.between[1] >= n || s.between[0] == s.between[1] {
+            c.fail(
+                sp.key("between"),
+                format!("{:?} does not name two distinct discrete masses", s.between),
+                format!("two different indices in 0..{n}"),
+            );
+        }
+        c.non_negative(sp.key("axial_stiffness"), s.axial_stiffness);
+        c.non_negative(sp.key("transverse_stiffness"), s.transverse_stiffness);
+        c.non_negative(sp.key("axial_damping"), s.axial_damping);
+        c.non_negative(sp.key("transverse_damping"), s.transverse_damping);
+    }
+    if let InitialShape::Report { a1, a2 } = r.initial_shape {
+        c.finite(p.key("initial_shape").key("a1"), a1);
+        c.finite(p.key("initial_shape").key("a2"), a2);
+    }
+}

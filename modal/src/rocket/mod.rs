@@ -1,0 +1,1 @@
+//! Rocket by free-free eigenfunctions (being written)
