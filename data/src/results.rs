@@ -48,6 +48,28 @@ pub mod channel {
     pub fn contact_normal_force(c: usize) -> String {
         format!("contact{c}.normal_force")
     }
+    /// Rocket: rigid-body position of the mass centre (inertial X, Y), attitude θ, mass.
+    pub const ROCKET_X: &str = "rocket.X";
+    pub const ROCKET_Y: &str = "rocket.Y";
+    pub const ROCKET_THETA: &str = "rocket.theta";
+    pub const ROCKET_MASS: &str = "rocket.mass";
+    /// Rocket: inertial velocity of the mass centre.
+    pub const ROCKET_VX: &str = "rocket.vX";
+    pub const ROCKET_VY: &str = "rocket.vY";
+    /// Rocket: elastic axial / transverse displacement at field station k (aft = 0 … nose).
+    pub fn rocket_axial(k: usize) -> String {
+        format!("rocket.u@{k}")
+    }
+    pub fn rocket_transverse(k: usize) -> String {
+        format!("rocket.w@{k}")
+    }
+    /// Rocket: displacement of discrete mass j (1-based) relative to its attachment station.
+    pub fn rocket_mass_axial(j: usize) -> String {
+        format!("rocket.mass{j}.u")
+    }
+    pub fn rocket_mass_transverse(j: usize) -> String {
+        format!("rocket.mass{j}.w")
+    }
     /// Time step in use (variable-step schemes).
     pub const STEP_SIZE: &str = "step_size";
     /// Stability bound on the step in force at that time (explicit schemes).

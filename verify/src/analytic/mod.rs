@@ -1,0 +1,1 @@
+//! Analytic references (being written)
