@@ -1,0 +1,222 @@
+//! Argument definitions (clap derive).
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+use crate::output::Format;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "flexverify",
+    version,
+    about = "Verify discretizations of flexible multibody dynamics: FEM, the 1969 NASA \
+             finite-difference scheme and assumed modes, cross-checked against each other and \
+             against analytic limits."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// List the embedded scene catalog.
+    Scenes {
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+    },
+    /// Show the physics a scene switches on and the DOFs each backend would build.
+    Describe {
+        /// Catalog name or path to a scene .toml file.
+        scene: String,
+        #[command(flatten)]
+        opts: CommonOpts,
+    },
+    /// Natural frequencies (Hz) of a scene.
+    Modes {
+        scene: String,
+        /// Number of frequencies to report.
+        #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=200))]
+        count: u32,
+        #[command(flatten)]
+        opts: CommonOpts,
+    },
+    /// Linear static response to the scene's [statics] loads.
+    Statics {
+        scene: String,
+        #[command(flatten)]
+        opts: CommonOpts,
+    },
+    /// Integrate a scene in time; print a summary and write observables, ledger and events.
+    Run {
+        scene: String,
+        #[command(flatten)]
+        opts: CommonOpts,
+    },
+    /// Run the verification suite (checks declared as data in data/cases/).
+    Verify {
+        #[arg(long, value_enum, default_value_t = Suite::Quick)]
+        suite: Suite,
+        /// Run only cases whose id contains this text.
+        #[arg(long)]
+        filter: Option<String>,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
+    /// Refinement study of one quantity: observed order, Richardson reference, work-precision.
+    Converge {
+        scene: String,
+        /// e.g. freq1, tip_static, tip_deflection@15, joint1.angle@2.5
+        #[arg(long)]
+        quantity: String,
+        /// Refine space (elements/stations/modes) or time (dt).
+        #[arg(long, value_enum, default_value_t = Refine::Space)]
+        refine: Refine,
+        #[command(flatten)]
+        opts: CommonOpts,
+    },
+    /// Cheapest backend + discretization meeting a tolerance on a quantity.
+    Recommend {
+        scene: String,
+        #[arg(long)]
+        quantity: String,
+        /// Relative tolerance the quantity must meet.
+        #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
+        tol: f64,
+        #[command(flatten)]
+        opts: CommonOpts,
+    },
+    /// Stiff and extreme cases: each backend's verdict.
+    Stability {
+        #[arg(long, value_enum, default_value_t = Suite::Quick)]
+        suite: Suite,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Suite {
+    Quick,
+    Full,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Refine {
+    Space,
+    Time,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BackendChoice {
+    Fem,
+    Fdm,
+    Modal,
+    All,
+}
+
+impl BackendChoice {
+    pub fn kinds(self) -> Vec<data::BackendKind> {
+        use data::BackendKind as K;
+        match self {
+            BackendChoice::Fem => vec![K::Fem],
+            BackendChoice::Fdm => vec![K::Fdm],
+            BackendChoice::Modal => vec![K::Modal],
+            BackendChoice::All => K::ALL.to_vec(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BasisChoice {
+    Poly,
+    ClampedFree,
+    TipMass,
+    FreeFree,
+}
+
+/// Options shared by the scene commands.
+#[derive(Debug, Clone, Args)]
+pub struct CommonOpts {
+    #[arg(long, value_enum, default_value_t = BackendChoice::All)]
+    pub backend: BackendChoice,
+    /// FEM: elements per link.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub elements: Option<u32>,
+    /// FDM: stations per link/body (both ends included).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1_000_000))]
+    pub stations: Option<u32>,
+    /// Modal: assumed modes per link and field.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub modes: Option<u32>,
+    /// Modal: basis functions.
+    #[arg(long, value_enum)]
+    pub basis: Option<BasisChoice>,
+    /// Time step (fixed step, or first step of adaptive methods).
+    #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
+    pub dt: Option<f64>,
+    /// End time (overrides the scene).
+    #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
+    pub t_end: Option<f64>,
+    /// Integration method (backend-specific; see `flexverify describe`).
+    #[arg(long)]
+    pub method: Option<String>,
+    /// Relative tolerance of adaptive integrators.
+    #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance of adaptive integrators.
+    #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
+    pub atol: Option<f64>,
+    /// Factor (0, 1] applied to a stability bound when the scheme chooses its own step.
+    #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
+    pub safety_factor: Option<f64>,
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
+    /// Write result files (atomically) into this folder.
+    #[arg(long)]
+    pub out: Option<std::path::PathBuf>,
+}
+
+/// A finite number > 0.
+pub fn positive_f64(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number; expected a finite number > 0"))?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{s} is not allowed; expected a finite number > 0"))
+    }
+}
+
+impl CommonOpts {
+    /// Backend settings from the options.
+    pub fn settings(&self) -> data::Settings {
+        data::Settings {
+            discretization: data::Discretization {
+                elements: self.elements.map(|n| n as usize),
+                stations: self.stations.map(|n| n as usize),
+                modes: self.modes.map(|n| n as usize),
+                basis: self.basis.map(|b| match b {
+                    BasisChoice::Poly => data::Basis::Poly,
+                    BasisChoice::ClampedFree => data::Basis::ClampedFree,
+                    BasisChoice::TipMass => data::Basis::TipMass,
+                    BasisChoice::FreeFree => data::Basis::FreeFree,
+                }),
+            },
+            time: data::TimeStepping {
+                dt: self.dt,
+                t_end: self.t_end,
+                method: self.method.clone(),
+                rtol: self.rtol,
+                atol: self.atol,
+                safety_factor: self.safety_factor,
+            },
+        }
+    }
+}

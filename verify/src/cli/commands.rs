@@ -1,0 +1,369 @@
+//! One function per subcommand.
+
+use data::{BackendError, BackendKind, Scene, StabilityVerdict, load_scene};
+
+use super::CliError;
+use super::args::{Cli, Command, CommonOpts};
+use crate::output::{Format, csv_table, ledger_csv, observables_csv, text_table, write_atomic};
+use crate::registry::backend;
+
+pub fn dispatch(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Scenes { format } => scenes(format),
+        Command::Describe { scene, opts } => describe(&scene, &opts),
+        Command::Modes { scene, count, opts } => modes(&scene, count as usize, &opts),
+        Command::Statics { scene, opts } => statics(&scene, &opts),
+        Command::Run { scene, opts } => run(&scene, &opts),
+        Command::Verify {
+            suite,
+            filter,
+            format,
+            out,
+        } => crate::suite::command(suite, filter.as_deref(), format, out.as_deref()),
+        Command::Converge {
+            scene,
+            quantity,
+            refine,
+            opts,
+        } => crate::study::converge_command(&scene, &quantity, refine, &opts),
+        Command::Recommend {
+            scene,
+            quantity,
+            tol,
+            opts,
+        } => crate::study::recommend_command(&scene, &quantity, tol, &opts),
+        Command::Stability {
+            suite,
+            format,
+            out,
+        } => crate::stability::command(suite, format, out.as_deref()),
+    }
+}
+
+fn print_json<T: serde::Serialize>(value: &T) -> Result<(), CliError> {
+    let text = serde_json::to_string_pretty(value)
+        .map_err(|e| CliError::Failed(format!("error: cannot serialize result: {e}")))?;
+    println!("{text}");
+    Ok(())
+}
+
+fn scenes(format: Format) -> Result<(), CliError> {
+    let mut rows = Vec::new();
+    for name in data::catalog_names() {
+        let scene = load_scene(name)?;
+        rows.push(vec![
+            name.to_string(),
+            scene.family().to_string(),
+            scene.description.clone(),
+        ]);
+    }
+    let header = ["scene", "family", "description"];
+    match format {
+        Format::Table => {
+            // Left-aligned listing reads better than the right-aligned numeric table.
+            let w0 = rows.iter().map(|r| r[0].len()).max().unwrap_or(5);
+            let w1 = rows.iter().map(|r| r[1].len()).max().unwrap_or(6);
+            for r in &rows {
+                println!("{:<w0$}  {:<w1$}  {}", r[0], r[1], r[2]);
+            }
+        }
+        Format::Csv => print!("{}", csv_table(&header, &rows)),
+        Format::Json => {
+            let v: Vec<_> = rows
+                .iter()
+                .map(|r| serde_json::json!({"scene": r[0], "family": r[1], "description": r[2]}))
+                .collect();
+            print_json(&v)?;
+        }
+    }
+    Ok(())
+}
+
+#[derive(serde::Serialize)]
+struct BackendPlan {
+    backend: BackendKind,
+    dofs: Option<usize>,
+    plan: Option<data::DofPlan>,
+    unsupported: Option<String>,
+}
+
+fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
+    let scene = load_scene(name)?;
+    let settings = opts.settings();
+    let mut plans = Vec::new();
+    for kind in opts.backend.kinds() {
+        match backend(kind).dof_plan(&scene, &settings.discretization) {
+            Ok(plan) => plans.push(BackendPlan {
+                backend: kind,
+                dofs: Some(plan.total()),
+                plan: Some(plan),
+                unsupported: None,
+            }),
+            Err(e @ (BackendError::Unsupported(_) | BackendError::Numerical { .. })) => {
+                plans.push(BackendPlan {
+                    backend: kind,
+                    dofs: None,
+                    plan: None,
+                    unsupported: Some(e.to_string()),
+                })
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+    let flags = scene.physics_flags();
+    match opts.format {
+        Format::Json => print_json(&serde_json::json!({
+            "scene": scene,
+            "family": scene.family(),
+            "physics": flags.iter().map(|(k, v)| (k.to_string(), *v)).collect::<std::collections::BTreeMap<_, _>>(),
+            "backends": plans,
+        })),
+        Format::Csv => {
+            let mut rows: Vec<Vec<String>> = flags
+                .iter()
+                .map(|(k, v)| vec!["physics".into(), k.to_string(), if *v { "on" } else { "off" }.into()])
+                .collect();
+            for p in &plans {
+                if let Some(plan) = &p.plan {
+                    for g in &plan.groups {
+                        rows.push(vec![p.backend.to_string(), g.what.clone(), g.count.to_string()]);
+                    }
+                    rows.push(vec![p.backend.to_string(), "total".into(), plan.total().to_string()]);
+                } else {
+                    rows.push(vec![p.backend.to_string(), "unsupported".into(), p.unsupported.clone().unwrap_or_default()]);
+                }
+            }
+            print!("{}", csv_table(&["section", "item", "value"], &rows));
+            Ok(())
+        }
+        Format::Table => {
+            println!("scene    {} — {}", scene.name, scene.description);
+            println!("family   {}", scene.family());
+            println!("units    {}", scene.units);
+            println!(
+                "run      t_end = {}, output every {}",
+                scene.simulation.t_end, scene.simulation.output_interval
+            );
+            println!("physics");
+            for (k, v) in &flags {
+                println!("  {:<18} {}", k, if *v { "on" } else { "off" });
+            }
+            for (i, l) in scene.links.iter().enumerate() {
+                println!(
+                    "link {} `{}`: L = {}, ρA = {}, EI = {}{}{}",
+                    i + 1,
+                    l.name,
+                    l.length,
+                    l.mass_per_length,
+                    l.bending_stiffness,
+                    l.axial_stiffness.map_or(String::new(), |v| format!(", EA = {v}")),
+                    l.tip_mass.map_or(String::new(), |v| format!(", tip mass {v}")),
+                );
+            }
+            for (i, c) in scene.contacts.iter().enumerate() {
+                println!(
+                    "contact {}: tip of `{}` against {:?} ({:?}, μ = {})",
+                    i + 1,
+                    c.link,
+                    c.surface,
+                    c.mode,
+                    c.friction
+                );
+            }
+            println!("degrees of freedom");
+            for p in &plans {
+                match &p.plan {
+                    Some(plan) => {
+                        println!("  {}: {} DOFs", p.backend, plan.total());
+                        for g in &plan.groups {
+                            println!("      {:>6}  {}", g.count, g.what);
+                        }
+                        for b in &plan.builds {
+                            println!("      builds: {b}");
+                        }
+                    }
+                    None => println!(
+                        "  {}: {}",
+                        p.backend,
+                        p.unsupported.as_deref().unwrap_or("unsupported")
+                    ),
+                }
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Runs `f` for each requested backend; unsupported backends are reported, and the command
+/// fails with status 3 only when none could answer.
+fn for_backends<T>(
+    scene: &Scene,
+    opts: &CommonOpts,
+    mut f: impl FnMut(&dyn data::Backend) -> Result<T, BackendError>,
+) -> Result<Vec<(BackendKind, T)>, CliError> {
+    let mut done = Vec::new();
+    let mut unsupported = Vec::new();
+    for kind in opts.backend.kinds() {
+        match f(backend(kind).as_ref()) {
+            Ok(v) => done.push((kind, v)),
+            Err(BackendError::Unsupported(why)) => unsupported.push(format!("{kind}: unsupported: {why}")),
+            Err(e) => return Err(e.into()),
+        }
+    }
+    for u in &unsupported {
+        eprintln!("{u}");
+    }
+    if done.is_empty() {
+        return Err(CliError::Unsupported(format!(
+            "unsupported: no requested backend can do this for scene `{}`",
+            scene.name
+        )));
+    }
+    Ok(done)
+}
+
+fn modes(name: &str, count: usize, opts: &CommonOpts) -> Result<(), CliError> {
+    let scene = load_scene(name)?;
+    let settings = opts.settings();
+    let results = for_backends(&scene, opts, |b| b.modes(&scene, &settings, count))?;
+    if let Some(dir) = &opts.out {
+        for (kind, r) in &results {
+            let json = serde_json::to_vec_pretty(r).expect("serializable");
+            write_atomic(dir, &format!("{}-{kind}-modes.json", scene.name), &json)?;
+        }
+    }
+    let n = results.iter().map(|(_, r)| r.frequencies_hz.len()).max().unwrap_or(0);
+    let mut header = vec!["mode".to_string()];
+    header.extend(results.iter().map(|(k, _)| format!("{k} [Hz]")));
+    let rows: Vec<Vec<String>> = (0..n)
+        .map(|i| {
+            let mut row = vec![(i + 1).to_string()];
+            row.extend(results.iter().map(|(_, r)| {
+                r.frequencies_hz
+                    .get(i)
+                    .map_or("-".into(), |f| format!("{f:.9e}"))
+            }));
+            row
+        })
+        .collect();
+    let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
+    match opts.format {
+        Format::Table => print!("{}", text_table(&header, &rows)),
+        Format::Csv => print!("{}", csv_table(&header, &rows)),
+        Format::Json => print_json(&results.iter().map(|(_, r)| r).collect::<Vec<_>>())?,
+    }
+    Ok(())
+}
+
+fn statics(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
+    let scene = load_scene(name)?;
+    let settings = opts.settings();
+    let results = for_backends(&scene, opts, |b| b.statics(&scene, &settings))?;
+    let rows: Vec<Vec<String>> = results
+        .iter()
+        .map(|(k, r)| {
+            vec![
+                k.to_string(),
+                format!("{:.12e}", r.tip_deflection),
+                format!("{:.12e}", r.tip_rotation),
+                r.cost.dofs.to_string(),
+            ]
+        })
+        .collect();
+    let header = ["backend", "tip deflection", "tip rotation", "dofs"];
+    match opts.format {
+        Format::Table => print!("{}", text_table(&header, &rows)),
+        Format::Csv => print!("{}", csv_table(&header, &rows)),
+        Format::Json => print_json(&results.iter().map(|(_, r)| r).collect::<Vec<_>>())?,
+    }
+    Ok(())
+}
+
+fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
+    let scene = load_scene(name)?;
+    let settings = opts.settings();
+    let results = for_backends(&scene, opts, |b| b.simulate(&scene, &settings))?;
+    if let Some(dir) = &opts.out {
+        for (kind, r) in &results {
+            let stem = format!("{}-{kind}", scene.name);
+            write_atomic(dir, &format!("{stem}.json"), &serde_json::to_vec_pretty(r).expect("serializable"))?;
+            write_atomic(dir, &format!("{stem}-observables.csv"), observables_csv(&r.observables).as_bytes())?;
+            write_atomic(dir, &format!("{stem}-ledger.csv"), ledger_csv(&r.ledger).as_bytes())?;
+            write_atomic(dir, &format!("{stem}-events.json"), &serde_json::to_vec_pretty(&r.events).expect("serializable"))?;
+        }
+        eprintln!("wrote results to {}", dir.display());
+    }
+    match opts.format {
+        Format::Json => print_json(&results.iter().map(|(_, r)| r).collect::<Vec<_>>())?,
+        Format::Csv => {
+            for (_, r) in &results {
+                print!("{}", observables_csv(&r.observables));
+            }
+        }
+        Format::Table => {
+            let header = [
+                "backend", "verdict", "t reached", "dofs", "steps", "rejected", "wall [s]",
+                "ledger closure", "events",
+            ];
+            let rows: Vec<Vec<String>> = results
+                .iter()
+                .map(|(k, r)| {
+                    vec![
+                        k.to_string(),
+                        match &r.verdict {
+                            StabilityVerdict::Completed => "completed".into(),
+                            StabilityVerdict::Stopped { .. } => "STOPPED".into(),
+                        },
+                        r.observables.time.last().map_or("-".into(), |t| format!("{t:.4}")),
+                        r.cost.dofs.to_string(),
+                        r.cost.steps.to_string(),
+                        r.cost.rejected_steps.to_string(),
+                        format!("{:.3e}", r.cost.wall_time_s),
+                        format!("{:.2e}", r.ledger.relative_closure()),
+                        r.events.len().to_string(),
+                    ]
+                })
+                .collect();
+            print!("{}", text_table(&header, &rows));
+            // Final values of every channel, one column per backend.
+            let mut names: Vec<String> = Vec::new();
+            for (_, r) in &results {
+                for c in &r.observables.channels {
+                    if !names.contains(&c.name) && !c.name.contains('@') {
+                        names.push(c.name.clone());
+                    }
+                }
+            }
+            let mut header = vec!["final value".to_string()];
+            header.extend(results.iter().map(|(k, _)| k.to_string()));
+            let rows: Vec<Vec<String>> = names
+                .iter()
+                .map(|n| {
+                    let mut row = vec![n.clone()];
+                    row.extend(results.iter().map(|(_, r)| {
+                        r.observables
+                            .get(n)
+                            .and_then(|c| c.values.last())
+                            .map_or("-".into(), |v| format!("{v:.6e}"))
+                    }));
+                    row
+                })
+                .collect();
+            let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
+            println!();
+            print!("{}", text_table(&header, &rows));
+        }
+    }
+    let stopped: Vec<String> = results
+        .iter()
+        .filter_map(|(k, r)| match &r.verdict {
+            StabilityVerdict::Stopped { diagnostic } => Some(format!("{k}: run stopped {diagnostic}")),
+            StabilityVerdict::Completed => None,
+        })
+        .collect();
+    if stopped.is_empty() {
+        Ok(())
+    } else {
+        Err(CliError::Stopped(stopped.join("\n")))
+    }
+}

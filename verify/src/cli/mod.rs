@@ -1,0 +1,73 @@
+//! The `flexverify` command line: argument definitions and dispatch.
+//!
+//! Exit status: 0 success; 1 a verification check failed (or output could not be written);
+//! 2 bad input (scene file, arguments); 3 unsupported (a backend or subcommand cannot do what
+//! was asked); 4 a run stopped early with a diagnostic (its partial results are still written).
+
+pub mod args;
+mod commands;
+
+pub use args::{Cli, Command, CommonOpts};
+
+use std::process::ExitCode;
+
+use thiserror::Error;
+
+/// Why a command did not succeed, mapped to the documented exit status.
+#[derive(Debug, Error)]
+pub enum CliError {
+    #[error("{0}")]
+    Input(String),
+    #[error("{0}")]
+    Unsupported(String),
+    #[error("{0}")]
+    Failed(String),
+    #[error("{0}")]
+    Stopped(String),
+}
+
+impl CliError {
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Failed(_) => 1,
+            CliError::Input(_) => 2,
+            CliError::Unsupported(_) => 3,
+            CliError::Stopped(_) => 4,
+        }
+    }
+}
+
+impl From<data::LoadError> for CliError {
+    fn from(e: data::LoadError) -> Self {
+        CliError::Input(format!("error: {e}"))
+    }
+}
+
+impl From<data::BackendError> for CliError {
+    fn from(e: data::BackendError) -> Self {
+        match e {
+            data::BackendError::Unsupported(_) => CliError::Unsupported(e.to_string()),
+            data::BackendError::InvalidSettings { .. } | data::BackendError::StabilityBound { .. } => {
+                CliError::Input(format!("error: {e}"))
+            }
+            data::BackendError::Numerical { .. } => CliError::Failed(format!("error: {e}")),
+        }
+    }
+}
+
+impl From<std::io::Error> for CliError {
+    fn from(e: std::io::Error) -> Self {
+        CliError::Failed(format!("error: cannot write output: {e}"))
+    }
+}
+
+/// Runs a parsed command line; prints results to stdout and the error (if any) to stderr.
+pub fn run(cli: Cli) -> ExitCode {
+    match commands::dispatch(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

@@ -1,0 +1,101 @@
+//! Writing results: atomic files (temp file + rename) and table/JSON/CSV rendering.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use data::{EnergyLedger, Observables};
+
+/// Output formats of the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum Format {
+    Table,
+    Json,
+    Csv,
+}
+
+/// Writes `bytes` to `dir/name` atomically: a reader sees the old file or the complete new one,
+/// never a partial write, even if the process dies mid-way.
+pub fn write_atomic(dir: &Path, name: &str, bytes: &[u8]) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(dir)?;
+    let target = dir.join(name);
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+    }
+    std::fs::rename(&tmp, &target)?;
+    Ok(target)
+}
+
+/// Observables as CSV: `time,<channel>...`.
+pub fn observables_csv(obs: &Observables) -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["time".to_string()];
+    header.extend(obs.channels.iter().map(|c| c.name.clone()));
+    w.write_record(&header).expect("in-memory csv");
+    for (k, t) in obs.time.iter().enumerate() {
+        let mut row = vec![format!("{t:.9e}")];
+        row.extend(obs.channels.iter().map(|c| format!("{:.9e}", c.values[k])));
+        w.write_record(&row).expect("in-memory csv");
+    }
+    String::from_utf8(w.into_inner().expect("in-memory csv")).expect("utf8")
+}
+
+/// The energy ledger as CSV with the closure residual in the last column.
+pub fn ledger_csv(ledger: &EnergyLedger) -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["time".to_string()];
+    header.extend(ledger.stored.iter().map(|t| format!("stored:{}", t.name)));
+    header.extend(ledger.inputs.iter().map(|t| format!("input:{}", t.name)));
+    header.extend(ledger.dissipation.iter().map(|t| format!("dissipated:{}", t.name)));
+    header.push("residual".into());
+    w.write_record(&header).expect("in-memory csv");
+    for (k, t) in ledger.time.iter().enumerate() {
+        let mut row = vec![format!("{t:.9e}")];
+        for terms in [&ledger.stored, &ledger.inputs, &ledger.dissipation] {
+            row.extend(terms.iter().map(|term| format!("{:.9e}", term.values[k])));
+        }
+        row.push(format!("{:.3e}", ledger.residual(k)));
+        w.write_record(&row).expect("in-memory csv");
+    }
+    String::from_utf8(w.into_inner().expect("in-memory csv")).expect("utf8")
+}
+
+/// A plain text table with right-aligned columns.
+pub fn text_table(header: &[&str], rows: &[Vec<String>]) -> String {
+    let n = header.len();
+    let mut width: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for r in rows {
+        for (i, c) in r.iter().enumerate().take(n) {
+            width[i] = width[i].max(c.chars().count());
+        }
+    }
+    let fmt_row = |cells: Vec<&str>| {
+        cells
+            .iter()
+            .enumerate()
+            .map(|(i, c)| format!("{:>w$}", c, w = width[i]))
+            .collect::<Vec<_>>()
+            .join("  ")
+    };
+    let mut out = fmt_row(header.to_vec());
+    out.push('\n');
+    out.push_str(&width.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>().join("  "));
+    out.push('\n');
+    for r in rows {
+        out.push_str(&fmt_row(r.iter().map(|s| s.as_str()).collect()));
+        out.push('\n');
+    }
+    out
+}
+
+/// CSV text of a header and rows.
+pub fn csv_table(header: &[&str], rows: &[Vec<String>]) -> String {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(header).expect("in-memory csv");
+    for r in rows {
+        w.write_record(r).expect("in-memory csv");
+    }
+    String::from_utf8(w.into_inner().expect("in-memory csv")).expect("utf8")
+}

@@ -1,0 +1,11 @@
+//! `flexverify verify`: the verification suite.
+
+use std::path::Path;
+
+use crate::cli::CliError;
+use crate::cli::args::Suite;
+use crate::output::Format;
+
+pub fn command(_suite: Suite, _filter: Option<&str>, _format: Format, _out: Option<&Path>) -> Result<(), CliError> {
+    Err(CliError::Unsupported("unsupported: the verification suite is not implemented yet".into()))
+}
