@@ -47,9 +47,10 @@ pub fn catalog_names() -> impl Iterator<Item = &'static str> {
 
 /// Parses a catalog scene by name.
 pub fn catalog_scene(name: &str) -> Option<Result<Scene, LoadError>> {
-    CATALOG.iter().find(|(n, _)| *n == name).map(|(n, text)| {
-        parse_scene(text, &format!("<catalog>/{n}.toml")).map_err(LoadError::from)
-    })
+    CATALOG
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(n, text)| parse_scene(text, &format!("<catalog>/{n}.toml")).map_err(LoadError::from))
 }
 
 /// Loads a scene by catalog name or, failing that, by file path.

@@ -11,6 +11,7 @@
 //! No physics lives here: agreement between backends must mean something.
 
 pub mod backend;
+pub mod cases;
 pub mod catalog;
 pub mod error;
 pub mod locate;

@@ -62,7 +62,9 @@ pub fn offset_of(root: &Spanned<DeTable<'_>>, path: &FieldPath) -> usize {
         match seg {
             Segment::Key(k) => {
                 let Some(t) = table else { break };
-                let Some((key, v)) = t.iter().find(|(key, _)| key.get_ref().as_ref() == k.as_str())
+                let Some((key, v)) = t
+                    .iter()
+                    .find(|(key, _)| key.get_ref().as_ref() == k.as_str())
                 else {
                     break;
                 };

@@ -276,7 +276,11 @@ pub enum Event {
         time_tolerance: f64,
     },
     /// Friction state change.
-    StickSlip { t: f64, contact: usize, sticking: bool },
+    StickSlip {
+        t: f64,
+        contact: usize,
+        sticking: bool,
+    },
     /// The step size changed for a stated reason (e.g. a stability bound moved).
     StepSizeChange {
         t: f64,

@@ -85,7 +85,11 @@ pub fn validate(scene: &Scene) -> Vec<Issue> {
         );
     }
     if scene.description.trim().is_empty() {
-        c.fail(root.key("description"), "is empty", "a one-line description");
+        c.fail(
+            root.key("description"),
+            "is empty",
+            "a one-line description",
+        );
     }
 
     let sim = root.key("simulation");
@@ -174,8 +178,14 @@ pub fn validate(scene: &Scene) -> Vec<Issue> {
     }
 
     if let Some(g) = &scene.gravity {
-        c.finite(FieldPath::root().key("gravity").key("vector").index(0), g.vector[0]);
-        c.finite(FieldPath::root().key("gravity").key("vector").index(1), g.vector[1]);
+        c.finite(
+            FieldPath::root().key("gravity").key("vector").index(0),
+            g.vector[0],
+        );
+        c.finite(
+            FieldPath::root().key("gravity").key("vector").index(1),
+            g.vector[1],
+        );
     }
 
     if scene.contacts.len() > MAX_CONTACTS {
@@ -186,7 +196,12 @@ pub fn validate(scene: &Scene) -> Vec<Issue> {
         );
     }
     for (i, contact) in scene.contacts.iter().enumerate() {
-        check_contact(&mut c, &FieldPath::root().key("contact").index(i), contact, scene);
+        check_contact(
+            &mut c,
+            &FieldPath::root().key("contact").index(i),
+            contact,
+            scene,
+        );
     }
 
     if let Some(st) = &scene.statics {
@@ -200,14 +215,21 @@ pub fn validate(scene: &Scene) -> Vec<Issue> {
         for (k, lp) in st.elastica_load_parameters.iter().enumerate() {
             let pp = p.key("elastica_load_parameters").index(k);
             if !(lp.is_finite() && *lp > 0.0 && *lp <= 100.0) {
-                c.fail(pp, format!("{lp} is out of range"), "a load parameter PL²/EI in (0, 100]");
+                c.fail(
+                    pp,
+                    format!("{lp} is out of range"),
+                    "a load parameter PL²/EI in (0, 100]",
+                );
             }
         }
     }
     if let Some(st) = &scene.studies {
         for (k, l) in st.rotation_speeds.iter().enumerate() {
             c.non_negative(
-                FieldPath::root().key("studies").key("rotation_speeds").index(k),
+                FieldPath::root()
+                    .key("studies")
+                    .key("rotation_speeds")
+                    .index(k),
                 *l,
             );
         }
@@ -286,7 +308,10 @@ fn check_link(c: &mut Checker, p: &FieldPath, l: &Link) {
     c.positive(p.key("bending_stiffness"), l.bending_stiffness);
     c.opt_positive(p.key("axial_stiffness"), l.axial_stiffness);
     c.opt_positive(p.key("shear_stiffness"), l.shear_stiffness);
-    c.opt_positive(p.key("rotary_inertia_per_length"), l.rotary_inertia_per_length);
+    c.opt_positive(
+        p.key("rotary_inertia_per_length"),
+        l.rotary_inertia_per_length,
+    );
     c.opt_positive(p.key("kelvin_voigt"), l.kelvin_voigt);
     c.opt_positive(p.key("tip_mass"), l.tip_mass);
     c.opt_positive(p.key("tip_inertia"), l.tip_inertia);
@@ -416,9 +441,14 @@ fn check_contact(c: &mut Checker, p: &FieldPath, ct: &Contact, scene: &Scene) {
         Surface::Line { point, normal } => {
             c.finite(sp.key("point").index(0), point[0]);
             c.finite(sp.key("point").index(1), point[1]);
-            if !(normal[0].is_finite() && normal[1].is_finite()) || normal[0].hypot(normal[1]) == 0.0
+            if !(normal[0].is_finite() && normal[1].is_finite())
+                || normal[0].hypot(normal[1]) == 0.0
             {
-                c.fail(sp.key("normal"), "the normal is zero or not finite", "a non-zero vector [nx, ny]");
+                c.fail(
+                    sp.key("normal"),
+                    "the normal is zero or not finite",
+                    "a non-zero vector [nx, ny]",
+                );
             }
         }
         Surface::Circle { center, radius } => {
@@ -463,7 +493,10 @@ fn check_rocket(c: &mut Checker, p: &FieldPath, r: &Rocket) {
             if cw > s.weight_per_length {
                 c.fail(
                     sp.key("casing_weight_per_length"),
-                    format!("casing weight {cw} exceeds the total weight {}", s.weight_per_length),
+                    format!(
+                        "casing weight {cw} exceeds the total weight {}",
+                        s.weight_per_length
+                    ),
                     "casing_weight_per_length ≤ weight_per_length",
                 );
             }

@@ -14,12 +14,18 @@ fn err(text: &str) -> SceneError {
 
 /// Line (1-based) of the first occurrence of `needle`.
 fn line_of(text: &str, needle: &str) -> usize {
-    text.lines().position(|l| l.contains(needle)).expect("needle") + 1
+    text.lines()
+        .position(|l| l.contains(needle))
+        .expect("needle")
+        + 1
 }
 
 #[test]
 fn unknown_key_is_named_with_its_line() {
-    let text = GOOD.replace("bending_stiffness = 10.0", "bending_stiffness = 10.0\nbending_stifness = 3.0");
+    let text = GOOD.replace(
+        "bending_stiffness = 10.0",
+        "bending_stiffness = 10.0\nbending_stifness = 3.0",
+    );
     let e = err(&text);
     assert_eq!(e.line, line_of(&text, "bending_stifness"), "{e}");
     assert!(e.message.contains("bending_stifness"), "{e}");
@@ -73,12 +79,18 @@ fn malformed_toml_gives_position() {
 fn wrong_type_names_expected_type() {
     let e = err(&GOOD.replace("length = 1.0", "length = \"one\""));
     assert_eq!(e.path, "link[0].length", "{e}");
-    assert!(e.expected.contains("f64") || e.expected.contains("float"), "{e}");
+    assert!(
+        e.expected.contains("f64") || e.expected.contains("float"),
+        "{e}"
+    );
 }
 
 #[test]
 fn axial_with_foreshortening_is_contradictory() {
-    let text = GOOD.replace("tip_mass = 0.5", "tip_mass = 0.5\naxial = true\nforeshortening = true\naxial_stiffness = 1e6");
+    let text = GOOD.replace(
+        "tip_mass = 0.5",
+        "tip_mass = 0.5\naxial = true\nforeshortening = true\naxial_stiffness = 1e6",
+    );
     let e = err(&text);
     assert!(e.message.contains("contradictory"), "{e}");
     assert_eq!(e.path, "link[0].foreshortening");
@@ -98,7 +110,10 @@ fn contact_naming_a_missing_link_lists_the_names() {
     );
     let e = err(&text);
     assert_eq!(e.path, "contact[0].link");
-    assert!(e.message.contains("elbow") && e.expected.contains("link"), "{e}");
+    assert!(
+        e.message.contains("elbow") && e.expected.contains("link"),
+        "{e}"
+    );
     assert_eq!(e.line, line_of(&text, "link = \"elbow\""));
 }
 
@@ -106,7 +121,10 @@ fn contact_naming_a_missing_link_lists_the_names() {
 fn absurd_sizes_are_refused() {
     let e = err(&GOOD.replace("output_interval = 0.005", "output_interval = 1e-12"));
     assert_eq!(e.path, "simulation.output_interval");
-    let e = err(&GOOD.replace("output_interval = 0.005", "output_interval = 0.005\nfield_stations = 100000000"));
+    let e = err(&GOOD.replace(
+        "output_interval = 0.005",
+        "output_interval = 0.005\nfield_stations = 100000000",
+    ));
     assert_eq!(e.path, "simulation.field_stations");
     let huge = format!("{GOOD}\n# {}\n", "x".repeat(2 << 20));
     assert!(err(&huge).message.contains("bytes"));

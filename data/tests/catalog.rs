@@ -9,19 +9,25 @@ fn every_catalog_file_is_embedded() {
         .unwrap()
         .filter_map(|e| {
             let p = e.unwrap().path();
-            (p.extension()? == "toml").then(|| p.file_stem().unwrap().to_string_lossy().into_owned())
+            (p.extension()? == "toml")
+                .then(|| p.file_stem().unwrap().to_string_lossy().into_owned())
         })
         .collect();
     on_disk.sort();
     let mut embedded: Vec<String> = CATALOG.iter().map(|(n, _)| n.to_string()).collect();
     embedded.sort();
-    assert_eq!(on_disk, embedded, "data/scenes/*.toml and the embedded CATALOG differ");
+    assert_eq!(
+        on_disk, embedded,
+        "data/scenes/*.toml and the embedded CATALOG differ"
+    );
 }
 
 #[test]
 fn every_catalog_scene_parses_and_names_itself() {
     for (name, _) in CATALOG {
-        let scene = catalog_scene(name).unwrap().unwrap_or_else(|e| panic!("{name}: {e}"));
+        let scene = catalog_scene(name)
+            .unwrap()
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(scene.name, *name);
     }
 }
@@ -31,7 +37,8 @@ fn every_catalog_scene_round_trips() {
     for (name, _) in CATALOG {
         let scene = catalog_scene(name).unwrap().unwrap();
         let text = toml::to_string(&scene).unwrap_or_else(|e| panic!("{name}: serialize: {e}"));
-        let again = parse_scene(&text, "round-trip").unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        let again =
+            parse_scene(&text, "round-trip").unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
         assert_eq!(scene, again, "{name} changed in the round trip");
     }
 }

@@ -20,8 +20,14 @@ fn mutate(text: &str, ops: &[(u8, usize, u8)]) -> String {
             2 => bytes.insert(i, byte),
             3 => {
                 // duplicate a line: exercises duplicate keys and repeated tables
-                let start = bytes[..i].iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
-                let end = bytes[i..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |p| i + p + 1);
+                let start = bytes[..i]
+                    .iter()
+                    .rposition(|&b| b == b'\n')
+                    .map_or(0, |p| p + 1);
+                let end = bytes[i..]
+                    .iter()
+                    .position(|&b| b == b'\n')
+                    .map_or(bytes.len(), |p| i + p + 1);
                 let line = bytes[start..end].to_vec();
                 bytes.splice(start..start, line);
             }

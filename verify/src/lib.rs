@@ -7,6 +7,7 @@
 pub mod analytic;
 pub mod cli;
 pub mod output;
+pub mod plot;
 pub mod registry;
 pub mod stability;
 pub mod study;

@@ -48,7 +48,12 @@ pub fn ledger_csv(ledger: &EnergyLedger) -> String {
     let mut header = vec!["time".to_string()];
     header.extend(ledger.stored.iter().map(|t| format!("stored:{}", t.name)));
     header.extend(ledger.inputs.iter().map(|t| format!("input:{}", t.name)));
-    header.extend(ledger.dissipation.iter().map(|t| format!("dissipated:{}", t.name)));
+    header.extend(
+        ledger
+            .dissipation
+            .iter()
+            .map(|t| format!("dissipated:{}", t.name)),
+    );
     header.push("residual".into());
     w.write_record(&header).expect("in-memory csv");
     for (k, t) in ledger.time.iter().enumerate() {
@@ -81,7 +86,13 @@ pub fn text_table(header: &[&str], rows: &[Vec<String>]) -> String {
     };
     let mut out = fmt_row(header.to_vec());
     out.push('\n');
-    out.push_str(&width.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>().join("  "));
+    out.push_str(
+        &width
+            .iter()
+            .map(|w| "-".repeat(*w))
+            .collect::<Vec<_>>()
+            .join("  "),
+    );
     out.push('\n');
     for r in rows {
         out.push_str(&fmt_row(r.iter().map(|s| s.as_str()).collect()));

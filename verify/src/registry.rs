@@ -15,10 +15,7 @@ struct Pending(BackendKind);
 
 impl Pending {
     fn unsupported(&self) -> BackendError {
-        BackendError::unsupported(format!(
-            "the `{}` backend is not implemented yet",
-            self.0
-        ))
+        BackendError::unsupported(format!("the `{}` backend is not implemented yet", self.0))
     }
 }
 

@@ -1,11 +1,225 @@
-//! `flexverify stability`: stiff and extreme cases.
+//! `flexverify stability`: stiff and extreme cases (verification.md §9).
+//!
+//! For every case and backend the verdict is one of
+//! * `bounded` — reached t_end, every output finite, energy ledger closed to 1e-3 relative;
+//! * `stopped` — the backend refused or stopped early with a diagnostic (what, when, why, remedy);
+//! * `unsupported` — the backend says it cannot do the scene (not a failure, reported);
+//! * `BLEW UP UNDETECTED` — non-finite output, or a ledger residual above 10 % presented as a
+//!   completed run: a failure of ours (exit status 1).
+//!
+//! With `probe_bound`, explicit schemes are also run at 0.99 and 1.01 times the smallest
+//! stability bound they reported: the first must complete, the second must be refused.
 
 use std::path::Path;
 
+use data::cases::{SuiteName, scene_with_overrides, stability_cases};
+use data::{BackendError, BackendKind, StabilityVerdict, channel};
+use rayon::prelude::*;
+use serde::Serialize;
+
 use crate::cli::CliError;
 use crate::cli::args::Suite;
-use crate::output::Format;
+use crate::output::{Format, csv_table, text_table, write_atomic};
+use crate::registry::backend;
 
-pub fn command(_suite: Suite, _format: Format, _out: Option<&Path>) -> Result<(), CliError> {
-    Err(CliError::Unsupported("unsupported: the stability suite is not implemented yet".into()))
+/// Ledger closure accepted for a `bounded` verdict: 1e-3 relative is far above any
+/// integrator error at default tolerances and far below a silent blow-up.
+const LEDGER_OK: f64 = 1e-3;
+/// Ledger residual above which a completed run is judged to have blown up.
+const LEDGER_BLOWN: f64 = 0.1;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Verdict {
+    pub case: String,
+    pub what: String,
+    pub scene: String,
+    pub backend: BackendKind,
+    pub verdict: String,
+    pub detail: String,
+    pub failure: bool,
+    pub wall_time_s: f64,
+}
+
+fn judge(case: &data::cases::StabilityCase, kind: BackendKind) -> Vec<Verdict> {
+    let mk = |verdict: &str, detail: String, failure: bool, wall: f64| Verdict {
+        case: case.id.clone(),
+        what: case.what.clone(),
+        scene: case.scene.clone(),
+        backend: kind,
+        verdict: verdict.into(),
+        detail,
+        failure,
+        wall_time_s: wall,
+    };
+    let scene = match scene_with_overrides(&case.scene, &case.overrides) {
+        Ok(s) => s,
+        Err(e) => return vec![mk("invalid case", e, true, 0.0)],
+    };
+    let settings = case.settings.to_settings();
+    let b = backend(kind);
+    let mut out = Vec::new();
+    let result = b.simulate(&scene, &settings);
+    let mut bound = None;
+    match result {
+        Err(BackendError::Unsupported(why)) => out.push(mk("unsupported", why, false, 0.0)),
+        Err(e @ BackendError::StabilityBound { .. }) => {
+            out.push(mk("stopped", e.to_string(), false, 0.0))
+        }
+        Err(e) => out.push(mk("stopped", e.to_string(), false, 0.0)),
+        Ok(r) => {
+            let wall = r.cost.wall_time_s;
+            bound = r
+                .observables
+                .get(channel::STABILITY_BOUND)
+                .map(|c| {
+                    c.values
+                        .iter()
+                        .copied()
+                        .filter(|v| v.is_finite() && *v > 0.0)
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .filter(|v| v.is_finite());
+            let closure = r.ledger.relative_closure();
+            match (&r.verdict, r.observables.first_non_finite()) {
+                (_, Some((c, t))) => out.push(mk(
+                    "BLEW UP UNDETECTED",
+                    format!("non-finite `{c}` at t = {t:.6e}"),
+                    true,
+                    wall,
+                )),
+                (StabilityVerdict::Stopped { diagnostic }, None) => {
+                    out.push(mk("stopped", diagnostic.to_string(), false, wall))
+                }
+                (StabilityVerdict::Completed, None) if closure > LEDGER_BLOWN => out.push(mk(
+                    "BLEW UP UNDETECTED",
+                    format!("completed, but the energy ledger is off by {closure:.2e} relative"),
+                    true,
+                    wall,
+                )),
+                (StabilityVerdict::Completed, None) => out.push(mk(
+                    if closure <= LEDGER_OK {
+                        "bounded"
+                    } else {
+                        "bounded, ledger loose"
+                    },
+                    format!("ledger closure {closure:.2e}, {} steps", r.cost.steps),
+                    false,
+                    wall,
+                )),
+            }
+        }
+    }
+    if case.probe_bound
+        && let Some(bound) = bound
+    {
+        for (factor, must_run) in [(0.99, true), (1.01, false)] {
+            let mut s = settings.clone();
+            s.time.dt = Some(bound * factor);
+            let label = format!("dt = {factor} × bound {bound:.3e}");
+            match (b.simulate(&scene, &s), must_run) {
+                (Ok(r), true)
+                    if matches!(r.verdict, StabilityVerdict::Completed)
+                        && r.observables.first_non_finite().is_none() =>
+                {
+                    out.push(mk(
+                        "bounded",
+                        format!("{label}: runs"),
+                        false,
+                        r.cost.wall_time_s,
+                    ))
+                }
+                (Ok(r), true) => out.push(mk(
+                    "stopped",
+                    format!(
+                        "{label}: should run below its bound but did not ({:?})",
+                        r.verdict
+                    ),
+                    true,
+                    r.cost.wall_time_s,
+                )),
+                (Err(e), true) => out.push(mk(
+                    "stopped",
+                    format!("{label}: refused below its bound: {e}"),
+                    true,
+                    0.0,
+                )),
+                (Err(e @ BackendError::StabilityBound { .. }), false) => {
+                    out.push(mk("stopped", format!("{label}: refused: {e}"), false, 0.0))
+                }
+                (other, false) => out.push(mk(
+                    "BLEW UP UNDETECTED",
+                    format!(
+                        "{label}: accepted a step above its own bound ({})",
+                        match other {
+                            Ok(_) => "ran".to_string(),
+                            Err(e) => e.to_string(),
+                        }
+                    ),
+                    true,
+                    0.0,
+                )),
+            }
+        }
+    }
+    out
+}
+
+pub fn run_stability(suite: Suite) -> Result<Vec<Verdict>, CliError> {
+    let cases = stability_cases().map_err(|e| CliError::Input(format!("error: {e}")))?;
+    let jobs: Vec<_> = cases
+        .iter()
+        .filter(|c| suite == Suite::Full || c.suite == SuiteName::Quick)
+        .flat_map(|c| c.backends.iter().map(move |k| (c, *k)))
+        .collect();
+    Ok(jobs.par_iter().flat_map(|(c, k)| judge(c, *k)).collect())
+}
+
+pub fn command(suite: Suite, format: Format, out: Option<&Path>) -> Result<(), CliError> {
+    let verdicts = run_stability(suite)?;
+    let header = ["case", "scene", "backend", "verdict", "detail", "wall [s]"];
+    let rows: Vec<Vec<String>> = verdicts
+        .iter()
+        .map(|v| {
+            vec![
+                v.case.clone(),
+                v.scene.clone(),
+                v.backend.to_string(),
+                v.verdict.clone(),
+                v.detail.clone(),
+                format!("{:.3}", v.wall_time_s),
+            ]
+        })
+        .collect();
+    match format {
+        Format::Table => print!("{}", text_table(&header, &rows)),
+        Format::Csv => print!("{}", csv_table(&header, &rows)),
+        Format::Json => println!("{}", serde_json::to_string_pretty(&verdicts).expect("json")),
+    }
+    if let Some(dir) = out {
+        write_atomic(
+            dir,
+            "stability.json",
+            serde_json::to_string_pretty(&verdicts)
+                .expect("json")
+                .as_bytes(),
+        )?;
+        write_atomic(dir, "stability.csv", csv_table(&header, &rows).as_bytes())?;
+    }
+    let failures: Vec<&Verdict> = verdicts.iter().filter(|v| v.failure).collect();
+    if failures.is_empty() {
+        Ok(())
+    } else {
+        Err(CliError::Failed(
+            failures
+                .iter()
+                .map(|v| {
+                    format!(
+                        "FAILED {} ({}): {} — {}",
+                        v.case, v.backend, v.verdict, v.detail
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join("\n"),
+        ))
+    }
 }

@@ -136,10 +136,7 @@ impl Scene {
             ("joint_torque", any(|l| l.joint.torque.is_some())),
             ("prescribed_motion", any(|l| l.joint.prescribed.is_some())),
             ("contact", !self.contacts.is_empty()),
-            (
-                "friction",
-                self.contacts.iter().any(|c| c.friction > 0.0),
-            ),
+            ("friction", self.contacts.iter().any(|c| c.friction > 0.0)),
         ];
         if self.family() != Family::PlanarChain {
             flags.retain(|(_, on)| *on);

@@ -111,7 +111,11 @@ pub enum TorqueLaw {
         until: Option<f64>,
     },
     /// τ = +amplitude on [0, switch), −amplitude on [switch, off), 0 afterwards.
-    BangBang { amplitude: f64, switch: f64, off: f64 },
+    BangBang {
+        amplitude: f64,
+        switch: f64,
+        off: f64,
+    },
 }
 
 impl TorqueLaw {

@@ -31,7 +31,11 @@ pub struct Rocket {
     #[serde(rename = "stage")]
     pub stages: Vec<Stage>,
     /// Discrete masses (instrument packages) carried on springs.
-    #[serde(default, rename = "discrete_mass", skip_serializing_if = "Vec::is_empty")]
+    #[serde(
+        default,
+        rename = "discrete_mass",
+        skip_serializing_if = "Vec::is_empty"
+    )]
     pub discrete_masses: Vec<DiscreteMass>,
     /// Springs between discrete masses.
     #[serde(default, rename = "spring", skip_serializing_if = "Vec::is_empty")]

@@ -32,11 +32,9 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             tol,
             opts,
         } => crate::study::recommend_command(&scene, &quantity, tol, &opts),
-        Command::Stability {
-            suite,
-            format,
-            out,
-        } => crate::stability::command(suite, format, out.as_deref()),
+        Command::Stability { suite, format, out } => {
+            crate::stability::command(suite, format, out.as_deref())
+        }
     }
 }
 
@@ -121,16 +119,34 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
         Format::Csv => {
             let mut rows: Vec<Vec<String>> = flags
                 .iter()
-                .map(|(k, v)| vec!["physics".into(), k.to_string(), if *v { "on" } else { "off" }.into()])
+                .map(|(k, v)| {
+                    vec![
+                        "physics".into(),
+                        k.to_string(),
+                        if *v { "on" } else { "off" }.into(),
+                    ]
+                })
                 .collect();
             for p in &plans {
                 if let Some(plan) = &p.plan {
                     for g in &plan.groups {
-                        rows.push(vec![p.backend.to_string(), g.what.clone(), g.count.to_string()]);
+                        rows.push(vec![
+                            p.backend.to_string(),
+                            g.what.clone(),
+                            g.count.to_string(),
+                        ]);
                     }
-                    rows.push(vec![p.backend.to_string(), "total".into(), plan.total().to_string()]);
+                    rows.push(vec![
+                        p.backend.to_string(),
+                        "total".into(),
+                        plan.total().to_string(),
+                    ]);
                 } else {
-                    rows.push(vec![p.backend.to_string(), "unsupported".into(), p.unsupported.clone().unwrap_or_default()]);
+                    rows.push(vec![
+                        p.backend.to_string(),
+                        "unsupported".into(),
+                        p.unsupported.clone().unwrap_or_default(),
+                    ]);
                 }
             }
             print!("{}", csv_table(&["section", "item", "value"], &rows));
@@ -156,8 +172,10 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                     l.length,
                     l.mass_per_length,
                     l.bending_stiffness,
-                    l.axial_stiffness.map_or(String::new(), |v| format!(", EA = {v}")),
-                    l.tip_mass.map_or(String::new(), |v| format!(", tip mass {v}")),
+                    l.axial_stiffness
+                        .map_or(String::new(), |v| format!(", EA = {v}")),
+                    l.tip_mass
+                        .map_or(String::new(), |v| format!(", tip mass {v}")),
                 );
             }
             for (i, c) in scene.contacts.iter().enumerate() {
@@ -206,7 +224,9 @@ fn for_backends<T>(
     for kind in opts.backend.kinds() {
         match f(backend(kind).as_ref()) {
             Ok(v) => done.push((kind, v)),
-            Err(BackendError::Unsupported(why)) => unsupported.push(format!("{kind}: unsupported: {why}")),
+            Err(BackendError::Unsupported(why)) => {
+                unsupported.push(format!("{kind}: unsupported: {why}"))
+            }
             Err(e) => return Err(e.into()),
         }
     }
@@ -232,7 +252,11 @@ fn modes(name: &str, count: usize, opts: &CommonOpts) -> Result<(), CliError> {
             write_atomic(dir, &format!("{}-{kind}-modes.json", scene.name), &json)?;
         }
     }
-    let n = results.iter().map(|(_, r)| r.frequencies_hz.len()).max().unwrap_or(0);
+    let n = results
+        .iter()
+        .map(|(_, r)| r.frequencies_hz.len())
+        .max()
+        .unwrap_or(0);
     let mut header = vec!["mode".to_string()];
     header.extend(results.iter().map(|(k, _)| format!("{k} [Hz]")));
     let rows: Vec<Vec<String>> = (0..n)
@@ -286,10 +310,26 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     if let Some(dir) = &opts.out {
         for (kind, r) in &results {
             let stem = format!("{}-{kind}", scene.name);
-            write_atomic(dir, &format!("{stem}.json"), &serde_json::to_vec_pretty(r).expect("serializable"))?;
-            write_atomic(dir, &format!("{stem}-observables.csv"), observables_csv(&r.observables).as_bytes())?;
-            write_atomic(dir, &format!("{stem}-ledger.csv"), ledger_csv(&r.ledger).as_bytes())?;
-            write_atomic(dir, &format!("{stem}-events.json"), &serde_json::to_vec_pretty(&r.events).expect("serializable"))?;
+            write_atomic(
+                dir,
+                &format!("{stem}.json"),
+                &serde_json::to_vec_pretty(r).expect("serializable"),
+            )?;
+            write_atomic(
+                dir,
+                &format!("{stem}-observables.csv"),
+                observables_csv(&r.observables).as_bytes(),
+            )?;
+            write_atomic(
+                dir,
+                &format!("{stem}-ledger.csv"),
+                ledger_csv(&r.ledger).as_bytes(),
+            )?;
+            write_atomic(
+                dir,
+                &format!("{stem}-events.json"),
+                &serde_json::to_vec_pretty(&r.events).expect("serializable"),
+            )?;
         }
         eprintln!("wrote results to {}", dir.display());
     }
@@ -302,8 +342,15 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
         }
         Format::Table => {
             let header = [
-                "backend", "verdict", "t reached", "dofs", "steps", "rejected", "wall [s]",
-                "ledger closure", "events",
+                "backend",
+                "verdict",
+                "t reached",
+                "dofs",
+                "steps",
+                "rejected",
+                "wall [s]",
+                "ledger closure",
+                "events",
             ];
             let rows: Vec<Vec<String>> = results
                 .iter()
@@ -314,7 +361,10 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                             StabilityVerdict::Completed => "completed".into(),
                             StabilityVerdict::Stopped { .. } => "STOPPED".into(),
                         },
-                        r.observables.time.last().map_or("-".into(), |t| format!("{t:.4}")),
+                        r.observables
+                            .time
+                            .last()
+                            .map_or("-".into(), |t| format!("{t:.4}")),
                         r.cost.dofs.to_string(),
                         r.cost.steps.to_string(),
                         r.cost.rejected_steps.to_string(),
@@ -357,7 +407,9 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     let stopped: Vec<String> = results
         .iter()
         .filter_map(|(k, r)| match &r.verdict {
-            StabilityVerdict::Stopped { diagnostic } => Some(format!("{k}: run stopped {diagnostic}")),
+            StabilityVerdict::Stopped { diagnostic } => {
+                Some(format!("{k}: run stopped {diagnostic}"))
+            }
             StabilityVerdict::Completed => None,
         })
         .collect();

@@ -47,9 +47,8 @@ impl From<data::BackendError> for CliError {
     fn from(e: data::BackendError) -> Self {
         match e {
             data::BackendError::Unsupported(_) => CliError::Unsupported(e.to_string()),
-            data::BackendError::InvalidSettings { .. } | data::BackendError::StabilityBound { .. } => {
-                CliError::Input(format!("error: {e}"))
-            }
+            data::BackendError::InvalidSettings { .. }
+            | data::BackendError::StabilityBound { .. } => CliError::Input(format!("error: {e}")),
             data::BackendError::Numerical { .. } => CliError::Failed(format!("error: {e}")),
         }
     }

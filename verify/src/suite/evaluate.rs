@@ -1,0 +1,301 @@
+//! One case → one outcome row.
+
+use data::cases::{Case, CaseSettings, Norm, Reference};
+use data::{BackendError, Scene, Settings, StabilityVerdict, load_scene};
+use serde::Serialize;
+
+use super::quantity::Quantity;
+use super::reference::analytic_value;
+use super::run_cache::{Answer, RunCache, mode_count};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Status {
+    Pass,
+    Fail,
+    /// The case could not be evaluated (unsupported, missing channel, …): counts as a failure.
+    Error,
+}
+
+/// A row of the verification table.
+#[derive(Debug, Clone, Serialize)]
+pub struct Outcome {
+    pub id: String,
+    pub check: String,
+    pub scene: String,
+    pub backend: String,
+    pub settings: CaseSettings,
+    pub quantity: String,
+    pub value: Option<f64>,
+    pub reference: Option<f64>,
+    /// Where the reference comes from, e.g. "analytic:clamped-free" or "modal(modes=8)".
+    pub reference_label: String,
+    pub norm: Norm,
+    pub error: Option<f64>,
+    pub tolerance: f64,
+    pub status: Status,
+    pub message: String,
+    pub why: String,
+    /// Backend wall time of the evaluated run(s), seconds.
+    pub wall_time_s: f64,
+}
+
+fn settings_label(s: &CaseSettings) -> String {
+    let mut parts = Vec::new();
+    if let Some(v) = s.elements {
+        parts.push(format!("elements={v}"));
+    }
+    if let Some(v) = s.stations {
+        parts.push(format!("stations={v}"));
+    }
+    if let Some(v) = s.modes {
+        parts.push(format!("modes={v}"));
+    }
+    if let Some(v) = s.basis {
+        parts.push(format!("basis={}", v.name()));
+    }
+    if let Some(v) = s.dt {
+        parts.push(format!("dt={v}"));
+    }
+    if let Some(v) = &s.method {
+        parts.push(format!("method={v}"));
+    }
+    if let Some(v) = s.rtol {
+        parts.push(format!("rtol={v}"));
+    }
+    parts.join(",")
+}
+
+/// Evaluates a quantity for one backend and settings: (value, peak scale, wall time).
+pub fn measure(
+    cache: &RunCache,
+    scene: &Scene,
+    kind: data::BackendKind,
+    settings: &Settings,
+    q: &Quantity,
+) -> Result<(f64, Option<f64>, f64), String> {
+    let modes = match q {
+        Quantity::Frequency { n, .. } => mode_count(*n),
+        _ => 0,
+    };
+    let fmt_err = |e: BackendError| format!("{kind}: {e}");
+    match cache.get(scene, kind, settings, q.analysis(), modes) {
+        Answer::Modes(r) => {
+            let r = r.map_err(fmt_err)?;
+            Ok((q.from_modes(&r)?, None, r.cost.wall_time_s))
+        }
+        Answer::Statics(r) => {
+            let r = r.map_err(fmt_err)?;
+            Ok((q.from_statics(&r)?, None, r.cost.wall_time_s))
+        }
+        Answer::Run(r) => {
+            let r = r.map_err(fmt_err)?;
+            if let StabilityVerdict::Stopped { diagnostic } = &r.verdict {
+                // A stopped run is still measured (the case may be about divergence), but only
+                // where the quantity lies inside the computed interval.
+                if let Quantity::At { t, .. } = q
+                    && *t > diagnostic.t
+                {
+                    return Err(format!("{kind}: run stopped before t = {t}: {diagnostic}"));
+                }
+            }
+            Ok((q.from_run(&r)?, q.peak_scale(&r), r.cost.wall_time_s))
+        }
+    }
+}
+
+/// Step size of a ladder rung for order fits.
+fn rung_size(s: &CaseSettings) -> Option<f64> {
+    if let Some(dt) = s.dt {
+        return Some(dt);
+    }
+    if let Some(e) = s.elements {
+        return Some(1.0 / e as f64);
+    }
+    if let Some(n) = s.stations {
+        return Some(1.0 / (n.max(2) - 1) as f64);
+    }
+    s.modes.map(|m| 1.0 / m as f64)
+}
+
+/// Least-squares slope of log|e| against log h.
+pub fn fit_order(h: &[f64], e: &[f64]) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = h
+        .iter()
+        .zip(e)
+        .filter(|(h, e)| **h > 0.0 && e.abs() > 0.0 && e.is_finite())
+        .map(|(h, e)| (h.ln(), e.abs().ln()))
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// Richardson extrapolation from the last three rungs (observed order), or the last two with
+/// the given order. Returns (extrapolated value, order used).
+pub fn richardson(h: &[f64], q: &[f64], assumed_order: Option<f64>) -> Option<(f64, f64)> {
+    let n = q.len();
+    if n < 2 {
+        return None;
+    }
+    let (h1, h2) = (h[n - 2], h[n - 1]);
+    let r = h1 / h2;
+    let p = if n >= 3 && assumed_order.is_none() {
+        let (d1, d2) = (q[n - 2] - q[n - 3], q[n - 1] - q[n - 2]);
+        if d1 == 0.0 || d2 == 0.0 || (d1 / d2) <= 0.0 {
+            return None;
+        }
+        let r0 = h[n - 3] / h1;
+        // Equal ratios assumed for the order estimate; ladders here are geometric.
+        ((d1 / d2).ln() / r0.ln()).max(0.1)
+    } else {
+        assumed_order?
+    };
+    Some((q[n - 1] + (q[n - 1] - q[n - 2]) / (r.powf(p) - 1.0), p))
+}
+
+pub fn evaluate(case: &Case, cache: &RunCache) -> Outcome {
+    let mut out = Outcome {
+        id: case.id.clone(),
+        check: case.check.clone(),
+        scene: case.scene.clone(),
+        backend: format!("{}({})", case.backend, settings_label(&case.settings)),
+        settings: case.settings.clone(),
+        quantity: case.quantity.clone(),
+        value: None,
+        reference: None,
+        reference_label: String::new(),
+        norm: case.norm,
+        error: None,
+        tolerance: case.tolerance,
+        status: Status::Error,
+        message: String::new(),
+        why: case.why.clone(),
+        wall_time_s: 0.0,
+    };
+    match evaluate_inner(case, cache, &mut out) {
+        Ok(()) => {
+            let err = out.error.unwrap_or(f64::INFINITY);
+            if err.is_finite() && err <= case.tolerance {
+                out.status = Status::Pass;
+            } else {
+                out.status = Status::Fail;
+                out.message = format!(
+                    "error {err:.3e} exceeds tolerance {:.1e} ({})",
+                    case.tolerance, out.reference_label
+                );
+            }
+        }
+        Err(msg) => {
+            out.status = Status::Error;
+            out.message = msg;
+        }
+    }
+    out
+}
+
+fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<(), String> {
+    let scene = load_scene(&case.scene).map_err(|e| e.to_string())?;
+    let q = Quantity::parse(&case.quantity, &scene)?;
+    let settings = case.settings.to_settings();
+
+    if let Reference::Order {
+        order,
+        ladder,
+        against,
+    } = &case.reference
+    {
+        let mut h = Vec::new();
+        let mut v = Vec::new();
+        for rung in ladder {
+            let (val, _, wall) = measure(cache, &scene, case.backend, &rung.to_settings(), &q)?;
+            h.push(rung_size(rung).ok_or("a ladder rung sets no refinement parameter")?);
+            v.push(val);
+            out.wall_time_s += wall;
+        }
+        let errors: Vec<f64> = match against {
+            Some(id) => {
+                let r = analytic_value(id, &scene, &q)?;
+                v.iter().map(|x| (x - r) / r).collect()
+            }
+            None => {
+                let (ext, _) = richardson(&h, &v, None).ok_or(
+                    "the ladder is not in the asymptotic range (non-monotone differences)",
+                )?;
+                v.iter().map(|x| x - ext).collect()
+            }
+        };
+        let observed = fit_order(&h, &errors).ok_or("cannot fit an order (zero errors)")?;
+        out.value = Some(observed);
+        out.reference = Some(*order);
+        out.reference_label = format!(
+            "order {order} over {} rungs vs {}",
+            ladder.len(),
+            against
+                .as_deref()
+                .map_or("Richardson".to_string(), |a| format!("analytic:{a}"))
+        );
+        out.error = Some((observed - order).abs());
+        out.quantity = format!("order({})", case.quantity);
+        return Ok(());
+    }
+
+    let (value, peak, wall) = measure(cache, &scene, case.backend, &settings, &q)?;
+    out.value = Some(value);
+    out.wall_time_s += wall;
+    let (reference, ref_peak) = match &case.reference {
+        Reference::Analytic { analytic } => {
+            out.reference_label = format!("analytic:{analytic}");
+            (analytic_value(analytic, &scene, &q)?, None)
+        }
+        Reference::Backend { backend, settings } => {
+            out.reference_label = format!("{backend}({})", settings_label(settings));
+            let (r, p, w) = measure(cache, &scene, *backend, &settings.to_settings(), &q)?;
+            out.wall_time_s += w;
+            (r, p)
+        }
+        Reference::Richardson { richardson: ladder } => {
+            let mut h = Vec::new();
+            let mut v = Vec::new();
+            for rung in ladder {
+                let (val, _, w) = measure(cache, &scene, case.backend, &rung.to_settings(), &q)?;
+                h.push(rung_size(rung).ok_or("a ladder rung sets no refinement parameter")?);
+                v.push(val);
+                out.wall_time_s += w;
+            }
+            let (ext, p) = richardson(&h, &v, None).ok_or("Richardson ladder not asymptotic")?;
+            out.reference_label = format!("Richardson over {} rungs (p = {p:.2})", ladder.len());
+            (ext, None)
+        }
+        Reference::Zero { .. } => {
+            out.reference_label = "zero".into();
+            (0.0, None)
+        }
+        Reference::Order { .. } => unreachable!("handled above"),
+    };
+    out.reference = Some(reference);
+    let err = match case.norm {
+        Norm::Absolute => (value - reference).abs(),
+        Norm::Relative => {
+            if reference == 0.0 {
+                return Err("relative norm against a zero reference".into());
+            }
+            ((value - reference) / reference).abs()
+        }
+        Norm::RelativeToPeak => {
+            let scale = ref_peak
+                .or(peak)
+                .filter(|s| *s > 0.0)
+                .ok_or("no peak scale")?;
+            (value - reference).abs() / scale
+        }
+    };
+    out.error = Some(err);
+    Ok(())
+}

@@ -1,0 +1,184 @@
+//! Quantities a case can measure, parsed from the case's `quantity` string.
+
+use data::{ModalResult, RunResult, Scene, StaticResult, channel};
+
+/// What to extract from a backend's answer.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Quantity {
+    /// N-th natural frequency (1-based), optionally only among modes of a kind.
+    Frequency { n: usize, kind: Option<String> },
+    /// Static tip deflection of the last link.
+    StaticTip,
+    /// Observable channel at time t.
+    At { channel: String, t: f64 },
+    /// max |channel| over the run.
+    Peak { channel: String },
+    /// Relative energy-ledger closure.
+    LedgerClosure,
+    /// Largest impact momentum residual.
+    MaxMomentumResidual,
+}
+
+/// Which backend analysis a quantity needs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Analysis {
+    Modes,
+    Statics,
+    Simulate,
+}
+
+impl Quantity {
+    /// Parses the grammar of `data::cases` against a scene (aliases resolve to its last link).
+    pub fn parse(text: &str, scene: &Scene) -> Result<Quantity, String> {
+        let t = text.trim();
+        let last = scene.links.len().max(1);
+        let alias = |c: &str| -> String {
+            match c {
+                "tip_deflection" => channel::tip_deflection(last),
+                "tip_x" => channel::tip_x(last),
+                "tip_y" => channel::tip_y(last),
+                "tip_axial" => channel::tip_axial(last),
+                "hub_angle" => channel::joint_angle(1),
+                "hub_torque" => channel::joint_torque(1),
+                other => other.to_string(),
+            }
+        };
+        let freq = |rest: &str, kind: Option<&str>| -> Result<Quantity, String> {
+            let n: usize = rest
+                .parse()
+                .map_err(|_| format!("`{text}`: expected a mode number after `freq`"))?;
+            if n == 0 {
+                return Err(format!("`{text}`: modes are numbered from 1"));
+            }
+            Ok(Quantity::Frequency {
+                n,
+                kind: kind.map(str::to_string),
+            })
+        };
+        if let Some(rest) = t.strip_prefix("axial_freq") {
+            return freq(rest, Some("axial"));
+        }
+        if let Some(rest) = t.strip_prefix("bending_freq") {
+            return freq(rest, Some("bending"));
+        }
+        if let Some(rest) = t.strip_prefix("freq") {
+            return freq(rest, None);
+        }
+        match t {
+            "tip_static" => return Ok(Quantity::StaticTip),
+            "ledger_closure" => return Ok(Quantity::LedgerClosure),
+            "max_momentum_residual" => return Ok(Quantity::MaxMomentumResidual),
+            _ => {}
+        }
+        if let Some(c) = t.strip_prefix("peak:") {
+            return Ok(Quantity::Peak { channel: alias(c) });
+        }
+        if let Some((c, time)) = t.split_once('@') {
+            // `link1.v@3` is a field channel name, not a time: only split on a float time when
+            // the channel part is not a field station.
+            let tv: f64 = time
+                .parse()
+                .map_err(|_| format!("`{text}`: `{time}` is not a time"))?;
+            if !tv.is_finite() || tv < 0.0 {
+                return Err(format!("`{text}`: time must be finite and ≥ 0"));
+            }
+            return Ok(Quantity::At {
+                channel: alias(c),
+                t: tv,
+            });
+        }
+        Err(format!(
+            "unknown quantity `{text}`; expected freqN, axial_freqN, bending_freqN, tip_static, \
+             CHANNEL@T, peak:CHANNEL, ledger_closure or max_momentum_residual"
+        ))
+    }
+
+    pub fn analysis(&self) -> Analysis {
+        match self {
+            Quantity::Frequency { .. } => Analysis::Modes,
+            Quantity::StaticTip => Analysis::Statics,
+            _ => Analysis::Simulate,
+        }
+    }
+
+    pub fn from_modes(&self, r: &ModalResult) -> Result<f64, String> {
+        let Quantity::Frequency { n, kind } = self else {
+            return Err("not a frequency".into());
+        };
+        let picked: Vec<f64> = match kind {
+            None => r.frequencies_hz.clone(),
+            Some(k) => r
+                .frequencies_hz
+                .iter()
+                .zip(&r.kinds)
+                .filter(|(_, kk)| *kk == k)
+                .map(|(f, _)| *f)
+                .collect(),
+        };
+        picked.get(n - 1).copied().ok_or_else(|| {
+            format!(
+                "the backend returned {} {}frequencies, mode {n} was asked for",
+                picked.len(),
+                kind.as_ref().map_or(String::new(), |k| format!("{k} "))
+            )
+        })
+    }
+
+    pub fn from_statics(&self, r: &StaticResult) -> Result<f64, String> {
+        Ok(r.tip_deflection)
+    }
+
+    pub fn from_run(&self, r: &RunResult) -> Result<f64, String> {
+        let missing = |c: &str| {
+            let names: Vec<&str> = r
+                .observables
+                .channels
+                .iter()
+                .map(|c| c.name.as_str())
+                .filter(|n| !n.contains('@'))
+                .collect();
+            format!(
+                "no channel `{c}` in the run; available: {}",
+                names.join(", ")
+            )
+        };
+        match self {
+            Quantity::At { channel, t } => {
+                r.observables.get(channel).ok_or_else(|| missing(channel))?;
+                r.observables.value_at(channel, *t).ok_or_else(|| {
+                    format!(
+                        "t = {t} is outside the run [0, {}]",
+                        r.observables.time.last().copied().unwrap_or(0.0)
+                    )
+                })
+            }
+            Quantity::Peak { channel } => {
+                let c = r.observables.get(channel).ok_or_else(|| missing(channel))?;
+                Ok(c.values.iter().fold(0.0f64, |m, v| m.max(v.abs())))
+            }
+            Quantity::LedgerClosure => Ok(r.ledger.relative_closure()),
+            Quantity::MaxMomentumResidual => Ok(r
+                .events
+                .iter()
+                .filter_map(|e| match e {
+                    data::Event::Impact {
+                        momentum_residual, ..
+                    } => Some(*momentum_residual),
+                    _ => None,
+                })
+                .fold(0.0, f64::max)),
+            _ => Err("not a run quantity".into()),
+        }
+    }
+
+    /// Scale of the reference time history for `relative-to-peak` norms.
+    pub fn peak_scale(&self, r: &RunResult) -> Option<f64> {
+        match self {
+            Quantity::At { channel, .. } | Quantity::Peak { channel } => r
+                .observables
+                .get(channel)
+                .map(|c| c.values.iter().fold(0.0f64, |m, v| m.max(v.abs()))),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! The verification table, its JSON/CSV forms and the HTML index.
+
+use std::path::Path;
+
+use super::evaluate::{Outcome, Status};
+use crate::output::{csv_table, text_table, write_atomic};
+
+const HEADER: [&str; 11] = [
+    "check",
+    "case",
+    "scene",
+    "backend",
+    "quantity",
+    "value",
+    "reference",
+    "error",
+    "tolerance",
+    "result",
+    "wall [s]",
+];
+
+fn fmt_opt(v: Option<f64>) -> String {
+    v.map_or("-".into(), |x| format!("{x:.6e}"))
+}
+
+fn rows(outcomes: &[Outcome]) -> Vec<Vec<String>> {
+    outcomes
+        .iter()
+        .map(|o| {
+            vec![
+                o.check.clone(),
+                o.id.clone(),
+                o.scene.clone(),
+                o.backend.clone(),
+                o.quantity.clone(),
+                fmt_opt(o.value),
+                format!("{} [{}]", fmt_opt(o.reference), o.reference_label),
+                o.error.map_or("-".into(), |e| format!("{e:.2e}")),
+                format!("{:.1e} {:?}", o.tolerance, o.norm).to_lowercase(),
+                match o.status {
+                    Status::Pass => "pass".into(),
+                    Status::Fail => "FAIL".into(),
+                    Status::Error => "ERROR".into(),
+                },
+                format!("{:.3}", o.wall_time_s),
+            ]
+        })
+        .collect()
+}
+
+pub fn table(outcomes: &[Outcome]) -> String {
+    let mut s = text_table(&HEADER, &rows(outcomes));
+    for o in outcomes.iter().filter(|o| o.status != Status::Pass) {
+        s.push_str(&format!("  {}: {}\n", o.id, o.message));
+    }
+    s
+}
+
+pub fn csv(outcomes: &[Outcome]) -> String {
+    let mut header = HEADER.to_vec();
+    header.push("why");
+    header.push("message");
+    let rows: Vec<Vec<String>> = rows(outcomes)
+        .into_iter()
+        .zip(outcomes)
+        .map(|(mut r, o)| {
+            r.push(o.why.clone());
+            r.push(o.message.clone());
+            r
+        })
+        .collect();
+    csv_table(&header, &rows)
+}
+
+pub fn json(outcomes: &[Outcome]) -> String {
+    serde_json::to_string_pretty(outcomes).expect("serializable outcomes")
+}
+
+fn html_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// JSON, CSV and an index.html linking them (plots are added by the studies).
+pub fn write_all(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<()> {
+    write_atomic(dir, "verification.json", json(outcomes).as_bytes())?;
+    write_atomic(dir, "verification.csv", csv(outcomes).as_bytes())?;
+    let mut html = String::from(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>flexverify report</title>\
+         <style>body{font-family:sans-serif}td,th{padding:2px 8px;border-bottom:1px solid #ddd}\
+         .FAIL,.ERROR{color:#b00;font-weight:bold}</style></head><body>\
+         <h1>flexverify verification report</h1>\
+         <p><a href=\"verification.json\">JSON</a> · <a href=\"verification.csv\">CSV</a></p><table><tr>",
+    );
+    for h in HEADER.iter().chain(["why"].iter()) {
+        html.push_str(&format!("<th>{h}</th>"));
+    }
+    html.push_str("</tr>");
+    for (r, o) in rows(outcomes).into_iter().zip(outcomes) {
+        html.push_str("<tr>");
+        let result = r[9].clone();
+        for (i, cell) in r.into_iter().enumerate() {
+            if i == 9 {
+                html.push_str(&format!(
+                    "<td class=\"{result}\">{}</td>",
+                    html_escape(&cell)
+                ));
+            } else {
+                html.push_str(&format!("<td>{}</td>", html_escape(&cell)));
+            }
+        }
+        html.push_str(&format!("<td>{}</td></tr>", html_escape(&o.why)));
+    }
+    html.push_str("</table>");
+    let plots: Vec<String> = std::fs::read_dir(dir)?
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".svg"))
+        .collect();
+    if !plots.is_empty() {
+        html.push_str("<h2>Plots</h2>");
+        let mut plots = plots;
+        plots.sort();
+        for p in plots {
+            html.push_str(&format!("<div><img src=\"{p}\" alt=\"{p}\"></div>"));
+        }
+    }
+    html.push_str("</body></html>\n");
+    write_atomic(dir, "index.html", html.as_bytes())?;
+    Ok(())
+}

@@ -1,0 +1,59 @@
+//! Backend answers shared between cases: each (scene, backend, settings, analysis) is computed
+//! once, even when several cases (and rayon threads) ask for it.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use data::{BackendError, BackendKind, ModalResult, RunResult, Scene, Settings, StaticResult};
+
+use super::quantity::Analysis;
+use crate::registry::backend;
+
+#[derive(Debug, Clone)]
+pub enum Answer {
+    Modes(Result<ModalResult, BackendError>),
+    Statics(Result<StaticResult, BackendError>),
+    Run(Result<RunResult, BackendError>),
+}
+
+type Slot = Arc<OnceLock<Answer>>;
+
+#[derive(Default)]
+pub struct RunCache {
+    slots: Mutex<HashMap<String, Slot>>,
+}
+
+/// Number of modes requested from a backend for frequency checks up to mode `n`.
+pub fn mode_count(n: usize) -> usize {
+    n.max(12)
+}
+
+impl RunCache {
+    pub fn get(
+        &self,
+        scene: &Scene,
+        kind: BackendKind,
+        settings: &Settings,
+        analysis: Analysis,
+        modes: usize,
+    ) -> Answer {
+        let key = format!(
+            "{}|{kind}|{}|{analysis:?}|{modes}",
+            scene.name,
+            serde_json::to_string(settings).expect("serializable settings")
+        );
+        let slot = {
+            let mut map = self.slots.lock().expect("cache lock");
+            map.entry(key).or_default().clone()
+        };
+        slot.get_or_init(|| {
+            let b = backend(kind);
+            match analysis {
+                Analysis::Modes => Answer::Modes(b.modes(scene, settings, modes)),
+                Analysis::Statics => Answer::Statics(b.statics(scene, settings)),
+                Analysis::Simulate => Answer::Run(b.simulate(scene, settings)),
+            }
+        })
+        .clone()
+    }
+}

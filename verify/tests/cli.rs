@@ -1,0 +1,122 @@
+//! End-to-end tests of the `flexverify` binary: listing, describing, bad input, exit codes.
+
+use std::process::Command;
+
+fn flexverify(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_flexverify"))
+        .args(args)
+        .output()
+        .expect("run flexverify");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn temp_file(name: &str, text: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("flexverify-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn cli_scenes_lists_the_whole_catalog() {
+    let (code, out, _) = flexverify(&["scenes"]);
+    assert_eq!(code, 0);
+    for name in data::catalog_names() {
+        assert!(
+            out.lines().any(|l| l.starts_with(name)),
+            "{name} missing:\n{out}"
+        );
+    }
+}
+
+#[test]
+fn cli_describe_barhorst_case1_shows_its_physics() {
+    let (code, out, err) = flexverify(&["describe", "barhorst-case1"]);
+    assert_eq!(code, 0, "{err}");
+    let state = |flag: &str| {
+        out.lines()
+            .find(|l| l.split_whitespace().next() == Some(flag))
+            .and_then(|l| l.split_whitespace().nth(1))
+            .unwrap_or_else(|| panic!("no `{flag}` line:\n{out}"))
+            .to_string()
+    };
+    assert_eq!(state("gravity"), "on");
+    assert_eq!(state("contact"), "on");
+    assert_eq!(state("kelvin_voigt"), "on");
+    assert_eq!(state("axial"), "off");
+    assert_eq!(state("shear"), "off");
+}
+
+#[test]
+fn cli_bad_scene_files_exit_2_with_location() {
+    let good = include_str!("../../data/scenes/single-link.toml");
+    let cases = [
+        (
+            "unknown-key",
+            good.replace("tip_mass = 0.5", "tip_mass = 0.5\ntip_mas = 1.0"),
+            "tip_mas",
+        ),
+        (
+            "negative",
+            good.replace("length = 1.0", "length = -2.0"),
+            "link[0].length",
+        ),
+        (
+            "nan",
+            good.replace("bending_stiffness = 10.0", "bending_stiffness = nan"),
+            "link[0].bending_stiffness",
+        ),
+        (
+            "syntax",
+            good.replace("[simulation]", "[simulation"),
+            "malformed TOML",
+        ),
+        (
+            "contradiction",
+            good.replace(
+                "tip_mass = 0.5",
+                "tip_mass = 0.5\naxial = true\nforeshortening = true\naxial_stiffness = 1.0",
+            ),
+            "contradictory",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        let p = temp_file(&format!("{name}.toml"), &text);
+        let (code, _, err) = flexverify(&["describe", p.to_str().unwrap()]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(err.contains(needle), "{name}: {err}");
+        assert!(
+            err.contains(&format!("{name}.toml:")),
+            "{name}: no file:line in {err}"
+        );
+        assert!(!err.contains("panicked"), "{name}: {err}");
+    }
+}
+
+#[test]
+fn cli_missing_scene_and_bad_numbers_exit_2() {
+    let (code, _, err) = flexverify(&["run", "no-such-scene"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("flexverify scenes"));
+    for bad in ["-1", "0", "nan", "inf", "abc"] {
+        let (code, _, err) = flexverify(&["run", "spin-up", "--dt", bad]);
+        assert_eq!(code, 2, "--dt {bad}: {err}");
+        assert!(err.contains("--dt"), "{err}");
+    }
+    let (code, _, _) = flexverify(&["run", "spin-up", "--elements", "0"]);
+    assert_eq!(code, 2);
+}
+
+#[test]
+fn cli_unsupported_requests_exit_3_without_results() {
+    // No backend integrates the 3-D payload link yet.
+    let (code, out, err) = flexverify(&["run", "single-link-3d", "--format", "json"]);
+    assert_eq!(code, 3, "{out}{err}");
+    assert!(err.contains("unsupported"), "{err}");
+    assert!(out.trim().is_empty(), "a fake result was printed: {out}");
+}
