@@ -1,1 +1,166 @@
-//! placeholder
+//! # fdm — the variable-step finite-difference scheme of the 1969 NASA report (seed 003 §5)
+//!
+//! ## Rocket (`rocket`, `rocket-case2`, `rocket-launch-60`, `rocket-launch-75`)
+//! Continuous equations (report 5.2–5.8, re-derived, OCR typos removed): per unit length of the
+//! case, m A_x = ∂/∂x(EA(u' + ½w'²)) + f_u and m A_y = −∂²/∂x²(EI w'') + ∂/∂x(P w') + f_w, with
+//! A the absolute acceleration in body axes (see [`rocket::system`]), P = EA u', free-free ends
+//! (EA u' = EI w'' = (EI w'')' = 0, 3.59–3.60), point loads ṁ_total v_e − p A_f at x = 0 and
+//! +p A_f at x = L₁, the internal-flow Coriolis load 2θ̇ m_f v with m_f v = ṁ (L₁ − x), gravity
+//! (−g sin θ, −g cos θ), discrete masses on springs/dampers (5.7–5.8), and the rigid equations
+//! (5.2–5.4) for the aft-end origin (X, Y, body components) and attitude θ. The mass-loss forces
+//! F_M (3.43) cancel the ṁ part of d/dt ∂L/∂q̇, so every mass element obeys m A = F with m(t).
+//!
+//! Discretization (report §5.2):
+//! * equal spatial steps h, stations 0…r; trapezoidal integrals (5.13) ⇒ lumped masses h/2 at
+//!   the ends, h inside, and the operator m{·} of 5.14; discrete masses attached between two
+//!   stations by linear interpolation (x = 125 in is not a station when h = 2 in);
+//! * the elastic forces are −∂V/∂q of the discrete strain energy ([`rocket::operators`]); they
+//!   coincide with the report's stencils 5.23/5.25 and with the ghost nodes 5.31–5.32 (tested),
+//!   and stay conservative across the stage junction (the report's EA' u' form does not);
+//! * the rigid/elastic split: 3×3 solve for (Ṙ, Ṡ, Ṫ) under 5.37 (5.38), then \[A₂₂\] = 1 (5.40).
+//!   The elastic accelerations satisfy 5.37 exactly, so the split loses nothing;
+//! * time: the two-step central difference 5.21/5.24–5.30 with (τ_j + τ_{j+1}) and steps from
+//!   σ² ≤ h² m/EA, σ² ≤ h⁴ m/(4EI) per segment (5.43–5.45), recomputed every step with the
+//!   masses of the new level as stage 1 burns ([`integrator`], which also states the start-up).
+//!
+//! **Stability finding.** The report's σ equals 2/ω_max of the discrete operator — the limit of
+//! the *one-step* second-order form. The two-step form 5.21 has roots ξ = iωτ ± √(1 − ω²τ²) and
+//! is stable only for ωτ ≤ 1, i.e. τ ≤ σ/2; at τ = σ its shortest bending waves grow by
+//! |ξ| = 2 + √3 per step (tested; the report itself warns that 5.45 "does not ensure
+//! stability"). Enforced limits, reported in the `stability_bound` channel:
+//!
+//! | `time.method` | scheme | step limit | computational mode |
+//! |---|---|---|---|
+//! | `report` (default) | two-step 5.21 | σ/2 | neutral undamped, grows with damping or velocity coupling |
+//! | `robert-asselin[=ν]` (ν = 0.01) | 5.21 + filter | ½(1 − ν)σ | damped ≈ 4ν per step; accuracy drops to first order |
+//! | `velocity-form` | one-step kick–drift–kick | σ | none |
+//!
+//! With h = 2 in: τ ≈ 1.99e-6 s (report, ≈ 50 800 steps in 0.1 s) and 3.97e-6 s (velocity form,
+//! ≈ 25 400 steps). Growth of the computational mode is detected (|Δ²v| against the solution)
+//! and the run stops with a diagnostic naming the coordinate and the remedies.
+//!
+//! Rocket observables: `rocket.X/Y` inertial mass centre (launch frame, origin at the aft end at
+//! t = 0), `rocket.theta`, `rocket.mass`, `rocket.vX/vY` rigid-body velocity of the body point at
+//! the mass centre, `rocket.u@k`/`rocket.w@k` elastic displacements in body axes at field
+//! stations k = 0 (aft) … F−1 (nose), `rocket.massj.u/.w` the discrete masses' displacements U_j,
+//! W_j in body axes (as the report's figures 9–10), `step_size`, `stability_bound`. Ledger:
+//! kinetic, strain, gravity, discrete_spring | thrust, pressure, coriolis_flow |
+//! discrete_damper, mass_outflow (kinetic + potential energy carried off by the burnt mass).
+//!
+//! ## Beams
+//! * [`beam`]: the clamped-free beam (`cantilever`, `cantilever-tip-mass`; `rotating-beam`
+//!   modes at its constant hub rate) — modes from the finite-difference eigenproblem with
+//!   ghost nodes (clamped w₀ = 0, w₋₁ = w₁; free end 5.32; tip mass in the shear condition),
+//!   statics; O(h²) convergence tested against root-found analytic values.
+//! * [`link`]: one link in a rotating frame (`spin-up`, `spin-up-linear`, `single-link`,
+//!   `rotating-beam` runs) on the same grid and stepping: foreshortening stiffening, prescribed
+//!   hub motion (reported torque) or hub torque with inertia, spring, damper, Kelvin–Voigt.
+//! * Unsupported (precise `Unsupported` messages): chains of links (`two-link-free`, Barhorst
+//!   cases), axial/shear fields, tip inertia, gravity on beams, contact, 3-D and mobile scenes.
+
+pub mod beam;
+pub mod error;
+pub mod integrator;
+pub mod link;
+pub mod rocket;
+pub mod settings;
+
+use data::{
+    Backend, BackendError, BackendKind, Discretization, DofPlan, Family, ModalResult, RunResult,
+    Scene, Settings, StaticResult,
+};
+
+pub use error::FdmError;
+pub use settings::{FdmSettings, Method};
+
+/// The finite-difference backend.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FdmBackend;
+
+fn is_rocket(scene: &Scene) -> bool {
+    scene.family() == Family::Rocket
+}
+
+/// A single link clamped to the ground (the cantilever family).
+fn is_clamped(scene: &Scene) -> bool {
+    scene.links.len() == 1
+        && matches!(
+            scene.links[0].joint.prescribed,
+            Some(data::scene::PrescribedMotion::Fixed)
+        )
+}
+
+fn unsupported_family(scene: &Scene) -> FdmError {
+    FdmError::Unsupported(format!(
+        "fdm backend: {} scenes (`{}`) are not implemented",
+        scene.family(),
+        scene.name
+    ))
+}
+
+impl Backend for FdmBackend {
+    fn kind(&self) -> BackendKind {
+        BackendKind::Fdm
+    }
+
+    fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
+        let s = FdmSettings::from_settings(&Settings {
+            discretization: disc.clone(),
+            ..Settings::default()
+        })?;
+        if is_rocket(scene) {
+            return Ok(rocket::dof_plan(scene, s.stations)?);
+        }
+        if scene.family() == Family::PlanarChain {
+            if is_clamped(scene) {
+                return Ok(beam::dof_plan(scene, s.stations)?);
+            }
+            return Ok(link::FloatingLink::from_scene(scene, s.stations)?.dof_plan());
+        }
+        Err(unsupported_family(scene).into())
+    }
+
+    fn modes(
+        &self,
+        scene: &Scene,
+        settings: &Settings,
+        count: usize,
+    ) -> Result<ModalResult, BackendError> {
+        let s = FdmSettings::from_settings(settings)?;
+        if scene.family() == Family::PlanarChain {
+            return Ok(beam::modes(scene, settings, &s, count)?);
+        }
+        if is_rocket(scene) {
+            return Err(BackendError::Unsupported(
+                "fdm modes of the rocket: the variable-mass body has no fixed modes; use `run`"
+                    .into(),
+            ));
+        }
+        Err(unsupported_family(scene).into())
+    }
+
+    fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
+        let s = FdmSettings::from_settings(settings)?;
+        if scene.family() == Family::PlanarChain {
+            return Ok(beam::statics(scene, settings, &s)?);
+        }
+        Err(BackendError::Unsupported(format!(
+            "fdm statics for {} scenes",
+            scene.family()
+        )))
+    }
+
+    fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+        let s = FdmSettings::from_settings(settings)?;
+        if is_rocket(scene) {
+            return Ok(rocket::simulate(scene, settings, &s)?);
+        }
+        if scene.family() == Family::PlanarChain {
+            if is_clamped(scene) {
+                return Err(beam::simulate_unsupported(scene).into());
+            }
+            return Ok(link::simulate(scene, settings, &s)?);
+        }
+        Err(unsupported_family(scene).into())
+    }
+}

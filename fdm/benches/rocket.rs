@@ -1,0 +1,37 @@
+//! 0.1 s of rocket flight with h = 2 in (76 stations), single-threaded.
+//! Run: CARGO_TARGET_DIR=/work/targets/fdm cargo bench -p fdm --bench rocket -- --quick
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use data::{Settings, load_scene};
+use fdm::FdmSettings;
+
+fn bench(c: &mut Criterion) {
+    let scene = load_scene("rocket").expect("catalog scene");
+    for (label, method) in [("report", "report"), ("velocity-form", "velocity-form")] {
+        let mut settings = Settings::default();
+        settings.time.method = Some(method.to_string());
+        let s = FdmSettings::from_settings(&settings).expect("valid settings");
+        c.bench_function(&format!("rocket_0.1s_76_stations_{label}"), |b| {
+            b.iter(|| {
+                let (_, out) = fdm::rocket::run_with(&scene, &s, true).expect("run");
+                std::hint::black_box(out.cost.steps)
+            })
+        });
+    }
+    for n in [151usize, 301] {
+        let mut settings = Settings::default();
+        settings.discretization.stations = Some(n);
+        settings.time.t_end = Some(0.01);
+        settings.time.method = Some("velocity-form".into());
+        let s = FdmSettings::from_settings(&settings).expect("valid settings");
+        c.bench_function(&format!("rocket_0.01s_{n}_stations_velocity-form"), |b| {
+            b.iter(|| {
+                let (_, out) = fdm::rocket::run_with(&scene, &s, true).expect("run");
+                std::hint::black_box(out.cost.steps)
+            })
+        });
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,138 @@
+//! The backend settings this crate reads, validated once.
+
+use data::Settings;
+
+use crate::error::FdmError;
+
+/// Default Robert–Asselin filter coefficient ν (Asselin 1972 used 0.01–0.25; 0.01 keeps the
+/// accuracy cost small while damping the computational mode by ≈ 4ν per step).
+pub const DEFAULT_ASSELIN_NU: f64 = 0.01;
+
+/// Time-integration method (`time.method`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// The report's two-step central difference (5.21, 5.24–5.30):
+    /// y_{j+1} = y_{j−1} + (τ_j + τ_{j+1}) f(t_j, y_j).
+    Report,
+    /// The report's scheme with a Robert–Asselin filter of the middle level:
+    /// ȳ_j = y_j + ν (ȳ_{j−1} − 2 y_j + y_{j+1}).
+    RobertAsselin { nu: f64 },
+    /// One-step velocity (kick–drift–kick) form: no computational mode.
+    VelocityForm,
+}
+
+impl Method {
+    pub const ACCEPTED: &'static str = "report, robert-asselin[=nu], velocity-form";
+
+    pub fn parse(name: &str) -> Result<Self, FdmError> {
+        let name = name.trim();
+        if name == "report" || name == "central-difference" {
+            return Ok(Method::Report);
+        }
+        if name == "velocity-form" {
+            return Ok(Method::VelocityForm);
+        }
+        if let Some(rest) = name.strip_prefix("robert-asselin") {
+            let nu = if rest.is_empty() {
+                DEFAULT_ASSELIN_NU
+            } else {
+                let v = rest.strip_prefix('=').unwrap_or("x");
+                v.parse::<f64>().map_err(|_| {
+                    FdmError::invalid("time.method", format!("cannot read ν in `{name}`"))
+                })?
+            };
+            if !(nu > 0.0 && nu < 0.5) {
+                return Err(FdmError::invalid(
+                    "time.method",
+                    format!("Robert–Asselin ν = {nu} must lie in (0, 0.5)"),
+                ));
+            }
+            return Ok(Method::RobertAsselin { nu });
+        }
+        Err(FdmError::invalid(
+            "time.method",
+            format!("unknown method `{name}`; accepted: {}", Self::ACCEPTED),
+        ))
+    }
+
+    pub fn name(&self) -> String {
+        match self {
+            Method::Report => "report".into(),
+            Method::RobertAsselin { nu } => format!("robert-asselin={nu}"),
+            Method::VelocityForm => "velocity-form".into(),
+        }
+    }
+
+    /// Whether the method carries the two-step scheme's computational (parasitic) mode.
+    pub fn is_two_step(&self) -> bool {
+        !matches!(self, Method::VelocityForm)
+    }
+
+    /// Ratio of the method's stability limit to the report's σ (5.41–5.44).
+    ///
+    /// The report's σ equals 2/ω_max of the discrete operator (the limit of the one-step
+    /// second-order form). The two-step form 5.21 has amplification roots
+    /// ξ = iωτ ± √(1 − ω²τ²), |ξ| = 1 only for ωτ ≤ 1: it needs half of σ.
+    ///
+    /// The Robert–Asselin filter shrinks the two-step limit further: the filtered scheme's
+    /// characteristic equation ξ² − 2(ν + iωτ)ξ − (1 − 2ν − 2iνωτ) = 0 has both roots in the unit
+    /// disc only for ωτ ≲ 1 − ν (ν = 0.01: 0.99004; ν = 0.1: 0.9045), so its factor is ½(1 − ν).
+    pub fn bound_factor(&self) -> f64 {
+        match self {
+            Method::Report => 0.5,
+            Method::RobertAsselin { nu } => 0.5 * (1.0 - nu),
+            Method::VelocityForm => 1.0,
+        }
+    }
+}
+
+/// Validated settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FdmSettings {
+    pub stations: Option<usize>,
+    pub dt: Option<f64>,
+    pub safety: f64,
+    pub method: Method,
+    pub t_end: Option<f64>,
+}
+
+impl FdmSettings {
+    pub fn from_settings(s: &Settings) -> Result<Self, FdmError> {
+        if let Some(n) = s.discretization.stations
+            && !(5..=100_000).contains(&n)
+        {
+            return Err(FdmError::invalid(
+                "discretization.stations",
+                format!("{n} stations: must lie in 5..=100000"),
+            ));
+        }
+        if let Some(dt) = s.time.dt
+            && !(dt.is_finite() && dt > 0.0)
+        {
+            return Err(FdmError::invalid("time.dt", format!("{dt} must be > 0")));
+        }
+        let safety = s.time.safety_factor.unwrap_or(1.0);
+        if !(safety > 0.0 && safety <= 1.0) {
+            return Err(FdmError::invalid(
+                "time.safety_factor",
+                format!("{safety} must lie in (0, 1]"),
+            ));
+        }
+        if let Some(t) = s.time.t_end
+            && !(t.is_finite() && t > 0.0)
+        {
+            return Err(FdmError::invalid("time.t_end", format!("{t} must be > 0")));
+        }
+        let method = match &s.time.method {
+            Some(m) => Method::parse(m)?,
+            None => Method::Report,
+        };
+        Ok(FdmSettings {
+            stations: s.discretization.stations,
+            dt: s.time.dt,
+            safety,
+            method,
+            t_end: s.time.t_end,
+        })
+    }
+}
