@@ -107,6 +107,12 @@ pub enum Reference {
     /// Richardson extrapolation from a ladder (the case's own settings are compared against
     /// the extrapolated value).
     Richardson { richardson: Vec<CaseSettings> },
+    /// Rayleigh–Ritz bound: over the ladder the value must never increase (relative increase
+    /// above the tolerance fails) and must stay above the analytic reference `above`.
+    Monotone {
+        decreasing: Vec<CaseSettings>,
+        above: String,
+    },
     /// Zero (residual quantities such as the ledger closure).
     Zero { zero: bool },
 }
@@ -137,6 +143,10 @@ pub struct Case {
     /// Which check of verification.md this row belongs to.
     pub check: String,
     pub scene: String,
+    /// Field path (as in error messages, e.g. `link[0].bending_stiffness`) → new value: a
+    /// catalog scene modified for this check (e.g. a stiff limit), validated like a user file.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub overrides: std::collections::BTreeMap<String, toml::Value>,
     pub backend: BackendKind,
     #[serde(default)]
     pub settings: CaseSettings,
@@ -253,7 +263,21 @@ pub struct StabilityCase {
     /// Also probe explicit schemes just below and just above their own stability bound.
     #[serde(default)]
     pub probe_bound: bool,
+    /// The physics must diverge (e.g. spin-up without geometric stiffening): a small bounded
+    /// answer is then wrong, while growth beyond `divergence_threshold` of `divergence_channel`
+    /// (or a stop that reports it) is right.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub expect_divergence: Option<Divergence>,
     pub suite: SuiteName,
+}
+
+/// What divergence looks like for a case that must diverge.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Divergence {
+    pub channel: String,
+    /// Growth beyond this |value| counts as divergence (e.g. the link length).
+    pub threshold: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -48,12 +48,15 @@ pub mod channel {
     pub fn contact_normal_force(c: usize) -> String {
         format!("contact{c}.normal_force")
     }
-    /// Rocket: rigid-body position of the mass centre (inertial X, Y), attitude θ, mass.
+    /// Rocket: inertial position of the mass centre (aft end at the origin at launch), attitude θ
+    /// of the body axis from the horizontal, current mass.
     pub const ROCKET_X: &str = "rocket.X";
     pub const ROCKET_Y: &str = "rocket.Y";
     pub const ROCKET_THETA: &str = "rocket.theta";
     pub const ROCKET_MASS: &str = "rocket.mass";
-    /// Rocket: inertial velocity of the mass centre.
+    /// Rocket: mass-averaged velocity of the material, linear momentum / mass (what the rocket
+    /// equation describes). It differs from d(rocket.X)/dt by the drift of the mass centre
+    /// through the body as stage 1 burns.
     pub const ROCKET_VX: &str = "rocket.vX";
     pub const ROCKET_VY: &str = "rocket.vY";
     /// Rocket: elastic axial / transverse displacement at field station k (aft = 0 … nose).
@@ -63,7 +66,8 @@ pub mod channel {
     pub fn rocket_transverse(k: usize) -> String {
         format!("rocket.w@{k}")
     }
-    /// Rocket: displacement of discrete mass j (1-based) relative to its attachment station.
+    /// Rocket: displacement of discrete mass j (1-based) from its attachment station, in body
+    /// axes (u along, w across).
     pub fn rocket_mass_axial(j: usize) -> String {
         format!("rocket.mass{j}.u")
     }
@@ -168,8 +172,10 @@ pub struct EnergyTerm {
 ///
 /// Closure: E(t) − E(0) − W_in(t) + W_diss(t) = 0, where E is the sum of `stored`.
 /// Standard names — stored: `kinetic`, `strain`, `gravity`, `joint_spring`, `discrete_spring`;
-/// inputs: `applied_torque`, `prescribed_motion`, `thrust`, `pressure`; dissipation:
-/// `joint_damper`, `kelvin_voigt`, `friction`, `impact`.
+/// inputs: `applied_torque`, `prescribed_motion`, `thrust`, `pressure`, `coriolis` (internal
+/// flow), `mass_outflow` (energy carried off by burnt propellant); dissipation: `joint_damper`,
+/// `kelvin_voigt`, `discrete_damper`, `friction`, `impact`. Backends may add terms with other
+/// names; the closure sums whatever is present.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnergyLedger {
     pub time: Vec<f64>,

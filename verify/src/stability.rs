@@ -80,6 +80,57 @@ fn judge(case: &data::cases::StabilityCase, kind: BackendKind) -> Vec<Verdict> {
                 })
                 .filter(|v| v.is_finite());
             let closure = r.ledger.relative_closure();
+            if let Some(div) = &case.expect_divergence {
+                let grown = r.observables.get(&div.channel).map(|c| {
+                    c.values
+                        .iter()
+                        .filter(|v| v.is_finite())
+                        .fold(0.0f64, |m, v| m.max(v.abs()))
+                });
+                let nonfinite = r.observables.first_non_finite();
+                let v = match (grown, &r.verdict, nonfinite) {
+                    (_, _, Some((c, t))) => mk(
+                        "BLEW UP UNDETECTED",
+                        format!(
+                            "must diverge, but emitted non-finite `{c}` at t = {t:.6e} instead of stopping"
+                        ),
+                        true,
+                        wall,
+                    ),
+                    (Some(g), StabilityVerdict::Stopped { diagnostic }, None) => mk(
+                        "diverged (stopped)",
+                        format!("|{}| reached {g:.3e}; {diagnostic}", div.channel),
+                        false,
+                        wall,
+                    ),
+                    (Some(g), StabilityVerdict::Completed, None) if g > div.threshold => mk(
+                        "diverged",
+                        format!(
+                            "|{}| reached {g:.3e} > {:.3e}, as the physics demands",
+                            div.channel, div.threshold
+                        ),
+                        false,
+                        wall,
+                    ),
+                    (Some(g), _, None) => mk(
+                        "WRONG: bounded",
+                        format!(
+                            "must diverge, but |{}| stayed at {g:.3e} ≤ {:.3e}",
+                            div.channel, div.threshold
+                        ),
+                        true,
+                        wall,
+                    ),
+                    (None, _, None) => mk(
+                        "invalid case",
+                        format!("no channel `{}`", div.channel),
+                        true,
+                        wall,
+                    ),
+                };
+                out.push(v);
+                return out;
+            }
             match (&r.verdict, r.observables.first_non_finite()) {
                 (_, Some((c, t))) => out.push(mk(
                     "BLEW UP UNDETECTED",
@@ -176,22 +227,33 @@ pub fn run_stability(suite: Suite) -> Result<Vec<Verdict>, CliError> {
 
 pub fn command(suite: Suite, format: Format, out: Option<&Path>) -> Result<(), CliError> {
     let verdicts = run_stability(suite)?;
-    let header = ["case", "scene", "backend", "verdict", "detail", "wall [s]"];
+    let header = [
+        "#", "case", "scene", "backend", "verdict", "wall [s]", "detail",
+    ];
     let rows: Vec<Vec<String>> = verdicts
         .iter()
-        .map(|v| {
+        .enumerate()
+        .map(|(i, v)| {
             vec![
+                (i + 1).to_string(),
                 v.case.clone(),
                 v.scene.clone(),
                 v.backend.to_string(),
                 v.verdict.clone(),
-                v.detail.clone(),
                 format!("{:.3}", v.wall_time_s),
+                v.detail.clone(),
             ]
         })
         .collect();
     match format {
-        Format::Table => print!("{}", text_table(&header, &rows)),
+        Format::Table => {
+            // Details are long diagnostics: list them under the table, keyed by row number.
+            let short: Vec<Vec<String>> = rows.iter().map(|r| r[..6].to_vec()).collect();
+            print!("{}", text_table(&header[..6], &short));
+            for r in &rows {
+                println!("  [{}] {}", r[0], r[6]);
+            }
+        }
         Format::Csv => print!("{}", csv_table(&header, &rows)),
         Format::Json => println!("{}", serde_json::to_string_pretty(&verdicts).expect("json")),
     }

@@ -10,10 +10,10 @@ use crate::cli::CliError;
 use crate::cli::args::{CommonOpts, Refine};
 use crate::output::{Format, csv_table, text_table, write_atomic};
 use crate::plot::{Series, plot};
-use crate::suite::evaluate::{fit_order, measure, richardson};
-use crate::suite::quantity::Quantity;
+use crate::suite::evaluate::{falling_prefix, fit_order, measure, richardson};
+use crate::suite::quantity::{Analysis, Quantity};
 use crate::suite::reference::{analytic_value, default_analytic_id};
-use crate::suite::run_cache::RunCache;
+use crate::suite::run_cache::{RunCache, mode_count};
 
 /// One rung of a refinement ladder.
 #[derive(Debug, Clone, Serialize)]
@@ -45,6 +45,8 @@ pub struct Ladder {
     pub richardson: Option<(f64, f64)>,
     /// True if the values decrease monotonically with refinement (Rayleigh–Ritz bound).
     pub monotone_from_above: bool,
+    /// First rung where the error stopped falling (round-off plateau), excluded from the fit.
+    pub plateau_from: Option<String>,
     /// Why the ladder stopped early, if it did (unsupported, stopped run, …).
     pub note: Option<String>,
 }
@@ -111,6 +113,42 @@ fn time_ladder(base: &Settings, scene: &Scene) -> Vec<(Settings, f64, String)> {
         .collect()
 }
 
+/// Smallest backend wall time over a few repeats (the first call of a process pays one-off
+/// costs, and a shared machine adds noise): repeat until 50 ms have been spent or 5 runs made.
+fn min_wall_time(
+    scene: &Scene,
+    kind: BackendKind,
+    settings: &Settings,
+    q: &Quantity,
+    first: f64,
+) -> f64 {
+    let b = crate::registry::backend(kind);
+    let mut best = first;
+    let mut spent = first;
+    let mut runs = 1;
+    while spent < 0.05 && runs < 5 {
+        let wall = match q.analysis() {
+            Analysis::Modes => b
+                .modes(
+                    scene,
+                    settings,
+                    mode_count(match q {
+                        Quantity::Frequency { n, .. } => *n,
+                        _ => 1,
+                    }),
+                )
+                .map(|r| r.cost.wall_time_s),
+            Analysis::Statics => b.statics(scene, settings).map(|r| r.cost.wall_time_s),
+            Analysis::Simulate => b.simulate(scene, settings).map(|r| r.cost.wall_time_s),
+        };
+        let Ok(w) = wall else { break };
+        best = best.min(w);
+        spent += w;
+        runs += 1;
+    }
+    best
+}
+
 /// Runs the ladders and fills errors against the best available reference.
 pub fn run_study(
     scene: &Scene,
@@ -133,12 +171,12 @@ pub fn run_study(
         for (settings, h, label) in rungs_spec {
             match measure(&cache, scene, kind, &settings, &q) {
                 Ok((value, peak, wall)) => rungs.push(Rung {
+                    wall_time_s: min_wall_time(scene, kind, &settings, &q, wall),
                     backend: kind,
                     discretization: label,
                     h,
                     value,
                     error: None,
-                    wall_time_s: wall,
                     settings,
                     peak,
                 }),
@@ -162,6 +200,7 @@ pub fn run_study(
             richardson: richardson(&hs, &values, None),
             rungs,
             observed_order: None,
+            plateau_from: None,
             monotone_from_above,
             note,
         });
@@ -209,7 +248,11 @@ pub fn run_study(
                 .filter_map(|r| Some((r.h, r.error?)))
                 .filter(|(_, e)| *e > 1e-13)
                 .unzip();
-            l.observed_order = fit_order(&h, &e);
+            let keep = falling_prefix(&e);
+            if keep < e.len() {
+                l.plateau_from = Some(l.rungs[keep].discretization.clone());
+            }
+            l.observed_order = fit_order(&h[..keep], &e[..keep]);
         }
     }
     Ok(Study {

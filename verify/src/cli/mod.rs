@@ -62,6 +62,9 @@ impl From<std::io::Error> for CliError {
 
 /// Runs a parsed command line; prints results to stdout and the error (if any) to stderr.
 pub fn run(cli: Cli) -> ExitCode {
+    // Parallelism lives at the level of cases and sweeps (rayon); inside one solve faer runs
+    // sequentially, which keeps results bit-identical and wall times comparable.
+    faer::set_global_parallelism(faer::Par::Seq);
     match commands::dispatch(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

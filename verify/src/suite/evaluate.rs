@@ -1,6 +1,6 @@
 //! One case → one outcome row.
 
-use data::cases::{Case, CaseSettings, Norm, Reference};
+use data::cases::{Case, CaseSettings, Norm, Reference, scene_with_overrides};
 use data::{BackendError, Scene, Settings, StabilityVerdict, load_scene};
 use serde::Serialize;
 
@@ -137,6 +137,17 @@ pub fn fit_order(h: &[f64], e: &[f64]) -> Option<f64> {
     (sxx > 0.0).then(|| sxy / sxx)
 }
 
+/// Number of leading rungs whose error keeps falling. Beyond it the ladder has reached the
+/// round-off plateau (beam stiffness conditioning grows like (L/h)⁴) and those rungs would
+/// bias the order fit.
+pub fn falling_prefix(errors: &[f64]) -> usize {
+    let mut n = errors.len().min(1);
+    while n < errors.len() && errors[n].abs() < errors[n - 1].abs() {
+        n += 1;
+    }
+    n
+}
+
 /// Richardson extrapolation from the last three rungs (observed order), or the last two with
 /// the given order. Returns (extrapolated value, order used).
 pub fn richardson(h: &[f64], q: &[f64], assumed_order: Option<f64>) -> Option<(f64, f64)> {
@@ -201,7 +212,11 @@ pub fn evaluate(case: &Case, cache: &RunCache) -> Outcome {
 }
 
 fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<(), String> {
-    let scene = load_scene(&case.scene).map_err(|e| e.to_string())?;
+    let scene = if case.overrides.is_empty() {
+        load_scene(&case.scene).map_err(|e| e.to_string())?
+    } else {
+        scene_with_overrides(&case.scene, &case.overrides)?
+    };
     let q = Quantity::parse(&case.quantity, &scene)?;
     let settings = case.settings.to_settings();
 
@@ -231,11 +246,13 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
                 v.iter().map(|x| x - ext).collect()
             }
         };
-        let observed = fit_order(&h, &errors).ok_or("cannot fit an order (zero errors)")?;
+        let keep = falling_prefix(&errors);
+        let observed =
+            fit_order(&h[..keep], &errors[..keep]).ok_or("cannot fit an order (zero errors)")?;
         out.value = Some(observed);
         out.reference = Some(*order);
         out.reference_label = format!(
-            "order {order} over {} rungs vs {}",
+            "order {order} over {keep} of {} rungs vs {}",
             ladder.len(),
             against
                 .as_deref()
@@ -243,6 +260,79 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
         );
         out.error = Some((observed - order).abs());
         out.quantity = format!("order({})", case.quantity);
+        return Ok(());
+    }
+
+    if let Reference::Monotone { decreasing, above } = &case.reference {
+        let mut values = Vec::new();
+        for rung in decreasing {
+            let (val, _, wall) = measure(cache, &scene, case.backend, &rung.to_settings(), &q)?;
+            values.push(val);
+            out.wall_time_s += wall;
+        }
+        let exact = analytic_value(above, &scene, &q)?;
+        // Worst violation of the Rayleigh–Ritz properties, relative to the exact value:
+        // an increase along the ladder, or a value below the exact one.
+        let rise = values
+            .windows(2)
+            .map(|w| (w[1] - w[0]) / exact.abs())
+            .fold(0.0f64, f64::max);
+        let below = values
+            .iter()
+            .map(|v| (exact - v) / exact.abs())
+            .fold(0.0f64, f64::max);
+        out.value = values.last().copied();
+        out.reference = Some(exact);
+        out.reference_label = format!(
+            "monotone from above over {} rungs, bound analytic:{above}",
+            values.len()
+        );
+        out.error = Some(rise.max(below).max(0.0));
+        out.quantity = format!("monotone({})", case.quantity);
+        return Ok(());
+    }
+
+    if let (
+        Quantity::History { channel },
+        Reference::Backend {
+            backend,
+            settings: ref_settings,
+        },
+    ) = (&q, &case.reference)
+    {
+        let run = |kind, s: &Settings| match cache.get(&scene, kind, s, q.analysis(), 0) {
+            Answer::Run(Ok(r)) => Ok(r),
+            Answer::Run(Err(e)) => Err(format!("{kind}: {e}")),
+            _ => Err("not a run".to_string()),
+        };
+        let a = run(case.backend, &settings)?;
+        let b = run(*backend, &ref_settings.to_settings())?;
+        let ca = a
+            .observables
+            .get(channel)
+            .ok_or_else(|| format!("{}: no channel `{channel}`", case.backend))?;
+        let cb = b
+            .observables
+            .get(channel)
+            .ok_or_else(|| format!("{backend}: no channel `{channel}`"))?;
+        let peak = cb.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let mut worst = 0.0f64;
+        for (t, va) in a.observables.time.iter().zip(&ca.values) {
+            if let Some(vb) = data::results::interpolate(&b.observables.time, &cb.values, *t) {
+                worst = worst.max((va - vb).abs());
+            }
+        }
+        out.wall_time_s += a.cost.wall_time_s + b.cost.wall_time_s;
+        out.value = Some(worst);
+        out.reference = Some(peak);
+        out.reference_label = format!(
+            "history of {backend}({}), error = max|Δ| / its peak",
+            settings_label(ref_settings)
+        );
+        if peak <= 0.0 {
+            return Err("the reference history is identically zero".into());
+        }
+        out.error = Some(worst / peak);
         return Ok(());
     }
 
@@ -277,7 +367,7 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
             out.reference_label = "zero".into();
             (0.0, None)
         }
-        Reference::Order { .. } => unreachable!("handled above"),
+        Reference::Order { .. } | Reference::Monotone { .. } => unreachable!("handled above"),
     };
     out.reference = Some(reference);
     let err = match case.norm {

@@ -4,6 +4,7 @@
 //! printed in case order, so results are identical with or without threads.
 
 pub mod evaluate;
+pub mod plots;
 pub mod quantity;
 pub mod reference;
 pub mod report;
@@ -20,8 +21,12 @@ use crate::output::Format;
 use evaluate::{Outcome, Status, evaluate};
 use run_cache::RunCache;
 
-/// Runs the selected cases and returns their outcomes in case order.
-pub fn run_cases(suite: Suite, filter: Option<&str>) -> Result<Vec<Outcome>, CliError> {
+/// Runs the selected cases and returns them with their outcomes in case order, and the cache
+/// of backend answers (for the report's plots).
+pub fn run_cases(
+    suite: Suite,
+    filter: Option<&str>,
+) -> Result<(Vec<data::cases::Case>, Vec<Outcome>, RunCache), CliError> {
     let cases = all_cases().map_err(|e| CliError::Input(format!("error: {e}")))?;
     let selected: Vec<_> = cases
         .into_iter()
@@ -47,7 +52,7 @@ pub fn run_cases(suite: Suite, filter: Option<&str>) -> Result<Vec<Outcome>, Cli
         })
         .collect();
     bar.finish_and_clear();
-    Ok(outcomes)
+    Ok((selected, outcomes, cache))
 }
 
 pub fn command(
@@ -57,7 +62,7 @@ pub fn command(
     out: Option<&Path>,
 ) -> Result<(), CliError> {
     let started = std::time::Instant::now();
-    let outcomes = run_cases(suite, filter)?;
+    let (cases, outcomes, cache) = run_cases(suite, filter)?;
     let wall = started.elapsed().as_secs_f64();
     match format {
         Format::Table => print!("{}", report::table(&outcomes)),
@@ -65,6 +70,7 @@ pub fn command(
         Format::Json => println!("{}", report::json(&outcomes)),
     }
     if let Some(dir) = out {
+        plots::draw_all(dir, &cases, &outcomes, &cache);
         report::write_all(dir, &outcomes)?;
         eprintln!(
             "wrote the verification report to {}/index.html",

@@ -13,6 +13,9 @@ pub enum Quantity {
     At { channel: String, t: f64 },
     /// max |channel| over the run.
     Peak { channel: String },
+    /// The whole time history of a channel; compared with another backend's history as
+    /// max_t |a(t) − b(t)| / max_t |b(t)|.
+    History { channel: String },
     /// Relative energy-ledger closure.
     LedgerClosure,
     /// Largest impact momentum residual.
@@ -70,6 +73,9 @@ impl Quantity {
             "max_momentum_residual" => return Ok(Quantity::MaxMomentumResidual),
             _ => {}
         }
+        if let Some(c) = t.strip_prefix("history:") {
+            return Ok(Quantity::History { channel: alias(c) });
+        }
         if let Some(c) = t.strip_prefix("peak:") {
             return Ok(Quantity::Peak { channel: alias(c) });
         }
@@ -89,7 +95,7 @@ impl Quantity {
         }
         Err(format!(
             "unknown quantity `{text}`; expected freqN, axial_freqN, bending_freqN, tip_static, \
-             CHANNEL@T, peak:CHANNEL, ledger_closure or max_momentum_residual"
+             CHANNEL@T, peak:CHANNEL, history:CHANNEL, ledger_closure or max_momentum_residual"
         ))
     }
 
@@ -152,7 +158,7 @@ impl Quantity {
                     )
                 })
             }
-            Quantity::Peak { channel } => {
+            Quantity::Peak { channel } | Quantity::History { channel } => {
                 let c = r.observables.get(channel).ok_or_else(|| missing(channel))?;
                 Ok(c.values.iter().fold(0.0f64, |m, v| m.max(v.abs())))
             }
@@ -174,7 +180,9 @@ impl Quantity {
     /// Scale of the reference time history for `relative-to-peak` norms.
     pub fn peak_scale(&self, r: &RunResult) -> Option<f64> {
         match self {
-            Quantity::At { channel, .. } | Quantity::Peak { channel } => r
+            Quantity::At { channel, .. }
+            | Quantity::Peak { channel }
+            | Quantity::History { channel } => r
                 .observables
                 .get(channel)
                 .map(|c| c.values.iter().fold(0.0f64, |m, v| m.max(v.abs()))),

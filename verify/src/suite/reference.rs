@@ -1,17 +1,255 @@
-//! Analytic reference values by id, computed from the scene's parameters by `crate::analytic`.
+//! Analytic reference values by id, computed from the scene's own parameters by
+//! [`crate::analytic`] (root finding, series, shooting — never typed-in numbers).
+//!
+//! | id | quantity | reference |
+//! |---|---|---|
+//! | `clamped-free` | `freqN`, `bending_freqN` | uniform Euler–Bernoulli cantilever, 1 + cos βL cosh βL = 0 |
+//! | `tip-mass` | `freqN`, `bending_freqN` | cantilever with the scene's tip mass and tip inertia |
+//! | `timoshenko` | `freqN`, `bending_freqN` | clamped-free Timoshenko beam (κGA, ρI) |
+//! | `axial-clamped-free` | `axial_freqN` | clamped-free bar (with tip mass when present) |
+//! | `rotating-in-plane` | `freqN` | in-plane bending of the cantilever at the scene's hub rate Ω: ω² = ω_flap² − Ω² (Frobenius series) |
+//! | `static-linear` | `tip_static` | PL³/3EI + qL⁴/8EI for the scene's `[statics]` loads |
+//! | `rigid-single-link` | `joint1.angle@T`, `joint1.rate@T` | rigid link + hub + tip mass under the torque law (closed form) |
+//! | `rigid-two-link` | `jointI.angle@T`, `jointI.rate@T` | rigid two-link arm with the scene's springs/dampers (tight RK) |
+//! | `rocket-translation` | `rocket.vX@T`, `rocket.vY@T`, `rocket.mass@T` | rocket equation with gravity: material (momentum / mass) velocity |
 
 use data::Scene;
+use data::scene::Link;
+use data::scene::PrescribedMotion;
 
 use super::quantity::Quantity;
+use crate::analytic as ana;
+
+fn single_link(scene: &Scene) -> Result<&Link, String> {
+    match scene.links.as_slice() {
+        [l] => Ok(l),
+        _ => Err(format!(
+            "this analytic reference needs a single-link scene; `{}` has {} links",
+            scene.name,
+            scene.links.len()
+        )),
+    }
+}
+
+fn mode_number(q: &Quantity, want_kind: Option<&str>) -> Result<usize, String> {
+    match q {
+        Quantity::Frequency { n, kind } if kind.as_deref() == want_kind || kind.is_none() => Ok(*n),
+        _ => Err(format!(
+            "this reference applies to frequencies{}",
+            want_kind.map_or(String::new(), |k| format!(" of kind `{k}`"))
+        )),
+    }
+}
+
+fn nth(v: ana::Result<Vec<f64>>, n: usize) -> Result<f64, String> {
+    let v = v.map_err(|e| e.to_string())?;
+    v.get(n - 1)
+        .copied()
+        .ok_or_else(|| format!("the reference has no mode {n}"))
+}
 
 /// The analytic value of a quantity for a scene.
-pub fn analytic_value(id: &str, _scene: &Scene, _q: &Quantity) -> Result<f64, String> {
-    Err(format!(
-        "unsupported: analytic reference `{id}` is not available yet"
-    ))
+pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, String> {
+    match id {
+        "clamped-free" => {
+            let l = single_link(scene)?;
+            let n = mode_number(q, Some("bending"))?;
+            nth(
+                ana::bending_frequencies_hz(
+                    ana::BeamSupport::ClampedFree,
+                    l.bending_stiffness,
+                    l.mass_per_length,
+                    l.length,
+                    n,
+                ),
+                n,
+            )
+        }
+        "tip-mass" => {
+            let l = single_link(scene)?;
+            let n = mode_number(q, Some("bending"))?;
+            nth(
+                ana::cantilever_tip_mass_frequencies_hz(
+                    l.bending_stiffness,
+                    l.mass_per_length,
+                    l.length,
+                    l.tip_mass.unwrap_or(0.0),
+                    l.tip_inertia.unwrap_or(0.0),
+                    n,
+                ),
+                n,
+            )
+        }
+        "timoshenko" => {
+            let l = single_link(scene)?;
+            let n = mode_number(q, Some("bending"))?;
+            let beam = ana::TimoshenkoBeam {
+                kappa_ga: l
+                    .shear_stiffness
+                    .ok_or("the scene has no shear_stiffness")?,
+                ei: l.bending_stiffness,
+                rho_a: l.mass_per_length,
+                rho_i: if l.rotary_inertia {
+                    l.rotary_inertia_per_length.unwrap_or(0.0)
+                } else {
+                    0.0
+                },
+                length: l.length,
+            };
+            nth(ana::timoshenko_clamped_free_hz(&beam, n), n)
+        }
+        "axial-clamped-free" => {
+            let l = single_link(scene)?;
+            let n = mode_number(q, Some("axial"))?;
+            let ea = l
+                .axial_stiffness
+                .ok_or("the scene has no axial_stiffness")?;
+            match l.tip_mass {
+                Some(m) => nth(
+                    ana::axial_tip_mass_frequencies_hz(ea, l.mass_per_length, l.length, m, n),
+                    n,
+                ),
+                None => nth(
+                    ana::axial_frequencies_hz(ea, l.mass_per_length, l.length, n),
+                    n,
+                ),
+            }
+        }
+        "rotating-in-plane" => {
+            let l = single_link(scene)?;
+            let n = mode_number(q, Some("bending"))?;
+            let omega = match l.joint.prescribed {
+                Some(PrescribedMotion::ConstantRate { rate }) => rate,
+                Some(PrescribedMotion::Fixed) => 0.0,
+                _ => {
+                    return Err(
+                        "the rotating-beam reference needs a constant-rate or fixed hub".into(),
+                    );
+                }
+            };
+            if l.tip_mass.is_some() || l.axial {
+                return Err(
+                    "the rotating-beam reference covers the uniform inextensible beam only".into(),
+                );
+            }
+            nth(
+                ana::rotating_frequencies_hz(
+                    ana::RotatingPlane::InPlane,
+                    l.bending_stiffness,
+                    l.mass_per_length,
+                    l.length,
+                    omega,
+                    n,
+                ),
+                n,
+            )
+        }
+        "static-linear" => {
+            if !matches!(q, Quantity::StaticTip) {
+                return Err("`static-linear` applies to `tip_static`".into());
+            }
+            let l = single_link(scene)?;
+            let st = scene
+                .statics
+                .as_ref()
+                .ok_or("the scene has no [statics] loads")?;
+            let mut w = 0.0;
+            if let Some(p) = st.tip_force {
+                w += ana::cantilever_tip_load(p, l.bending_stiffness, l.length)
+                    .map_err(|e| e.to_string())?
+                    .deflection;
+            }
+            if let Some(qd) = st.distributed_load {
+                w += ana::cantilever_uniform_load(qd, l.bending_stiffness, l.length)
+                    .map_err(|e| e.to_string())?
+                    .deflection;
+            }
+            Ok(w)
+        }
+        "rigid-single-link" => {
+            let Quantity::At { channel, t } = q else {
+                return Err("`rigid-single-link` applies to CHANNEL@T".into());
+            };
+            let st = ana::RigidLink::from_scene(scene)
+                .and_then(|r| r.state(*t))
+                .map_err(|e| e.to_string())?;
+            match channel.as_str() {
+                "joint1.angle" => Ok(st.angle),
+                "joint1.rate" => Ok(st.rate),
+                c => Err(format!(
+                    "`rigid-single-link` has no channel `{c}` (joint1.angle, joint1.rate)"
+                )),
+            }
+        }
+        "rigid-two-link" => {
+            let Quantity::At { channel, t } = q else {
+                return Err("`rigid-two-link` applies to CHANNEL@T".into());
+            };
+            let h = ana::RigidTwoLink::from_scene(scene)
+                .and_then(|r| r.simulate(&[0.0, *t]))
+                .map_err(|e| e.to_string())?;
+            let last = |v: &Vec<f64>| v.last().copied().ok_or("empty rigid history".to_string());
+            match channel.as_str() {
+                "joint1.angle" => last(&h.q1),
+                "joint2.angle" => last(&h.q5),
+                c => Err(format!(
+                    "`rigid-two-link` has no channel `{c}` (joint1.angle, joint2.angle)"
+                )),
+            }
+        }
+        "rocket-translation" => {
+            let Quantity::At { channel, t } = q else {
+                return Err("`rocket-translation` applies to CHANNEL@T".into());
+            };
+            let st = ana::RocketTranslation::from_scene(scene)
+                .and_then(|r| r.state(*t))
+                .map_err(|e| e.to_string())?;
+            match channel.as_str() {
+                "rocket.vX" => Ok(st.body_vx),
+                "rocket.vY" => Ok(st.body_vy),
+                "rocket.mass" => Ok(st.mass),
+                c => Err(format!(
+                    "`rocket-translation` has no channel `{c}` (rocket.vX, rocket.vY, rocket.mass)"
+                )),
+            }
+        }
+        other => Err(format!(
+            "unknown analytic reference `{other}`; known: clamped-free, tip-mass, timoshenko, \
+             axial-clamped-free, rotating-in-plane, static-linear, rigid-single-link, rigid-two-link, \
+             rocket-translation"
+        )),
+    }
 }
 
 /// The analytic reference that naturally applies to a quantity on a scene, if any.
-pub fn default_analytic_id(_scene: &Scene, _q: &Quantity) -> Option<String> {
-    None
+pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
+    let [l] = scene.links.as_slice() else {
+        return None;
+    };
+    let clamped = matches!(l.joint.prescribed, Some(PrescribedMotion::Fixed));
+    let spinning = matches!(
+        l.joint.prescribed,
+        Some(PrescribedMotion::ConstantRate { .. })
+    );
+    let id = match q {
+        Quantity::Frequency { kind, .. } if kind.as_deref() == Some("axial") && clamped => {
+            "axial-clamped-free"
+        }
+        Quantity::Frequency { kind, .. } if kind.as_deref() != Some("axial") => {
+            if clamped && l.shear {
+                "timoshenko"
+            } else if clamped && (l.tip_mass.is_some() || l.tip_inertia.is_some()) {
+                "tip-mass"
+            } else if clamped {
+                "clamped-free"
+            } else if spinning && !l.axial && l.tip_mass.is_none() {
+                "rotating-in-plane"
+            } else {
+                return None;
+            }
+        }
+        Quantity::StaticTip if clamped => "static-linear",
+        _ => return None,
+    };
+    Some(id.to_string())
 }

@@ -19,6 +19,14 @@ const HEADER: [&str; 11] = [
     "wall [s]",
 ];
 
+fn norm_name(n: data::cases::Norm) -> &'static str {
+    match n {
+        data::cases::Norm::Relative => "relative",
+        data::cases::Norm::Absolute => "absolute",
+        data::cases::Norm::RelativeToPeak => "rel. to peak",
+    }
+}
+
 fn fmt_opt(v: Option<f64>) -> String {
     v.map_or("-".into(), |x| format!("{x:.6e}"))
 }
@@ -36,7 +44,7 @@ fn rows(outcomes: &[Outcome]) -> Vec<Vec<String>> {
                 fmt_opt(o.value),
                 format!("{} [{}]", fmt_opt(o.reference), o.reference_label),
                 o.error.map_or("-".into(), |e| format!("{e:.2e}")),
-                format!("{:.1e} {:?}", o.tolerance, o.norm).to_lowercase(),
+                format!("{:.1e} {}", o.tolerance, norm_name(o.norm)),
                 match o.status {
                     Status::Pass => "pass".into(),
                     Status::Fail => "FAIL".into(),

@@ -1,0 +1,118 @@
+//! The verification machinery itself: cases parse, checks can fail, orders are fitted right.
+
+use data::BackendKind;
+use data::cases::{Case, CaseSettings, Norm, Reference, SuiteName, all_cases, stability_cases};
+use verify::suite::evaluate::{Status, evaluate, fit_order, richardson};
+use verify::suite::run_cache::RunCache;
+
+#[test]
+fn sys_every_embedded_case_file_parses() {
+    let cases = all_cases().unwrap();
+    assert!(cases.iter().any(|c| c.suite == SuiteName::Quick));
+    for c in &cases {
+        assert!(
+            !c.why.trim().is_empty(),
+            "{}: no reason for its tolerance",
+            c.id
+        );
+    }
+    stability_cases().unwrap();
+}
+
+#[test]
+fn prop_order_fit_recovers_a_known_power_law() {
+    let h = [0.5, 0.25, 0.125, 0.0625];
+    for p in [1.0, 2.0, 4.0] {
+        let e: Vec<f64> = h.iter().map(|h: &f64| 3.0 * h.powf(p)).collect();
+        assert!((fit_order(&h, &e).unwrap() - p).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn prop_richardson_extrapolates_a_known_limit() {
+    let h = [0.2, 0.1, 0.05];
+    let q: Vec<f64> = h.iter().map(|h: &f64| 7.0 + 0.3 * h * h).collect();
+    let (ext, p) = richardson(&h, &q, None).unwrap();
+    assert!(
+        (p - 2.0).abs() < 1e-9 && (ext - 7.0).abs() < 1e-12,
+        "{ext} {p}"
+    );
+}
+
+fn case(
+    backend: BackendKind,
+    settings: CaseSettings,
+    quantity: &str,
+    reference: Reference,
+    tol: f64,
+) -> Case {
+    Case {
+        id: "negative-control".into(),
+        check: "frequency vs analytic".into(),
+        scene: "cantilever".into(),
+        overrides: Default::default(),
+        backend,
+        settings,
+        quantity: quantity.into(),
+        reference,
+        norm: Norm::Relative,
+        tolerance: tol,
+        why: "deliberately impossible: proves the check can fail".into(),
+        suite: SuiteName::Quick,
+    }
+}
+
+#[test]
+fn cross_a_two_element_mesh_cannot_meet_1e_8() {
+    let c = case(
+        BackendKind::Fem,
+        CaseSettings {
+            elements: Some(2),
+            ..Default::default()
+        },
+        "freq2",
+        Reference::Analytic {
+            analytic: "clamped-free".into(),
+        },
+        1e-8,
+    );
+    let o = evaluate(&c, &RunCache::default());
+    assert_eq!(o.status, Status::Fail, "{o:?}");
+    assert!(o.message.contains("exceeds tolerance"), "{}", o.message);
+    // …while the same check with a fine mesh and an honest tolerance passes.
+    let c = case(
+        BackendKind::Fem,
+        CaseSettings {
+            elements: Some(16),
+            ..Default::default()
+        },
+        "freq2",
+        Reference::Analytic {
+            analytic: "clamped-free".into(),
+        },
+        1e-5,
+    );
+    assert_eq!(evaluate(&c, &RunCache::default()).status, Status::Pass);
+}
+
+#[test]
+fn cross_unknown_quantities_and_references_are_errors_not_passes() {
+    let c = case(
+        BackendKind::Fem,
+        CaseSettings::default(),
+        "freq0",
+        Reference::Zero { zero: true },
+        1.0,
+    );
+    assert_eq!(evaluate(&c, &RunCache::default()).status, Status::Error);
+    let c = case(
+        BackendKind::Fem,
+        CaseSettings::default(),
+        "freq1",
+        Reference::Analytic {
+            analytic: "no-such-reference".into(),
+        },
+        1.0,
+    );
+    assert_eq!(evaluate(&c, &RunCache::default()).status, Status::Error);
+}
