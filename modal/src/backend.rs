@@ -1,0 +1,51 @@
+//! The `data::Backend` implementation: planar chains here, the rocket in [`crate::rocket`].
+
+use data::{
+    Backend, BackendError, BackendKind, Discretization, DofPlan, Family, ModalResult, RunResult,
+    Scene, Settings, StaticResult,
+};
+
+use crate::{modes, rocket, setup, simulate, statics};
+
+/// The assumed-mode backend (unit struct; all state lives in a run).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ModalBackend;
+
+impl Backend for ModalBackend {
+    fn kind(&self) -> BackendKind {
+        BackendKind::Modal
+    }
+
+    fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
+        match scene.family() {
+            Family::Rocket => rocket::dof_plan(scene, disc),
+            _ => Ok(setup::dof_plan(scene, disc)?),
+        }
+    }
+
+    fn modes(
+        &self,
+        scene: &Scene,
+        settings: &Settings,
+        count: usize,
+    ) -> Result<ModalResult, BackendError> {
+        match scene.family() {
+            Family::Rocket => rocket::modes(scene, settings, count),
+            _ => Ok(modes::modes(scene, settings, count)?),
+        }
+    }
+
+    fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
+        match scene.family() {
+            Family::Rocket => Err(BackendError::unsupported("modal: statics of the rocket")),
+            _ => Ok(statics::statics(scene, settings)?),
+        }
+    }
+
+    fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+        match scene.family() {
+            Family::Rocket => rocket::simulate(scene, settings),
+            _ => Ok(simulate::simulate(scene, settings)?),
+        }
+    }
+}

@@ -1,0 +1,412 @@
+//! One flexible link as a floating-frame body: kinetic energy T = ½ νᵀ 𝕄(e) ν in the body
+//! velocities ν = (V_x, V_y, ω, ȧ, ḃ), its Lagrange terms h, and the gravity force.
+//!
+//! Local position of the material point x (frame axes): p = (x + u − f·s(x), v) with
+//! u = ψᵀa, v = φᵀb, s(x) = ½ bᵀS(x)b (foreshortening, f = 1 when on, 0 otherwise). Its local
+//! velocity is V + ω J p + ṗ (J = rotation by +90°). The distributed kinetic energy is
+//! ½∫ρA |V + ωJp + ṗ|², expanded as
+//!
+//!   2T = m|V|² + 2ω[−V_x Φ₁ᵀb + V_y(c₀ + Ψ₁ᵀa − ½f bᵀS₁b)] + 2V_x(Ψ₁ᵀȧ − f bᵀS₁ḃ)
+//!        + 2V_y Φ₁ᵀḃ + ω²[c₂ + 2Ψₓᵀa + aᵀM_ψa − f bᵀSₓb + bᵀM_φb]
+//!        + 2ω[−(Cb)ᵀȧ + (Φₓ + Cᵀa)ᵀḃ] + ȧᵀM_ψȧ + ḃᵀM_φḃ  (+ 2ΔT when f = 1)
+//!
+//! where ΔT = ½∫ρA[ω²s² + 2ω(vṡ − sv̇) + ṡ²] completes it to the exact kinetic energy of the
+//! inextensible link ([`exact_inextensible_terms`]; needs the tensors ∫ρA S⊗S and ∫ρA φ⊗S, so
+//! a right-hand side costs O(n⁴) per link with foreshortening, O(n²) otherwise). The truncated
+//! form is not positive definite in the stiff direction "turn an inertia-free hub frame and
+//! counter-bend the link", which made two-link runs fail.
+//!
+//! The −f ω² bᵀSₓb term is the centrifugal (geometric) stiffening; ω² bᵀM_φb the in-plane
+//! softening. The tip mass is an exact point at p(L); the tip inertia rotates with α + v'(L);
+//! a hub inertia rotates with the frame. Because the equations are Lagrange's equations of this
+//! one energy, energy balance holds exactly for the discretized system.
+//!
+//! Lagrange terms in body velocities (ν̇ = (V̇, ω̇, ë), V̇ the derivative of the local V):
+//! E = 𝕄 ν̇ + h with h = 𝕄̇ν + (ω J P, −(J P)·V, −∂T/∂e), P = ∂T/∂V.
+
+use super::chain::LinkModel;
+use super::integrals::{dot, mat_vec};
+
+/// Work vectors and tip quantities of one body evaluation.
+#[derive(Debug, Clone)]
+pub struct BodyScratch {
+    mphib: Vec<f64>,
+    mphibd: Vec<f64>,
+    s1b: Vec<f64>,
+    s1bd: Vec<f64>,
+    sxb: Vec<f64>,
+    pub(crate) slb: Vec<f64>,
+    pub(crate) slbd: Vec<f64>,
+    mpsia: Vec<f64>,
+    mpsiad: Vec<f64>,
+    cb: Vec<f64>,
+    cbd: Vec<f64>,
+    cta: Vec<f64>,
+    ctad: Vec<f64>,
+    bl: Vec<f64>,
+    // Exact-inextensible terms.
+    bq: Vec<f64>,
+    eq: Vec<f64>,
+    amat: Vec<f64>,
+    rv: Vec<f64>,
+    rvd: Vec<f64>,
+    zv: Vec<f64>,
+    t1: Vec<f64>,
+    t2: Vec<f64>,
+    /// Tip position p(L), its velocity ṗ(L) (both in frame axes) and the tip's full local
+    /// velocity w = V + ωJp + ṗ.
+    pub(crate) p_tip: [f64; 2],
+    pub(crate) pd_tip: [f64; 2],
+    pub(crate) w_tip: [f64; 2],
+    /// ∫ρA p dx + M_tip p(L): first moment of mass in frame axes.
+    pub(crate) p_bar: [f64; 2],
+}
+
+impl BodyScratch {
+    pub fn new(na: usize, nb: usize) -> Self {
+        let z = |k: usize| vec![0.0; k];
+        BodyScratch {
+            mphib: z(nb),
+            mphibd: z(nb),
+            s1b: z(nb),
+            s1bd: z(nb),
+            sxb: z(nb),
+            slb: z(nb),
+            slbd: z(nb),
+            mpsia: z(na),
+            mpsiad: z(na),
+            cb: z(na),
+            cbd: z(na),
+            cta: z(nb),
+            ctad: z(nb),
+            bl: z(2 * (3 + na + nb)),
+            bq: z(nb * nb),
+            eq: z(nb * nb),
+            amat: z(nb * nb),
+            rv: z(nb * nb),
+            rvd: z(nb * nb),
+            zv: z(nb),
+            t1: z(nb),
+            t2: z(nb),
+            p_tip: [0.0; 2],
+            pd_tip: [0.0; 2],
+            w_tip: [0.0; 2],
+            p_bar: [0.0; 2],
+        }
+    }
+}
+
+/// Fills 𝕄 (d × d row-major), h and the gravity force Q_g (zero without gravity) for one link
+/// at elastic state (a, b) and body velocities ν. `g_loc` is gravity in frame axes.
+#[allow(clippy::too_many_arguments)]
+pub fn body_terms(
+    link: &LinkModel,
+    a: &[f64],
+    b: &[f64],
+    nu: &[f64],
+    g_loc: Option<[f64; 2]>,
+    mb: &mut [f64],
+    h: &mut [f64],
+    qg: &mut [f64],
+    s: &mut BodyScratch,
+) {
+    let it = &link.ints;
+    let (na, nb) = (it.na, it.nb);
+    let d = 3 + na + nb;
+    let (ia, ib) = (3, 3 + na);
+    let f = if link.foreshortening { 1.0 } else { 0.0 };
+    let (vx, vy, om) = (nu[0], nu[1], nu[2]);
+    let ad = &nu[ia..ia + na];
+    let bd = &nu[ib..ib + nb];
+
+    mat_vec(&it.mphi, nb, b, &mut s.mphib);
+    mat_vec(&it.mphi, nb, bd, &mut s.mphibd);
+    if link.foreshortening {
+        mat_vec(&it.s1, nb, b, &mut s.s1b);
+        mat_vec(&it.s1, nb, bd, &mut s.s1bd);
+        mat_vec(&it.sx, nb, b, &mut s.sxb);
+        mat_vec(&it.sl, nb, b, &mut s.slb);
+        mat_vec(&it.sl, nb, bd, &mut s.slbd);
+    }
+    if na > 0 {
+        mat_vec(&it.mpsi, na, a, &mut s.mpsia);
+        mat_vec(&it.mpsi, na, ad, &mut s.mpsiad);
+        for k in 0..na {
+            let row = &it.c[k * nb..(k + 1) * nb];
+            s.cb[k] = dot(row, b);
+            s.cbd[k] = dot(row, bd);
+        }
+        for l in 0..nb {
+            let (mut x, mut y) = (0.0, 0.0);
+            for k in 0..na {
+                x += it.c[k * nb + l] * a[k];
+                y += it.c[k * nb + l] * ad[k];
+            }
+            s.cta[l] = x;
+            s.ctad[l] = y;
+        }
+    }
+    let phi1_b = dot(&it.phi1, b);
+    let phi1_bd = dot(&it.phi1, bd);
+    let psi1_a = dot(&it.psi1, a);
+    let psi1_ad = dot(&it.psi1, ad);
+    let (bs1b, bs1bd, bsxb, bsxbd, bds1bd) = if link.foreshortening {
+        (
+            dot(b, &s.s1b),
+            dot(b, &s.s1bd),
+            dot(b, &s.sxb),
+            dot(bd, &s.sxb),
+            dot(bd, &s.s1bd),
+        )
+    } else {
+        (0.0, 0.0, 0.0, 0.0, 0.0)
+    };
+    let inertia = it.c2 + 2.0 * dot(&it.psix, a) + dot(a, &s.mpsia) - f * bsxb + dot(b, &s.mphib);
+    let m02 = -phi1_b;
+    let m12 = it.c0 + psi1_a - 0.5 * f * bs1b;
+
+    // 𝕄 of the distributed mass.
+    mb.iter_mut().for_each(|v| *v = 0.0);
+    mb[0] = it.m;
+    mb[d + 1] = it.m;
+    mb[2] = m02;
+    mb[2 * d] = m02;
+    mb[d + 2] = m12;
+    mb[2 * d + 1] = m12;
+    mb[2 * d + 2] = inertia + link.hub_inertia;
+    for k in 0..na {
+        mb[ia + k] = it.psi1[k];
+        mb[(ia + k) * d] = it.psi1[k];
+        mb[2 * d + ia + k] = -s.cb[k];
+        mb[(ia + k) * d + 2] = -s.cb[k];
+        for l in 0..na {
+            mb[(ia + k) * d + ia + l] = it.mpsi[k * na + l];
+        }
+    }
+    for k in 0..nb {
+        let v0 = -f * s.s1b[k];
+        mb[ib + k] = v0;
+        mb[(ib + k) * d] = v0;
+        mb[d + ib + k] = it.phi1[k];
+        mb[(ib + k) * d + 1] = it.phi1[k];
+        let v2 = it.phix[k] + if na > 0 { s.cta[k] } else { 0.0 };
+        mb[2 * d + ib + k] = v2;
+        mb[(ib + k) * d + 2] = v2;
+        for l in 0..nb {
+            mb[(ib + k) * d + ib + l] = it.mphi[k * nb + l];
+        }
+    }
+
+    // Momenta and h of the distributed mass.
+    let px = it.m * vx + m02 * om + psi1_ad - f * dot(&s.s1b, bd);
+    let py = it.m * vy + m12 * om + phi1_bd;
+    let d_inertia = 2.0 * dot(&it.psix, ad) + 2.0 * dot(a, &s.mpsiad) - 2.0 * f * bsxbd
+        + 2.0 * dot(b, &s.mphibd);
+    h[0] = -om * phi1_bd - f * bds1bd - om * py;
+    h[1] = om * (psi1_ad - f * bs1bd) + om * px;
+    h[2] = -vx * phi1_bd + vy * (psi1_ad - f * bs1bd) + om * d_inertia + py * vx - px * vy;
+    for k in 0..na {
+        // 𝕄̇ν = −ω C ḃ;  ∂T/∂a = V_y ω Ψ₁ + ω²(Ψₓ + M_ψ a) + ω C ḃ.
+        let dtda = vy * om * it.psi1[k] + om * om * (it.psix[k] + s.mpsia[k]) + om * s.cbd[k];
+        h[ia + k] = -om * s.cbd[k] - dtda;
+    }
+    for k in 0..nb {
+        let ctad = if na > 0 { s.ctad[k] } else { 0.0 };
+        // 𝕄̇ν = −f V_x S₁ḃ + ω Cᵀȧ;
+        // ∂T/∂b = −V_x ω Φ₁ − f V_y ω S₁b − f V_x S₁ḃ + ω²(−f Sₓb + M_φ b) − ω Cᵀȧ.
+        let mdot = -f * vx * s.s1bd[k] + om * ctad;
+        let dtdb = -vx * om * it.phi1[k] - f * vy * om * s.s1b[k] - f * vx * s.s1bd[k]
+            + om * om * (-f * s.sxb[k] + s.mphib[k])
+            - om * ctad;
+        h[ib + k] = mdot - dtdb;
+    }
+
+    if link.foreshortening {
+        exact_inextensible_terms(it, b, bd, om, mb, h, s);
+    }
+
+    // Tip point p(L) = (L + ψ(L)ᵀa − ½f bᵀS_L b, φ(L)ᵀb), exact.
+    let pl = [
+        it.length + dot(&it.psi_l, a) - 0.5 * f * dot(b, &s.slb),
+        dot(&it.phi_l, b),
+    ];
+    let pld = [dot(&it.psi_l, ad) - f * dot(&s.slb, bd), dot(&it.phi_l, bd)];
+    let wl = [vx - om * pl[1] + pld[0], vy + om * pl[0] + pld[1]];
+    s.p_tip = pl;
+    s.pd_tip = pld;
+    s.w_tip = wl;
+
+    if link.tip_mass > 0.0 {
+        let mt = link.tip_mass;
+        // Columns of B_L (2 × d): w = B_L ν.
+        let (bx, by) = s.bl.split_at_mut(d);
+        bx.iter_mut().for_each(|v| *v = 0.0);
+        by.iter_mut().for_each(|v| *v = 0.0);
+        bx[0] = 1.0;
+        by[1] = 1.0;
+        bx[2] = -pl[1];
+        by[2] = pl[0];
+        bx[ia..ia + na].copy_from_slice(&it.psi_l[..na]);
+        for k in 0..nb {
+            bx[ib + k] = -f * s.slb[k];
+            by[ib + k] = it.phi_l[k];
+        }
+        // Inertial acceleration (frame axes) minus B_L ν̇: Ḃ_L ν + ω J w.
+        let bsb = if link.foreshortening {
+            dot(bd, &s.slbd)
+        } else {
+            0.0
+        };
+        let cx = -om * pld[1] - bsb - om * wl[1];
+        let cy = om * pld[0] + om * wl[0];
+        for r in 0..d {
+            h[r] += mt * (bx[r] * cx + by[r] * cy);
+            for c in 0..d {
+                mb[r * d + c] += mt * (bx[r] * bx[c] + by[r] * by[c]);
+            }
+        }
+    }
+    if link.tip_inertia > 0.0 {
+        // Tip body rotates with α + φ(L)'ᵀ b: T = ½ J (ω + φ'(L)ᵀḃ)².
+        let jt = link.tip_inertia;
+        mb[2 * d + 2] += jt;
+        for k in 0..nb {
+            let ck = it.dphi_l[k];
+            mb[2 * d + ib + k] += jt * ck;
+            mb[(ib + k) * d + 2] += jt * ck;
+            for l in 0..nb {
+                mb[(ib + k) * d + ib + l] += jt * ck * it.dphi_l[l];
+            }
+        }
+    }
+
+    // First moment of mass (frame axes) and gravity.
+    s.p_bar = [
+        it.c0 + psi1_a - 0.5 * f * bs1b + link.tip_mass * pl[0],
+        phi1_b + link.tip_mass * pl[1],
+    ];
+    qg.iter_mut().for_each(|v| *v = 0.0);
+    if let Some(g) = g_loc {
+        let mt = it.m + link.tip_mass;
+        qg[0] = mt * g[0];
+        qg[1] = mt * g[1];
+        qg[2] = -g[0] * s.p_bar[1] + g[1] * s.p_bar[0];
+        for k in 0..na {
+            qg[ia + k] = g[0] * (it.psi1[k] + link.tip_mass * it.psi_l[k]);
+        }
+        for k in 0..nb {
+            qg[ib + k] = g[0] * (-f * (s.s1b[k] + link.tip_mass * s.slb[k]))
+                + g[1] * (it.phi1[k] + link.tip_mass * it.phi_l[k]);
+        }
+    }
+}
+
+/// Terms that make the inextensible (foreshortening) kinetic energy exact:
+/// ΔT = ½∫ρA [ω² s² + 2ω(v ṡ − s v̇) + ṡ²], with s = ½bᵀS b, ṡ = bᵀS ḃ. Without them the
+/// truncated T loses positive definiteness in the stiff direction "turn the frame, counter-bend
+/// the link" (its inertia there is ∫ρA(ωx + v̇)², while the kept −ω²∫ρA·2xs is negative).
+///
+/// With Q_ijkl = ∫ρA S_ij S_kl, R_mij = ∫ρA φ_m S_ij and the contractions
+/// Bq = Q:(b⊗b) (= 2∫ρA s S), Eq = Q:(ḃ⊗ḃ), A_jl = ∫ρA (Sb)_j (Sb)_l,
+/// Rv = R·b (= ∫ρA v S), Rvd = R·ḃ, z_p = R_p:(b⊗ḃ), w_j = R_j:(b⊗b):
+///   𝕄_ωω += ¼ bᵀBq b,   𝕄_ωb += Rv b − ½w,   𝕄_bb += A,
+///   h_ω += ω ḃᵀBq b + ḃ·(Rvd b + Rv ḃ − z),
+///   h_b += 2ω (Rvd b − z) + Eq b − ½ω² Bq b.
+fn exact_inextensible_terms(
+    it: &super::integrals::LinkIntegrals,
+    b: &[f64],
+    bd: &[f64],
+    om: f64,
+    mb: &mut [f64],
+    h: &mut [f64],
+    s: &mut BodyScratch,
+) {
+    let n = it.nb;
+    let nn = n * n;
+    let na = it.na;
+    let d = 3 + na + n;
+    let ib = 3 + na;
+    // Contractions of Q over its first index pair (symmetric in i, j: upper triangle, weight 2).
+    s.bq.iter_mut().for_each(|v| *v = 0.0);
+    s.eq.iter_mut().for_each(|v| *v = 0.0);
+    for i in 0..n {
+        for j in i..n {
+            let wgt = if i == j { 1.0 } else { 2.0 };
+            let (bb, bdbd) = (wgt * b[i] * b[j], wgt * bd[i] * bd[j]);
+            let row = &it.q4[(i * n + j) * nn..(i * n + j + 1) * nn];
+            for ((bq, eq), q) in s.bq.iter_mut().zip(s.eq.iter_mut()).zip(row) {
+                *bq += bb * q;
+                *eq += bdbd * q;
+            }
+        }
+    }
+    // A_jl = Σ_i b_i (Σ_k b_k Q_ij,kl).
+    s.amat.iter_mut().for_each(|v| *v = 0.0);
+    for i in 0..n {
+        if b[i] == 0.0 {
+            continue;
+        }
+        for j in 0..n {
+            let row = &it.q4[(i * n + j) * nn..(i * n + j + 1) * nn];
+            let arow = &mut s.amat[j * n..(j + 1) * n];
+            for (k, qk) in row.chunks_exact(n).enumerate() {
+                let c = b[i] * b[k];
+                for (a, q) in arow.iter_mut().zip(qk) {
+                    *a += c * q;
+                }
+            }
+        }
+    }
+    s.rv.iter_mut().for_each(|v| *v = 0.0);
+    s.rvd.iter_mut().for_each(|v| *v = 0.0);
+    for m in 0..n {
+        let r = &it.r3[m * nn..(m + 1) * nn];
+        let (bm, bdm) = (b[m], bd[m]);
+        for ((rv, rvd), q) in s.rv.iter_mut().zip(s.rvd.iter_mut()).zip(r) {
+            *rv += bm * q;
+            *rvd += bdm * q;
+        }
+    }
+    for p in 0..n {
+        let r = &it.r3[p * nn..(p + 1) * nn];
+        let (mut zp, mut wp) = (0.0, 0.0);
+        for (i, ri) in r.chunks_exact(n).enumerate() {
+            zp += b[i] * dot(ri, bd);
+            wp += b[i] * dot(ri, b);
+        }
+        s.zv[p] = zp;
+        s.t2[p] = wp;
+    }
+    let quadform = |m: &[f64], x: &[f64], y: &[f64]| -> f64 {
+        let mut acc = 0.0;
+        for r in 0..n {
+            acc += x[r] * dot(&m[r * n..(r + 1) * n], y);
+        }
+        acc
+    };
+    let bqbb = quadform(&s.bq, b, b);
+    let bqbdb = quadform(&s.bq, bd, b);
+    mb[2 * d + 2] += 0.25 * bqbb;
+    for j in 0..n {
+        let rvb = dot(&s.rv[j * n..(j + 1) * n], b);
+        let c = rvb - 0.5 * s.t2[j];
+        mb[2 * d + ib + j] += c;
+        mb[(ib + j) * d + 2] += c;
+        for l in 0..n {
+            mb[(ib + j) * d + ib + l] += s.amat[j * n + l];
+        }
+    }
+    let mut h_om = om * bqbdb;
+    for j in 0..n {
+        let rvdb = dot(&s.rvd[j * n..(j + 1) * n], b);
+        let rvbd = dot(&s.rv[j * n..(j + 1) * n], bd);
+        h_om += bd[j] * (rvdb + rvbd - s.zv[j]);
+        s.t1[j] = rvdb;
+    }
+    h[2] += h_om;
+    for p in 0..n {
+        let eqb = dot(&s.eq[p * n..(p + 1) * n], b);
+        let bqb = dot(&s.bq[p * n..(p + 1) * n], b);
+        h[ib + p] += 2.0 * om * (s.t1[p] - s.zv[p]) + eqb - 0.5 * om * om * bqb;
+    }
+}

@@ -1,0 +1,586 @@
+//! Floating-frame chain of assumed-mode links: mass matrix M(q), generalized forces, energies.
+//!
+//! Generalized coordinates, link by link: q = [θᵢ, aᵢ (axial), bᵢ (transverse)]. Each link is a
+//! body with frame origin Oᵢ, frame angle αᵢ and body velocities νᵢ = (V, ω, ė) (V = frame-origin
+//! velocity in the frame's own axes). Its kinetic energy is Tᵢ = ½ νᵢᵀ 𝕄ᵢ(e) νᵢ (see
+//! [`super::body`]). The chain kinematics of scenes.md (link i+1 clamped to the tip of link i and
+//! turned by θᵢ₊₁: αᵢ₊₁ = αᵢ + vᵢ'(Lᵢ) + θᵢ₊₁) give νᵢ = Gᵢ(q) q̇ and ν̇ᵢ = Gᵢ q̈ + γᵢ(q, q̇), so
+//! Lagrange's equations of the chain are the body equations projected by Gᵢᵀ:
+//!
+//!   Σᵢ Gᵢᵀ 𝕄ᵢ Gᵢ q̈ = Q − Σᵢ Gᵢᵀ (𝕄ᵢ γᵢ + hᵢ − Q_gravity,ᵢ)
+//!
+//! with hᵢ = 𝕄̇ᵢ νᵢ + (ω J P, −(J P)·V, −∂Tᵢ/∂e), P the body's linear momentum in its frame, and
+//! Q the elastic, Kelvin–Voigt, joint spring/damper and applied torques. All per-step work is
+//! O(N²) products of precomputed integrals — no spatial quadrature.
+
+use data::scene::{PrescribedMotion, TorqueLaw};
+
+use super::body::{BodyScratch, body_terms};
+use super::integrals::{LinkIntegrals, dot};
+use crate::basis::ShapeSet;
+
+/// One joint: its law and initial state.
+#[derive(Debug, Clone)]
+pub struct JointModel {
+    pub initial_angle: f64,
+    pub initial_rate: f64,
+    pub stiffness: f64,
+    pub set_point: f64,
+    pub damping: f64,
+    pub torque: Option<TorqueLaw>,
+    pub prescribed: Option<PrescribedMotion>,
+}
+
+impl JointModel {
+    /// (θ, θ̇, θ̈) of a prescribed joint.
+    pub fn prescribed_state(&self, t: f64) -> Option<(f64, f64, f64)> {
+        self.prescribed.as_ref().map(|p| {
+            let (a, r, acc) = p.kinematics(t);
+            (self.initial_angle + a, r, acc)
+        })
+    }
+}
+
+/// One link: shape functions, precomputed integrals, lumped extras and its DOF offsets.
+#[derive(Debug, Clone)]
+pub struct LinkModel {
+    pub name: String,
+    pub transverse: ShapeSet,
+    pub axial: Option<ShapeSet>,
+    pub ints: LinkIntegrals,
+    pub foreshortening: bool,
+    pub tip_mass: f64,
+    pub tip_inertia: f64,
+    pub hub_inertia: f64,
+    /// Kelvin–Voigt γ/EI (the damping matrix is (γ/EI) K_b); 0 when off.
+    pub kv_ratio: f64,
+    pub theta: usize,
+    pub a0: usize,
+    pub b0: usize,
+}
+
+impl LinkModel {
+    pub fn na(&self) -> usize {
+        self.ints.na
+    }
+    pub fn nb(&self) -> usize {
+        self.ints.nb
+    }
+    /// Body dimension 3 + na + nb.
+    pub fn body_dim(&self) -> usize {
+        3 + self.na() + self.nb()
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+pub struct EnergyParts {
+    pub kinetic: f64,
+    pub strain: f64,
+    pub joint_spring: f64,
+    pub gravity: f64,
+}
+
+/// Per-link state of the last evaluation.
+#[derive(Debug, Clone)]
+pub(crate) struct LinkWork {
+    /// Rows (V_x, V_y, ω) of Gᵢ, each of length N.
+    pub gr: Vec<f64>,
+    /// Convective part of V̇ (the ω part is identically zero for this joint convention).
+    pub gamma: [f64; 2],
+    pub alpha: f64,
+    pub origin: [f64; 2],
+    pub nu: Vec<f64>,
+    pub mb: Vec<f64>,
+    pub h: Vec<f64>,
+    pub qg: Vec<f64>,
+    pub x: Vec<f64>,
+    pub u: Vec<f64>,
+    pub scratch: BodyScratch,
+    /// nb × nb work matrix of the von Kármán terms (empty without axial field).
+    pub vk: Vec<f64>,
+}
+
+#[derive(Debug, Clone)]
+pub struct Chain {
+    pub links: Vec<LinkModel>,
+    pub joints: Vec<JointModel>,
+    pub gravity: Option<[f64; 2]>,
+    /// Number of generalized coordinates.
+    pub n: usize,
+    /// Indices of free / prescribed coordinates.
+    pub free: Vec<usize>,
+    pub prescribed: Vec<usize>,
+    pub(crate) work: Vec<LinkWork>,
+    /// M(q), N × N row-major, and the force side of the last evaluation.
+    pub(crate) mass: Vec<f64>,
+    pub(crate) force: Vec<f64>,
+    wrows: Vec<f64>,
+    mff: Vec<f64>,
+    rhs_f: Vec<f64>,
+    /// Torques the prescribed joints needed at the last `accelerations` call (per joint; 0 for free).
+    pub(crate) tau_prescribed: Vec<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SingularMass;
+
+impl Chain {
+    pub fn new(links: Vec<LinkModel>, joints: Vec<JointModel>, gravity: Option<[f64; 2]>) -> Self {
+        let n = links.last().map_or(0, |l| l.b0 + l.nb());
+        let mut free = Vec::new();
+        let mut prescribed = Vec::new();
+        for (i, l) in links.iter().enumerate() {
+            if joints[i].prescribed.is_some() {
+                prescribed.push(l.theta);
+            } else {
+                free.push(l.theta);
+            }
+            free.extend(l.a0..l.a0 + l.na());
+            free.extend(l.b0..l.b0 + l.nb());
+        }
+        let work = links
+            .iter()
+            .map(|l| {
+                let d = l.body_dim();
+                LinkWork {
+                    gr: vec![0.0; 3 * n],
+                    gamma: [0.0; 2],
+                    alpha: 0.0,
+                    origin: [0.0; 2],
+                    nu: vec![0.0; d],
+                    mb: vec![0.0; d * d],
+                    h: vec![0.0; d],
+                    qg: vec![0.0; d],
+                    x: vec![0.0; d * n],
+                    u: vec![0.0; d],
+                    scratch: BodyScratch::new(l.na(), l.nb()),
+                    vk: if l.na() > 0 {
+                        vec![0.0; l.nb() * l.nb()]
+                    } else {
+                        vec![]
+                    },
+                }
+            })
+            .collect();
+        let nf = free.len();
+        let nj = joints.len();
+        Chain {
+            links,
+            joints,
+            gravity,
+            n,
+            free,
+            prescribed,
+            work,
+            mass: vec![0.0; n * n],
+            force: vec![0.0; n],
+            wrows: vec![0.0; 2 * n],
+            mff: vec![0.0; nf * nf],
+            rhs_f: vec![0.0; nf],
+            tau_prescribed: vec![0.0; nj],
+        }
+    }
+
+    /// Kinematics, body terms, M(q) and the force side f(q, q̇, t) (everything except the
+    /// actuator torques of prescribed joints).
+    pub fn evaluate(&mut self, t: f64, q: &[f64], qd: &[f64]) {
+        let n = self.n;
+        self.mass.iter_mut().for_each(|v| *v = 0.0);
+        self.force.iter_mut().for_each(|v| *v = 0.0);
+        let g = self.gravity;
+        for i in 0..self.links.len() {
+            // Frame kinematics of link i.
+            if i == 0 {
+                let th = self.links[0].theta;
+                let w = &mut self.work[0];
+                w.gr.iter_mut().for_each(|v| *v = 0.0);
+                w.gr[2 * n + th] = 1.0;
+                w.gamma = [0.0; 2];
+                w.alpha = q[th];
+                w.origin = [0.0; 2];
+                w.nu[0] = 0.0;
+                w.nu[1] = 0.0;
+                w.nu[2] = qd[th];
+            } else {
+                self.propagate(i - 1, q, qd);
+            }
+            // Elastic body velocities.
+            {
+                let (a0, na, b0, nb) = {
+                    let l = &self.links[i];
+                    (l.a0, l.na(), l.b0, l.nb())
+                };
+                let w = &mut self.work[i];
+                w.nu[3..3 + na].copy_from_slice(&qd[a0..a0 + na]);
+                w.nu[3 + na..3 + na + nb].copy_from_slice(&qd[b0..b0 + nb]);
+            }
+            let link = &self.links[i];
+            let w = &mut self.work[i];
+            let a = &q[link.a0..link.a0 + link.na()];
+            let b = &q[link.b0..link.b0 + link.nb()];
+            let g_loc = g.map(|gv| {
+                let (s, c) = w.alpha.sin_cos();
+                [c * gv[0] + s * gv[1], -s * gv[0] + c * gv[1]]
+            });
+            body_terms(
+                link,
+                a,
+                b,
+                &w.nu,
+                g_loc,
+                &mut w.mb,
+                &mut w.h,
+                &mut w.qg,
+                &mut w.scratch,
+            );
+            // Project: M += Gᵀ 𝕄 G, f += Gᵀ (Q_g − 𝕄 γ − h).
+            let d = link.body_dim();
+            for l in 0..d {
+                let mrow = &w.mb[l * d..(l + 1) * d];
+                let xrow = &mut w.x[l * n..(l + 1) * n];
+                for c in 0..n {
+                    xrow[c] = mrow[0] * w.gr[c] + mrow[1] * w.gr[n + c] + mrow[2] * w.gr[2 * n + c];
+                }
+                for m in 3..d {
+                    let gm = if m - 3 < link.na() {
+                        link.a0 + (m - 3)
+                    } else {
+                        link.b0 + (m - 3 - link.na())
+                    };
+                    xrow[gm] += mrow[m];
+                }
+                w.u[l] = w.qg[l] - w.h[l] - mrow[0] * w.gamma[0] - mrow[1] * w.gamma[1];
+            }
+            for l in 0..3 {
+                let grow = &w.gr[l * n..(l + 1) * n];
+                let xrow = &w.x[l * n..(l + 1) * n];
+                for r in 0..n {
+                    let gr = grow[r];
+                    if gr != 0.0 {
+                        let mrow = &mut self.mass[r * n..(r + 1) * n];
+                        for c in 0..n {
+                            mrow[c] += gr * xrow[c];
+                        }
+                        self.force[r] += gr * w.u[l];
+                    }
+                }
+            }
+            for l in 3..d {
+                let gl = if l - 3 < link.na() {
+                    link.a0 + (l - 3)
+                } else {
+                    link.b0 + (l - 3 - link.na())
+                };
+                let xrow = &w.x[l * n..(l + 1) * n];
+                let mrow = &mut self.mass[gl * n..(gl + 1) * n];
+                for c in 0..n {
+                    mrow[c] += xrow[c];
+                }
+                self.force[gl] += w.u[l];
+            }
+            // Elastic forces: −K_b b − (γ/EI) K_b ḃ, −K_a a.
+            let nb = link.nb();
+            let bd = &qd[link.b0..link.b0 + nb];
+            for r in 0..nb {
+                let row = &link.ints.kb[r * nb..(r + 1) * nb];
+                self.force[link.b0 + r] -= dot(row, b) + link.kv_ratio * dot(row, bd);
+            }
+            let na = link.na();
+            for r in 0..na {
+                let row = &link.ints.ka[r * na..(r + 1) * na];
+                self.force[link.a0 + r] -= dot(row, a);
+            }
+            if na > 0 {
+                // von Kármán coupling: −∂/∂q of ½Σ a_k bᵀT3_k b + ⅛ T4(b,b,b,b).
+                let w = &mut self.work[i];
+                vk_forces(
+                    &link.ints,
+                    a,
+                    b,
+                    &mut w.vk,
+                    &mut self.force[link.a0..link.b0 + nb],
+                );
+            }
+            // Joint laws (free joints only; a prescribed joint's actuator is the unknown torque).
+            let j = &self.joints[i];
+            if j.prescribed.is_none() {
+                let th = link.theta;
+                let mut tau = -j.stiffness * (q[th] - j.set_point) - j.damping * qd[th];
+                if let Some(law) = &j.torque {
+                    tau += law.torque(t);
+                }
+                self.force[th] += tau;
+            }
+        }
+        // Exact symmetry of M (the projections are symmetric up to summation order).
+        for r in 0..n {
+            for c in 0..r {
+                let v = 0.5 * (self.mass[r * n + c] + self.mass[c * n + r]);
+                self.mass[r * n + c] = v;
+                self.mass[c * n + r] = v;
+            }
+        }
+    }
+
+    /// Frame kinematics of link i+1 from link i (whose body terms are already computed).
+    fn propagate(&mut self, i: usize, q: &[f64], qd: &[f64]) {
+        let n = self.n;
+        let (head, tail) = self.work.split_at_mut(i + 1);
+        let wi = &head[i];
+        let wn = &mut tail[0];
+        let li = &self.links[i];
+        let ln = &self.links[i + 1];
+        let sc = &wi.scratch;
+        let (pl, wl, pld) = (sc.p_tip, sc.w_tip, sc.pd_tip);
+        let fsf = if li.foreshortening { 1.0 } else { 0.0 };
+        // Rows of the tip velocity w_L = B_L Gᵢ q̇ in link-i axes.
+        let (wx, wy) = self.wrows.split_at_mut(n);
+        for c in 0..n {
+            wx[c] = wi.gr[c] - pl[1] * wi.gr[2 * n + c];
+            wy[c] = wi.gr[n + c] + pl[0] * wi.gr[2 * n + c];
+        }
+        for k in 0..li.na() {
+            wx[li.a0 + k] += li.ints.psi_l[k];
+        }
+        for k in 0..li.nb() {
+            wx[li.b0 + k] += -fsf * sc.slb[k];
+            wy[li.b0 + k] += li.ints.phi_l[k];
+        }
+        let bi = &q[li.b0..li.b0 + li.nb()];
+        let bdi = &qd[li.b0..li.b0 + li.nb()];
+        let delta = dot(&li.ints.dphi_l, bi) + q[ln.theta];
+        let delta_d = dot(&li.ints.dphi_l, bdi) + qd[ln.theta];
+        let (s, c) = delta.sin_cos();
+        // V_{i+1} = R(−δ) w_L.
+        for col in 0..n {
+            let (x, y) = (wx[col], wy[col]);
+            wn.gr[col] = c * x + s * y;
+            wn.gr[n + col] = -s * x + c * y;
+            wn.gr[2 * n + col] = wi.gr[2 * n + col];
+        }
+        for k in 0..li.nb() {
+            wn.gr[2 * n + li.b0 + k] += li.ints.dphi_l[k];
+        }
+        wn.gr[2 * n + ln.theta] += 1.0;
+        wn.nu[0] = c * wl[0] + s * wl[1];
+        wn.nu[1] = -s * wl[0] + c * wl[1];
+        wn.nu[2] = wi.nu[2] + delta_d;
+        // γ_{i+1} = R(−δ)[γᵢ + Ḃ_L νᵢ − δ̇ J w_L], Ḃ_L ν = ω J ṗ_L + (−ḃᵀ S_L ḃ, 0).
+        let om = wi.nu[2];
+        let bsb = if li.foreshortening {
+            dot(bdi, &sc.slbd)
+        } else {
+            0.0
+        };
+        let gx = wi.gamma[0] - om * pld[1] - bsb + delta_d * wl[1];
+        let gy = wi.gamma[1] + om * pld[0] - delta_d * wl[0];
+        wn.gamma = [c * gx + s * gy, -s * gx + c * gy];
+        let (sa, ca) = wi.alpha.sin_cos();
+        wn.origin = [
+            wi.origin[0] + ca * pl[0] - sa * pl[1],
+            wi.origin[1] + sa * pl[0] + ca * pl[1],
+        ];
+        wn.alpha = wi.alpha + delta;
+    }
+
+    /// Solves for q̈ (free part from the equations, prescribed part from the motion law) and
+    /// stores the actuator torques the prescribed joints needed. Requires `evaluate` first.
+    pub fn accelerations(&mut self, t: f64, qdd: &mut [f64]) -> Result<(), SingularMass> {
+        let n = self.n;
+        for (i, j) in self.joints.iter().enumerate() {
+            if let Some((_, _, acc)) = j.prescribed_state(t) {
+                qdd[self.links[i].theta] = acc;
+            }
+        }
+        let nf = self.free.len();
+        for (r, &gr) in self.free.iter().enumerate() {
+            let mut v = self.force[gr];
+            for &p in &self.prescribed {
+                v -= self.mass[gr * n + p] * qdd[p];
+            }
+            self.rhs_f[r] = v;
+            for (c, &gc) in self.free.iter().enumerate() {
+                self.mff[r * nf + c] = self.mass[gr * n + gc];
+            }
+        }
+        cholesky_solve(&mut self.mff, nf, &mut self.rhs_f)?;
+        for (r, &gr) in self.free.iter().enumerate() {
+            qdd[gr] = self.rhs_f[r];
+        }
+        for (i, link) in self.links.iter().enumerate() {
+            self.tau_prescribed[i] = if self.joints[i].prescribed.is_some() {
+                let p = link.theta;
+                let row = &self.mass[p * n..(p + 1) * n];
+                dot(row, qdd) - self.force[p]
+            } else {
+                0.0
+            };
+        }
+        Ok(())
+    }
+
+    /// Stored energies at the last evaluated state (call `evaluate` first). No allocation.
+    pub fn energy(&self, q: &[f64]) -> EnergyParts {
+        let quad = |m: &[f64], n: usize, x: &[f64]| -> f64 {
+            let mut acc = 0.0;
+            for r in 0..n {
+                acc += x[r] * dot(&m[r * n..(r + 1) * n], x);
+            }
+            acc
+        };
+        let mut e = EnergyParts::default();
+        for (i, link) in self.links.iter().enumerate() {
+            let w = &self.work[i];
+            e.kinetic += 0.5 * quad(&w.mb, link.body_dim(), &w.nu);
+            let nb = link.nb();
+            e.strain += 0.5 * quad(&link.ints.kb, nb, &q[link.b0..link.b0 + nb]);
+            let na = link.na();
+            if na > 0 {
+                let a = &q[link.a0..link.a0 + na];
+                let b = &q[link.b0..link.b0 + nb];
+                e.strain += 0.5 * quad(&link.ints.ka, na, a);
+                // ½ Σ a_k bᵀT3_k b + ⅛ Σ T4_ijkl b_i b_j b_k b_l.
+                let nn = nb * nb;
+                for (k, ak) in a.iter().enumerate() {
+                    e.strain += 0.5 * ak * quad(&link.ints.t3[k * nn..(k + 1) * nn], nb, b);
+                }
+                for (ij, row) in link.ints.t4.chunks_exact(nn).enumerate() {
+                    e.strain += 0.125 * b[ij / nb] * b[ij % nb] * quad(row, nb, b);
+                }
+            }
+            let j = &self.joints[i];
+            if j.prescribed.is_none() {
+                e.joint_spring += 0.5 * j.stiffness * (q[link.theta] - j.set_point).powi(2);
+            }
+            if let Some(gv) = self.gravity {
+                // V_g = −g·(m_tot O + R p̄).
+                let (s, c) = w.alpha.sin_cos();
+                let pb = w.scratch.p_bar;
+                let r = [c * pb[0] - s * pb[1], s * pb[0] + c * pb[1]];
+                let mt = link.ints.m + link.tip_mass;
+                e.gravity -= gv[0] * (mt * w.origin[0] + r[0]) + gv[1] * (mt * w.origin[1] + r[1]);
+            }
+        }
+        e
+    }
+
+    /// Tip of link i: inertial position, and its frame angle α (after `evaluate`).
+    pub fn tip_position(&self, i: usize) -> [f64; 2] {
+        let w = &self.work[i];
+        let pl = w.scratch.p_tip;
+        let (s, c) = w.alpha.sin_cos();
+        [
+            w.origin[0] + c * pl[0] - s * pl[1],
+            w.origin[1] + s * pl[0] + c * pl[1],
+        ]
+    }
+
+    pub fn frame_angle(&self, i: usize) -> f64 {
+        self.work[i].alpha
+    }
+
+    /// Inertial tip-velocity Jacobian of link i (2 × N row-major): ṙ_tip = J q̇ (after
+    /// `evaluate`). Provided for constraint/impact formulations.
+    pub fn tip_jacobian(&self, i: usize, out: &mut [f64]) {
+        let n = self.n;
+        let w = &self.work[i];
+        let li = &self.links[i];
+        let sc = &w.scratch;
+        let pl = sc.p_tip;
+        let fsf = if li.foreshortening { 1.0 } else { 0.0 };
+        let (wx, wy) = out.split_at_mut(n);
+        for c in 0..n {
+            wx[c] = w.gr[c] - pl[1] * w.gr[2 * n + c];
+            wy[c] = w.gr[n + c] + pl[0] * w.gr[2 * n + c];
+        }
+        for k in 0..li.na() {
+            wx[li.a0 + k] += li.ints.psi_l[k];
+        }
+        for k in 0..li.nb() {
+            wx[li.b0 + k] += -fsf * sc.slb[k];
+            wy[li.b0 + k] += li.ints.phi_l[k];
+        }
+        let (s, c) = w.alpha.sin_cos();
+        for col in 0..n {
+            let (x, y) = (wx[col], wy[col]);
+            wx[col] = c * x - s * y;
+            wy[col] = s * x + c * y;
+        }
+    }
+
+    /// M(q) of the last evaluation (row-major N × N).
+    pub fn mass_matrix(&self) -> &[f64] {
+        &self.mass
+    }
+
+    /// Force side f(q, q̇, t) of the last evaluation.
+    pub fn force(&self) -> &[f64] {
+        &self.force
+    }
+}
+
+/// In-place Cholesky solve of the SPD system A x = b (A row-major n × n, overwritten).
+pub(crate) fn cholesky_solve(a: &mut [f64], n: usize, b: &mut [f64]) -> Result<(), SingularMass> {
+    for j in 0..n {
+        let mut d = a[j * n + j];
+        for k in 0..j {
+            d -= a[j * n + k] * a[j * n + k];
+        }
+        if d <= 0.0 || !d.is_finite() {
+            return Err(SingularMass);
+        }
+        let d = d.sqrt();
+        a[j * n + j] = d;
+        for i in j + 1..n {
+            let mut s = a[i * n + j];
+            for k in 0..j {
+                s -= a[i * n + k] * a[j * n + k];
+            }
+            a[i * n + j] = s / d;
+        }
+    }
+    for i in 0..n {
+        let mut s = b[i];
+        for k in 0..i {
+            s -= a[i * n + k] * b[k];
+        }
+        b[i] = s / a[i * n + i];
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for k in i + 1..n {
+            s -= a[k * n + i] * b[k];
+        }
+        b[i] = s / a[i * n + i];
+    }
+    Ok(())
+}
+
+/// Adds the von Kármán forces to `f` (the link's slice starting at a0: axial then transverse):
+/// f_a,k −= ½ bᵀT3_k b,  f_b −= Σ_k a_k T3_k b + ½ G b  with G_kl = Σ_ij b_i b_j T4_ijkl.
+fn vk_forces(ints: &LinkIntegrals, a: &[f64], b: &[f64], g: &mut [f64], f: &mut [f64]) {
+    let (na, nb) = (ints.na, ints.nb);
+    let nn = nb * nb;
+    g.iter_mut().for_each(|v| *v = 0.0);
+    for k in 0..na {
+        let t = &ints.t3[k * nn..(k + 1) * nn];
+        let mut btb = 0.0;
+        for (i, row) in t.chunks_exact(nb).enumerate() {
+            let tb = dot(row, b);
+            btb += b[i] * tb;
+            f[na + i] -= a[k] * tb;
+        }
+        f[k] -= 0.5 * btb;
+    }
+    for (ij, row) in ints.t4.chunks_exact(nn).enumerate() {
+        let c = b[ij / nb] * b[ij % nb];
+        if c != 0.0 {
+            for (gv, t) in g.iter_mut().zip(row) {
+                *gv += c * t;
+            }
+        }
+    }
+    for p in 0..nb {
+        f[na + p] -= 0.5 * dot(&g[p * nb..(p + 1) * nb], b);
+    }
+}

@@ -1,0 +1,529 @@
+//! Time integration of the reduced rocket, sampling of observables, ledger and balances.
+
+use std::time::Instant;
+
+use data::{
+    BackendKind, Cost, Diagnostic, EnergyLedger, Event, Observables, RunResult, Settings,
+    StabilityVerdict, channel,
+};
+
+use super::basis::Basis;
+use super::body::Body;
+use super::config::{self, Method, TimeConfig};
+use super::dynamics::{Model, Phase, StationModes, Workspace, quad, rhs, snapshot};
+use super::error::RocketError;
+use crate::integrate::{Dopri5, IntegrateError, OdeRhs, Sdirk, StepStats, Tolerances};
+
+/// The ODE right-hand side handed to the integrators.
+struct RocketRhs<'a> {
+    model: &'a Model,
+    ws: Workspace,
+}
+
+impl OdeRhs for RocketRhs<'_> {
+    fn dim(&self) -> usize {
+        self.model.layout.state_len()
+    }
+    fn eval(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        rhs(self.model, &mut self.ws, t, y, dydt);
+    }
+}
+
+/// The reduced rocket as a first-order ODE y' = f(t, y), for callers that integrate it
+/// themselves (benches, allocation checks, other integrators). State layout:
+/// [q (X, Y, θ, a, b, u_j, w_j) | quasi-velocities (V_x, V_y, ω, ȧ, ḃ, u̇_j, ẇ_j) | 15 balances].
+pub struct RocketOde {
+    model: Model,
+    ws: Workspace,
+}
+
+impl RocketOde {
+    pub fn new(scene: &data::Scene, settings: &Settings) -> Result<RocketOde, RocketError> {
+        let body = Body::from_scene(scene)?;
+        let n = config::modes(&settings.discretization)?;
+        let basis = Basis::new(&body, n)?;
+        let model = Model::new(body, &basis);
+        let ws = Workspace::new(model.layout);
+        Ok(RocketOde { model, ws })
+    }
+
+    /// The scene's initial state (see the module docs).
+    pub fn initial_state(&self) -> Vec<f64> {
+        initial_state(&self.model)
+    }
+
+    /// Number of generalized coordinates (3 + 2n + 2·masses).
+    pub fn dofs(&self) -> usize {
+        self.model.layout.dofs()
+    }
+}
+
+impl OdeRhs for RocketOde {
+    fn dim(&self) -> usize {
+        self.model.layout.state_len()
+    }
+    fn eval(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        rhs(&self.model, &mut self.ws, t, y, dydt);
+    }
+}
+
+fn initial_state(model: &Model) -> Vec<f64> {
+    let l = model.layout;
+    let mut y = vec![0.0; l.state_len()];
+    y[2] = model.body.launch_angle;
+    y[l.b()..l.b() + l.n].copy_from_slice(&model.initial_b);
+    y
+}
+
+enum Stepper {
+    Explicit(Box<Dopri5>),
+    Implicit(Box<Sdirk>),
+}
+
+impl Stepper {
+    fn new(method: Method, dim: usize, tol: Tolerances, h0: Option<f64>) -> Stepper {
+        match method {
+            Method::Dopri5 => Stepper::Explicit(Box::new(Dopri5::new(dim, tol, h0, None))),
+            Method::TrBdf2 => Stepper::Implicit(Box::new(Sdirk::new(dim, tol, h0, None))),
+        }
+    }
+    fn step(
+        &mut self,
+        f: &mut RocketRhs,
+        t: &mut f64,
+        y: &mut [f64],
+        t_stop: f64,
+    ) -> Result<(), IntegrateError> {
+        match self {
+            Stepper::Explicit(s) => s.step(f, t, y, t_stop),
+            Stepper::Implicit(s) => s.step(f, t, y, t_stop),
+        }
+    }
+    fn dense(&self, t: f64, out: &mut [f64]) {
+        match self {
+            Stepper::Explicit(s) => s.dense(t, out),
+            Stepper::Implicit(s) => s.dense(t, out),
+        }
+    }
+    fn reset(&mut self) {
+        match self {
+            Stepper::Explicit(s) => s.reset(),
+            Stepper::Implicit(s) => s.reset(),
+        }
+    }
+    fn stats(&self) -> StepStats {
+        match self {
+            Stepper::Explicit(s) => *s.stats(),
+            Stepper::Implicit(s) => *s.stats(),
+        }
+    }
+    fn last_step(&self) -> f64 {
+        match self {
+            Stepper::Explicit(s) => s.last_step(),
+            Stepper::Implicit(s) => s.last_step(),
+        }
+    }
+}
+
+/// Linear-momentum account of a run, sampled at the output times (inertial components).
+///
+/// Balance: P(t) − P(0) = I_thrust + I_pressure + I_coriolis + I_gravity + P_outflow, where
+/// P_outflow = ∫∫ ṁ Ṙ dx dt is the momentum the burnt mass takes with it (it leaves the case
+/// with the local case velocity). All impulses are integrated with the state, so the balance
+/// holds to the integrator's tolerance.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MomentumBalance {
+    pub time: Vec<f64>,
+    pub total_mass: Vec<f64>,
+    pub momentum: Vec<[f64; 2]>,
+    pub impulse_thrust: Vec<[f64; 2]>,
+    pub impulse_pressure: Vec<[f64; 2]>,
+    pub impulse_coriolis: Vec<[f64; 2]>,
+    pub impulse_gravity: Vec<[f64; 2]>,
+    pub momentum_outflow: Vec<[f64; 2]>,
+}
+
+impl MomentumBalance {
+    /// max over samples of |P − P₀ − Σ impulses| / max |P|.
+    pub fn relative_residual(&self) -> f64 {
+        let mut worst: f64 = 0.0;
+        let mut scale: f64 = 0.0;
+        for k in 0..self.time.len() {
+            for c in 0..2 {
+                let r = self.momentum[k][c]
+                    - self.momentum[0][c]
+                    - self.impulse_thrust[k][c]
+                    - self.impulse_pressure[k][c]
+                    - self.impulse_coriolis[k][c]
+                    - self.impulse_gravity[k][c]
+                    - self.momentum_outflow[k][c];
+                worst = worst.max(r.abs());
+                scale = scale.max(self.momentum[k][c].abs());
+            }
+        }
+        if scale > 0.0 { worst / scale } else { worst }
+    }
+}
+
+/// A run with the extra accounts the generic [`RunResult`] has no place for.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DetailedRun {
+    pub run: RunResult,
+    pub balance: MomentumBalance,
+    /// Relative m₀-weighted residual of projecting the initial shape onto the basis.
+    pub initial_shape_residual: f64,
+    /// Elastic frequencies (Hz) of the constant-mass case used as the basis (axial, bending).
+    pub basis_frequencies_hz: (Vec<f64>, Vec<f64>),
+}
+
+/// Names of the channels, in recording order.
+fn channel_specs(stations: usize, masses: usize) -> Vec<(String, &'static str)> {
+    let mut v: Vec<(String, &'static str)> = vec![
+        (channel::ROCKET_X.to_string(), "length"),
+        (channel::ROCKET_Y.to_string(), "length"),
+        (channel::ROCKET_THETA.to_string(), "rad"),
+        (channel::ROCKET_MASS.to_string(), "mass"),
+        (channel::ROCKET_VX.to_string(), "length/time"),
+        (channel::ROCKET_VY.to_string(), "length/time"),
+    ];
+    for k in 0..stations {
+        v.push((channel::rocket_axial(k), "length"));
+    }
+    for k in 0..stations {
+        v.push((channel::rocket_transverse(k), "length"));
+    }
+    for j in 1..=masses {
+        v.push((channel::rocket_mass_axial(j), "length"));
+    }
+    for j in 1..=masses {
+        v.push((channel::rocket_mass_transverse(j), "length"));
+    }
+    v
+}
+
+struct Recorder<'a> {
+    model: &'a Model,
+    stations: Vec<StationModes>,
+    obs: Observables,
+    ledger: EnergyLedger,
+    balance: MomentumBalance,
+    row: Vec<f64>,
+    has_burn: bool,
+    has_masses: bool,
+    has_dampers: bool,
+}
+
+impl<'a> Recorder<'a> {
+    fn new(model: &'a Model, basis: &Basis, scene: &data::Scene) -> Recorder<'a> {
+        let ns = scene.simulation.field_stations.max(2);
+        let len = model.body.length;
+        let stations = (0..ns)
+            .map(|k| StationModes::new(basis, len * k as f64 / (ns - 1) as f64))
+            .collect::<Vec<_>>();
+        let nm = model.layout.nm;
+        let has_burn = model.body.burn.is_some();
+        let has_masses = nm > 0;
+        let has_dampers = model.body.has_dampers();
+        let mut stored = vec!["kinetic", "strain", "gravity"];
+        if has_masses {
+            stored.push("discrete_spring");
+        }
+        let inputs: Vec<&str> = if has_burn {
+            vec!["thrust", "pressure", "coriolis", "mass_outflow"]
+        } else {
+            vec![]
+        };
+        let diss: Vec<&str> = if has_dampers {
+            vec!["discrete_damper"]
+        } else {
+            vec![]
+        };
+        let specs = channel_specs(ns, nm);
+        Recorder {
+            model,
+            stations,
+            row: vec![0.0; specs.len()],
+            obs: Observables::with_channels(&specs),
+            ledger: EnergyLedger::new(&stored, &inputs, &diss),
+            balance: MomentumBalance::default(),
+            has_burn,
+            has_masses,
+            has_dampers,
+        }
+    }
+
+    fn record(&mut self, ws: &mut Workspace, t: f64, y: &[f64]) {
+        let m = self.model;
+        let l = m.layout;
+        let n = l.n;
+        let snap = snapshot(m, ws, t, y);
+        let q = &y[..l.dofs()];
+        let (a, b) = (&q[l.a()..l.a() + n], &q[l.b()..l.b() + n]);
+        let mt = snap.total_mass;
+        let mut i = 0;
+        for v in [
+            snap.centre.0,
+            snap.centre.1,
+            q[2],
+            mt,
+            snap.momentum.0 / mt,
+            snap.momentum.1 / mt,
+        ] {
+            self.row[i] = v;
+            i += 1;
+        }
+        for st in &self.stations {
+            self.row[i] = super::dense::dot(&st.u, a);
+            i += 1;
+        }
+        for st in &self.stations {
+            self.row[i] = super::dense::dot(&st.w, b);
+            i += 1;
+        }
+        for j in 0..l.nm {
+            self.row[i] = q[l.mu() + j];
+            i += 1;
+        }
+        for j in 0..l.nm {
+            self.row[i] = q[l.mw() + j];
+            i += 1;
+        }
+        self.obs.push(t, &self.row);
+
+        let qs = &y[l.quad()..];
+        let stored = [snap.kinetic, snap.strain, snap.gravity, snap.springs];
+        let inputs = [
+            qs[quad::W_THRUST],
+            qs[quad::W_PRESSURE],
+            qs[quad::W_CORIOLIS],
+            qs[quad::E_OUTFLOW],
+        ];
+        let diss = [qs[quad::W_DAMPING]];
+        // the ledger holds only the terms this scene has (see `Recorder::new`)
+        let ns = if self.has_masses { 4 } else { 3 };
+        let ni = if self.has_burn { 4 } else { 0 };
+        let nd = if self.has_dampers { 1 } else { 0 };
+        self.ledger
+            .push(t, &stored[..ns], &inputs[..ni], &diss[..nd]);
+
+        let pair = |k: usize| [qs[k], qs[k + 1]];
+        let bal = &mut self.balance;
+        bal.time.push(t);
+        bal.total_mass.push(mt);
+        bal.momentum.push([snap.momentum.0, snap.momentum.1]);
+        bal.impulse_thrust.push(pair(quad::IMP_THRUST));
+        bal.impulse_pressure.push(pair(quad::IMP_PRESSURE));
+        bal.impulse_coriolis.push(pair(quad::IMP_CORIOLIS));
+        bal.impulse_gravity.push(pair(quad::IMP_GRAVITY));
+        bal.momentum_outflow.push(pair(quad::MOM_OUTFLOW));
+    }
+}
+
+/// At most this many `StepRejected` events are listed (oscillatory runs reject a few percent of
+/// their steps); the total is always in `cost.rejected_steps`.
+const MAX_REJECTION_EVENTS: usize = 100;
+
+/// Largest elastic displacement before a run is declared run away: 5 % of the body length, far
+/// outside the small-deflection kinematics the model assumes.
+const RUNAWAY_FRACTION: f64 = 0.05;
+
+fn runaway(model: &Model, y: &[f64]) -> Option<(String, f64)> {
+    let l = model.layout;
+    let limit = RUNAWAY_FRACTION * model.body.length;
+    for (i, v) in y.iter().enumerate() {
+        if !v.is_finite() {
+            return Some((format!("state component {i}"), *v));
+        }
+    }
+    for i in l.a()..l.dofs() {
+        if y[i].abs() > limit {
+            let what = if i < l.b() {
+                format!("axial mode {}", i - l.a() + 1)
+            } else if i < l.mu() {
+                format!("bending mode {}", i - l.b() + 1)
+            } else if i < l.mw() {
+                format!("discrete mass {} axial", i - l.mu() + 1)
+            } else {
+                format!("discrete mass {} transverse", i - l.mw() + 1)
+            };
+            return Some((what, y[i]));
+        }
+    }
+    None
+}
+
+pub fn simulate_detailed(
+    scene: &data::Scene,
+    settings: &Settings,
+) -> Result<DetailedRun, RocketError> {
+    let wall = Instant::now();
+    let body = Body::from_scene(scene)?;
+    let n = config::modes(&settings.discretization)?;
+    let tc: TimeConfig = config::time(scene, settings)?;
+    let basis = Basis::new(&body, n)?;
+    let model = Model::new(body, &basis);
+    let l = model.layout;
+    let dim = l.state_len();
+
+    let mut y = initial_state(&model);
+
+    let mut f = RocketRhs {
+        model: &model,
+        ws: Workspace::new(l),
+    };
+    let mut rec_ws = Workspace::new(l);
+    let mut rec = Recorder::new(&model, &basis, scene);
+    let tol = Tolerances {
+        rtol: tc.rtol,
+        atol: tc.atol,
+    };
+    let mut stepper = Stepper::new(tc.method, dim, tol, tc.dt);
+
+    // Output grid and the one discontinuity of the loads (burn-out).
+    // the last sample is t_end itself, also when it is not a multiple of the interval
+    let samples = (tc.t_end / tc.output_interval - 1e-9).ceil().max(1.0) as usize;
+    let output_time = |k: usize| (k as f64 * tc.output_interval).min(tc.t_end);
+    let burnout = model
+        .body
+        .burn
+        .as_ref()
+        .map(|b| b.burnout_time())
+        .filter(|tb| *tb < tc.t_end);
+    let mut events = Vec::new();
+    let mut t = 0.0;
+    rec.record(&mut rec_ws, t, &y);
+    let mut next_out = 1;
+    let mut dense_buf = vec![0.0; dim];
+    let mut verdict = StabilityVerdict::Completed;
+    let mut rejected_seen = 0;
+    let mut rejection_events = 0;
+    let mut pending_burnout: Option<usize> = None;
+
+    'outer: while t < tc.t_end {
+        let t_stop = match burnout {
+            Some(tb) if t < tb => {
+                f.ws.phase = Phase::Burning;
+                tb
+            }
+            Some(_) => {
+                f.ws.phase = Phase::BurntOut;
+                tc.t_end
+            }
+            None => tc.t_end,
+        };
+        if let Err(e) = stepper.step(&mut f, &mut t, &mut y, t_stop) {
+            let (what, why, remedy) = match e {
+                IntegrateError::StepTooSmall { .. } => (
+                    "step size underflow".to_string(),
+                    e.to_string(),
+                    "loosen time.rtol/time.atol or use time.method = \"tr-bdf2\" for stiff \
+                     cases (many modes)"
+                        .to_string(),
+                ),
+                _ => (
+                    "non-finite state".to_string(),
+                    e.to_string(),
+                    "check the scene parameters; try time.method = \"tr-bdf2\"".to_string(),
+                ),
+            };
+            let why = match f.ws.failed_pivot {
+                Some((tp, p)) => format!(
+                    "{why}; reduced mass matrix lost positive definiteness at t = {tp:.6e} (pivot {p})"
+                ),
+                None => why,
+            };
+            verdict = StabilityVerdict::Stopped {
+                diagnostic: Diagnostic {
+                    t,
+                    what,
+                    location: None,
+                    why,
+                    remedy,
+                },
+            };
+            break;
+        }
+        let st = stepper.stats();
+        if st.rejected > rejected_seen && rejection_events < MAX_REJECTION_EVENTS {
+            rejection_events += 1;
+            events.push(Event::StepRejected {
+                t,
+                dt: stepper.last_step(),
+                reason: format!(
+                    "local error above tolerance: {} attempt(s) rejected before this accepted step",
+                    st.rejected - rejected_seen
+                ),
+            });
+        }
+        rejected_seen = st.rejected;
+        if let Some(idx) = pending_burnout.take()
+            && let Some(Event::StepSizeChange { to, .. }) = events.get_mut(idx)
+        {
+            *to = stepper.last_step();
+        }
+        while next_out <= samples && output_time(next_out) <= t * (1.0 + 1e-14) {
+            let to = output_time(next_out);
+            stepper.dense(to, &mut dense_buf);
+            rec.record(&mut rec_ws, to, &dense_buf);
+            next_out += 1;
+        }
+        if let Some((where_, value)) = runaway(&model, &y) {
+            verdict = StabilityVerdict::Stopped {
+                diagnostic: Diagnostic {
+                    t,
+                    what: "elastic displacement grew without bound".into(),
+                    location: Some(where_),
+                    why: format!(
+                        "value {value:.3e} exceeds {RUNAWAY_FRACTION} × body length: outside the \
+                         small-deflection model (physical instability or integration error)"
+                    ),
+                    remedy: "tighten time.rtol/time.atol or use time.method = \"tr-bdf2\"; check \
+                             stiffness and spring parameters"
+                        .into(),
+                },
+            };
+            break 'outer;
+        }
+        if burnout.is_some_and(|tb| t == tb) {
+            // Thrust, chamber pressure and internal flow end: restart the integrator's history.
+            // The event's `to` is filled in with the first step after the restart.
+            stepper.reset();
+            events.push(Event::StepSizeChange {
+                t,
+                from: stepper.last_step(),
+                to: stepper.last_step(),
+                reason: "burn-out: thrust, chamber pressure and internal flow end; integrator \
+                         restarted at the discontinuity"
+                    .into(),
+            });
+            pending_burnout = Some(events.len() - 1);
+        }
+    }
+    let st = stepper.stats();
+    let cost = Cost {
+        wall_time_s: wall.elapsed().as_secs_f64(),
+        dofs: l.dofs(),
+        steps: st.steps,
+        rejected_steps: st.rejected,
+        rhs_evaluations: st.rhs_evals,
+        jacobian_evaluations: st.jacobian_evals,
+        factorizations: st.factorizations,
+        newton_iterations: st.newton_iters,
+    };
+    let hz = |w: &Vec<f64>| w.iter().map(|w| w / (2.0 * std::f64::consts::PI)).collect();
+    Ok(DetailedRun {
+        run: RunResult {
+            backend: BackendKind::Modal,
+            scene: scene.name.clone(),
+            settings: settings.clone(),
+            observables: rec.obs,
+            ledger: rec.ledger,
+            events,
+            cost,
+            verdict,
+        },
+        balance: rec.balance,
+        initial_shape_residual: model.initial_shape_residual,
+        basis_frequencies_hz: (hz(&model.omega_axial), hz(&model.omega_bending)),
+    })
+}

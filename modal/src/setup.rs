@@ -1,0 +1,271 @@
+//! Scene + settings → assumed-mode chain model (bases, integrals, joints), and the DOF plan.
+
+use data::scene::Link;
+use data::{Basis, Discretization, DofPlan, Family, Scene};
+
+use crate::basis::ShapeSet;
+use crate::error::ModalError;
+use crate::model::{Chain, JointModel, LinkIntegrals, LinkModel};
+
+/// Modes per link and field when `--modes` is absent.
+pub const DEFAULT_MODES: usize = 6;
+/// Largest accepted `--modes` (the eigenfunction bases stay accurate well beyond this; the
+/// bound keeps set-up and the dense O(N³) solves small).
+pub const MAX_MODES: usize = 40;
+
+/// What a chain model is built for (modes of a spinning extensible link are not supported).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Purpose {
+    Dynamics,
+    Modes,
+}
+
+/// Rejects what this backend does not build for planar chains, with a precise message.
+pub fn check_supported(scene: &Scene, purpose: Purpose) -> Result<(), ModalError> {
+    if scene.family() != Family::PlanarChain {
+        return Err(ModalError::Unsupported(format!(
+            "modal: the {} family is not a planar chain",
+            scene.family()
+        )));
+    }
+    if scene.links.is_empty() {
+        return Err(ModalError::Unsupported("modal: scene has no links".into()));
+    }
+    if !scene.contacts.is_empty() {
+        return Err(ModalError::Unsupported(format!(
+            "modal: contact of link `{}` with a rigid surface (impact/constraint phases are not \
+             implemented in the modal backend yet)",
+            scene.contacts[0].link
+        )));
+    }
+    for (i, l) in scene.links.iter().enumerate() {
+        if l.shear || l.rotary_inertia {
+            return Err(ModalError::Unsupported(format!(
+                "modal: Timoshenko shear/rotary inertia on link {} (`{}`): no shear modes in the \
+                 assumed-mode basis",
+                i + 1,
+                l.name
+            )));
+        }
+        let spinning = l
+            .joint
+            .prescribed
+            .as_ref()
+            .is_some_and(|p| p.kinematics(0.0).1 != 0.0);
+        if l.axial && purpose == Purpose::Modes && spinning {
+            return Err(ModalError::Unsupported(format!(
+                "modal: modes of the spinning extensible link {} (`{}`) need the centrifugally \
+                 stretched steady state and gyroscopic terms, which are not implemented",
+                i + 1,
+                l.name
+            )));
+        }
+        if l.axial && l.foreshortening {
+            return Err(ModalError::Unsupported(format!(
+                "modal: link {} has both `axial` and `foreshortening`; choose one",
+                i + 1
+            )));
+        }
+        if l.axial && l.axial_stiffness.is_none() {
+            return Err(ModalError::Unsupported(format!(
+                "modal: link {} has `axial` on but no `axial_stiffness`",
+                i + 1
+            )));
+        }
+        if i > 0 && l.joint.prescribed.is_some() {
+            return Err(ModalError::Unsupported(format!(
+                "modal: prescribed motion of joint {} (only the hub joint may be prescribed)",
+                i + 1
+            )));
+        }
+    }
+    Ok(())
+}
+
+pub fn modes_per_link(disc: &Discretization) -> Result<usize, ModalError> {
+    let n = disc.modes.unwrap_or(DEFAULT_MODES);
+    if n == 0 || n > MAX_MODES {
+        return Err(ModalError::invalid(
+            "discretization.modes",
+            format!("{n} modes per link: must be between 1 and {MAX_MODES}"),
+        ));
+    }
+    Ok(n)
+}
+
+pub fn basis_choice(scene: &Scene, disc: &Discretization) -> Result<Basis, ModalError> {
+    let basis = disc.basis.unwrap_or(Basis::ClampedFree);
+    match basis {
+        Basis::FreeFree => Err(ModalError::invalid(
+            "discretization.basis",
+            "`free-free` is the rocket's basis; links are clamped to their frames: use \
+             `clamped-free`, `tip-mass` or `poly`",
+        )),
+        Basis::TipMass => {
+            if let Some(l) = scene
+                .links
+                .iter()
+                .find(|l| l.tip_mass.is_none() && l.tip_inertia.is_none())
+            {
+                Err(ModalError::invalid(
+                    "discretization.basis",
+                    format!(
+                        "`tip-mass` needs a tip mass or tip inertia on every link; link `{}` has none",
+                        l.name
+                    ),
+                ))
+            } else {
+                Ok(basis)
+            }
+        }
+        _ => Ok(basis),
+    }
+}
+
+fn shapes(link: &Link, index: usize, basis: Basis, n: usize) -> Result<ShapeSet, ModalError> {
+    let l = link.length;
+    match basis {
+        Basis::Poly => Ok(ShapeSet::poly(l, n)),
+        Basis::ClampedFree => ShapeSet::clamped_free(l, n).map_err(|source| ModalError::Basis {
+            link: index + 1,
+            source,
+        }),
+        Basis::TipMass => {
+            let m = link.beam_mass();
+            let mu = link.tip_mass.unwrap_or(0.0) / m;
+            let j = link.tip_inertia.unwrap_or(0.0) / (m * l * l);
+            ShapeSet::tip_mass(l, n, mu, j).map_err(|source| ModalError::Basis {
+                link: index + 1,
+                source,
+            })
+        }
+        Basis::FreeFree => unreachable!("rejected by basis_choice"),
+    }
+}
+
+/// Builds the chain model. Everything the scene leaves off is not allocated: no foreshortening
+/// integrals without `foreshortening`, no tip terms without a tip mass, no gravity force without
+/// `[gravity]`.
+pub fn build_chain(scene: &Scene, disc: &Discretization) -> Result<Chain, ModalError> {
+    build_chain_for(scene, disc, Purpose::Dynamics)
+}
+
+/// Axial shapes matching the transverse basis: clamped-free bar modes √2 sin((2k−1)πx/2L)
+/// (exact for the bar without tip mass), or ξ·Pₖ(2ξ−1) for `poly`.
+fn axial_shapes(link: &Link, basis: Basis, n: usize) -> ShapeSet {
+    match basis {
+        Basis::Poly => ShapeSet::axial_poly(link.length, n),
+        _ => ShapeSet::axial_sine(link.length, n),
+    }
+}
+
+pub fn build_chain_for(
+    scene: &Scene,
+    disc: &Discretization,
+    purpose: Purpose,
+) -> Result<Chain, ModalError> {
+    check_supported(scene, purpose)?;
+    let n = modes_per_link(disc)?;
+    let basis = basis_choice(scene, disc)?;
+    let mut links = Vec::new();
+    let mut joints = Vec::new();
+    let mut offset = 0;
+    for (i, l) in scene.links.iter().enumerate() {
+        let transverse = shapes(l, i, basis, n)?;
+        let axial = l.axial.then(|| axial_shapes(l, basis, n));
+        let ints = LinkIntegrals::new(
+            l.length,
+            l.mass_per_length,
+            l.bending_stiffness,
+            l.axial_stiffness.unwrap_or(0.0),
+            &transverse,
+            axial.as_ref(),
+            l.foreshortening,
+        );
+        let na = axial.as_ref().map_or(0, |a| a.count());
+        let theta = offset;
+        let a0 = offset + 1;
+        let b0 = a0 + na;
+        offset = b0 + n;
+        links.push(LinkModel {
+            name: l.name.clone(),
+            transverse,
+            axial,
+            ints,
+            foreshortening: l.foreshortening,
+            tip_mass: l.tip_mass.unwrap_or(0.0),
+            tip_inertia: l.tip_inertia.unwrap_or(0.0),
+            hub_inertia: l.joint.hub_inertia.unwrap_or(0.0),
+            kv_ratio: l.kelvin_voigt.map_or(0.0, |g| g / l.bending_stiffness),
+            theta,
+            a0,
+            b0,
+        });
+        let j = &l.joint;
+        joints.push(JointModel {
+            initial_angle: j.initial_angle,
+            initial_rate: j.initial_rate,
+            stiffness: j.stiffness.unwrap_or(0.0),
+            set_point: j.set_point.unwrap_or(0.0),
+            damping: j.damping.unwrap_or(0.0),
+            torque: j.torque.clone(),
+            prescribed: j.prescribed.clone(),
+        });
+    }
+    let gravity = scene.gravity.as_ref().map(|g| g.vector);
+    Ok(Chain::new(links, joints, gravity))
+}
+
+/// The DOFs of the model (the axial field is listed when on; simulate then reports Unsupported).
+pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalError> {
+    check_supported(scene, Purpose::Modes)?;
+    let n = modes_per_link(disc)?;
+    let basis = basis_choice(scene, disc)?;
+    let mut plan = DofPlan::default();
+    for (i, l) in scene.links.iter().enumerate() {
+        let k = i + 1;
+        if l.joint.prescribed.is_none() {
+            plan.add(format!("joint{k} angle"), 1);
+        }
+        if l.axial {
+            plan.add(format!("link{k} axial modes"), n);
+            plan.builds
+                .push(format!("link{k}: axial field, von Kármán strain u' + ½v'²"));
+        }
+        plan.add(format!("link{k} transverse modes ({})", basis.name()), n);
+        if l.foreshortening {
+            plan.builds
+                .push(format!("link{k}: foreshortening (centrifugal) stiffening"));
+        }
+        if l.tip_mass.is_some() {
+            plan.builds.push(format!("link{k}: tip mass"));
+        }
+        if l.tip_inertia.is_some() {
+            plan.builds.push(format!("link{k}: tip inertia"));
+        }
+        if l.kelvin_voigt.is_some() {
+            plan.builds.push(format!("link{k}: Kelvin-Voigt damping"));
+        }
+        let j = &l.joint;
+        if j.hub_inertia.is_some() {
+            plan.builds.push(format!("joint{k}: hub inertia"));
+        }
+        if j.stiffness.is_some_and(|v| v > 0.0) {
+            plan.builds.push(format!("joint{k}: spring"));
+        }
+        if j.damping.is_some_and(|v| v > 0.0) {
+            plan.builds.push(format!("joint{k}: damper"));
+        }
+        if j.torque.is_some() {
+            plan.builds.push(format!("joint{k}: applied torque"));
+        }
+        if j.prescribed.is_some() {
+            plan.builds
+                .push(format!("joint{k}: prescribed motion (torque reported)"));
+        }
+    }
+    if scene.gravity.is_some() {
+        plan.builds.push("gravity".into());
+    }
+    Ok(plan)
+}

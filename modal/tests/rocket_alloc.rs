@@ -1,0 +1,54 @@
+//! The rocket's right-hand side and integration steps perform no heap allocation (counting
+//! global allocator; this binary holds only this test so nothing else allocates meanwhile).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use data::{Settings, load_scene};
+use modal::integrate::{Dopri5, OdeRhs, Tolerances};
+use modal::rocket::RocketOde;
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn dyn_rocket_rhs_and_steps_do_not_allocate() {
+    let scene = load_scene("rocket").unwrap();
+    let mut ode = RocketOde::new(&scene, &Settings::default()).unwrap();
+    let mut y = ode.initial_state();
+    let mut dydt = vec![0.0; ode.dim()];
+    let mut s = Dopri5::new(
+        ode.dim(),
+        Tolerances {
+            rtol: 1e-8,
+            atol: 1e-10,
+        },
+        None,
+        None,
+    );
+    let mut t = 0.0;
+    s.step(&mut ode, &mut t, &mut y, 0.01).unwrap(); // warm-up
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    for k in 0..50 {
+        ode.eval(1e-3 * k as f64, &y, &mut dydt);
+    }
+    for _ in 0..50 {
+        s.step(&mut ode, &mut t, &mut y, 0.01).unwrap();
+    }
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert_eq!(after - before, 0, "allocations in the step loop");
+    assert!(t > 0.0 && dydt.iter().all(|v| v.is_finite()));
+}
