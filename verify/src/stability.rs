@@ -4,8 +4,9 @@
 //! * `bounded` — reached t_end, every output finite, energy ledger closed to 1e-3 relative;
 //! * `stopped` — the backend refused or stopped early with a diagnostic (what, when, why, remedy);
 //! * `unsupported` — the backend says it cannot do the scene (not a failure, reported);
-//! * `BLEW UP UNDETECTED` — non-finite output, or a ledger residual above 10 % presented as a
-//!   completed run: a failure of ours (exit status 1).
+//! * `BLEW UP UNDETECTED` — non-finite output presented as a result, or
+//!   `SILENT FAILURE` — a completed run whose energy ledger is off by more than 10 %: both are
+//!   failures of ours (exit status 1).
 //!
 //! With `probe_bound`, explicit schemes are also run at 0.99 and 1.01 times the smallest
 //! stability bound they reported: the first must complete, the second must be refused.
@@ -142,7 +143,7 @@ fn judge(case: &data::cases::StabilityCase, kind: BackendKind) -> Vec<Verdict> {
                     out.push(mk("stopped", diagnostic.to_string(), false, wall))
                 }
                 (StabilityVerdict::Completed, None) if closure > LEDGER_BLOWN => out.push(mk(
-                    "BLEW UP UNDETECTED",
+                    "SILENT FAILURE",
                     format!("completed, but the energy ledger is off by {closure:.2e} relative"),
                     true,
                     wall,
@@ -158,6 +159,14 @@ fn judge(case: &data::cases::StabilityCase, kind: BackendKind) -> Vec<Verdict> {
                     wall,
                 )),
             }
+        }
+    }
+    if case.probe_bound && bound.is_none() {
+        // Schemes that check their bound at set-up report it in the refusal of a huge step.
+        let mut s = settings.clone();
+        s.time.dt = Some(scene.simulation.t_end);
+        if let Err(BackendError::StabilityBound { bound: b, .. }) = b.simulate(&scene, &s) {
+            bound = Some(b);
         }
     }
     if case.probe_bound

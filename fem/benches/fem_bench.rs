@@ -1,0 +1,77 @@
+//! Criterion benches: assembly (residual + Newton matrix), one generalized-α step, and the full
+//! 20 s spin-up, for 4–64 elements.
+//! Run: `CARGO_TARGET_DIR=/work/targets/fem cargo bench -p fem --bench fem_bench -- --quick`
+
+use std::hint::black_box;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use data::{Backend, Settings};
+use fem::FemBackend;
+use fem::chain::{Chain, NewtonCoefficients};
+use fem::run::prepare;
+
+const MESHES: [usize; 5] = [4, 8, 16, 32, 64];
+
+fn settings(n: usize, dt: f64) -> Settings {
+    let mut s = Settings::default();
+    s.discretization.elements = Some(n);
+    s.time.dt = Some(dt);
+    s
+}
+
+fn assembly(c: &mut Criterion) {
+    let sc = data::load_scene("spin-up").unwrap();
+    let mut g = c.benchmark_group("assembly");
+    for n in MESHES {
+        let mut ch = Chain::new(&sc.links, None, n).unwrap();
+        let nd = ch.ndof;
+        let q: Vec<f64> = (0..nd).map(|i| 1e-3 * (i as f64).sin()).collect();
+        let qd = vec![0.1; nd];
+        let qdd = vec![0.2; nd];
+        let mut r = vec![0.0; nd];
+        let mut s = ch.new_matrix();
+        let coef = NewtonCoefficients {
+            c_a: 1.0,
+            c_v: 5e-3,
+            c_q: 2.5e-5,
+        };
+        g.bench_with_input(BenchmarkId::new("residual+newton_matrix", n), &n, |b, _| {
+            b.iter(|| {
+                ch.residual(black_box(3.0), &q, &qd, &qdd, &mut r);
+                ch.newton_matrix(&q, coef, &mut s);
+                s.factorize().unwrap();
+                black_box(&r);
+            })
+        });
+    }
+    g.finish();
+}
+
+fn one_step(c: &mut Criterion) {
+    let sc = data::load_scene("spin-up").unwrap();
+    let mut g = c.benchmark_group("step");
+    for n in MESHES {
+        let mut p = prepare(&sc, &settings(n, 1e-2)).unwrap();
+        p.integrator.set_stop(1e9);
+        g.bench_with_input(BenchmarkId::new("generalized-alpha", n), &n, |b, _| {
+            b.iter(|| black_box(p.integrator.step().unwrap()))
+        });
+    }
+    g.finish();
+}
+
+fn spin_up(c: &mut Criterion) {
+    let sc = data::load_scene("spin-up").unwrap();
+    let mut g = c.benchmark_group("spin-up-20s-dt1e-2");
+    g.sample_size(10);
+    for n in MESHES {
+        let st = settings(n, 1e-2);
+        g.bench_with_input(BenchmarkId::new("simulate", n), &n, |b, _| {
+            b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, assembly, one_step, spin_up);
+criterion_main!(benches);

@@ -1,0 +1,80 @@
+//! DOF plan: what the backend builds for a scene (reported by `describe`, asserted in tests).
+
+use data::{DofPlan, Scene};
+
+use crate::error::FemError;
+use crate::support::check_planar;
+
+/// DOFs per field and the physics built, for `n_el` elements per link.
+pub fn dof_plan(scene: &Scene, n_el: usize) -> Result<DofPlan, FemError> {
+    check_planar(scene)?;
+    let mut plan = DofPlan::default();
+    for (i, l) in scene.links.iter().enumerate() {
+        let li = i + 1;
+        if l.joint.prescribed.is_none() {
+            plan.add(format!("joint{li} angle"), 1);
+        }
+        plan.add(format!("link{li} transverse v"), n_el);
+        if l.shear {
+            plan.add(format!("link{li} section rotation θ"), n_el);
+        } else {
+            plan.add(format!("link{li} slope v′"), n_el);
+        }
+        if l.axial {
+            plan.add(format!("link{li} axial u"), n_el);
+        }
+        let mut b = vec![format!(
+            "link{li}: {} beam, {n_el} elements (Hermite cubic v{})",
+            if l.shear {
+                "Timoshenko (IIE)"
+            } else {
+                "Euler–Bernoulli"
+            },
+            if l.axial { ", linear u" } else { "" }
+        )];
+        if l.axial {
+            b.push(format!("link{li}: von Kármán strain u′ + ½v′²"));
+        }
+        if l.foreshortening {
+            b.push(format!("link{li}: foreshortening stiffening s = −½∫v′²"));
+        }
+        if !l.axial && !l.foreshortening {
+            b.push(format!("link{li}: linear model (no geometric stiffening)"));
+        }
+        if l.rotary_inertia {
+            b.push(format!("link{li}: rotary inertia ρI"));
+        }
+        if l.kelvin_voigt.is_some_and(|g| g > 0.0) {
+            b.push(format!("link{li}: Kelvin–Voigt bending damping"));
+        }
+        if l.tip_mass.is_some_and(|m| m > 0.0) {
+            b.push(format!("link{li}: tip mass"));
+        }
+        if l.tip_inertia.is_some_and(|j| j > 0.0) {
+            b.push(format!("link{li}: tip inertia"));
+        }
+        let j = &l.joint;
+        if j.hub_inertia.is_some_and(|x| x > 0.0) {
+            b.push(format!("joint{li}: hub inertia"));
+        }
+        if j.stiffness.is_some_and(|x| x > 0.0) {
+            b.push(format!("joint{li}: spring"));
+        }
+        if j.damping.is_some_and(|x| x > 0.0) {
+            b.push(format!("joint{li}: damper"));
+        }
+        if j.torque.is_some() {
+            b.push(format!("joint{li}: applied torque law"));
+        }
+        if j.prescribed.is_some() {
+            b.push(format!(
+                "joint{li}: prescribed motion (reports required torque)"
+            ));
+        }
+        plan.builds.extend(b);
+    }
+    if scene.gravity.is_some() {
+        plan.builds.push("gravity".into());
+    }
+    Ok(plan)
+}

@@ -1,0 +1,357 @@
+//! `simulate`: builds the chain, chooses the step, drives the stepper and samples observables and
+//! the energy ledger at the scene's output interval.
+
+use std::time::Instant;
+
+use data::{
+    Cost, Diagnostic, EnergyLedger, Event, Observables, RunResult, Scene, Settings,
+    StabilityVerdict, channel,
+};
+
+use crate::chain::{Chain, NONE};
+use crate::error::FemError;
+use crate::integrator::{Adaptive, Integrator, StopReason};
+use crate::settings::{self, Method};
+use crate::support::check_planar;
+
+/// Safety factor below the central-difference bound when the backend picks the step.
+pub const DEFAULT_SAFETY: f64 = 0.9;
+/// Default step: this many steps per period of the stiffest link's first clamped-free bending
+/// mode (ω₁ = (β₁L)²·sqrt(EI/ρA L⁴), β₁L = 1.8751…), and never more than the output interval.
+pub const STEPS_PER_PERIOD: f64 = 40.0;
+
+/// Root of cos x cosh x + 1 = 0 near 1.875 (first clamped-free eigenvalue), by bisection.
+pub fn clamped_free_beta1() -> f64 {
+    let f = |x: f64| x.cos() * x.cosh() + 1.0;
+    let (mut a, mut b) = (1.5, 2.2);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if f(a) * f(m) <= 0.0 {
+            b = m;
+        } else {
+            a = m;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// Generalized-α spectral radius: 1 (trapezoidal, exactly energy-conserving for linear systems,
+/// what the ledger checks need) unless a link is extensible, where ρ∞ = 0.9 damps the spurious
+/// high axial frequencies (EA/EI ≫ 1) that the time step cannot resolve.
+pub fn default_rho_inf(scene: &Scene) -> f64 {
+    if scene.links.iter().any(|l| l.axial) {
+        0.9
+    } else {
+        1.0
+    }
+}
+
+/// Everything `simulate` needs, built once (benches reuse it).
+pub struct Prepared {
+    pub integrator: Integrator,
+    pub t_end: f64,
+    pub output_interval: f64,
+    pub stations: usize,
+    pub h_nominal: f64,
+}
+
+/// Builds the chain and the stepper for a scene and settings (step chosen per the documented rule).
+pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
+    check_planar(scene)?;
+    let n_el = settings::elements(&settings.discretization)?;
+    let method = settings::method(&settings.time)?;
+    let dt_user = settings::positive("time.dt", settings.time.dt)?;
+    let rtol = settings::positive("time.rtol", settings.time.rtol)?;
+    let atol = settings::positive("time.atol", settings.time.atol)?;
+    let t_end =
+        settings::positive("time.t_end", settings.time.t_end)?.unwrap_or(scene.simulation.t_end);
+    let safety = settings.time.safety_factor.unwrap_or(DEFAULT_SAFETY);
+    if !(safety > 0.0 && safety <= 1.0) {
+        return Err(FemError::InvalidSettings {
+            field: "time.safety_factor".into(),
+            message: format!("must lie in (0, 1], got {safety}"),
+        });
+    }
+    if rtol.is_some() && method == Method::CentralDifference {
+        return Err(FemError::InvalidSettings {
+            field: "time.rtol".into(),
+            message: "adaptive stepping is available with generalized-alpha only".into(),
+        });
+    }
+    let mut chain = Chain::new(&scene.links, scene.gravity.as_ref(), n_el)?;
+    if let Some(st) = &scene.statics {
+        // The scene's static loads act as a step load in dynamics (scene `cantilever`: the
+        // response oscillates about the static deflection).
+        chain.tip_load = st.tip_force.unwrap_or(0.0);
+        chain.distributed_load = st.distributed_load.unwrap_or(0.0);
+    }
+    let out = scene.simulation.output_interval;
+    let beta1 = clamped_free_beta1();
+    let omega1 = scene
+        .links
+        .iter()
+        .map(|l| {
+            beta1 * beta1 * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt()
+        })
+        .fold(0.0f64, f64::max);
+    let h_rule = 2.0 * std::f64::consts::PI / (STEPS_PER_PERIOD * omega1);
+    let mut integ = Integrator::new(chain, method, h_rule.min(out), default_rho_inf(scene))?;
+    let h_nominal = match method {
+        Method::GeneralizedAlpha => {
+            let h = dt_user.unwrap_or_else(|| fit(h_rule.min(out), out));
+            if let Some(rtol) = rtol {
+                integ.adaptive = Some(Adaptive {
+                    rtol,
+                    atol: atol.unwrap_or(rtol * 1e-3 * integ.length_scale),
+                });
+            }
+            h
+        }
+        Method::CentralDifference => {
+            let (w, dof) = integ.max_frequency()?;
+            let bound = 2.0 / w;
+            let location = integ.chain.describe_dof(dof);
+            match dt_user {
+                Some(dt) if dt > bound => {
+                    return Err(FemError::StabilityBound {
+                        dt,
+                        bound,
+                        bound_kind: "central-difference (2/ω_max)".into(),
+                        location,
+                    });
+                }
+                Some(dt) => dt,
+                None => fit(safety * bound, out),
+            }
+        }
+    };
+    integ.h = h_nominal;
+    integ.h_nominal = h_nominal;
+    Ok(Prepared {
+        integrator: integ,
+        t_end,
+        output_interval: out,
+        stations: scene.simulation.field_stations.max(2),
+        h_nominal,
+    })
+}
+
+/// Largest step ≤ h that divides the output interval evenly.
+fn fit(h: f64, out: f64) -> f64 {
+    if h >= out {
+        out
+    } else {
+        out / (out / h).ceil()
+    }
+}
+
+/// Channel layout of the observables.
+fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, &'static str)> {
+    let mut specs = Vec::new();
+    for (i, l) in chain.links.iter().enumerate() {
+        let k = i + 1;
+        specs.push((channel::joint_angle(k), "rad"));
+        specs.push((channel::joint_rate(k), "rad/time"));
+        specs.push((channel::joint_torque(k), "force·length"));
+        specs.push((channel::tip_x(k), "length"));
+        specs.push((channel::tip_y(k), "length"));
+        specs.push((channel::tip_deflection(k), "length"));
+        if l.axial {
+            specs.push((channel::tip_axial(k), "length"));
+        }
+        for s in 0..stations {
+            specs.push((channel::field_deflection(k, s), "length"));
+        }
+    }
+    let _ = scene;
+    specs
+}
+
+/// Samples the observables at the integrator's current state into `buf`.
+fn sample(integ: &Integrator, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<f64>) {
+    buf.clear();
+    let ch = &integ.chain;
+    ch.tip_positions(integ.t, &integ.q, tips);
+    for (i, l) in ch.links.iter().enumerate() {
+        let (th, rate) = ch.joint_state(i, integ.t, &integ.q, &integ.qd);
+        buf.push(th);
+        buf.push(rate);
+        buf.push(ch.joint_torque[i]);
+        buf.push(tips[i][0]);
+        buf.push(tips[i][1]);
+        buf.push(ch.tip_deflection(i, &integ.q));
+        if l.axial {
+            buf.push(ch.tip_axial(i, &integ.q));
+        }
+        for s in 0..stations {
+            let x = l.length * s as f64 / (stations - 1) as f64;
+            buf.push(ch.deflection(i, &integ.q, x));
+        }
+    }
+}
+
+/// Names of the ledger terms the scene needs.
+fn ledger_terms(chain: &Chain) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
+    let mut stored = vec!["kinetic", "strain"];
+    if chain.links.iter().any(|l| l.joint.stiffness > 0.0) {
+        stored.push("joint_spring");
+    }
+    if chain.gravity != [0.0, 0.0] {
+        stored.push("gravity");
+    }
+    let mut inputs = Vec::new();
+    if chain.tip_load != 0.0 || chain.distributed_load != 0.0 {
+        inputs.push("applied_load");
+    }
+    if chain.links.iter().any(|l| l.joint.torque.is_some()) {
+        inputs.push("applied_torque");
+    }
+    if chain.links.iter().any(|l| l.joint.dof == NONE) {
+        inputs.push("prescribed_motion");
+    }
+    let mut diss = Vec::new();
+    if chain.links.iter().any(|l| l.joint.damping > 0.0) {
+        diss.push("joint_damper");
+    }
+    if chain.links.iter().any(|l| l.kelvin_voigt > 0.0) {
+        diss.push("kelvin_voigt");
+    }
+    (stored, inputs, diss)
+}
+
+fn push_ledger(integ: &Integrator, ledger: &mut EnergyLedger) {
+    let [kin, strain, spring, grav] = integ.chain.energies(integ.t, &integ.q, &integ.qd);
+    let mut stored = [0.0; 4];
+    let mut ns = 0;
+    for term in &ledger.stored {
+        stored[ns] = match term.name.as_str() {
+            "kinetic" => kin,
+            "strain" => strain,
+            "joint_spring" => spring,
+            _ => grav,
+        };
+        ns += 1;
+    }
+    let w = integ.works;
+    let mut inputs = [0.0; 3];
+    for (k, term) in ledger.inputs.iter().enumerate() {
+        inputs[k] = match term.name.as_str() {
+            "applied_torque" => w.applied_torque,
+            "applied_load" => w.applied_load,
+            _ => w.prescribed_motion,
+        };
+    }
+    let mut diss = [0.0; 2];
+    for (k, term) in ledger.dissipation.iter().enumerate() {
+        diss[k] = if term.name == "joint_damper" {
+            w.joint_damper
+        } else {
+            w.kelvin_voigt
+        };
+    }
+    let (ni, nd) = (ledger.inputs.len(), ledger.dissipation.len());
+    ledger.push(integ.t, &stored[..ns], &inputs[..ni], &diss[..nd]);
+}
+
+/// Runs a scene to t_end; early stops become a `Stopped` verdict with the output so far.
+pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemError> {
+    let start = Instant::now();
+    let Prepared {
+        integrator: mut integ,
+        t_end,
+        output_interval,
+        stations,
+        h_nominal,
+    } = prepare(scene, settings)?;
+    let specs = channel_specs(scene, &integ.chain, stations);
+    let mut obs = Observables::with_channels(&specs);
+    let (s, i, d) = ledger_terms(&integ.chain);
+    let mut ledger = EnergyLedger::new(&s, &i, &d);
+    let mut events = Vec::new();
+    let mut tips = vec![[0.0; 2]; integ.chain.links.len()];
+    let n_out = (t_end / output_interval - 1e-9).ceil().max(1.0) as usize;
+    let mut buf = Vec::with_capacity(specs.len());
+    sample(&integ, stations, &mut tips, &mut buf);
+    obs.push(0.0, &buf);
+    push_ledger(&integ, &mut ledger);
+    let mut verdict = StabilityVerdict::Completed;
+    'outer: for k in 1..=n_out {
+        let t_stop = (k as f64 * output_interval).min(t_end);
+        integ.set_stop(t_stop);
+        loop {
+            let h_before = integ.h;
+            match integ.step() {
+                Ok(StopReason::ReachedStop) => break,
+                Ok(StopReason::Stepped) => {}
+                Ok(StopReason::Rejected) => {
+                    events.push(Event::StepRejected {
+                        t: integ.t,
+                        dt: h_before,
+                        reason: if integ.adaptive.is_some() {
+                            "local error estimate above tolerance or Newton failure".into()
+                        } else {
+                            "Newton iteration failed; retried with a quarter step".into()
+                        },
+                    });
+                }
+                Err(FemError::Runaway {
+                    t,
+                    what,
+                    location,
+                    why,
+                    remedy,
+                }) => {
+                    verdict = StabilityVerdict::Stopped {
+                        diagnostic: Diagnostic {
+                            t,
+                            what,
+                            location,
+                            why,
+                            remedy,
+                        },
+                    };
+                    break 'outer;
+                }
+                Err(FemError::Singular { what, pivot, t }) => {
+                    verdict = StabilityVerdict::Stopped {
+                        diagnostic: Diagnostic {
+                            t,
+                            what: format!("singular {what} matrix"),
+                            location: Some(
+                                integ.chain.describe_dof(pivot.min(integ.chain.ndof - 1)),
+                            ),
+                            why: "the iteration matrix lost definiteness".into(),
+                            remedy: "reduce --dt".into(),
+                        },
+                    };
+                    break 'outer;
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        sample(&integ, stations, &mut tips, &mut buf);
+        obs.push(integ.t, &buf);
+        push_ledger(&integ, &mut ledger);
+    }
+    let c = integ.counters;
+    let _ = h_nominal;
+    Ok(RunResult {
+        backend: data::BackendKind::Fem,
+        scene: scene.name.clone(),
+        settings: settings.clone(),
+        observables: obs,
+        ledger,
+        events,
+        cost: Cost {
+            wall_time_s: start.elapsed().as_secs_f64(),
+            dofs: integ.chain.ndof,
+            steps: c.steps,
+            rejected_steps: c.rejected,
+            rhs_evaluations: c.rhs,
+            jacobian_evaluations: c.jacobians,
+            factorizations: c.factorizations,
+            newton_iterations: c.newton,
+        },
+        verdict,
+    })
+}

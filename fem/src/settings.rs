@@ -1,0 +1,52 @@
+//! The FEM backend's reading of [`data::Settings`].
+
+use crate::error::FemError;
+
+/// Elements per link when `discretization.elements` is absent.
+pub const DEFAULT_ELEMENTS: usize = 16;
+/// Largest accepted element count per link (keeps dense modal analysis and memory bounded).
+pub const MAX_ELEMENTS: usize = 20_000;
+
+/// Time-integration method names accepted in `time.method`.
+pub const METHODS: [&str; 2] = ["generalized-alpha", "central-difference"];
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// Implicit generalized-α (Chung–Hulbert, Arnold–Brüls form) with Newton iterations.
+    GeneralizedAlpha,
+    /// Explicit central difference (velocity-Verlet form) under its stability bound.
+    CentralDifference,
+}
+
+pub fn elements(disc: &data::Discretization) -> Result<usize, FemError> {
+    let n = disc.elements.unwrap_or(DEFAULT_ELEMENTS);
+    if n == 0 || n > MAX_ELEMENTS {
+        return Err(FemError::InvalidSettings {
+            field: "discretization.elements".into(),
+            message: format!("{n} elements per link; accepted 1..={MAX_ELEMENTS}"),
+        });
+    }
+    Ok(n)
+}
+
+pub fn method(time: &data::TimeStepping) -> Result<Method, FemError> {
+    match time.method.as_deref() {
+        None | Some("generalized-alpha") => Ok(Method::GeneralizedAlpha),
+        Some("central-difference") => Ok(Method::CentralDifference),
+        Some(other) => Err(FemError::InvalidSettings {
+            field: "time.method".into(),
+            message: format!("unknown method `{other}`; accepted: {}", METHODS.join(", ")),
+        }),
+    }
+}
+
+/// Checks a user-given positive finite number.
+pub fn positive(field: &str, v: Option<f64>) -> Result<Option<f64>, FemError> {
+    match v {
+        Some(x) if !(x.is_finite() && x > 0.0) => Err(FemError::InvalidSettings {
+            field: field.into(),
+            message: format!("must be positive and finite, got {x}"),
+        }),
+        other => Ok(other),
+    }
+}

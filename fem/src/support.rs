@@ -1,0 +1,61 @@
+//! What the FEM backend can build: precise `unsupported` messages for everything else.
+
+use data::{Family, Scene};
+
+use crate::error::FemError;
+
+/// Planar chains without contact; every other family or feature is refused by name.
+pub fn check_planar(scene: &Scene) -> Result<(), FemError> {
+    match scene.family() {
+        Family::PlanarChain => {}
+        other => {
+            return Err(FemError::unsupported(format!(
+                "fem: the {other} family (scene `{}`) is not implemented; only planar link chains",
+                scene.name
+            )));
+        }
+    }
+    if !scene.contacts.is_empty() {
+        return Err(FemError::unsupported(format!(
+            "fem: contact (scene `{}`: tip of `{}` against a rigid surface) is not implemented yet; \
+             the stepper stops on events so it can be added",
+            scene.name, scene.contacts[0].link
+        )));
+    }
+    if scene.links.is_empty() {
+        return Err(FemError::unsupported("fem: scene has no links".to_string()));
+    }
+    for (i, l) in scene.links.iter().enumerate() {
+        if l.axial && l.foreshortening {
+            return Err(FemError::unsupported(format!(
+                "fem: link {} has both `axial` and `foreshortening`; choose one stiffening model",
+                i + 1
+            )));
+        }
+        if l.axial && l.axial_stiffness.is_none() {
+            return Err(FemError::unsupported(format!(
+                "fem: link {} has `axial` without `axial_stiffness`",
+                i + 1
+            )));
+        }
+        if l.shear && l.shear_stiffness.is_none() {
+            return Err(FemError::unsupported(format!(
+                "fem: link {} has `shear` without `shear_stiffness`",
+                i + 1
+            )));
+        }
+        if l.rotary_inertia && l.rotary_inertia_per_length.is_none() {
+            return Err(FemError::unsupported(format!(
+                "fem: link {} has `rotary_inertia` without `rotary_inertia_per_length`",
+                i + 1
+            )));
+        }
+        if l.shear && (l.axial || l.foreshortening) {
+            return Err(FemError::unsupported(format!(
+                "fem: link {}: Timoshenko shear combined with geometric stiffening is not implemented",
+                i + 1
+            )));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,179 @@
+//! Analytic references computed by code (root finding to 1e-12), shared by the test files.
+#![allow(dead_code, clippy::needless_range_loop)]
+
+/// Bisection for a sign change of f on [a, b] to |b − a| ≤ 1e-13·max(1, |a|).
+pub fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+    let mut fa = f(a);
+    for _ in 0..300 {
+        let m = 0.5 * (a + b);
+        let fm = f(m);
+        if fa * fm <= 0.0 {
+            b = m;
+        } else {
+            a = m;
+            fa = fm;
+        }
+        if (b - a).abs() <= 1e-13 * a.abs().max(1.0) {
+            break;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// First `count` roots of f on (lo, hi) found by scanning `steps` sub-intervals for sign changes
+/// (rejecting poles where |f| is large on both sides) and bisecting each.
+pub fn roots(f: impl Fn(f64) -> f64, lo: f64, hi: f64, steps: usize, count: usize) -> Vec<f64> {
+    let mut out = Vec::new();
+    let dx = (hi - lo) / steps as f64;
+    let mut x0 = lo;
+    let mut f0 = f(x0);
+    for k in 1..=steps {
+        let x1 = lo + k as f64 * dx;
+        let f1 = f(x1);
+        if f0.is_finite() && f1.is_finite() && f0 * f1 < 0.0 {
+            let r = bisect(&f, x0, x1);
+            // A genuine root has a small residual compared with the bracketing values.
+            if f(r).abs() < 1e-6 * (f0.abs() + f1.abs()) {
+                out.push(r);
+                if out.len() == count {
+                    break;
+                }
+            }
+        }
+        x0 = x1;
+        f0 = f1;
+    }
+    out
+}
+
+/// Determinant of a 4×4 matrix (Gaussian elimination with partial pivoting).
+pub fn det4(mut a: [[f64; 4]; 4]) -> f64 {
+    let mut det = 1.0;
+    for k in 0..4 {
+        let p = (k..4)
+            .max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))
+            .unwrap();
+        if p != k {
+            a.swap(p, k);
+            det = -det;
+        }
+        let d = a[k][k];
+        if d == 0.0 {
+            return 0.0;
+        }
+        det *= d;
+        for i in (k + 1)..4 {
+            let l = a[i][k] / d;
+            for j in k..4 {
+                a[i][j] -= l * a[k][j];
+            }
+        }
+    }
+    det
+}
+
+/// Clamped-free Euler–Bernoulli eigenvalues βₖL: roots of cos x cosh x + 1 = 0.
+pub fn clamped_free_beta(count: usize) -> Vec<f64> {
+    roots(
+        |x| x.cos() + 1.0 / x.cosh(),
+        0.5,
+        4.0 * count as f64 + 2.0,
+        4000,
+        count,
+    )
+}
+
+/// Clamped-free ω (rad/s) of a uniform EB beam.
+pub fn clamped_free_omega(ei: f64, rho_a: f64, l: f64, count: usize) -> Vec<f64> {
+    clamped_free_beta(count)
+        .into_iter()
+        .map(|b| b * b / (l * l) * (ei / rho_a).sqrt())
+        .collect()
+}
+
+/// EB cantilever with tip mass M and tip inertia J: ω from the 4×4 boundary determinant of
+/// v = C₁ cosh βx + C₂ sinh βx + C₃ cos βx + C₄ sin βx with v(0) = v′(0) = 0,
+/// EI v″(L) = J ω² v′(L), EI v‴(L) = −M ω² v(L).
+pub fn tip_mass_omega(ei: f64, rho_a: f64, l: f64, m: f64, j: f64, count: usize) -> Vec<f64> {
+    let det = |bl: f64| {
+        let b = bl / l;
+        let w2 = b.powi(4) * ei / rho_a;
+        let x = l;
+        let (ch, sh, c, s) = ((b * x).cosh(), (b * x).sinh(), (b * x).cos(), (b * x).sin());
+        // Rows scaled by cosh βL so the determinant stays O(1).
+        let sc = 1.0 / ch;
+        let v = [ch, sh, c, s];
+        let d1 = [b * sh, b * ch, -b * s, b * c];
+        let d2 = [b * b * ch, b * b * sh, -b * b * c, -b * b * s];
+        let d3 = [
+            b.powi(3) * sh,
+            b.powi(3) * ch,
+            b.powi(3) * s,
+            -b.powi(3) * c,
+        ];
+        let mut r3 = [0.0; 4];
+        let mut r4 = [0.0; 4];
+        for k in 0..4 {
+            r3[k] = sc * (ei * d2[k] - j * w2 * d1[k]) / (ei * b * b);
+            r4[k] = sc * (ei * d3[k] + m * w2 * v[k]) / (ei * b.powi(3));
+        }
+        det4([[1.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 1.0], r3, r4])
+    };
+    roots(det, 0.3, 4.0 * count as f64 + 3.0, 8000, count)
+        .into_iter()
+        .map(|bl| (bl / l).powi(2) * (ei / rho_a).sqrt())
+        .collect()
+}
+
+/// Timoshenko clamped-free ω (below the cut-off √(κGA/ρI)) from the 4×4 determinant of the
+/// exact solution V = C₁ cosh αx + C₂ sinh αx + C₃ cos βx + C₄ sin βx, Θ accordingly;
+/// BCs V(0) = Θ(0) = 0, EI Θ′(L) = 0, κGA(V′ − Θ)(L) = 0.
+pub fn timoshenko_omega(
+    ei: f64,
+    kga: f64,
+    rho_a: f64,
+    rho_i: f64,
+    l: f64,
+    count: usize,
+    w_max: f64,
+) -> Vec<f64> {
+    let det = |w: f64| {
+        let w2 = w * w;
+        // κGA·EI s⁴ + (κGA ρI + ρA EI) ω² s² + ρAω²(ρIω² − κGA) = 0 in s².
+        let a = kga * ei;
+        let bq = (kga * rho_i + rho_a * ei) * w2;
+        let c = rho_a * w2 * (rho_i * w2 - kga);
+        let disc = (bq * bq - 4.0 * a * c).sqrt();
+        let s2_pos = (-bq + disc) / (2.0 * a);
+        let s2_neg = (-bq - disc) / (2.0 * a);
+        let al = s2_pos.sqrt();
+        let be = (-s2_neg).sqrt();
+        let cc = rho_a * w2 / kga;
+        let ka = (al * al + cc) / al; // Θ = ka sinh for V = cosh, ka cosh for V = sinh
+        let kb = (cc - be * be) / be; // Θ = kb sin for V = cos, −kb cos for V = sin
+        let x = l;
+        let (ch, sh, co, si) = (
+            (al * x).cosh(),
+            (al * x).sinh(),
+            (be * x).cos(),
+            (be * x).sin(),
+        );
+        let sc = 1.0 / ch;
+        // Columns 1–2 (cosh, sinh) are scaled by sc = 1/cosh αL in every row (a column scaling
+        // keeps the roots and the determinant O(1)).
+        // V(0) = C1 + C3; Θ(0) = ka C2 − kb C4.
+        let r1 = [sc, 0.0, 1.0, 0.0];
+        let r2 = [0.0, sc * ka, 0.0, -kb];
+        // Θ′(L): ka al cosh, ka al sinh, kb be cos, kb be sin.
+        let r3 = [
+            sc * ka * al * ch,
+            sc * ka * al * sh,
+            kb * be * co,
+            kb * be * si,
+        ];
+        // (V′ − Θ)(L)/c with α − k_α = −c/α and β + k_β = c/β written out (no cancellation).
+        let r4 = [-sc * sh / al, -sc * ch / al, -si / be, co / be];
+        det4([r1, r2, r3, r4])
+    };
+    roots(det, 1.0, w_max, 200_000, count)
+}
