@@ -55,10 +55,28 @@
 //! * [`link`]: one link in a rotating frame (`spin-up`, `spin-up-linear`, `single-link`,
 //!   `rotating-beam` runs) on the same grid and stepping: foreshortening stiffening, prescribed
 //!   hub motion (reported torque) or hub torque with inertia, spring, damper, Kelvin–Voigt.
-//! * Unsupported (precise `Unsupported` messages): chains of links (`two-link-free`, Barhorst
-//!   cases), axial/shear fields, tip inertia, gravity on beams, contact, 3-D and mobile scenes.
+//! * [`chain`]: two links in series (`two-link-free`, `two-link-free-undamped`): link 2 clamped to
+//!   link 1's tip and turned by the elbow angle θ₂ (clamp angle of link 2 = θ₁ + v₁'(L₁) + θ₂).
+//!   Same stations, ghost-node bending energy, Kelvin–Voigt and foreshortening per link. Each
+//!   link's frame is its tip chord (v₀ = v_r = 0) with the clamp ghost node x = v₋₁ as an
+//!   unknown (clamp angle = chord angle + (v₁ − x)/(2h)) carrying the half-cell rotary inertia
+//!   ρAh³/24: with zero hub inertia the single link's clamp-tangent frame makes the
+//!   second-order kinetic energy indefinite (see [`chain`]). Kinetic energy to second order in
+//!   the deflections, exact in the angles (the single link's order); Lagrange's equations with
+//!   p = ∂T/∂q̇ and the exact (∂p/∂q)q̇ by dual numbers; mass matrix = lumped diagonal + four
+//!   full columns (4×4 Schur complement, O(n) per step). Joint springs/dampers (set-points) on
+//!   θ₁ and θ₂ = β-clamp angle − θ − ψ (ψ one-sided second-order tip slope). Ledger: kinetic,
+//!   strain, joint_spring | applied_torque | joint_damper, kelvin_voigt. **Default method:
+//!   velocity-form** (free joints make the inertia forces velocity dependent and damping is on;
+//!   the two-step scheme's parasitic root grows). Measured (tests/chain.rs): undamped 10 s
+//!   energy error bounded (no drift), O(τ²); damped ledger closure 7e-6; joint angles O(h²)
+//!   (orders 1.99, 1.91); rigid limit within 0.5 % of the swing.
+//! * Unsupported (precise `Unsupported` messages): chains of more than two links (Barhorst
+//!   cases with contact), axial/shear fields, tip inertia, gravity on beams, contact, 3-D and
+//!   mobile scenes.
 
 pub mod beam;
+pub mod chain;
 pub mod error;
 pub mod integrator;
 pub mod link;
@@ -115,6 +133,9 @@ impl Backend for FdmBackend {
             if is_clamped(scene) {
                 return Ok(beam::dof_plan(scene, s.stations)?);
             }
+            if scene.links.len() == 2 {
+                return Ok(chain::TwoLinkChain::from_scene(scene, s.stations)?.dof_plan());
+            }
             return Ok(link::FloatingLink::from_scene(scene, s.stations)?.dof_plan());
         }
         Err(unsupported_family(scene).into())
@@ -158,6 +179,9 @@ impl Backend for FdmBackend {
         if scene.family() == Family::PlanarChain {
             if is_clamped(scene) {
                 return Err(beam::simulate_unsupported(scene).into());
+            }
+            if scene.links.len() == 2 {
+                return Ok(chain::simulate(scene, settings, &s)?);
             }
             return Ok(link::simulate(scene, settings, &s)?);
         }

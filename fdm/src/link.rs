@@ -184,7 +184,7 @@ impl FloatingLink {
     }
 
     /// Adds −∂/∂v of ½ Σ c_i h c κ_i² (c = EI with v, or γ with v̇) into f; returns the energy.
-    fn add_bending(h: f64, c: f64, vs: &[f64], f: &mut [f64]) -> f64 {
+    pub(crate) fn add_bending(h: f64, c: f64, vs: &[f64], f: &mut [f64]) -> f64 {
         let r = vs.len();
         let inv_h3 = 1.0 / (h * h * h);
         // clamped end: κ₀ = 2v₁/h², weight ½
@@ -220,7 +220,7 @@ impl FloatingLink {
     }
 
     /// ½ Σ c_i h c κ_i² without forces (output path: no scratch).
-    fn bending_energy(h: f64, c: f64, vs: &[f64]) -> f64 {
+    pub(crate) fn bending_energy(h: f64, c: f64, vs: &[f64]) -> f64 {
         let r = vs.len();
         let mut e = 0.5 * 0.5 * h * c * (2.0 * vs[0] / (h * h)).powi(2);
         for i in 1..r {

@@ -25,12 +25,21 @@
 //! imposed exactly and the torque it needs is reported. Time integration: [`integrate`]
 //! (Dormand–Prince 5(4) by default, TR-BDF2 for stiff cases). The rocket (seed 003) is in
 //! [`rocket`].
+//!
+//! Contact (Barhorst's work surface, [`contact`]): the gap g = n̂·(r_tip − p₀) is an event
+//! function located by Illinois root finding on the integrator's dense output (bracket
+//! ≤ [`simulate::EVENT_TIME_TOLERANCE`]); impact is the plastic generalized impulse–momentum
+//! jump M(q̇⁺ − q̇⁻) = GᵀΛ, G q̇⁺ = 0 (G = n̂ᵀJ_tip); while the normal force pushes, the tip
+//! slides on the surface with a Lagrange multiplier (M q̈ = f + Gᵀλ, G q̈ = −Ġq̇, index 1) and
+//! projection of q, q̇ back onto g = 0, G q̇ = 0 after every step; release is the located zero
+//! crossing of λ. The kinetic energy lost in impacts enters the ledger as `impact`.
 
 // Dense numerical kernels index several arrays with one loop variable on purpose.
 #![allow(clippy::needless_range_loop)]
 
 pub mod backend;
 pub mod basis;
+pub mod contact;
 pub mod error;
 pub mod integrate;
 pub mod model;

@@ -31,13 +31,7 @@ pub fn check_supported(scene: &Scene, purpose: Purpose) -> Result<(), ModalError
     if scene.links.is_empty() {
         return Err(ModalError::Unsupported("modal: scene has no links".into()));
     }
-    if !scene.contacts.is_empty() {
-        return Err(ModalError::Unsupported(format!(
-            "modal: contact of link `{}` with a rigid surface (impact/constraint phases are not \
-             implemented in the modal backend yet)",
-            scene.contacts[0].link
-        )));
-    }
+    crate::contact::check(scene)?;
     for (i, l) in scene.links.iter().enumerate() {
         if l.shear || l.rotary_inertia {
             return Err(ModalError::Unsupported(format!(
@@ -266,6 +260,15 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
     }
     if scene.gravity.is_some() {
         plan.builds.push("gravity".into());
+    }
+    for (c, ct) in scene.contacts.iter().enumerate() {
+        plan.builds.push(format!(
+            "contact{}: unilateral frictionless tip contact of `{}` (gap event, plastic impact \
+             M(q̇⁺−q̇⁻) = GᵀΛ; while sliding 1 constraint G q̈ = −Ġq̇ with multiplier λ = normal \
+             force, i.e. one fewer DOF; drift control by projection)",
+            c + 1,
+            ct.link
+        ));
     }
     Ok(plan)
 }

@@ -8,6 +8,7 @@ use data::{
     channel,
 };
 
+use crate::contact::{ContactState, locate_crossing};
 use crate::error::ModalError;
 use crate::integrate::{Dopri5, IntegrateError, OdeRhs, Sdirk, StepStats, Tolerances};
 use crate::model::Chain;
@@ -57,6 +58,10 @@ pub struct ChainRhs {
     pub qdd: Vec<f64>,
     slots: WorkSlots,
     pub singular: bool,
+    /// The tip contact, when the scene has one (see [`crate::contact`]).
+    pub contact: Option<ContactState>,
+    /// Model evaluations outside the integrator (event location, impacts, projections).
+    pub event_solves: usize,
 }
 
 impl ChainRhs {
@@ -95,6 +100,8 @@ impl ChainRhs {
             qdd: vec![0.0; n],
             slots,
             singular: false,
+            contact: None,
+            event_solves: 0,
         }
     }
 
@@ -133,10 +140,47 @@ impl ChainRhs {
     }
 
     /// Evaluates the model at (t, y): M, forces, accelerations, prescribed torques.
+    /// [`Self::solve`] outside the integrator, counted in the cost.
+    fn solve_counted(&mut self, t: f64, y: &[f64]) -> bool {
+        self.event_solves += 1;
+        self.solve(t, y)
+    }
+
     fn solve(&mut self, t: f64, y: &[f64]) -> bool {
         self.load(t, y);
         self.chain.evaluate(t, &self.q, &self.qd);
-        self.chain.accelerations(t, &mut self.qdd).is_ok()
+        if self.chain.accelerations(t, &mut self.qdd).is_err() {
+            return false;
+        }
+        if let Some(c) = self.contact.as_mut() {
+            let chain = &self.chain;
+            let n = chain.n;
+            chain.tip_jacobian(c.link, &mut c.jac);
+            let tip = chain.tip_position(c.link);
+            c.gap = c.normal[0] * (tip[0] - c.point[0]) + c.normal[1] * (tip[1] - c.point[1]);
+            for (k, &g) in chain.free.iter().enumerate() {
+                c.g_row[k] = c.normal[0] * c.jac[g] + c.normal[1] * c.jac[n + g];
+                c.minv_gt[k] = c.g_row[k];
+            }
+            chain.solve_free_mass(&mut c.minv_gt);
+            c.gmg = dot(&c.g_row, &c.minv_gt);
+            c.normal_velocity = 0.0;
+            let mut g_qdd = 0.0;
+            for (k, &g) in chain.free.iter().enumerate() {
+                c.normal_velocity += c.g_row[k] * self.qd[g];
+                g_qdd += c.g_row[k] * self.qdd[g];
+            }
+            c.lambda = 0.0;
+            if c.constrained {
+                let conv = chain.tip_convective_acceleration(c.link);
+                let gdot_qd = c.normal[0] * conv[0] + c.normal[1] * conv[1];
+                c.lambda = -(g_qdd + gdot_qd) / c.gmg;
+                for (k, &g) in chain.free.iter().enumerate() {
+                    self.qdd[g] += c.minv_gt[k] * c.lambda;
+                }
+            }
+        }
+        true
     }
 
     /// Total joint torque of joint i at the last solve (applied law + spring + damper for free
@@ -280,6 +324,13 @@ impl Output {
                 specs.push((channel::field_deflection(k, s), "length"));
             }
         }
+        let has_contact = rhs.contact.is_some();
+        if has_contact {
+            specs.push((channel::contact_normal_force(1), "force"));
+            specs.push((channel::contact_phase(1), "1"));
+            // Not a standard channel: the constraint violation (penetration < 0) at the samples.
+            specs.push(("contact1.gap".to_string(), "length"));
+        }
         let mut obs = Observables::with_channels(&specs);
         obs.time.reserve(n_samples);
         for c in &mut obs.channels {
@@ -310,6 +361,9 @@ impl Output {
         }
         if rhs.slots.kelvin_voigt.is_some() {
             diss.push("kelvin_voigt");
+        }
+        if has_contact {
+            diss.push("impact");
         }
         let mut ledger = EnergyLedger::new(&stored, &inputs, &diss);
         ledger.time.reserve(n_samples);
@@ -371,6 +425,11 @@ impl Output {
                 c += 1;
             }
         }
+        if let Some(ct) = &rhs.contact {
+            self.values[c] = ct.lambda;
+            self.values[c + 1] = if ct.constrained { 1.0 } else { 0.0 };
+            self.values[c + 2] = ct.gap;
+        }
         self.obs.push(t, &self.values);
         let e = rhs.chain.energy(&rhs.q);
         let mut stored = [e.kinetic, e.strain, 0.0, 0.0];
@@ -389,9 +448,13 @@ impl Output {
             inputs[ni] = y[i];
             ni += 1;
         }
-        let (mut diss, mut nd) = ([0.0; 2], 0);
+        let (mut diss, mut nd) = ([0.0; 3], 0);
         for i in [s.joint_damper, s.kelvin_voigt].into_iter().flatten() {
             diss[nd] = y[i];
+            nd += 1;
+        }
+        if let Some(ct) = &rhs.contact {
+            diss[nd] = ct.impact_loss;
             nd += 1;
         }
         self.ledger
@@ -418,7 +481,47 @@ fn runaway(rhs: &ChainRhs, y: &[f64]) -> Option<(usize, f64)> {
     None
 }
 
+/// Diagnostics of a contact run that the `RunResult` has no field for.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ContactReport {
+    /// Largest |g| and |G q̇| found at the end of a constrained step, before the projection.
+    pub max_gap_violation: f64,
+    pub max_normal_velocity_violation: f64,
+    /// Largest penetration −g seen in free flight at a located contact start.
+    pub max_gap_at_contact_start: f64,
+    /// Stated time tolerance of the event location (bracket width bound).
+    pub time_tolerance: f64,
+    /// Number of drift projections applied.
+    pub projections: usize,
+    /// Largest constraint power |λ·G q̇| at the end of a constrained step (zero in exact
+    /// arithmetic on a fixed frictionless surface) and the kinetic energy the velocity
+    /// projections removed in total (½(Gq̇)²/(GM⁻¹Gᵀ) each).
+    pub max_constraint_power: f64,
+    pub projection_energy: f64,
+}
+
+/// Full generalized coordinates q and rates q̇ at the end of a run, plus the contact report.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FinalState {
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub contact: ContactReport,
+}
+
+/// Time tolerance of the contact-start and release events (width of the final bracket).
+pub const EVENT_TIME_TOLERANCE: f64 = 1e-12;
+/// Upper bound on the number of contact events in a run (guards a Zeno-like accumulation).
+pub const MAX_CONTACT_EVENTS: usize = 20_000;
+
 pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalError> {
+    simulate_detailed(scene, settings).map(|(r, _)| r)
+}
+
+/// [`simulate`] that also returns the final state and the contact diagnostics.
+pub fn simulate_detailed(
+    scene: &Scene,
+    settings: &Settings,
+) -> Result<(RunResult, FinalState), ModalError> {
     let wall = Instant::now();
     let chain = build_chain(scene, &settings.discretization)?;
     let method = Method::parse(settings.time.method.as_deref())?;
@@ -448,7 +551,9 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
     let dt_out = scene.simulation.output_interval;
     let n_out = (t_end / dt_out - 1e-9).ceil() as usize + 1;
 
+    let (n_all, n_free) = (chain.n, chain.free.len());
     let mut rhs = ChainRhs::new(chain);
+    rhs.contact = ContactState::from_scene(scene, n_all, n_free)?;
     let mut y = rhs.initial_state();
     let dim = y.len();
     let tol = Tolerances { rtol, atol };
@@ -485,13 +590,62 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
         });
     }
     k_out = k_out.max(1);
+    let mut events: Vec<data::Event> = Vec::new();
+    let mut report = ContactReport {
+        time_tolerance: EVENT_TIME_TOLERANCE,
+        ..Default::default()
+    };
+    // Event function of the current phase at the last accepted state: the gap in free flight,
+    // the normal force when constrained.
+    let mut event_prev = rhs.contact.as_ref().map_or(0.0, |c| c.gap);
+    if event_prev < 0.0 {
+        return Err(ModalError::invalid(
+            "contact",
+            format!("the tip starts {:.3e} inside the surface", -event_prev),
+        ));
+    }
+    let mut scratch = vec![0.0; dim];
     'outer: for &target in &breaks {
         while t < target {
+            let t_old = t;
             if let Err(e) = stepper.step(&mut rhs, &mut t, &mut y, target) {
                 verdict = stopped(&rhs, t, &e.to_string(), None);
                 break 'outer;
             }
-            while k_out < n_out && out_time(k_out) <= t {
+            // Event detection at the end of the step, located on the dense output.
+            let mut event_time = None;
+            if rhs.contact.is_some() {
+                if !rhs.solve_counted(t, &y) {
+                    verdict = stopped(&rhs, t, "mass matrix lost positive definiteness", None);
+                    break 'outer;
+                }
+                let now = phase_event_value(&rhs);
+                if now <= 0.0 && event_prev > 0.0 {
+                    let mut eval = |tau: f64| {
+                        stepper.dense(tau, &mut scratch);
+                        if rhs.solve_counted(tau, &scratch) {
+                            phase_event_value(&rhs)
+                        } else {
+                            f64::NAN
+                        }
+                    };
+                    let (te, _, width) =
+                        locate_crossing(&mut eval, t_old, event_prev, t, now, EVENT_TIME_TOLERANCE);
+                    event_time = Some((te, width));
+                } else if now < 0.0 && !rhs.contact.as_ref().is_some_and(|c| c.constrained) {
+                    // Free flight that began on the surface and went below it without first
+                    // leaving: take the contact at the step start (reported tolerance: the step).
+                    let tol_gap = 1e-9
+                        * rhs.chain.links[rhs.contact.as_ref().unwrap().link]
+                            .ints
+                            .length;
+                    if now < -tol_gap {
+                        event_time = Some((t_old, t - t_old));
+                    }
+                }
+            }
+            let t_limit = event_time.map_or(t, |(te, _)| te);
+            while k_out < n_out && out_time(k_out) <= t_limit {
                 let to = out_time(k_out);
                 if to == t {
                     yd.copy_from_slice(&y);
@@ -503,6 +657,43 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
                     break 'outer;
                 }
                 k_out += 1;
+            }
+            if let Some((te, tol_t)) = event_time {
+                if te != t {
+                    stepper.dense(te, &mut yd);
+                    y.copy_from_slice(&yd);
+                    t = te;
+                }
+                if events.len() >= MAX_CONTACT_EVENTS {
+                    verdict = StabilityVerdict::Stopped {
+                        diagnostic: Diagnostic {
+                            t,
+                            what: format!("{} contact events", events.len()),
+                            location: Some("contact1".into()),
+                            why: "impacts/releases accumulate (Zeno-like chattering)".into(),
+                            remedy: "shorten t_end or add damping".into(),
+                        },
+                    };
+                    break 'outer;
+                }
+                if !switch_phase(&mut rhs, t, &mut y, tol_t, &mut events, &mut report) {
+                    verdict = stopped(&rhs, t, "mass matrix lost positive definiteness", None);
+                    break 'outer;
+                }
+                stepper.reset();
+            } else if rhs.contact.as_ref().is_some_and(|c| c.constrained) {
+                if !project(&mut rhs, t, &mut y, &mut report) {
+                    verdict = stopped(&rhs, t, "mass matrix lost positive definiteness", None);
+                    break 'outer;
+                }
+                stepper.reset();
+            }
+            if rhs.contact.is_some() {
+                if !rhs.solve_counted(t, &y) {
+                    verdict = stopped(&rhs, t, "mass matrix lost positive definiteness", None);
+                    break 'outer;
+                }
+                event_prev = phase_event_value(&rhs);
             }
             if let Some((i, v)) = runaway(&rhs, &y) {
                 verdict = stopped(&rhs, t, "", Some((i, v)));
@@ -517,21 +708,163 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
         dofs: rhs.nf(),
         steps: st.steps,
         rejected_steps: st.rejected,
-        rhs_evaluations: st.rhs_evals,
+        rhs_evaluations: st.rhs_evals + rhs.event_solves,
         jacobian_evaluations: st.jacobian_evals,
         factorizations: st.factorizations,
         newton_iterations: st.newton_iters,
     };
-    Ok(RunResult {
+    rhs.load(t, &y);
+    let fin = FinalState {
+        q: rhs.q.clone(),
+        qd: rhs.qd.clone(),
+        contact: report,
+    };
+    let result = RunResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
         settings: settings.clone(),
         observables: out.obs,
         ledger: out.ledger,
-        events: Vec::new(),
+        events,
         cost,
         verdict,
-    })
+    };
+    Ok((result, fin))
+}
+
+/// Event function of the current phase (after `solve`): the gap in free flight, the normal
+/// force in contact. A phase ends when it goes from positive to non-positive.
+fn phase_event_value(rhs: &ChainRhs) -> f64 {
+    match &rhs.contact {
+        Some(c) if c.constrained => c.lambda,
+        Some(c) => c.gap,
+        None => 0.0,
+    }
+}
+
+/// Applies the located event at (t, y): contact start + impact (then constrained or free by the
+/// sign of the would-be normal force), or release. Returns false on a singular mass matrix.
+fn switch_phase(
+    rhs: &mut ChainRhs,
+    t: f64,
+    y: &mut [f64],
+    time_tolerance: f64,
+    events: &mut Vec<data::Event>,
+    report: &mut ContactReport,
+) -> bool {
+    let nf = rhs.nf();
+    if !rhs.solve_counted(t, y) {
+        return false;
+    }
+    let c = rhs.contact.as_ref().expect("contact run");
+    if c.constrained {
+        events.push(data::Event::Release {
+            t,
+            contact: 1,
+            normal_force: c.lambda,
+            time_tolerance,
+        });
+        rhs.contact.as_mut().unwrap().constrained = false;
+        return true;
+    }
+    report.max_gap_at_contact_start = report.max_gap_at_contact_start.max(-c.gap);
+    events.push(data::Event::ContactStart {
+        t,
+        contact: 1,
+        time_tolerance,
+    });
+    // Impact: Λ = −G q̇⁻ / (G M⁻¹ Gᵀ), q̇⁺ = q̇⁻ + M⁻¹Gᵀ Λ.
+    let ke_before = rhs.chain.energy(&rhs.q).kinetic;
+    let v_before = c.normal_velocity;
+    let impulse = -v_before / c.gmg;
+    let velocity_before: Vec<f64> = y[nf..2 * nf].to_vec();
+    for k in 0..nf {
+        y[nf + k] += c.minv_gt[k] * impulse;
+    }
+    // Momentum residual with the mass matrix at q (unchanged by the jump).
+    let n = rhs.chain.n;
+    let mass = rhs.chain.mass_matrix();
+    let (mut res2, mut mom2) = (0.0, 0.0);
+    for (r, &gr) in rhs.chain.free.iter().enumerate() {
+        let mut m_dv = 0.0;
+        for (k, &gc) in rhs.chain.free.iter().enumerate() {
+            m_dv += mass[gr * n + gc] * (y[nf + k] - velocity_before[k]);
+        }
+        let r_k = m_dv - c.g_row[r] * impulse;
+        res2 += r_k * r_k;
+        mom2 += m_dv * m_dv;
+    }
+    let momentum_residual = if mom2 > 0.0 {
+        (res2 / mom2).sqrt()
+    } else {
+        res2.sqrt()
+    };
+    // Decide the next phase by the sign of the would-be normal force at (q, q̇⁺).
+    rhs.contact.as_mut().unwrap().constrained = true;
+    if !rhs.solve_counted(t, y) {
+        return false;
+    }
+    let ke_after = rhs.chain.energy(&rhs.q).kinetic;
+    let c = rhs.contact.as_mut().unwrap();
+    let loss = ke_before - ke_after;
+    c.impact_loss += loss;
+    events.push(data::Event::Impact {
+        t,
+        contact: 1,
+        velocity_before,
+        velocity_after: y[nf..2 * nf].to_vec(),
+        impulse,
+        momentum_residual,
+        normal_velocity_after: c.normal_velocity,
+        kinetic_energy_lost: loss,
+    });
+    if c.lambda <= 0.0 {
+        c.constrained = false;
+    }
+    true
+}
+
+/// Drift control of the constrained phase: q ← q − M⁻¹Gᵀ g/(GM⁻¹Gᵀ) (Newton on g = 0, at
+/// most 3 passes), then q̇ ← q̇ − M⁻¹Gᵀ (Gq̇)/(GM⁻¹Gᵀ) (the M-orthogonal projection).
+fn project(rhs: &mut ChainRhs, t: f64, y: &mut [f64], report: &mut ContactReport) -> bool {
+    let nf = rhs.nf();
+    if !rhs.solve_counted(t, y) {
+        return false;
+    }
+    {
+        let c = rhs.contact.as_ref().unwrap();
+        report.max_gap_violation = report.max_gap_violation.max(c.gap.abs());
+        report.max_normal_velocity_violation = report
+            .max_normal_velocity_violation
+            .max(c.normal_velocity.abs());
+        report.max_constraint_power = report
+            .max_constraint_power
+            .max((c.lambda * c.normal_velocity).abs());
+    }
+    for pass in 0..3 {
+        let c = rhs.contact.as_ref().unwrap();
+        let scale = c.gap / c.gmg;
+        for k in 0..nf {
+            y[k] -= c.minv_gt[k] * scale;
+        }
+        if !rhs.solve_counted(t, y) {
+            return false;
+        }
+        let len = rhs.chain.links[rhs.contact.as_ref().unwrap().link]
+            .ints
+            .length;
+        if rhs.contact.as_ref().unwrap().gap.abs() <= 1e-14 * len || pass == 2 {
+            break;
+        }
+    }
+    let c = rhs.contact.as_ref().unwrap();
+    let scale = c.normal_velocity / c.gmg;
+    report.projection_energy += 0.5 * c.normal_velocity * scale;
+    for k in 0..nf {
+        y[nf + k] -= c.minv_gt[k] * scale;
+    }
+    report.projections += 1;
+    true
 }
 
 fn stopped(

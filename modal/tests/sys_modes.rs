@@ -257,7 +257,11 @@ fn sys_dof_plans_per_scene() {
 #[test]
 fn sys_unsupported_and_invalid_requests_are_typed_errors() {
     let s = Settings::default();
-    for name in ["cantilever-timoshenko", "barhorst-case1", "constrained-arm"] {
+    for name in [
+        "cantilever-timoshenko",
+        "barhorst-case1-timoshenko",
+        "constrained-arm",
+    ] {
         let scene = load_scene(name).unwrap();
         match ModalBackend.simulate(&scene, &s) {
             Err(BackendError::Unsupported(msg)) => assert!(msg.starts_with("modal:"), "{msg}"),

@@ -508,6 +508,34 @@ impl Chain {
         }
     }
 
+    /// Velocity-dependent part of the inertial tip acceleration of link i, r̈_tip = J q̈ + c(q, q̇)
+    /// (after `evaluate`; requires no prescribed joint before link i, whose q̈ would enter J q̈).
+    /// In the link frame ẇ_L + ω J w_L with w_L = V + ω J p + ṗ gives
+    /// c = R(α)[γ + ω J ṗ + (−f ḃᵀS_L ḃ, 0) + ω J w_L].
+    pub fn tip_convective_acceleration(&self, i: usize) -> [f64; 2] {
+        let w = &self.work[i];
+        let li = &self.links[i];
+        let sc = &w.scratch;
+        let (pld, wl) = (sc.pd_tip, sc.w_tip);
+        let om = w.nu[2];
+        let bsb = if li.foreshortening {
+            let nb = li.nb();
+            dot(&w.nu[3 + li.na()..3 + li.na() + nb], &sc.slbd)
+        } else {
+            0.0
+        };
+        let cx = w.gamma[0] - om * pld[1] - bsb - om * wl[1];
+        let cy = w.gamma[1] + om * pld[0] + om * wl[0];
+        let (s, c) = w.alpha.sin_cos();
+        [c * cx - s * cy, s * cx + c * cy]
+    }
+
+    /// Solves M_ff x = b with the Cholesky factor of the free block left by the last successful
+    /// `accelerations` call (b of length = number of free coordinates, overwritten by x).
+    pub fn solve_free_mass(&self, b: &mut [f64]) {
+        cholesky_substitute(&self.mff, self.free.len(), b);
+    }
+
     /// M(q) of the last evaluation (row-major N × N).
     pub fn mass_matrix(&self) -> &[f64] {
         &self.mass
@@ -539,6 +567,12 @@ pub(crate) fn cholesky_solve(a: &mut [f64], n: usize, b: &mut [f64]) -> Result<(
             a[i * n + j] = s / d;
         }
     }
+    cholesky_substitute(a, n, b);
+    Ok(())
+}
+
+/// Forward/back substitution with the lower Cholesky factor stored in `a` (row-major n × n).
+fn cholesky_substitute(a: &[f64], n: usize, b: &mut [f64]) {
     for i in 0..n {
         let mut s = b[i];
         for k in 0..i {
@@ -553,7 +587,6 @@ pub(crate) fn cholesky_solve(a: &mut [f64], n: usize, b: &mut [f64]) -> Result<(
         }
         b[i] = s / a[i * n + i];
     }
-    Ok(())
 }
 
 /// Adds the von Kármán forces to `f` (the link's slice starting at a0: axial then transverse):

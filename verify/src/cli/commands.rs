@@ -38,6 +38,10 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
     }
 }
 
+/// Ledger closure above which `run` warns that the answer is not time-converged: an
+/// integrator at a sensible step closes the ledger to 1e-4 or better on every catalog scene.
+const LEDGER_WARNING: f64 = 1e-3;
+
 fn print_json<T: serde::Serialize>(value: &T) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(value)
         .map_err(|e| CliError::Failed(format!("error: cannot serialize result: {e}")))?;
@@ -402,6 +406,15 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
             let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
             println!();
             print!("{}", text_table(&header, &rows));
+        }
+    }
+    for (k, r) in &results {
+        let closure = r.ledger.relative_closure();
+        if closure > LEDGER_WARNING {
+            eprintln!(
+                "warning: {k}: the energy ledger closes only to {closure:.2e} (relative); the time \
+                 step is too coarse for this scene — refine --dt (or --rtol) and compare"
+            );
         }
     }
     let stopped: Vec<String> = results

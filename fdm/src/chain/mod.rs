@@ -1,0 +1,871 @@
+//! Two flexible links in series (`two-link-free`, `two-link-free-undamped`): link 2 is clamped to
+//! the tip of link 1 and rotated by the elbow angle θ₂, so its clamp tangent has the angle
+//! θ₁ + ψ + θ₂ with ψ = v₁'(L₁) (scenes.md; Barhorst's q₁, q₅).
+//!
+//! **Frames.** Each link's floating frame is its *tip chord* (v₀ = v_r = 0): θ and β are the
+//! chord angles of links 1 and 2. The clamp condition is the report's ghost node, kept as an
+//! unknown x = v₋₁: the clamp tangent turns by (v₁ − x)/(2h) from the chord and κ₀ =
+//! (v₁ + x)/h². Why not the clamp-tangent frame of the single link? With zero hub inertia (both
+//! joints here) a tangent-frame rotation against the opposite linear deflection moves no lumped
+//! mass, and the second-order kinetic energy (exact value ½Σm s² ≥ 0) becomes *indefinite* in
+//! that direction for deflections of a few mm (measured: M loses definiteness, the run blows up
+//! at any step). Pinning the tip to the chord makes every frame rotation move the link's mass.
+//! The clamp section's own rotation carries the half-cell rotary inertia J_c = ρA h³/24
+//! (O(h³), exact positive term ½J_c(clamp angle rate)²).
+//!
+//! **Equations.** Lagrange's equations of L = T − V with the dissipation function D:
+//! * T: [`kinetic`] (second order in the deflections, exact in the angles: the single link's
+//!   order) + Σ ½J_c,ℓ (clamp angle rate)²;
+//! * V = Σ_ℓ ½ Σᵢ cᵢ h EI κᵢ² (the single link's ghost-node bending energy, [`crate::link`],
+//!   with κ₀ from the ghost) plus ½K₁(θ₁ − θ₁⁰)² + ½K₂(θ₂ − θ₂⁰)², θ₁ the clamp angle of
+//!   link 1, θ₂ = (clamp angle of link 2) − θ − ψ(v), ψ = (−4v_{r−1} + v_{r−2})/(2h₁) (the
+//!   second-order one-sided slope with v_r = 0): the elbow spring loads link 1's free end with
+//!   the moment K₂(θ₂ − θ₂⁰) — the free end of a pinned elbow when K₂ = 0;
+//! * D = Σ_ℓ ½ Σᵢ cᵢ h γ κ̇ᵢ² + ½D₁θ̇₁² + ½D₂θ̇₂²; applied torque laws τⱼ(t) do the work ∫τⱼ θ̇ⱼ.
+//!
+//! M(q) q̈ = Q − ∂V/∂q − ∂D/∂q̇ + ∂T/∂q − (∂p/∂q) q̇, with p = ∂T/∂q̇ = M q̇. The last term is one
+//! forward-mode dual-number pass over p ([`dual`]); the columns of M for θ, β, x₁, x₂ are p at
+//! unit velocities plus J_c e eᵀ; the rest of M is the diagonal of lumped masses, so the solve
+//! is a 4×4 Schur complement: O(n) per force evaluation, no allocation in the step loop.
+//!
+//! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
+//! on). Bound: 0.9 · 2/ω_max with ω_max from a power iteration on the linearized chain at t = 0
+//! (once per run, O(n²)), the Kelvin–Voigt factor of that frequency, and the clamp-rotation
+//! modes with their joint-damper ratio. Observables: joint angles/rates (clamp angles),
+//! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame.
+
+// Index loops over parallel buffers (q, v, a, columns of M) read like the formulas.
+#![allow(clippy::needless_range_loop)]
+
+pub mod dual;
+pub mod kinetic;
+
+use data::scene::{Link, TorqueLaw};
+use data::{BackendKind, DofPlan, RunResult, Scene, Settings, channel};
+
+use crate::error::FdmError;
+use crate::integrator::{Bound, BoundKind, StepControl, System, damped_step_factor, integrate};
+use crate::link::FloatingLink;
+use crate::settings::{FdmSettings, Method};
+use dual::Dual;
+use kinetic::{BE, ChainInertia, TH, seg_energy};
+
+/// Default stations per link.
+pub const DEFAULT_STATIONS: usize = 21;
+
+#[derive(Debug, Clone, Default)]
+struct JointLaw {
+    stiffness: f64,
+    damping: f64,
+    set_point: f64,
+    law: Option<TorqueLaw>,
+}
+
+impl JointLaw {
+    fn torque(&self, t: f64) -> f64 {
+        self.law.as_ref().map_or(0.0, |l| l.torque(t))
+    }
+}
+
+#[derive(Debug, Clone)]
+struct LinkProps {
+    length: f64,
+    ei: f64,
+    gamma: f64,
+    rho_a: f64,
+}
+
+/// The two-link chain as a [`System`].
+#[derive(Debug, Clone)]
+pub struct TwoLinkChain {
+    pub inertia: ChainInertia,
+    links: [LinkProps; 2],
+    joints: [JointLaw; 2],
+    init: [(f64, f64); 2],
+    field_stations: usize,
+    /// highest angular frequency of the linearized chain at t = 0 (power iteration)
+    omega_max: f64,
+    /// clamp half-cell rotary inertias ρA h³/24 of links 1 and 2
+    jc: [f64; 2],
+    /// q-slots of the clamp ghost deflections x₁, x₂ (station 1 of each link is the chord
+    /// frame's zero) and the link steps
+    slots: [usize; 2],
+    hs: [f64; 2],
+    qk: Vec<f64>,
+    vk: Vec<f64>,
+    obs_scratch: std::cell::RefCell<Vec<f64>>,
+    obs_scratch_v: std::cell::RefCell<Vec<f64>>,
+    // scratch (allocated once)
+    p: Vec<Dual>,
+    cols: [Vec<f64>; 4],
+    unit: Vec<f64>,
+    zeros: Vec<f64>,
+    rhs: Vec<f64>,
+    fv: Vec<f64>,
+    fw: Vec<f64>,
+    power: [f64; 3],
+    torques: [f64; 2],
+}
+
+fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
+    let mut missing = Vec::new();
+    for (flag, on) in [
+        ("axial", l.axial),
+        ("shear", l.shear),
+        ("rotary_inertia", l.rotary_inertia),
+        ("tip_inertia", l.tip_inertia.is_some()),
+        ("prescribed joint", l.joint.prescribed.is_some()),
+        ("gravity", scene.gravity.is_some()),
+        ("contact", !scene.contacts.is_empty()),
+    ] {
+        if on {
+            missing.push(flag);
+        }
+    }
+    if !missing.is_empty() {
+        return Err(FdmError::Unsupported(format!(
+            "fdm: `{}` (link `{}`) switches on {} — not implemented by the finite-difference chain",
+            scene.name,
+            l.name,
+            missing.join(", ")
+        )));
+    }
+    Ok(())
+}
+
+impl TwoLinkChain {
+    pub fn from_scene(scene: &Scene, stations: Option<usize>) -> Result<Self, FdmError> {
+        if scene.links.len() != 2 {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: `{}` has {} links; the finite-difference chain handles exactly two",
+                scene.name,
+                scene.links.len()
+            )));
+        }
+        for l in &scene.links {
+            check_link(scene, l)?;
+        }
+        if scene.links[1].joint.hub_inertia.unwrap_or(0.0) != 0.0 {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: `{}`: a rotor inertia at the elbow is not implemented",
+                scene.name
+            )));
+        }
+        let n = stations.unwrap_or(DEFAULT_STATIONS);
+        let lump = |l: &Link| -> (usize, f64, Vec<f64>) {
+            let r = n - 1;
+            let h = l.length / r as f64;
+            let mut m = vec![l.mass_per_length * h; r];
+            m[r - 1] = 0.5 * l.mass_per_length * h + l.tip_mass.unwrap_or(0.0);
+            (r, h, m)
+        };
+        let (r1, h1, m1) = lump(&scene.links[0]);
+        let (r2, h2, m2) = lump(&scene.links[1]);
+        // outboard sums per segment: Σ_{i > seg} mᵢ xᵢ and Σ_{i > seg} mᵢ
+        let outboard = |m: &[f64], h: f64, moment: bool| -> Vec<f64> {
+            let mut out = vec![0.0; m.len()];
+            let mut acc = 0.0;
+            for seg in (0..m.len()).rev() {
+                acc += m[seg] * if moment { (seg + 1) as f64 * h } else { 1.0 };
+                out[seg] = acc;
+            }
+            out
+        };
+        // Rotary inertia ρA h³/24 of the half cell at each clamp: its section turns with the
+        // clamp tangent (module docs). O(h³): the O(h²) convergence is unaffected.
+        let clamp = |l: &Link, h: f64| l.mass_per_length * h.powi(3) / 24.0;
+        let jc = [clamp(&scene.links[0], h1), clamp(&scene.links[1], h2)];
+        let inertia = ChainInertia {
+            hub: scene.links[0].joint.hub_inertia.unwrap_or(0.0),
+            l1: scene.links[0].length,
+            h1,
+            h2,
+            r1,
+            r2,
+            fs1: scene.links[0].foreshortening,
+            fs2: scene.links[1].foreshortening,
+            w1: outboard(&m1, h1, true),
+            w2: outboard(&m2, h2, true),
+            mu2: outboard(&m2, h2, false),
+            sum_mx2_1: (0..r1).map(|k| m1[k] * ((k + 1) as f64 * h1).powi(2)).sum(),
+            // link 2's clamp half cell (mass ρA₂h₂/2 at ξ = 0) rides on the elbow
+            mass2: m2.iter().sum::<f64>() + 0.5 * scene.links[1].mass_per_length * h2,
+            q2: (0..r2).map(|j| m2[j] * (j + 1) as f64 * h2).sum(),
+            i2: (0..r2).map(|j| m2[j] * ((j + 1) as f64 * h2).powi(2)).sum(),
+            m1,
+            m2,
+        };
+        let props = |l: &Link| LinkProps {
+            length: l.length,
+            ei: l.bending_stiffness,
+            gamma: l.kelvin_voigt.unwrap_or(0.0),
+            rho_a: l.mass_per_length,
+        };
+        let joint = |l: &Link| JointLaw {
+            stiffness: l.joint.stiffness.unwrap_or(0.0),
+            damping: l.joint.damping.unwrap_or(0.0),
+            set_point: l.joint.set_point.unwrap_or(0.0),
+            law: l.joint.torque.clone(),
+        };
+        let nd = inertia.dofs();
+        let (j1, j2) = (&scene.links[0].joint, &scene.links[1].joint);
+        let mut chain = TwoLinkChain {
+            links: [props(&scene.links[0]), props(&scene.links[1])],
+            joints: [joint(&scene.links[0]), joint(&scene.links[1])],
+            init: [
+                (j1.initial_angle, j1.initial_rate),
+                (j2.initial_angle, j2.initial_rate),
+            ],
+            field_stations: scene.simulation.field_stations.max(2),
+            p: vec![Dual::default(); nd],
+            cols: [vec![0.0; nd], vec![0.0; nd], vec![0.0; nd], vec![0.0; nd]],
+            unit: vec![0.0; nd],
+            zeros: vec![0.0; nd],
+            rhs: vec![0.0; nd],
+            fv: vec![0.0; r1],
+            fw: vec![0.0; r2],
+            power: [0.0; 3],
+            torques: [0.0; 2],
+            omega_max: 0.0,
+            jc,
+            slots: [1 + r1, 1 + r1 + r2],
+            hs: [h1, h2],
+            qk: vec![0.0; nd],
+            vk: vec![0.0; nd],
+            obs_scratch: std::cell::RefCell::new(vec![0.0; nd]),
+            obs_scratch_v: std::cell::RefCell::new(vec![0.0; nd]),
+            inertia,
+        };
+        chain.omega_max = chain.top_frequency();
+        Ok(chain)
+    }
+
+    /// Highest ω of the chain linearized about its initial state at rest: power iteration on
+    /// −∂a/∂q (columns by forward differences of the accelerations). Once per run, O(n²).
+    fn top_frequency(&mut self) -> f64 {
+        let (q0, _) = self.initial_state();
+        let n = self.dofs();
+        let rest = vec![0.0; n];
+        let mut a0 = vec![0.0; n];
+        self.accel(0.0, &q0, &rest, &mut a0);
+        let mut jac = vec![0.0; n * n];
+        let mut a = vec![0.0; n];
+        let mut q = q0.clone();
+        for j in 0..n {
+            let eps = 1e-7 * (1.0 + q0[j].abs());
+            q[j] = q0[j] + eps;
+            self.accel(0.0, &q, &rest, &mut a);
+            q[j] = q0[j];
+            for i in 0..n {
+                jac[i * n + j] = -(a[i] - a0[i]) / eps;
+            }
+        }
+        let mut x: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
+        let mut y = vec![0.0; n];
+        let mut lam = 0.0;
+        for _ in 0..400 {
+            for i in 0..n {
+                y[i] = (0..n).map(|j| jac[i * n + j] * x[j]).sum();
+            }
+            lam = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            if lam == 0.0 || !lam.is_finite() {
+                break;
+            }
+            for i in 0..n {
+                x[i] = y[i] / lam;
+            }
+        }
+        // power iteration approaches the top eigenvalue from below: 2 % margin
+        1.02 * lam.max(0.0).sqrt()
+    }
+
+    fn any_law(&self) -> bool {
+        self.joints.iter().any(|j| j.law.is_some())
+    }
+    fn any_damper(&self) -> bool {
+        self.joints.iter().any(|j| j.damping != 0.0)
+    }
+    fn any_kv(&self) -> bool {
+        self.links.iter().any(|l| l.gamma != 0.0)
+    }
+
+    pub fn dof_plan(&self) -> DofPlan {
+        let mut plan = DofPlan::default();
+        plan.add("link-1 tip-chord angle θ", 1);
+        plan.add("link-2 tip-chord angle β", 1);
+        plan.add(
+            "clamp ghost deflections x₁, x₂ (clamp turn against the chord)",
+            2,
+        );
+        plan.add(
+            "link 1 transverse v at stations 1…r−1 (tip-chord frame: v₀ = v_r = 0)",
+            self.inertia.r1 - 1,
+        );
+        plan.add(
+            "link 2 transverse w at stations 1…r−1 (tip-chord frame: w₀ = w_r = 0)",
+            self.inertia.r2 - 1,
+        );
+        if self.inertia.fs1 || self.inertia.fs2 {
+            plan.builds
+                .push("foreshortening (inertial axial-load) stiffening".into());
+        }
+        if self.any_kv() {
+            plan.builds.push("Kelvin–Voigt damping".into());
+        }
+        if self.any_damper() {
+            plan.builds.push("joint dampers".into());
+        }
+        plan.builds.push(
+            "default time method: velocity-form (the hub coupling is velocity dependent)".into(),
+        );
+        plan
+    }
+
+    pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
+        let n = self.inertia.dofs();
+        let mut q = vec![0.0; n];
+        let mut v = vec![0.0; n];
+        // elastic fields at rest and straight: ψ = 0, β = θ₁ + θ₂
+        q[TH] = self.init[0].0;
+        q[BE] = self.init[0].0 + self.init[1].0;
+        v[TH] = self.init[0].1;
+        v[BE] = self.init[0].1 + self.init[1].1;
+        (q, v)
+    }
+
+    /// Tip slope ψ of link 1 and the stencil (indices into q, weights).
+    fn slope_stencil(&self) -> [(usize, f64); 2] {
+        // (3v_r − 4v_{r−1} + v_{r−2})/(2h) with v_r = 0 in the chord frame
+        let i = self.inertia.i_tip1();
+        let h = self.inertia.h1;
+        [(i - 1, -4.0 / (2.0 * h)), (i - 2, 1.0 / (2.0 * h))]
+    }
+
+    /// q-index of station 1 of link ℓ.
+    fn first(&self, link: usize) -> usize {
+        if link == 0 { 2 } else { 2 + self.inertia.r1 }
+    }
+
+    /// Clamp tangent angle of link ℓ: chord angle + (v₁ − x)/(2h) (applied to q or q̇).
+    pub fn clamp_angle(&self, q: &[f64], link: usize) -> f64 {
+        let frame = if link == 0 { q[TH] } else { q[BE] };
+        frame + (q[self.first(link)] - q[self.slots[link]]) / (2.0 * self.hs[link])
+    }
+
+    /// Bending energy of one link in the tip-chord frame with the clamp ghost x: the
+    /// single-link energy on u (u_r = 0) with κ₀ = 2u₁/h² replaced by (u₁ + x)/h². Adds −∂/∂u
+    /// into f (its tip entry left untouched) and returns (energy, −∂/∂x).
+    fn ghost_bending(h: f64, c: f64, u: &[f64], x: f64, f: &mut [f64]) -> (f64, f64) {
+        let r = u.len();
+        let tip = f[r - 1];
+        let e = FloatingLink::add_bending(h, c, u, f);
+        f[r - 1] = tip;
+        let h3 = h * h * h;
+        f[0] += 2.0 * c * u[0] / h3;
+        let g = c * (u[0] + x) / (2.0 * h3);
+        f[0] -= g;
+        (
+            e - c * u[0] * u[0] / h3 + c * (u[0] + x).powi(2) / (4.0 * h3),
+            -g,
+        )
+    }
+
+    /// Elbow angle θ₂ = (clamp tangent of link 2) − θ − ψ (applied to q or q̇).
+    pub fn elbow(&self, q: &[f64]) -> f64 {
+        let psi: f64 = self.slope_stencil().iter().map(|(i, c)| c * q[*i]).sum();
+        self.clamp_angle(q, 1) - q[TH] - psi
+    }
+
+    /// Copies of (q, q̇) with the ghost slots zeroed: the chord-frame deflections (v₁ = 0).
+    fn chord(&mut self, q: &[f64], v: &[f64]) {
+        self.qk.copy_from_slice(q);
+        self.vk.copy_from_slice(v);
+        for s in self.slots {
+            self.qk[s] = 0.0;
+            self.vk[s] = 0.0;
+        }
+    }
+
+    /// Diagonal mass of coordinate i outside the full columns θ, β, x₁, x₂.
+    fn diag_mass(&self, i: usize) -> f64 {
+        let mut d = self.inertia.diag_mass(i);
+        for k in 0..2 {
+            if i == self.first(k) {
+                d += self.jc[k] / (4.0 * self.hs[k] * self.hs[k]);
+            }
+        }
+        d
+    }
+
+    /// Adds J_c e eᵀ·(scale at `along`) of link ℓ's clamp rotation to a column/momentum vector:
+    /// e = ∂(clamp angle)/∂q (1 at the frame, ±1/(2h) at station 1 and the ghost).
+    fn add_clamp(&self, link: usize, weight: f64, out: &mut [f64]) {
+        let frame = if link == 0 { TH } else { BE };
+        let a = 1.0 / (2.0 * self.hs[link]);
+        out[frame] += weight;
+        out[self.first(link)] += weight * a;
+        out[self.slots[link]] -= weight * a;
+    }
+
+    /// Generalized momenta p = M(q) q̇ of the whole chain (chord-frame kinetic energy plus the
+    /// clamp rotary inertias). Allocates: for checks and output, not for the step loop.
+    pub fn momenta(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        self.chord(q, qd);
+        let zeros = vec![0.0; q.len()];
+        let mut p = vec![Dual::default(); q.len()];
+        self.inertia.momenta(&self.qk, &zeros, &self.vk, &mut p);
+        for i in 0..q.len() {
+            out[i] = p[i].re;
+        }
+        for k in 0..2 {
+            out[self.slots[k]] = 0.0;
+        }
+        for k in 0..2 {
+            let w = self.jc[k] * self.clamp_angle(qd, k);
+            self.add_clamp(k, w, out);
+        }
+    }
+
+    pub fn total_energy(&self, q: &[f64], v: &[f64]) -> f64 {
+        let mut e = [0.0; 3];
+        self.stored_energies(0.0, q, v, &mut e);
+        e.iter().sum()
+    }
+
+    /// Generalized forces Q − ∂V/∂q − ∂D/∂q̇ into `out`; sets the powers.
+    fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
+        let mut p_kv = 0.0;
+        for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
+            .into_iter()
+            .enumerate()
+        {
+            f.iter_mut().for_each(|x| *x = 0.0);
+            let h = if link == 0 {
+                self.inertia.h1
+            } else {
+                self.inertia.h2
+            };
+            let lp = &self.links[link];
+            let slot = self.slots[link];
+            let (_, gx) = Self::ghost_bending(h, lp.ei, &self.qk[range.clone()], q[slot], f);
+            let mut fx = gx;
+            if lp.gamma != 0.0 {
+                let (d2, gv) =
+                    Self::ghost_bending(h, lp.gamma, &self.vk[range.clone()], v[slot], f);
+                p_kv += 2.0 * d2;
+                fx += gv;
+            }
+            let r = f.len();
+            f[r - 1] = fx; // the tip entry carries the ghost's force
+            out[range].copy_from_slice(f);
+        }
+        let th2 = self.elbow(q);
+        let th2d = self.elbow(v);
+        let j = &self.joints;
+        let ext = [j[0].torque(t), j[1].torque(t)];
+        let th1 = self.clamp_angle(q, 0);
+        let th1d = self.clamp_angle(v, 0);
+        let tau1 = ext[0] - j[0].stiffness * (th1 - j[0].set_point) - j[0].damping * th1d;
+        let tau2 = ext[1] - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * th2d;
+        // τ₁ on θ₁ (clamp angle of link 1); τ₂ on θ₂ = clamp angle of link 2 − θ − ψ(v)
+        self.add_clamp(0, tau1, out);
+        self.add_clamp(1, tau2, out);
+        out[TH] -= tau2;
+        for (i, c) in self.slope_stencil() {
+            out[i] -= tau2 * c;
+        }
+        self.torques = [tau1, tau2];
+        self.power = [
+            ext[0] * th1d + ext[1] * th2d,
+            j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
+            p_kv,
+        ];
+    }
+}
+
+impl System for TwoLinkChain {
+    fn dofs(&self) -> usize {
+        self.inertia.dofs()
+    }
+
+    fn accel(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) {
+        let n = self.dofs();
+        let mut rhs = std::mem::take(&mut self.rhs);
+        self.chord(q, v);
+        self.forces(t, q, v, &mut rhs);
+        // + ∂T/∂q − (∂p/∂q)q̇ (a holds ∂T/∂q temporarily); the clamp inertias are constant
+        // and the chord-frame T does not see the ghost slots
+        self.inertia.grad_q(&self.qk, &self.vk, a);
+        self.inertia
+            .momenta(&self.qk, &self.vk, &self.vk, &mut self.p);
+        for s in self.slots {
+            a[s] = 0.0;
+            self.p[s] = Dual::default();
+        }
+        for i in 0..n {
+            rhs[i] += a[i] - self.p[i].du;
+        }
+        // full columns of M: p at unit velocities, plus the clamp inertias
+        let full = [TH, BE, self.slots[0], self.slots[1]];
+        for c in 0..4 {
+            self.cols[c].iter_mut().for_each(|x| *x = 0.0);
+        }
+        for (c, &idx) in full.iter().enumerate().take(2) {
+            self.unit[idx] = 1.0;
+            self.inertia
+                .momenta(&self.qk, &self.zeros, &self.unit, &mut self.p);
+            self.unit[idx] = 0.0;
+            for i in 0..n {
+                self.cols[c][i] = self.p[i].re;
+            }
+            for s in self.slots {
+                self.cols[c][s] = 0.0;
+            }
+        }
+        for k in 0..2 {
+            // J_c e eᵀ: column of the frame angle gets J_c e, of the ghost −J_c e/(2h)
+            let mut col = std::mem::take(&mut self.cols[k]);
+            self.add_clamp(k, self.jc[k], &mut col);
+            self.cols[k] = col;
+            let mut col = std::mem::take(&mut self.cols[2 + k]);
+            self.add_clamp(k, -self.jc[k] / (2.0 * self.hs[k]), &mut col);
+            self.cols[2 + k] = col;
+        }
+        // Schur complement on {θ, β, V}; the rest of M is diagonal.
+        let mut s = [[0.0; 4]; 4];
+        let mut b = [0.0; 4];
+        for r in 0..4 {
+            b[r] = rhs[full[r]];
+            for c in 0..4 {
+                s[r][c] = self.cols[c][full[r]];
+            }
+        }
+        for i in 0..n {
+            if full.contains(&i) {
+                continue;
+            }
+            let d = self.diag_mass(i);
+            for r in 0..4 {
+                let mri = self.cols[r][i];
+                b[r] -= mri * rhs[i] / d;
+                for c in 0..4 {
+                    s[r][c] -= mri * self.cols[c][i] / d;
+                }
+            }
+        }
+        let x = solve4(s, b);
+        for i in 0..n {
+            if let Some(k) = full.iter().position(|&f| f == i) {
+                a[i] = x[k];
+            } else {
+                let coupled: f64 = (0..4).map(|c| self.cols[c][i] * x[c]).sum();
+                a[i] = (rhs[i] - coupled) / self.diag_mass(i);
+            }
+        }
+        self.rhs = rhs;
+    }
+
+    fn powers(&self, out: &mut [f64]) {
+        let mut k = 0;
+        if self.any_law() {
+            out[k] = self.power[0];
+            k += 1;
+        }
+        if self.any_damper() {
+            out[k] = self.power[1];
+            k += 1;
+        }
+        if self.any_kv() {
+            out[k] = self.power[2];
+        }
+    }
+
+    fn bound(&self, _t: f64) -> Bound {
+        // 5.44 per link (σ² = h⁴ρA/(4EI)) with the Kelvin–Voigt factor of the shortest wave
+        // (as for the single link); the smaller binds.
+        // The measured top frequency of the coupled chain (clamp-rotation modes included),
+        // with the Kelvin–Voigt ζ of that frequency; margin 0.9 for its drift with the
+        // configuration (the inertia depends on the angles and deflections).
+        let zeta = self
+            .links
+            .iter()
+            .map(|lp| lp.gamma * self.omega_max / (2.0 * lp.ei))
+            .fold(0.0f64, f64::max);
+        let mut best = Bound {
+            sigma: 0.9 * 2.0 / self.omega_max * damped_step_factor(zeta),
+            kind: BoundKind::Transverse,
+            site: 2,
+        };
+        // The clamp-rotation modes (ghost x against J_c/(4h²), stiffness EI/(2h³) + K/(4h²))
+        // also carry the joint damper D/(4h²): ζ = c/(2√(k m)) can be large at tiny J_c.
+        for (k, lp) in self.links.iter().enumerate() {
+            let h = self.hs[k];
+            let m = self.jc[k] / (4.0 * h * h);
+            let stiff = lp.ei / (2.0 * h * h * h) + self.joints[k].stiffness / (4.0 * h * h);
+            let damp = lp.gamma / (2.0 * h * h * h) + self.joints[k].damping / (4.0 * h * h);
+            let w = (stiff / m).sqrt();
+            let zeta = damp / (2.0 * (stiff * m).sqrt());
+            let sig = 0.9 * 2.0 / w * damped_step_factor(zeta);
+            if sig < best.sigma {
+                best = Bound {
+                    sigma: sig,
+                    kind: BoundKind::Transverse,
+                    site: 3 + k,
+                };
+            }
+        }
+        for (k, lp) in self.links.iter().enumerate() {
+            let h = if k == 0 {
+                self.inertia.h1
+            } else {
+                self.inertia.h2
+            };
+            let sigma = (h.powi(4) * lp.rho_a / (4.0 * lp.ei)).sqrt();
+            let zeta = lp.gamma * (2.0 / sigma) / (2.0 * lp.ei);
+            let s = sigma * damped_step_factor(zeta);
+            if s < best.sigma {
+                best = Bound {
+                    sigma: s,
+                    kind: BoundKind::Transverse,
+                    site: k,
+                };
+            }
+        }
+        best
+    }
+
+    fn describe(&self, b: &Bound) -> String {
+        if b.site >= 3 {
+            format!(
+                "clamp-rotation mode of link {} (ghost node against J_c)",
+                b.site - 2
+            )
+        } else if b.site == 2 {
+            "the coupled chain's highest mode (power iteration at t = 0)".into()
+        } else {
+            format!("link {} (uniform: every segment)", b.site + 1)
+        }
+    }
+
+    fn channels(&self) -> Vec<(String, &'static str)> {
+        let mut c = Vec::new();
+        for j in 1..=2 {
+            c.push((channel::joint_angle(j), "rad"));
+            c.push((channel::joint_rate(j), "rad/time"));
+            c.push((channel::joint_torque(j), "torque"));
+        }
+        for l in 1..=2 {
+            c.push((channel::tip_x(l), "length"));
+            c.push((channel::tip_y(l), "length"));
+            c.push((channel::tip_deflection(l), "length"));
+            for k in 0..self.field_stations {
+                c.push((channel::field_deflection(l, k), "length"));
+            }
+        }
+        c
+    }
+
+    fn observe(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        let ine = &self.inertia;
+        let mut qk = self.obs_scratch.borrow_mut();
+        qk.copy_from_slice(q);
+        for s in self.slots {
+            qk[s] = 0.0;
+        }
+        // chord-frame deflections (station 1 at zero)
+        let (vs, ws) = (&qk[ine.iv()], &qk[ine.iw()]);
+        let th1 = self.clamp_angle(q, 0);
+        let th2 = self.elbow(q);
+        let j = &self.joints;
+        // joint torques: applied law + spring + damper at this state
+        let tau1 = j[0].torque(t)
+            - j[0].stiffness * (th1 - j[0].set_point)
+            - j[0].damping * self.clamp_angle(v, 0);
+        let tau2 =
+            j[1].torque(t) - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * self.elbow(v);
+        out[0] = th1;
+        out[1] = self.clamp_angle(v, 0);
+        out[2] = tau1;
+        out[3] = th2;
+        out[4] = self.elbow(v);
+        out[5] = tau2;
+        let s1 = if ine.fs1 {
+            seg_energy(vs, ine.h1, None)
+        } else {
+            0.0
+        };
+        let s2 = if ine.fs2 {
+            seg_energy(ws, ine.h2, None)
+        } else {
+            0.0
+        };
+        let (c1, n1) = (q[TH].cos(), q[TH].sin());
+        let (c2, n2) = (q[BE].cos(), q[BE].sin());
+        let (x1, y1) = (self.links[0].length - s1, vs[ine.r1 - 1]);
+        let tip1 = (c1 * x1 - n1 * y1, n1 * x1 + c1 * y1);
+        let (x2, y2) = (self.links[1].length - s2, ws[ine.r2 - 1]);
+        let tip2 = (tip1.0 + c2 * x2 - n2 * y2, tip1.1 + n2 * x2 + c2 * y2);
+        let nf = self.field_stations;
+        let mut k = 6;
+        for (l, (tip, us, h)) in [(tip1, vs, ine.h1), (tip2, ws, ine.h2)]
+            .into_iter()
+            .enumerate()
+        {
+            // deflections reported in the clamp-tangent frame, turned by
+            // ε = (u₁ − x)/(2h) from the chord: u − Xε (small angle)
+            let turn = -(us[0] - q[self.slots[l]]) / (2.0 * h);
+            out[k] = tip.0;
+            out[k + 1] = tip.1;
+            out[k + 2] = us[us.len() - 1] + self.links[l].length * turn;
+            k += 3;
+            let r = us.len();
+            let at = |i: usize| {
+                if i == 0 {
+                    0.0
+                } else {
+                    us[i - 1] + i as f64 * h * turn
+                }
+            };
+            for f in 0..nf {
+                let x = f as f64 * self.links[l].length / (nf - 1) as f64;
+                let pos = (x / h).clamp(0.0, r as f64);
+                let i = (pos.floor() as usize).min(r - 1);
+                let al = pos - i as f64;
+                out[k] = at(i) * (1.0 - al) + at(i + 1) * al;
+                k += 1;
+            }
+        }
+    }
+
+    fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
+        let mut inputs = Vec::new();
+        if self.any_law() {
+            inputs.push("applied_torque");
+        }
+        let mut diss = Vec::new();
+        if self.any_damper() {
+            diss.push("joint_damper");
+        }
+        if self.any_kv() {
+            diss.push("kelvin_voigt");
+        }
+        (vec!["kinetic", "strain", "joint_spring"], inputs, diss)
+    }
+
+    fn stored_energies(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        let ine = &self.inertia;
+        let mut qk = self.obs_scratch.borrow_mut();
+        let mut vk = self.obs_scratch_v.borrow_mut();
+        qk.copy_from_slice(q);
+        vk.copy_from_slice(v);
+        for s in self.slots {
+            qk[s] = 0.0;
+            vk[s] = 0.0;
+        }
+        let mut ke = ine.kinetic(&qk, &vk);
+        let mut strain = FloatingLink::bending_energy(ine.h1, self.links[0].ei, &qk[ine.iv()])
+            + FloatingLink::bending_energy(ine.h2, self.links[1].ei, &qk[ine.iw()]);
+        for k in 0..2 {
+            let (h, c) = (self.hs[k], self.links[k].ei);
+            let (u1, x) = (q[self.first(k)], q[self.slots[k]]);
+            ke += 0.5 * self.jc[k] * self.clamp_angle(v, k).powi(2);
+            // κ₀ = (u₁ + x)/h² instead of the single link's 2u₁/h²
+            strain += c * ((u1 + x).powi(2) / 4.0 - u1 * u1) / (h * h * h);
+        }
+        let j = &self.joints;
+        let spring = 0.5 * j[0].stiffness * (self.clamp_angle(q, 0) - j[0].set_point).powi(2)
+            + 0.5 * j[1].stiffness * (self.elbow(q) - j[1].set_point).powi(2);
+        out.copy_from_slice(&[ke, strain, spring]);
+    }
+
+    fn monitored(&self) -> std::ops::Range<usize> {
+        2..self.dofs()
+    }
+
+    fn dof_name(&self, i: usize) -> String {
+        let ine = &self.inertia;
+        match i {
+            TH => "link-1 tip-chord angle θ".into(),
+            BE => "link-2 tip-chord angle β".into(),
+            _ if i == self.slots[0] => "link 1 clamp ghost deflection x₁ = v₋₁".into(),
+            _ if i == self.slots[1] => "link 2 clamp ghost deflection x₂ = w₋₁".into(),
+            _ if ine.iv().contains(&i) => {
+                let k = i - 1;
+                format!("link 1 v at station {k} (x = {:.4})", k as f64 * ine.h1)
+            }
+            _ => {
+                let k = i - 1 - ine.r1;
+                format!("link 2 w at station {k} (x = {:.4})", k as f64 * ine.h2)
+            }
+        }
+    }
+
+    fn damped(&self) -> bool {
+        // free joints: velocity-coupled (gyroscopic) inertia forces, as the torque-driven link
+        true
+    }
+}
+
+/// Gaussian elimination with partial pivoting on a 4×4 system.
+fn solve4(mut a: [[f64; 4]; 4], mut b: [f64; 4]) -> [f64; 4] {
+    for col in 0..4 {
+        let piv = (col..4)
+            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
+            .unwrap_or(col);
+        a.swap(col, piv);
+        b.swap(col, piv);
+        for row in col + 1..4 {
+            let f = a[row][col] / a[col][col];
+            for k in col..4 {
+                a[row][k] -= f * a[col][k];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0; 4];
+    for row in (0..4).rev() {
+        let s: f64 = (row + 1..4).map(|k| a[row][k] * x[k]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    x
+}
+
+/// Runs a two-link chain. Default method (no `time.method`): the one-step velocity form — the
+/// free joints make the inertia forces velocity dependent and damping is on in the damped scene,
+/// both of which grow the two-step scheme's computational mode.
+pub fn simulate(
+    scene: &Scene,
+    settings: &Settings,
+    s: &FdmSettings,
+) -> Result<RunResult, FdmError> {
+    let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
+    let method = if settings.time.method.is_none() {
+        Method::VelocityForm
+    } else {
+        s.method
+    };
+    let (q0, v0) = sys.initial_state();
+    let ctl = StepControl {
+        method,
+        safety: s.safety,
+        forced_dt: s.dt,
+        t_end: s.t_end.unwrap_or(scene.simulation.t_end),
+        output_interval: scene.simulation.output_interval,
+        log_change: crate::rocket::LOG_CHANGE,
+        lookahead: false,
+        enforce_bound: true,
+    };
+    let out = integrate(&mut sys, &q0, &v0, &ctl)?;
+    Ok(RunResult {
+        backend: BackendKind::Fdm,
+        scene: scene.name.clone(),
+        settings: settings.clone(),
+        observables: out.observables,
+        ledger: out.ledger,
+        events: out.events,
+        cost: out.cost,
+        verdict: out.verdict,
+    })
+}
