@@ -116,3 +116,26 @@ fn cross_unknown_quantities_and_references_are_errors_not_passes() {
     );
     assert_eq!(evaluate(&c, &RunCache::default()).status, Status::Error);
 }
+
+#[test]
+fn cross_cache_distinguishes_overridden_scenes_of_the_same_name() {
+    use data::cases::scene_with_overrides;
+    use verify::suite::quantity::Analysis;
+    use verify::suite::run_cache::Answer;
+    let cache = RunCache::default();
+    let plain = data::load_scene("cantilever").unwrap();
+    let mut overrides = std::collections::BTreeMap::new();
+    overrides.insert(
+        "link[0].bending_stiffness".to_string(),
+        toml::Value::Float(700.0),
+    );
+    let stiff = scene_with_overrides("cantilever", &overrides).unwrap();
+    assert_eq!(plain.name, stiff.name);
+    let settings = data::Settings::default();
+    let f = |s: &data::Scene| match cache.get(s, BackendKind::Fem, &settings, Analysis::Modes, 4) {
+        Answer::Modes(Ok(r)) => r.frequencies_hz[0],
+        other => panic!("{other:?}"),
+    };
+    // EI × 4 doubles every bending frequency.
+    assert!((f(&stiff) / f(&plain) - 2.0).abs() < 1e-9);
+}

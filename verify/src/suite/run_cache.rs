@@ -37,9 +37,11 @@ impl RunCache {
         analysis: Analysis,
         modes: usize,
     ) -> Answer {
+        // The whole scene is part of the key: cases with overrides share the catalog name
+        // but are different problems.
         let key = format!(
             "{}|{kind}|{}|{analysis:?}|{modes}",
-            scene.name,
+            serde_json::to_string(scene).expect("serializable scene"),
             serde_json::to_string(settings).expect("serializable settings")
         );
         let slot = {
