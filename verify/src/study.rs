@@ -484,16 +484,28 @@ pub fn recommend_command(
         Some(r) => {
             let flag = r.discretization.replace('=', " ");
             println!(
-                "recommended: {} with {} — measured error {:.3e} ≤ {tol:.1e} against {} = {reference:.10e}, wall time {:.3e} s",
+                "recommended: {} with {} — value {:.10e}, measured error {:.3e} ≤ {tol:.1e} against {} = {reference:.10e}, wall time {:.3e} s",
                 r.backend,
                 r.discretization,
+                r.value,
                 r.error.unwrap_or(f64::NAN),
                 study.reference_label,
                 r.wall_time_s
             );
+            // Ending the re-run at the quantity's time makes its final value the quantity.
+            let parsed = Quantity::parse(quantity, &scene);
+            let until = match parsed {
+                Ok(Quantity::At { t, .. }) => format!(" --t-end {t}"),
+                _ => String::new(),
+            };
+            let what = match parsed {
+                Ok(Quantity::Frequency { .. }) => "modes",
+                Ok(Quantity::StaticTip) => "statics",
+                _ => "run",
+            };
             println!(
-                "re-run: flexverify run {} --backend {} --{}",
-                scene.name, r.backend, flag
+                "re-run: flexverify {what} {} --backend {} --{flag}{until}",
+                scene.name, r.backend
             );
             println!(
                 "({} of {} measured discretizations meet the tolerance)",

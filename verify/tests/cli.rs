@@ -120,3 +120,114 @@ fn cli_unsupported_requests_exit_3_without_results() {
     assert!(err.contains("unsupported"), "{err}");
     assert!(out.trim().is_empty(), "a fake result was printed: {out}");
 }
+
+#[test]
+fn cli_converge_cantilever_reports_the_orders_of_each_method() {
+    let (code, out, err) = flexverify(&[
+        "converge",
+        "cantilever",
+        "--quantity",
+        "freq1",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let study: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(
+        study["reference_label"]
+            .as_str()
+            .unwrap()
+            .contains("analytic:clamped-free")
+    );
+    let ladder = |b: &str| {
+        study["ladders"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|l| l["backend"] == b)
+            .unwrap_or_else(|| panic!("no {b} ladder"))
+            .clone()
+    };
+    let order = |b: &str| ladder(b)["observed_order"].as_f64().unwrap();
+    assert!(
+        (order("fem") - 4.0).abs() < 0.3,
+        "fem order {}",
+        order("fem")
+    );
+    assert!(
+        (order("fdm") - 2.0).abs() < 0.2,
+        "fdm order {}",
+        order("fdm")
+    );
+    assert_eq!(ladder("modal")["monotone_from_above"], true);
+    // Every rung carries a measured (positive) wall time for the work-precision diagram.
+    for b in ["fem", "fdm", "modal"] {
+        for r in ladder(b)["rungs"].as_array().unwrap() {
+            assert!(r["wall_time_s"].as_f64().unwrap() > 0.0);
+        }
+    }
+}
+
+#[test]
+fn cli_recommend_names_a_discretization_that_a_rerun_confirms() {
+    let (code, out, err) = flexverify(&[
+        "recommend",
+        "spin-up",
+        "--quantity",
+        "tip_deflection@15",
+        "--tol",
+        "1e-3",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("re-run: flexverify "))
+        .expect(&out);
+    let value: f64 = out
+        .split("value ")
+        .nth(1)
+        .and_then(|s| s.split(',').next())
+        .and_then(|s| s.trim().parse().ok())
+        .expect(&out);
+    let args: Vec<&str> = line
+        .trim_start_matches("re-run: flexverify ")
+        .split_whitespace()
+        .collect();
+    let mut args = args.clone();
+    args.extend(["--format", "json"]);
+    let (code, rerun, err) = flexverify(&args);
+    assert_eq!(code, 0, "{err}");
+    let runs: serde_json::Value = serde_json::from_str(&rerun).unwrap();
+    let channel = runs[0]["observables"]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == "link1.tip_deflection")
+        .unwrap()
+        .clone();
+    let last = channel["values"]
+        .as_array()
+        .unwrap()
+        .last()
+        .unwrap()
+        .as_f64()
+        .unwrap();
+    // The recommendation prints 11 significant digits; the re-run is bit-identical.
+    assert!(
+        (last - value).abs() <= 1e-10 * value.abs(),
+        "{last} vs {value}"
+    );
+    // And an impossible tolerance is refused with the best error found.
+    let (code, _, err) = flexverify(&[
+        "recommend",
+        "cantilever",
+        "--quantity",
+        "freq1",
+        "--tol",
+        "1e-30",
+        "--backend",
+        "fdm",
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("no measured discretization meets"), "{err}");
+}
