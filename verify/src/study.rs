@@ -156,6 +156,7 @@ pub fn run_study(
     refine: Refine,
     kinds: &[BackendKind],
     base: &Settings,
+    rung_budget_s: Option<f64>,
 ) -> Result<Study, CliError> {
     let q = Quantity::parse(quantity, scene)
         .map_err(|e| CliError::Input(format!("error: --quantity: {e}")))?;
@@ -166,9 +167,17 @@ pub fn run_study(
             Refine::Space => space_ladder(kind, base),
             Refine::Time => time_ladder(base, scene),
         };
-        let mut rungs = Vec::new();
+        let mut rungs: Vec<Rung> = Vec::new();
         let mut note = None;
+        let rungs_total = rungs_spec.len();
         for (settings, h, label) in rungs_spec {
+            // A full-suite ladder stops once a rung costs more than the budget: the next
+            // rung would cost several times more.
+            if let (Some(budget), Some(last)) = (rung_budget_s, rungs.last())
+                && last.wall_time_s > budget
+            {
+                break;
+            }
             match measure(&cache, scene, kind, &settings, &q) {
                 Ok((value, peak, wall)) => rungs.push(Rung {
                     wall_time_s: min_wall_time(scene, kind, &settings, &q, wall),
@@ -190,6 +199,17 @@ pub fn run_study(
                     break;
                 }
             }
+        }
+        if let Some(budget) = rung_budget_s
+            && note.is_none()
+            && let Some(last) = rungs.last()
+            && last.wall_time_s > budget
+            && rungs.len() < rungs_total
+        {
+            note = Some(format!(
+                "ladder capped after {}: that rung took {:.1} s, above the {budget} s budget per rung",
+                last.discretization, last.wall_time_s
+            ));
         }
         let values: Vec<f64> = rungs.iter().map(|r| r.value).collect();
         let hs: Vec<f64> = rungs.iter().map(|r| r.h).collect();
@@ -281,7 +301,7 @@ fn rows(study: &Study) -> Vec<Vec<String>> {
     rows
 }
 
-fn write_study(dir: &std::path::Path, study: &Study) -> Result<(), CliError> {
+pub fn write_study(dir: &std::path::Path, study: &Study) -> Result<(), CliError> {
     let stem = format!(
         "converge-{}-{}",
         study.scene,
@@ -390,6 +410,7 @@ pub fn converge_command(
         refine,
         &opts.backend.kinds(),
         &opts.settings(),
+        None,
     )?;
     if study.ladders.iter().all(|l| l.rungs.is_empty()) {
         let notes: Vec<String> = study
@@ -464,6 +485,7 @@ pub fn recommend_command(
         Refine::Space,
         &opts.backend.kinds(),
         &opts.settings(),
+        None,
     )?;
     let Some(reference) = study.reference else {
         return Err(CliError::Failed(format!(

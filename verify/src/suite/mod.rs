@@ -69,6 +69,9 @@ pub fn command(
         Format::Csv => print!("{}", report::csv(&outcomes)),
         Format::Json => println!("{}", report::json(&outcomes)),
     }
+    if suite == Suite::Full {
+        full_ladders(out)?;
+    }
     if let Some(dir) = out {
         plots::draw_all(dir, &cases, &outcomes, &cache);
         report::write_all(dir, &outcomes)?;
@@ -98,4 +101,67 @@ pub fn command(
                 .join("\n"),
         ))
     }
+}
+
+/// Per-rung wall-time budget of the full suite's ladders.
+const FULL_RUNG_BUDGET_S: f64 = 10.0;
+
+/// The quantity a scene's refinement ladder follows in the full suite.
+fn ladder_quantity(scene: &data::Scene) -> Option<String> {
+    use data::scene::PrescribedMotion;
+    if let Some(_r) = &scene.rocket {
+        return Some(format!("rocket.vY@{}", scene.simulation.t_end));
+    }
+    let first = scene.links.first()?;
+    let t = scene.simulation.t_end;
+    Some(match first.joint.prescribed {
+        Some(PrescribedMotion::Fixed) | Some(PrescribedMotion::ConstantRate { .. }) => "freq1".into(),
+        Some(PrescribedMotion::SpinUp { .. }) => format!("tip_deflection@{t}"),
+        None => format!("joint1.angle@{t}"),
+    })
+}
+
+/// `--suite full`: every catalog scene through every rung of each backend's space ladder (a
+/// rung costing more than the budget ends its ladder), with convergence and work-precision
+/// plots when `--out` is given.
+fn full_ladders(out: Option<&Path>) -> Result<(), CliError> {
+    use crate::output::text_table;
+    let mut rows = Vec::new();
+    for name in data::catalog_names() {
+        let scene = data::load_scene(name)?;
+        let Some(q) = ladder_quantity(&scene) else { continue };
+        let study = crate::study::run_study(
+            &scene,
+            &q,
+            crate::cli::args::Refine::Space,
+            &data::BackendKind::ALL,
+            &data::Settings::default(),
+            Some(FULL_RUNG_BUDGET_S),
+        )?;
+        for l in &study.ladders {
+            rows.push(vec![
+                name.to_string(),
+                q.clone(),
+                l.backend.to_string(),
+                l.rungs.len().to_string(),
+                l.rungs.last().map_or("-".into(), |r| format!("{:.9e}", r.value)),
+                l.observed_order.map_or("-".into(), |p| format!("{p:.2}")),
+                l.note.clone().unwrap_or_default().chars().take(90).collect(),
+            ]);
+        }
+        if let Some(dir) = out
+            && study.ladders.iter().any(|l| !l.rungs.is_empty())
+        {
+            crate::study::write_study(&dir.join("ladders"), &study)?;
+        }
+    }
+    println!();
+    print!(
+        "{}",
+        text_table(
+            &["scene", "quantity", "backend", "rungs", "finest value", "order", "note"],
+            &rows
+        )
+    );
+    Ok(())
 }
