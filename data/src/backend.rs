@@ -134,8 +134,8 @@ pub enum BackendError {
     InvalidSettings { field: String, message: String },
     /// A user-forced step is above an explicit scheme's stability bound.
     #[error(
-        "time step {dt:.3e} exceeds the {bound_kind} stability bound {bound:.3e} at {location} \
-         (t = {t:.6e}); use --dt {bound:.3e} or smaller, or omit --dt to let the scheme choose"
+        "time step {dt:.6e} exceeds the {bound_kind} stability bound {bound:.6e} at {location} \
+         (t = {t:.6e}); use a --dt below {bound:.6e}, or omit --dt to let the scheme choose"
     )]
     StabilityBound {
         t: f64,

@@ -35,6 +35,9 @@ use crate::settings::Method;
 pub enum BoundKind {
     Axial,
     Transverse,
+    /// Bending plus the string-like geometric stiffness of a tension (the centrifugal tension
+    /// N(x) of a spinning link's foreshortening): ω² ≤ (bending row + N row)/m per station.
+    TransverseTension,
     /// A discrete mass on its springs (not in the report's 5.45; checked so that no step is ever
     /// taken above a known limit).
     DiscreteMass,
@@ -45,6 +48,7 @@ impl BoundKind {
         match self {
             BoundKind::Axial => "axial",
             BoundKind::Transverse => "transverse",
+            BoundKind::TransverseTension => "transverse (bending + centrifugal tension)",
             BoundKind::DiscreteMass => "discrete-mass",
         }
     }
@@ -373,7 +377,7 @@ pub fn integrate<S: System>(
                 from: tau_logged,
                 to: tau_next,
                 reason: format!(
-                    "{} stability bound moved to {:.4e} ({}) as the mass changed",
+                    "{} stability bound moved to {:.4e} ({}) as the mass or the hub rate changed",
                     b.kind.name(),
                     limit_next,
                     sys.describe(&b)

@@ -55,6 +55,23 @@
 //! * [`link`]: one link in a rotating frame (`spin-up`, `spin-up-linear`, `single-link`,
 //!   `rotating-beam` runs) on the same grid and stepping: foreshortening stiffening, prescribed
 //!   hub motion (reported torque) or hub torque with inertia, spring, damper, Kelvin–Voigt.
+//!   **Step bound with the centrifugal tension.** The report's σ² ≤ h⁴m/(4EI) is 2/ω_max of the
+//!   bending stencil alone. With foreshortening the spinning link carries the tension
+//!   N(x) = θ̇² W(x) ≈ ρAθ̇²(L² − x²)/2 (W = Σ_{i>x} m_i x_i), whose string stiffness N/h² raises
+//!   the sawtooth frequency: per station k, by Gershgorin on the assembled M⁻¹K,
+//!   ω_k² = Σ_j |K_b,kj|/m_k + θ̇² Σ_j |Φ_kj|/m_k − θ̇² = (16EI/h⁴ + 2(N_{k−½} + N_{k+½})/h²)/ρA − θ̇²
+//!   inside the link (N_{k±½} the segment tensions; the −θ̇² is the exact centrifugal softening
+//!   on the diagonal), σ = min_k 2/ω_k × the Kelvin–Voigt factor with ζ_k = γ (K_b row)/(2EIω_k).
+//!   It is evaluated at the current hub rate before every step (prescribed: its kinematics;
+//!   torque-driven: the rate of the current state), reported in `stability_bound`, and named in
+//!   forced-step refusals as kind "transverse (bending + centrifugal tension)" with the station,
+//!   the rate and the three parts of ω². At rest it is the report's 5.44. Measured: the true
+//!   ω_max (dense eigenvalues) lies 1.0 % below it at θ̇ = 60 rad/s, where the bending-only value
+//!   is 9 % too low; forced steps of 0.95 × the limit run, 1.05 × diverge (`dyn_link_tension_*`).
+//!   `spin-up` at ω_s = 12.96 rad/s (λ = 12), which stopped at t ≈ 8.5 s at the bending-only
+//!   limit 1.447e-4, completes with τ from 1.447e-4 down to 1.439e-4 (ledger closure 2.8e-10).
+//!   Not in the bound: the free hub's rank-one coupling through θ̈ (the single link runs the
+//!   velocity form, stable to 2/ω; it has not bound in any tested scene).
 //! * [`chain`]: two links in series (`two-link-free`, `two-link-free-undamped`): link 2 clamped to
 //!   link 1's tip and turned by the elbow angle θ₂ (clamp angle of link 2 = θ₁ + v₁'(L₁) + θ₂).
 //!   Same stations, ghost-node bending energy, Kelvin–Voigt and foreshortening per link. Each
@@ -70,7 +87,11 @@
 //!   velocity-form** (free joints make the inertia forces velocity dependent and damping is on;
 //!   the two-step scheme's parasitic root grows). Measured (tests/chain.rs): undamped 10 s
 //!   energy error bounded (no drift), O(τ²); damped ledger closure 7e-6; joint angles O(h²)
-//!   (orders 1.99, 1.91); rigid limit within 0.5 % of the swing.
+//!   (orders 1.99, 1.91); rigid limit within 0.5 % of the swing. Step bound: 0.9 × 2/ω_max of
+//!   the chain linearized at rest (no rates, so no centrifugal tension) and the per-link 5.44;
+//!   the 0.9 leaves room for a 23 % rise of ω_max², while the tension share N h²/(4EI) at the
+//!   undamped scene's peak rate (θ̇₁ ≈ 22 rad/s, N₁ ≈ 9e3 lbf, 21 stations) is ≈ 1e-2 —
+//!   covered, but a chain spun at ≳ 100 rad/s would need the link's tension term (not done).
 //! * Unsupported (precise `Unsupported` messages): chains of more than two links (Barhorst
 //!   cases with contact), axial/shear fields, tip inertia, gravity on beams, contact, 3-D and
 //!   mobile scenes.

@@ -17,6 +17,10 @@
 //! and for the hub, with p_θ = I θ̇ + Σ m_i x_i v̇_i, I = J + Σ m_i (x_i² + v_i²) − 2Φ,
 //!   (J + Σ m_i v_i² − 2Φ) θ̈ = τ − İ θ̇ − Σ x_i F_i      (v̈ eliminated, as in 5.38/5.40).
 //! With a prescribed joint the second line gives the torque the motor needed.
+//!
+//! Step bound: θ̇²∂²Φ is the string stiffness of the centrifugal tension N = θ̇²W, so the
+//! linearized operator is M⁻¹(K_b + θ̇²∂²Φ − θ̇²M); its Gershgorin discs give, per station,
+//! ω_k² = bend_row_k + θ̇² geo_row_k − θ̇² (see `bound`), rather than the report's bending-only 5.44.
 
 use std::ops::Range;
 
@@ -59,10 +63,20 @@ pub struct FloatingLink {
     /// W_seg for segments 0…r−1
     wseg: Vec<f64>,
     field_stations: usize,
+    /// Gershgorin row sums Σ_j |K_b[k][j]| / m_k of the bending operator (1/time²), per station.
+    bend_row: Vec<f64>,
+    /// Gershgorin row sums Σ_j |∂²Φ/∂v_k∂v_j| / m_k of the foreshortening (geometric) operator
+    /// per unit θ̇² (zero without foreshortening): θ̇² ∂²Φ is the centrifugal tension
+    /// N(x) = θ̇² W(x) acting as a string, N/h · [−1 2 −1].
+    geo_row: Vec<f64>,
     // scratch
     f: Vec<f64>,
     power: [f64; 3],
     torque: f64,
+    /// Hub rate of the latest force evaluation (the bound of a torque-driven hub uses it).
+    last_rate: f64,
+    /// Hub rate the latest bound was evaluated at (for its description).
+    bound_rate: std::cell::Cell<f64>,
 }
 
 impl FloatingLink {
@@ -134,7 +148,13 @@ impl FloatingLink {
             acc += m[i - 1] * i as f64 * h;
             wseg[seg] = acc;
         }
+        let (bend_row, geo_row) =
+            Self::gershgorin_rows(h, l.bending_stiffness, &m, &wseg, l.foreshortening);
         Ok(FloatingLink {
+            bend_row,
+            geo_row,
+            last_rate: j.initial_rate,
+            bound_rate: std::cell::Cell::new(j.initial_rate),
             r,
             h,
             length: l.length,
@@ -152,6 +172,69 @@ impl FloatingLink {
             power: [0.0; 3],
             torque: 0.0,
         })
+    }
+
+    /// Gershgorin row sums of M⁻¹K_b and M⁻¹∂²Φ, built by applying the force routines to unit
+    /// vectors (once per run, O(r²)), so that the bound reads the very stencil that is integrated.
+    /// Both operators have positive diagonals and non-positive nearest-neighbour entries, so the
+    /// row sum of |K_b + θ̇²∂²Φ| is the sum of the two row sums.
+    fn gershgorin_rows(
+        h: f64,
+        ei: f64,
+        m: &[f64],
+        wseg: &[f64],
+        foreshortening: bool,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let r = m.len();
+        let mut bend = vec![0.0; r];
+        let mut geo = vec![0.0; r];
+        let mut unit = vec![0.0; r];
+        let mut col = vec![0.0; r];
+        for j in 0..r {
+            unit[j] = 1.0;
+            col.iter_mut().for_each(|x| *x = 0.0);
+            Self::add_bending(h, ei, &unit, &mut col); // col = −K_b e_j
+            for k in 0..r {
+                bend[k] += col[k].abs() / m[k];
+            }
+            if foreshortening {
+                col.iter_mut().for_each(|x| *x = 0.0);
+                Self::add_phi_stencil(h, wseg, &unit, 1.0, &mut col); // col = ∂²Φ e_j
+                for k in 0..r {
+                    geo[k] += col[k].abs() / m[k];
+                }
+            }
+            unit[j] = 0.0;
+        }
+        (bend, geo)
+    }
+
+    /// Highest ω² of the linearized transverse operator at hub rate `rate`, by Gershgorin per
+    /// station k: ω_k² = bend_row_k + θ̇² geo_row_k − θ̇² (the diagonal centrifugal softening
+    /// −θ̇² m_k v_k shifts every disc centre down). Returns the binding station (index into the
+    /// elastic coordinates) and its σ_k = 2/ω_k × the Kelvin–Voigt factor, minimal over k.
+    fn binding_station(&self, rate: f64) -> (usize, f64) {
+        let w2 = rate * rate;
+        let mut best = (0, f64::INFINITY);
+        for k in 0..self.r {
+            let om2 = (self.bend_row[k] + w2 * self.geo_row[k] - w2).max(0.0);
+            if om2 <= 0.0 {
+                continue;
+            }
+            let om = om2.sqrt();
+            // Kelvin–Voigt: C = (γ/EI) K_b, so per station c/m = (γ/EI) bend_row and
+            // ζ = c/(2mω) = γ bend_row/(2 EI ω) (= γω/(2EI) without tension, as before).
+            let zeta = if self.ei > 0.0 {
+                self.gamma * self.bend_row[k] / (2.0 * self.ei * om)
+            } else {
+                0.0
+            };
+            let sigma = 2.0 / om * crate::integrator::damped_step_factor(zeta);
+            if sigma < best.1 {
+                best = (k, sigma);
+            }
+        }
+        best
     }
 
     fn prescribed(&self) -> bool {
@@ -206,11 +289,15 @@ impl FloatingLink {
 
     /// Φ and its gradient added (times `scale`) into f.
     fn add_phi(&self, vs: &[f64], scale: f64, f: &mut [f64]) -> f64 {
+        Self::add_phi_stencil(self.h, &self.wseg, vs, scale, f)
+    }
+
+    fn add_phi_stencil(h: f64, wseg: &[f64], vs: &[f64], scale: f64, f: &mut [f64]) -> f64 {
         let mut phi = 0.0;
-        for seg in 0..self.r {
-            let g = (Self::at(vs, seg + 1) - Self::at(vs, seg)) / self.h;
-            phi += 0.5 * self.h * self.wseg[seg] * g * g;
-            let d = scale * self.wseg[seg] * g; // ∂Φ/∂v_{seg+1} = W g, ∂/∂v_seg = −W g
+        for seg in 0..wseg.len() {
+            let g = (Self::at(vs, seg + 1) - Self::at(vs, seg)) / h;
+            phi += 0.5 * h * wseg[seg] * g * g;
+            let d = scale * wseg[seg] * g; // ∂Φ/∂v_{seg+1} = W g, ∂/∂v_seg = −W g
             f[seg] += d;
             if seg >= 1 {
                 f[seg - 1] -= d;
@@ -301,6 +388,7 @@ impl System for FloatingLink {
     fn accel(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) {
         let vr = self.vrange();
         let (th, rate, pres) = self.hub_state(t, q, v);
+        self.last_rate = rate;
         let (vs, vd) = (&q[vr.clone()], &v[vr.clone()]);
         let mut f = std::mem::take(&mut self.f);
         f.iter_mut().for_each(|x| *x = 0.0);
@@ -356,26 +444,50 @@ impl System for FloatingLink {
         out.copy_from_slice(&self.power);
     }
 
-    fn bound(&self, _t: f64) -> Bound {
-        // 5.44 per segment: σ² = h⁴ m/(4EI) with m the lumped mass per length (ρA inside).
-        let rho_a = self.m[0] / self.h;
-        let sigma = (self.h.powi(4) * rho_a / (4.0 * self.ei)).sqrt();
-        // Kelvin–Voigt damps the shortest wave (ω_max = 2/σ) with ζ = γω_max/(2EI); the
-        // velocity form on ẍ + 2ζωẋ + ω²x = 0 is stable for ωτ ≤ 2(√(1 + 4ζ²) − 2ζ) (spectral
-        // radius of its 3×3 step matrix, checked numerically: ζ = 0.1, 0.3, 0.5 → 1.640, 1.132,
-        // 0.828). ζ grows with ω for Kelvin–Voigt, so the shortest wave binds.
-        let zeta = self.gamma * (2.0 / sigma) / (2.0 * self.ei);
+    fn bound(&self, t: f64) -> Bound {
+        // The report's 5.44, σ² = h⁴m/(4EI), is 2/ω_max of the bending stencil alone
+        // (ω_max² = 16EI/(m h⁴), the sawtooth wave). A spinning link with foreshortening also
+        // carries the centrifugal tension N(x) = θ̇² W(x) ≈ ρAθ̇²(L² − x²)/2, whose string stiffness
+        // N/h² raises the sawtooth frequency to ω² ≈ (16EI/h⁴ + 4N/h²)/m − θ̇². The bound is
+        // therefore taken per station from the Gershgorin discs of the assembled operator at the
+        // current hub rate (prescribed: its kinematics at t; torque-driven: the rate of the
+        // latest force evaluation, i.e. of the current state), σ = min_k 2/ω_k × KV factor.
+        let rate = match &self.drive {
+            Drive::Prescribed(p) => self.rate0 + p.kinematics(t).1,
+            Drive::Torque { .. } => self.last_rate,
+        };
+        self.bound_rate.set(rate);
+        let (site, sigma) = self.binding_station(rate);
+        let tension = self.foreshortening && rate != 0.0 && self.geo_row[site] > 0.0;
         Bound {
-            sigma: sigma * crate::integrator::damped_step_factor(zeta),
-            kind: BoundKind::Transverse,
-            site: 0,
+            sigma,
+            kind: if tension {
+                BoundKind::TransverseTension
+            } else {
+                BoundKind::Transverse
+            },
+            site,
         }
     }
 
     fn describe(&self, b: &Bound) -> String {
+        let rate = self.bound_rate.get();
+        let k = b.site;
+        let w2 = rate * rate;
+        let tension = if self.foreshortening {
+            w2 * self.wseg[k]
+        } else {
+            0.0
+        };
         format!(
-            "station {}, segment {} (uniform link: every segment)",
-            b.site, b.site
+            "station {} (x = {:.4}), hub rate {:.4}: ω² = {:.4e} bending + {:.4e} tension (N = {:.4e}) − {:.4e} softening",
+            k + 1,
+            (k + 1) as f64 * self.h,
+            rate,
+            self.bend_row[k],
+            w2 * self.geo_row[k],
+            tension,
+            w2
         )
     }
 
@@ -516,6 +628,7 @@ pub fn simulate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::System;
 
     #[test]
     fn elem_link_forces_are_minus_energy_gradients() {
@@ -565,5 +678,154 @@ mod tests {
             (quad - e).abs() < 1e-12 * e.abs().max(1e-30),
             "{quad} vs {e}"
         );
+    }
+
+    /// The link of `spin-up` spun to a constant rate Ω after a 0.2 s ramp (the ramp's θ̈x load
+    /// seeds every wave, the sawtooth by round-off), with `stations` stations.
+    fn spinning(omega: f64, stations: usize) -> (FloatingLink, Scene) {
+        let mut scene = data::load_scene("spin-up").unwrap();
+        scene.links[0].joint.prescribed = Some(PrescribedMotion::SpinUp {
+            omega_s: omega,
+            t_s: 0.2,
+        });
+        let link = FloatingLink::from_scene(&scene, Some(stations)).unwrap();
+        (link, scene)
+    }
+
+    /// Top eigenvalue ω² of the linearized transverse operator −∂a/∂v at hub rate Ω (prescribed,
+    /// θ̈ = 0 after the ramp): dense M^{½}(−∂a/∂v)M^{−½}, symmetric, by faer.
+    fn top_omega2(link: &mut FloatingLink, t: f64) -> f64 {
+        use faer::{Mat, Side};
+        let n = link.dofs();
+        let zero = vec![0.0; n];
+        let (mut a0, mut a) = (vec![0.0; n], vec![0.0; n]);
+        link.accel(t, &zero, &zero, &mut a0);
+        let mut s = Mat::<f64>::zeros(n, n);
+        let mut q = zero.clone();
+        for j in 0..n {
+            q[j] = 1.0; // the forces are linear in v: unit columns are exact
+            link.accel(t, &q, &zero, &mut a);
+            q[j] = 0.0;
+            for i in 0..n {
+                s[(i, j)] = -(a[i] - a0[i]) * (link.m[i] / link.m[j]).sqrt();
+            }
+        }
+        let vals = s.self_adjoint_eigenvalues(Side::Lower).unwrap();
+        vals.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
+    }
+
+    #[test]
+    fn elem_link_bound_includes_centrifugal_tension_and_is_tight() {
+        // Ω = 60 rad/s on the 41-station spin-up link: the tension term 4N/(m h²) is ≈ 25 % of
+        // the bending term 16EI/(m h⁴) at the root, so the report's bending-only bound is wrong
+        // by ≈ 10 % in τ.
+        let omega = 60.0;
+        let (mut link, _) = spinning(omega, 41);
+        let t = 0.5; // after the ramp: θ̇ = Ω, θ̈ = 0
+        let b = link.bound(t);
+        assert_eq!(b.kind, BoundKind::TransverseTension);
+        let w_true = top_omega2(&mut link, t).sqrt();
+        let w_bound = 2.0 / b.sigma;
+        let rho_a = link.m[0] / link.h;
+        let w_report = (16.0 * link.ei / (rho_a * link.h.powi(4))).sqrt();
+        // closed form at the binding interior station: (16EI/h⁴ + 2(W_{k−1} + W_k)Ω²/h²)/ρA − Ω²
+        let k = b.site;
+        let w2_closed = (16.0 * link.ei / link.h.powi(4)
+            + 2.0 * (link.wseg[k] + link.wseg[k + 1]) * omega * omega / (link.h * link.h))
+            / rho_a
+            - omega * omega;
+        eprintln!(
+            "Ω = {omega}: ω_max true {w_true:.6e}, bound {w_bound:.6e} (station {}), bending-only {w_report:.6e}",
+            k + 1
+        );
+        // Gershgorin is a rigorous upper bound: ω_true ≤ ω_bound up to eigen-solver round-off
+        assert!(w_true <= w_bound * (1.0 + 1e-12), "{w_true} > {w_bound}");
+        // ...and tight: the sawtooth wave under a slowly varying N sits within 2 % of it (its
+        // envelope costs O((π/r)²) of the bending symbol and averages N over the wave)
+        assert!(w_bound < 1.02 * w_true, "{w_bound} vs {w_true}");
+        // the report's bending-only value misses the tension: below the true frequency
+        assert!(w_report < 0.95 * w_true, "{w_report} vs {w_true}");
+        // the per-station Gershgorin row at an interior station equals the closed form (same
+        // arithmetic up to summation order: 1e-12); stations 2…r−2 carry the full bending stencil
+        assert!((1..link.r - 2).contains(&k), "binding station {}", k + 1);
+        assert!(((w_bound * w_bound) / w2_closed - 1.0).abs() < 1e-12);
+        // at rest the bound is the report's 5.44 (the interior bending row is 16EI/(m h⁴))
+        let rest = link.bound(0.0);
+        assert_eq!(rest.kind, BoundKind::Transverse);
+        assert!((2.0 / rest.sigma / w_report - 1.0).abs() < 1e-12);
+    }
+
+    /// Runs the spinning link with a forced step `ratio` × the method's limit at full rate,
+    /// bypassing the forced-step check, and returns the verdict.
+    fn forced_run(omega: f64, ratio: f64) -> (data::StabilityVerdict, f64) {
+        let (mut link, _) = spinning(omega, 41);
+        let method = crate::settings::Method::Report;
+        let limit = method.bound_factor() * link.bound(1.0).sigma;
+        let (q0, v0) = link.initial_state();
+        let ctl = StepControl {
+            method,
+            safety: 1.0,
+            forced_dt: Some(ratio * limit),
+            t_end: 0.4,
+            output_interval: 0.01,
+            log_change: 1.0,
+            lookahead: false,
+            enforce_bound: false,
+        };
+        (
+            integrate(&mut link, &q0, &v0, &ctl).unwrap().verdict,
+            ratio * limit,
+        )
+    }
+
+    #[test]
+    fn dyn_link_tension_bound_is_sharp() {
+        // The two-step scheme is stable for ω_max τ ≤ 1 and the new limit (½σ) overestimates
+        // the true ω_max by < 2 % (elem_ test above): 0.95 × the limit at full rate runs to the
+        // end, 1.05 × grows without bound once the ramp brings the rate near Ω = 60 rad/s.
+        let omega = 60.0;
+        let (stable, _) = forced_run(omega, 0.95);
+        assert!(
+            matches!(stable, data::StabilityVerdict::Completed),
+            "0.95 × bound: {stable:?}"
+        );
+        let (unstable, dt) = forced_run(omega, 1.05);
+        match &unstable {
+            data::StabilityVerdict::Stopped { diagnostic } => {
+                eprintln!("1.05 × bound: {diagnostic}");
+                // it diverged only where the forced step exceeds the limit at the current rate
+                let (link, _) = spinning(omega, 41);
+                assert!(
+                    dt > 0.5 * link.bound(diagnostic.t).sigma,
+                    "t = {}",
+                    diagnostic.t
+                );
+            }
+            v => panic!("1.05 × bound should diverge: {v:?}"),
+        }
+        // The report's bending-only limit lies above 1.05 × the new one here, so a step it
+        // allows diverges: the test discriminates the two bounds.
+        let (link, _) = spinning(omega, 41);
+        let rho_a = link.m[0] / link.h;
+        let report = (link.h.powi(4) * rho_a / (4.0 * link.ei)).sqrt();
+        assert!(report > 1.05 * link.bound(1.0).sigma);
+        // Through the public path, the forced step is refused when the rate has grown enough,
+        // with the new kind and the station in the error.
+        let (_, scene) = spinning(omega, 41);
+        let mut s = Settings::default();
+        s.time.dt = Some(1.05 * 0.5 * link.bound(1.0).sigma);
+        s.time.t_end = Some(0.4);
+        let fs = crate::settings::FdmSettings::from_settings(&s).unwrap();
+        match simulate(&scene, &s, &fs) {
+            Err(FdmError::StabilityBound {
+                t, kind, location, ..
+            }) => {
+                eprintln!("refused at t = {t}: {kind} at {location}");
+                assert!(kind.contains("tension"));
+                assert!(location.contains("station"));
+                assert!(t > 0.0 && t <= 0.2);
+            }
+            other => panic!("expected a refusal: {other:?}"),
+        }
     }
 }

@@ -12,7 +12,9 @@
 //!   e = h²(β − 1/6)(q̈_{n+1} − q̈_n) (Zienkiewicz–Xie), step ratio 0.9·err^(−1/3) ∈ [0.2, 2].
 //! * Explicit central difference (velocity-Verlet form): q̇_{n+½} = q̇_n + h/2 q̈_n,
 //!   q_{n+1} = q_n + h q̇_{n+½}, M(q_{n+1}) q̈_{n+1} = −(rest of R) with velocity terms evaluated at
-//!   the predicted q̇, q̇_{n+1} = q̇_{n+½} + h/2 q̈_{n+1}. Stable for h ≤ 2/ω_max.
+//!   the predicted q̇, q̇_{n+1} = q̇_{n+½} + h/2 q̈_{n+1}. Stable for h ≤ 2/ω_max provided the
+//!   step is constant: each stretch between stop times is split into equal steps ≤ dt (a
+//!   periodic short step near the bound makes the composed map unstable).
 //!
 //! The stepper stops exactly on requested times (outputs, torque-law breakpoints, t_end) so that
 //! discontinuities — and later contact events — are never stepped over.
@@ -374,7 +376,18 @@ impl Integrator {
         {
             target = b;
         }
-        let mut h = self.h.min(target - self.t);
+        let span = target - self.t;
+        let mut h = if self.method == Method::CentralDifference {
+            // Equal steps between stops: near its bound (hω → 2) each velocity-Verlet step is a
+            // stable but strongly non-normal map, and a periodic pattern of full steps plus one
+            // short step per output interval composes into an unstable map (measured: spin-up at
+            // 0.99 × 2/ω_max, 83 full + 1 short step per 0.01 s, diverged at t ≈ 0.32 s while
+            // ω_max stayed constant to 1e-9). Every step is ≤ h_nominal (up to 1e-9 relative).
+            let n = (span / self.h_nominal * (1.0 - 1e-9)).ceil().max(1.0);
+            span / n
+        } else {
+            self.h.min(span)
+        };
         if target - self.t - h <= 1e-9 * h {
             h = target - self.t;
         }
