@@ -115,7 +115,9 @@ fn ladder_quantity(scene: &data::Scene) -> Option<String> {
     let first = scene.links.first()?;
     let t = scene.simulation.t_end;
     Some(match first.joint.prescribed {
-        Some(PrescribedMotion::Fixed) | Some(PrescribedMotion::ConstantRate { .. }) => "freq1".into(),
+        Some(PrescribedMotion::Fixed) | Some(PrescribedMotion::ConstantRate { .. }) => {
+            "freq1".into()
+        }
         Some(PrescribedMotion::SpinUp { .. }) => format!("tip_deflection@{t}"),
         None => format!("joint1.angle@{t}"),
     })
@@ -129,7 +131,9 @@ fn full_ladders(out: Option<&Path>) -> Result<(), CliError> {
     let mut rows = Vec::new();
     for name in data::catalog_names() {
         let scene = data::load_scene(name)?;
-        let Some(q) = ladder_quantity(&scene) else { continue };
+        let Some(q) = ladder_quantity(&scene) else {
+            continue;
+        };
         let study = crate::study::run_study(
             &scene,
             &q,
@@ -144,9 +148,16 @@ fn full_ladders(out: Option<&Path>) -> Result<(), CliError> {
                 q.clone(),
                 l.backend.to_string(),
                 l.rungs.len().to_string(),
-                l.rungs.last().map_or("-".into(), |r| format!("{:.9e}", r.value)),
+                l.rungs
+                    .last()
+                    .map_or("-".into(), |r| format!("{:.9e}", r.value)),
                 l.observed_order.map_or("-".into(), |p| format!("{p:.2}")),
-                l.note.clone().unwrap_or_default().chars().take(90).collect(),
+                l.note
+                    .clone()
+                    .unwrap_or_default()
+                    .chars()
+                    .take(90)
+                    .collect(),
             ]);
         }
         if let Some(dir) = out
@@ -159,7 +170,15 @@ fn full_ladders(out: Option<&Path>) -> Result<(), CliError> {
     print!(
         "{}",
         text_table(
-            &["scene", "quantity", "backend", "rungs", "finest value", "order", "note"],
+            &[
+                "scene",
+                "quantity",
+                "backend",
+                "rungs",
+                "finest value",
+                "order",
+                "note"
+            ],
             &rows
         )
     );
