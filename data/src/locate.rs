@@ -82,9 +82,8 @@ pub fn offset_of(root: &Spanned<DeTable<'_>>, path: &FieldPath) -> usize {
                     break;
                 };
                 let Some(v) = arr.get(*i) else { break };
-                if v.span().start > 0 || offset == 0 {
-                    offset = v.span().start.max(offset);
-                }
+                // Array-of-tables elements may carry an empty span: never move backwards.
+                offset = offset.max(v.span().start);
                 value = Some(v);
             }
         }

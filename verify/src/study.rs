@@ -11,9 +11,9 @@ use crate::cli::args::{CommonOpts, Refine};
 use crate::output::{Format, csv_table, text_table, write_atomic};
 use crate::plot::{Series, plot};
 use crate::suite::evaluate::{falling_prefix, fit_order, measure, richardson};
-use crate::suite::quantity::{Analysis, Quantity};
+use crate::suite::quantity::Quantity;
 use crate::suite::reference::{analytic_value, default_analytic_id};
-use crate::suite::run_cache::{RunCache, mode_count};
+use crate::suite::run_cache::{RunCache, compute};
 
 /// One rung of a refinement ladder.
 #[derive(Debug, Clone, Serialize)]
@@ -122,26 +122,14 @@ fn min_wall_time(
     q: &Quantity,
     first: f64,
 ) -> f64 {
-    let b = crate::registry::backend(kind);
     let mut best = first;
     let mut spent = first;
     let mut runs = 1;
     while spent < 0.05 && runs < 5 {
-        let wall = match q.analysis() {
-            Analysis::Modes => b
-                .modes(
-                    scene,
-                    settings,
-                    mode_count(match q {
-                        Quantity::Frequency { n, .. } => *n,
-                        _ => 1,
-                    }),
-                )
-                .map(|r| r.cost.wall_time_s),
-            Analysis::Statics => b.statics(scene, settings).map(|r| r.cost.wall_time_s),
-            Analysis::Simulate => b.simulate(scene, settings).map(|r| r.cost.wall_time_s),
+        let Some(w) = compute(scene, kind, settings, q.analysis(), q.modes_needed()).wall_time_s()
+        else {
+            break;
         };
-        let Ok(w) = wall else { break };
         best = best.min(w);
         spent += w;
         runs += 1;

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use super::quantity::Quantity;
 use super::reference::analytic_value;
-use super::run_cache::{Answer, RunCache, mode_count};
+use super::run_cache::{Answer, RunCache};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -74,10 +74,7 @@ pub fn measure(
     settings: &Settings,
     q: &Quantity,
 ) -> Result<(f64, Option<f64>, f64), String> {
-    let modes = match q {
-        Quantity::Frequency { n, .. } => mode_count(*n),
-        _ => 0,
-    };
+    let modes = q.modes_needed();
     let fmt_err = |e: BackendError| format!("{kind}: {e}");
     match cache.get(scene, kind, settings, q.analysis(), modes) {
         Answer::Modes(r) => {
@@ -105,7 +102,7 @@ pub fn measure(
 }
 
 /// Step size of a ladder rung for order fits.
-fn rung_size(s: &CaseSettings) -> Option<f64> {
+pub fn rung_size(s: &CaseSettings) -> Option<f64> {
     if let Some(dt) = s.dt {
         return Some(dt);
     }
@@ -116,6 +113,28 @@ fn rung_size(s: &CaseSettings) -> Option<f64> {
         return Some(1.0 / (n.max(2) - 1) as f64);
     }
     s.modes.map(|m| 1.0 / m as f64)
+}
+
+/// Measures the quantity on every rung of a ladder: (h of each rung, values, total wall time).
+/// `h` is empty when a rung sets no refinement parameter and `need_h` is false.
+fn measure_ladder(
+    cache: &RunCache,
+    scene: &Scene,
+    kind: data::BackendKind,
+    ladder: &[CaseSettings],
+    q: &Quantity,
+    need_h: bool,
+) -> Result<(Vec<f64>, Vec<f64>, f64), String> {
+    let (mut h, mut v, mut wall) = (Vec::new(), Vec::new(), 0.0);
+    for rung in ladder {
+        let (val, _, w) = measure(cache, scene, kind, &rung.to_settings(), q)?;
+        if need_h {
+            h.push(rung_size(rung).ok_or("a ladder rung sets no refinement parameter")?);
+        }
+        v.push(val);
+        wall += w;
+    }
+    Ok((h, v, wall))
 }
 
 /// Least-squares slope of log|e| against log h.
@@ -226,14 +245,8 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
         against,
     } = &case.reference
     {
-        let mut h = Vec::new();
-        let mut v = Vec::new();
-        for rung in ladder {
-            let (val, _, wall) = measure(cache, &scene, case.backend, &rung.to_settings(), &q)?;
-            h.push(rung_size(rung).ok_or("a ladder rung sets no refinement parameter")?);
-            v.push(val);
-            out.wall_time_s += wall;
-        }
+        let (h, v, wall) = measure_ladder(cache, &scene, case.backend, ladder, &q, true)?;
+        out.wall_time_s += wall;
         let errors: Vec<f64> = match against {
             Some(id) => {
                 let r = analytic_value(id, &scene, &q)?;
@@ -264,12 +277,8 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
     }
 
     if let Reference::Monotone { decreasing, above } = &case.reference {
-        let mut values = Vec::new();
-        for rung in decreasing {
-            let (val, _, wall) = measure(cache, &scene, case.backend, &rung.to_settings(), &q)?;
-            values.push(val);
-            out.wall_time_s += wall;
-        }
+        let (_, values, wall) = measure_ladder(cache, &scene, case.backend, decreasing, &q, false)?;
+        out.wall_time_s += wall;
         let exact = analytic_value(above, &scene, &q)?;
         // Worst violation of the Rayleigh–Ritz properties, relative to the exact value:
         // an increase along the ladder, or a value below the exact one.
@@ -351,14 +360,8 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
             (r, p)
         }
         Reference::Richardson { richardson: ladder } => {
-            let mut h = Vec::new();
-            let mut v = Vec::new();
-            for rung in ladder {
-                let (val, _, w) = measure(cache, &scene, case.backend, &rung.to_settings(), &q)?;
-                h.push(rung_size(rung).ok_or("a ladder rung sets no refinement parameter")?);
-                v.push(val);
-                out.wall_time_s += w;
-            }
+            let (h, v, wall) = measure_ladder(cache, &scene, case.backend, ladder, &q, true)?;
+            out.wall_time_s += wall;
             let (ext, p) = richardson(&h, &v, None).ok_or("Richardson ladder not asymptotic")?;
             out.reference_label = format!("Richardson over {} rungs (p = {p:.2})", ladder.len());
             (ext, None)

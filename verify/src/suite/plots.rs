@@ -7,7 +7,7 @@ use std::path::Path;
 use data::cases::{Case, Reference, scene_with_overrides};
 use data::{RunResult, Scene, load_scene};
 
-use super::evaluate::{Outcome, measure};
+use super::evaluate::{Outcome, measure, rung_size};
 use super::quantity::Quantity;
 use super::reference::analytic_value;
 use super::run_cache::{Answer, RunCache};
@@ -161,11 +161,7 @@ pub fn draw_all(dir: &Path, cases: &[Case], outcomes: &[Outcome], cache: &RunCac
                 let mut work = Vec::new();
                 for rung in ladder {
                     let s = rung.to_settings();
-                    let h = rung
-                        .dt
-                        .or(rung.elements.map(|e| 1.0 / e as f64))
-                        .or(rung.stations.map(|n| 1.0 / (n.max(2) - 1) as f64))
-                        .or(rung.modes.map(|m| 1.0 / m as f64));
+                    let h = rung_size(rung);
                     if let (Ok((v, _, wall)), Some(h), Some(x)) =
                         (measure(cache, &scene, case.backend, &s, &q), h, exact)
                     {

@@ -99,6 +99,14 @@ impl Quantity {
         ))
     }
 
+    /// Modes to request from a backend (0 for non-modal quantities).
+    pub fn modes_needed(&self) -> usize {
+        match self {
+            Quantity::Frequency { n, .. } => super::run_cache::mode_count(*n),
+            _ => 0,
+        }
+    }
+
     pub fn analysis(&self) -> Analysis {
         match self {
             Quantity::Frequency { .. } => Analysis::Modes,

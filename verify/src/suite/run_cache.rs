@@ -48,14 +48,35 @@ impl RunCache {
             let mut map = self.slots.lock().expect("cache lock");
             map.entry(key).or_default().clone()
         };
-        slot.get_or_init(|| {
-            let b = backend(kind);
-            match analysis {
-                Analysis::Modes => Answer::Modes(b.modes(scene, settings, modes)),
-                Analysis::Statics => Answer::Statics(b.statics(scene, settings)),
-                Analysis::Simulate => Answer::Run(b.simulate(scene, settings)),
-            }
-        })
-        .clone()
+        slot.get_or_init(|| compute(scene, kind, settings, analysis, modes))
+            .clone()
+    }
+}
+
+/// One backend call for an analysis, uncached (timing repeats use it directly).
+pub fn compute(
+    scene: &Scene,
+    kind: BackendKind,
+    settings: &Settings,
+    analysis: Analysis,
+    modes: usize,
+) -> Answer {
+    let b = backend(kind);
+    match analysis {
+        Analysis::Modes => Answer::Modes(b.modes(scene, settings, modes)),
+        Analysis::Statics => Answer::Statics(b.statics(scene, settings)),
+        Analysis::Simulate => Answer::Run(b.simulate(scene, settings)),
+    }
+}
+
+impl Answer {
+    /// Backend wall time of a successful answer.
+    pub fn wall_time_s(&self) -> Option<f64> {
+        match self {
+            Answer::Modes(Ok(r)) => Some(r.cost.wall_time_s),
+            Answer::Statics(Ok(r)) => Some(r.cost.wall_time_s),
+            Answer::Run(Ok(r)) => Some(r.cost.wall_time_s),
+            _ => None,
+        }
     }
 }

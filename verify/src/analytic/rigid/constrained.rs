@@ -139,24 +139,8 @@ pub fn evolve_quadratic_friction(a: f64, b: f64, theta0: f64, rate0: f64, h: f64
 impl ConstrainedRigidLink {
     /// Rigid limit of a one-link scene whose tip is held on a circle of radius L about the hub.
     pub fn from_scene(scene: &Scene) -> Result<Self> {
-        reject(
-            scene.links.len() != 1,
-            "constrained rigid link: the scene must have exactly one link",
-        )?;
-        let link = &scene.links[0];
+        let link = super::torque_driven_single_link(scene, "constrained rigid link")?;
         let j = &link.joint;
-        reject(
-            scene.gravity.is_some(),
-            "constrained rigid link: gravity (horizontal plane only)",
-        )?;
-        reject(
-            j.stiffness.is_some_and(|k| k != 0.0) || j.damping.is_some_and(|d| d != 0.0),
-            "constrained rigid link: joint spring/damper",
-        )?;
-        reject(
-            j.prescribed.is_some(),
-            "constrained rigid link: prescribed motion",
-        )?;
         let [contact] = scene.contacts.as_slice() else {
             return Err(AnalyticError::Unsupported(
                 "constrained rigid link: exactly one contact is required".into(),

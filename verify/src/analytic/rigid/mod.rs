@@ -15,6 +15,7 @@ pub mod resting;
 pub mod single;
 pub mod two_link;
 
+use data::Scene;
 use data::scene::{Link, TorqueLaw};
 
 use crate::analytic::error::{AnalyticError, Result};
@@ -48,4 +49,28 @@ pub(crate) fn reject(cond: bool, what: &str) -> Result<()> {
     } else {
         Ok(())
     }
+}
+
+/// The one link of a horizontal-plane scene driven only by a torque law at its hub (no gravity,
+/// joint spring/damper or prescribed motion): what the single-link rigid limits require.
+pub(crate) fn torque_driven_single_link<'a>(scene: &'a Scene, who: &str) -> Result<&'a Link> {
+    reject(
+        scene.links.len() != 1,
+        &format!("{who}: the scene must have exactly one link"),
+    )?;
+    let link = &scene.links[0];
+    let j = &link.joint;
+    reject(
+        scene.gravity.is_some(),
+        &format!("{who}: gravity (only the horizontal plane is modelled)"),
+    )?;
+    reject(
+        j.stiffness.is_some_and(|k| k != 0.0) || j.damping.is_some_and(|d| d != 0.0),
+        &format!("{who}: joint spring/damper"),
+    )?;
+    reject(
+        j.prescribed.is_some(),
+        &format!("{who}: prescribed joint motion"),
+    )?;
+    Ok(link)
 }

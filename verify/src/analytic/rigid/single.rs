@@ -46,24 +46,8 @@ pub struct RigidLinkState {
 impl RigidLink {
     /// The rigid limit of a single-link planar scene (horizontal plane, torque-driven hub).
     pub fn from_scene(scene: &Scene) -> Result<Self> {
-        reject(
-            scene.links.len() != 1,
-            "rigid single-link reference: the scene must have exactly one link",
-        )?;
-        let link = &scene.links[0];
+        let link = super::torque_driven_single_link(scene, "rigid single-link reference")?;
         let j = &link.joint;
-        reject(
-            scene.gravity.is_some(),
-            "rigid single-link reference: gravity (only the horizontal plane is modelled)",
-        )?;
-        reject(
-            j.stiffness.is_some_and(|k| k != 0.0) || j.damping.is_some_and(|d| d != 0.0),
-            "rigid single-link reference: joint spring/damper",
-        )?;
-        reject(
-            j.prescribed.is_some(),
-            "rigid single-link reference: prescribed joint motion",
-        )?;
         reject(
             !scene.contacts.is_empty(),
             "rigid single-link reference: contact (see rigid::constrained for the circular wall)",
