@@ -20,11 +20,10 @@ pub struct BorderedBand {
     ib: Vec<f64>,
     /// S_BI (n_B × n_I), row-major.
     bi: Vec<f64>,
-    /// S_BB (n_B × n_B), row-major; after factorization the LU of the Schur complement.
-    bb: Vec<f64>,
+    /// S_BB (n_B × n_B); after factorization the LU of the Schur complement.
+    schur: DenseLu,
     /// Y = A⁻¹ S_IB after factorization (n_I × n_B, row-major).
     y: Vec<f64>,
-    piv: Vec<usize>,
     tmp_b: Vec<f64>,
     factored: bool,
 }
@@ -38,9 +37,8 @@ impl BorderedBand {
             band: vec![0.0; ni * (2 * b + 1)],
             ib: vec![0.0; ni * nb],
             bi: vec![0.0; nb * ni],
-            bb: vec![0.0; nb * nb],
+            schur: DenseLu::new(nb),
             y: vec![0.0; ni * nb],
-            piv: vec![0; nb],
             tmp_b: vec![0.0; nb],
             factored: false,
         }
@@ -58,7 +56,7 @@ impl BorderedBand {
         self.band.iter_mut().for_each(|x| *x = 0.0);
         self.ib.iter_mut().for_each(|x| *x = 0.0);
         self.bi.iter_mut().for_each(|x| *x = 0.0);
-        self.bb.iter_mut().for_each(|x| *x = 0.0);
+        self.schur.a.iter_mut().for_each(|x| *x = 0.0);
         self.factored = false;
     }
 
@@ -73,7 +71,7 @@ impl BorderedBand {
             }
             (true, false) => self.ib[i * nb + (j - ni)] += v,
             (false, true) => self.bi[(i - ni) * ni + j] += v,
-            (false, false) => self.bb[(i - ni) * nb + (j - ni)] += v,
+            (false, false) => self.schur.a[(i - ni) * nb + (j - ni)] += v,
         }
     }
 
@@ -90,7 +88,7 @@ impl BorderedBand {
             }
             (true, false) => self.ib[i * nb + (j - ni)],
             (false, true) => self.bi[(i - ni) * ni + j],
-            (false, false) => self.bb[(i - ni) * nb + (j - ni)],
+            (false, false) => self.schur.a[(i - ni) * nb + (j - ni)],
         }
     }
 
@@ -116,7 +114,7 @@ impl BorderedBand {
                 s += self.bi[r * ni + j] * x[j];
             }
             for k in 0..nb {
-                s += self.bb[r * nb + k] * x[ni + k];
+                s += self.schur.a[r * nb + k] * x[ni + k];
             }
             y[ni + r] = s;
         }
@@ -183,39 +181,18 @@ impl BorderedBand {
                 for j in 0..ni {
                     s += self.bi[r * ni + j] * self.y[j * nb + c];
                 }
-                self.bb[r * nb + c] -= s;
+                self.schur.a[r * nb + c] -= s;
             }
         }
         // Dense LU with partial pivoting.
-        for k in 0..nb {
-            let mut p = k;
-            for i in (k + 1)..nb {
-                if self.bb[i * nb + k].abs() > self.bb[p * nb + k].abs() {
-                    p = i;
-                }
-            }
-            self.piv[k] = p;
-            if p != k {
-                for j in 0..nb {
-                    self.bb.swap(k * nb + j, p * nb + j);
-                }
-            }
-            let d = self.bb[k * nb + k];
-            if d == 0.0 || !d.is_finite() {
-                return Err(FemError::Singular {
-                    what: "Newton (border Schur complement)".into(),
-                    pivot: ni + k,
-                    t: f64::NAN,
-                });
-            }
-            for i in (k + 1)..nb {
-                let l = self.bb[i * nb + k] / d;
-                self.bb[i * nb + k] = l;
-                for j in (k + 1)..nb {
-                    self.bb[i * nb + j] -= l * self.bb[k * nb + j];
-                }
-            }
-        }
+        self.schur.factorize().map_err(|e| match e {
+            FemError::Singular { pivot, .. } => FemError::Singular {
+                what: "Newton (border Schur complement)".into(),
+                pivot: ni + pivot,
+                t: f64::NAN,
+            },
+            other => other,
+        })?;
         self.factored = true;
         Ok(())
     }
@@ -233,21 +210,7 @@ impl BorderedBand {
             }
             self.tmp_b[r] = s;
         }
-        for k in 0..nb {
-            self.tmp_b.swap(k, self.piv[k]);
-        }
-        for k in 0..nb {
-            for i in (k + 1)..nb {
-                self.tmp_b[i] -= self.bb[i * nb + k] * self.tmp_b[k];
-            }
-        }
-        for k in (0..nb).rev() {
-            let mut s = self.tmp_b[k];
-            for j in (k + 1)..nb {
-                s -= self.bb[k * nb + j] * self.tmp_b[j];
-            }
-            self.tmp_b[k] = s / self.bb[k * nb + k];
-        }
+        self.schur.solve_in_place(&mut self.tmp_b);
         for i in 0..ni {
             let mut s = 0.0;
             for c in 0..nb {
@@ -256,6 +219,86 @@ impl BorderedBand {
             x[i] -= s;
         }
         x[ni..].copy_from_slice(&self.tmp_b);
+    }
+}
+
+/// Dense LU with partial pivoting: the border Schur complement above, and the exact
+/// finite-difference Jacobian of chains whose foreshortening couples whole links to the joint
+/// angles.
+#[derive(Debug, Clone)]
+pub struct DenseLu {
+    n: usize,
+    a: Vec<f64>,
+    piv: Vec<usize>,
+}
+
+impl DenseLu {
+    pub fn new(n: usize) -> Self {
+        DenseLu {
+            n,
+            a: vec![0.0; n * n],
+            piv: vec![0; n],
+        }
+    }
+    /// Column j of the matrix (before factorization).
+    pub fn set_column(&mut self, j: usize, col: &[f64]) {
+        for i in 0..self.n {
+            self.a[i * self.n + j] = col[i];
+        }
+    }
+    pub fn factorize(&mut self) -> Result<(), FemError> {
+        let n = self.n;
+        for k in 0..n {
+            let mut p = k;
+            for i in (k + 1)..n {
+                if self.a[i * n + k].abs() > self.a[p * n + k].abs() {
+                    p = i;
+                }
+            }
+            self.piv[k] = p;
+            if p != k {
+                for j in 0..n {
+                    self.a.swap(k * n + j, p * n + j);
+                }
+            }
+            let d = self.a[k * n + k];
+            if d == 0.0 || !d.is_finite() {
+                return Err(FemError::Singular {
+                    what: "Newton (dense)".into(),
+                    pivot: k,
+                    t: f64::NAN,
+                });
+            }
+            for i in (k + 1)..n {
+                let l = self.a[i * n + k] / d;
+                self.a[i * n + k] = l;
+                if l != 0.0 {
+                    for j in (k + 1)..n {
+                        self.a[i * n + j] -= l * self.a[k * n + j];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+    pub fn solve_in_place(&self, x: &mut [f64]) {
+        let n = self.n;
+        // Rows were swapped whole during factorization: permute b completely first.
+        for k in 0..n {
+            x.swap(k, self.piv[k]);
+        }
+        for k in 0..n {
+            for i in (k + 1)..n {
+                x[i] -= self.a[i * n + k] * x[k];
+            }
+        }
+        for k in (0..n).rev() {
+            let mut s = x[k];
+            for j in (k + 1)..n {
+                s -= self.a[k * n + j] * x[j];
+            }
+            x[k] = s / self.a[k * n + k];
+        }
     }
 }
 

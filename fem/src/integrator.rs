@@ -19,89 +19,10 @@
 //! The stepper stops exactly on requested times (outputs, torque-law breakpoints, t_end) so that
 //! discontinuities — and later contact events — are never stepped over.
 
-use crate::band::BorderedBand;
+use crate::band::{BorderedBand, DenseLu};
 use crate::chain::{Chain, NONE, NewtonCoefficients};
 use crate::error::FemError;
 use crate::settings::Method;
-
-/// Dense LU with partial pivoting (for the exact finite-difference Jacobian of chains whose
-/// foreshortening couples whole links to the joint angles).
-#[derive(Debug, Clone)]
-pub struct DenseLu {
-    n: usize,
-    a: Vec<f64>,
-    piv: Vec<usize>,
-}
-
-impl DenseLu {
-    pub fn new(n: usize) -> Self {
-        DenseLu {
-            n,
-            a: vec![0.0; n * n],
-            piv: vec![0; n],
-        }
-    }
-    /// Column j of the matrix (before factorization).
-    pub fn set_column(&mut self, j: usize, col: &[f64]) {
-        for i in 0..self.n {
-            self.a[i * self.n + j] = col[i];
-        }
-    }
-    pub fn factorize(&mut self) -> Result<(), FemError> {
-        let n = self.n;
-        for k in 0..n {
-            let mut p = k;
-            for i in (k + 1)..n {
-                if self.a[i * n + k].abs() > self.a[p * n + k].abs() {
-                    p = i;
-                }
-            }
-            self.piv[k] = p;
-            if p != k {
-                for j in 0..n {
-                    self.a.swap(k * n + j, p * n + j);
-                }
-            }
-            let d = self.a[k * n + k];
-            if d == 0.0 || !d.is_finite() {
-                return Err(FemError::Singular {
-                    what: "Newton (dense)".into(),
-                    pivot: k,
-                    t: f64::NAN,
-                });
-            }
-            for i in (k + 1)..n {
-                let l = self.a[i * n + k] / d;
-                self.a[i * n + k] = l;
-                if l != 0.0 {
-                    for j in (k + 1)..n {
-                        self.a[i * n + j] -= l * self.a[k * n + j];
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
-    pub fn solve_in_place(&self, x: &mut [f64]) {
-        let n = self.n;
-        // Rows were swapped whole during factorization: permute b completely first.
-        for k in 0..n {
-            x.swap(k, self.piv[k]);
-        }
-        for k in 0..n {
-            for i in (k + 1)..n {
-                x[i] -= self.a[i * n + k] * x[k];
-            }
-        }
-        for k in (0..n).rev() {
-            let mut s = x[k];
-            for j in (k + 1)..n {
-                s -= self.a[k * n + j] * x[j];
-            }
-            x[k] = s / self.a[k * n + k];
-        }
-    }
-}
 
 /// How the Newton matrix is formed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -689,10 +610,12 @@ impl Integrator {
                 let Some(dense) = self.dense.as_mut() else {
                     return Ok(());
                 };
+                // Perturb one entry per column and restore it afterwards (O(n) per column,
+                // not three full copies).
+                self.fd_q.copy_from_slice(&self.q1);
+                self.fd_qd.copy_from_slice(&self.qd1);
+                self.fd_qdd.copy_from_slice(&self.qdd1);
                 for j in 0..n {
-                    self.fd_q.copy_from_slice(&self.q1);
-                    self.fd_qd.copy_from_slice(&self.qd1);
-                    self.fd_qdd.copy_from_slice(&self.qdd1);
                     self.fd_q[j] += c.c_q * eps;
                     self.fd_qd[j] += c.c_v * eps;
                     self.fd_qdd[j] += eps;
@@ -703,6 +626,9 @@ impl Integrator {
                         &self.fd_qdd,
                         &mut self.fd_res,
                     );
+                    self.fd_q[j] = self.q1[j];
+                    self.fd_qd[j] = self.qd1[j];
+                    self.fd_qdd[j] = self.qdd1[j];
                     for i in 0..n {
                         self.fd_res[i] = (self.fd_res[i] - self.res[i]) / eps;
                     }

@@ -32,22 +32,16 @@ pub fn pinned_free_beta1() -> f64 {
         // (sin x cosh x − cos x sinh x) e^{−x} = ½[sin x (1 + e^{−2x}) − cos x (1 − e^{−2x})]
         0.5 * (x.sin() * (1.0 + e * e) - x.cos() * (1.0 - e * e))
     };
-    let (mut a, mut b) = (3.5, 4.2);
-    for _ in 0..200 {
-        let m = 0.5 * (a + b);
-        if f(a) * f(m) <= 0.0 {
-            b = m;
-        } else {
-            a = m;
-        }
-    }
-    0.5 * (a + b)
+    bisect(f, 3.5, 4.2)
 }
 
 /// Root of cos x cosh x + 1 = 0 near 1.875 (first clamped-free eigenvalue), by bisection.
 pub fn clamped_free_beta1() -> f64 {
-    let f = |x: f64| x.cos() * x.cosh() + 1.0;
-    let (mut a, mut b) = (1.5, 2.2);
+    bisect(|x: f64| x.cos() * x.cosh() + 1.0, 1.5, 2.2)
+}
+
+/// Root of `f` in the bracket [a, b] by bisection (200 halvings: to the last bit).
+fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
     for _ in 0..200 {
         let m = 0.5 * (a + b);
         if f(a) * f(m) <= 0.0 {
@@ -394,5 +388,12 @@ mod default_step_tests {
         let x = pinned_free_beta1();
         assert!((x.tan() - x.tanh()).abs() < 1e-12, "{x}");
         assert!(x > 3.9 && x < 3.95);
+    }
+
+    #[test]
+    fn elem_clamped_free_root_solves_cos_cosh() {
+        let x = clamped_free_beta1();
+        assert!((x.cos() * x.cosh() + 1.0).abs() < 1e-12, "{x}");
+        assert!(x > 1.87 && x < 1.88);
     }
 }

@@ -94,6 +94,28 @@ fn state(n: usize, seed: f64, amp_q: f64, amp_qd: f64) -> (Vec<f64>, Vec<f64>) {
     (q, qd)
 }
 
+/// Builds the chain of `scene` with `disc` and checks its equations of motion against the
+/// energy at the state [`state`]`(n, seed, amp_q, amp_qd)`.
+fn check_lagrange_scene(
+    scene: &data::Scene,
+    disc: &Discretization,
+    seed: f64,
+    amp_q: f64,
+    amp_qd: f64,
+) {
+    let mut chain = build_chain(scene, disc).unwrap();
+    let (q, qd) = state(chain.n, seed, amp_q, amp_qd);
+    check_lagrange(&mut chain, &q, &qd);
+}
+
+/// A discretization with `modes` modes per link, defaults otherwise.
+fn with_modes(modes: usize) -> Discretization {
+    Discretization {
+        modes: Some(modes),
+        ..Default::default()
+    }
+}
+
 #[test]
 fn dyn_equations_of_motion_match_the_energy_two_link_with_everything() {
     let mut scene = load_scene("two-link-free-undamped").unwrap();
@@ -110,24 +132,13 @@ fn dyn_equations_of_motion_match_the_energy_two_link_with_everything() {
             basis: Some(basis),
             ..Default::default()
         };
-        let mut chain = build_chain(&scene, &disc).unwrap();
-        let (q, qd) = state(chain.n, 0.7, 0.05, 2.0);
-        check_lagrange(&mut chain, &q, &qd);
+        check_lagrange_scene(&scene, &disc, 0.7, 0.05, 2.0);
     }
     // Linear model (no foreshortening) too.
     for l in &mut scene.links {
         l.foreshortening = false;
     }
-    let mut chain = build_chain(
-        &scene,
-        &Discretization {
-            modes: Some(3),
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let (q, qd) = state(chain.n, 1.1, 0.05, 2.0);
-    check_lagrange(&mut chain, &q, &qd);
+    check_lagrange_scene(&scene, &with_modes(3), 1.1, 0.05, 2.0);
 }
 
 #[test]
@@ -143,31 +154,13 @@ fn dyn_equations_of_motion_match_the_energy_extensible_links() {
         l.axial = true;
         l.axial_stiffness = Some(1e5);
     }
-    let mut chain = build_chain(
-        &scene,
-        &Discretization {
-            modes: Some(3),
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let (q, qd) = state(chain.n, 0.9, 0.05, 2.0);
-    check_lagrange(&mut chain, &q, &qd);
+    check_lagrange_scene(&scene, &with_modes(3), 0.9, 0.05, 2.0);
 }
 
 #[test]
 fn dyn_equations_of_motion_match_the_energy_spin_up() {
     let scene = load_scene("spin-up").unwrap();
-    let mut chain = build_chain(
-        &scene,
-        &Discretization {
-            modes: Some(4),
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let (q, qd) = state(chain.n, 0.4, 0.2, 3.0);
-    check_lagrange(&mut chain, &q, &qd);
+    check_lagrange_scene(&scene, &with_modes(4), 0.4, 0.2, 3.0);
 }
 
 fn run(name: &str, modes: usize, rtol: f64, method: Option<&str>) -> RunResult {

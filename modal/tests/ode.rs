@@ -153,32 +153,68 @@ fn ode_sdirk_tolerance_proportionality() {
     );
 }
 
+/// A fixed-step integrator with dense output, for [`dense_output_error`].
+trait DenseStepper {
+    fn with_step(h: f64) -> Self;
+    fn advance(&mut self, f: &mut Oscillator, t: &mut f64, y: &mut [f64], t_stop: f64);
+    fn dense_at(&self, t: f64, out: &mut [f64]);
+}
+
+impl DenseStepper for Dopri5 {
+    fn with_step(h: f64) -> Self {
+        Dopri5::new(2, NO_CONTROL, Some(h), Some(h))
+    }
+    fn advance(&mut self, f: &mut Oscillator, t: &mut f64, y: &mut [f64], t_stop: f64) {
+        self.step(f, t, y, t_stop).unwrap();
+    }
+    fn dense_at(&self, t: f64, out: &mut [f64]) {
+        self.dense(t, out);
+    }
+}
+
+impl DenseStepper for Sdirk {
+    fn with_step(h: f64) -> Self {
+        Sdirk::new(2, NO_CONTROL, Some(h), Some(h))
+    }
+    fn advance(&mut self, f: &mut Oscillator, t: &mut f64, y: &mut [f64], t_stop: f64) {
+        self.step(f, t, y, t_stop).unwrap();
+    }
+    fn dense_at(&self, t: f64, out: &mut [f64]) {
+        self.dense(t, out);
+    }
+}
+
+/// Fixed steps h over [0, 2] on the unit oscillator: the worst dense-output error at the
+/// fractions `fracs` of every step. End points must be reproduced exactly.
+fn dense_output_error<S: DenseStepper>(h: f64, fracs: &[f64]) -> f64 {
+    let mut f = Oscillator { omega: 1.0 };
+    let mut s = S::with_step(h);
+    let (mut t, mut y) = (0.0, [1.0, 0.0]);
+    let mut worst: f64 = 0.0;
+    let mut out = [0.0; 2];
+    while t < 2.0 - 1e-12 {
+        let t0 = t;
+        s.advance(&mut f, &mut t, &mut y, 2.0);
+        for &frac in fracs {
+            let tt = t0 + frac * (t - t0);
+            s.dense_at(tt, &mut out);
+            let e = exact(1.0, tt);
+            worst = worst.max((out[0] - e[0]).hypot(out[1] - e[1]));
+        }
+        s.dense_at(t, &mut out);
+        assert!((out[0] - y[0]).abs() < 1e-15 && (out[1] - y[1]).abs() < 1e-15);
+    }
+    worst
+}
+
 #[test]
 fn conv_ode_dopri5_dense_output_order() {
     // Fixed steps; dense error measured at the 1/3 and 2/3 points of every step over [0, 2].
-    let dense_err = |h: f64| {
-        let mut f = Oscillator { omega: 1.0 };
-        let mut s = Dopri5::new(2, NO_CONTROL, Some(h), Some(h));
-        let (mut t, mut y) = (0.0, [1.0, 0.0]);
-        let mut worst: f64 = 0.0;
-        let mut out = [0.0; 2];
-        while t < 2.0 - 1e-12 {
-            let t0 = t;
-            s.step(&mut f, &mut t, &mut y, 2.0).unwrap();
-            for frac in [1.0 / 3.0, 2.0 / 3.0] {
-                let tt = t0 + frac * (t - t0);
-                s.dense(tt, &mut out);
-                let e = exact(1.0, tt);
-                worst = worst.max((out[0] - e[0]).hypot(out[1] - e[1]));
-            }
-            // End points are reproduced exactly.
-            s.dense(t, &mut out);
-            assert!((out[0] - y[0]).abs() < 1e-15 && (out[1] - y[1]).abs() < 1e-15);
-        }
-        worst
-    };
     let hs = [0.4, 0.2, 0.1, 0.05];
-    let es: Vec<f64> = hs.iter().map(|&h| dense_err(h)).collect();
+    let es: Vec<f64> = hs
+        .iter()
+        .map(|&h| dense_output_error::<Dopri5>(h, &[1.0 / 3.0, 2.0 / 3.0]))
+        .collect();
     let p = observed_order(&hs, &es);
     // Continuous extension of order 4 (local error O(h⁵), global over a fixed interval O(h⁴)).
     assert!(p > 3.7, "dense output order {p}, errors {es:?}");
@@ -186,24 +222,12 @@ fn conv_ode_dopri5_dense_output_order() {
 
 #[test]
 fn conv_ode_sdirk_dense_output_order() {
-    let dense_err = |h: f64| {
-        let mut f = Oscillator { omega: 1.0 };
-        let mut s = Sdirk::new(2, NO_CONTROL, Some(h), Some(h));
-        let (mut t, mut y) = (0.0, [1.0, 0.0]);
-        let mut worst: f64 = 0.0;
-        let mut out = [0.0; 2];
-        while t < 2.0 - 1e-12 {
-            let t0 = t;
-            s.step(&mut f, &mut t, &mut y, 2.0).unwrap();
-            let tt = t0 + 0.5 * (t - t0);
-            s.dense(tt, &mut out);
-            let e = exact(1.0, tt);
-            worst = worst.max((out[0] - e[0]).hypot(out[1] - e[1]));
-        }
-        worst
-    };
+    // Dense error measured at the midpoint of every step over [0, 2].
     let hs = [0.1, 0.05, 0.025, 0.0125];
-    let es: Vec<f64> = hs.iter().map(|&h| dense_err(h)).collect();
+    let es: Vec<f64> = hs
+        .iter()
+        .map(|&h| dense_output_error::<Sdirk>(h, &[0.5]))
+        .collect();
     let p = observed_order(&hs, &es);
     // Hermite interpolation (local O(h⁴)) of a 2nd-order solution: the global order 2 dominates.
     assert!(p > 1.7, "dense output order {p}, errors {es:?}");

@@ -36,6 +36,10 @@ impl OdeRhs for Pendulums {
 
 #[test]
 fn ode_steps_do_not_allocate() {
+    // Sdirk's dense LU goes through faer; with its default rayon parallelism the worker pool
+    // allocates on first use from other threads, which this global counter would see (one
+    // flaky failure was observed). Run sequentially, as the CLI does.
+    faer::set_global_parallelism(faer::Par::Seq);
     let tol = Tolerances {
         rtol: 1e-9,
         atol: 1e-12,

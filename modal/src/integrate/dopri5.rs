@@ -1,6 +1,9 @@
 //! Dormand–Prince 5(4) with FSAL, PI step control and Hairer's 4th-order dense output.
 
-use super::{IntegrateError, OdeRhs, StepStats, Tolerances, error_norm, initial_step};
+use super::{
+    IntegrateError, OdeRhs, StepStats, Tolerances, clip_step, error_norm, initial_step, min_step,
+    next_step, shrink_after_blowup,
+};
 
 // Butcher tableau (Dormand & Prince 1980).
 const C2: f64 = 1.0 / 5.0;
@@ -166,14 +169,9 @@ impl Dopri5 {
             }
         };
         h = h.min(self.h_max);
-        let h_min = 16.0 * f64::EPSILON * t.abs().max(span.abs()).max(1e-300);
+        let h_min = min_step(*t, span);
         loop {
-            // Never step past t_stop; land exactly on it when close.
-            let clipped = h >= span * (1.0 - 1e-12);
-            let h_try = if clipped { span } else { h };
-            if !clipped && h_try < h_min {
-                return Err(IntegrateError::StepTooSmall { t: *t, h: h_try });
-            }
+            let (h_try, clipped) = clip_step(h, span, h_min, *t)?;
             self.stages(f, *t, y, h_try);
             for i in 0..n {
                 self.err[i] = h_try
@@ -188,10 +186,7 @@ impl Dopri5 {
             if !err.is_finite() {
                 // Blow-up inside the step: shrink hard and retry.
                 self.stats.rejected += 1;
-                h = 0.1 * h_try;
-                if h < h_min {
-                    return Err(IntegrateError::NonFinite { t: *t });
-                }
+                h = shrink_after_blowup(h_try, h_min, *t)?;
                 continue;
             }
             if err <= 1.0 {
@@ -208,13 +203,7 @@ impl Dopri5 {
                 y.copy_from_slice(&self.y_new);
                 std::mem::swap(&mut self.k1, &mut self.k7); // FSAL
                 self.stats.steps += 1;
-                // A step clipped to t_stop keeps the controller's natural size.
-                let h_keep = if clipped && h_next >= h_try {
-                    h_next.max(h)
-                } else {
-                    h_next
-                };
-                self.h = Some(h_keep.min(self.h_max));
+                self.h = Some(next_step(h_next, h, h_try, clipped, self.h_max));
                 return Ok(());
             }
             self.stats.rejected += 1;

@@ -80,6 +80,48 @@ pub(crate) fn error_norm(tol: &Tolerances, y0: &[f64], y1: &[f64], err: &[f64]) 
     (acc / n as f64).sqrt()
 }
 
+/// Smallest step allowed from `t` over a remaining `span` (a few ulps of the time scale).
+pub(crate) fn min_step(t: f64, span: f64) -> f64 {
+    16.0 * f64::EPSILON * t.abs().max(span.abs()).max(1e-300)
+}
+
+/// The step to attempt from `t` with proposal `h` and `span` left to `t_stop`: never past
+/// `t_stop`, landing exactly on it when close. Returns `(h_try, clipped)`.
+pub(crate) fn clip_step(
+    h: f64,
+    span: f64,
+    h_min: f64,
+    t: f64,
+) -> Result<(f64, bool), IntegrateError> {
+    let clipped = h >= span * (1.0 - 1e-12);
+    let h_try = if clipped { span } else { h };
+    if !clipped && h_try < h_min {
+        return Err(IntegrateError::StepTooSmall { t, h: h_try });
+    }
+    Ok((h_try, clipped))
+}
+
+/// Retry step after a non-finite error estimate (blow-up inside the step): shrink hard.
+pub(crate) fn shrink_after_blowup(h_try: f64, h_min: f64, t: f64) -> Result<f64, IntegrateError> {
+    let h = 0.1 * h_try;
+    if h < h_min {
+        return Err(IntegrateError::NonFinite { t });
+    }
+    Ok(h)
+}
+
+/// Step proposed after an accepted step of size `h_try` (the controller suggests `h_next`,
+/// `h` was the proposal before clipping): a step clipped to `t_stop` keeps the controller's
+/// natural size; the result never exceeds `h_max`.
+pub(crate) fn next_step(h_next: f64, h: f64, h_try: f64, clipped: bool, h_max: f64) -> f64 {
+    let h_keep = if clipped && h_next >= h_try {
+        h_next.max(h)
+    } else {
+        h_next
+    };
+    h_keep.min(h_max)
+}
+
 /// Initial step guess (Hairer's HINIT): h such that an explicit Euler step changes y by about
 /// the tolerance, limited by a second-derivative estimate. Uses `f0 = f(t, y)`;
 /// `y1`, `f1` are scratch arrays. Costs one extra RHS evaluation.

@@ -16,7 +16,10 @@ use faer::linalg::lu::partial_pivoting::{factor, solve};
 use faer::perm::PermRef;
 use faer::{Conj, Mat, MatMut, Par};
 
-use super::{IntegrateError, OdeRhs, StepStats, Tolerances, error_norm, initial_step};
+use super::{
+    IntegrateError, OdeRhs, StepStats, Tolerances, clip_step, error_norm, initial_step, min_step,
+    next_step, shrink_after_blowup,
+};
 
 const SQRT2: f64 = std::f64::consts::SQRT_2;
 const GAMMA: f64 = 2.0 - SQRT2;
@@ -285,17 +288,13 @@ impl Sdirk {
             }
         };
         h = h.min(self.h_max);
-        let h_min = 16.0 * f64::EPSILON * t.abs().max(span.abs()).max(1e-300);
+        let h_min = min_step(*t, span);
         self.jac_fresh = false;
         if !self.have_jac {
             self.update_jacobian(f, *t, y);
         }
         loop {
-            let clipped = h >= span * (1.0 - 1e-12);
-            let h_try = if clipped { span } else { h };
-            if !clipped && h_try < h_min {
-                return Err(IntegrateError::StepTooSmall { t: *t, h: h_try });
-            }
+            let (h_try, clipped) = clip_step(h, span, h_min, *t)?;
             if self.lu_h != h_try {
                 self.factorize(h_try);
             }
@@ -340,10 +339,7 @@ impl Sdirk {
             let err = error_norm(&self.tol, y, &self.y_new, &self.err);
             if !err.is_finite() {
                 self.stats.rejected += 1;
-                h = 0.1 * h_try;
-                if h < h_min {
-                    return Err(IntegrateError::NonFinite { t: *t });
-                }
+                h = shrink_after_blowup(h_try, h_min, *t)?;
                 continue;
             }
             // Error of order h³.
@@ -366,10 +362,7 @@ impl Sdirk {
                 if (0.9..=1.3).contains(&(h_next / h_try)) {
                     h_next = h_try;
                 }
-                if clipped && h_next >= h_try {
-                    h_next = h_next.max(h);
-                }
-                self.h = Some(h_next.min(self.h_max));
+                self.h = Some(next_step(h_next, h, h_try, clipped, self.h_max));
                 return Ok(());
             }
             self.stats.rejected += 1;
