@@ -56,27 +56,19 @@ impl Cantilever {
                 )));
             }
         };
-        let mut missing = Vec::new();
-        for (flag, on) in [
-            ("axial", l.axial),
-            ("shear", l.shear),
-            ("rotary_inertia", l.rotary_inertia),
-            ("kelvin_voigt", l.kelvin_voigt.is_some()),
-            ("tip_inertia", l.tip_inertia.is_some()),
-            ("gravity", scene.gravity.is_some()),
-            ("contact", !scene.contacts.is_empty()),
-        ] {
-            if on {
-                missing.push(flag);
-            }
-        }
-        if !missing.is_empty() {
-            return Err(FdmError::Unsupported(format!(
-                "fdm: `{}` switches on {} — not implemented by the finite-difference beam",
-                scene.name,
-                missing.join(", ")
-            )));
-        }
+        FdmError::check_switches(
+            &format!("`{}`", scene.name),
+            "beam",
+            &[
+                ("axial", l.axial),
+                ("shear", l.shear),
+                ("rotary_inertia", l.rotary_inertia),
+                ("kelvin_voigt", l.kelvin_voigt.is_some()),
+                ("tip_inertia", l.tip_inertia.is_some()),
+                ("gravity", scene.gravity.is_some()),
+                ("contact", !scene.contacts.is_empty()),
+            ],
+        )?;
         let n = stations.unwrap_or(DEFAULT_STATIONS);
         Ok(Cantilever {
             stations: n,

@@ -26,6 +26,27 @@ pub enum FdmError {
 }
 
 impl FdmError {
+    /// Rejects a scene that switches on physics the finite-difference `model` does not carry:
+    /// `Err` naming every switch in `switches` that is on (`subject` names the scene/link).
+    pub(crate) fn check_switches(
+        subject: &str,
+        model: &str,
+        switches: &[(&str, bool)],
+    ) -> Result<(), Self> {
+        let missing: Vec<&str> = switches
+            .iter()
+            .filter(|&&(_, on)| on)
+            .map(|&(flag, _)| flag)
+            .collect();
+        if missing.is_empty() {
+            return Ok(());
+        }
+        Err(FdmError::Unsupported(format!(
+            "fdm: {subject} switches on {} — not implemented by the finite-difference {model}",
+            missing.join(", ")
+        )))
+    }
+
     pub fn invalid(field: &str, message: impl Into<String>) -> Self {
         FdmError::InvalidSettings {
             field: field.to_string(),

@@ -114,6 +114,29 @@ pub struct StepControl {
     pub enforce_bound: bool,
 }
 
+impl StepControl {
+    /// The control every scene run uses: step settings from `s`, horizon and output grid from
+    /// the scene, τ changes logged at [`crate::rocket::LOG_CHANGE`].
+    pub(crate) fn for_scene(
+        scene: &data::Scene,
+        s: &crate::settings::FdmSettings,
+        method: Method,
+        lookahead: bool,
+        enforce_bound: bool,
+    ) -> Self {
+        StepControl {
+            method,
+            safety: s.safety,
+            forced_dt: s.dt,
+            t_end: s.t_end.unwrap_or(scene.simulation.t_end),
+            output_interval: scene.simulation.output_interval,
+            log_change: crate::rocket::LOG_CHANGE,
+            lookahead,
+            enforce_bound,
+        }
+    }
+}
+
 /// Everything a run produced.
 #[derive(Debug, Clone)]
 pub struct Outcome {
@@ -125,6 +148,26 @@ pub struct Outcome {
     /// Smallest and largest step taken.
     pub tau_min: f64,
     pub tau_max: f64,
+}
+
+impl Outcome {
+    /// Wraps the run as the backend-neutral result of `scene` under `settings`.
+    pub(crate) fn into_run_result(
+        self,
+        scene: &data::Scene,
+        settings: &data::Settings,
+    ) -> data::RunResult {
+        data::RunResult {
+            backend: data::BackendKind::Fdm,
+            scene: scene.name.clone(),
+            settings: settings.clone(),
+            observables: self.observables,
+            ledger: self.ledger,
+            events: self.events,
+            cost: self.cost,
+            verdict: self.verdict,
+        }
+    }
 }
 
 struct Levels {
@@ -325,7 +368,7 @@ pub fn integrate<S: System>(
     sys.accel(t, &cur.q, &cur.v, &mut acc);
     sys.powers(&mut p_cur);
     cost.rhs_evaluations += 1;
-    let (mut tau, mut limit, _) = choose(sys, t)?;
+    let (mut tau, limit, _) = choose(sys, t)?;
     let mut tau_logged = tau;
     let (mut tau_min, mut tau_max) = (tau, tau);
     rec.record(sys, t, &cur, &w_cur, t, &cur, &w_cur, tau, limit);
@@ -520,10 +563,8 @@ pub fn integrate<S: System>(
         std::mem::swap(&mut p_cur, &mut p_new);
         t = t_new;
         tau = tau_next;
-        limit = limit_next;
         cost.steps += 1;
     }
-    let _ = limit;
     cost.wall_time_s = clock.elapsed().as_secs_f64();
     Ok(Outcome {
         observables: rec.obs,

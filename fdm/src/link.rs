@@ -25,7 +25,7 @@
 use std::ops::Range;
 
 use data::scene::{PrescribedMotion, TorqueLaw};
-use data::{BackendKind, DofPlan, RunResult, Scene, Settings, channel};
+use data::{DofPlan, RunResult, Scene, Settings, channel};
 
 use crate::error::FdmError;
 use crate::integrator::{Bound, BoundKind, StepControl, System, integrate};
@@ -90,26 +90,18 @@ impl FloatingLink {
             )));
         }
         let l = &scene.links[0];
-        let mut missing = Vec::new();
-        for (flag, on) in [
-            ("axial", l.axial),
-            ("shear", l.shear),
-            ("rotary_inertia", l.rotary_inertia),
-            ("tip_inertia", l.tip_inertia.is_some()),
-            ("gravity", scene.gravity.is_some()),
-            ("contact", !scene.contacts.is_empty()),
-        ] {
-            if on {
-                missing.push(flag);
-            }
-        }
-        if !missing.is_empty() {
-            return Err(FdmError::Unsupported(format!(
-                "fdm: `{}` switches on {} — not implemented by the finite-difference floating link",
-                scene.name,
-                missing.join(", ")
-            )));
-        }
+        FdmError::check_switches(
+            &format!("`{}`", scene.name),
+            "floating link",
+            &[
+                ("axial", l.axial),
+                ("shear", l.shear),
+                ("rotary_inertia", l.rotary_inertia),
+                ("tip_inertia", l.tip_inertia.is_some()),
+                ("gravity", scene.gravity.is_some()),
+                ("contact", !scene.contacts.is_empty()),
+            ],
+        )?;
         let j = &l.joint;
         let drive = match &j.prescribed {
             Some(PrescribedMotion::Fixed) => {
@@ -529,13 +521,13 @@ impl System for FloatingLink {
         out[4] = s * xt + c * tip;
         out[5] = tip;
         let nf = self.field_stations;
-        for k in 0..nf {
-            let x = k as f64 * self.length / (nf - 1) as f64;
-            let pos = (x / self.h).clamp(0.0, self.r as f64);
-            let i = (pos.floor() as usize).min(self.r - 1);
-            let al = pos - i as f64;
-            out[6 + k] = Self::at(vs, i) * (1.0 - al) + Self::at(vs, i + 1) * al;
-        }
+        sample_field(
+            self.length,
+            self.h,
+            self.r,
+            |i| Self::at(vs, i),
+            &mut out[6..6 + nf],
+        );
     }
 
     fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
@@ -595,6 +587,25 @@ impl System for FloatingLink {
     }
 }
 
+/// Samples a link's deflection at `out.len()` equally spaced points over its `length`, linearly
+/// between the stations 0…r of step `h` (`at(i)`: deflection of station i).
+pub(crate) fn sample_field(
+    length: f64,
+    h: f64,
+    r: usize,
+    at: impl Fn(usize) -> f64,
+    out: &mut [f64],
+) {
+    let nf = out.len();
+    for (k, o) in out.iter_mut().enumerate() {
+        let x = k as f64 * length / (nf - 1) as f64;
+        let pos = (x / h).clamp(0.0, r as f64);
+        let i = (pos.floor() as usize).min(r - 1);
+        let al = pos - i as f64;
+        *o = at(i) * (1.0 - al) + at(i + 1) * al;
+    }
+}
+
 pub fn simulate(
     scene: &Scene,
     settings: &Settings,
@@ -602,27 +613,8 @@ pub fn simulate(
 ) -> Result<RunResult, FdmError> {
     let mut sys = FloatingLink::from_scene(scene, s.stations)?;
     let (q0, v0) = sys.initial_state();
-    let ctl = StepControl {
-        method: s.method,
-        safety: s.safety,
-        forced_dt: s.dt,
-        t_end: s.t_end.unwrap_or(scene.simulation.t_end),
-        output_interval: scene.simulation.output_interval,
-        log_change: crate::rocket::LOG_CHANGE,
-        lookahead: false,
-        enforce_bound: true,
-    };
-    let out = integrate(&mut sys, &q0, &v0, &ctl)?;
-    Ok(RunResult {
-        backend: BackendKind::Fdm,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        observables: out.observables,
-        ledger: out.ledger,
-        events: out.events,
-        cost: out.cost,
-        verdict: out.verdict,
-    })
+    let ctl = StepControl::for_scene(scene, s, s.method, false, true);
+    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, settings))
 }
 
 #[cfg(test)]

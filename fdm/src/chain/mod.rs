@@ -41,11 +41,11 @@ pub mod dual;
 pub mod kinetic;
 
 use data::scene::{Link, TorqueLaw};
-use data::{BackendKind, DofPlan, RunResult, Scene, Settings, channel};
+use data::{DofPlan, RunResult, Scene, Settings, channel};
 
 use crate::error::FdmError;
 use crate::integrator::{Bound, BoundKind, StepControl, System, damped_step_factor, integrate};
-use crate::link::FloatingLink;
+use crate::link::{FloatingLink, sample_field};
 use crate::settings::{FdmSettings, Method};
 use dual::Dual;
 use kinetic::{BE, ChainInertia, TH, seg_energy};
@@ -108,28 +108,19 @@ pub struct TwoLinkChain {
 }
 
 fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
-    let mut missing = Vec::new();
-    for (flag, on) in [
-        ("axial", l.axial),
-        ("shear", l.shear),
-        ("rotary_inertia", l.rotary_inertia),
-        ("tip_inertia", l.tip_inertia.is_some()),
-        ("prescribed joint", l.joint.prescribed.is_some()),
-        ("gravity", scene.gravity.is_some()),
-        ("contact", !scene.contacts.is_empty()),
-    ] {
-        if on {
-            missing.push(flag);
-        }
-    }
-    if !missing.is_empty() {
-        return Err(FdmError::Unsupported(format!(
-            "fdm: `{}` (link `{}`) switches on {} — not implemented by the finite-difference chain",
-            scene.name,
-            l.name,
-            missing.join(", ")
-        )));
-    }
+    FdmError::check_switches(
+        &format!("`{}` (link `{}`)", scene.name, l.name),
+        "chain",
+        &[
+            ("axial", l.axial),
+            ("shear", l.shear),
+            ("rotary_inertia", l.rotary_inertia),
+            ("tip_inertia", l.tip_inertia.is_some()),
+            ("prescribed joint", l.joint.prescribed.is_some()),
+            ("gravity", scene.gravity.is_some()),
+            ("contact", !scene.contacts.is_empty()),
+        ],
+    )?;
     Ok(())
 }
 
@@ -236,6 +227,13 @@ impl TwoLinkChain {
             obs_scratch_v: std::cell::RefCell::new(vec![0.0; nd]),
             inertia,
         };
+        // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
+        // built once here, `accel` refreshes only the θ and β columns.
+        for k in 0..2 {
+            let mut col = std::mem::take(&mut chain.cols[2 + k]);
+            chain.add_clamp(k, -chain.jc[k] / (2.0 * chain.hs[k]), &mut col);
+            chain.cols[2 + k] = col;
+        }
         chain.omega_max = chain.top_frequency();
         Ok(chain)
     }
@@ -509,7 +507,7 @@ impl System for TwoLinkChain {
         }
         // full columns of M: p at unit velocities, plus the clamp inertias
         let full = [TH, BE, self.slots[0], self.slots[1]];
-        for c in 0..4 {
+        for c in 0..2 {
             self.cols[c].iter_mut().for_each(|x| *x = 0.0);
         }
         for (c, &idx) in full.iter().enumerate().take(2) {
@@ -525,13 +523,10 @@ impl System for TwoLinkChain {
             }
         }
         for k in 0..2 {
-            // J_c e eᵀ: column of the frame angle gets J_c e, of the ghost −J_c e/(2h)
+            // J_c e eᵀ: column of the frame angle gets J_c e (the ghost's −J_c e/(2h) is fixed)
             let mut col = std::mem::take(&mut self.cols[k]);
             self.add_clamp(k, self.jc[k], &mut col);
             self.cols[k] = col;
-            let mut col = std::mem::take(&mut self.cols[2 + k]);
-            self.add_clamp(k, -self.jc[k] / (2.0 * self.hs[k]), &mut col);
-            self.cols[2 + k] = col;
         }
         // Schur complement on {θ, β, V}; the rest of M is diagonal.
         let mut s = [[0.0; 4]; 4];
@@ -731,14 +726,8 @@ impl System for TwoLinkChain {
                     us[i - 1] + i as f64 * h * turn
                 }
             };
-            for f in 0..nf {
-                let x = f as f64 * self.links[l].length / (nf - 1) as f64;
-                let pos = (x / h).clamp(0.0, r as f64);
-                let i = (pos.floor() as usize).min(r - 1);
-                let al = pos - i as f64;
-                out[k] = at(i) * (1.0 - al) + at(i + 1) * al;
-                k += 1;
-            }
+            sample_field(self.links[l].length, h, r, at, &mut out[k..k + nf]);
+            k += nf;
         }
     }
 
@@ -850,25 +839,6 @@ pub fn simulate(
         s.method
     };
     let (q0, v0) = sys.initial_state();
-    let ctl = StepControl {
-        method,
-        safety: s.safety,
-        forced_dt: s.dt,
-        t_end: s.t_end.unwrap_or(scene.simulation.t_end),
-        output_interval: scene.simulation.output_interval,
-        log_change: crate::rocket::LOG_CHANGE,
-        lookahead: false,
-        enforce_bound: true,
-    };
-    let out = integrate(&mut sys, &q0, &v0, &ctl)?;
-    Ok(RunResult {
-        backend: BackendKind::Fdm,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        observables: out.observables,
-        ledger: out.ledger,
-        events: out.events,
-        cost: out.cost,
-        verdict: out.verdict,
-    })
+    let ctl = StepControl::for_scene(scene, s, method, false, true);
+    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, settings))
 }

@@ -68,16 +68,7 @@ pub fn run_with(
     let mut sys = build(scene, s)?;
     let r = scene.rocket.as_ref().expect("checked in build");
     let (q0, v0) = sys.initial_state(&r.initial_shape);
-    let ctl = StepControl {
-        method: s.method,
-        safety: s.safety,
-        forced_dt: s.dt,
-        t_end: s.t_end.unwrap_or(scene.simulation.t_end),
-        output_interval: scene.simulation.output_interval,
-        log_change: LOG_CHANGE,
-        lookahead: true,
-        enforce_bound,
-    };
+    let ctl = StepControl::for_scene(scene, s, s.method, true, enforce_bound);
     let out = integrate(&mut sys, &q0, &v0, &ctl)?;
     Ok((sys, out))
 }
@@ -88,14 +79,5 @@ pub fn simulate(
     s: &FdmSettings,
 ) -> Result<RunResult, FdmError> {
     let (_, out) = run_with(scene, s, true)?;
-    Ok(RunResult {
-        backend: data::BackendKind::Fdm,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        observables: out.observables,
-        ledger: out.ledger,
-        events: out.events,
-        cost: out.cost,
-        verdict: out.verdict,
-    })
+    Ok(out.into_run_result(scene, settings))
 }
