@@ -71,6 +71,33 @@ pub struct Discretization {
     /// Modal: assumed modes per link (per field).
     pub modes: Option<usize>,
     pub basis: Option<Basis>,
+    /// FEM: Euler–Bernoulli element (`hermite-cubic` when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element: Option<FemElement>,
+}
+
+/// Euler–Bernoulli beam element of the FEM backend. Both keep the nodal DOFs (v, v′), so tip
+/// bodies, loads and supports attach the same way.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FemElement {
+    /// Hermite cubic: frequency error O(h⁴).
+    #[default]
+    HermiteCubic,
+    /// Hermite cubic plus two interior C¹ bubbles (complete quintic): frequency error O(h⁸).
+    HermiteQuintic,
+}
+
+impl FemElement {
+    /// Accepted spellings, for error messages and CLI help.
+    pub const NAMES: [&'static str; 2] = ["hermite-cubic", "hermite-quintic"];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            FemElement::HermiteCubic => "hermite-cubic",
+            FemElement::HermiteQuintic => "hermite-quintic",
+        }
+    }
 }
 
 /// How time is integrated.

@@ -24,7 +24,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::backend::{BackendKind, Basis};
+use crate::backend::{BackendKind, Basis, FemElement};
 use crate::error::SceneError;
 
 /// A whole case file.
@@ -47,6 +47,9 @@ pub struct CaseSettings {
     pub modes: Option<usize>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub basis: Option<Basis>,
+    /// FEM element (`hermite-cubic` / `hermite-quintic`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element: Option<FemElement>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dt: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -69,6 +72,7 @@ impl CaseSettings {
                 stations: self.stations,
                 modes: self.modes,
                 basis: self.basis,
+                element: self.element,
             },
             time: crate::TimeStepping {
                 dt: self.dt,

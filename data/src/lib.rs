@@ -21,8 +21,8 @@ pub mod scene;
 pub mod validate;
 
 pub use backend::{
-    Backend, BackendError, BackendKind, Basis, Discretization, DofGroup, DofPlan, Settings,
-    TimeStepping,
+    Backend, BackendError, BackendKind, Basis, Discretization, DofGroup, DofPlan, FemElement,
+    Settings, TimeStepping,
 };
 pub use catalog::{CATALOG, catalog_names, catalog_scene, load_scene};
 pub use error::{LoadError, SceneError};

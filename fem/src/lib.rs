@@ -100,12 +100,13 @@ impl FemBackend {
         let n_el = settings::elements(&settings.discretization)?;
         let link = &scene.links[0];
         let omega = linear::hub_rate(link)?;
-        let sys = linear::LinearLink::assemble(link, n_el, omega)?;
+        let element = linear::ElementKind::for_link(link, settings.discretization.element)?;
+        let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
         let modes = modes::link_modes(&sys, count)?;
         let stations = scene.simulation.field_stations;
         let mut shapes = Vec::with_capacity(modes.len());
         for m in &modes {
-            let (x, transverse) = modes::sample_shape(&sys, link, &m.vector, stations);
+            let (x, transverse) = modes::sample_shape(&sys, &m.vector, stations);
             shapes.push(ModeShape {
                 link: 1,
                 x,
@@ -137,7 +138,8 @@ impl FemBackend {
         let n_el = settings::elements(&settings.discretization)?;
         let link = &scene.links[0];
         let omega = linear::hub_rate(link)?;
-        let sys = linear::LinearLink::assemble(link, n_el, omega)?;
+        let element = linear::ElementKind::for_link(link, settings.discretization.element)?;
+        let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
         let (tip_deflection, tip_rotation) = statics::solve(scene, &sys)?;
         Ok(StaticResult {
             backend: BackendKind::Fem,
@@ -162,7 +164,7 @@ impl Backend for FemBackend {
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
         let n_el = settings::elements(disc)?;
-        Ok(plan::dof_plan(scene, n_el)?)
+        Ok(plan::dof_plan(scene, n_el, disc.element)?)
     }
 
     fn modes(
@@ -179,6 +181,13 @@ impl Backend for FemBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+        if settings.discretization.element == Some(data::FemElement::HermiteQuintic) {
+            return Err(FemError::unsupported(
+                "fem run: the `hermite-quintic` element is implemented for modes and statics \
+                 only; dynamics uses `hermite-cubic` (omit `discretization.element`)",
+            )
+            .into());
+        }
         Ok(run::simulate(scene, settings)?)
     }
 }

@@ -1,7 +1,11 @@
 //! Linear model of one clamped link (modes and statics): dense K and M about the reference state.
 //!
-//! DOFs per node k = 1..n (node 0 is clamped): v, rotation (v′ for Euler–Bernoulli, θ for
-//! Timoshenko), then u when `axial` is on. For a hub spinning at constant Ω (prescribed
+//! Elements ([`ElementKind`]): Hermite cubic (default) or hierarchical Hermite quintic for
+//! Euler–Bernoulli links (`discretization.element`), the cubic-v/quadratic-θ element for `shear`
+//! links. DOF order per element e = 0..n−1: its interior DOFs (quintic bubbles a₁, a₂; Timoshenko
+//! v(⅓), v(⅔), θ(½)), then the DOFs of its end node e+1: v, rotation (v′ for Euler–Bernoulli, θ
+//! for Timoshenko), then u when `axial` is on. Node 0 is clamped and has no DOFs. Interleaving the
+//! interior DOFs keeps the matrices banded. For a hub spinning at constant Ω (prescribed
 //! `constant-rate`), the linearization of the floating-frame energy about the undeformed state adds
 //! * with `foreshortening`: the centrifugal geometric stiffness ∫N v′² with
 //!   N(x) = ρAΩ²(L² − x²)/2 + m_tip Ω² L (from −Ω²∫ρA x s, s = −½∫v′²), and
@@ -9,31 +13,152 @@
 //!
 //! so that in-plane bending obeys ω_in² = ω_out² − Ω² for the inextensible model.
 
+use data::FemElement;
 use data::scene::{Link, PrescribedMotion};
 use faer::Mat;
 
 use crate::element::euler_bernoulli as eb;
-use crate::element::hermite::hermite;
-use crate::element::timoshenko::TimoshenkoElement;
+use crate::element::quadrature::gauss01;
+use crate::element::{hermite, quintic, timoshenko};
 use crate::error::FemError;
 
-/// Where a node's DOFs sit.
+/// Largest local DOF count of any element (Timoshenko: 7).
+const MAX_LOCAL: usize = timoshenko::NDOF;
+
+/// Local element matrix padded to the largest element; only the leading `n` × `n` block is used.
+type Local = [[f64; MAX_LOCAL]; MAX_LOCAL];
+
+/// The transverse element a link uses in the linear model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ElementKind {
+    /// Euler–Bernoulli, Hermite cubic: DOFs (v₁, v₁′, v₂, v₂′).
+    HermiteCubic,
+    /// Euler–Bernoulli, Hermite cubic + two bubbles: (v₁, v₁′, v₂, v₂′, a₁, a₂).
+    HermiteQuintic,
+    /// Timoshenko, cubic v / quadratic θ: (v₁, θ₁, v₂, θ₂, v(⅓), v(⅔), θ(½)).
+    Timoshenko,
+}
+
+impl ElementKind {
+    /// The element for `link` under the `discretization.element` choice. The choice names an
+    /// Euler–Bernoulli element; a `shear` link always uses the Timoshenko element, and asking
+    /// for the quintic there is refused rather than silently ignored.
+    pub fn for_link(link: &Link, choice: Option<FemElement>) -> Result<Self, FemError> {
+        match (link.shear, choice.unwrap_or_default()) {
+            (false, FemElement::HermiteCubic) => Ok(ElementKind::HermiteCubic),
+            (false, FemElement::HermiteQuintic) => Ok(ElementKind::HermiteQuintic),
+            (true, FemElement::HermiteCubic) => Ok(ElementKind::Timoshenko),
+            (true, FemElement::HermiteQuintic) => Err(FemError::InvalidSettings {
+                field: "discretization.element".into(),
+                message: "`hermite-quintic` is an Euler–Bernoulli element; a `shear` link uses                           the Timoshenko (cubic v, quadratic θ) element: omit the field or use                           `hermite-cubic`"
+                    .into(),
+            }),
+        }
+    }
+
+    /// Element-interior DOFs per element.
+    pub fn interior(self) -> usize {
+        match self {
+            ElementKind::HermiteCubic => 0,
+            ElementKind::HermiteQuintic => quintic::INTERIOR,
+            ElementKind::Timoshenko => timoshenko::INTERIOR,
+        }
+    }
+
+    /// Local transverse DOFs per element (4 nodal + interior).
+    pub fn local_dofs(self) -> usize {
+        4 + self.interior()
+    }
+
+    /// Transverse-deflection shape functions of the local DOFs at ξ (zero for rotation DOFs θ).
+    pub fn v_shapes(self, xi: f64, h: f64) -> [f64; MAX_LOCAL] {
+        let mut n = [0.0; MAX_LOCAL];
+        match self {
+            ElementKind::HermiteCubic => n[..4].copy_from_slice(&hermite::hermite(xi, h).n),
+            ElementKind::HermiteQuintic => {
+                n[..quintic::NDOF].copy_from_slice(&quintic::shapes(xi, h).n)
+            }
+            ElementKind::Timoshenko => n.copy_from_slice(&timoshenko::shapes(xi, h).v),
+        }
+        n
+    }
+
+    /// Element mass and stiffness (ρI enters through the slope for Euler–Bernoulli and through θ
+    /// for Timoshenko).
+    fn matrices(self, link: &Link, rho_a: f64, rho_i: f64, h: f64) -> (Local, Local) {
+        let ei = link.bending_stiffness;
+        match self {
+            ElementKind::HermiteCubic => (
+                pad(&eb::mass(rho_a, rho_i, h)),
+                pad(&eb::bending_stiffness(ei, h)),
+            ),
+            ElementKind::HermiteQuintic => (
+                pad(&quintic::mass(rho_a, rho_i, h)),
+                pad(&quintic::bending_stiffness(ei, h)),
+            ),
+            ElementKind::Timoshenko => {
+                // support::check_planar guarantees κGA for shear links.
+                let kga = link.shear_stiffness.unwrap_or(f64::INFINITY);
+                (
+                    timoshenko::mass(rho_a, rho_i, h),
+                    timoshenko::stiffness(ei, kga, h),
+                )
+            }
+        }
+    }
+}
+
+/// Copies an N×N element matrix into the padded local block.
+fn pad<const N: usize>(a: &[[f64; N]; N]) -> Local {
+    let mut out = [[0.0; MAX_LOCAL]; MAX_LOCAL];
+    for i in 0..N {
+        out[i][..N].copy_from_slice(&a[i]);
+    }
+    out
+}
+
+/// Where the DOFs sit: per element, `interior` DOFs, then `dofs_per_node` DOFs of its end node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct NodeLayout {
     pub dofs_per_node: usize,
+    pub interior: usize,
     pub axial: bool,
     pub shear: bool,
 }
 
 impl NodeLayout {
+    fn block(&self) -> usize {
+        self.dofs_per_node + self.interior
+    }
     pub fn v(&self, node: usize) -> Option<usize> {
-        (node > 0).then(|| (node - 1) * self.dofs_per_node)
+        (node > 0).then(|| (node - 1) * self.block() + self.interior)
     }
     pub fn rot(&self, node: usize) -> Option<usize> {
-        (node > 0).then(|| (node - 1) * self.dofs_per_node + 1)
+        self.v(node).map(|i| i + 1)
     }
     pub fn u(&self, node: usize) -> Option<usize> {
-        (node > 0 && self.axial).then(|| (node - 1) * self.dofs_per_node + 2)
+        self.v(node).filter(|_| self.axial).map(|i| i + 2)
+    }
+    /// Interior DOF `k` of element `e`.
+    pub fn interior(&self, e: usize, k: usize) -> usize {
+        debug_assert!(k < self.interior);
+        e * self.block() + k
+    }
+    /// Whether global DOF `i` is an axial displacement u.
+    pub fn is_axial(&self, i: usize) -> bool {
+        self.axial && i % self.block() == self.interior + 2
+    }
+    /// Global index of each local transverse DOF of element `e` (None: clamped).
+    pub fn element_dofs(&self, e: usize) -> [Option<usize>; MAX_LOCAL] {
+        let mut d = [None; MAX_LOCAL];
+        d[0] = self.v(e);
+        d[1] = self.rot(e);
+        d[2] = self.v(e + 1);
+        d[3] = self.rot(e + 1);
+        for k in 0..self.interior {
+            d[4 + k] = Some(self.interior(e, k));
+        }
+        d
     }
 }
 
@@ -41,6 +166,7 @@ impl NodeLayout {
 #[derive(Debug, Clone)]
 pub struct LinearLink {
     pub layout: NodeLayout,
+    pub element: ElementKind,
     pub n_el: usize,
     pub length: f64,
     pub m: Mat<f64>,
@@ -63,10 +189,17 @@ pub fn hub_rate(link: &Link) -> Result<f64, FemError> {
 }
 
 impl LinearLink {
-    /// Assembles K and M of `link` with `n_el` elements, spinning at constant `omega`.
-    pub fn assemble(link: &Link, n_el: usize, omega: f64) -> Result<Self, FemError> {
+    /// Assembles K and M of `link` with `n_el` elements of kind `element`, spinning at constant
+    /// `omega`.
+    pub fn assemble(
+        link: &Link,
+        n_el: usize,
+        omega: f64,
+        element: ElementKind,
+    ) -> Result<Self, FemError> {
         let layout = NodeLayout {
             dofs_per_node: if link.axial { 3 } else { 2 },
+            interior: element.interior(),
             axial: link.axial,
             shear: link.shear,
         };
@@ -76,7 +209,12 @@ impl LinearLink {
                  coupling makes this a gyroscopic (state-space) eigenproblem, not implemented",
             ));
         }
-        let n = n_el * layout.dofs_per_node;
+        if element == ElementKind::Timoshenko && link.foreshortening && omega != 0.0 {
+            return Err(FemError::unsupported(
+                "fem modes: centrifugal stiffening of a Timoshenko link is not implemented",
+            ));
+        }
+        let n = n_el * layout.block();
         let h = link.length / n_el as f64;
         let mut m = Mat::<f64>::zeros(n, n);
         let mut k = Mat::<f64>::zeros(n, n);
@@ -89,61 +227,42 @@ impl LinearLink {
         let tip_mass = link.tip_mass.unwrap_or(0.0);
         let l = link.length;
         let w2 = omega * omega;
+        let nl = element.local_dofs();
+        // Same for every element: h is uniform.
+        let (me, ke) = element.matrices(link, rho_a, rho_i, h);
+        // Rotating-frame softening −Ω²∫ρA v² (translational mass only).
+        let (mv, _) = element.matrices(link, rho_a, 0.0, h);
         for e in 0..n_el {
-            let dofs = [
-                layout.v(e),
-                layout.rot(e),
-                layout.v(e + 1),
-                layout.rot(e + 1),
-            ];
-            let (me, ke) = if link.shear {
-                let kga = link.shear_stiffness.unwrap_or(f64::INFINITY);
-                let el = TimoshenkoElement::new(h, link.bending_stiffness, kga);
-                (
-                    el.mass(rho_a, rho_i),
-                    el.stiffness(link.bending_stiffness, kga),
-                )
-            } else {
-                (
-                    eb::mass(rho_a, rho_i, h),
-                    eb::bending_stiffness(link.bending_stiffness, h),
-                )
-            };
+            let dofs = layout.element_dofs(e);
             let mut kt = ke;
             if w2 != 0.0 {
-                // Rotating-frame softening −Ω²∫ρA v² (translational mass only).
-                let mv = eb::mass(rho_a, 0.0, h);
-                let mv = if link.shear {
-                    TimoshenkoElement::new(
-                        h,
-                        link.bending_stiffness,
-                        link.shear_stiffness.unwrap_or(f64::INFINITY),
-                    )
-                    .mass(rho_a, 0.0)
-                } else {
-                    mv
-                };
-                for i in 0..4 {
-                    for j in 0..4 {
+                for i in 0..nl {
+                    for j in 0..nl {
                         kt[i][j] -= w2 * mv[i][j];
                     }
                 }
                 if link.foreshortening {
                     let xa = e as f64 * h;
-                    let kg = eb::geometric_stiffness(h, |xi| {
+                    let force = |xi: f64| {
                         let x = xa + xi * h;
                         0.5 * rho_a * w2 * (l * l - x * x) + tip_mass * w2 * l
-                    });
-                    for i in 0..4 {
-                        for j in 0..4 {
+                    };
+                    let kg = match element {
+                        ElementKind::HermiteCubic => pad(&eb::geometric_stiffness(h, force)),
+                        ElementKind::HermiteQuintic => pad(&quintic::geometric_stiffness(h, force)),
+                        // Refused above.
+                        ElementKind::Timoshenko => [[0.0; MAX_LOCAL]; MAX_LOCAL],
+                    };
+                    for i in 0..nl {
+                        for j in 0..nl {
                             kt[i][j] += kg[i][j];
                         }
                     }
                 }
             }
-            for i in 0..4 {
+            for i in 0..nl {
                 let Some(a) = dofs[i] else { continue };
-                for j in 0..4 {
+                for j in 0..nl {
                     let Some(b) = dofs[j] else { continue };
                     m[(a, b)] += me[i][j];
                     k[(a, b)] += kt[i][j];
@@ -176,6 +295,7 @@ impl LinearLink {
         }
         Ok(LinearLink {
             layout,
+            element,
             n_el,
             length: l,
             m,
@@ -187,30 +307,37 @@ impl LinearLink {
         self.m.nrows()
     }
 
-    /// Transverse deflection at x for DOF vector `d` (Hermite interpolation for Euler–Bernoulli,
-    /// the element's own interpolation for Timoshenko).
-    pub fn deflection_at(&self, d: &[f64], x: f64, link: &Link) -> f64 {
+    /// Transverse deflection at x for DOF vector `d`, with the element's own interpolation.
+    pub fn deflection_at(&self, d: &[f64], x: f64) -> f64 {
         let h = self.length / self.n_el as f64;
         let e = ((x / h).floor() as usize).min(self.n_el - 1);
         let xi = ((x - e as f64 * h) / h).clamp(0.0, 1.0);
-        let get = |o: Option<usize>| o.map_or(0.0, |i| d[i]);
-        let nd = [
-            get(self.layout.v(e)),
-            get(self.layout.rot(e)),
-            get(self.layout.v(e + 1)),
-            get(self.layout.rot(e + 1)),
-        ];
-        let n = if link.shear {
-            let el = TimoshenkoElement::new(
-                h,
-                link.bending_stiffness,
-                link.shear_stiffness.unwrap_or(f64::INFINITY),
-            );
-            let s = el.shapes(xi * h);
-            [s[0][0], s[1][0], s[2][0], s[3][0]]
-        } else {
-            hermite(xi, h).n
-        };
-        (0..4).map(|k| n[k] * nd[k]).sum()
+        let n = self.element.v_shapes(xi, h);
+        let dofs = self.layout.element_dofs(e);
+        (0..self.element.local_dofs())
+            .map(|k| dofs[k].map_or(0.0, |i| n[k] * d[i]))
+            .sum()
+    }
+
+    /// Consistent load vector ∫q Nᵥ of a uniform transverse load q (exact: 6-point Gauss).
+    pub fn uniform_load(&self, q: f64, f: &mut [f64]) {
+        let h = self.length / self.n_el as f64;
+        let (pts, wts) = gauss01(6);
+        let nl = self.element.local_dofs();
+        let mut fe = [0.0; MAX_LOCAL];
+        for (xi, w) in pts.iter().zip(wts) {
+            let nv = self.element.v_shapes(*xi, h);
+            for k in 0..nl {
+                fe[k] += w * h * q * nv[k];
+            }
+        }
+        for e in 0..self.n_el {
+            let dofs = self.layout.element_dofs(e);
+            for k in 0..nl {
+                if let Some(i) = dofs[k] {
+                    f[i] += fe[k];
+                }
+            }
+        }
     }
 }

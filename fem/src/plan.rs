@@ -1,12 +1,18 @@
 //! DOF plan: what the backend builds for a scene (reported by `describe`, asserted in tests).
 
-use data::{DofPlan, Scene};
+use data::{DofPlan, FemElement, Scene};
 
 use crate::error::FemError;
+use crate::linear::ElementKind;
 use crate::support::check_planar;
 
-/// DOFs per field and the physics built, for `n_el` elements per link.
-pub fn dof_plan(scene: &Scene, n_el: usize) -> Result<DofPlan, FemError> {
+/// DOFs per field and the physics built, for `n_el` elements per link of the chosen element
+/// (interior DOFs of the quintic and Timoshenko elements are counted: they are global DOFs).
+pub fn dof_plan(
+    scene: &Scene,
+    n_el: usize,
+    element: Option<FemElement>,
+) -> Result<DofPlan, FemError> {
     check_planar(scene)?;
     let mut plan = DofPlan::default();
     for (i, l) in scene.links.iter().enumerate() {
@@ -14,22 +20,37 @@ pub fn dof_plan(scene: &Scene, n_el: usize) -> Result<DofPlan, FemError> {
         if l.joint.prescribed.is_none() {
             plan.add(format!("joint{li} angle"), 1);
         }
-        plan.add(format!("link{li} transverse v"), n_el);
-        if l.shear {
-            plan.add(format!("link{li} section rotation θ"), n_el);
-        } else {
-            plan.add(format!("link{li} slope v′"), n_el);
+        let kind = ElementKind::for_link(l, element)?;
+        match kind {
+            ElementKind::HermiteCubic => {
+                plan.add(format!("link{li} transverse v"), n_el);
+                plan.add(format!("link{li} slope v′"), n_el);
+            }
+            ElementKind::HermiteQuintic => {
+                plan.add(format!("link{li} transverse v"), n_el);
+                plan.add(format!("link{li} slope v′"), n_el);
+                plan.add(format!("link{li} bubble amplitudes a₁, a₂"), 2 * n_el);
+            }
+            ElementKind::Timoshenko => {
+                // Nodal v plus v(⅓), v(⅔) per element; nodal θ plus θ(½).
+                plan.add(format!("link{li} transverse v"), 3 * n_el);
+                plan.add(format!("link{li} section rotation θ"), 2 * n_el);
+            }
         }
         if l.axial {
             plan.add(format!("link{li} axial u"), n_el);
         }
+        let beam = match kind {
+            ElementKind::HermiteCubic => "Euler–Bernoulli beam (Hermite cubic v",
+            ElementKind::HermiteQuintic => {
+                "Euler–Bernoulli beam (Hermite quintic v: cubic + 2 C¹ bubbles; modes/statics only"
+            }
+            ElementKind::Timoshenko => {
+                "Timoshenko beam (cubic v, quadratic θ, interior DOFs global; modes/statics only"
+            }
+        };
         let mut b = vec![format!(
-            "link{li}: {} beam, {n_el} elements (Hermite cubic v{})",
-            if l.shear {
-                "Timoshenko (IIE)"
-            } else {
-                "Euler–Bernoulli"
-            },
+            "link{li}: {beam}{}), {n_el} elements",
             if l.axial { ", linear u" } else { "" }
         )];
         if l.axial {

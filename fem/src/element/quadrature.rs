@@ -1,7 +1,7 @@
 //! Gauss–Legendre quadrature on [0, 1].
 
-/// Points and weights of the n-point Gauss–Legendre rule on [0, 1] (n = 1..=5); exact for
-/// polynomials of degree 2n − 1.
+/// Points and weights of the n-point Gauss–Legendre rule on [0, 1] (n = 1..=6; a larger n gets
+/// the 6-point rule); exact for polynomials of degree 2n − 1.
 pub fn gauss01(n: usize) -> (&'static [f64], &'static [f64]) {
     // Nodes/weights on [−1, 1] mapped to [0, 1]: ξ = (1 + t)/2, w = w_t / 2.
     const P1: [f64; 1] = [0.5];
@@ -40,12 +40,30 @@ pub fn gauss01(n: usize) -> (&'static [f64], &'static [f64]) {
         0.239_314_335_249_683_2,
         0.118_463_442_528_094_5,
     ];
+    // Six points: the quintic element's mass (degree 10) and geometric stiffness.
+    const P6: [f64; 6] = [
+        0.033_765_242_898_423_99,
+        0.169_395_306_766_867_73,
+        0.380_690_406_958_401_56,
+        0.619_309_593_041_598_5,
+        0.830_604_693_233_132_2,
+        0.966_234_757_101_576,
+    ];
+    const W6: [f64; 6] = [
+        0.085_662_246_189_585_18,
+        0.180_380_786_524_069_3,
+        0.233_956_967_286_345_52,
+        0.233_956_967_286_345_52,
+        0.180_380_786_524_069_3,
+        0.085_662_246_189_585_18,
+    ];
     match n {
         1 => (&P1, &W1),
         2 => (&P2, &W2),
         3 => (&P3, &W3),
         4 => (&P4, &W4),
-        _ => (&P5, &W5),
+        5 => (&P5, &W5),
+        _ => (&P6, &W6),
     }
 }
 
@@ -55,7 +73,7 @@ mod tests {
 
     #[test]
     fn elem_gauss_rules_integrate_monomials_exactly() {
-        for n in 1..=5 {
+        for n in 1..=6 {
             let (p, w) = gauss01(n);
             for deg in 0..(2 * n) {
                 let q: f64 = p.iter().zip(w).map(|(x, w)| w * x.powi(deg as i32)).sum();

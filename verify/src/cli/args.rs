@@ -139,6 +139,12 @@ pub enum BasisChoice {
     FreeFree,
 }
 
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ElementChoice {
+    HermiteCubic,
+    HermiteQuintic,
+}
+
 /// Options shared by the scene commands.
 #[derive(Debug, Clone, Args)]
 pub struct CommonOpts {
@@ -147,6 +153,9 @@ pub struct CommonOpts {
     /// FEM: elements per link.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub elements: Option<u32>,
+    /// FEM: Euler–Bernoulli element (default hermite-cubic; quintic for modes and statics).
+    #[arg(long, value_enum)]
+    pub element: Option<ElementChoice>,
     /// FDM: stations per link/body (both ends included).
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1_000_000))]
     pub stations: Option<u32>,
@@ -207,6 +216,10 @@ impl CommonOpts {
                     BasisChoice::ClampedFree => data::Basis::ClampedFree,
                     BasisChoice::TipMass => data::Basis::TipMass,
                     BasisChoice::FreeFree => data::Basis::FreeFree,
+                }),
+                element: self.element.map(|e| match e {
+                    ElementChoice::HermiteCubic => data::FemElement::HermiteCubic,
+                    ElementChoice::HermiteQuintic => data::FemElement::HermiteQuintic,
                 }),
             },
             time: data::TimeStepping {
