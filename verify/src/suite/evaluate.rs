@@ -54,6 +54,9 @@ fn settings_label(s: &CaseSettings) -> String {
     if let Some(v) = s.basis {
         parts.push(format!("basis={}", v.name()));
     }
+    if let Some(v) = s.element {
+        parts.push(format!("element={}", v.name()));
+    }
     if let Some(v) = s.dt {
         parts.push(format!("dt={v}"));
     }
