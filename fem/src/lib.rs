@@ -19,7 +19,11 @@
 //! Lagrange's equations are R(q, q̇, q̈, t) = Σ m Jᵀ(r̈ − g) + ∂U/∂q + C q̇ − Q = 0 with
 //! J = ∂r/∂q ([`chain`]), evaluated in O(n) per link by a forward kinematic and a backward force
 //! pass. Discretization: Hermite-cubic v (+ linear u) per element ([`element`]), consistent mass
-//! by 4-point Gauss quadrature, IIE Timoshenko elements for modes and statics.
+//! by 4-point Gauss quadrature (frequency error O(h⁴)). Modes and statics ([`linear`]) also offer
+//! the hierarchical Hermite-quintic element (`discretization.element = "hermite-quintic"`: cubic
+//! plus two C¹ interior bubbles, frequency error O(h⁸)) and, for `shear` links, a Timoshenko
+//! element with cubic v and quadratic θ (locking-free, O(h⁴)); their interior DOFs are global
+//! DOFs, never condensed. Dynamics refuses both (`unsupported`).
 //!
 //! ## Time integration
 //! Generalized-α (ρ∞ = 1, i.e. the trapezoidal rule, unless a link is extensible: ρ∞ = 0.9) with
