@@ -218,6 +218,21 @@ pub fn check(scene: &Scene) -> Result<(), ModalError> {
             "modal: contact together with a prescribed joint motion".into(),
         ));
     }
+    if let (false, [l], Surface::Circle { center, radius }) =
+        (unilateral, scene.links.as_slice(), &c.surface)
+    {
+        // An inextensible link (linear or foreshortening kinematics) has |r_tip − hub| ≤ L with
+        // equality only when it is straight (∫v'² ≥ v(L)²/L), so on the circle of radius L
+        // about its hub the gap has a double root at b = 0: G = 0, λ is undetermined and the
+        // link is held straight — the rigid model, whose wall load needs the axial field.
+        let tol = 1e-12 * l.length;
+        if !l.axial && center[0].hypot(center[1]) <= tol && (*radius - l.length).abs() <= tol {
+            return Err(ModalError::Unsupported(format!(
+                "modal: bilateral circle of radius L about the hub for the inextensible link                  `{}`: the tip can stay at radius L only if the link stays straight, so this                  model degenerates to the rigid link (constraint gradient zero, normal force                  undetermined); use `axial = true` (Euler model) or the rigid closed form",
+                l.name
+            )));
+        }
+    }
     if unilateral && scene.links.iter().any(|l| l.axial) {
         return Err(ModalError::Unsupported(
             "modal: unilateral contact of a chain with axial fields (impacts are implemented for \

@@ -963,9 +963,8 @@ fn start_bilateral(
         t: 0.0,
         message: "mass matrix not positive definite at the initial state".into(),
     };
-    if !rhs.solve_counted(0.0, y) {
-        return Err(singular());
-    }
+    // The geometry (gap, G) is set even when the constrained solve fails: check it first.
+    let solved = rhs.solve_counted(0.0, y);
     let c = rhs.contact.as_ref().unwrap();
     let len = rhs.chain.links[c.link].ints.length;
     if c.gap.abs() > 1e-9 * len {
@@ -977,6 +976,24 @@ fn start_bilateral(
             ),
         ));
     }
+    if !(c.gmg > 0.0) {
+        return Err(ModalError::Unsupported(
+            "modal: the bilateral constraint gradient G = n̂ᵀJ vanishes at the initial state \
+             (no coordinate moves the tip along the normal): the constraint is degenerate"
+                .into(),
+        ));
+    }
+    if !solved {
+        return Err(if rhs.painleve {
+            ModalError::Numerical {
+                t: 0.0,
+                message: "Painlevé's paradox at the initial state: G M⁻¹Gᵀ ≤ μ|G M⁻¹Tᵀ|".into(),
+            }
+        } else {
+            singular()
+        });
+    }
+    let c = rhs.contact.as_ref().unwrap();
     if c.has_friction() {
         let vt = c.slip_velocity;
         if vt == 0.0 {
