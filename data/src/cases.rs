@@ -174,7 +174,8 @@ case_files!(
     "statics",
     "dynamics",
     "rocket",
-    "convergence"
+    "convergence",
+    "friction"
 );
 
 /// Parses a case file with located errors.

@@ -400,6 +400,7 @@ impl Output {
             // Not standard channels: tangential tip velocity T q̇ and friction force along t̂.
             specs.push((SLIP_VELOCITY_CHANNEL.to_string(), "length/time"));
             specs.push((FRICTION_FORCE_CHANNEL.to_string(), "force"));
+            specs.push((FRICTION_WORK_CHANNEL.to_string(), "energy"));
         }
         let mut obs = Observables::with_channels(&specs);
         obs.time.reserve(n_samples);
@@ -511,6 +512,7 @@ impl Output {
             if ct.has_friction() {
                 self.values[c + 3] = ct.slip_velocity;
                 self.values[c + 4] = ct.lambda_t;
+                self.values[c + 5] = rhs.slots.friction.map_or(0.0, |i| y[i]);
             }
         }
         self.obs.push(t, &self.values);
@@ -606,6 +608,10 @@ pub struct FinalState {
 pub const SLIP_VELOCITY_CHANNEL: &str = "contact1.slip_velocity";
 /// Tangential (friction) force on the tip along t̂ of a friction contact.
 pub const FRICTION_FORCE_CHANNEL: &str = "contact1.friction_force";
+
+/// Cumulative friction work ∫ μ|λ||v_t| dt (the ledger's `friction` term, as a channel so that
+/// summaries show it).
+pub const FRICTION_WORK_CHANNEL: &str = "contact1.friction_work";
 
 /// Time tolerance of the contact-start and release events (width of the final bracket).
 pub const EVENT_TIME_TOLERANCE: f64 = 1e-12;
@@ -776,7 +782,9 @@ pub fn simulate_detailed(
                             t,
                             what: format!("{} contact events", events.len()),
                             location: Some("contact1".into()),
-                            why: "impacts/releases accumulate (Zeno-like chattering)".into(),
+                            why: "impacts/releases or stick–slip transitions accumulate \
+                                  (Zeno-like chattering)"
+                                .into(),
                             remedy: "shorten t_end or add damping".into(),
                         },
                     };
@@ -976,7 +984,7 @@ fn start_bilateral(
             ),
         ));
     }
-    if !(c.gmg > 0.0) {
+    if c.gmg.is_nan() || c.gmg <= 0.0 {
         return Err(ModalError::Unsupported(
             "modal: the bilateral constraint gradient G = n̂ᵀJ vanishes at the initial state \
              (no coordinate moves the tip along the normal): the constraint is degenerate"

@@ -8,7 +8,8 @@ use data::{
 };
 use modal::ModalBackend;
 use modal::simulate::{
-    FRICTION_FORCE_CHANNEL, FinalState, SLIP_VELOCITY_CHANNEL, simulate_detailed,
+    FRICTION_FORCE_CHANNEL, FRICTION_WORK_CHANNEL, FinalState, SLIP_VELOCITY_CHANNEL,
+    simulate_detailed,
 };
 
 fn settings(modes: usize, rtol: f64, t_end: Option<f64>) -> Settings {
@@ -184,29 +185,37 @@ fn dyn_friction_arm_constraint_ledger_and_friction_work() {
     );
     let gap = channel(&r, "contact1.gap");
     assert!(gap.iter().all(|g| g.abs() <= 1e-12 * len));
-    // The wall is bilateral: phase 1 (sliding) throughout after the start from rest, which the
-    // Coulomb test turns into sliding (no normal load at rest).
-    assert_eq!(stick_slips(&r), vec![(0.0, false)]);
-    assert!(channel(&r, "contact1.phase").iter().all(|&p| p == 1.0));
+    // Started at rest without normal load, the Coulomb test sends the tip sliding at t = 0.
+    // (Whether it later sticks depends on the truncation: the converged Euler model locks,
+    // see the crate report; with 3 clamped-free modes it keeps sliding.)
+    assert_eq!(stick_slips(&r).first(), Some(&(0.0, false)));
     // Ledger: applied work = ΔT + ΔU + friction work (issue target 1e-5; measured ~3e-10).
     let closure = r.ledger.relative_closure();
     assert!(closure < 1e-7, "ledger closure {closure:.3e}");
     let w = friction_ledger(&r);
+    assert_eq!(w, channel(&r, FRICTION_WORK_CHANNEL));
     assert!(
         w.windows(2).all(|p| p[1] >= p[0]),
         "friction work must not decrease"
     );
     assert!(*w.last().unwrap() > 0.0);
-    // Coulomb law at every sample: |friction force| = μ|N| while sliding, opposing v_t.
+    // Coulomb law at every sample: |friction force| = μ|N| opposing v_t while sliding, inside
+    // the cone with the tip at rest while sticking.
     let mu = scene.contacts[0].friction;
     let (n, ft, vt) = (
         channel(&r, "contact1.normal_force"),
         channel(&r, FRICTION_FORCE_CHANNEL),
         channel(&r, SLIP_VELOCITY_CHANNEL),
     );
+    let phase = channel(&r, "contact1.phase");
     for k in 1..n.len() {
-        assert!((ft[k].abs() - mu * n[k].abs()).abs() <= 1e-12 * (1.0 + n[k].abs()));
-        assert!(ft[k] * vt[k] <= 0.0);
+        if phase[k] == 1.0 {
+            assert!((ft[k].abs() - mu * n[k].abs()).abs() <= 1e-12 * (1.0 + n[k].abs()));
+            assert!(ft[k] * vt[k] <= 0.0);
+        } else {
+            assert_eq!(phase[k], 2.0);
+            assert!(ft[k].abs() <= mu * n[k].abs() && vt[k].abs() < 1e-12);
+        }
     }
 }
 
@@ -234,10 +243,10 @@ fn dyn_friction_work_equals_integral_of_mu_n_vt() {
         .collect();
     let h = scene.simulation.output_interval;
     let m = p.len() - 1;
-    assert!(m % 2 == 0);
+    assert!(m.is_multiple_of(2));
     let mut simpson = p[0] + p[m];
-    for k in 1..m {
-        simpson += if k % 2 == 1 { 4.0 } else { 2.0 } * p[k];
+    for (k, v) in p.iter().enumerate().take(m).skip(1) {
+        simpson += if k % 2 == 1 { 4.0 } else { 2.0 } * v;
     }
     simpson *= h / 3.0;
     let w = *friction_ledger(&r).last().unwrap();
