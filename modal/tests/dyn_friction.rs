@@ -390,3 +390,36 @@ fn dyn_friction_simple_flexure_is_the_rigid_model() {
         other => panic!("expected InvalidSettings, got {other:?}"),
     }
 }
+
+#[test]
+fn dyn_friction_inclined_line_bilateral_ledger_closes() {
+    // Bilateral straight line through the tip, inclined 45° to the link (normal and tangent both
+    // mix the axial and the hub/bending directions): constraint, Coulomb law and ledger hold
+    // for the line geometry as for the circle.
+    let mut scene = arm();
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    scene.contacts[0].surface = data::scene::Surface::Line {
+        point: [1.0, 0.0],
+        normal: [-h, -h],
+    };
+    scene.contacts[0].friction = 0.3;
+    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, Some(0.2))).unwrap();
+    assert_eq!(r.verdict, StabilityVerdict::Completed);
+    assert!(f.contact.max_gap_violation <= 1e-12, "{:?}", f.contact);
+    assert!(f.contact.max_stick_velocity <= 1e-9, "{:?}", f.contact);
+    assert!(r.ledger.relative_closure() < 1e-7);
+    assert!(*friction_ledger(&r).last().unwrap() > 0.0);
+    let (n, ft, phase) = (
+        channel(&r, "contact1.normal_force"),
+        channel(&r, FRICTION_FORCE_CHANNEL),
+        channel(&r, "contact1.phase"),
+    );
+    for k in 1..n.len() {
+        let cone = scene.contacts[0].friction * n[k].abs();
+        if phase[k] == 1.0 {
+            assert!((ft[k].abs() - cone).abs() <= 1e-12 * (1.0 + n[k].abs()));
+        } else {
+            assert!(ft[k].abs() <= cone);
+        }
+    }
+}
