@@ -178,7 +178,8 @@ case_files!(
     "statics",
     "dynamics",
     "rocket",
-    "convergence"
+    "convergence",
+    "friction"
 );
 
 /// Parses a case file with located errors.

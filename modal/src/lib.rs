@@ -33,6 +33,16 @@
 //! slides on the surface with a Lagrange multiplier (M q̈ = f + Gᵀλ, G q̈ = −Ġq̇, index 1) and
 //! projection of q, q̇ back onto g = 0, G q̇ = 0 after every step; release is the located zero
 //! crossing of λ. The kinetic energy lost in impacts enters the ledger as `impact`.
+//!
+//! Seed 001's wall (`constrained-arm`): a bilateral contact (circle or line) keeps g = 0 for all
+//! time with the multiplier λ = normal force in newtons (g = R − |r − c| is the normalized form
+//! of Φ = X² + Y² − L², |∇g| = 1); Coulomb friction −μ|λ| sign(v_t) t̂ enters as the generalized
+//! force −μ s|λ|Tᵀ (T = t̂ᵀJ), which keeps the acceleration-level solve for λ linear for a fixed
+//! sign; stick–slip transitions are located events (zero of the slip velocity, then the Coulomb
+//! test with the tip held by a second constraint; while sticking, zero of μ|λ_n| − |λ_t|), and
+//! the friction work ∫μ|λ||v_t| dt is integrated with the state (ledger term `friction`). Axial
+//! links are accepted there: the tip position and Jacobian carry u(L). The inextensible link on
+//! the circle of radius L about its own hub is refused: it must stay straight (the rigid model).
 
 // Dense numerical kernels index several arrays with one loop variable on purpose.
 #![allow(clippy::needless_range_loop)]

@@ -262,6 +262,18 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
         plan.builds.push("gravity".into());
     }
     for (c, ct) in scene.contacts.iter().enumerate() {
+        if ct.mode == data::scene::ContactMode::Bilateral {
+            plan.builds.push(format!(
+                "contact{}: bilateral tip contact of `{}` (constraint g = 0 for all time, \
+                 multiplier λ = normal force; Coulomb friction μ = {} with located stick–slip \
+                 events, tip held by a second constraint while sticking; drift control by \
+                 projection)",
+                c + 1,
+                ct.link,
+                ct.friction
+            ));
+            continue;
+        }
         plan.builds.push(format!(
             "contact{}: unilateral frictionless tip contact of `{}` (gap event, plastic impact \
              M(q̇⁺−q̇⁻) = GᵀΛ; while sliding 1 constraint G q̈ = −Ġq̇ with multiplier λ = normal \

@@ -47,6 +47,8 @@ struct WorkSlots {
     prescribed: Option<usize>,
     joint_damper: Option<usize>,
     kelvin_voigt: Option<usize>,
+    /// ∫ μ|λ||v_t| dt of a friction contact.
+    friction: Option<usize>,
     count: usize,
 }
 
@@ -58,6 +60,8 @@ pub struct ChainRhs {
     pub qdd: Vec<f64>,
     slots: WorkSlots,
     pub singular: bool,
+    /// A failed evaluation was Painlevé's paradox of the friction contact, not a singular M.
+    pub painleve: bool,
     /// The tip contact, when the scene has one (see [`crate::contact`]).
     pub contact: Option<ContactState>,
     /// Model evaluations outside the integrator (event location, impacts, projections).
@@ -100,6 +104,7 @@ impl ChainRhs {
             qdd: vec![0.0; n],
             slots,
             singular: false,
+            painleve: false,
             contact: None,
             event_solves: 0,
         }
@@ -107,6 +112,15 @@ impl ChainRhs {
 
     fn nf(&self) -> usize {
         self.chain.free.len()
+    }
+
+    /// Attaches the tip contact; a friction contact gets its dissipation integral in the state.
+    pub fn attach_contact(&mut self, contact: Option<ContactState>) {
+        if contact.as_ref().is_some_and(|c| c.has_friction()) {
+            self.slots.friction = Some(2 * self.nf() + self.slots.count);
+            self.slots.count += 1;
+        }
+        self.contact = contact;
     }
 
     /// Full q, q̇ from the state and the prescribed motion at t.
@@ -143,7 +157,9 @@ impl ChainRhs {
     /// [`Self::solve`] outside the integrator, counted in the cost.
     fn solve_counted(&mut self, t: f64, y: &[f64]) -> bool {
         self.event_solves += 1;
-        self.solve(t, y)
+        let ok = self.solve(t, y);
+        self.painleve |= !ok && self.contact.as_ref().is_some_and(|c| c.painleve);
+        ok
     }
 
     fn solve(&mut self, t: f64, y: &[f64]) -> bool {
@@ -156,27 +172,71 @@ impl ChainRhs {
             let chain = &self.chain;
             let n = chain.n;
             chain.tip_jacobian(c.link, &mut c.jac);
-            let tip = chain.tip_position(c.link);
-            c.gap = c.normal[0] * (tip[0] - c.point[0]) + c.normal[1] * (tip[1] - c.point[1]);
+            c.set_geometry(chain.tip_position(c.link));
+            let (nv, tv) = (c.normal, c.tangent);
             for (k, &g) in chain.free.iter().enumerate() {
-                c.g_row[k] = c.normal[0] * c.jac[g] + c.normal[1] * c.jac[n + g];
+                c.g_row[k] = nv[0] * c.jac[g] + nv[1] * c.jac[n + g];
+                c.t_row[k] = tv[0] * c.jac[g] + tv[1] * c.jac[n + g];
                 c.minv_gt[k] = c.g_row[k];
             }
             chain.solve_free_mass(&mut c.minv_gt);
             c.gmg = dot(&c.g_row, &c.minv_gt);
-            c.normal_velocity = 0.0;
-            let mut g_qdd = 0.0;
+            let (mut vn, mut vt, mut g_qdd, mut t_qdd) = (0.0, 0.0, 0.0, 0.0);
             for (k, &g) in chain.free.iter().enumerate() {
-                c.normal_velocity += c.g_row[k] * self.qd[g];
+                vn += c.g_row[k] * self.qd[g];
+                vt += c.t_row[k] * self.qd[g];
                 g_qdd += c.g_row[k] * self.qdd[g];
+                t_qdd += c.t_row[k] * self.qdd[g];
             }
+            c.normal_velocity = vn;
+            c.slip_velocity = vt;
             c.lambda = 0.0;
+            c.lambda_t = 0.0;
+            c.friction_power = 0.0;
+            c.painleve = false;
             if c.constrained {
                 let conv = chain.tip_convective_acceleration(c.link);
-                let gdot_qd = c.normal[0] * conv[0] + c.normal[1] * conv[1];
-                c.lambda = -(g_qdd + gdot_qd) / c.gmg;
-                for (k, &g) in chain.free.iter().enumerate() {
-                    self.qdd[g] += c.minv_gt[k] * c.lambda;
+                // g̈ = G q̈ + n̂·c − κ v_t² must vanish (see crate::contact).
+                let hn = nv[0] * conv[0] + nv[1] * conv[1] - c.curvature * vt * vt;
+                let rhs_n = -(g_qdd + hn);
+                let friction = c.bilateral && c.mu > 0.0;
+                if friction {
+                    c.minv_tt.copy_from_slice(&c.t_row);
+                    chain.solve_free_mass(&mut c.minv_tt);
+                }
+                if c.sticking {
+                    // Tip held: J q̈ + c = 0 in (n̂, t̂); the tip is at rest so κ v_t² ≈ 0.
+                    let gmt = dot(&c.g_row, &c.minv_tt);
+                    let tmt = dot(&c.t_row, &c.minv_tt);
+                    let rhs_t = -(t_qdd + tv[0] * conv[0] + tv[1] * conv[1]);
+                    let [ln, lt] = crate::contact::solve2(c.gmg, gmt, tmt, [rhs_n, rhs_t]);
+                    c.lambda = ln;
+                    c.lambda_t = lt;
+                    for (k, &g) in chain.free.iter().enumerate() {
+                        self.qdd[g] += c.minv_gt[k] * ln + c.minv_tt[k] * lt;
+                    }
+                } else if friction {
+                    let gmt = dot(&c.g_row, &c.minv_tt);
+                    if c.gmg <= c.mu * gmt.abs() {
+                        c.painleve = true;
+                        return false;
+                    }
+                    // Both denominators are positive: σ = sign λ = sign rhs_n.
+                    let s = c.slip_dir;
+                    let sigma = if rhs_n >= 0.0 { 1.0 } else { -1.0 };
+                    let lam = rhs_n / (c.gmg - c.mu * s * sigma * gmt);
+                    let ft = -c.mu * s * lam.abs();
+                    c.lambda = lam;
+                    c.lambda_t = ft;
+                    c.friction_power = c.mu * lam.abs() * vt.abs();
+                    for (k, &g) in chain.free.iter().enumerate() {
+                        self.qdd[g] += c.minv_gt[k] * lam + c.minv_tt[k] * ft;
+                    }
+                } else {
+                    c.lambda = rhs_n / c.gmg;
+                    for (k, &g) in chain.free.iter().enumerate() {
+                        self.qdd[g] += c.minv_gt[k] * c.lambda;
+                    }
                 }
             }
         }
@@ -207,6 +267,7 @@ impl OdeRhs for ChainRhs {
         let nf = self.nf();
         if !self.solve(t, y) {
             self.singular = true;
+            self.painleve |= self.contact.as_ref().is_some_and(|c| c.painleve);
             dydt.iter_mut().for_each(|v| *v = f64::NAN);
             return;
         }
@@ -255,6 +316,9 @@ impl OdeRhs for ChainRhs {
                 }
             }
             dydt[k] = p;
+        }
+        if let Some(k) = s.friction {
+            dydt[k] = self.contact.as_ref().map_or(0.0, |c| c.friction_power);
         }
     }
 }
@@ -331,6 +395,13 @@ impl Output {
             // Not a standard channel: the constraint violation (penetration < 0) at the samples.
             specs.push(("contact1.gap".to_string(), "length"));
         }
+        let has_friction = rhs.contact.as_ref().is_some_and(|c| c.has_friction());
+        if has_friction {
+            // Not standard channels: tangential tip velocity T q̇ and friction force along t̂.
+            specs.push((SLIP_VELOCITY_CHANNEL.to_string(), "length/time"));
+            specs.push((FRICTION_FORCE_CHANNEL.to_string(), "force"));
+            specs.push((FRICTION_WORK_CHANNEL.to_string(), "energy"));
+        }
         let mut obs = Observables::with_channels(&specs);
         obs.time.reserve(n_samples);
         for c in &mut obs.channels {
@@ -362,8 +433,11 @@ impl Output {
         if rhs.slots.kelvin_voigt.is_some() {
             diss.push("kelvin_voigt");
         }
-        if has_contact {
+        if rhs.contact.as_ref().is_some_and(|c| !c.bilateral) {
             diss.push("impact");
+        }
+        if rhs.slots.friction.is_some() {
+            diss.push("friction");
         }
         let mut ledger = EnergyLedger::new(&stored, &inputs, &diss);
         ledger.time.reserve(n_samples);
@@ -427,8 +501,19 @@ impl Output {
         }
         if let Some(ct) = &rhs.contact {
             self.values[c] = ct.lambda;
-            self.values[c + 1] = if ct.constrained { 1.0 } else { 0.0 };
+            self.values[c + 1] = if ct.sticking {
+                2.0
+            } else if ct.constrained {
+                1.0
+            } else {
+                0.0
+            };
             self.values[c + 2] = ct.gap;
+            if ct.has_friction() {
+                self.values[c + 3] = ct.slip_velocity;
+                self.values[c + 4] = ct.lambda_t;
+                self.values[c + 5] = rhs.slots.friction.map_or(0.0, |i| y[i]);
+            }
         }
         self.obs.push(t, &self.values);
         let e = rhs.chain.energy(&rhs.q);
@@ -448,13 +533,17 @@ impl Output {
             inputs[ni] = y[i];
             ni += 1;
         }
-        let (mut diss, mut nd) = ([0.0; 3], 0);
+        let (mut diss, mut nd) = ([0.0; 4], 0);
         for i in [s.joint_damper, s.kelvin_voigt].into_iter().flatten() {
             diss[nd] = y[i];
             nd += 1;
         }
-        if let Some(ct) = &rhs.contact {
+        if let Some(ct) = rhs.contact.as_ref().filter(|c| !c.bilateral) {
             diss[nd] = ct.impact_loss;
+            nd += 1;
+        }
+        if let Some(i) = s.friction {
+            diss[nd] = y[i];
             nd += 1;
         }
         self.ledger
@@ -498,6 +587,12 @@ pub struct ContactReport {
     /// projections removed in total (½(Gq̇)²/(GM⁻¹Gᵀ) each).
     pub max_constraint_power: f64,
     pub projection_energy: f64,
+    /// Friction contact: largest |v_t| and tangential drift |t̂·(r − stick point)| found at the
+    /// end of a stick step, before the projection; number of slip reversals (v_t crossed zero
+    /// and the Coulomb test sent the tip back the other way without sticking).
+    pub max_stick_velocity: f64,
+    pub max_stick_offset: f64,
+    pub slip_reversals: usize,
 }
 
 /// Full generalized coordinates q and rates q̇ at the end of a run, plus the contact report.
@@ -507,6 +602,16 @@ pub struct FinalState {
     pub qd: Vec<f64>,
     pub contact: ContactReport,
 }
+
+/// Tangential tip velocity v_t = t̂·ṙ_tip of a friction contact (no `data::channel` convention
+/// exists for it).
+pub const SLIP_VELOCITY_CHANNEL: &str = "contact1.slip_velocity";
+/// Tangential (friction) force on the tip along t̂ of a friction contact.
+pub const FRICTION_FORCE_CHANNEL: &str = "contact1.friction_force";
+
+/// Cumulative friction work ∫ μ|λ||v_t| dt (the ledger's `friction` term, as a channel so that
+/// summaries show it).
+pub const FRICTION_WORK_CHANNEL: &str = "contact1.friction_work";
 
 /// Time tolerance of the contact-start and release events (width of the final bracket).
 pub const EVENT_TIME_TOLERANCE: f64 = 1e-12;
@@ -553,7 +658,7 @@ pub fn simulate_detailed(
 
     let (n_all, n_free) = (chain.n, chain.free.len());
     let mut rhs = ChainRhs::new(chain);
-    rhs.contact = ContactState::from_scene(scene, n_all, n_free)?;
+    rhs.attach_contact(ContactState::from_scene(scene, n_all, n_free)?);
     let mut y = rhs.initial_state();
     let dim = y.len();
     let tol = Tolerances { rtol, atol };
@@ -583,6 +688,14 @@ pub fn simulate_detailed(
     let mut yd = vec![0.0; dim];
     let mut k_out = 0usize;
     let out_time = |k: usize| (k as f64 * dt_out).min(t_end);
+    let mut events: Vec<data::Event> = Vec::new();
+    let mut report = ContactReport {
+        time_tolerance: EVENT_TIME_TOLERANCE,
+        ..Default::default()
+    };
+    if rhs.contact.as_ref().is_some_and(|c| c.bilateral) {
+        start_bilateral(&mut rhs, &mut y, &mut events, &mut report)?;
+    }
     if !out.sample(&mut rhs, 0.0, &y) {
         return Err(ModalError::Numerical {
             t: 0.0,
@@ -590,15 +703,14 @@ pub fn simulate_detailed(
         });
     }
     k_out = k_out.max(1);
-    let mut events: Vec<data::Event> = Vec::new();
-    let mut report = ContactReport {
-        time_tolerance: EVENT_TIME_TOLERANCE,
-        ..Default::default()
-    };
     // Event function of the current phase at the last accepted state: the gap in free flight,
-    // the normal force when constrained.
-    let mut event_prev = rhs.contact.as_ref().map_or(0.0, |c| c.gap);
-    if event_prev < 0.0 {
+    // the normal force when constrained, the slip velocity or the Coulomb margin with friction.
+    let mut event_prev = match &rhs.contact {
+        Some(c) if c.bilateral => phase_event_value(&rhs),
+        Some(c) => c.gap,
+        None => 0.0,
+    };
+    if event_prev < 0.0 && rhs.contact.as_ref().is_some_and(|c| !c.bilateral) {
         return Err(ModalError::invalid(
             "contact",
             format!("the tip starts {:.3e} inside the surface", -event_prev),
@@ -670,7 +782,9 @@ pub fn simulate_detailed(
                             t,
                             what: format!("{} contact events", events.len()),
                             location: Some("contact1".into()),
-                            why: "impacts/releases accumulate (Zeno-like chattering)".into(),
+                            why: "impacts/releases or stick–slip transitions accumulate \
+                                  (Zeno-like chattering)"
+                                .into(),
                             remedy: "shorten t_end or add damping".into(),
                         },
                     };
@@ -736,6 +850,9 @@ pub fn simulate_detailed(
 /// force in contact. A phase ends when it goes from positive to non-positive.
 fn phase_event_value(rhs: &ChainRhs) -> f64 {
     match &rhs.contact {
+        Some(c) if c.bilateral && !c.has_friction() => 1.0,
+        Some(c) if c.bilateral && c.sticking => c.mu * c.lambda.abs() - c.lambda_t.abs(),
+        Some(c) if c.bilateral => c.slip_dir * c.slip_velocity,
         Some(c) if c.constrained => c.lambda,
         Some(c) => c.gap,
         None => 0.0,
@@ -757,6 +874,23 @@ fn switch_phase(
         return false;
     }
     let c = rhs.contact.as_ref().expect("contact run");
+    if c.bilateral {
+        if c.sticking {
+            // The Coulomb margin reached zero: slide in the direction the tangential load drives.
+            let s = if c.lambda_t > 0.0 { -1.0 } else { 1.0 };
+            let c = rhs.contact.as_mut().unwrap();
+            c.sticking = false;
+            c.slip_dir = s;
+            events.push(data::Event::StickSlip {
+                t,
+                contact: 1,
+                sticking: false,
+            });
+            return true;
+        }
+        let s = c.slip_dir;
+        return coulomb_test(rhs, t, y, events, report, Some(s));
+    }
     if c.constrained {
         events.push(data::Event::Release {
             t,
@@ -824,8 +958,113 @@ fn switch_phase(
     true
 }
 
-/// Drift control of the constrained phase: q ← q − M⁻¹Gᵀ g/(GM⁻¹Gᵀ) (Newton on g = 0, at
-/// most 3 passes), then q̇ ← q̇ − M⁻¹Gᵀ (Gq̇)/(GM⁻¹Gᵀ) (the M-orthogonal projection).
+/// Start of a bilateral contact run: the initial state must lie on the surface; its velocity is
+/// projected onto G q̇ = 0 and, with friction, the phase is decided (a tip at rest gets the
+/// Coulomb test, a moving one slides in the direction of v_t).
+fn start_bilateral(
+    rhs: &mut ChainRhs,
+    y: &mut [f64],
+    events: &mut Vec<data::Event>,
+    report: &mut ContactReport,
+) -> Result<(), ModalError> {
+    let singular = || ModalError::Numerical {
+        t: 0.0,
+        message: "mass matrix not positive definite at the initial state".into(),
+    };
+    // The geometry (gap, G) is set even when the constrained solve fails: check it first.
+    let solved = rhs.solve_counted(0.0, y);
+    let c = rhs.contact.as_ref().unwrap();
+    let len = rhs.chain.links[c.link].ints.length;
+    if c.gap.abs() > 1e-9 * len {
+        return Err(ModalError::invalid(
+            "contact",
+            format!(
+                "bilateral contact: the tip starts {:.3e} off the surface (the initial state must                  satisfy the constraint to 1e-9 L)",
+                c.gap
+            ),
+        ));
+    }
+    if c.gmg.is_nan() || c.gmg <= 0.0 {
+        return Err(ModalError::Unsupported(
+            "modal: the bilateral constraint gradient G = n̂ᵀJ vanishes at the initial state \
+             (no coordinate moves the tip along the normal): the constraint is degenerate"
+                .into(),
+        ));
+    }
+    if !solved {
+        return Err(if rhs.painleve {
+            ModalError::Numerical {
+                t: 0.0,
+                message: "Painlevé's paradox at the initial state: G M⁻¹Gᵀ ≤ μ|G M⁻¹Tᵀ|".into(),
+            }
+        } else {
+            singular()
+        });
+    }
+    let c = rhs.contact.as_ref().unwrap();
+    if c.has_friction() {
+        let vt = c.slip_velocity;
+        if vt == 0.0 {
+            if !coulomb_test(rhs, 0.0, y, events, report, None) {
+                return Err(singular());
+            }
+        } else {
+            rhs.contact.as_mut().unwrap().slip_dir = vt.signum();
+        }
+    }
+    if !project(rhs, 0.0, y, report) {
+        return Err(singular());
+    }
+    Ok(())
+}
+
+/// Coulomb test with the tip at rest tangentially (v_t = 0): the forces that hold it
+/// (λ_n, λ_t) decide stick (|λ_t| ≤ μ|λ_n|) or slip in direction −sign λ_t. `sliding` is the
+/// direction before (None at the start of the run).
+fn coulomb_test(
+    rhs: &mut ChainRhs,
+    t: f64,
+    y: &[f64],
+    events: &mut Vec<data::Event>,
+    report: &mut ContactReport,
+    sliding: Option<f64>,
+) -> bool {
+    rhs.contact.as_mut().unwrap().sticking = true;
+    if !rhs.solve_counted(t, y) {
+        return false;
+    }
+    let link = rhs.contact.as_ref().unwrap().link;
+    let tip = rhs.chain.tip_position(link);
+    let c = rhs.contact.as_mut().unwrap();
+    if c.lambda_t.abs() <= c.mu * c.lambda.abs() {
+        c.stick_point = tip;
+        c.stick_offset = 0.0;
+        events.push(data::Event::StickSlip {
+            t,
+            contact: 1,
+            sticking: true,
+        });
+    } else {
+        c.sticking = false;
+        let s = if c.lambda_t > 0.0 { -1.0 } else { 1.0 };
+        match sliding {
+            None => events.push(data::Event::StickSlip {
+                t,
+                contact: 1,
+                sticking: false,
+            }),
+            Some(old) if old != s => report.slip_reversals += 1,
+            Some(_) => {}
+        }
+        c.slip_dir = s;
+    }
+    true
+}
+
+/// Drift control of the constrained phase: Newton on the position constraints in the M⁻¹
+/// metric, q ← q − M⁻¹Aᵀ(A M⁻¹Aᵀ)⁻¹e (at most 3 passes), then the M-orthogonal velocity
+/// projection q̇ ← q̇ − M⁻¹Aᵀ(A M⁻¹Aᵀ)⁻¹A q̇. A = G (e = g) while sliding; A = (G; T),
+/// e = (g, t̂·(r − stick point)) while sticking.
 fn project(rhs: &mut ChainRhs, t: f64, y: &mut [f64], report: &mut ContactReport) -> bool {
     let nf = rhs.nf();
     if !rhs.solve_counted(t, y) {
@@ -840,28 +1079,49 @@ fn project(rhs: &mut ChainRhs, t: f64, y: &mut [f64], report: &mut ContactReport
         report.max_constraint_power = report
             .max_constraint_power
             .max((c.lambda * c.normal_velocity).abs());
+        if c.sticking {
+            report.max_stick_velocity = report.max_stick_velocity.max(c.slip_velocity.abs());
+            report.max_stick_offset = report.max_stick_offset.max(c.stick_offset.abs());
+        }
     }
+    // (a, b) = (A M⁻¹Aᵀ)⁻¹ r for the active rows (b = 0 while sliding).
+    let weights = |c: &ContactState, r: [f64; 2]| -> [f64; 2] {
+        if c.sticking {
+            let gmt = dot(&c.g_row, &c.minv_tt);
+            let tmt = dot(&c.t_row, &c.minv_tt);
+            crate::contact::solve2(c.gmg, gmt, tmt, r)
+        } else {
+            [r[0] / c.gmg, 0.0]
+        }
+    };
     for pass in 0..3 {
         let c = rhs.contact.as_ref().unwrap();
-        let scale = c.gap / c.gmg;
+        let [a, b] = weights(c, [c.gap, c.stick_offset]);
         for k in 0..nf {
-            y[k] -= c.minv_gt[k] * scale;
+            y[k] -= c.minv_gt[k] * a;
+            if c.sticking {
+                y[k] -= c.minv_tt[k] * b;
+            }
         }
         if !rhs.solve_counted(t, y) {
             return false;
         }
-        let len = rhs.chain.links[rhs.contact.as_ref().unwrap().link]
-            .ints
-            .length;
-        if rhs.contact.as_ref().unwrap().gap.abs() <= 1e-14 * len || pass == 2 {
+        let c = rhs.contact.as_ref().unwrap();
+        let len = rhs.chain.links[c.link].ints.length;
+        let held = !c.sticking || c.stick_offset.abs() <= 1e-14 * len;
+        if (c.gap.abs() <= 1e-14 * len && held) || pass == 2 {
             break;
         }
     }
     let c = rhs.contact.as_ref().unwrap();
-    let scale = c.normal_velocity / c.gmg;
-    report.projection_energy += 0.5 * c.normal_velocity * scale;
+    let vt = if c.sticking { c.slip_velocity } else { 0.0 };
+    let [a, b] = weights(c, [c.normal_velocity, vt]);
+    report.projection_energy += 0.5 * (a * c.normal_velocity + b * vt);
     for k in 0..nf {
-        y[nf + k] -= c.minv_gt[k] * scale;
+        y[nf + k] -= c.minv_gt[k] * a;
+        if c.sticking {
+            y[nf + k] -= c.minv_tt[k] * b;
+        }
     }
     report.projections += 1;
     true
@@ -903,7 +1163,11 @@ fn stopped(
             t,
             what: format!("integrator stopped: {integrator}"),
             location: None,
-            why: if rhs.singular {
+            why: if rhs.painleve {
+                "Painlevé's paradox: G M⁻¹Gᵀ ≤ μ|G M⁻¹Tᵀ|, the sliding friction contact has no \
+                 unique normal force"
+                    .into()
+            } else if rhs.singular {
                 "the mass matrix lost positive definiteness".into()
             } else {
                 "the solution could not be resolved at the requested tolerance (blow-up or a \

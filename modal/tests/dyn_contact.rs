@@ -332,11 +332,20 @@ fn dyn_contact_dof_plan_and_unsupported_variants() {
         Err(data::BackendError::Unsupported(m)) => assert!(m.contains("shear"), "{m}"),
         other => panic!("expected Unsupported, got {other:?}"),
     }
-    let arm = load_scene("constrained-arm").unwrap();
-    assert!(matches!(
-        ModalBackend.simulate(&arm, &s),
-        Err(data::BackendError::Unsupported(_))
-    ));
+    // Seed 001's Timoshenko model of the constrained arm: no shear modes in the basis.
+    let mut arm = load_scene("constrained-arm").unwrap();
+    arm.links[0].shear = true;
+    match ModalBackend.simulate(&arm, &s) {
+        Err(data::BackendError::Unsupported(m)) => assert!(m.contains("shear"), "{m}"),
+        other => panic!("expected Unsupported, got {other:?}"),
+    }
+    // Friction on a unilateral contact (impacts with friction) stays refused.
+    let mut tipmass = load_scene("barhorst-case1-tipmass").unwrap();
+    tipmass.contacts[0].friction = 0.3;
+    match ModalBackend.simulate(&tipmass, &s) {
+        Err(data::BackendError::Unsupported(m)) => assert!(m.contains("unilateral"), "{m}"),
+        other => panic!("expected Unsupported, got {other:?}"),
+    }
 }
 
 /// Study helper: full run of any contact scene with the event list printed. Run with e.g.
