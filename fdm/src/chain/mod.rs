@@ -37,6 +37,7 @@
 // Index loops over parallel buffers (q, v, a, columns of M) read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
+pub mod contact;
 pub mod dual;
 pub mod kinetic;
 
@@ -48,7 +49,8 @@ use crate::integrator::{Bound, BoundKind, StepControl, System, damped_step_facto
 use crate::link::{FloatingLink, sample_field};
 use crate::settings::{FdmSettings, Method};
 use dual::Dual;
-use kinetic::{BE, ChainInertia, TH, seg_energy};
+use contact::TipContact;
+use kinetic::{BE, ChainInertia, TH, seg_energy, seg_grad};
 
 /// Default stations per link.
 pub const DEFAULT_STATIONS: usize = 21;
@@ -105,6 +107,20 @@ pub struct TwoLinkChain {
     fw: Vec<f64>,
     power: [f64; 3],
     torques: [f64; 2],
+    /// uniform gravity (inertial gx, gy), if the scene has it
+    gravity: Option<[f64; 2]>,
+    /// gravity weights of link 1's foreshortening: outboard mass of each segment plus the
+    /// whole of link 2 (which rides on link 1's tip)
+    mu1g: Vec<f64>,
+    /// the tip contact of link 2, if any ([`contact`])
+    contact: Option<TipContact>,
+    /// whether the tip is held on the surface (constrained phase)
+    constrained: bool,
+    /// normal force λ of the last constrained `accel` (0 in free flight)
+    lambda: f64,
+    /// scratch of the constraint: G = ∂g/∂q and M⁻¹Gᵀ
+    grow: Vec<f64>,
+    minv_g: Vec<f64>,
 }
 
 fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
@@ -117,8 +133,6 @@ fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
             ("rotary_inertia", l.rotary_inertia),
             ("tip_inertia", l.tip_inertia.is_some()),
             ("prescribed joint", l.joint.prescribed.is_some()),
-            ("gravity", scene.gravity.is_some()),
-            ("contact", !scene.contacts.is_empty()),
         ],
     )?;
     Ok(())
@@ -199,6 +213,16 @@ impl TwoLinkChain {
             law: l.joint.torque.clone(),
         };
         let nd = inertia.dofs();
+        let contact = TipContact::from_scene(scene)?;
+        let mu1g = {
+            let mut acc = inertia.mass2;
+            let mut out = vec![0.0; r1];
+            for seg in (0..r1).rev() {
+                acc += inertia.m1[seg];
+                out[seg] = acc;
+            }
+            out
+        };
         let (j1, j2) = (&scene.links[0].joint, &scene.links[1].joint);
         let mut chain = TwoLinkChain {
             links: [props(&scene.links[0]), props(&scene.links[1])],
@@ -226,6 +250,13 @@ impl TwoLinkChain {
             obs_scratch: std::cell::RefCell::new(vec![0.0; nd]),
             obs_scratch_v: std::cell::RefCell::new(vec![0.0; nd]),
             inertia,
+            gravity: scene.gravity.as_ref().map(|g| g.vector),
+            mu1g,
+            contact,
+            constrained: false,
+            lambda: 0.0,
+            grow: vec![0.0; nd],
+            minv_g: vec![0.0; nd],
         };
         // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
         // built once here, `accel` refreshes only the θ and β columns.
@@ -424,10 +455,155 @@ impl TwoLinkChain {
         }
     }
 
+    /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`; the ghost
+    /// columns are constant (built in `from_scene`).
+    fn build_columns(&mut self) {
+        let n = self.dofs();
+        let full = [TH, BE];
+        for (c, &idx) in full.iter().enumerate() {
+            self.cols[c].iter_mut().for_each(|x| *x = 0.0);
+            self.unit[idx] = 1.0;
+            self.inertia
+                .momenta(&self.qk, &self.zeros, &self.unit, &mut self.p);
+            self.unit[idx] = 0.0;
+            for i in 0..n {
+                self.cols[c][i] = self.p[i].re;
+            }
+            for s in self.slots {
+                self.cols[c][s] = 0.0;
+            }
+            // J_c e eᵀ: column of the frame angle gets J_c e (the ghost's −J_c e/(2h) is fixed)
+            let mut col = std::mem::take(&mut self.cols[c]);
+            self.add_clamp(c, self.jc[c], &mut col);
+            self.cols[c] = col;
+        }
+    }
+
+    /// The indices of the four full columns of M: θ, β and the ghosts x₁, x₂.
+    fn full(&self) -> [usize; 4] {
+        [TH, BE, self.slots[0], self.slots[1]]
+    }
+
+    /// out = M⁻¹ rhs with the columns of the last [`Self::build_columns`]: Schur complement
+    /// on {θ, β, x₁, x₂}; the rest of M is diagonal. O(n), no allocation.
+    fn solve_mass(&self, rhs: &[f64], out: &mut [f64]) {
+        let n = self.dofs();
+        let full = self.full();
+        let mut s = [[0.0; 4]; 4];
+        let mut b = [0.0; 4];
+        for r in 0..4 {
+            b[r] = rhs[full[r]];
+            for c in 0..4 {
+                s[r][c] = self.cols[c][full[r]];
+            }
+        }
+        for i in 0..n {
+            if full.contains(&i) {
+                continue;
+            }
+            let d = self.diag_mass(i);
+            for r in 0..4 {
+                let mri = self.cols[r][i];
+                b[r] -= mri * rhs[i] / d;
+                for c in 0..4 {
+                    s[r][c] -= mri * self.cols[c][i] / d;
+                }
+            }
+        }
+        let x = solve4(s, b);
+        for i in 0..n {
+            if let Some(k) = full.iter().position(|&f| f == i) {
+                out[i] = x[k];
+            } else {
+                let coupled: f64 = (0..4).map(|c| self.cols[c][i] * x[c]).sum();
+                out[i] = (rhs[i] - coupled) / self.diag_mass(i);
+            }
+        }
+    }
+
+    /// out = M x with the columns of the last [`Self::build_columns`] (M symmetric: full
+    /// column c also gives row c).
+    fn mass_mul(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.dofs();
+        let full = self.full();
+        for i in 0..n {
+            if let Some(r) = full.iter().position(|&f| f == i) {
+                let mut acc = 0.0;
+                for j in 0..n {
+                    if let Some(c) = full.iter().position(|&f| f == j) {
+                        acc += self.cols[c][i] * x[j];
+                    } else {
+                        acc += self.cols[r][j] * x[j];
+                    }
+                }
+                out[i] = acc;
+            } else {
+                out[i] = self.diag_mass(i) * x[i]
+                    + (0..4).map(|c| self.cols[c][i] * x[full[c]]).sum::<f64>();
+            }
+        }
+    }
+
     pub fn total_energy(&self, q: &[f64], v: &[f64]) -> f64 {
-        let mut e = [0.0; 3];
-        self.stored_energies(0.0, q, v, &mut e);
+        let mut e = [0.0; 4];
+        let k = self.ledger_names().0.len();
+        self.stored_energies(0.0, q, v, &mut e[..k]);
         e.iter().sum()
+    }
+
+    /// Gravity potential V_g = −g·Σ m r of the lumped masses, from the chord-frame coordinates
+    /// `qk` (ghost slots zero); adds −∂V_g/∂q into `out` when given (not at the ghost slots:
+    /// the ghosts move no mass). With A(α) = g·(cos α, sin α), B(α) = g·(−sin α, cos α),
+    /// ∂A/∂α = B, ∂B/∂α = −A:
+    /// V_g = −[A(θ)X₁ + B(θ)Y₁ + A(β)X₂ + B(β)Y₂], X₁ = Σm₁x + M₂L₁ − Σ_seg c₁ ½h g²
+    /// (foreshortening; c₁ = outboard mass of link 1 + M₂), Y₁ = Σm₁v, X₂ = Q₂ − Ψ, Y₂ = Σm₂w:
+    /// the positions the kinetic energy uses, so the gravity work is exactly −ΔV_g.
+    fn gravity_potential(&self, qk: &[f64], out: Option<&mut [f64]>) -> f64 {
+        let Some([gx, gy]) = self.gravity else {
+            return 0.0;
+        };
+        let ine = &self.inertia;
+        let (v, w) = (&qk[ine.iv()], &qk[ine.iw()]);
+        let ab = |a: f64| {
+            let (s, c) = a.sin_cos();
+            (gx * c + gy * s, -gx * s + gy * c)
+        };
+        let (a1, b1) = ab(qk[TH]);
+        let (a2, b2) = ab(qk[BE]);
+        let mut x1 = ine.mass2 * ine.l1;
+        let mut y1 = 0.0;
+        for k in 0..ine.r1 {
+            x1 += ine.m1[k] * (k + 1) as f64 * ine.h1;
+            y1 += ine.m1[k] * v[k];
+        }
+        if ine.fs1 {
+            x1 -= seg_energy(v, ine.h1, Some(&self.mu1g));
+        }
+        let mut x2 = ine.q2;
+        let y2: f64 = (0..ine.r2).map(|j| ine.m2[j] * w[j]).sum();
+        if ine.fs2 {
+            x2 -= seg_energy(w, ine.h2, Some(&ine.mu2));
+        }
+        if let Some(out) = out {
+            out[TH] += b1 * x1 - a1 * y1;
+            out[BE] += b2 * x2 - a2 * y2;
+            // the tip entries (k = r − 1) are the ghost slots: no mass moves with them
+            for k in 0..ine.r1 - 1 {
+                let mut f = b1 * ine.m1[k];
+                if ine.fs1 {
+                    f -= a1 * seg_grad(v, ine.h1, Some(&self.mu1g), k);
+                }
+                out[2 + k] += f;
+            }
+            for j in 0..ine.r2 - 1 {
+                let mut f = b2 * ine.m2[j];
+                if ine.fs2 {
+                    f -= a2 * seg_grad(w, ine.h2, Some(&ine.mu2), j);
+                }
+                out[2 + ine.r1 + j] += f;
+            }
+        }
+        -(a1 * x1 + b1 * y1 + a2 * x2 + b2 * y2)
     }
 
     /// Generalized forces Q − ∂V/∂q − ∂D/∂q̇ into `out`; sets the powers.
@@ -475,6 +651,9 @@ impl TwoLinkChain {
             out[i] -= tau2 * c;
         }
         self.torques = [tau1, tau2];
+        let qk = std::mem::take(&mut self.qk);
+        self.gravity_potential(&qk, Some(out));
+        self.qk = qk;
         self.power = [
             ext[0] * th1d + ext[1] * th2d,
             j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
@@ -505,61 +684,21 @@ impl System for TwoLinkChain {
         for i in 0..n {
             rhs[i] += a[i] - self.p[i].du;
         }
-        // full columns of M: p at unit velocities, plus the clamp inertias
-        let full = [TH, BE, self.slots[0], self.slots[1]];
-        for c in 0..2 {
-            self.cols[c].iter_mut().for_each(|x| *x = 0.0);
-        }
-        for (c, &idx) in full.iter().enumerate().take(2) {
-            self.unit[idx] = 1.0;
-            self.inertia
-                .momenta(&self.qk, &self.zeros, &self.unit, &mut self.p);
-            self.unit[idx] = 0.0;
-            for i in 0..n {
-                self.cols[c][i] = self.p[i].re;
-            }
-            for s in self.slots {
-                self.cols[c][s] = 0.0;
-            }
-        }
-        for k in 0..2 {
-            // J_c e eᵀ: column of the frame angle gets J_c e (the ghost's −J_c e/(2h) is fixed)
-            let mut col = std::mem::take(&mut self.cols[k]);
-            self.add_clamp(k, self.jc[k], &mut col);
-            self.cols[k] = col;
-        }
-        // Schur complement on {θ, β, V}; the rest of M is diagonal.
-        let mut s = [[0.0; 4]; 4];
-        let mut b = [0.0; 4];
-        for r in 0..4 {
-            b[r] = rhs[full[r]];
-            for c in 0..4 {
-                s[r][c] = self.cols[c][full[r]];
-            }
-        }
-        for i in 0..n {
-            if full.contains(&i) {
-                continue;
-            }
-            let d = self.diag_mass(i);
-            for r in 0..4 {
-                let mri = self.cols[r][i];
-                b[r] -= mri * rhs[i] / d;
-                for c in 0..4 {
-                    s[r][c] -= mri * self.cols[c][i] / d;
-                }
-            }
-        }
-        let x = solve4(s, b);
-        for i in 0..n {
-            if let Some(k) = full.iter().position(|&f| f == i) {
-                a[i] = x[k];
-            } else {
-                let coupled: f64 = (0..4).map(|c| self.cols[c][i] * x[c]).sum();
-                a[i] = (rhs[i] - coupled) / self.diag_mass(i);
-            }
-        }
+        self.build_columns();
+        self.solve_mass(&rhs, a);
         self.rhs = rhs;
+        self.lambda = 0.0;
+        if self.constrained {
+            // M q̈ = f + Gᵀλ with G q̈ + Ġq̇ = 0: q̈ = a_free + M⁻¹Gᵀ λ,
+            // λ = −(G a_free + Ġq̇)/(G M⁻¹Gᵀ) — one more solve with the same M.
+            let (gmg, curv) = self.constraint_solve();
+            let ga: f64 = (0..n).map(|i| self.grow[i] * a[i]).sum();
+            let lam = -(ga + curv) / gmg;
+            for i in 0..n {
+                a[i] += self.minv_g[i] * lam;
+            }
+            self.lambda = lam;
+        }
     }
 
     fn powers(&self, out: &mut [f64]) {
@@ -574,6 +713,12 @@ impl System for TwoLinkChain {
         }
         if self.any_kv() {
             out[k] = self.power[2];
+            k += 1;
+        }
+        if self.contact.is_some() {
+            // the impact loss is a jump booked by the contact driver; the frictionless fixed
+            // surface does no work while the tip slides (λ Gq̇ = 0)
+            out[k] = 0.0;
         }
     }
 
@@ -662,6 +807,12 @@ impl System for TwoLinkChain {
                 c.push((channel::field_deflection(l, k), "length"));
             }
         }
+        if self.contact.is_some() {
+            c.push((channel::contact_normal_force(1), "force"));
+            c.push((channel::contact_phase(1), "1"));
+            // not a standard channel (as modal): the gap, negative = penetration
+            c.push(("contact1.gap".to_string(), "length"));
+        }
         c
     }
 
@@ -729,6 +880,12 @@ impl System for TwoLinkChain {
             sample_field(self.links[l].length, h, r, at, &mut out[k..k + nf]);
             k += nf;
         }
+        if let Some(ct) = &self.contact {
+            // λ of the last evaluation: the step end of the sampled interval (O(τ) in time)
+            out[k] = self.lambda;
+            out[k + 1] = if self.constrained { 1.0 } else { 0.0 };
+            out[k + 2] = ct.gap(self, &qk);
+        }
     }
 
     fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
@@ -743,7 +900,14 @@ impl System for TwoLinkChain {
         if self.any_kv() {
             diss.push("kelvin_voigt");
         }
-        (vec!["kinetic", "strain", "joint_spring"], inputs, diss)
+        if self.contact.is_some() {
+            diss.push("impact");
+        }
+        let mut stored = vec!["kinetic", "strain", "joint_spring"];
+        if self.gravity.is_some() {
+            stored.push("gravity");
+        }
+        (stored, inputs, diss)
     }
 
     fn stored_energies(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
@@ -769,7 +933,10 @@ impl System for TwoLinkChain {
         let j = &self.joints;
         let spring = 0.5 * j[0].stiffness * (self.clamp_angle(q, 0) - j[0].set_point).powi(2)
             + 0.5 * j[1].stiffness * (self.elbow(q) - j[1].set_point).powi(2);
-        out.copy_from_slice(&[ke, strain, spring]);
+        out[..3].copy_from_slice(&[ke, strain, spring]);
+        if self.gravity.is_some() {
+            out[3] = self.gravity_potential(&qk, None);
+        }
     }
 
     fn monitored(&self) -> std::ops::Range<usize> {
@@ -832,6 +999,9 @@ pub fn simulate(
     settings: &Settings,
     s: &FdmSettings,
 ) -> Result<RunResult, FdmError> {
+    if !scene.contacts.is_empty() {
+        return Ok(contact::simulate(scene, settings, s)?.0);
+    }
     let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
     let method = if settings.time.method.is_none() {
         Method::VelocityForm
