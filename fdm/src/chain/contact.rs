@@ -118,7 +118,8 @@ impl TipContact {
     /// g(q) from the chord-frame coordinates `qk` (ghost slots zero).
     pub fn gap(&self, chain: &TwoLinkChain, qk: &[f64]) -> f64 {
         let (s1, s2) = chain.shortenings(qk);
-        self.nc(qk[TH]) * (chain.links[0].length - s1) + self.nc(qk[BE]) * (chain.links[1].length - s2)
+        self.nc(qk[TH]) * (chain.links[0].length - s1)
+            + self.nc(qk[BE]) * (chain.links[1].length - s2)
             - self.offset
     }
 }
@@ -423,9 +424,9 @@ fn solve_dense(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
 }
 
 /// Illinois regula falsi on [a, b] with f(a) > 0 ≥ f(b) (or the reverse): stops when the
-/// bracket is narrower than `tol_w` or |f| ≤ `tol_f`. Returns (point, time tolerance,
-/// evaluations): the point is the last evaluated one, the tolerance the bracket width or, when
-/// |f| ≤ `tol_f`, |f| over the secant slope.
+/// bracket is narrower than `tol_w`, or when |f| ≤ `tol_f` and |f| over the secant slope is
+/// below `tol_w`. Returns (point, time tolerance, evaluations): the point is the last evaluated
+/// one, the tolerance the bracket width or |f|/|secant slope|.
 fn illinois(
     mut f: impl FnMut(f64) -> f64,
     (mut a, mut fa): (f64, f64),
@@ -444,14 +445,20 @@ fn illinois(
         };
         let fc = f(c);
         evals += 1;
+        if fc == 0.0 {
+            return (c, 0.0, evals);
+        }
         if fc.abs() <= tol_f {
+            // |f| small enough; the time is known to |f|/|f'| (grazing: f' small, go on)
             let slope = ((fb - fa) / (b - a)).abs();
             let tol = if slope > 0.0 {
                 (fc.abs() / slope).min((b - a).abs())
             } else {
                 (b - a).abs()
             };
-            return (c, tol, evals);
+            if tol <= tol_w {
+                return (c, tol, evals);
+            }
         }
         if (fc > 0.0) == (fb > 0.0) {
             b = c;
@@ -620,7 +627,11 @@ pub fn simulate(
                     what: "non-finite state".into(),
                     location: Some(format!(
                         "{} phase",
-                        if sys.constrained { "constrained" } else { "free" }
+                        if sys.constrained {
+                            "constrained"
+                        } else {
+                            "free"
+                        }
                     )),
                     why: format!("step {tau:.3e} against the bound {limit:.3e}"),
                     remedy: "lower the safety factor".into(),
@@ -690,8 +701,7 @@ pub fn simulate(
         }
         if sys.constrained {
             report.max_gap_violation = report.max_gap_violation.max(proj.0);
-            report.max_normal_velocity_violation =
-                report.max_normal_velocity_violation.max(proj.1);
+            report.max_normal_velocity_violation = report.max_normal_velocity_violation.max(proj.1);
             report.projection_energy += proj.2;
         }
         if tau_eff > 0.0 {
