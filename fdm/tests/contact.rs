@@ -124,10 +124,13 @@ fn dyn_contact_events_are_located_and_releases_have_small_force() {
         "{:e}",
         rep.max_normal_velocity_violation
     );
-    // the recorded gap never goes measurably negative
+    // the recorded gap never goes measurably negative: free flight that leaves the surface at
+    // a release may dip by up to 1e-9 (L₁ + L₂) before a contact is declared, and samples
+    // interpolate linearly between step ends (the tip path is curved)
     let gap = channel(&r, "contact1.gap");
     let worst = gap.iter().fold(0.0f64, |m, g| m.min(*g));
-    assert!(worst > -1e-9, "penetration {worst:e}");
+    println!("most negative recorded gap {worst:.2e}");
+    assert!(worst > -1e-9 * len, "penetration {worst:e}");
 }
 
 #[test]

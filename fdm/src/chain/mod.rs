@@ -30,8 +30,11 @@
 //!
 //! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
 //! on). Bound: 0.9 · 2/ω_max with ω_max from a power iteration on the linearized chain at t = 0
-//! (once per run, O(n²)), the Kelvin–Voigt factor of that frequency, and the clamp-rotation
-//! modes with their joint-damper ratio. Observables: joint angles/rates (clamp angles),
+//! (once per run, O(n²)), with ζ = max(Kelvin–Voigt ζ of that frequency, κ_max/(2ω_max)) —
+//! κ_max the fastest damping rate, a power iteration on −∂a/∂q̇ (the joint dampers act on the
+//! clamp half-cell inertia: overdamped modes, velocity-form limit τ → 1/κ) — and the
+//! clamp-rotation modes with their joint-damper ratio. Gravity: V_g of the lumped masses
+//! ([`TwoLinkChain`]'s `gravity_potential`). Tip contact: [`contact`]. Observables: joint angles/rates (clamp angles),
 //! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame.
 
 // Index loops over parallel buffers (q, v, a, columns of M) read like the formulas.
@@ -642,6 +645,45 @@ impl TwoLinkChain {
             }
         }
         -(a1 * x1 + b1 * y1 + a2 * x2 + b2 * y2)
+    }
+
+    /// Stores the input/dissipation powers at (q, q̇) — without the force evaluation — and
+    /// writes them as [`System::powers`] does. The velocity form evaluates the forces of a step
+    /// end at the *predicted* velocity; its ledger takes the powers at the final one (the
+    /// overdamped clamp-rotation modes make the two differ at O(1) near the step bound).
+    pub(super) fn powers_at(&mut self, t: f64, v: &[f64], out: &mut [f64]) {
+        self.vk.copy_from_slice(v);
+        for s in self.slots {
+            self.vk[s] = 0.0;
+        }
+        let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
+        let mut p_kv = 0.0;
+        for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
+            .into_iter()
+            .enumerate()
+        {
+            let lp = &self.links[link];
+            if lp.gamma == 0.0 {
+                continue;
+            }
+            f.iter_mut().for_each(|x| *x = 0.0);
+            let (d2, _) = Self::ghost_bending(
+                self.hs[link],
+                lp.gamma,
+                &self.vk[range],
+                v[self.slots[link]],
+                f,
+            );
+            p_kv += 2.0 * d2;
+        }
+        let (th1d, th2d) = (self.clamp_angle(v, 0), self.elbow(v));
+        let j = &self.joints;
+        self.power = [
+            j[0].torque(t) * th1d + j[1].torque(t) * th2d,
+            j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
+            p_kv,
+        ];
+        self.powers(out);
     }
 
     /// Generalized forces Q − ∂V/∂q − ∂D/∂q̇ into `out`; sets the powers.
