@@ -301,13 +301,17 @@ impl TwoLinkChain {
     }
 
     /// The impact at (q, q̇⁻): q̇ ← q̇⁺. Allocates (once per impact, outside the step loop).
-    fn impact(&mut self, t: f64, q: &[f64], v: &mut [f64]) -> Event {
+    /// `None` (q̇ untouched) when GM⁻¹Gᵀ is not positive: M lost definiteness.
+    fn impact(&mut self, t: f64, q: &[f64], v: &mut [f64]) -> Option<Event> {
         let n = q.len();
         let ke_before = self.kinetic_energy(q, v);
         let before = v.to_vec();
         self.chord(q, v);
         self.build_columns();
         let (gmg, _) = self.constraint_solve();
+        if !(gmg > 0.0 && gmg.is_finite()) {
+            return None;
+        }
         let gv: f64 = (0..n).map(|i| self.grow[i] * v[i]).sum();
         let impulse = -gv / gmg;
         let mut dv = vec![0.0; n];
@@ -331,7 +335,7 @@ impl TwoLinkChain {
         let normal_velocity_after: f64 = (0..n).map(|i| self.grow[i] * v[i]).sum();
         let kinetic_energy_lost = ke_before - self.kinetic_energy(q, v);
 
-        Event::Impact {
+        Some(Event::Impact {
             t,
             contact: 1,
             velocity_before: before,
@@ -340,7 +344,7 @@ impl TwoLinkChain {
             momentum_residual,
             normal_velocity_after,
             kinetic_energy_lost,
-        }
+        })
     }
 
     /// Static equilibrium resting on the surface: −∂V/∂q + Gᵀλ = 0, g = 0 (V: strain, joint
@@ -542,6 +546,21 @@ enum Switch {
     Release { tol: f64 },
 }
 
+/// The verdict when the constraint's GM⁻¹Gᵀ is not positive (M lost definiteness).
+fn singular(t: f64) -> StabilityVerdict {
+    StabilityVerdict::Stopped {
+        diagnostic: Diagnostic {
+            t,
+            what: "the constraint's G M⁻¹ Gᵀ is not positive".into(),
+            location: Some("contact1".into()),
+            why: "the chain's mass matrix lost positive definiteness (deflections far outside \
+                  the second-order kinetic energy's range)"
+                .into(),
+            remedy: "lower the safety factor or refine the stations".into(),
+        },
+    }
+}
+
 /// Runs a two-link chain with its tip contact (velocity form). Returns the run and the
 /// contact diagnostics.
 pub fn simulate(
@@ -634,6 +653,10 @@ pub fn simulate(
         let mut tau_eff = tau;
         let mut proj = step.take(&mut sys, t, tau, &cur, &acc, &mut next, &mut acc2);
         cost.rhs_evaluations += 1;
+        if sys.constrained && !sys.lambda.is_finite() {
+            verdict = singular(t);
+            break;
+        }
         if !(next.q.iter().chain(&next.v).all(|x| x.is_finite())) {
             verdict = StabilityVerdict::Stopped {
                 diagnostic: Diagnostic {
@@ -771,7 +794,10 @@ pub fn simulate(
                         contact: 1,
                         time_tolerance: tol,
                     });
-                    let ev = sys.impact(t, &cur.q, &mut cur.v);
+                    let Some(ev) = sys.impact(t, &cur.q, &mut cur.v) else {
+                        verdict = singular(t);
+                        break;
+                    };
                     refine_until = t + window;
                     if let Event::Impact {
                         kinetic_energy_lost,

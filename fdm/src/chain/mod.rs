@@ -773,7 +773,12 @@ impl System for TwoLinkChain {
             // λ = −(G a_free + Ġq̇)/(G M⁻¹Gᵀ) — one more solve with the same M.
             let (gmg, curv) = self.constraint_solve();
             let ga: f64 = (0..n).map(|i| self.grow[i] * a[i]).sum();
-            let lam = -(ga + curv) / gmg;
+            // a non-positive GM⁻¹Gᵀ means M lost definiteness: NaN stops the contact driver
+            let lam = if gmg > 0.0 {
+                -(ga + curv) / gmg
+            } else {
+                f64::NAN
+            };
             for i in 0..n {
                 a[i] += self.minv_g[i] * lam;
             }
