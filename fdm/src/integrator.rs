@@ -170,13 +170,13 @@ impl Outcome {
     }
 }
 
-struct Levels {
-    q: Vec<f64>,
-    v: Vec<f64>,
+pub(crate) struct Levels {
+    pub(crate) q: Vec<f64>,
+    pub(crate) v: Vec<f64>,
 }
 
 impl Levels {
-    fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         Levels {
             q: vec![0.0; n],
             v: vec![0.0; n],
@@ -185,11 +185,11 @@ impl Levels {
 }
 
 /// Output recorder: samples at the output times by linear interpolation between levels.
-struct Recorder {
+pub(crate) struct Recorder {
     times: Vec<f64>,
     next: usize,
-    obs: Observables,
-    ledger: EnergyLedger,
+    pub(crate) obs: Observables,
+    pub(crate) ledger: EnergyLedger,
     row: Vec<f64>,
     stored: Vec<f64>,
     q: Vec<f64>,
@@ -199,7 +199,7 @@ struct Recorder {
 }
 
 impl Recorder {
-    fn new<S: System>(sys: &S, ctl: &StepControl) -> Self {
+    pub(crate) fn new<S: System>(sys: &S, ctl: &StepControl) -> Self {
         let n_out = (ctl.t_end / ctl.output_interval - 1e-9).ceil().max(0.0) as usize;
         let mut times: Vec<f64> = (0..=n_out)
             .map(|k| (k as f64 * ctl.output_interval).min(ctl.t_end))
@@ -241,7 +241,7 @@ impl Recorder {
 
     /// Records every output time in (t_a, t_b] (and t_a itself if it is the first sample).
     #[allow(clippy::too_many_arguments)]
-    fn record<S: System>(
+    pub(crate) fn record<S: System>(
         &mut self,
         sys: &S,
         ta: f64,
@@ -286,7 +286,7 @@ impl Recorder {
         }
     }
 
-    fn done(&self) -> bool {
+    pub(crate) fn done(&self) -> bool {
         self.next >= self.times.len()
     }
 }

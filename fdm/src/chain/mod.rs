@@ -30,13 +30,17 @@
 //!
 //! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
 //! on). Bound: 0.9 · 2/ω_max with ω_max from a power iteration on the linearized chain at t = 0
-//! (once per run, O(n²)), the Kelvin–Voigt factor of that frequency, and the clamp-rotation
-//! modes with their joint-damper ratio. Observables: joint angles/rates (clamp angles),
+//! (once per run, O(n²)), with ζ = max(Kelvin–Voigt ζ of that frequency, κ_max/(2ω_max)) —
+//! κ_max the fastest damping rate, a power iteration on −∂a/∂q̇ (the joint dampers act on the
+//! clamp half-cell inertia: overdamped modes, velocity-form limit τ → 1/κ) — and the
+//! clamp-rotation modes with their joint-damper ratio. Gravity: V_g of the lumped masses
+//! ([`TwoLinkChain`]'s `gravity_potential`). Tip contact: [`contact`]. Observables: joint angles/rates (clamp angles),
 //! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame.
 
 // Index loops over parallel buffers (q, v, a, columns of M) read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
+pub mod contact;
 pub mod dual;
 pub mod kinetic;
 
@@ -47,8 +51,9 @@ use crate::error::FdmError;
 use crate::integrator::{Bound, BoundKind, StepControl, System, damped_step_factor, integrate};
 use crate::link::{FloatingLink, sample_field};
 use crate::settings::{FdmSettings, Method};
+use contact::TipContact;
 use dual::Dual;
-use kinetic::{BE, ChainInertia, TH, seg_energy};
+use kinetic::{BE, ChainInertia, TH, seg_energy, seg_grad};
 
 /// Default stations per link.
 pub const DEFAULT_STATIONS: usize = 21;
@@ -85,6 +90,8 @@ pub struct TwoLinkChain {
     field_stations: usize,
     /// highest angular frequency of the linearized chain at t = 0 (power iteration)
     omega_max: f64,
+    /// fastest damping rate of the linearized chain at t = 0 (power iteration on −∂a/∂q̇)
+    kappa_max: f64,
     /// clamp half-cell rotary inertias ρA h³/24 of links 1 and 2
     jc: [f64; 2],
     /// q-slots of the clamp ghost deflections x₁, x₂ (station 1 of each link is the chord
@@ -105,6 +112,20 @@ pub struct TwoLinkChain {
     fw: Vec<f64>,
     power: [f64; 3],
     torques: [f64; 2],
+    /// uniform gravity (inertial gx, gy), if the scene has it
+    gravity: Option<[f64; 2]>,
+    /// gravity weights of link 1's foreshortening: outboard mass of each segment plus the
+    /// whole of link 2 (which rides on link 1's tip)
+    mu1g: Vec<f64>,
+    /// the tip contact of link 2, if any ([`contact`])
+    contact: Option<TipContact>,
+    /// whether the tip is held on the surface (constrained phase)
+    constrained: bool,
+    /// normal force λ of the last constrained `accel` (0 in free flight)
+    lambda: f64,
+    /// scratch of the constraint: G = ∂g/∂q and M⁻¹Gᵀ
+    grow: Vec<f64>,
+    minv_g: Vec<f64>,
 }
 
 fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
@@ -117,8 +138,6 @@ fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
             ("rotary_inertia", l.rotary_inertia),
             ("tip_inertia", l.tip_inertia.is_some()),
             ("prescribed joint", l.joint.prescribed.is_some()),
-            ("gravity", scene.gravity.is_some()),
-            ("contact", !scene.contacts.is_empty()),
         ],
     )?;
     Ok(())
@@ -199,6 +218,16 @@ impl TwoLinkChain {
             law: l.joint.torque.clone(),
         };
         let nd = inertia.dofs();
+        let contact = TipContact::from_scene(scene)?;
+        let mu1g = {
+            let mut acc = inertia.mass2;
+            let mut out = vec![0.0; r1];
+            for seg in (0..r1).rev() {
+                acc += inertia.m1[seg];
+                out[seg] = acc;
+            }
+            out
+        };
         let (j1, j2) = (&scene.links[0].joint, &scene.links[1].joint);
         let mut chain = TwoLinkChain {
             links: [props(&scene.links[0]), props(&scene.links[1])],
@@ -218,6 +247,7 @@ impl TwoLinkChain {
             power: [0.0; 3],
             torques: [0.0; 2],
             omega_max: 0.0,
+            kappa_max: 0.0,
             jc,
             slots: [1 + r1, 1 + r1 + r2],
             hs: [h1, h2],
@@ -226,6 +256,13 @@ impl TwoLinkChain {
             obs_scratch: std::cell::RefCell::new(vec![0.0; nd]),
             obs_scratch_v: std::cell::RefCell::new(vec![0.0; nd]),
             inertia,
+            gravity: scene.gravity.as_ref().map(|g| g.vector),
+            mu1g,
+            contact,
+            constrained: false,
+            lambda: 0.0,
+            grow: vec![0.0; nd],
+            minv_g: vec![0.0; nd],
         };
         // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
         // built once here, `accel` refreshes only the θ and β columns.
@@ -235,6 +272,7 @@ impl TwoLinkChain {
             chain.cols[2 + k] = col;
         }
         chain.omega_max = chain.top_frequency();
+        chain.kappa_max = chain.top_damping_rate();
         Ok(chain)
     }
 
@@ -242,22 +280,57 @@ impl TwoLinkChain {
     /// −∂a/∂q (columns by forward differences of the accelerations). Once per run, O(n²).
     fn top_frequency(&mut self) -> f64 {
         let (q0, _) = self.initial_state();
+        let rest = vec![0.0; self.dofs()];
+        self.top_frequency_at(0.0, &q0, &rest)
+    }
+
+    /// Fastest damping rate κ_max (largest |eigenvalue| of −∂a/∂q̇) at the initial state at
+    /// rest, 2 % margin. The joint dampers act on the clamp rotations with their tiny
+    /// half-cell inertia J_c: strongly overdamped modes whose velocity-form limit is τ ≤ 1/κ.
+    fn top_damping_rate(&mut self) -> f64 {
+        let (q0, _) = self.initial_state();
+        let rest = vec![0.0; self.dofs()];
+        1.02 * self.top_eigen(0.0, &q0, &rest, true)
+    }
+
+    /// Highest ω of the chain linearized in q about (q, q̇) (in the current contact phase):
+    /// power iteration on −∂a/∂q. O(n²) with n + 1 force evaluations; allocates.
+    fn top_frequency_at(&mut self, t: f64, q0: &[f64], v: &[f64]) -> f64 {
+        // power iteration approaches the top eigenvalue from below: 2 % margin on ω
+        1.02 * self.top_eigen(t, q0, v, false).sqrt()
+    }
+
+    /// Largest |eigenvalue| of −∂a/∂q (`wrt_v` false: ω²_max) or −∂a/∂q̇ (`wrt_v` true: the
+    /// fastest damping rate κ = c/m) at (q, q̇), by power iteration on a forward-difference
+    /// Jacobian (no margin).
+    fn top_eigen(&mut self, t: f64, q0: &[f64], v0: &[f64], wrt_v: bool) -> f64 {
         let n = self.dofs();
-        let rest = vec![0.0; n];
+        let (q0, v) = (q0, v0);
+        let lambda = self.lambda;
         let mut a0 = vec![0.0; n];
-        self.accel(0.0, &q0, &rest, &mut a0);
+        self.accel(t, q0, v, &mut a0);
         let mut jac = vec![0.0; n * n];
         let mut a = vec![0.0; n];
-        let mut q = q0.clone();
+        let mut q = q0.to_vec();
+        let mut vv = v.to_vec();
         for j in 0..n {
-            let eps = 1e-7 * (1.0 + q0[j].abs());
-            q[j] = q0[j] + eps;
-            self.accel(0.0, &q, &rest, &mut a);
-            q[j] = q0[j];
+            let eps;
+            if wrt_v {
+                eps = 1e-7 * (1.0 + v[j].abs());
+                vv[j] = v[j] + eps;
+                self.accel(t, q0, &vv, &mut a);
+                vv[j] = v[j];
+            } else {
+                eps = 1e-7 * (1.0 + q0[j].abs());
+                q[j] = q0[j] + eps;
+                self.accel(t, &q, v, &mut a);
+                q[j] = q0[j];
+            }
             for i in 0..n {
                 jac[i * n + j] = -(a[i] - a0[i]) / eps;
             }
         }
+        self.lambda = lambda;
         let mut x: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
         let mut y = vec![0.0; n];
         let mut lam = 0.0;
@@ -273,8 +346,7 @@ impl TwoLinkChain {
                 x[i] = y[i] / lam;
             }
         }
-        // power iteration approaches the top eigenvalue from below: 2 % margin
-        1.02 * lam.max(0.0).sqrt()
+        lam.max(0.0)
     }
 
     fn any_law(&self) -> bool {
@@ -424,10 +496,194 @@ impl TwoLinkChain {
         }
     }
 
+    /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`; the ghost
+    /// columns are constant (built in `from_scene`).
+    fn build_columns(&mut self) {
+        let n = self.dofs();
+        let full = [TH, BE];
+        for (c, &idx) in full.iter().enumerate() {
+            self.cols[c].iter_mut().for_each(|x| *x = 0.0);
+            self.unit[idx] = 1.0;
+            self.inertia
+                .momenta(&self.qk, &self.zeros, &self.unit, &mut self.p);
+            self.unit[idx] = 0.0;
+            for i in 0..n {
+                self.cols[c][i] = self.p[i].re;
+            }
+            for s in self.slots {
+                self.cols[c][s] = 0.0;
+            }
+            // J_c e eᵀ: column of the frame angle gets J_c e (the ghost's −J_c e/(2h) is fixed)
+            let mut col = std::mem::take(&mut self.cols[c]);
+            self.add_clamp(c, self.jc[c], &mut col);
+            self.cols[c] = col;
+        }
+    }
+
+    /// The indices of the four full columns of M: θ, β and the ghosts x₁, x₂.
+    fn full(&self) -> [usize; 4] {
+        [TH, BE, self.slots[0], self.slots[1]]
+    }
+
+    /// out = M⁻¹ rhs with the columns of the last [`Self::build_columns`]: Schur complement
+    /// on {θ, β, x₁, x₂}; the rest of M is diagonal. O(n), no allocation.
+    fn solve_mass(&self, rhs: &[f64], out: &mut [f64]) {
+        let n = self.dofs();
+        let full = self.full();
+        let mut s = [[0.0; 4]; 4];
+        let mut b = [0.0; 4];
+        for r in 0..4 {
+            b[r] = rhs[full[r]];
+            for c in 0..4 {
+                s[r][c] = self.cols[c][full[r]];
+            }
+        }
+        for i in 0..n {
+            if full.contains(&i) {
+                continue;
+            }
+            let d = self.diag_mass(i);
+            for r in 0..4 {
+                let mri = self.cols[r][i];
+                b[r] -= mri * rhs[i] / d;
+                for c in 0..4 {
+                    s[r][c] -= mri * self.cols[c][i] / d;
+                }
+            }
+        }
+        let x = solve4(s, b);
+        for i in 0..n {
+            if let Some(k) = full.iter().position(|&f| f == i) {
+                out[i] = x[k];
+            } else {
+                let coupled: f64 = (0..4).map(|c| self.cols[c][i] * x[c]).sum();
+                out[i] = (rhs[i] - coupled) / self.diag_mass(i);
+            }
+        }
+    }
+
+    /// out = M x with the columns of the last [`Self::build_columns`] (M symmetric: full
+    /// column c also gives row c).
+    fn mass_mul(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.dofs();
+        let full = self.full();
+        for i in 0..n {
+            if let Some(r) = full.iter().position(|&f| f == i) {
+                let mut acc = 0.0;
+                for j in 0..n {
+                    if let Some(c) = full.iter().position(|&f| f == j) {
+                        acc += self.cols[c][i] * x[j];
+                    } else {
+                        acc += self.cols[r][j] * x[j];
+                    }
+                }
+                out[i] = acc;
+            } else {
+                out[i] = self.diag_mass(i) * x[i]
+                    + (0..4).map(|c| self.cols[c][i] * x[full[c]]).sum::<f64>();
+            }
+        }
+    }
+
     pub fn total_energy(&self, q: &[f64], v: &[f64]) -> f64 {
-        let mut e = [0.0; 3];
-        self.stored_energies(0.0, q, v, &mut e);
+        let mut e = [0.0; 4];
+        let k = self.ledger_names().0.len();
+        self.stored_energies(0.0, q, v, &mut e[..k]);
         e.iter().sum()
+    }
+
+    /// Gravity potential V_g = −g·Σ m r of the lumped masses, from the chord-frame coordinates
+    /// `qk` (ghost slots zero); adds −∂V_g/∂q into `out` when given (not at the ghost slots:
+    /// the ghosts move no mass). With A(α) = g·(cos α, sin α), B(α) = g·(−sin α, cos α),
+    /// ∂A/∂α = B, ∂B/∂α = −A:
+    /// V_g = −[A(θ)X₁ + B(θ)Y₁ + A(β)X₂ + B(β)Y₂], X₁ = Σm₁x + M₂L₁ − Σ_seg c₁ ½h g²
+    /// (foreshortening; c₁ = outboard mass of link 1 + M₂), Y₁ = Σm₁v, X₂ = Q₂ − Ψ, Y₂ = Σm₂w:
+    /// the positions the kinetic energy uses, so the gravity work is exactly −ΔV_g.
+    fn gravity_potential(&self, qk: &[f64], out: Option<&mut [f64]>) -> f64 {
+        let Some([gx, gy]) = self.gravity else {
+            return 0.0;
+        };
+        let ine = &self.inertia;
+        let (v, w) = (&qk[ine.iv()], &qk[ine.iw()]);
+        let ab = |a: f64| {
+            let (s, c) = a.sin_cos();
+            (gx * c + gy * s, -gx * s + gy * c)
+        };
+        let (a1, b1) = ab(qk[TH]);
+        let (a2, b2) = ab(qk[BE]);
+        let mut x1 = ine.mass2 * ine.l1;
+        let mut y1 = 0.0;
+        for k in 0..ine.r1 {
+            x1 += ine.m1[k] * (k + 1) as f64 * ine.h1;
+            y1 += ine.m1[k] * v[k];
+        }
+        if ine.fs1 {
+            x1 -= seg_energy(v, ine.h1, Some(&self.mu1g));
+        }
+        let mut x2 = ine.q2;
+        let y2: f64 = (0..ine.r2).map(|j| ine.m2[j] * w[j]).sum();
+        if ine.fs2 {
+            x2 -= seg_energy(w, ine.h2, Some(&ine.mu2));
+        }
+        if let Some(out) = out {
+            out[TH] += b1 * x1 - a1 * y1;
+            out[BE] += b2 * x2 - a2 * y2;
+            // the tip entries (k = r − 1) are the ghost slots: no mass moves with them
+            for k in 0..ine.r1 - 1 {
+                let mut f = b1 * ine.m1[k];
+                if ine.fs1 {
+                    f -= a1 * seg_grad(v, ine.h1, Some(&self.mu1g), k);
+                }
+                out[2 + k] += f;
+            }
+            for j in 0..ine.r2 - 1 {
+                let mut f = b2 * ine.m2[j];
+                if ine.fs2 {
+                    f -= a2 * seg_grad(w, ine.h2, Some(&ine.mu2), j);
+                }
+                out[2 + ine.r1 + j] += f;
+            }
+        }
+        -(a1 * x1 + b1 * y1 + a2 * x2 + b2 * y2)
+    }
+
+    /// Stores the input/dissipation powers at (q, q̇) — without the force evaluation — and
+    /// writes them as [`System::powers`] does. The velocity form evaluates the forces of a step
+    /// end at the *predicted* velocity; its ledger takes the powers at the final one (the
+    /// overdamped clamp-rotation modes make the two differ at O(1) near the step bound).
+    pub(super) fn powers_at(&mut self, t: f64, v: &[f64], out: &mut [f64]) {
+        self.vk.copy_from_slice(v);
+        for s in self.slots {
+            self.vk[s] = 0.0;
+        }
+        let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
+        let mut p_kv = 0.0;
+        for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
+            .into_iter()
+            .enumerate()
+        {
+            let lp = &self.links[link];
+            if lp.gamma == 0.0 {
+                continue;
+            }
+            f.iter_mut().for_each(|x| *x = 0.0);
+            let (d2, _) = Self::ghost_bending(
+                self.hs[link],
+                lp.gamma,
+                &self.vk[range],
+                v[self.slots[link]],
+                f,
+            );
+            p_kv += 2.0 * d2;
+        }
+        let (th1d, th2d) = (self.clamp_angle(v, 0), self.elbow(v));
+        let j = &self.joints;
+        self.power = [
+            j[0].torque(t) * th1d + j[1].torque(t) * th2d,
+            j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
+            p_kv,
+        ];
+        self.powers(out);
     }
 
     /// Generalized forces Q − ∂V/∂q − ∂D/∂q̇ into `out`; sets the powers.
@@ -475,6 +731,9 @@ impl TwoLinkChain {
             out[i] -= tau2 * c;
         }
         self.torques = [tau1, tau2];
+        let qk = std::mem::take(&mut self.qk);
+        self.gravity_potential(&qk, Some(out));
+        self.qk = qk;
         self.power = [
             ext[0] * th1d + ext[1] * th2d,
             j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
@@ -505,61 +764,26 @@ impl System for TwoLinkChain {
         for i in 0..n {
             rhs[i] += a[i] - self.p[i].du;
         }
-        // full columns of M: p at unit velocities, plus the clamp inertias
-        let full = [TH, BE, self.slots[0], self.slots[1]];
-        for c in 0..2 {
-            self.cols[c].iter_mut().for_each(|x| *x = 0.0);
-        }
-        for (c, &idx) in full.iter().enumerate().take(2) {
-            self.unit[idx] = 1.0;
-            self.inertia
-                .momenta(&self.qk, &self.zeros, &self.unit, &mut self.p);
-            self.unit[idx] = 0.0;
-            for i in 0..n {
-                self.cols[c][i] = self.p[i].re;
-            }
-            for s in self.slots {
-                self.cols[c][s] = 0.0;
-            }
-        }
-        for k in 0..2 {
-            // J_c e eᵀ: column of the frame angle gets J_c e (the ghost's −J_c e/(2h) is fixed)
-            let mut col = std::mem::take(&mut self.cols[k]);
-            self.add_clamp(k, self.jc[k], &mut col);
-            self.cols[k] = col;
-        }
-        // Schur complement on {θ, β, V}; the rest of M is diagonal.
-        let mut s = [[0.0; 4]; 4];
-        let mut b = [0.0; 4];
-        for r in 0..4 {
-            b[r] = rhs[full[r]];
-            for c in 0..4 {
-                s[r][c] = self.cols[c][full[r]];
-            }
-        }
-        for i in 0..n {
-            if full.contains(&i) {
-                continue;
-            }
-            let d = self.diag_mass(i);
-            for r in 0..4 {
-                let mri = self.cols[r][i];
-                b[r] -= mri * rhs[i] / d;
-                for c in 0..4 {
-                    s[r][c] -= mri * self.cols[c][i] / d;
-                }
-            }
-        }
-        let x = solve4(s, b);
-        for i in 0..n {
-            if let Some(k) = full.iter().position(|&f| f == i) {
-                a[i] = x[k];
-            } else {
-                let coupled: f64 = (0..4).map(|c| self.cols[c][i] * x[c]).sum();
-                a[i] = (rhs[i] - coupled) / self.diag_mass(i);
-            }
-        }
+        self.build_columns();
+        self.solve_mass(&rhs, a);
         self.rhs = rhs;
+        self.lambda = 0.0;
+        if self.constrained {
+            // M q̈ = f + Gᵀλ with G q̈ + Ġq̇ = 0: q̈ = a_free + M⁻¹Gᵀ λ,
+            // λ = −(G a_free + Ġq̇)/(G M⁻¹Gᵀ) — one more solve with the same M.
+            let (gmg, curv) = self.constraint_solve();
+            let ga: f64 = (0..n).map(|i| self.grow[i] * a[i]).sum();
+            // a non-positive GM⁻¹Gᵀ means M lost definiteness: NaN stops the contact driver
+            let lam = if gmg > 0.0 {
+                -(ga + curv) / gmg
+            } else {
+                f64::NAN
+            };
+            for i in 0..n {
+                a[i] += self.minv_g[i] * lam;
+            }
+            self.lambda = lam;
+        }
     }
 
     fn powers(&self, out: &mut [f64]) {
@@ -574,6 +798,12 @@ impl System for TwoLinkChain {
         }
         if self.any_kv() {
             out[k] = self.power[2];
+            k += 1;
+        }
+        if self.contact.is_some() {
+            // the impact loss is a jump booked by the contact driver; the frictionless fixed
+            // surface does no work while the tip slides (λ Gq̇ = 0)
+            out[k] = 0.0;
         }
     }
 
@@ -586,11 +816,14 @@ impl System for TwoLinkChain {
         // it leaves out the centrifugal tension's string stiffness N/h² (see the single link's
         // bound); the 0.9 covers a 23 % rise of ω_max², the tension adds N h²/(4EI) ≈ 1e-2 at
         // the undamped scene's peak rate (θ̇₁ ≈ 22 rad/s, 21 stations).
+        // ζ of the top mode: at least the Kelvin–Voigt ζ of that frequency, and at least
+        // κ_max/(2ω_max) — the fastest damping rate as if it sat on the top frequency
+        // (conservative: for ζ ≫ 1 the factor gives τ → 1/κ_max, the overdamped limit).
         let zeta = self
             .links
             .iter()
             .map(|lp| lp.gamma * self.omega_max / (2.0 * lp.ei))
-            .fold(0.0f64, f64::max);
+            .fold(self.kappa_max / (2.0 * self.omega_max), f64::max);
         let mut best = Bound {
             sigma: 0.9 * 2.0 / self.omega_max * damped_step_factor(zeta),
             kind: BoundKind::Transverse,
@@ -662,6 +895,12 @@ impl System for TwoLinkChain {
                 c.push((channel::field_deflection(l, k), "length"));
             }
         }
+        if self.contact.is_some() {
+            c.push((channel::contact_normal_force(1), "force"));
+            c.push((channel::contact_phase(1), "1"));
+            // not a standard channel (as modal): the gap, negative = penetration
+            c.push(("contact1.gap".to_string(), "length"));
+        }
         c
     }
 
@@ -729,6 +968,12 @@ impl System for TwoLinkChain {
             sample_field(self.links[l].length, h, r, at, &mut out[k..k + nf]);
             k += nf;
         }
+        if let Some(ct) = &self.contact {
+            // λ of the last evaluation: the step end of the sampled interval (O(τ) in time)
+            out[k] = self.lambda;
+            out[k + 1] = if self.constrained { 1.0 } else { 0.0 };
+            out[k + 2] = ct.gap(self, &qk);
+        }
     }
 
     fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
@@ -743,7 +988,14 @@ impl System for TwoLinkChain {
         if self.any_kv() {
             diss.push("kelvin_voigt");
         }
-        (vec!["kinetic", "strain", "joint_spring"], inputs, diss)
+        if self.contact.is_some() {
+            diss.push("impact");
+        }
+        let mut stored = vec!["kinetic", "strain", "joint_spring"];
+        if self.gravity.is_some() {
+            stored.push("gravity");
+        }
+        (stored, inputs, diss)
     }
 
     fn stored_energies(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
@@ -769,7 +1021,10 @@ impl System for TwoLinkChain {
         let j = &self.joints;
         let spring = 0.5 * j[0].stiffness * (self.clamp_angle(q, 0) - j[0].set_point).powi(2)
             + 0.5 * j[1].stiffness * (self.elbow(q) - j[1].set_point).powi(2);
-        out.copy_from_slice(&[ke, strain, spring]);
+        out[..3].copy_from_slice(&[ke, strain, spring]);
+        if self.gravity.is_some() {
+            out[3] = self.gravity_potential(&qk, None);
+        }
     }
 
     fn monitored(&self) -> std::ops::Range<usize> {
@@ -832,6 +1087,9 @@ pub fn simulate(
     settings: &Settings,
     s: &FdmSettings,
 ) -> Result<RunResult, FdmError> {
+    if !scene.contacts.is_empty() {
+        return Ok(contact::simulate(scene, settings, s)?.0);
+    }
     let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
     let method = if settings.time.method.is_none() {
         Method::VelocityForm
