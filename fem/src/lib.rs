@@ -55,6 +55,7 @@ pub mod element;
 pub mod error;
 pub mod integrator;
 pub mod linear;
+pub mod midpoint;
 pub mod modes;
 pub mod plan;
 pub mod run;
