@@ -572,8 +572,10 @@ impl Chain {
                     } else {
                         0.0
                     };
-                    self.force[li][e * NG + g] =
-                        sub(scale(m, sub(scale(inertia, a), g_loc)), [0.0, q_load * tb.wh[g]]);
+                    self.force[li][e * NG + g] = sub(
+                        scale(m, sub(scale(inertia, a), g_loc)),
+                        [0.0, q_load * tb.wh[g]],
+                    );
                     self.pos[li][e * NG + g] = p;
                     self.vel[li][e * NG + g] = pd;
                 }

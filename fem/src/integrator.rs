@@ -16,6 +16,9 @@
 //!   step is constant: each stretch between stop times is split into equal steps ≤ dt (a
 //!   periodic short step near the bound makes the composed map unstable).
 //!
+//! * Energy-consistent midpoint (`energy-midpoint`, the default for free-joint chains): see
+//!   [`crate::midpoint`]; it shares the Newton-matrix machinery, the stops and the step control.
+//!
 //! The stepper stops exactly on requested times (outputs, torque-law breakpoints, t_end) so that
 //! discontinuities — and later contact events — are never stepped over.
 
@@ -614,7 +617,12 @@ impl Integrator {
     }
 
     /// Forms and factorizes the Newton matrix at (q1, q̇1, q̈1) after a residual evaluation there.
-    pub(crate) fn form_matrix(&mut self, c: NewtonCoefficients, t_law: f64, t: f64) -> Result<(), FemError> {
+    pub(crate) fn form_matrix(
+        &mut self,
+        c: NewtonCoefficients,
+        t_law: f64,
+        t: f64,
+    ) -> Result<(), FemError> {
         self.counters.jacobians += 1;
         self.counters.factorizations += 1;
         match self.jacobian {

@@ -40,12 +40,12 @@
 //! (third-derivative term of the trapezoidal/midpoint family, from successive mean
 //! accelerations), step ratio 0.9·err^(−1/3) as for generalized-α.
 
-use crate::chain::{NONE, NewtonCoefficients, Parts};
+use crate::chain::{Chain, NONE, NewtonCoefficients, Parts};
 use crate::error::FemError;
 use crate::integrator::{Integrator, JacobianKind, Works};
 
 /// Relative size of the finite-difference perturbation of q for Ṁ(x)x.
-const FD_STEP: f64 = 1e-5;
+pub const FD_STEP: f64 = 1e-5;
 /// Newton iterations at most before the step is retried shorter.
 const MAX_ITERATIONS: usize = 30;
 /// Energy defect h v̄ᵀ(residual) accepted per step, relative to the step's energy scale
@@ -141,50 +141,75 @@ fn max_abs(a: &[f64]) -> f64 {
     a.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
-/// ∂T/∂q(q, x) added to `out` with factor `sign` (3 inertial passes; see module docs).
-fn add_dtdq(
-    chain: &mut crate::chain::Chain,
-    w: &mut MidpointWork,
+/// Scratch vectors and the output of [`add_kinetic_gradient`].
+struct Scratch<'a> {
+    out: &'a mut [f64],
+    zero: &'a [f64],
+    qp: &'a mut [f64],
+    tmp: &'a mut [f64],
+    tmp2: &'a mut [f64],
+}
+
+/// Adds `sign`·∂T/∂q(q, x) to `out` (3 inertial passes; 0 if x = 0): the central difference
+/// Ṁ(x)x = [M(q + εx)x − M(q − εx)x]/(2ε) with ε‖x‖∞ = `delta`, minus R_in(q, x, 0).
+fn add_kinetic_gradient(
+    chain: &mut Chain,
     t: f64,
-    which: Which,
+    q: &[f64],
+    x: &[f64],
     delta: f64,
     sign: f64,
-    out: &mut [f64],
+    s: Scratch<'_>,
 ) -> usize {
-    let n = w.qbar.len();
-    let x: &[f64] = match which {
-        Which::Mean => &w.vbar,
-        Which::HalfChange => &w.half_dv,
-    };
     let xmax = max_abs(x);
     if xmax == 0.0 {
         return 0;
     }
     let eps = delta / xmax;
-    // Ṁ(x)x by a central difference of M(q ± εx)x.
+    let n = q.len();
     for i in 0..n {
-        w.qp[i] = w.qbar[i] + eps * x[i];
+        s.qp[i] = q[i] + eps * x[i];
     }
-    chain.residual_parts(t, &w.qp, &w.zero, x, Parts::INERTIA, &mut w.tmp);
+    chain.residual_parts(t, s.qp, s.zero, x, Parts::INERTIA, s.tmp);
     for i in 0..n {
-        w.qp[i] = w.qbar[i] - eps * x[i];
+        s.qp[i] = q[i] - eps * x[i];
     }
-    chain.residual_parts(t, &w.qp, &w.zero, x, Parts::INERTIA, &mut w.tmp2);
+    chain.residual_parts(t, s.qp, s.zero, x, Parts::INERTIA, s.tmp2);
     for i in 0..n {
-        out[i] += sign * (w.tmp[i] - w.tmp2[i]) / (2.0 * eps);
+        s.out[i] += sign * (s.tmp[i] - s.tmp2[i]) / (2.0 * eps);
     }
-    // − R_in(q, x, 0) = ∂T/∂q − Ṁ(x)x.
-    chain.residual_parts(t, &w.qbar, x, &w.zero, Parts::INERTIA, &mut w.tmp);
+    chain.residual_parts(t, q, x, s.zero, Parts::INERTIA, s.tmp);
     for i in 0..n {
-        out[i] -= sign * w.tmp[i];
+        s.out[i] -= sign * s.tmp[i];
     }
     3
 }
 
-#[derive(Clone, Copy)]
-enum Which {
-    Mean,
-    HalfChange,
+/// ∂T/∂q at (q, x) with T = ½xᵀM(q)x, by the scheme's own evaluation (perturbation
+/// `delta` = ε‖x‖∞). Allocates: for checks, not for step loops.
+pub fn kinetic_gradient(chain: &mut Chain, t: f64, q: &[f64], x: &[f64], delta: f64) -> Vec<f64> {
+    let n = q.len();
+    let zero = vec![0.0; n];
+    let (mut qp, mut tmp, mut tmp2, mut out) =
+        (zero.clone(), zero.clone(), zero.clone(), zero.clone());
+    let s = Scratch {
+        out: &mut out,
+        zero: &zero,
+        qp: &mut qp,
+        tmp: &mut tmp,
+        tmp2: &mut tmp2,
+    };
+    add_kinetic_gradient(chain, t, q, x, delta, 1.0, s);
+    out
+}
+
+/// The mass product M(q)x = R_in(q, 0, x). Allocates: for checks, not for step loops.
+pub fn mass_product(chain: &mut Chain, t: f64, q: &[f64], x: &[f64]) -> Vec<f64> {
+    let n = q.len();
+    let zero = vec![0.0; n];
+    let mut out = zero.clone();
+    chain.residual_parts(t, q, &zero, x, Parts::INERTIA, &mut out);
+    out
 }
 
 impl Integrator {
@@ -280,19 +305,18 @@ impl Integrator {
                 &mut w.minus_q,
             );
             passes += 4;
-            let mut grad_g = std::mem::take(&mut w.grad_g);
-            grad_g.iter_mut().for_each(|x| *x = 0.0);
-            passes += add_dtdq(&mut self.chain, w, t_mid, Which::Mean, delta, 1.0, &mut grad_g);
-            passes += add_dtdq(
-                &mut self.chain,
-                w,
-                t_mid,
-                Which::HalfChange,
-                delta,
-                -1.0,
-                &mut grad_g,
-            );
-            w.grad_g = grad_g;
+            // ∇g(q̄) = ∂T/∂q(q̄, v̄) − ∂T/∂q(q̄, ½Δv).
+            w.grad_g.iter_mut().for_each(|x| *x = 0.0);
+            for (x, sign) in [(&w.vbar, 1.0), (&w.half_dv, -1.0)] {
+                let s = Scratch {
+                    out: &mut w.grad_g,
+                    zero: &w.zero,
+                    qp: &mut w.qp,
+                    tmp: &mut w.tmp,
+                    tmp2: &mut w.tmp2,
+                };
+                passes += add_kinetic_gradient(&mut self.chain, t_mid, &w.qbar, x, delta, sign, s);
+            }
             // Metric W = M(q̄).
             self.chain
                 .residual_parts(t_mid, &w.qbar, &w.zero, &w.dq, Parts::INERTIA, &mut w.w_dq);
@@ -356,9 +380,7 @@ impl Integrator {
             let defect = (h * dot(&w.vbar, &w.res)).abs();
             let e_scale = scale0 + scale1 + dot(&w.minus_q, &w.dq).abs();
             if dq <= tol
-                && (defect <= ENERGY_TOL * e_scale
-                    || dq <= 1e-4 * tol
-                    || it + 1 == MAX_ITERATIONS)
+                && (defect <= ENERGY_TOL * e_scale || dq <= 1e-4 * tol || it + 1 == MAX_ITERATIONS)
             {
                 converged = true;
                 break;

@@ -80,7 +80,11 @@ pub fn default_method(scene: &Scene) -> Method {
 /// The energy-midpoint scheme needs every joint free: a prescribed joint would need the work
 /// of its actuator booked with the scheme's quadrature, which is not implemented.
 fn check_midpoint(scene: &Scene) -> Result<(), FemError> {
-    if let Some(i) = scene.links.iter().position(|l| l.joint.prescribed.is_some()) {
+    if let Some(i) = scene
+        .links
+        .iter()
+        .position(|l| l.joint.prescribed.is_some())
+    {
         return Err(FemError::unsupported(format!(
             "fem energy-midpoint: prescribed joint motion (link {}); use generalized-alpha",
             i + 1
