@@ -63,7 +63,7 @@ fn dyn_midpoint_is_the_default_for_free_chains_only() {
 fn dyn_midpoint_ledger_closes_with_a_heavy_tip_mass() {
     // single-link with 100× the tip mass (50 kg on a 1 kg link): M(q) varies strongly with the
     // deflection; generalized-α at the default step closes only to 7.7e-2 here. Measured with
-    // energy-midpoint at default settings: 1.6e-12.
+    // energy-midpoint at default settings: 4.0e-12.
     let mut sc = data::load_scene("single-link").unwrap();
     let m = sc.links[0].tip_mass.unwrap();
     sc.links[0].tip_mass = Some(100.0 * m);
