@@ -1,5 +1,6 @@
-//! Criterion benches: assembly (residual + Newton matrix), one generalized-α step, and the full
-//! 20 s spin-up, for 4–64 elements.
+//! Criterion benches: assembly (residual + Newton matrix), one generalized-α step, the full
+//! 20 s spin-up for 4–64 elements, and the full 3 s `single-link` run at default settings with
+//! energy-midpoint (the default there) and generalized-α.
 //! Run: `CARGO_TARGET_DIR=/work/targets/fem cargo bench -p fem --bench fem_bench -- --quick`
 
 use std::hint::black_box;
@@ -73,5 +74,19 @@ fn spin_up(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, assembly, one_step, spin_up);
+fn single_link(c: &mut Criterion) {
+    let sc = data::load_scene("single-link").unwrap();
+    let mut g = c.benchmark_group("single-link-3s-default");
+    g.sample_size(10);
+    for m in ["energy-midpoint", "generalized-alpha"] {
+        let mut st = Settings::default();
+        st.time.method = Some(m.to_string());
+        g.bench_function(m, |b| {
+            b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, assembly, one_step, spin_up, single_link);
 criterion_main!(benches);

@@ -267,6 +267,42 @@ struct ColumnAt {
     rate_dot: f64,
 }
 
+/// Which force groups [`Chain::residual_parts`] includes. The energy-consistent integrator
+/// needs them apart: the inertial operator alone gives mass products M(q)x = R_in(q, 0, x) and
+/// the velocity terms R_in(q, v, 0) = Ṁv − ∂T/∂q; the conservative group is ∇V; the rest is −Q.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Parts {
+    /// Σ m Jᵀ r̈ (with hub and tip rotary inertias).
+    pub inertia: bool,
+    /// ∂V/∂q: strain, joint springs, gravity.
+    pub conservative: bool,
+    /// −Q: applied joint torques and loads, joint dampers, Kelvin–Voigt.
+    pub nonconservative: bool,
+}
+
+impl Parts {
+    pub const ALL: Parts = Parts {
+        inertia: true,
+        conservative: true,
+        nonconservative: true,
+    };
+    pub const INERTIA: Parts = Parts {
+        inertia: true,
+        conservative: false,
+        nonconservative: false,
+    };
+    pub const CONSERVATIVE: Parts = Parts {
+        inertia: false,
+        conservative: true,
+        nonconservative: false,
+    };
+    pub const NONCONSERVATIVE: Parts = Parts {
+        inertia: false,
+        conservative: false,
+        nonconservative: true,
+    };
+}
+
 /// What the Newton matrix is a derivative of: S = ∂R/∂q̈ + c_v ∂R/∂q̇ + c_q ∂R/∂q.
 #[derive(Debug, Clone, Copy)]
 pub struct NewtonCoefficients {
@@ -434,8 +470,13 @@ impl Chain {
     }
 
     /// Forward pass: frame and tip kinematics of every link (no forces).
-    fn forward(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], with_points: bool) {
-        let g_in = self.gravity;
+    fn forward(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], parts: Parts) {
+        let g_in = if parts.conservative {
+            self.gravity
+        } else {
+            [0.0; 2]
+        };
+        let inertia = if parts.inertia { 1.0 } else { 0.0 };
         let mut parent: Option<FrameState> = None;
         for li in 0..self.links.len() {
             let l = &self.links[li];
@@ -499,7 +540,7 @@ impl Chain {
                             sdd -= wgt * (vpd * vpd + vp * vpdd);
                         }
                     }
-                    if j == NG || !with_points {
+                    if j == NG {
                         continue;
                     }
                     let g = j;
@@ -526,13 +567,15 @@ impl Chain {
                     let m = l.rho_a * tb.wh[g];
                     // Applied uniform transverse load on the last link (frame y), as a density
                     // with the d'Alembert sign: Gauss-4 gives its consistent nodal loads exactly.
-                    let q_load = if li + 1 == self.links.len() {
+                    let q_load = if li + 1 == self.links.len() && parts.nonconservative {
                         self.distributed_load
                     } else {
                         0.0
                     };
-                    self.force[li][e * NG + g] =
-                        sub(scale(m, sub(a, g_loc)), [0.0, q_load * tb.wh[g]]);
+                    self.force[li][e * NG + g] = sub(
+                        scale(m, sub(scale(inertia, a), g_loc)),
+                        [0.0, q_load * tb.wh[g]],
+                    );
                     self.pos[li][e * NG + g] = p;
                     self.vel[li][e * NG + g] = pd;
                 }
@@ -570,9 +613,30 @@ impl Chain {
     /// Residual R(q, q̇, q̈) of the equations of motion at time t (see module docs), written
     /// into `res`; also fills the joint torques.
     pub fn residual(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], res: &mut [f64]) {
+        self.residual_parts(t, q, qd, qdd, Parts::ALL, res);
+    }
+
+    /// The force groups `parts` of the residual (see [`Parts`]); the sum over all groups is
+    /// [`Chain::residual`]. Only the full residual updates [`Chain::joint_torque`]; the Newton
+    /// matrix reads the point data of the last call, which must therefore be a full residual.
+    pub fn residual_parts(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        parts: Parts,
+        res: &mut [f64],
+    ) {
         res.iter_mut().for_each(|x| *x = 0.0);
-        self.forward(t, q, qd, qdd, true);
-        let g_in = self.gravity;
+        self.forward(t, q, qd, qdd, parts);
+        let g_in = if parts.conservative {
+            self.gravity
+        } else {
+            [0.0; 2]
+        };
+        let inertia = if parts.inertia { 1.0 } else { 0.0 };
+        let (cons, noncons) = (parts.conservative, parts.nonconservative);
         let nl = self.links.len();
         // Child loads passed to the parent: resultant (inertial) and moment about the child root.
         let mut child_f = [0.0; 2];
@@ -584,11 +648,15 @@ impl Chain {
             let g_loc = rot_t(fr.phi, g_in);
             let k = l.n_el;
             // Tip body and child loads (frame coordinates).
-            let f_tipmass = scale(l.tip_mass, sub(fr.a_tip, g_loc));
+            let f_tipmass = scale(l.tip_mass, sub(scale(inertia, fr.a_tip), g_loc));
             // An applied tip force enters with the d'Alembert sign (R collects −Q).
-            let p_tip = if li + 1 == nl { self.tip_load } else { 0.0 };
+            let p_tip = if li + 1 == nl && noncons {
+                self.tip_load
+            } else {
+                0.0
+            };
             let f_tip = sub(add(f_tipmass, rot_t(fr.phi, child_f)), [0.0, p_tip]);
-            let m_tip = l.tip_inertia * (fr.ddphi + fr.ddslope_tip) + child_m;
+            let m_tip = inertia * l.tip_inertia * (fr.ddphi + fr.ddslope_tip) + child_m;
             let mut add_res = |i: usize, v: f64| {
                 if i != NONE {
                     res[i] += v;
@@ -638,7 +706,7 @@ impl Chain {
                     }
                 }
                 // Elastic forces.
-                if l.axial {
+                if cons && l.axial {
                     let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
                     let fv = eb::von_karman_force(
                         l.ea,
@@ -651,12 +719,12 @@ impl Chain {
                     for a in 0..4 {
                         fe[a] += fv[2 + a];
                     }
-                } else {
+                } else if cons {
                     for a in 0..4 {
                         fe[a] += dot4(&l.k_el[a], &d);
                     }
                 }
-                if l.kelvin_voigt > 0.0 {
+                if l.kelvin_voigt > 0.0 && noncons {
                     let dd = Self::elem_v(qd, &dofs);
                     let c = l.kelvin_voigt / l.ei;
                     for a in 0..4 {
@@ -679,7 +747,8 @@ impl Chain {
             }
             // Subtree resultant and moment about this link's root Rᵢ.
             let f_total_loc = add(f_sum, f_tip);
-            let moment = m_sum + cross(fr.p_tip, f_tip) + m_tip + l.hub_inertia * fr.ddphi;
+            let moment =
+                m_sum + cross(fr.p_tip, f_tip) + m_tip + inertia * l.hub_inertia * fr.ddphi;
             let fr_mut = &mut self.frames[li];
             fr_mut.subtree_moment = moment;
             fr_mut.subtree_force = rot(fr.phi, f_total_loc);
@@ -687,13 +756,25 @@ impl Chain {
             child_m = moment;
             // Joint equation: moment + spring + damper − applied = actuator torque.
             let j = &l.joint;
-            let spring_damper = j.stiffness * (fr.theta - j.set_point) + j.damping * fr.dtheta;
-            let law = j.applied(t);
-            if j.dof != NONE {
-                res[j.dof] += moment + spring_damper - law;
-                self.joint_torque[li] = law;
+            let spring = if cons {
+                j.stiffness * (fr.theta - j.set_point)
             } else {
-                self.joint_torque[li] = moment + spring_damper - law;
+                0.0
+            };
+            let (damper, law) = if noncons {
+                (j.damping * fr.dtheta, j.applied(t))
+            } else {
+                (0.0, 0.0)
+            };
+            if j.dof != NONE {
+                res[j.dof] += moment + spring + damper - law;
+            }
+            if parts == Parts::ALL {
+                self.joint_torque[li] = if j.dof != NONE {
+                    law
+                } else {
+                    moment + spring + damper - law
+                };
             }
         }
     }

@@ -16,12 +16,16 @@
 //!   step is constant: each stretch between stop times is split into equal steps ≤ dt (a
 //!   periodic short step near the bound makes the composed map unstable).
 //!
+//! * Energy-consistent midpoint (`energy-midpoint`, the default for free-joint chains): see
+//!   [`crate::midpoint`]; it shares the Newton-matrix machinery, the stops and the step control.
+//!
 //! The stepper stops exactly on requested times (outputs, torque-law breakpoints, t_end) so that
 //! discontinuities — and later contact events — are never stepped over.
 
 use crate::band::{BorderedBand, DenseLu};
 use crate::chain::{Chain, NONE, NewtonCoefficients};
 use crate::error::FemError;
+use crate::midpoint::MidpointWork;
 use crate::settings::Method;
 
 /// How the Newton matrix is formed.
@@ -108,41 +112,43 @@ pub struct Integrator {
     pub q: Vec<f64>,
     pub qd: Vec<f64>,
     pub qdd: Vec<f64>,
-    a: Vec<f64>,
-    q1: Vec<f64>,
-    qd1: Vec<f64>,
-    qdd1: Vec<f64>,
-    a1: Vec<f64>,
-    res: Vec<f64>,
-    delta: Vec<f64>,
-    qd_mid: Vec<f64>,
+    pub(crate) a: Vec<f64>,
+    pub(crate) q1: Vec<f64>,
+    pub(crate) qd1: Vec<f64>,
+    pub(crate) qdd1: Vec<f64>,
+    pub(crate) a1: Vec<f64>,
+    pub(crate) res: Vec<f64>,
+    pub(crate) delta: Vec<f64>,
+    pub(crate) qd_mid: Vec<f64>,
     pub matrix: BorderedBand,
     pub jacobian: JacobianKind,
-    dense: Option<DenseLu>,
+    pub(crate) dense: Option<DenseLu>,
     /// Step size the current Newton matrix was formed with, and whether it must be refreshed.
-    matrix_h: f64,
-    slow_convergence: bool,
-    fd_q: Vec<f64>,
-    fd_qd: Vec<f64>,
-    fd_qdd: Vec<f64>,
-    fd_res: Vec<f64>,
+    pub(crate) matrix_h: f64,
+    pub(crate) slow_convergence: bool,
+    pub(crate) fd_q: Vec<f64>,
+    pub(crate) fd_qd: Vec<f64>,
+    pub(crate) fd_qdd: Vec<f64>,
+    pub(crate) fd_res: Vec<f64>,
     params: AlphaParams,
     pub adaptive: Option<Adaptive>,
     /// Times the stepper must land on and restart from (torque-law discontinuities).
-    breakpoints: Vec<f64>,
-    next_break: usize,
-    stop: f64,
+    pub(crate) breakpoints: Vec<f64>,
+    pub(crate) next_break: usize,
+    pub(crate) stop: f64,
     /// Newton displacement tolerance.
-    newton_tol: f64,
+    pub(crate) newton_tol: f64,
     pub counters: Counters,
     pub works: Works,
     /// Joint torques at the start of the current step (law and required).
-    torque_law_start: Vec<f64>,
-    torque_req_start: Vec<f64>,
-    theta_start: Vec<f64>,
-    rate_start: Vec<f64>,
+    pub(crate) torque_law_start: Vec<f64>,
+    pub(crate) torque_req_start: Vec<f64>,
+    pub(crate) theta_start: Vec<f64>,
+    pub(crate) rate_start: Vec<f64>,
     /// Largest link length (scales Newton and error tolerances).
     pub length_scale: f64,
+    /// Work buffers of the energy-consistent midpoint scheme (allocated only for that method).
+    pub midpoint: Option<Box<MidpointWork>>,
 }
 
 impl Integrator {
@@ -207,7 +213,11 @@ impl Integrator {
             theta_start: vec![0.0; nl],
             rate_start: vec![0.0; nl],
             length_scale,
+            midpoint: None,
         };
+        if method == Method::EnergyMidpoint {
+            it.midpoint = Some(Box::new(MidpointWork::new(n)));
+        }
         it.jacobian = jacobian;
         if jacobian == JacobianKind::DenseFiniteDifference {
             it.dense = Some(DenseLu::new(n));
@@ -324,6 +334,7 @@ impl Integrator {
         let result = match self.method {
             Method::GeneralizedAlpha => self.alpha_step(h, t1, t_law),
             Method::CentralDifference => self.central_step(h, t1, t_law),
+            Method::EnergyMidpoint => self.midpoint_step(h, t1, t_law),
         };
         match result {
             Ok(Some(err)) if self.adaptive.is_none() && err.is_infinite() => {
@@ -364,6 +375,9 @@ impl Integrator {
                 if on_break {
                     // Restart from the discontinuity with the new law value.
                     self.initial_acceleration(self.t)?;
+                    if let Some(w) = self.midpoint.as_mut() {
+                        w.restart();
+                    }
                 }
             }
             Err(e) => return Err(e),
@@ -419,6 +433,12 @@ impl Integrator {
 
     /// Commits q1, q̇1, q̈1 and updates the work integrals.
     fn accept(&mut self, h: f64, t1: f64, t_law: f64) {
+        if let Some(w) = self.midpoint.as_mut() {
+            // The midpoint scheme books its works with its own quadrature (see `midpoint`).
+            w.commit(h, &mut self.works);
+            self.finish_accept(t1, t_law);
+            return;
+        }
         let nl = self.chain.links.len();
         // Midpoint velocity: ½(F_n + F_{n+1})·Δq for linear dampers under the trapezoidal rule.
         for i in 0..self.qd.len() {
@@ -439,6 +459,11 @@ impl Integrator {
                 self.works.prescribed_motion += 0.5 * (self.torque_req_start[li] + req1) * dth;
             }
         }
+        self.finish_accept(t1, t_law);
+    }
+
+    /// Swaps the new state in and starts the next step's work records.
+    fn finish_accept(&mut self, t1: f64, t_law: f64) {
         std::mem::swap(&mut self.q, &mut self.q1);
         std::mem::swap(&mut self.qd, &mut self.qd1);
         std::mem::swap(&mut self.qdd, &mut self.qdd1);
@@ -592,7 +617,12 @@ impl Integrator {
     }
 
     /// Forms and factorizes the Newton matrix at (q1, q̇1, q̈1) after a residual evaluation there.
-    fn form_matrix(&mut self, c: NewtonCoefficients, t_law: f64, t: f64) -> Result<(), FemError> {
+    pub(crate) fn form_matrix(
+        &mut self,
+        c: NewtonCoefficients,
+        t_law: f64,
+        t: f64,
+    ) -> Result<(), FemError> {
         self.counters.jacobians += 1;
         self.counters.factorizations += 1;
         match self.jacobian {
@@ -643,7 +673,7 @@ impl Integrator {
         }
     }
 
-    fn solve_matrix(&mut self) {
+    pub(crate) fn solve_matrix(&mut self) {
         match (&self.jacobian, &self.dense) {
             (JacobianKind::DenseFiniteDifference, Some(d)) => d.solve_in_place(&mut self.delta),
             _ => self.matrix.solve_in_place(&mut self.delta),

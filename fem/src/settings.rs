@@ -8,10 +8,13 @@ pub const DEFAULT_ELEMENTS: usize = 16;
 pub const MAX_ELEMENTS: usize = 20_000;
 
 /// Time-integration method names accepted in `time.method`.
-pub const METHODS: [&str; 2] = ["generalized-alpha", "central-difference"];
+pub const METHODS: [&str; 3] = ["energy-midpoint", "generalized-alpha", "central-difference"];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
+    /// Energy-consistent implicit midpoint (discrete-gradient) scheme for free-joint chains:
+    /// the ledger closes to the Newton tolerance (see [`crate::midpoint`]).
+    EnergyMidpoint,
     /// Implicit generalized-α (Chung–Hulbert, Arnold–Brüls form) with Newton iterations.
     GeneralizedAlpha,
     /// Explicit central difference (velocity-Verlet form) under its stability bound.
@@ -29,9 +32,12 @@ pub fn elements(disc: &data::Discretization) -> Result<usize, FemError> {
     Ok(n)
 }
 
-pub fn method(time: &data::TimeStepping) -> Result<Method, FemError> {
+/// The method named in `time.method`, or `default` when none is given.
+pub fn method(time: &data::TimeStepping, default: Method) -> Result<Method, FemError> {
     match time.method.as_deref() {
-        None | Some("generalized-alpha") => Ok(Method::GeneralizedAlpha),
+        None => Ok(default),
+        Some("energy-midpoint") => Ok(Method::EnergyMidpoint),
+        Some("generalized-alpha") => Ok(Method::GeneralizedAlpha),
         Some("central-difference") => Ok(Method::CentralDifference),
         Some(other) => Err(FemError::InvalidSettings {
             field: "time.method".into(),

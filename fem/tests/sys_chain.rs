@@ -157,3 +157,103 @@ fn sys_newton_matrix_is_the_residual_derivative() {
         );
     }
 }
+
+#[test]
+fn sys_mass_product_and_kinetic_gradient_match_the_reported_kinetic_energy() {
+    // The energy-midpoint ingredients against finite differences of `energies()`' kinetic term
+    // T(q, x) = ½xᵀM(q)x: M(q)x = ∂T/∂x (T is quadratic in x: central differences are exact up
+    // to round-off), ½xᵀM(q)x = T, and ∂T/∂q from Ṁ(x)x − R_in(q, x, 0).
+    for (name, fs) in [
+        ("single-link", false),
+        ("single-link", true),
+        ("two-link-free-undamped", true),
+    ] {
+        let (mut ch, q, x, _) = setup(name, 3, fs);
+        let n = ch.ndof;
+        let t = 0.3;
+        let mx = fem::midpoint::mass_product(&mut ch, t, &q, &x);
+        let dtdq = fem::midpoint::kinetic_gradient(&mut ch, t, &q, &x, fem::midpoint::FD_STEP);
+        let kinetic = |q: &[f64], x: &[f64]| ch.energies(t, q, x)[0];
+        let t0 = kinetic(&q, &x);
+        let half_xmx = 0.5 * x.iter().zip(&mx).map(|(a, b)| a * b).sum::<f64>();
+        assert!(
+            (half_xmx - t0).abs() <= 1e-13 * t0,
+            "{name}: ½xᵀMx {half_xmx} vs T {t0}"
+        );
+        let (mscale, gscale) = (
+            mx.iter().fold(0.0f64, |a, b| a.max(b.abs())),
+            dtdq.iter().fold(0.0f64, |a, b| a.max(b.abs())),
+        );
+        let e = 1e-4;
+        let (mut worst_m, mut worst_g) = (0.0f64, 0.0f64);
+        for i in 0..n {
+            let (mut a, mut b) = (x.clone(), x.clone());
+            a[i] += e;
+            b[i] -= e;
+            let fd = (kinetic(&q, &a) - kinetic(&q, &b)) / (2.0 * e);
+            worst_m = worst_m.max((fd - mx[i]).abs() / mscale);
+            // ∂T/∂q: fourth-order central difference (the error of the check stays below the
+            // tolerance; the scheme's own ε = 1e-5 difference is accurate to ~1e-10).
+            let h = 1e-3;
+            let tq = |s: f64| {
+                let mut p = q.clone();
+                p[i] += s * h;
+                kinetic(&p, &x)
+            };
+            let fd = (8.0 * (tq(1.0) - tq(-1.0)) - (tq(2.0) - tq(-2.0))) / (12.0 * h);
+            worst_g = worst_g.max((fd - dtdq[i]).abs() / gscale);
+        }
+        eprintln!("{name} (fs {fs}): M x error {worst_m:.2e}, ∂T/∂q error {worst_g:.2e}");
+        assert!(worst_m < 1e-9, "{name}: M x error {worst_m}");
+        assert!(worst_g < 1e-7, "{name}: ∂T/∂q error {worst_g}");
+    }
+}
+
+#[test]
+fn sys_residual_parts_sum_to_the_residual_and_conservative_part_is_grad_v() {
+    use fem::chain::Parts;
+    for (name, fs) in [("single-link", true), ("two-link-free", true)] {
+        let (mut ch, q, qd, qdd) = setup(name, 3, fs);
+        let n = ch.ndof;
+        let t = 0.7;
+        let mut full = vec![0.0; n];
+        ch.residual(t, &q, &qd, &qdd, &mut full);
+        let mut sum = vec![0.0; n];
+        let mut part = vec![0.0; n];
+        for p in [Parts::INERTIA, Parts::CONSERVATIVE, Parts::NONCONSERVATIVE] {
+            ch.residual_parts(t, &q, &qd, &qdd, p, &mut part);
+            for i in 0..n {
+                sum[i] += part[i];
+            }
+        }
+        let scale = full.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        for i in 0..n {
+            assert!(
+                (sum[i] - full[i]).abs() <= 1e-12 * scale,
+                "{name}: dof {i}: {} vs {}",
+                sum[i],
+                full[i]
+            );
+        }
+        let zero = vec![0.0; n];
+        let mut grad = vec![0.0; n];
+        ch.residual_parts(t, &q, &zero, &zero, Parts::CONSERVATIVE, &mut grad);
+        let potential = |q: &[f64]| {
+            let e = ch.energies(t, q, &zero);
+            e[1] + e[2] + e[3]
+        };
+        let gscale = grad.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let h = 1e-5;
+        for i in 0..n {
+            let (mut a, mut b) = (q.clone(), q.clone());
+            a[i] += h;
+            b[i] -= h;
+            let fd = (potential(&a) - potential(&b)) / (2.0 * h);
+            assert!(
+                (fd - grad[i]).abs() <= 1e-6 * gscale,
+                "{name}: ∂V/∂q[{i}] {} vs {fd}",
+                grad[i]
+            );
+        }
+    }
+}

@@ -1,0 +1,455 @@
+//! Energy-consistent midpoint scheme (`energy-midpoint`) for chains whose joints are all free.
+//!
+//! State (q, v), energy E(q, v) = ½vᵀM(q)v + V(q) with V = strain + joint springs + gravity, and
+//! non-conservative generalized forces Q(t, q, v) (applied joint torques and loads, joint
+//! dampers, Kelvin–Voigt). One step t₀ → t₁ = t₀ + h solves, for v₁,
+//!
+//!   q₁ − q₀ = h v̄,   v̄ = ½(v₀ + v₁),
+//!   M(q₁)v₁ − M(q₀)v₀ = −h ∇̄Φ + h Q(t₀ + h/2, q̄, v̄),   q̄ = ½(q₀ + q₁),
+//!
+//! with Φ(q) = V(q) − g(q), g(q) = ½v₀ᵀM(q)v₁ (v₀, v₁ frozen) and ∇̄ the Gonzalez discrete
+//! gradient in the metric W = M(q̄):
+//!
+//!   ∇̄Φ = ∇Φ(q̄) + [(Φ(q₁) − Φ(q₀) − ∇Φ(q̄)·Δq) / (ΔqᵀWΔq)] WΔq   (no correction if Δq = 0).
+//!
+//! Energy identity: with p = M(q)v, v̄ᵀ(p₁ − p₀) = ΔT + Δg (M symmetric), and Δqᵀ∇̄Φ = ΔΦ exactly,
+//! so v̄ᵀ(momentum equation) gives E₁ − E₀ = Δqᵀ Q(t_mid, q̄, v̄) exactly — to the Newton
+//! tolerance and round-off. The backend books the works with that same midpoint quadrature
+//! (applied torque τ(t_mid)Δθ, joint damper D θ̄̇Δθ, Kelvin–Voigt h v̄ᵀC v̄, applied loads
+//! Q_load(q̄)·Δq), so the ledger closes by construction. The scheme is symmetric and second
+//! order: ∇g(q) = ½∇(v₀ᵀMv₁) approximates ∂T/∂q|_v̄, i.e. it discretizes Lagrange's equations.
+//!
+//! Ingredients, each one O(n) pass of [`Chain::residual_parts`]:
+//! * M(q)x = R_in(q, 0, x) (inertial part only, exact: R is affine in q̈);
+//! * ∂T/∂q(q, x) = Ṁ(x)x − R_in(q, x, 0), since R_in(q, x, 0) = Ṁ(x)x − ∂T/∂q, with the
+//!   directional derivative Ṁ(x)x = [M(q + εx)x − M(q − εx)x]/(2ε), ε‖x‖∞ = 10⁻⁵·max(L, 1)
+//!   (central difference: truncation ~10⁻¹⁰, round-off ~10⁻¹¹ relative). Only ∇Φ(q̄) uses it; the
+//!   Gonzalez correction is built from exact values Φ(q₀), Φ(q₁), so this error affects the
+//!   trajectory at that level but never the energy balance;
+//! * ∇g(q̄) = ∂T/∂q(q̄, a) − ∂T/∂q(q̄, b), a = v̄, b = ½(v₁ − v₀) (polarization);
+//! * ∇V(q̄) = conservative part; Q = −(non-conservative part); V(q₁) from [`Chain::energies`].
+//!
+//! Newton on the mean acceleration a = (v₁ − v₀)/h with the generalized-α matrix machinery at
+//! (q̄, v̄, a): S = M + (h/2)C + (h²/4)K (∂q̄/∂a = h²/4, ∂v̄/∂a = h/2), analytic bordered-band or
+//! the exact finite-difference dense matrix for free chains with foreshortening (reused across
+//! steps while Newton converges in ≤ 8 iterations: S is the derivative of R(q̄, v̄, a), not of
+//! the discrete equations, so convergence is linear — about 1e-2..1e-3 per iteration — and
+//! re-forming the dense matrix after every slow step cost 1.5× more, measured on
+//! `two-link-free-undamped`). The correction term is not differentiated (quasi-Newton). The iterate is accepted at the point where the residual was evaluated, so the
+//! booked energies and works are those of the equations actually solved.
+//!
+//! Adaptive steps (`rtol`): local error estimate e = (h²/12)(ā_k − ā_{k−1})·2h_k/(h_k + h_{k−1})
+//! (third-derivative term of the trapezoidal/midpoint family, from successive mean
+//! accelerations), step ratio 0.9·err^(−1/3) as for generalized-α.
+
+use crate::chain::{Chain, NONE, NewtonCoefficients, Parts};
+use crate::error::FemError;
+use crate::integrator::{Integrator, JacobianKind, Works};
+
+/// Relative size of the finite-difference perturbation of q for Ṁ(x)x.
+pub const FD_STEP: f64 = 1e-5;
+/// Newton iterations at most before the step is retried shorter.
+const MAX_ITERATIONS: usize = 30;
+/// Energy defect h v̄ᵀ(residual) accepted per step, relative to the step's energy scale
+/// (kinetic + |potential parts| at both ends + |work of the step|). Where round-off (of the
+/// momentum difference and of the finite-difference Ṁ terms) keeps the defect above this, the
+/// iteration stops once the defect no longer falls (measured floor ≈ 1e-13 on `single-link`).
+const ENERGY_TOL: f64 = 1e-14;
+
+/// Work buffers of the midpoint step (allocated once per run).
+#[derive(Debug, Clone)]
+pub struct MidpointWork {
+    /// p₀ = M(q₀)v₀.
+    p0: Vec<f64>,
+    qbar: Vec<f64>,
+    vbar: Vec<f64>,
+    /// b = ½(v₁ − v₀).
+    half_dv: Vec<f64>,
+    dq: Vec<f64>,
+    /// M(q₁)v₁.
+    mv1: Vec<f64>,
+    /// ∇V(q̄).
+    grad_v: Vec<f64>,
+    /// Non-conservative part of R at (q̄, v̄): −Q.
+    minus_q: Vec<f64>,
+    /// ∇g(q̄).
+    grad_g: Vec<f64>,
+    /// W Δq = M(q̄)Δq.
+    w_dq: Vec<f64>,
+    /// Residual of the momentum equation divided by h.
+    res: Vec<f64>,
+    zero: Vec<f64>,
+    qp: Vec<f64>,
+    tmp: Vec<f64>,
+    tmp2: Vec<f64>,
+    /// Whether the previous step's mean acceleration is in `Integrator::qdd` (else it holds
+    /// the point acceleration of a (re)start), and that step's length.
+    have_prev: bool,
+    h_prev: f64,
+    /// Works of the step being taken, added to the ledger on acceptance.
+    pending: Works,
+    /// Last Gonzalez correction factor relative to the midpoint-gradient work (diagnostic).
+    pub last_correction: f64,
+}
+
+impl MidpointWork {
+    pub fn new(n: usize) -> Self {
+        let z = vec![0.0; n];
+        MidpointWork {
+            p0: z.clone(),
+            qbar: z.clone(),
+            vbar: z.clone(),
+            half_dv: z.clone(),
+            dq: z.clone(),
+            mv1: z.clone(),
+            grad_v: z.clone(),
+            minus_q: z.clone(),
+            grad_g: z.clone(),
+            w_dq: z.clone(),
+            res: z.clone(),
+            zero: z.clone(),
+            qp: z.clone(),
+            tmp: z.clone(),
+            tmp2: z,
+            have_prev: false,
+            h_prev: 0.0,
+            pending: Works::default(),
+            last_correction: 0.0,
+        }
+    }
+
+    /// Forget the previous step (restart at a torque-law discontinuity).
+    pub fn restart(&mut self) {
+        self.have_prev = false;
+        self.h_prev = 0.0;
+    }
+
+    /// Adds the accepted step's works to the ledger integrals.
+    pub fn commit(&mut self, h: f64, works: &mut Works) {
+        let p = self.pending;
+        works.applied_torque += p.applied_torque;
+        works.applied_load += p.applied_load;
+        works.joint_damper += p.joint_damper;
+        works.kelvin_voigt += p.kelvin_voigt;
+        self.have_prev = true;
+        self.h_prev = h;
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn max_abs(a: &[f64]) -> f64 {
+    a.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// Scratch vectors and the output of [`add_kinetic_gradient`].
+struct Scratch<'a> {
+    out: &'a mut [f64],
+    zero: &'a [f64],
+    qp: &'a mut [f64],
+    tmp: &'a mut [f64],
+    tmp2: &'a mut [f64],
+}
+
+/// Adds `sign`·∂T/∂q(q, x) to `out` (3 inertial passes; 0 if x = 0): the central difference
+/// Ṁ(x)x = [M(q + εx)x − M(q − εx)x]/(2ε) with ε‖x‖∞ = `delta`, minus R_in(q, x, 0).
+fn add_kinetic_gradient(
+    chain: &mut Chain,
+    t: f64,
+    q: &[f64],
+    x: &[f64],
+    delta: f64,
+    sign: f64,
+    s: Scratch<'_>,
+) -> usize {
+    let xmax = max_abs(x);
+    if xmax == 0.0 {
+        return 0;
+    }
+    let eps = delta / xmax;
+    let n = q.len();
+    for i in 0..n {
+        s.qp[i] = q[i] + eps * x[i];
+    }
+    chain.residual_parts(t, s.qp, s.zero, x, Parts::INERTIA, s.tmp);
+    for i in 0..n {
+        s.qp[i] = q[i] - eps * x[i];
+    }
+    chain.residual_parts(t, s.qp, s.zero, x, Parts::INERTIA, s.tmp2);
+    for i in 0..n {
+        s.out[i] += sign * (s.tmp[i] - s.tmp2[i]) / (2.0 * eps);
+    }
+    chain.residual_parts(t, q, x, s.zero, Parts::INERTIA, s.tmp);
+    for i in 0..n {
+        s.out[i] -= sign * s.tmp[i];
+    }
+    3
+}
+
+/// ∂T/∂q at (q, x) with T = ½xᵀM(q)x, by the scheme's own evaluation (perturbation
+/// `delta` = ε‖x‖∞). Allocates: for checks, not for step loops.
+pub fn kinetic_gradient(chain: &mut Chain, t: f64, q: &[f64], x: &[f64], delta: f64) -> Vec<f64> {
+    let n = q.len();
+    let zero = vec![0.0; n];
+    let (mut qp, mut tmp, mut tmp2, mut out) =
+        (zero.clone(), zero.clone(), zero.clone(), zero.clone());
+    let s = Scratch {
+        out: &mut out,
+        zero: &zero,
+        qp: &mut qp,
+        tmp: &mut tmp,
+        tmp2: &mut tmp2,
+    };
+    add_kinetic_gradient(chain, t, q, x, delta, 1.0, s);
+    out
+}
+
+/// The mass product M(q)x = R_in(q, 0, x). Allocates: for checks, not for step loops.
+pub fn mass_product(chain: &mut Chain, t: f64, q: &[f64], x: &[f64]) -> Vec<f64> {
+    let n = q.len();
+    let zero = vec![0.0; n];
+    let mut out = zero.clone();
+    chain.residual_parts(t, q, &zero, x, Parts::INERTIA, &mut out);
+    out
+}
+
+impl Integrator {
+    /// One energy-midpoint step; returns the scaled error estimate when adaptive (infinite when
+    /// Newton failed).
+    pub(crate) fn midpoint_step(
+        &mut self,
+        h: f64,
+        t1: f64,
+        t_law: f64,
+    ) -> Result<Option<f64>, FemError> {
+        let Some(mut w) = self.midpoint.take() else {
+            return Err(FemError::Numerical {
+                t: self.t,
+                message: "energy-midpoint work buffers missing".into(),
+            });
+        };
+        let result = self.midpoint_solve(&mut w, h, t1, t_law);
+        self.midpoint = Some(w);
+        result
+    }
+
+    fn midpoint_solve(
+        &mut self,
+        w: &mut MidpointWork,
+        h: f64,
+        t1: f64,
+        t_law: f64,
+    ) -> Result<Option<f64>, FemError> {
+        let n = self.q.len();
+        let t0 = self.t;
+        // Laws are sampled at the midpoint: exact work for piecewise-constant torques, since
+        // steps land on their breakpoints.
+        let t_mid = t0 + 0.5 * h;
+        let delta = FD_STEP * self.length_scale.max(1.0);
+        // Start-of-step momentum and potential.
+        self.chain
+            .residual_parts(t_mid, &self.q, &w.zero, &self.qd, Parts::INERTIA, &mut w.p0);
+        let [k0, s0, sp0, g0] = self.chain.energies(t0, &self.q, &self.qd);
+        let v0_pot = s0 + sp0 + g0;
+        let scale0 = k0.abs() + s0.abs() + sp0.abs() + g0.abs();
+        let mut passes = 2usize;
+        // Predictor: the previous step's mean acceleration; zero after a (re)start, where the
+        // point acceleration of a released pre-loaded spring is a mesh-dependent spike.
+        for i in 0..n {
+            self.qdd1[i] = if w.have_prev { self.qdd[i] } else { 0.0 };
+        }
+        let c = NewtonCoefficients {
+            c_a: 1.0,
+            c_v: 0.5 * h,
+            c_q: 0.25 * h * h,
+        };
+        let mut converged = false;
+        let mut last = f64::INFINITY;
+        let mut last_defect = f64::INFINITY;
+        let mut iterations = 0;
+        for it in 0..MAX_ITERATIONS {
+            for i in 0..n {
+                let a = self.qdd1[i];
+                w.vbar[i] = self.qd[i] + 0.5 * h * a;
+                w.half_dv[i] = 0.5 * h * a;
+                w.dq[i] = h * w.vbar[i];
+                w.qbar[i] = self.q[i] + 0.5 * w.dq[i];
+                self.q1[i] = self.q[i] + w.dq[i];
+                self.qd1[i] = self.qd[i] + h * a;
+            }
+            // Momentum and potential at the end point.
+            self.chain.residual_parts(
+                t_mid,
+                &self.q1,
+                &w.zero,
+                &self.qd1,
+                Parts::INERTIA,
+                &mut w.mv1,
+            );
+            let [k1, s1, sp1, g1] = self.chain.energies(t1, &self.q1, &self.qd1);
+            let v1_pot = s1 + sp1 + g1;
+            let scale1 = k1.abs() + s1.abs() + sp1.abs() + g1.abs();
+            // Forces at the midpoint.
+            self.chain.residual_parts(
+                t_mid,
+                &w.qbar,
+                &w.zero,
+                &w.zero,
+                Parts::CONSERVATIVE,
+                &mut w.grad_v,
+            );
+            self.chain.residual_parts(
+                t_mid,
+                &w.qbar,
+                &w.vbar,
+                &w.zero,
+                Parts::NONCONSERVATIVE,
+                &mut w.minus_q,
+            );
+            passes += 4;
+            // ∇g(q̄) = ∂T/∂q(q̄, v̄) − ∂T/∂q(q̄, ½Δv).
+            w.grad_g.iter_mut().for_each(|x| *x = 0.0);
+            for (x, sign) in [(&w.vbar, 1.0), (&w.half_dv, -1.0)] {
+                let s = Scratch {
+                    out: &mut w.grad_g,
+                    zero: &w.zero,
+                    qp: &mut w.qp,
+                    tmp: &mut w.tmp,
+                    tmp2: &mut w.tmp2,
+                };
+                passes += add_kinetic_gradient(&mut self.chain, t_mid, &w.qbar, x, delta, sign, s);
+            }
+            // Metric W = M(q̄).
+            self.chain
+                .residual_parts(t_mid, &w.qbar, &w.zero, &w.dq, Parts::INERTIA, &mut w.w_dq);
+            passes += 1;
+            let phi1 = v1_pot - 0.5 * dot(&self.qd, &w.mv1);
+            let phi0 = v0_pot - 0.5 * dot(&w.p0, &self.qd1);
+            let mut grad_dq = 0.0;
+            for i in 0..n {
+                grad_dq += (w.grad_v[i] - w.grad_g[i]) * w.dq[i];
+            }
+            let denom = dot(&w.dq, &w.w_dq);
+            let corr = if denom > 0.0 {
+                (phi1 - phi0 - grad_dq) / denom
+            } else {
+                0.0
+            };
+            w.last_correction = if grad_dq != 0.0 {
+                (phi1 - phi0 - grad_dq) / grad_dq
+            } else {
+                0.0
+            };
+            for i in 0..n {
+                w.res[i] = (w.mv1[i] - w.p0[i]) / h + w.grad_v[i] - w.grad_g[i]
+                    + corr * w.w_dq[i]
+                    + w.minus_q[i];
+            }
+            self.counters.newton += 1;
+            // Newton matrix at (q̄, v̄, a): a full residual there fills the chain's point data.
+            let fresh = self.jacobian == JacobianKind::Banded
+                || self.matrix_h != h
+                || self.slow_convergence;
+            if (it == 0 && fresh) || it == 6 || it == 12 || it == 18 {
+                self.q1.copy_from_slice(&w.qbar);
+                self.qd1.copy_from_slice(&w.vbar);
+                self.chain
+                    .residual(t_mid, &self.q1, &self.qd1, &self.qdd1, &mut self.res);
+                passes += 1;
+                self.form_matrix(c, t_mid, t1)?;
+                self.matrix_h = h;
+                self.slow_convergence = false;
+                for i in 0..n {
+                    self.q1[i] = self.q[i] + w.dq[i];
+                    self.qd1[i] = self.qd[i] + h * self.qdd1[i];
+                }
+            }
+            self.delta.copy_from_slice(&w.res);
+            self.solve_matrix();
+            let big = max_abs(&self.delta);
+            let dq = big * c.c_q;
+            if !dq.is_finite() {
+                break;
+            }
+            iterations = it + 1;
+            // Absolute tolerance, floored at the round-off level of the update itself. The
+            // state where the residual was evaluated is kept (the update is below tolerance).
+            let amax = max_abs(&self.qdd1);
+            let vmax = max_abs(&self.qd1);
+            let tol = self.newton_tol + 1e-13 * (c.c_q * amax + h * vmax);
+            // The energy balance of the step is off by exactly h v̄ᵀ(residual): demand it
+            // small too, unless it has reached its round-off floor (no longer falls) or the
+            // update is far below tolerance.
+            let defect = (h * dot(&w.vbar, &w.res)).abs();
+            let e_scale = scale0 + scale1 + dot(&w.minus_q, &w.dq).abs();
+            if dq <= tol
+                && (defect <= ENERGY_TOL * e_scale
+                    || defect >= 0.5 * last_defect
+                    || dq <= 1e-4 * tol
+                    || it + 1 == MAX_ITERATIONS)
+            {
+                converged = true;
+                break;
+            }
+            last_defect = if dq <= tol { defect } else { f64::INFINITY };
+            if it > 2 && dq > 10.0 * last {
+                // Diverging: give up early, the caller retries with a shorter step.
+                break;
+            }
+            last = dq;
+            for i in 0..n {
+                self.qdd1[i] -= self.delta[i];
+            }
+        }
+        self.counters.rhs += passes;
+        // See the module docs: the linear contraction makes > 3 iterations normal here.
+        self.slow_convergence = !converged || iterations > 8;
+        if !converged {
+            if self.adaptive.is_some() || h > 1e-6 * self.h_nominal {
+                return Ok(Some(f64::INFINITY));
+            }
+            return Err(FemError::Runaway {
+                t: self.t,
+                what: format!("Newton iteration did not converge (last update {last:.3e})"),
+                location: None,
+                why: "the step is too large for the nonlinearity or the solution diverged".into(),
+                remedy: "reduce --dt or give --rtol for adaptive stepping".into(),
+            });
+        }
+        // Works with the scheme's own quadrature: their sum is Δqᵀ Q(t_mid, q̄, v̄).
+        let mut pending = Works::default();
+        let (_, p_kv) = self.chain.dissipation_power(t_mid, &w.vbar);
+        pending.kelvin_voigt = p_kv * h;
+        for li in 0..self.chain.links.len() {
+            let j = &self.chain.links[li].joint;
+            if j.dof == NONE {
+                continue;
+            }
+            let dth = w.dq[j.dof];
+            let law = j.applied(t_mid);
+            pending.applied_torque += law * dth;
+            pending.joint_damper += j.damping * w.vbar[j.dof] * dth;
+            // The torque channel reports the law at the sample time.
+            self.chain.joint_torque[li] = j.applied(t_law);
+        }
+        if self.chain.tip_load != 0.0 || self.chain.distributed_load != 0.0 {
+            let total = -dot(&w.minus_q, &w.dq);
+            pending.applied_load =
+                total - pending.applied_torque + pending.joint_damper + pending.kelvin_voigt;
+        }
+        w.pending = pending;
+        // q̈ slot holds the mean acceleration ā (predictor and error estimate of the next step).
+        self.a1.copy_from_slice(&self.qdd1);
+        Ok(self.adaptive.map(|ad| {
+            let ratio = 2.0 * h / (h + if w.have_prev { w.h_prev } else { 0.0 });
+            let mut err = 0.0f64;
+            for i in 0..n {
+                let e = h * h / 12.0 * (self.qdd1[i] - self.qdd[i]) * ratio;
+                err = err.max(e.abs() / (ad.atol + ad.rtol * self.q1[i].abs()));
+            }
+            err
+        }))
+    }
+}
