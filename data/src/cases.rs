@@ -179,7 +179,8 @@ case_files!(
     "dynamics",
     "rocket",
     "convergence",
-    "friction"
+    "friction",
+    "contact"
 );
 
 /// Parses a case file with located errors.
