@@ -56,7 +56,8 @@ pub enum Command {
     Verify {
         #[arg(long, value_enum, default_value_t = Suite::Quick)]
         suite: Suite,
-        /// Run only cases whose id contains this text.
+        /// Run only cases whose id contains this text (a filtered full suite skips the
+        /// refinement ladders).
         #[arg(long)]
         filter: Option<String>,
         #[arg(long, value_enum, default_value_t = Format::Table)]

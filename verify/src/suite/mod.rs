@@ -69,7 +69,9 @@ pub fn command(
         Format::Csv => print!("{}", report::csv(&outcomes)),
         Format::Json => println!("{}", report::json(&outcomes)),
     }
-    if suite == Suite::Full {
+    // The refinement ladders are a study of every scene, not a case: `--filter` selects cases,
+    // so a filtered run skips them (it would otherwise cost the whole study's wall time).
+    if suite == Suite::Full && filter.is_none() {
         full_ladders(out)?;
     }
     if let Some(dir) = out {

@@ -197,6 +197,24 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
                 )),
             }
         }
+        "constrained-rigid-link" => {
+            let Quantity::At { channel, t } = q else {
+                return Err("`constrained-rigid-link` applies to CHANNEL@T".into());
+            };
+            let st = ana::ConstrainedRigidLink::from_scene(scene)
+                .and_then(|r| r.state(*t))
+                .map_err(|e| e.to_string())?;
+            match channel.as_str() {
+                "joint1.angle" => Ok(st.angle),
+                "joint1.rate" => Ok(st.rate),
+                "contact1.normal_force" => Ok(st.normal_force),
+                "contact1.friction_work" => Ok(st.friction_work),
+                c => Err(format!(
+                    "`constrained-rigid-link` has no channel `{c}` (joint1.angle, joint1.rate, \
+                     contact1.normal_force, contact1.friction_work)"
+                )),
+            }
+        }
         "rocket-translation" => {
             let Quantity::At { channel, t } = q else {
                 return Err("`rocket-translation` applies to CHANNEL@T".into());
@@ -216,7 +234,7 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
         other => Err(format!(
             "unknown analytic reference `{other}`; known: clamped-free, tip-mass, timoshenko, \
              axial-clamped-free, rotating-in-plane, static-linear, rigid-single-link, rigid-two-link, \
-             rocket-translation"
+             constrained-rigid-link, rocket-translation"
         )),
     }
 }
