@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use data::{EnergyLedger, Observables};
+use data::{EnergyLedger, Event, Observables};
 
 /// Output formats of the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
@@ -40,6 +40,91 @@ pub fn observables_csv(obs: &Observables) -> String {
         w.write_record(&row).expect("in-memory csv");
     }
     String::from_utf8(w.into_inner().expect("in-memory csv")).expect("utf8")
+}
+
+/// Header of [`switching_rows`].
+pub const SWITCHING_HEADER: [&str; 8] = [
+    "t",
+    "event",
+    "contact",
+    "impulse",
+    "kinetic energy lost",
+    "momentum residual",
+    "normal force",
+    "time tolerance",
+];
+
+/// The contact switching history (contact start, impact, release, stick/slip), one row per
+/// event in time order; columns that do not apply to an event are `-`.
+pub fn switching_rows(events: &[Event]) -> Vec<Vec<String>> {
+    let dash = || "-".to_string();
+    let e = |x: f64| format!("{x:.9e}");
+    events
+        .iter()
+        .filter_map(|ev| match ev {
+            Event::ContactStart {
+                t,
+                contact,
+                time_tolerance,
+            } => Some(vec![
+                e(*t),
+                "contact".into(),
+                contact.to_string(),
+                dash(),
+                dash(),
+                dash(),
+                dash(),
+                format!("{time_tolerance:.1e}"),
+            ]),
+            Event::Impact {
+                t,
+                contact,
+                impulse,
+                momentum_residual,
+                kinetic_energy_lost,
+                ..
+            } => Some(vec![
+                e(*t),
+                "impact".into(),
+                contact.to_string(),
+                e(*impulse),
+                e(*kinetic_energy_lost),
+                format!("{momentum_residual:.2e}"),
+                dash(),
+                dash(),
+            ]),
+            Event::Release {
+                t,
+                contact,
+                normal_force,
+                time_tolerance,
+            } => Some(vec![
+                e(*t),
+                "release".into(),
+                contact.to_string(),
+                dash(),
+                dash(),
+                dash(),
+                format!("{normal_force:.2e}"),
+                format!("{time_tolerance:.1e}"),
+            ]),
+            Event::StickSlip {
+                t,
+                contact,
+                sticking,
+            } => Some(vec![
+                e(*t),
+                if *sticking { "stick" } else { "slip" }.into(),
+                contact.to_string(),
+                dash(),
+                dash(),
+                dash(),
+                dash(),
+                dash(),
+            ]),
+            Event::StepSizeChange { .. } | Event::StepRejected { .. } => None,
+        })
+        .collect()
 }
 
 /// The energy ledger as CSV with the closure residual in the last column.

@@ -231,3 +231,38 @@ fn cli_recommend_names_a_discretization_that_a_rerun_confirms() {
     assert_eq!(code, 1);
     assert!(err.contains("no measured discretization meets"), "{err}");
 }
+
+#[test]
+fn cli_run_contact_scene_writes_the_switching_history() {
+    let dir = std::env::temp_dir().join(format!("flexverify-cli-switch-{}", std::process::id()));
+    let (code, out, err) = flexverify(&[
+        "run",
+        "barhorst-case1-tipmass",
+        "--backend",
+        "modal",
+        "--modes",
+        "2",
+        "--t-end",
+        "0.6",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("switching events"), "{out}");
+    let csv = std::fs::read_to_string(dir.join("barhorst-case1-tipmass-modal-switching.csv"))
+        .expect("switching history written");
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert!(
+        rows.iter().any(|r| r.split(',').nth(1) == Some("impact")),
+        "no impact row:\n{csv}"
+    );
+    // Rows are in time order.
+    let times: Vec<f64> = rows
+        .iter()
+        .map(|r| r.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(times.windows(2).all(|w| w[0] <= w[1]), "{csv}");
+    let obs =
+        std::fs::read_to_string(dir.join("barhorst-case1-tipmass-modal-observables.csv")).unwrap();
+    assert!(obs.lines().next().unwrap().contains("contact1.phase"));
+}

@@ -4,7 +4,10 @@ use data::{BackendError, BackendKind, Scene, StabilityVerdict, load_scene};
 
 use super::CliError;
 use super::args::{Cli, Command, CommonOpts};
-use crate::output::{Format, csv_table, ledger_csv, observables_csv, text_table, write_atomic};
+use crate::output::{
+    Format, SWITCHING_HEADER, csv_table, ledger_csv, observables_csv, switching_rows, text_table,
+    write_atomic,
+};
 use crate::registry::backend;
 
 pub fn dispatch(cli: Cli) -> Result<(), CliError> {
@@ -334,6 +337,13 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 &format!("{stem}-events.json"),
                 &serde_json::to_vec_pretty(&r.events).expect("serializable"),
             )?;
+            if !scene.contacts.is_empty() {
+                write_atomic(
+                    dir,
+                    &format!("{stem}-switching.csv"),
+                    csv_table(&SWITCHING_HEADER, &switching_rows(&r.events)).as_bytes(),
+                )?;
+            }
         }
         eprintln!("wrote results to {}", dir.display());
     }
@@ -406,6 +416,13 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
             let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
             println!();
             print!("{}", text_table(&header, &rows));
+            if !scene.contacts.is_empty() {
+                for (k, r) in &results {
+                    let rows = switching_rows(&r.events);
+                    println!("\n{k}: {} switching events", rows.len());
+                    print!("{}", text_table(&SWITCHING_HEADER, &rows));
+                }
+            }
         }
     }
     for (k, r) in &results {
