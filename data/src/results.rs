@@ -40,7 +40,7 @@ pub mod channel {
     pub fn field_deflection(i: usize, k: usize) -> String {
         format!("link{i}.v@{k}")
     }
-    /// Contact phase of contact c: 0 free, 1 constrained (sliding/sticking).
+    /// Contact phase of contact c: 0 free, 1 constrained and sliding (or frictionless), 2 sticking.
     pub fn contact_phase(c: usize) -> String {
         format!("contact{c}.phase")
     }
