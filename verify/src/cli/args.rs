@@ -68,7 +68,7 @@ pub enum Command {
     /// Refinement study of one quantity: observed order, Richardson reference, work-precision.
     Converge {
         scene: String,
-        /// e.g. freq1, tip_static, tip_deflection@15, joint1.angle@2.5
+        /// e.g. freq1, tip_static, tip_deflection@15, joint1.angle@2.5, impulse1
         #[arg(long)]
         quantity: String,
         /// Refine space (elements/stations/modes) or time (dt).

@@ -18,8 +18,14 @@ pub enum Quantity {
     History { channel: String },
     /// Relative energy-ledger closure.
     LedgerClosure,
-    /// Largest impact momentum residual.
+    /// Largest impact momentum residual (an error when the run had no impact).
     MaxMomentumResidual,
+    /// Normal impulse Λ of the n-th impact (1-based).
+    Impulse { n: usize },
+    /// Time of the n-th impact.
+    ImpactTime { n: usize },
+    /// Time of the n-th release (normal force through zero).
+    ReleaseTime { n: usize },
 }
 
 /// Which backend analysis a quantity needs.
@@ -58,6 +64,29 @@ impl Quantity {
                 kind: kind.map(str::to_string),
             })
         };
+        let nth = |rest: &str, what: &str| -> Result<usize, String> {
+            match rest.parse::<usize>() {
+                Ok(n) if n >= 1 => Ok(n),
+                _ => Err(format!(
+                    "`{text}`: expected the number (from 1) of the {what} after the name"
+                )),
+            }
+        };
+        if let Some(rest) = t.strip_prefix("impact_time") {
+            return Ok(Quantity::ImpactTime {
+                n: nth(rest, "impact")?,
+            });
+        }
+        if let Some(rest) = t.strip_prefix("release_time") {
+            return Ok(Quantity::ReleaseTime {
+                n: nth(rest, "release")?,
+            });
+        }
+        if let Some(rest) = t.strip_prefix("impulse") {
+            return Ok(Quantity::Impulse {
+                n: nth(rest, "impact")?,
+            });
+        }
         if let Some(rest) = t.strip_prefix("axial_freq") {
             return freq(rest, Some("axial"));
         }
@@ -95,7 +124,8 @@ impl Quantity {
         }
         Err(format!(
             "unknown quantity `{text}`; expected freqN, axial_freqN, bending_freqN, tip_static, \
-             CHANNEL@T, peak:CHANNEL, history:CHANNEL, ledger_closure or max_momentum_residual"
+             CHANNEL@T, peak:CHANNEL, history:CHANNEL, ledger_closure, max_momentum_residual, \
+             impulseN, impact_timeN or release_timeN"
         ))
     }
 
@@ -171,16 +201,53 @@ impl Quantity {
                 Ok(c.values.iter().fold(0.0f64, |m, v| m.max(v.abs())))
             }
             Quantity::LedgerClosure => Ok(r.ledger.relative_closure()),
-            Quantity::MaxMomentumResidual => Ok(r
-                .events
-                .iter()
-                .filter_map(|e| match e {
-                    data::Event::Impact {
-                        momentum_residual, ..
-                    } => Some(*momentum_residual),
-                    _ => None,
+            Quantity::MaxMomentumResidual => {
+                let residuals: Vec<f64> = r
+                    .events
+                    .iter()
+                    .filter_map(|e| match e {
+                        data::Event::Impact {
+                            momentum_residual, ..
+                        } => Some(*momentum_residual),
+                        _ => None,
+                    })
+                    .collect();
+                if residuals.is_empty() {
+                    return Err("the run had no impact: no momentum balance to check".into());
+                }
+                Ok(residuals.into_iter().fold(0.0, f64::max))
+            }
+            Quantity::Impulse { n } | Quantity::ImpactTime { n } => {
+                let impacts: Vec<(f64, f64)> = r
+                    .events
+                    .iter()
+                    .filter_map(|e| match e {
+                        data::Event::Impact { t, impulse, .. } => Some((*t, *impulse)),
+                        _ => None,
+                    })
+                    .collect();
+                let (t, impulse) = impacts.get(n - 1).copied().ok_or_else(|| {
+                    format!("impact {n} was asked for; the run had {}", impacts.len())
+                })?;
+                Ok(if matches!(self, Quantity::Impulse { .. }) {
+                    impulse
+                } else {
+                    t
                 })
-                .fold(0.0, f64::max)),
+            }
+            Quantity::ReleaseTime { n } => {
+                let releases: Vec<f64> = r
+                    .events
+                    .iter()
+                    .filter_map(|e| match e {
+                        data::Event::Release { t, .. } => Some(*t),
+                        _ => None,
+                    })
+                    .collect();
+                releases.get(n - 1).copied().ok_or_else(|| {
+                    format!("release {n} was asked for; the run had {}", releases.len())
+                })
+            }
             _ => Err("not a run quantity".into()),
         }
     }
