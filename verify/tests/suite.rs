@@ -139,3 +139,52 @@ fn cross_cache_distinguishes_overridden_scenes_of_the_same_name() {
     // EI × 4 doubles every bending frequency.
     assert!((f(&stiff) / f(&plain) - 2.0).abs() < 1e-9);
 }
+
+#[test]
+fn prop_contact_quantities_read_the_events_and_refuse_missing_ones() {
+    use data::{Event, RunResult};
+    use verify::suite::quantity::Quantity;
+    let scene = data::load_scene("barhorst-case1").unwrap();
+    for bad in ["impulse0", "impulse", "release_time-1", "impact_timex"] {
+        assert!(Quantity::parse(bad, &scene).is_err(), "{bad} parsed");
+    }
+    let impact = |t: f64, impulse: f64| Event::Impact {
+        t,
+        contact: 1,
+        velocity_before: vec![],
+        velocity_after: vec![],
+        impulse,
+        momentum_residual: 1e-16,
+        normal_velocity_after: 0.0,
+        kinetic_energy_lost: 1.0,
+    };
+    let mut run = RunResult {
+        backend: BackendKind::Modal,
+        scene: scene.name.clone(),
+        settings: Default::default(),
+        observables: Default::default(),
+        ledger: data::EnergyLedger::new(&[], &[], &[]),
+        events: vec![],
+        cost: Default::default(),
+        verdict: data::StabilityVerdict::Completed,
+    };
+    let q = |text: &str| Quantity::parse(text, &scene).unwrap();
+    // No impact: neither a momentum residual of 0 nor an impulse.
+    assert!(q("max_momentum_residual").from_run(&run).is_err());
+    assert!(q("impulse1").from_run(&run).is_err());
+    run.events = vec![
+        impact(0.25, 7.0),
+        Event::Release {
+            t: 0.3,
+            contact: 1,
+            normal_force: 0.0,
+            time_tolerance: 1e-12,
+        },
+        impact(0.34, 1.0),
+    ];
+    assert_eq!(q("impulse2").from_run(&run), Ok(1.0));
+    assert_eq!(q("impact_time1").from_run(&run), Ok(0.25));
+    assert_eq!(q("release_time1").from_run(&run), Ok(0.3));
+    assert!(q("release_time2").from_run(&run).is_err());
+    assert_eq!(q("max_momentum_residual").from_run(&run), Ok(1e-16));
+}
