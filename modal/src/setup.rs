@@ -5,7 +5,7 @@ use data::{Basis, Discretization, DofPlan, Family, Scene};
 
 use crate::basis::ShapeSet;
 use crate::error::ModalError;
-use crate::model::{Chain, JointModel, LinkIntegrals, LinkModel};
+use crate::model::{Chain, JointModel, LinkIntegrals, LinkModel, Section, SectionParams};
 
 /// Modes per link and field when `--modes` is absent.
 pub const DEFAULT_MODES: usize = 6;
@@ -33,10 +33,23 @@ pub fn check_supported(scene: &Scene, purpose: Purpose) -> Result<(), ModalError
     }
     crate::contact::check(scene)?;
     for (i, l) in scene.links.iter().enumerate() {
-        if l.shear || l.rotary_inertia {
+        if l.shear && l.shear_stiffness.is_none() {
             return Err(ModalError::Unsupported(format!(
-                "modal: Timoshenko shear/rotary inertia on link {} (`{}`): no shear modes in the \
-                 assumed-mode basis",
+                "modal: link {} has `shear` on but no `shear_stiffness`",
+                i + 1
+            )));
+        }
+        if l.rotary_inertia && l.rotary_inertia_per_length.is_none() {
+            return Err(ModalError::Unsupported(format!(
+                "modal: link {} has `rotary_inertia` on but no `rotary_inertia_per_length`",
+                i + 1
+            )));
+        }
+        if l.shear && !l.rotary_inertia && l.tip_inertia.is_some_and(|j| j > 0.0) {
+            return Err(ModalError::Unsupported(format!(
+                "modal: Timoshenko link {} (`{}`) with a tip inertia but without section rotary \
+                 inertia: the section rotation ψ would carry inertia only through ψ(L) (singular \
+                 ψ mass, not condensable exactly); turn `rotary_inertia` on",
                 i + 1,
                 l.name
             )));
@@ -144,6 +157,26 @@ pub fn build_chain(scene: &Scene, disc: &Discretization) -> Result<Chain, ModalE
     build_chain_for(scene, disc, Purpose::Dynamics)
 }
 
+/// The (v, ψ) shapes of a Timoshenko link, n each (see [`crate::model::section`]): `poly` →
+/// both span{ξ, …, ξⁿ}; `clamped-free` / `tip-mass` → v ∈ {ξ, φ₁…φₙ₋₁}, ψ ∈ {ξ, φ₁'…φₙ₋₁'}.
+fn timoshenko_shapes(
+    link: &Link,
+    index: usize,
+    basis: Basis,
+    n: usize,
+) -> Result<(ShapeSet, ShapeSet), ModalError> {
+    match basis {
+        Basis::Poly => Ok((
+            ShapeSet::axial_poly(link.length, n),
+            ShapeSet::axial_poly(link.length, n),
+        )),
+        _ => {
+            let base = shapes(link, index, basis, n - 1)?;
+            Ok(ShapeSet::timoshenko_eigen_pair(base))
+        }
+    }
+}
+
 /// Axial shapes matching the transverse basis: clamped-free bar modes √2 sin((2k−1)πx/2L)
 /// (exact for the bar without tip mass), or ξ·Pₖ(2ξ−1) for `poly`.
 fn axial_shapes(link: &Link, basis: Basis, n: usize) -> ShapeSet {
@@ -165,7 +198,12 @@ pub fn build_chain_for(
     let mut joints = Vec::new();
     let mut offset = 0;
     for (i, l) in scene.links.iter().enumerate() {
-        let transverse = shapes(l, i, basis, n)?;
+        let (transverse, rotation) = if l.shear {
+            let (v, psi) = timoshenko_shapes(l, i, basis, n)?;
+            (v, Some(psi))
+        } else {
+            (shapes(l, i, basis, n)?, None)
+        };
         let axial = l.axial.then(|| axial_shapes(l, basis, n));
         let ints = LinkIntegrals::new(
             l.length,
@@ -177,10 +215,26 @@ pub fn build_chain_for(
             l.foreshortening,
         );
         let na = axial.as_ref().map_or(0, |a| a.count());
+        let params = SectionParams {
+            ei: l.bending_stiffness,
+            shear_stiffness: l.shear_stiffness.filter(|_| l.shear),
+            rho_i: l.rotary_inertia_per_length.filter(|_| l.rotary_inertia),
+            kelvin_voigt: l.kelvin_voigt.filter(|g| *g > 0.0),
+        };
+        let section = match (&rotation, params.shear_stiffness) {
+            (Some(chi), Some(kga)) => {
+                Section::timoshenko(na, &transverse, chi, params, kga, params.rho_i.is_none())
+                    .map_err(|m| ModalError::Numerical {
+                        t: 0.0,
+                        message: format!("link {}: {m}", i + 1),
+                    })?
+            }
+            _ => Section::euler(na, &transverse, &ints.kb, params),
+        };
         let theta = offset;
         let a0 = offset + 1;
         let b0 = a0 + na;
-        offset = b0 + n;
+        offset = b0 + transverse.count() + section.nc;
         links.push(LinkModel {
             name: l.name.clone(),
             transverse,
@@ -190,7 +244,7 @@ pub fn build_chain_for(
             tip_mass: l.tip_mass.unwrap_or(0.0),
             tip_inertia: l.tip_inertia.unwrap_or(0.0),
             hub_inertia: l.joint.hub_inertia.unwrap_or(0.0),
-            kv_ratio: l.kelvin_voigt.map_or(0.0, |g| g / l.bending_stiffness),
+            section,
             theta,
             a0,
             b0,
@@ -227,6 +281,23 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
                 .push(format!("link{k}: axial field, von Kármán strain u' + ½v'²"));
         }
         plan.add(format!("link{k} transverse modes ({})", basis.name()), n);
+        if l.shear {
+            if l.rotary_inertia {
+                plan.add(format!("link{k} section-rotation modes ψ"), n);
+                plan.builds.push(format!(
+                    "link{k}: Timoshenko shear ½∫κGA(v' − ψ)², bending ½∫EI ψ'², rotary inertia ρI"
+                ));
+            } else {
+                plan.builds.push(format!(
+                    "link{k}: Timoshenko shear ½∫κGA(v' − ψ)², bending ½∫EI ψ'²; massless ψ \
+                     condensed (ψ = χᵀT b, {n} ψ shapes)"
+                ));
+            }
+        } else if l.rotary_inertia {
+            plan.builds.push(format!(
+                "link{k}: rotary inertia ρI of the sections (ψ = v')"
+            ));
+        }
         if l.foreshortening {
             plan.builds
                 .push(format!("link{k}: foreshortening (centrifugal) stiffening"));

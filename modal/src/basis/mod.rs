@@ -32,6 +32,12 @@ enum Kind {
     AxialSine,
     /// Beam eigenfunctions: β and (A, B, C, D) per mode.
     Eigen { beta: Vec<f64>, coef: Vec<[f64; 4]> },
+    /// Timoshenko field built on an eigenfunction basis: shape 0 is √3·ξ (a root shear strain /
+    /// linear rotation), shapes 1.. are the base's φₖ, or with `derivative` its (L/βₖ)·φₖ'.
+    Augmented {
+        base: Box<ShapeSet>,
+        derivative: bool,
+    },
 }
 
 /// n shape functions on [0, L] with derivatives up to order 2 (3 for eigenfunctions).
@@ -56,6 +62,7 @@ impl ShapeSet {
         match &self.kind {
             Kind::Eigen { beta, .. } => beta.last().copied().unwrap_or(1.0),
             Kind::AxialSine => (2.0 * self.count as f64 - 1.0) * std::f64::consts::FRAC_PI_2,
+            Kind::Augmented { base, .. } => base.max_wavenumber().max(1.0),
             // A polynomial of degree d oscillates like a wave of wavenumber ≈ d.
             Kind::Poly { .. } | Kind::AxialPoly { .. } => self.count as f64 + 2.0,
         }
@@ -153,12 +160,59 @@ impl ShapeSet {
         Ok(s)
     }
 
+    /// The (v, ψ) shape pair of a Timoshenko link built on a cantilever eigenfunction basis
+    /// (`base`, n − 1 functions): v ∈ span{ξ, φ₁, …, φₙ₋₁}, ψ ∈ span{ξ, φ₁', …, φₙ₋₁'}.
+    /// The ξ in v carries the root shear strain v'(0) = γ(0) ≠ 0 that every φₖ (φₖ'(0) = 0)
+    /// lacks; ψ contains every φₖ', so the κGA → ∞ limit ψ = v' is the Euler model on
+    /// {φ₁, …, φₙ₋₁} (no shear locking).
+    pub fn timoshenko_eigen_pair(base: ShapeSet) -> (ShapeSet, ShapeSet) {
+        let (length, count) = (base.length, base.count + 1);
+        let v = ShapeSet {
+            length,
+            count,
+            kind: Kind::Augmented {
+                base: Box::new(base.clone()),
+                derivative: false,
+            },
+        };
+        let psi = ShapeSet {
+            length,
+            count,
+            kind: Kind::Augmented {
+                base: Box::new(base),
+                derivative: true,
+            },
+        };
+        (v, psi)
+    }
+
     /// Writes d^deriv φₖ/dx^deriv at x for all k.
     pub fn eval(&self, x: f64, deriv: usize, out: &mut [f64]) {
         let l = self.length;
         let xi = x / l;
         let dscale = l.powi(-(deriv as i32));
         match &self.kind {
+            Kind::Augmented { base, derivative } => {
+                let s3 = 3f64.sqrt();
+                out[0] = match deriv {
+                    0 => s3 * xi,
+                    1 => s3 / l,
+                    _ => 0.0,
+                };
+                if self.count > 1 {
+                    let rest = &mut out[1..self.count];
+                    if *derivative {
+                        base.eval(x, deriv + 1, rest);
+                        if let Kind::Eigen { beta, .. } = &base.kind {
+                            for (o, b) in rest.iter_mut().zip(beta) {
+                                *o *= l / b;
+                            }
+                        }
+                    } else {
+                        base.eval(x, deriv, rest);
+                    }
+                }
+            }
             Kind::Eigen { beta, coef } => {
                 for (k, o) in out.iter_mut().enumerate().take(self.count) {
                     let b = beta[k];
