@@ -157,22 +157,40 @@ pub fn build_chain(scene: &Scene, disc: &Discretization) -> Result<Chain, ModalE
     build_chain_for(scene, disc, Purpose::Dynamics)
 }
 
-/// The (v, ψ) shapes of a Timoshenko link, n each (see [`crate::model::section`]): `poly` →
-/// both span{ξ, …, ξⁿ}; `clamped-free` / `tip-mass` → v ∈ {ξ, φ₁…φₙ₋₁}, ψ ∈ {ξ, φ₁'…φₙ₋₁'}.
+/// Whether a Timoshenko link's v basis carries the root shear strain v'(0) (see
+/// [`crate::model::section`]): only when the frame rotation cannot be traded for a root shear
+/// at zero kinetic energy, i.e. the joint is prescribed or the sections have rotary inertia.
+pub fn has_root_shear(link: &Link) -> bool {
+    link.joint.prescribed.is_some() || link.rotary_inertia
+}
+
+/// The (v, ψ) shapes of a Timoshenko link, n each (see [`crate::model::section`]). With root
+/// shear: `poly` → both span{ξ, …, ξⁿ}; eigenfunction bases → v ∈ {ξ, φ₁…φₙ₋₁},
+/// ψ ∈ {ξ, φ₁'…φₙ₋₁'}. Without: `poly` → v ∈ span{ξ², …, ξⁿ⁺¹}, ψ ∈ span{ξ, …, ξⁿ};
+/// eigenfunction bases → v ∈ {φ₁…φₙ}, ψ ∈ {φ₁'…φₙ'}.
 fn timoshenko_shapes(
     link: &Link,
     index: usize,
     basis: Basis,
     n: usize,
 ) -> Result<(ShapeSet, ShapeSet), ModalError> {
-    match basis {
-        Basis::Poly => Ok((
+    let root_shear = has_root_shear(link);
+    match (basis, root_shear) {
+        (Basis::Poly, true) => Ok((
             ShapeSet::axial_poly(link.length, n),
             ShapeSet::axial_poly(link.length, n),
         )),
-        _ => {
+        (Basis::Poly, false) => Ok((
+            ShapeSet::poly(link.length, n),
+            ShapeSet::axial_poly(link.length, n),
+        )),
+        (_, true) => {
             let base = shapes(link, index, basis, n - 1)?;
-            Ok(ShapeSet::timoshenko_eigen_pair(base))
+            Ok(ShapeSet::timoshenko_eigen_pair(base, true))
+        }
+        (_, false) => {
+            let base = shapes(link, index, basis, n)?;
+            Ok(ShapeSet::timoshenko_eigen_pair(base, false))
         }
     }
 }

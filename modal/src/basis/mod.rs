@@ -32,11 +32,13 @@ enum Kind {
     AxialSine,
     /// Beam eigenfunctions: β and (A, B, C, D) per mode.
     Eigen { beta: Vec<f64>, coef: Vec<[f64; 4]> },
-    /// Timoshenko field built on an eigenfunction basis: shape 0 is √3·ξ (a root shear strain /
-    /// linear rotation), shapes 1.. are the base's φₖ, or with `derivative` its (L/βₖ)·φₖ'.
+    /// Timoshenko field built on an eigenfunction basis: with `linear`, shape 0 is √3·ξ (a root
+    /// shear strain / linear rotation); the others are the base's φₖ, or with `derivative` its
+    /// (L/βₖ)·φₖ'.
     Augmented {
         base: Box<ShapeSet>,
         derivative: bool,
+        linear: bool,
     },
 }
 
@@ -165,25 +167,23 @@ impl ShapeSet {
     /// The ξ in v carries the root shear strain v'(0) = γ(0) ≠ 0 that every φₖ (φₖ'(0) = 0)
     /// lacks; ψ contains every φₖ', so the κGA → ∞ limit ψ = v' is the Euler model on
     /// {φ₁, …, φₙ₋₁} (no shear locking).
-    pub fn timoshenko_eigen_pair(base: ShapeSet) -> (ShapeSet, ShapeSet) {
-        let (length, count) = (base.length, base.count + 1);
-        let v = ShapeSet {
+    ///
+    /// Without `root_shear` the pair is v ∈ span{φ₁, …, φₙ}, ψ ∈ span{φ₁', …, φₙ'} (n = base
+    /// count): the frame keeps v'(0) = 0 (see [`crate::model::section`] for when that is used).
+    pub fn timoshenko_eigen_pair(base: ShapeSet, root_shear: bool) -> (ShapeSet, ShapeSet) {
+        let length = base.length;
+        let count = base.count + usize::from(root_shear);
+        let make = |derivative: bool| ShapeSet {
             length,
             count,
             kind: Kind::Augmented {
                 base: Box::new(base.clone()),
-                derivative: false,
+                derivative,
+                linear: root_shear,
             },
         };
-        let psi = ShapeSet {
-            length,
-            count,
-            kind: Kind::Augmented {
-                base: Box::new(base),
-                derivative: true,
-            },
-        };
-        (v, psi)
+        let psi = make(true);
+        (make(false), psi)
     }
 
     /// Writes d^deriv φₖ/dx^deriv at x for all k.
@@ -192,15 +192,22 @@ impl ShapeSet {
         let xi = x / l;
         let dscale = l.powi(-(deriv as i32));
         match &self.kind {
-            Kind::Augmented { base, derivative } => {
-                let s3 = 3f64.sqrt();
-                out[0] = match deriv {
-                    0 => s3 * xi,
-                    1 => s3 / l,
-                    _ => 0.0,
-                };
-                if self.count > 1 {
-                    let rest = &mut out[1..self.count];
+            Kind::Augmented {
+                base,
+                derivative,
+                linear,
+            } => {
+                let first = usize::from(*linear);
+                if *linear {
+                    let s3 = 3f64.sqrt();
+                    out[0] = match deriv {
+                        0 => s3 * xi,
+                        1 => s3 / l,
+                        _ => 0.0,
+                    };
+                }
+                if self.count > first {
+                    let rest = &mut out[first..self.count];
                     if *derivative {
                         base.eval(x, deriv + 1, rest);
                         if let Kind::Eigen { beta, .. } = &base.kind {

@@ -14,11 +14,24 @@
 //!   K = [[κGA∫φ'φ'ᵀ, −κGA∫φ'χᵀ], [−κGA∫χφ'ᵀ, EI∫χ'χ'ᵀ + κGA∫χχᵀ]],
 //!
 //!   Kelvin–Voigt on ψ' only (moment EI ψ' + γ ψ̇', dissipation γ∫ψ̇'², no shear damping):
-//!   D = [[0, 0], [0, γ∫χ'χ'ᵀ]]. Bases: `poly` → φ, χ ∈ span{ξ, …, ξⁿ} (ξ·Pₖ(2ξ−1));
-//!   eigenfunction bases → φ ∈ span{ξ, φ₁…φₙ₋₁}, χ ∈ span{ξ, φ₁'…φₙ₋₁'}
-//!   ([`crate::basis::ShapeSet::timoshenko_eigen_pair`]). In both, χ contains every φ' with
-//!   φ(0) = 0 up to one degree less, so ψ = v' is representable and the κGA → ∞ limit is the
-//!   Euler model on n − 1 functions (ξ², …, ξⁿ resp. φ₁…φₙ₋₁): no shear locking.
+//!   D = [[0, 0], [0, γ∫χ'χ'ᵀ]].
+//!
+//!   Bases (n functions per field). The frame is the root cross-section (ψ(0) = 0), so the root
+//!   shear strain is v'(0). With a prescribed joint or with section rotary inertia the v basis
+//!   carries it: `poly` → φ, χ ∈ span{ξ, …, ξⁿ} (ξ·Pₖ(2ξ−1)); eigenfunction bases →
+//!   φ ∈ {ξ, φ₁…φₙ₋₁}, χ ∈ {ξ, φ₁'…φₙ₋₁'} ([`crate::basis::ShapeSet::timoshenko_eigen_pair`]).
+//!   With a free joint and massless sections the combination "turn the frame by ε, shear the
+//!   root by −ε" moves no mass at all (every mass point keeps its velocity; only the massless
+//!   sections turn), so M(q) would be singular — in the continuum that combination is a
+//!   first-order relaxation through the joint damper, which M q̈ = f cannot carry. There the v
+//!   basis keeps v'(0) = 0 (`poly` → v ∈ span{ξ², …, ξⁿ⁺¹}, χ ∈ span{ξ, …, ξⁿ};
+//!   eigenfunction bases → φ ∈ {φ₁…φₙ}, χ ∈ {φ₁'…φₙ'}): the root shear is carried by the frame
+//!   angle, an approximation of the clamp that converges with n (functions with v'(0) = 0 are
+//!   dense in the shear energy space H¹) but is not exact at finite n.
+//!   In every case χ contains the derivative of every v shape except the root-shear ξ, so ψ = v'
+//!   is representable and
+//!   the κGA → ∞ limit is the Euler model on the v shapes without the root-shear function
+//!   (no shear locking).
 //! * **Rotary inertia** (`rotary_inertia`, ρI): ½∫ρI (ω + ψ̇)² adds to the body mass matrix
 //!   ρI·L (ωω), ∫ρI r (ωe) and ∫ρI r rᵀ (ee) — constant, so no convective terms. With the
 //!   Euler model r = φ'.
@@ -70,8 +83,10 @@ pub struct Section {
     pub kbc: Vec<f64>,
     /// Kelvin–Voigt damping matrix of the bending block (empty without Kelvin–Voigt).
     pub dbc: Vec<f64>,
-    /// Condensed Timoshenko only: T (nψ × nb, row-major), ψ = χᵀT b, and the ψ shapes χ.
-    pub condensation: Option<(Vec<f64>, ShapeSet)>,
+    /// Timoshenko only: the ψ shapes χ.
+    pub psi_shapes: Option<ShapeSet>,
+    /// Condensed Timoshenko only: T (nψ × nb, row-major), ψ = χᵀT b.
+    pub condensation: Option<Vec<f64>>,
 }
 
 /// Section parameters of a link.
@@ -152,6 +167,7 @@ impl Section {
             rotary,
             kbc: kb.to_vec(),
             dbc,
+            psi_shapes: None,
             condensation: None,
         }
     }
@@ -244,7 +260,8 @@ impl Section {
                 rotary: None,
                 kbc,
                 dbc,
-                condensation: Some((t, chi.clone())),
+                psi_shapes: Some(chi.clone()),
+                condensation: Some(t),
             });
         }
         let n = nb + nc;
@@ -304,6 +321,7 @@ impl Section {
             rotary,
             kbc,
             dbc,
+            psi_shapes: Some(chi.clone()),
             condensation: None,
         })
     }
