@@ -384,13 +384,23 @@ fn dyn_timoshenko_barhorst_impacts_and_ledger() {
 
 /// Switching times of barhorst-case1-timoshenko in the first 0.5 s against the number of modes
 /// per field (issue 7). Long: run with
-/// `cargo test --release -p modal --test dyn_timoshenko -- --ignored --nocapture switching`.
+/// `cargo test --release -p modal --test dyn_timoshenko -- --ignored --nocapture switching`
+/// (env `TIMO_MODES=2,3,4,6` and `TIMO_SCENE=barhorst-case1-timoshenko` select the ladder and
+/// the scene, e.g. `barhorst-case1` for the Euler comparison).
 #[test]
 #[ignore]
 fn dyn_timoshenko_switching_times_vs_modes() {
-    let scene = load_scene("barhorst-case1-timoshenko").unwrap();
+    let name =
+        std::env::var("TIMO_SCENE").unwrap_or_else(|_| "barhorst-case1-timoshenko".to_string());
+    let ladder: Vec<usize> = std::env::var("TIMO_MODES")
+        .unwrap_or_else(|_| "2,3,4,6".to_string())
+        .split(',')
+        .map(|v| v.trim().parse().unwrap())
+        .collect();
+    let scene = load_scene(&name).unwrap();
+    println!("{name}");
     for basis in [Basis::Poly, Basis::ClampedFree] {
-        for n in [2, 3, 4, 6] {
+        for &n in &ladder {
             let (r, _) =
                 simulate_detailed(&scene, &run_settings(n, Some(basis), 1e-8, Some(0.5))).unwrap();
             let sw: Vec<String> = switching(&r)
@@ -460,4 +470,41 @@ fn dyn_timoshenko_arm_approaches_euler_as_slenderness_grows() {
         diffs.windows(2).all(|p| p[1] < p[0]),
         "Timoshenko − Euler must fall with slenderness: {diffs:?}"
     );
+}
+
+#[test]
+fn dyn_timoshenko_rotary_inertia_chain_impact_and_ledger() {
+    // With section rotary inertia (ρI chosen: 1e-2 slug·ft) ψ is a set of true coordinates
+    // (no condensation) carrying the Kelvin–Voigt damping on ψ̇' and the joint chaining
+    // through ψ₁(L): the ledger must close through free flight and the first impact.
+    let mut scene = load_scene("barhorst-case1-timoshenko").unwrap();
+    for l in &mut scene.links {
+        l.rotary_inertia = true;
+        l.rotary_inertia_per_length = Some(1e-2);
+    }
+    let plan = ModalBackend
+        .dof_plan(&scene, &disc(3, Basis::ClampedFree))
+        .unwrap();
+    assert_eq!(plan.total(), 2 + 2 * (3 + 3));
+    let (r, _) = simulate_detailed(&scene, &run_settings(3, None, 1e-8, Some(0.3))).unwrap();
+    assert_eq!(r.verdict, StabilityVerdict::Completed);
+    let sw = switching(&r);
+    println!(
+        "switching {sw:?}; closure {:.3e}; steps {} wall {:.2}s",
+        r.ledger.relative_closure(),
+        r.cost.steps,
+        r.cost.wall_time_s
+    );
+    assert!(sw.first().is_some_and(|(_, k)| *k == "I"), "{sw:?}");
+    for e in &r.events {
+        if let Event::Impact {
+            momentum_residual,
+            kinetic_energy_lost,
+            ..
+        } = e
+        {
+            assert!(*momentum_residual <= 1e-10 && *kinetic_energy_lost >= 0.0);
+        }
+    }
+    assert!(r.ledger.relative_closure() <= 1e-5);
 }
