@@ -327,7 +327,11 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
             plan.builds.push(format!("link{k}: tip inertia"));
         }
         if l.kelvin_voigt.is_some() {
-            plan.builds.push(format!("link{k}: Kelvin-Voigt damping"));
+            plan.builds.push(if l.shear {
+                format!("link{k}: Kelvin-Voigt damping on ψ' (no shear damping)")
+            } else {
+                format!("link{k}: Kelvin-Voigt damping")
+            });
         }
         let j = &l.joint;
         if j.hub_inertia.is_some() {
