@@ -508,3 +508,32 @@ fn dyn_timoshenko_rotary_inertia_chain_impact_and_ledger() {
     }
     assert!(r.ledger.relative_closure() <= 1e-5);
 }
+
+/// Cost of the v'(0) = 0 basis used with a free joint and massless sections: the stocky
+/// cantilever without rotary inertia, clamped either by a prescribed joint (root-shear basis,
+/// exponentially convergent reference) or by a free joint with a very stiff spring (v'(0) = 0
+/// basis). Run with
+/// `cargo test --release -p modal --test dyn_timoshenko -- --ignored --nocapture root_shear`.
+#[test]
+#[ignore]
+fn conv_timoshenko_root_shear_basis_study() {
+    let mut clamped = load_scene("cantilever-timoshenko").unwrap();
+    clamped.links[0].rotary_inertia = false;
+    let reference = freqs(&clamped, 16, Basis::Poly, 3);
+    let mut sprung = clamped.clone();
+    sprung.links[0].joint.prescribed = None;
+    // Root compliance 1/K ≪ the beam's (L/EI ≈ 6e-4): the spring error is ~1e-7.
+    sprung.links[0].joint.stiffness = Some(1e10);
+    for basis in [Basis::Poly, Basis::ClampedFree] {
+        for n in [2, 4, 6, 8, 12, 16] {
+            // Eigenvalues below the solver's round-off floor (1e-12 λ_max, reported as 0) are
+            // dropped: the stiff spring mode sets λ_max.
+            let f: Vec<f64> = freqs(&sprung, n, basis, 6)
+                .into_iter()
+                .filter(|v| *v > 0.0)
+                .collect();
+            let e: Vec<f64> = f.iter().zip(&reference).map(|(a, b)| (a - b) / b).collect();
+            println!("{basis:?} n={n:2}: v'(0) = 0 basis rel errors {e:?}");
+        }
+    }
+}

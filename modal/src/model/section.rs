@@ -27,7 +27,10 @@
 //!   basis keeps v'(0) = 0 (`poly` → v ∈ span{ξ², …, ξⁿ⁺¹}, χ ∈ span{ξ, …, ξⁿ};
 //!   eigenfunction bases → φ ∈ {φ₁…φₙ}, χ ∈ {φ₁'…φₙ'}): the root shear is carried by the frame
 //!   angle, an approximation of the clamp that converges with n (functions with v'(0) = 0 are
-//!   dense in the shear energy space H¹) but is not exact at finite n.
+//!   dense in the shear energy space H¹) but is not exact at finite n: algebraically, measured
+//!   on the stocky cantilever without rotary inertia (κGA L²/EI ≈ 385) as a mode-1 error of
+//!   2.0e-4 / 5.7e-5 at n = 6 / 12 (`poly`) against the root-shear basis (test
+//!   `conv_timoshenko_root_shear_basis_study`).
 //!   In every case χ contains the derivative of every v shape except the root-shear ξ, so ψ = v'
 //!   is representable and
 //!   the κGA → ∞ limit is the Euler model on the v shapes without the root-shear function
