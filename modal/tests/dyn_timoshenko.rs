@@ -537,3 +537,35 @@ fn conv_timoshenko_root_shear_basis_study() {
         }
     }
 }
+
+#[test]
+fn sys_timoshenko_tip_load_statics_is_exact() {
+    // Tip load P on the clamped Timoshenko beam: ψ = (P/EI)(Lx − x²/2),
+    // v = (P/EI)(Lx²/2 − x³/6) + P x/κGA, so v(L) = PL³/3EI + PL/κGA and ψ(L) = PL²/2EI.
+    // The root-shear polynomial pair (n ≥ 3) contains both fields: exact to round-off. The
+    // eigenfunction pair approximates them (measured at n = 8: 5.6e-5 on v(L), 8.0e-4 on ψ(L)).
+    let scene = load_scene("cantilever-timoshenko").unwrap();
+    let l = &scene.links[0];
+    let p = scene.statics.as_ref().unwrap().tip_force.unwrap();
+    let (len, ei, kga) = (l.length, l.bending_stiffness, l.shear_stiffness.unwrap());
+    let v_exact = p * len.powi(3) / (3.0 * ei) + p * len / kga;
+    let psi_exact = p * len * len / (2.0 * ei);
+    for (basis, n, tol) in [
+        (Basis::Poly, 3, 1e-12),
+        (Basis::Poly, 8, 1e-11),
+        (Basis::ClampedFree, 8, 2e-3),
+    ] {
+        let s = Settings {
+            discretization: disc(n, basis),
+            ..Default::default()
+        };
+        let r = ModalBackend.statics(&scene, &s).unwrap();
+        let ev = (r.tip_deflection - v_exact) / v_exact;
+        let ep = (r.tip_rotation - psi_exact) / psi_exact;
+        println!("{basis:?} n={n}: v(L) error {ev:.2e}, ψ(L) error {ep:.2e}");
+        assert!(
+            ev.abs() < tol && ep.abs() < tol,
+            "{basis:?} n={n}: {ev:e} {ep:e}"
+        );
+    }
+}
