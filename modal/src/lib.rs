@@ -1,6 +1,6 @@
 //! # modal — assumed-mode (Rayleigh–Ritz) reduction of flexible multibody scenes
 //!
-//! Each planar link is an Euler–Bernoulli beam in a floating frame, clamped to the frame at its
+//! Each planar link is an Euler–Bernoulli (or Timoshenko, below) beam in a floating frame, clamped to the frame at its
 //! root: transverse deflection v(x, t) = Σ φₖ(x) bₖ(t) with a basis chosen per run (`poly`,
 //! `clamped-free`, `tip-mass`; see [`basis`]). With the frame angle α (joint convention of
 //! scenes.md: αᵢ₊₁ = αᵢ + vᵢ'(Lᵢ) + θᵢ₊₁) the energies are
@@ -14,6 +14,14 @@
 //!   (beware membrane locking: with as many axial as bending modes the Ritz model is too stiff);
 //!   joint springs ½K(θ − θ₀)²; gravity −g·Σ∫ρA r;
 //! * dissipation: Kelvin–Voigt γ ∫ v̇''² (damping matrix (γ/EI) K_b), joint dampers D θ̇².
+//!
+//! Timoshenko links (`shear`, [`model::section`]) carry an independent section rotation
+//! ψ = Σ χₖ cₖ (clamped v(0) = ψ(0) = 0): U = ½∫EI ψ'² + ½∫κGA (v' − ψ)², Kelvin–Voigt
+//! γ∫ψ̇'², rotary inertia ½∫ρI (α̇ + ψ̇)², tip inertia ½J(α̇ + ψ̇(L))², and the next link is
+//! clamped to the tip cross-section: αᵢ₊₁ = αᵢ + ψᵢ(Lᵢ) + θᵢ₊₁ (the foreshortening and von
+//! Kármán terms keep the centre-line slope v'). Without rotary inertia ψ is massless and is
+//! condensed (ψ = χᵀT b, T = −K_cc⁻¹K_cb; the Kelvin–Voigt relaxation of ψ enters to first
+//! order). Rotary inertia is also accepted on Euler links (ψ = v').
 //!
 //! Lagrange's equations M(q) q̈ = f(q, q̇, t) follow by projecting each body's equations with
 //! the chain's velocity map ([`model::chain`]); every spatial integral (modal mass, stiffness,

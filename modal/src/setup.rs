@@ -5,7 +5,7 @@ use data::{Basis, Discretization, DofPlan, Family, Scene};
 
 use crate::basis::ShapeSet;
 use crate::error::ModalError;
-use crate::model::{Chain, JointModel, LinkIntegrals, LinkModel};
+use crate::model::{Chain, JointModel, LinkIntegrals, LinkModel, Section, SectionParams};
 
 /// Modes per link and field when `--modes` is absent.
 pub const DEFAULT_MODES: usize = 6;
@@ -33,10 +33,23 @@ pub fn check_supported(scene: &Scene, purpose: Purpose) -> Result<(), ModalError
     }
     crate::contact::check(scene)?;
     for (i, l) in scene.links.iter().enumerate() {
-        if l.shear || l.rotary_inertia {
+        if l.shear && l.shear_stiffness.is_none() {
             return Err(ModalError::Unsupported(format!(
-                "modal: Timoshenko shear/rotary inertia on link {} (`{}`): no shear modes in the \
-                 assumed-mode basis",
+                "modal: link {} has `shear` on but no `shear_stiffness`",
+                i + 1
+            )));
+        }
+        if l.rotary_inertia && l.rotary_inertia_per_length.is_none() {
+            return Err(ModalError::Unsupported(format!(
+                "modal: link {} has `rotary_inertia` on but no `rotary_inertia_per_length`",
+                i + 1
+            )));
+        }
+        if l.shear && !l.rotary_inertia && l.tip_inertia.is_some_and(|j| j > 0.0) {
+            return Err(ModalError::Unsupported(format!(
+                "modal: Timoshenko link {} (`{}`) with a tip inertia but without section rotary \
+                 inertia: the section rotation ψ would carry inertia only through ψ(L) (singular \
+                 ψ mass, not condensable exactly); turn `rotary_inertia` on",
                 i + 1,
                 l.name
             )));
@@ -144,6 +157,44 @@ pub fn build_chain(scene: &Scene, disc: &Discretization) -> Result<Chain, ModalE
     build_chain_for(scene, disc, Purpose::Dynamics)
 }
 
+/// Whether a Timoshenko link's v basis carries the root shear strain v'(0) (see
+/// [`crate::model::section`]): only when the frame rotation cannot be traded for a root shear
+/// at zero kinetic energy, i.e. the joint is prescribed or the sections have rotary inertia.
+pub fn has_root_shear(link: &Link) -> bool {
+    link.joint.prescribed.is_some() || link.rotary_inertia
+}
+
+/// The (v, ψ) shapes of a Timoshenko link, n each (see [`crate::model::section`]). With root
+/// shear: `poly` → both span{ξ, …, ξⁿ}; eigenfunction bases → v ∈ {ξ, φ₁…φₙ₋₁},
+/// ψ ∈ {ξ, φ₁'…φₙ₋₁'}. Without: `poly` → v ∈ span{ξ², …, ξⁿ⁺¹}, ψ ∈ span{ξ, …, ξⁿ};
+/// eigenfunction bases → v ∈ {φ₁…φₙ}, ψ ∈ {φ₁'…φₙ'}.
+fn timoshenko_shapes(
+    link: &Link,
+    index: usize,
+    basis: Basis,
+    n: usize,
+) -> Result<(ShapeSet, ShapeSet), ModalError> {
+    let root_shear = has_root_shear(link);
+    match (basis, root_shear) {
+        (Basis::Poly, true) => Ok((
+            ShapeSet::axial_poly(link.length, n),
+            ShapeSet::axial_poly(link.length, n),
+        )),
+        (Basis::Poly, false) => Ok((
+            ShapeSet::poly(link.length, n),
+            ShapeSet::axial_poly(link.length, n),
+        )),
+        (_, true) => {
+            let base = shapes(link, index, basis, n - 1)?;
+            Ok(ShapeSet::timoshenko_eigen_pair(base, true))
+        }
+        (_, false) => {
+            let base = shapes(link, index, basis, n)?;
+            Ok(ShapeSet::timoshenko_eigen_pair(base, false))
+        }
+    }
+}
+
 /// Axial shapes matching the transverse basis: clamped-free bar modes √2 sin((2k−1)πx/2L)
 /// (exact for the bar without tip mass), or ξ·Pₖ(2ξ−1) for `poly`.
 fn axial_shapes(link: &Link, basis: Basis, n: usize) -> ShapeSet {
@@ -165,7 +216,12 @@ pub fn build_chain_for(
     let mut joints = Vec::new();
     let mut offset = 0;
     for (i, l) in scene.links.iter().enumerate() {
-        let transverse = shapes(l, i, basis, n)?;
+        let (transverse, rotation) = if l.shear {
+            let (v, psi) = timoshenko_shapes(l, i, basis, n)?;
+            (v, Some(psi))
+        } else {
+            (shapes(l, i, basis, n)?, None)
+        };
         let axial = l.axial.then(|| axial_shapes(l, basis, n));
         let ints = LinkIntegrals::new(
             l.length,
@@ -177,10 +233,26 @@ pub fn build_chain_for(
             l.foreshortening,
         );
         let na = axial.as_ref().map_or(0, |a| a.count());
+        let params = SectionParams {
+            ei: l.bending_stiffness,
+            shear_stiffness: l.shear_stiffness.filter(|_| l.shear),
+            rho_i: l.rotary_inertia_per_length.filter(|_| l.rotary_inertia),
+            kelvin_voigt: l.kelvin_voigt.filter(|g| *g > 0.0),
+        };
+        let section = match (&rotation, params.shear_stiffness) {
+            (Some(chi), Some(kga)) => {
+                Section::timoshenko(na, &transverse, chi, params, kga, params.rho_i.is_none())
+                    .map_err(|m| ModalError::Numerical {
+                        t: 0.0,
+                        message: format!("link {}: {m}", i + 1),
+                    })?
+            }
+            _ => Section::euler(na, &transverse, &ints.kb, params),
+        };
         let theta = offset;
         let a0 = offset + 1;
         let b0 = a0 + na;
-        offset = b0 + n;
+        offset = b0 + transverse.count() + section.nc;
         links.push(LinkModel {
             name: l.name.clone(),
             transverse,
@@ -190,7 +262,7 @@ pub fn build_chain_for(
             tip_mass: l.tip_mass.unwrap_or(0.0),
             tip_inertia: l.tip_inertia.unwrap_or(0.0),
             hub_inertia: l.joint.hub_inertia.unwrap_or(0.0),
-            kv_ratio: l.kelvin_voigt.map_or(0.0, |g| g / l.bending_stiffness),
+            section,
             theta,
             a0,
             b0,
@@ -227,6 +299,23 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
                 .push(format!("link{k}: axial field, von Kármán strain u' + ½v'²"));
         }
         plan.add(format!("link{k} transverse modes ({})", basis.name()), n);
+        if l.shear {
+            if l.rotary_inertia {
+                plan.add(format!("link{k} section-rotation modes ψ"), n);
+                plan.builds.push(format!(
+                    "link{k}: Timoshenko shear ½∫κGA(v' − ψ)², bending ½∫EI ψ'², rotary inertia ρI"
+                ));
+            } else {
+                plan.builds.push(format!(
+                    "link{k}: Timoshenko shear ½∫κGA(v' − ψ)², bending ½∫EI ψ'²; massless ψ \
+                     condensed (ψ = χᵀT b, {n} ψ shapes)"
+                ));
+            }
+        } else if l.rotary_inertia {
+            plan.builds.push(format!(
+                "link{k}: rotary inertia ρI of the sections (ψ = v')"
+            ));
+        }
         if l.foreshortening {
             plan.builds
                 .push(format!("link{k}: foreshortening (centrifugal) stiffening"));
@@ -238,7 +327,11 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
             plan.builds.push(format!("link{k}: tip inertia"));
         }
         if l.kelvin_voigt.is_some() {
-            plan.builds.push(format!("link{k}: Kelvin-Voigt damping"));
+            plan.builds.push(if l.shear {
+                format!("link{k}: Kelvin-Voigt damping on ψ' (no shear damping)")
+            } else {
+                format!("link{k}: Kelvin-Voigt damping")
+            });
         }
         let j = &l.joint;
         if j.hub_inertia.is_some() {

@@ -95,7 +95,7 @@ impl ChainRhs {
                 .iter()
                 .any(|j| j.prescribed.is_none() && j.damping > 0.0),
         );
-        slots.kelvin_voigt = take(chain.links.iter().any(|l| l.kv_ratio > 0.0));
+        slots.kelvin_voigt = take(chain.links.iter().any(|l| l.has_kelvin_voigt()));
         slots.count = k - 2 * nf;
         ChainRhs {
             chain,
@@ -307,11 +307,12 @@ impl OdeRhs for ChainRhs {
         if let Some(k) = s.kelvin_voigt {
             let mut p = 0.0;
             for l in &self.chain.links {
-                if l.kv_ratio > 0.0 {
-                    let nb = l.nb();
-                    let bd = &self.qd[l.b0..l.b0 + nb];
-                    for r in 0..nb {
-                        p += l.kv_ratio * bd[r] * dot(&l.ints.kb[r * nb..(r + 1) * nb], bd);
+                if l.has_kelvin_voigt() {
+                    // ẋᵀD ẋ over the bending block x = [b, c].
+                    let nbc = l.nbc();
+                    let xd = &self.qd[l.b0..l.b0 + nbc];
+                    for r in 0..nbc {
+                        p += xd[r] * dot(&l.section.dbc[r * nbc..(r + 1) * nbc], xd);
                     }
                 }
             }

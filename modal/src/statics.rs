@@ -29,13 +29,21 @@ pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, Modal
     let chain = build_chain(scene, &settings.discretization)?;
     let l = &chain.links[0];
     let nb = l.nb();
-    let mut k = l.ints.kb.clone();
+    let nbc = l.nbc();
+    // Bending block [b, c] (c: Timoshenko section rotations); loads act on v only.
+    let mut k = l.section.kbc.clone();
     let p = loads.tip_force.unwrap_or(0.0);
     let q = loads.distributed_load.unwrap_or(0.0) / l_mass_per_length(scene);
-    let mut b: Vec<f64> = (0..nb)
-        .map(|i| p * l.ints.phi_l[i] + q * l.ints.phi1[i])
+    let mut b: Vec<f64> = (0..nbc)
+        .map(|i| {
+            if i < nb {
+                p * l.ints.phi_l[i] + q * l.ints.phi1[i]
+            } else {
+                0.0
+            }
+        })
         .collect();
-    cholesky_solve(&mut k, nb, &mut b).map_err(|_| ModalError::Numerical {
+    cholesky_solve(&mut k, nbc, &mut b).map_err(|_| ModalError::Numerical {
         t: 0.0,
         message: "bending stiffness matrix not positive definite".into(),
     })?;
@@ -43,11 +51,12 @@ pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, Modal
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
         settings: settings.clone(),
-        tip_deflection: dot(&l.ints.phi_l, &b),
-        tip_rotation: dot(&l.ints.dphi_l, &b),
+        tip_deflection: dot(&l.ints.phi_l, &b[..nb]),
+        // ψ(L) = r(L)ᵀ[b, c] (= v′(L) for Euler links).
+        tip_rotation: dot(&l.section.rot_l[l.na()..], &b),
         cost: Cost {
             wall_time_s: wall.elapsed().as_secs_f64(),
-            dofs: nb,
+            dofs: nbc,
             ..Cost::default()
         },
     })

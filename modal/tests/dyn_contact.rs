@@ -327,18 +327,15 @@ fn dyn_contact_dof_plan_and_unsupported_variants() {
             .any(|b| b.starts_with("contact1: unilateral"))
     );
     let s = settings(2, 1e-8, None);
+    // Timoshenko links are supported (issue 7, dyn_timoshenko.rs): the plan names the model.
     let timo = load_scene("barhorst-case1-timoshenko").unwrap();
-    match ModalBackend.simulate(&timo, &s) {
-        Err(data::BackendError::Unsupported(m)) => assert!(m.contains("shear"), "{m}"),
-        other => panic!("expected Unsupported, got {other:?}"),
-    }
-    // Seed 001's Timoshenko model of the constrained arm: no shear modes in the basis.
-    let mut arm = load_scene("constrained-arm").unwrap();
-    arm.links[0].shear = true;
-    match ModalBackend.simulate(&arm, &s) {
-        Err(data::BackendError::Unsupported(m)) => assert!(m.contains("shear"), "{m}"),
-        other => panic!("expected Unsupported, got {other:?}"),
-    }
+    let plan = ModalBackend.dof_plan(&timo, &disc).unwrap();
+    assert_eq!(
+        plan.total(),
+        2 + 2 * 3,
+        "massless ψ is condensed: no extra DOFs"
+    );
+    assert!(plan.builds.iter().any(|b| b.contains("Timoshenko")));
     // Friction on a unilateral contact (impacts with friction) stays refused.
     let mut tipmass = load_scene("barhorst-case1-tipmass").unwrap();
     tipmass.contacts[0].friction = 0.3;

@@ -32,6 +32,14 @@ enum Kind {
     AxialSine,
     /// Beam eigenfunctions: β and (A, B, C, D) per mode.
     Eigen { beta: Vec<f64>, coef: Vec<[f64; 4]> },
+    /// Timoshenko field built on an eigenfunction basis: with `linear`, shape 0 is √3·ξ (a root
+    /// shear strain / linear rotation); the others are the base's φₖ, or with `derivative` its
+    /// (L/βₖ)·φₖ'.
+    Augmented {
+        base: Box<ShapeSet>,
+        derivative: bool,
+        linear: bool,
+    },
 }
 
 /// n shape functions on [0, L] with derivatives up to order 2 (3 for eigenfunctions).
@@ -56,6 +64,7 @@ impl ShapeSet {
         match &self.kind {
             Kind::Eigen { beta, .. } => beta.last().copied().unwrap_or(1.0),
             Kind::AxialSine => (2.0 * self.count as f64 - 1.0) * std::f64::consts::FRAC_PI_2,
+            Kind::Augmented { base, .. } => base.max_wavenumber().max(1.0),
             // A polynomial of degree d oscillates like a wave of wavenumber ≈ d.
             Kind::Poly { .. } | Kind::AxialPoly { .. } => self.count as f64 + 2.0,
         }
@@ -153,12 +162,64 @@ impl ShapeSet {
         Ok(s)
     }
 
+    /// The (v, ψ) shape pair of a Timoshenko link built on a cantilever eigenfunction basis
+    /// (`base`, n − 1 functions): v ∈ span{ξ, φ₁, …, φₙ₋₁}, ψ ∈ span{ξ, φ₁', …, φₙ₋₁'}.
+    /// The ξ in v carries the root shear strain v'(0) = γ(0) ≠ 0 that every φₖ (φₖ'(0) = 0)
+    /// lacks; ψ contains every φₖ', so the κGA → ∞ limit ψ = v' is the Euler model on
+    /// {φ₁, …, φₙ₋₁} (no shear locking).
+    ///
+    /// Without `root_shear` the pair is v ∈ span{φ₁, …, φₙ}, ψ ∈ span{φ₁', …, φₙ'} (n = base
+    /// count): the frame keeps v'(0) = 0 (see [`crate::model::section`] for when that is used).
+    pub fn timoshenko_eigen_pair(base: ShapeSet, root_shear: bool) -> (ShapeSet, ShapeSet) {
+        let length = base.length;
+        let count = base.count + usize::from(root_shear);
+        let make = |derivative: bool| ShapeSet {
+            length,
+            count,
+            kind: Kind::Augmented {
+                base: Box::new(base.clone()),
+                derivative,
+                linear: root_shear,
+            },
+        };
+        let psi = make(true);
+        (make(false), psi)
+    }
+
     /// Writes d^deriv φₖ/dx^deriv at x for all k.
     pub fn eval(&self, x: f64, deriv: usize, out: &mut [f64]) {
         let l = self.length;
         let xi = x / l;
         let dscale = l.powi(-(deriv as i32));
         match &self.kind {
+            Kind::Augmented {
+                base,
+                derivative,
+                linear,
+            } => {
+                let first = usize::from(*linear);
+                if *linear {
+                    let s3 = 3f64.sqrt();
+                    out[0] = match deriv {
+                        0 => s3 * xi,
+                        1 => s3 / l,
+                        _ => 0.0,
+                    };
+                }
+                if self.count > first {
+                    let rest = &mut out[first..self.count];
+                    if *derivative {
+                        base.eval(x, deriv + 1, rest);
+                        if let Kind::Eigen { beta, .. } = &base.kind {
+                            for (o, b) in rest.iter_mut().zip(beta) {
+                                *o *= l / b;
+                            }
+                        }
+                    } else {
+                        base.eval(x, deriv, rest);
+                    }
+                }
+            }
             Kind::Eigen { beta, coef } => {
                 for (k, o) in out.iter_mut().enumerate().take(self.count) {
                     let b = beta[k];

@@ -63,7 +63,7 @@ pub struct BodyScratch {
 }
 
 impl BodyScratch {
-    pub fn new(na: usize, nb: usize) -> Self {
+    pub fn new(na: usize, nb: usize, nc: usize) -> Self {
         let z = |k: usize| vec![0.0; k];
         BodyScratch {
             mphib: z(nb),
@@ -79,7 +79,7 @@ impl BodyScratch {
             cbd: z(na),
             cta: z(nb),
             ctad: z(nb),
-            bl: z(2 * (3 + na + nb)),
+            bl: z(2 * (3 + na + nb + nc)),
             bq: z(nb * nb),
             eq: z(nb * nb),
             amat: z(nb * nb),
@@ -112,7 +112,7 @@ pub fn body_terms(
 ) {
     let it = &link.ints;
     let (na, nb) = (it.na, it.nb);
-    let d = 3 + na + nb;
+    let d = link.body_dim();
     let (ia, ib) = (3, 3 + na);
     let f = if link.foreshortening { 1.0 } else { 0.0 };
     let (vx, vy, om) = (nu[0], nu[1], nu[2]);
@@ -165,8 +165,9 @@ pub fn body_terms(
     let m02 = -phi1_b;
     let m12 = it.c0 + psi1_a - 0.5 * f * bs1b;
 
-    // 𝕄 of the distributed mass.
+    // 𝕄 of the distributed mass (the ψ coordinates c, if any, only get section/tip inertia).
     mb.iter_mut().for_each(|v| *v = 0.0);
+    h.iter_mut().for_each(|v| *v = 0.0);
     mb[0] = it.m;
     mb[d + 1] = it.m;
     mb[2] = m02;
@@ -266,16 +267,33 @@ pub fn body_terms(
             }
         }
     }
+    let ne = d - 3;
+    let rot_l = &link.section.rot_l;
     if link.tip_inertia > 0.0 {
-        // Tip body rotates with α + φ(L)'ᵀ b: T = ½ J (ω + φ'(L)ᵀḃ)².
+        // Tip body rotates with the tip section, α + ψ(L) = α + r(L)ᵀe: T = ½ J (ω + r(L)ᵀė)².
         let jt = link.tip_inertia;
         mb[2 * d + 2] += jt;
-        for k in 0..nb {
-            let ck = it.dphi_l[k];
-            mb[2 * d + ib + k] += jt * ck;
-            mb[(ib + k) * d + 2] += jt * ck;
-            for l in 0..nb {
-                mb[(ib + k) * d + ib + l] += jt * ck * it.dphi_l[l];
+        for k in 0..ne {
+            let ck = rot_l[k];
+            if ck == 0.0 {
+                continue;
+            }
+            mb[2 * d + 3 + k] += jt * ck;
+            mb[(3 + k) * d + 2] += jt * ck;
+            for l in 0..ne {
+                mb[(3 + k) * d + 3 + l] += jt * ck * rot_l[l];
+            }
+        }
+    }
+    if let Some(rot) = &link.section.rotary {
+        // Section rotary inertia ½∫ρI (ω + r(x)ᵀė)²: constant entries, no convective terms.
+        mb[2 * d + 2] += rot.j0;
+        for k in 0..ne {
+            mb[2 * d + 3 + k] += rot.r1[k];
+            mb[(3 + k) * d + 2] += rot.r1[k];
+            let row = &rot.rm[k * ne..(k + 1) * ne];
+            for (l, v) in row.iter().enumerate() {
+                mb[(3 + k) * d + 3 + l] += v;
             }
         }
     }
@@ -324,7 +342,7 @@ fn exact_inextensible_terms(
     let n = it.nb;
     let nn = n * n;
     let na = it.na;
-    let d = 3 + na + n;
+    let d = h.len();
     let ib = 3 + na;
     // Contractions of Q over its first index pair (symmetric in i, j: upper triangle, weight 2).
     s.bq.iter_mut().for_each(|v| *v = 0.0);

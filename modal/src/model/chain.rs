@@ -17,6 +17,7 @@ use data::scene::{PrescribedMotion, TorqueLaw};
 
 use super::body::{BodyScratch, body_terms};
 use super::integrals::{LinkIntegrals, dot};
+use super::section::Section;
 use crate::basis::ShapeSet;
 
 /// One joint: its law and initial state.
@@ -52,8 +53,9 @@ pub struct LinkModel {
     pub tip_mass: f64,
     pub tip_inertia: f64,
     pub hub_inertia: f64,
-    /// Kelvin–Voigt γ/EI (the damping matrix is (γ/EI) K_b); 0 when off.
-    pub kv_ratio: f64,
+    /// Section rotation ψ, rotary inertia, and the stiffness/Kelvin–Voigt matrices of the
+    /// bending block [b, c] ([`super::section`]).
+    pub section: Section,
     pub theta: usize,
     pub a0: usize,
     pub b0: usize,
@@ -66,9 +68,25 @@ impl LinkModel {
     pub fn nb(&self) -> usize {
         self.ints.nb
     }
-    /// Body dimension 3 + na + nb.
+    /// Number of section-rotation coordinates c (Timoshenko with rotary inertia; else 0).
+    pub fn nc(&self) -> usize {
+        self.section.nc
+    }
+    /// Number of elastic coordinates na + nb + nc (contiguous from `a0`).
+    pub fn ne(&self) -> usize {
+        self.na() + self.nb() + self.nc()
+    }
+    /// Size of the bending block [b, c] (contiguous from `b0`).
+    pub fn nbc(&self) -> usize {
+        self.nb() + self.nc()
+    }
+    /// Body dimension 3 + na + nb + nc.
     pub fn body_dim(&self) -> usize {
-        3 + self.na() + self.nb()
+        3 + self.ne()
+    }
+    /// Kelvin–Voigt on.
+    pub fn has_kelvin_voigt(&self) -> bool {
+        !self.section.dbc.is_empty()
     }
 }
 
@@ -126,7 +144,7 @@ pub struct SingularMass;
 
 impl Chain {
     pub fn new(links: Vec<LinkModel>, joints: Vec<JointModel>, gravity: Option<[f64; 2]>) -> Self {
-        let n = links.last().map_or(0, |l| l.b0 + l.nb());
+        let n = links.last().map_or(0, |l| l.a0 + l.ne());
         let mut free = Vec::new();
         let mut prescribed = Vec::new();
         for (i, l) in links.iter().enumerate() {
@@ -135,8 +153,7 @@ impl Chain {
             } else {
                 free.push(l.theta);
             }
-            free.extend(l.a0..l.a0 + l.na());
-            free.extend(l.b0..l.b0 + l.nb());
+            free.extend(l.a0..l.a0 + l.ne());
         }
         let work = links
             .iter()
@@ -153,7 +170,7 @@ impl Chain {
                     qg: vec![0.0; d],
                     x: vec![0.0; d * n],
                     u: vec![0.0; d],
-                    scratch: BodyScratch::new(l.na(), l.nb()),
+                    scratch: BodyScratch::new(l.na(), l.nb(), l.nc()),
                     vk: if l.na() > 0 {
                         vec![0.0; l.nb() * l.nb()]
                     } else {
@@ -206,13 +223,9 @@ impl Chain {
             }
             // Elastic body velocities.
             {
-                let (a0, na, b0, nb) = {
-                    let l = &self.links[i];
-                    (l.a0, l.na(), l.b0, l.nb())
-                };
+                let (a0, ne) = (self.links[i].a0, self.links[i].ne());
                 let w = &mut self.work[i];
-                w.nu[3..3 + na].copy_from_slice(&qd[a0..a0 + na]);
-                w.nu[3 + na..3 + na + nb].copy_from_slice(&qd[b0..b0 + nb]);
+                w.nu[3..3 + ne].copy_from_slice(&qd[a0..a0 + ne]);
             }
             let link = &self.links[i];
             let w = &mut self.work[i];
@@ -241,13 +254,9 @@ impl Chain {
                 for c in 0..n {
                     xrow[c] = mrow[0] * w.gr[c] + mrow[1] * w.gr[n + c] + mrow[2] * w.gr[2 * n + c];
                 }
+                // Elastic body coordinates e = [a, b, c] are contiguous in q from a0.
                 for m in 3..d {
-                    let gm = if m - 3 < link.na() {
-                        link.a0 + (m - 3)
-                    } else {
-                        link.b0 + (m - 3 - link.na())
-                    };
-                    xrow[gm] += mrow[m];
+                    xrow[link.a0 + m - 3] += mrow[m];
                 }
                 w.u[l] = w.qg[l] - w.h[l] - mrow[0] * w.gamma[0] - mrow[1] * w.gamma[1];
             }
@@ -266,11 +275,7 @@ impl Chain {
                 }
             }
             for l in 3..d {
-                let gl = if l - 3 < link.na() {
-                    link.a0 + (l - 3)
-                } else {
-                    link.b0 + (l - 3 - link.na())
-                };
+                let gl = link.a0 + l - 3;
                 let xrow = &w.x[l * n..(l + 1) * n];
                 let mrow = &mut self.mass[gl * n..(gl + 1) * n];
                 for c in 0..n {
@@ -278,12 +283,18 @@ impl Chain {
                 }
                 self.force[gl] += w.u[l];
             }
-            // Elastic forces: −K_b b − (γ/EI) K_b ḃ, −K_a a.
+            // Elastic forces of the bending block x = [b, c]: −K x − D ẋ; axial −K_a a.
             let nb = link.nb();
-            let bd = &qd[link.b0..link.b0 + nb];
-            for r in 0..nb {
-                let row = &link.ints.kb[r * nb..(r + 1) * nb];
-                self.force[link.b0 + r] -= dot(row, b) + link.kv_ratio * dot(row, bd);
+            let nbc = link.nbc();
+            let xb = &q[link.b0..link.b0 + nbc];
+            let xbd = &qd[link.b0..link.b0 + nbc];
+            let sec = &link.section;
+            for r in 0..nbc {
+                let mut fr = dot(&sec.kbc[r * nbc..(r + 1) * nbc], xb);
+                if !sec.dbc.is_empty() {
+                    fr += dot(&sec.dbc[r * nbc..(r + 1) * nbc], xbd);
+                }
+                self.force[link.b0 + r] -= fr;
             }
             let na = link.na();
             for r in 0..na {
@@ -346,10 +357,12 @@ impl Chain {
             wx[li.b0 + k] += -fsf * sc.slb[k];
             wy[li.b0 + k] += li.ints.phi_l[k];
         }
-        let bi = &q[li.b0..li.b0 + li.nb()];
         let bdi = &qd[li.b0..li.b0 + li.nb()];
-        let delta = dot(&li.ints.dphi_l, bi) + q[ln.theta];
-        let delta_d = dot(&li.ints.dphi_l, bdi) + qd[ln.theta];
+        // Joint convention: the next frame turns with the tip cross-section, ψᵢ(Lᵢ) = r(L)ᵀe.
+        let ne = li.ne();
+        let rot_l = &li.section.rot_l;
+        let delta = dot(rot_l, &q[li.a0..li.a0 + ne]) + q[ln.theta];
+        let delta_d = dot(rot_l, &qd[li.a0..li.a0 + ne]) + qd[ln.theta];
         let (s, c) = delta.sin_cos();
         // V_{i+1} = R(−δ) w_L.
         for col in 0..n {
@@ -358,8 +371,8 @@ impl Chain {
             wn.gr[n + col] = -s * x + c * y;
             wn.gr[2 * n + col] = wi.gr[2 * n + col];
         }
-        for k in 0..li.nb() {
-            wn.gr[2 * n + li.b0 + k] += li.ints.dphi_l[k];
+        for k in 0..ne {
+            wn.gr[2 * n + li.a0 + k] += rot_l[k];
         }
         wn.gr[2 * n + ln.theta] += 1.0;
         wn.nu[0] = c * wl[0] + s * wl[1];
@@ -433,7 +446,8 @@ impl Chain {
             let w = &self.work[i];
             e.kinetic += 0.5 * quad(&w.mb, link.body_dim(), &w.nu);
             let nb = link.nb();
-            e.strain += 0.5 * quad(&link.ints.kb, nb, &q[link.b0..link.b0 + nb]);
+            let nbc = link.nbc();
+            e.strain += 0.5 * quad(&link.section.kbc, nbc, &q[link.b0..link.b0 + nbc]);
             let na = link.na();
             if na > 0 {
                 let a = &q[link.a0..link.a0 + na];
