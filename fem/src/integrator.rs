@@ -235,10 +235,19 @@ impl Integrator {
     /// Consistent q̈ at the current state: solves R(q, q̇, q̈) = 0 for q̈ (R is affine in q̈; the
     /// iteration converges because the mass-matrix approximation misses only O(v′²) terms).
     fn initial_acceleration(&mut self, t_law: f64) -> Result<(), FemError> {
+        // Section rotations of Timoshenko links without rotary inertia carry no mass: M is
+        // singular on them and their rows of R do not involve q̈. A small stiffness share
+        // ε·K (ε = 10⁻⁶h², εω² ≪ 1 for the resolved modes) regularizes the matrix; its massless
+        // rows then set q̈_b = −K_bb⁻¹K_ba q̈_a (their equations stay satisfied to first order),
+        // and the iteration still converges to R = 0 in the mass-carrying rows.
         let c = NewtonCoefficients {
             c_a: 1.0,
             c_v: 0.0,
-            c_q: 0.0,
+            c_q: if self.chain.has_massless_dofs() {
+                1e-6 * self.h * self.h
+            } else {
+                0.0
+            },
         };
         for it in 0..50 {
             self.chain

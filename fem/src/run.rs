@@ -122,6 +122,18 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
             message: format!("must lie in (0, 1], got {safety}"),
         });
     }
+    if method == Method::CentralDifference {
+        if let Some(i) = scene
+            .links
+            .iter()
+            .position(|l| l.shear && !l.rotary_inertia)
+        {
+            return Err(FemError::unsupported(format!(
+                "fem central-difference: link {} is a Timoshenko link without `rotary_inertia`:                  its section rotations carry no mass (M is singular), which an explicit scheme                  cannot step; use generalized-alpha or energy-midpoint",
+                i + 1
+            )));
+        }
+    }
     if rtol.is_some() && method == Method::CentralDifference {
         return Err(FemError::InvalidSettings {
             field: "time.rtol".into(),
