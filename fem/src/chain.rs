@@ -571,6 +571,132 @@ impl Chain {
         self.links.iter().any(|l| l.shear && l.rho_i == 0.0)
     }
 
+    /// Basis of the massless directions (null space of M at a rest state) of the Timoshenko
+    /// links without rotary inertia, as sparse vectors (DOF, coefficient):
+    /// * every ψ DOF (interior and nodal), except the tip ψ(L) that turns a tip inertia, or a
+    ///   child whose joint is prescribed; a tip ψ(L) that carries a child on a free joint turns
+    ///   the child like its joint angle θ, so there the direction is e_ψ(L) − e_θ;
+    /// * for a free joint without hub inertia: turning the frame by α while v = −αx (and
+    ///   ψ(L) = −α, which keeps tip bodies and the child in place) moves no material point at
+    ///   v = 0: the frame angle is tied to the mass only through the root section, which has no
+    ///   inertia. (Euler–Bernoulli links have no such direction: v′(0) = 0 ties the frame to
+    ///   the mass.) Its stiffness is the shear and bending of the root element.
+    fn massless_directions(&self) -> Vec<Vec<(usize, f64)>> {
+        let mut dirs = Vec::new();
+        for (li, l) in self.links.iter().enumerate() {
+            if !l.shear || l.rho_i > 0.0 {
+                continue;
+            }
+            for e in 0..l.n_el {
+                dirs.push(vec![(l.int_dof[3 * e + 2], 1.0)]);
+            }
+            for k in 1..l.n_el {
+                dirs.push(vec![(l.r_dof[k], 1.0)]);
+            }
+            let tip = l.r_dof[l.n_el];
+            if l.tip_inertia == 0.0 {
+                match self.links.get(li + 1) {
+                    None => dirs.push(vec![(tip, 1.0)]),
+                    Some(c) if c.joint.dof != NONE => {
+                        dirs.push(vec![(tip, 1.0), (c.joint.dof, -1.0)]);
+                    }
+                    // A prescribed child joint: ψ(L) turns the child, it carries its mass.
+                    Some(_) => {}
+                }
+            }
+            if l.joint.dof != NONE && l.hub_inertia == 0.0 {
+                let mut d = vec![(l.joint.dof, 1.0)];
+                for k in 1..=l.n_el {
+                    if l.v_dof[k] != NONE {
+                        d.push((l.v_dof[k], -(k as f64) * l.h));
+                    }
+                }
+                for e in 0..l.n_el {
+                    for (j, at) in [(0, 1.0 / 3.0), (1, 2.0 / 3.0)] {
+                        d.push((l.int_dof[3 * e + j], -(e as f64 + at) * l.h));
+                    }
+                }
+                if tip != NONE {
+                    d.push((tip, -1.0));
+                }
+                dirs.push(d);
+            }
+        }
+        dirs
+    }
+
+    /// Makes a state consistent in the massless directions (see [`Chain::has_massless_dofs`]):
+    /// their equations Nᵀ R = 0 involve no acceleration — they are static balances (e.g. the
+    /// tip section of a link carries the next joint's spring moment, the root section the
+    /// joint's) that must hold from the start. Solves them by moving along those directions
+    /// (Newton, finite-difference Jacobian; once, at the start of a run — the stepper then keeps
+    /// them satisfied). Along the frame-rotation directions this shifts a joint angle by the
+    /// root shear rotation of the settled state, with the material points held in place.
+    /// No-op for chains without massless DOFs.
+    pub fn settle_massless(&mut self, t: f64, q: &mut [f64], qd: &[f64]) -> Result<(), FemError> {
+        if !self.has_massless_dofs() {
+            return Ok(());
+        }
+        let dirs = self.massless_directions();
+        let (n, nb) = (self.ndof, dirs.len());
+        let zero = vec![0.0; n];
+        let mut r = vec![0.0; n];
+        let mut f0 = vec![0.0; nb];
+        let mut col = vec![0.0; nb];
+        let mut lu = crate::band::DenseLu::new(nb);
+        let project = |r: &[f64], out: &mut [f64]| {
+            for (k, d) in dirs.iter().enumerate() {
+                out[k] = d.iter().map(|&(i, c)| c * r[i]).sum();
+            }
+        };
+        for _ in 0..20 {
+            self.residual(t, q, qd, &zero, &mut r);
+            project(&r, &mut f0);
+            // Forward differences with a step far below the rotations involved (linear at a
+            // rest state: the Newton step is then exact to the difference error).
+            let eps = 1e-7;
+            for k in 0..nb {
+                for &(i, c) in &dirs[k] {
+                    q[i] += eps * c;
+                }
+                self.residual(t, q, qd, &zero, &mut r);
+                for &(i, c) in &dirs[k] {
+                    q[i] -= eps * c;
+                }
+                project(&r, &mut col);
+                for i in 0..nb {
+                    col[i] = (col[i] - f0[i]) / eps;
+                }
+                lu.set_column(k, &col);
+            }
+            lu.factorize()?;
+            let mut dy = f0.clone();
+            lu.solve_in_place(&mut dy);
+            let mut big = 0.0f64;
+            for (k, d) in dirs.iter().enumerate() {
+                for &(i, c) in d {
+                    q[i] -= dy[k] * c;
+                }
+                big = big.max(dy[k].abs());
+            }
+            if !big.is_finite() {
+                break;
+            }
+            // Rotations: 1e-12 rad is far below any discretization error.
+            if big <= 1e-12 {
+                // Leave the chain's cached point data at the settled state.
+                self.residual(t, q, qd, &zero, &mut r);
+                return Ok(());
+            }
+        }
+        Err(FemError::Numerical {
+            t,
+            message: "could not make the massless section rotations (Timoshenko links without \
+                      rotary inertia) consistent with the initial state"
+                .into(),
+        })
+    }
+
     /// A Newton-matrix container with this chain's pattern.
     pub fn new_matrix(&self) -> BorderedBand {
         BorderedBand::new(

@@ -223,6 +223,7 @@ impl Integrator {
             it.dense = Some(DenseLu::new(n));
         }
         it.chain.initial_state(&mut it.q, &mut it.qd);
+        it.chain.settle_massless(0.0, &mut it.q, &it.qd)?;
         it.initial_acceleration(0.0)?;
         Ok(it)
     }
@@ -235,19 +236,13 @@ impl Integrator {
     /// Consistent q̈ at the current state: solves R(q, q̇, q̈) = 0 for q̈ (R is affine in q̈; the
     /// iteration converges because the mass-matrix approximation misses only O(v′²) terms).
     fn initial_acceleration(&mut self, t_law: f64) -> Result<(), FemError> {
-        // Section rotations of Timoshenko links without rotary inertia carry no mass: M is
-        // singular on them and their rows of R do not involve q̈. A small stiffness share
-        // ε·K (ε = 10⁻⁶h², εω² ≪ 1 for the resolved modes) regularizes the matrix; its massless
-        // rows then set q̈_b = −K_bb⁻¹K_ba q̈_a (their equations stay satisfied to first order),
-        // and the iteration still converges to R = 0 in the mass-carrying rows.
+        if self.chain.has_massless_dofs() {
+            return self.regularized_initial_acceleration(t_law);
+        }
         let c = NewtonCoefficients {
             c_a: 1.0,
             c_v: 0.0,
-            c_q: if self.chain.has_massless_dofs() {
-                1e-6 * self.h * self.h
-            } else {
-                0.0
-            },
+            c_q: 0.0,
         };
         for it in 0..50 {
             self.chain
@@ -284,6 +279,53 @@ impl Integrator {
             t: self.t,
             message: "could not compute a consistent initial acceleration".into(),
         })
+    }
+
+    /// Initial acceleration of a chain with massless directions (Timoshenko links without
+    /// rotary inertia: see `Chain::settle_massless`). There M is singular and, along the
+    /// frame-rotation directions, only O(v²)-massive: the acceleration is not determined by M
+    /// (those are algebraic variables of a DAE). It is defined here as the solution of
+    /// (M + εK) q̈ = −R(q, q̇, 0) with ε = 10⁻⁴h² (the implicit step's own regularization
+    /// β h² scaled down: resolved modes, εω² ≪ 1, get their exact acceleration to a relative
+    /// 10⁻⁴(hω)²; the massless directions get the acceleration that keeps their static balance
+    /// to first order). R is affine in q̈ and the band matrix is analytic, so one solve is
+    /// exact for that system.
+    fn regularized_initial_acceleration(&mut self, t_law: f64) -> Result<(), FemError> {
+        let c = NewtonCoefficients {
+            c_a: 1.0,
+            c_v: 0.0,
+            c_q: 1e-4 * self.h * self.h,
+        };
+        self.qdd.iter_mut().for_each(|x| *x = 0.0);
+        self.chain
+            .residual(t_law, &self.q, &self.qd, &self.qdd, &mut self.res);
+        self.counters.rhs += 1;
+        self.counters.jacobians += 1;
+        self.counters.factorizations += 1;
+        // The analytic band matrix even where steps use the finite-difference one:
+        // differences of the small ε·K share would drown in round-off.
+        self.chain.newton_matrix(&self.q, c, &mut self.matrix);
+        self.matrix
+            .factorize()
+            .map_err(|e| with_time(e, self.t))?;
+        self.delta.copy_from_slice(&self.res);
+        self.matrix.solve_in_place(&mut self.delta);
+        for i in 0..self.qdd.len() {
+            self.qdd[i] = -self.delta[i];
+        }
+        if self.qdd.iter().any(|x| !x.is_finite()) {
+            return Err(FemError::Numerical {
+                t: self.t,
+                message: "could not compute a consistent initial acceleration".into(),
+            });
+        }
+        // Leave the chain's cached data (joint torques) at the initial state.
+        self.chain
+            .residual(t_law, &self.q, &self.qd, &self.qdd, &mut self.res);
+        self.matrix_h = f64::NAN;
+        self.a.copy_from_slice(&self.qdd);
+        self.record_step_start(t_law);
+        Ok(())
     }
 
     /// Stores the joint quantities at the start of a step for the work integrals.
