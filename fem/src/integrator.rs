@@ -223,6 +223,8 @@ impl Integrator {
             it.dense = Some(DenseLu::new(n));
         }
         it.chain.initial_state(&mut it.q, &mut it.qd);
+        // The unsettled rest configuration (v = 0) is kept in q1 for the initial acceleration.
+        it.q1.copy_from_slice(&it.q);
         it.chain.settle_massless(0.0, &mut it.q, &it.qd)?;
         it.initial_acceleration(0.0)?;
         Ok(it)
@@ -282,14 +284,16 @@ impl Integrator {
     }
 
     /// Initial acceleration of a chain with massless directions (Timoshenko links without
-    /// rotary inertia: see `Chain::settle_massless`). There M is singular and, along the
-    /// frame-rotation directions, only O(v²)-massive: the acceleration is not determined by M
-    /// (those are algebraic variables of a DAE). It is defined here as the solution of
-    /// (M + εK) q̈ = −R(q, q̇, 0) with ε = 10⁻⁴h² (the implicit step's own regularization
-    /// β h² scaled down: resolved modes, εω² ≪ 1, get their exact acceleration to a relative
-    /// 10⁻⁴(hω)²; the massless directions get the acceleration that keeps their static balance
-    /// to first order). R is affine in q̈ and the band matrix is analytic, so one solve is
-    /// exact for that system.
+    /// rotary inertia: see `Chain::settle_massless`). There M is singular: the massless
+    /// directions N are algebraic variables, whose acceleration follows from differentiating
+    /// their balance Nᵀ R = 0 (to first order Nᵀ K q̈ = 0 at rest), not from M. One solve of
+    /// (M₀ + εK₀) q̈ = −R(q, q̇, 0) gives both: M₀, K₀ are the matrices at the unsettled rest
+    /// configuration (v = 0, kept in `q1` by `new`), where NᵀM₀ = 0 exactly, so with the
+    /// settled residual (NᵀR = 0) its N-rows read ε NᵀK₀ q̈ = 0; the mass-carrying rows are
+    /// M q̈ = −R up to ε K₀ q̈ (ε = 10⁻⁴h²: a relative 10⁻⁴(hω)² for the resolved modes) and the
+    /// O(ψ) settling shift. (At the settled state itself NᵀM = O(ψ) ≠ 0, and that coupling,
+    /// divided by ε, made generalized-α first order.) R is affine in q̈ and the band matrix
+    /// is analytic: one solve is exact for that system.
     fn regularized_initial_acceleration(&mut self, t_law: f64) -> Result<(), FemError> {
         let c = NewtonCoefficients {
             c_a: 1.0,
@@ -297,17 +301,19 @@ impl Integrator {
             c_q: 1e-4 * self.h * self.h,
         };
         self.qdd.iter_mut().for_each(|x| *x = 0.0);
-        self.chain
-            .residual(t_law, &self.q, &self.qd, &self.qdd, &mut self.res);
-        self.counters.rhs += 1;
+        self.counters.rhs += 2;
         self.counters.jacobians += 1;
         self.counters.factorizations += 1;
         // The analytic band matrix even where steps use the finite-difference one:
         // differences of the small ε·K share would drown in round-off.
-        self.chain.newton_matrix(&self.q, c, &mut self.matrix);
+        self.chain
+            .residual(t_law, &self.q1, &self.qd, &self.qdd, &mut self.res);
+        self.chain.newton_matrix(&self.q1, c, &mut self.matrix);
         self.matrix
             .factorize()
             .map_err(|e| with_time(e, self.t))?;
+        self.chain
+            .residual(t_law, &self.q, &self.qd, &self.qdd, &mut self.res);
         self.delta.copy_from_slice(&self.res);
         self.matrix.solve_in_place(&mut self.delta);
         for i in 0..self.qdd.len() {

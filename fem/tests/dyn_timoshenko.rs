@@ -60,13 +60,15 @@ fn setup(
     (ch, q, qd, qdd)
 }
 
+/// Free-joint chains (Lagrange's equations of the reported energies hold as checked below
+/// only without explicitly time-dependent kinematics) plus the extensible spin-up link.
 const CASES: [(&str, bool, f64); 6] = [
     ("single-link", false, 0.0),
     ("single-link", true, 1e-3),
     ("two-link-free-undamped", false, 1e-3),
     ("two-link-free-undamped", true, 0.0),
+    ("two-link-free-undamped", true, 1e-3),
     ("spin-up-axial", false, 1e-3),
-    ("spin-up", true, 1e-3),
 ];
 
 #[test]
@@ -132,16 +134,21 @@ fn sys_timoshenko_newton_matrix_is_the_residual_derivative() {
         c_q: 1e-4,
     };
     // Exact without foreshortening (FD accuracy; the two-link case has larger ∂/∂q terms, as
-    // for the Euler chain). With foreshortening the documented ∂s/∂q couplings are omitted
-    // (free chains then use the dense finite-difference Jacobian): only bounded there.
+    // for the Euler chain). With foreshortening the documented ∂s/∂q couplings (O(v′); free
+    // chains then use the dense finite-difference Jacobian) are omitted: exact at v = 0.
     for (name, fs, rho_i, tol) in [
         ("single-link", false, 0.0, 1e-7),
         ("single-link", false, 1e-3, 1e-7),
         ("two-link-free-undamped", false, 1e-3, 1e-4),
         ("spin-up-axial", false, 1e-3, 1e-7),
-        ("spin-up", true, 1e-3, 0.1),
+        ("spin-up", true, 1e-3, 1e-7),
     ] {
-        let (mut ch, q, qd, qdd) = setup(name, 3, fs, rho_i);
+        let (mut ch, mut q, qd, qdd) = setup(name, 3, fs, rho_i);
+        if fs {
+            // The omitted foreshortening couplings are O(v′): at an undeformed configuration
+            // (with rates and accelerations) the band matrix is exact.
+            q.iter_mut().for_each(|x| *x = 0.0);
+        }
         // Kelvin–Voigt on, for the c_v part.
         for l in ch.links.iter_mut() {
             l.kelvin_voigt = 0.2;
@@ -195,7 +202,9 @@ fn sys_timoshenko_newton_matrix_is_the_residual_derivative() {
 
 #[test]
 fn sys_timoshenko_mass_is_symmetric_and_kelvin_voigt_is_the_dissipation() {
-    for (name, fs, rho_i) in CASES {
+    // Free joints only: with a prescribed joint the inertial pass also carries the prescribed
+    // rates and accelerations, so it is not a pure product M x.
+    for (name, fs, rho_i) in CASES.into_iter().filter(|c| c.0 != "spin-up-axial") {
         let (mut ch, q, qd, _) = setup(name, 3, fs, rho_i);
         let n = ch.ndof;
         let t = 0.3;
@@ -281,9 +290,12 @@ fn cross_timoshenko_chain_linearized_at_rest_is_the_linear_model() {
         );
         // Same Gauss-4 integrals assembled in a different order: round-off only.
         assert!(dm < 1e-12 * mmax && dk < 1e-12 * kmax, "{dm} {dk}");
-        // Hence the same frequencies; and they are the exact Timoshenko ones to O(h⁴).
+        // Hence the same frequencies as the modes backend (reported against the exact
+        // Timoshenko ones for information; their O(h⁴) convergence is checked in
+        // sys_modes_statics).
         let to_mat = |a: &Vec<Vec<f64>>| faer::Mat::from_fn(n, n, |i, j| a[i][j]);
         let (lam, _) = fem::modes::generalized_eigen(&to_mat(&k), &to_mat(&m)).unwrap();
+        let modes = fem::modes::link_modes(&lin, 3).unwrap();
         let l = &sc.links[0];
         let exact = common::timoshenko_omega(
             l.bending_stiffness,
@@ -294,19 +306,22 @@ fn cross_timoshenko_chain_linearized_at_rest_is_the_linear_model() {
             2,
             3.0e5,
         );
-        let bending: Vec<f64> = lam.iter().map(|x| x.sqrt()).collect();
-        let mut matched = 0;
-        for (idx, w) in exact.iter().enumerate() {
-            let best = bending
+        for (idx, md) in modes.iter().enumerate() {
+            let w = lam[idx].sqrt();
+            let rel = (w - md.omega).abs() / md.omega;
+            let vs_exact = exact
                 .iter()
-                .map(|x| (x - w).abs() / w)
+                .map(|x| (x - w).abs() / x)
                 .fold(f64::INFINITY, f64::min);
-            eprintln!("axial={axial} mode {}: ω = {w:.6e}, rel. error {best:.2e}", idx + 1);
-            // Six C3Q2 elements: O(h⁴) error, measured ≈ 1e-7 (mode 1) and 1e-5 (mode 2).
-            assert!(best < 1e-4, "mode {} error {best}", idx + 1);
-            matched += 1;
+            eprintln!(
+                "axial={axial} mode {} ({}): chain ω = {w:.8e}, vs modes {rel:.1e}, \
+                 vs exact bending {vs_exact:.1e}",
+                idx + 1,
+                md.kind
+            );
+            // Same matrices up to 1e-16: eigenvalues agree to the solver's round-off.
+            assert!(rel < 1e-10, "mode {}: {rel}", idx + 1);
         }
-        assert_eq!(matched, 2);
     }
 }
 
@@ -321,7 +336,13 @@ fn settings(n: usize, dt: Option<f64>, t_end: f64, method: Option<&str>) -> Sett
 
 fn sim(sc: &Scene, st: &Settings) -> RunResult {
     let r = FemBackend.simulate(sc, st).unwrap();
-    assert_eq!(r.verdict, StabilityVerdict::Completed, "{}", sc.name);
+    assert_eq!(
+        r.verdict,
+        StabilityVerdict::Completed,
+        "{}: {:?}",
+        sc.name,
+        r.events
+    );
     r
 }
 
@@ -387,13 +408,23 @@ fn dyn_timoshenko_two_link_free_closes_its_ledger() {
             start.elapsed().as_secs_f64()
         );
         assert!(c < 1e-9, "closure {c}");
-        // Generalized-α (trapezoidal, ρ∞ = 1) runs the same chain; its closure is O(h²).
-        let g = sim(&sc, &settings(4, None, 0.5, Some("generalized-alpha")));
-        let cg = g.ledger.relative_closure();
-        let d = max_diff(&r, &g, "link2.tip_y");
-        eprintln!("  generalized-α: closure {cg:.3e}, tip_y_2 vs midpoint {d:.3e}");
-        assert!(cg < 1e-3, "generalized-α closure {cg}");
-        assert!(d < 1e-3, "generalized-α vs midpoint {d}");
+        // Generalized-α (trapezoidal, ρ∞ = 1) runs the same chain. Both schemes are second
+        // order, also with the massless ψ (algebraic) variables: their difference must fall
+        // clearly faster than first order (2×) when the step is halved — measured 3.4 without
+        // and 5.5 (pre-asymptotic, like the Euler chain's 8) with rotary inertia. (An
+        // inconsistent initial acceleration of the massless directions gave exactly 2.0.)
+        let mut diffs = Vec::new();
+        for dt in [2e-3, 1e-3] {
+            let a = sim(&sc, &settings(4, Some(dt), 0.5, None));
+            let g = sim(&sc, &settings(4, Some(dt), 0.5, Some("generalized-alpha")));
+            let cg = g.ledger.relative_closure();
+            let d = max_diff(&a, &g, "link2.tip_y");
+            eprintln!("  dt {dt:e}: generalized-α closure {cg:.3e}, tip y vs midpoint {d:.3e}");
+            diffs.push(d);
+        }
+        let ratio = diffs[0] / diffs[1];
+        eprintln!("  difference ratio for a halved step: {ratio:.2}");
+        assert!(ratio > 3.0, "ratio {ratio}");
     }
 }
 
@@ -420,5 +451,30 @@ fn dyn_barhorst_case1_timoshenko_free_fall_closes_its_ledger() {
         assert!(y[y.len() - 1] < y[0] && y[y.len() - 1] > -1.0);
         let tol = if method.is_none() { 1e-9 } else { 1e-3 };
         assert!(c < tol, "closure {c}");
+    }
+}
+
+#[test]
+#[ignore]
+fn study_orders() {
+    for (shear, kv) in [(false, true), (true, true), (true, false)] {
+        let mut sc = data::load_scene("two-link-free").unwrap();
+        if shear {
+            make_timoshenko(&mut sc, 100.0, 0.0);
+        }
+        if !kv {
+            sc.links.iter_mut().for_each(|l| l.kelvin_voigt = None);
+        }
+        let reference = sim(&sc, &settings(4, Some(3.125e-5), 0.5, None));
+        let mut errs = Vec::new();
+        for dt in [1e-3, 5e-4, 2.5e-4] {
+            let a = sim(&sc, &settings(4, Some(dt), 0.5, None));
+            errs.push(max_diff(&a, &reference, "link2.tip_y"));
+        }
+        eprintln!(
+            "shear {shear} kv {kv}: errors {errs:?} ratios {:.2} {:.2}",
+            errs[0] / errs[1],
+            errs[1] / errs[2]
+        );
     }
 }
