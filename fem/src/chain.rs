@@ -2,8 +2,20 @@
 //!
 //! Link i carries a frame (angle φᵢ, origin Rᵢ). A material point at x has local position
 //! p(x) = (x + w(x), v(x)) with w = u (axial field), w = s = −½∫₀ˣ v′² (foreshortening) or w = 0,
-//! and inertial position r = Rᵢ + A(φᵢ) p. Frames: φ₁ = θ₁, R₁ = 0; φᵢ₊₁ = φᵢ + vᵢ′(Lᵢ) + θᵢ₊₁,
-//! Rᵢ₊₁ = rᵢ(Lᵢ) (scenes.md joint convention).
+//! and inertial position r = Rᵢ + A(φᵢ) p. Frames: φ₁ = θ₁, R₁ = 0; φᵢ₊₁ = φᵢ + βᵢ(Lᵢ) + θᵢ₊₁,
+//! Rᵢ₊₁ = rᵢ(Lᵢ) (scenes.md joint convention), with β the section angle relative to the frame:
+//! v′ for Euler–Bernoulli links, the section rotation ψ for Timoshenko (`shear`) links.
+//!
+//! Elements: Hermite cubic v (DOFs v, v′ per node), or for `shear` links the Timoshenko element
+//! of [`crate::element::timoshenko`]: cubic Lagrange v, quadratic ψ, DOFs (v, ψ) per node plus
+//! v(⅓), v(⅔), ψ(½) per element (global, numbered just before the element's end node so the band
+//! stays 2·dpn + 2 wide). Its strain energy ½∫EI ψ′² + ½∫κGA(v′ − ψ)² is locking-free (the
+//! Kirchhoff subspace is the C¹ cubics) and reduces to the Hermite cubic as κGA → ∞; the
+//! foreshortening and membrane strain use the centre-line slope v′ (quartic v′²: integrated
+//! exactly). Kelvin–Voigt acts on the curvature (β′) only. Section rotary inertia adds
+//! ½∫ρI(φ̇ + β̇)² (angle linear in q: mass only). The "tip slope" column of J that an ancestor
+//! link contributes is β(L), so the per-point Jacobian columns (joint, tip slope, tip v, tip u
+//! per ancestor) are the same for both element kinds.
 //!
 //! With T = ½Σ m|ṙ|² (Gauss quadrature of ρA, tip masses, tip and hub inertias) and
 //! V = U_elastic + U_joint − Σ m g·r, Lagrange's equations are exactly
@@ -23,8 +35,8 @@ use data::scene::{Gravity, Link, PrescribedMotion, TorqueLaw};
 use crate::band::BorderedBand;
 use crate::element::euler_bernoulli as eb;
 use crate::element::hermite::{dot4, hermite};
-use crate::element::timoshenko as timo;
 use crate::element::quadrature::gauss01;
+use crate::element::timoshenko as timo;
 use crate::error::FemError;
 
 /// Index value meaning "no DOF" (clamped node or prescribed joint).

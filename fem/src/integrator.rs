@@ -309,9 +309,7 @@ impl Integrator {
         self.chain
             .residual(t_law, &self.q1, &self.qd, &self.qdd, &mut self.res);
         self.chain.newton_matrix(&self.q1, c, &mut self.matrix);
-        self.matrix
-            .factorize()
-            .map_err(|e| with_time(e, self.t))?;
+        self.matrix.factorize().map_err(|e| with_time(e, self.t))?;
         self.chain
             .residual(t_law, &self.q, &self.qd, &self.qdd, &mut self.res);
         self.delta.copy_from_slice(&self.res);
