@@ -482,6 +482,18 @@ fn dyn_barhorst_case1_timoshenko_free_fall_closes_its_ledger() {
             y[y.len() - 1],
             start.elapsed().as_secs_f64()
         );
+        // The settled start (massless directions balanced: the tip section of link 1 carries
+        // joint 2's spring moment 20·5° = 1.75, the root sections turn their frames against
+        // v = −αx) moves the joint angles only by the root shear rotations, O(moment/κGA·L).
+        for (k, l) in sc.links.iter().enumerate() {
+            let a0 = channel(&r, &format!("joint{}.angle", k + 1))[0];
+            let shift = a0 - l.joint.initial_angle;
+            eprintln!(
+                "  joint {} angle at t = 0 − initial_angle: {shift:.3e}",
+                k + 1
+            );
+            assert!(shift.abs() < 1e-3 * l.joint.initial_angle);
+        }
         // The arm falls (gravity) but has not reached the surface y = −1 yet.
         assert!(y[y.len() - 1] < y[0] && y[y.len() - 1] > -1.0);
         let tol = if method.is_none() { 1e-9 } else { 1e-3 };
