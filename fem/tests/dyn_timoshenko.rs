@@ -35,8 +35,18 @@ fn setup(
     foreshortening: bool,
     rho_i_ratio: f64,
 ) -> (Chain, Vec<f64>, Vec<f64>, Vec<f64>) {
+    // "euler:<scene>": Euler–Bernoulli links with section rotary inertia ½∫ρI(φ̇ + v̇′)².
+    let (name, shear) = match name.strip_prefix("euler:") {
+        Some(n) => (n, false),
+        None => (name, true),
+    };
     let mut sc = data::load_scene(name).unwrap();
-    make_timoshenko(&mut sc, 30.0, rho_i_ratio);
+    if shear {
+        make_timoshenko(&mut sc, 30.0, rho_i_ratio);
+    } else {
+        make_timoshenko(&mut sc, 30.0, rho_i_ratio);
+        sc.links.iter_mut().for_each(|l| l.shear = false);
+    }
     for l in sc.links.iter_mut() {
         l.foreshortening = foreshortening && !l.axial;
         l.kelvin_voigt = None;
@@ -62,7 +72,8 @@ fn setup(
 
 /// Free-joint chains (Lagrange's equations of the reported energies hold as checked below
 /// only without explicitly time-dependent kinematics) plus the extensible spin-up link.
-const CASES: [(&str, bool, f64); 6] = [
+const CASES: [(&str, bool, f64); 7] = [
+    ("euler:two-link-free-undamped", true, 1e-3),
     ("single-link", false, 0.0),
     ("single-link", true, 1e-3),
     ("two-link-free-undamped", false, 1e-3),
@@ -139,6 +150,7 @@ fn sys_timoshenko_newton_matrix_is_the_residual_derivative() {
     for (name, fs, rho_i, tol) in [
         ("single-link", false, 0.0, 1e-7),
         ("single-link", false, 1e-3, 1e-7),
+        ("euler:single-link", false, 1e-3, 1e-7),
         ("two-link-free-undamped", false, 1e-3, 1e-4),
         ("spin-up-axial", false, 1e-3, 1e-7),
         ("spin-up", true, 1e-3, 1e-7),
@@ -604,4 +616,37 @@ fn dyn_constrained_arm_timoshenko_axial_runs_without_contact() {
     let r = diffs[0] / diffs[1];
     eprintln!("  difference ratio per decade of κGA: {r:.2}");
     assert!((5.0..20.0).contains(&r), "ratio {r}");
+}
+
+#[test]
+fn sys_timoshenko_rigid_rotation_kinetic_energy_is_the_rigid_inertia() {
+    // Undeformed link turning at ω: T = ½(J_hub + ρA L³/3 + m L² + J_tip + ρI L)ω², with the
+    // section rotary inertia ρI L counted once (Timoshenko ψ = 0 and Euler v′ = 0 alike).
+    for shear in [true, false] {
+        let mut sc = data::load_scene("single-link").unwrap();
+        make_timoshenko(&mut sc, 30.0, 1e-2);
+        let l = &mut sc.links[0];
+        l.shear = shear;
+        l.tip_mass = Some(0.3);
+        l.tip_inertia = Some(0.01);
+        l.joint.hub_inertia = Some(0.02);
+        let l = &sc.links[0];
+        let ch = Chain::new(&sc.links, None, 3).unwrap();
+        let n = ch.ndof;
+        let q = vec![0.0; n];
+        let mut qd = vec![0.0; n];
+        let w = 1.7;
+        qd[ch.links[0].joint.dof] = w;
+        let len = l.length;
+        let inertia = 0.02
+            + l.mass_per_length * len.powi(3) / 3.0
+            + 0.3 * len * len
+            + 0.01
+            + l.rotary_inertia_per_length.unwrap() * len;
+        let t = ch.energies(0.0, &q, &qd)[0];
+        let exact = 0.5 * inertia * w * w;
+        eprintln!("shear {shear}: T = {t:.15e}, rigid {exact:.15e}");
+        // Gauss quadrature of polynomials of degree ≤ 2: exact to round-off.
+        assert!((t - exact).abs() < 1e-13 * exact, "{t} vs {exact}");
+    }
 }
