@@ -293,7 +293,9 @@ impl Integrator {
     /// M q̈ = −R up to ε K₀ q̈ (ε = 10⁻⁴h²: a relative 10⁻⁴(hω)² for the resolved modes) and the
     /// O(ψ) settling shift. (At the settled state itself NᵀM = O(ψ) ≠ 0, and that coupling,
     /// divided by ε, made generalized-α first order.) R is affine in q̈ and the band matrix
-    /// is analytic: one solve is exact for that system.
+    /// is analytic; refinement passes (below) then drive the mass rows to R = 0 (measured:
+    /// Timoshenko cantilever without rotary inertia, step load, trapezoidal ledger 4e-12
+    /// instead of 1.6e-8 after the single solve).
     fn regularized_initial_acceleration(&mut self, t_law: f64) -> Result<(), FemError> {
         let c = NewtonCoefficients {
             c_a: 1.0,
@@ -301,7 +303,7 @@ impl Integrator {
             c_q: 1e-4 * self.h * self.h,
         };
         self.qdd.iter_mut().for_each(|x| *x = 0.0);
-        self.counters.rhs += 2;
+        self.counters.rhs += 1;
         self.counters.jacobians += 1;
         self.counters.factorizations += 1;
         // The analytic band matrix even where steps use the finite-difference one:
@@ -310,14 +312,40 @@ impl Integrator {
             .residual(t_law, &self.q1, &self.qd, &self.qdd, &mut self.res);
         self.chain.newton_matrix(&self.q1, c, &mut self.matrix);
         self.matrix.factorize().map_err(|e| with_time(e, self.t))?;
-        self.chain
-            .residual(t_law, &self.q, &self.qd, &self.qdd, &mut self.res);
-        self.delta.copy_from_slice(&self.res);
-        self.matrix.solve_in_place(&mut self.delta);
-        for i in 0..self.qdd.len() {
-            self.qdd[i] = -self.delta[i];
+        // Refinement: q̈ ← q̈ − S₀⁻¹R(q̈) removes the ε K₀ q̈ error of the mass rows (factor
+        // ≈ εω² per pass) while the massless rows stay balanced; where the settled state turns
+        // the frame directions slightly massive (NᵀM = O(ψ)) the passes stop improving, and the
+        // q̈ with the smallest residual is kept.
+        let n = self.qdd.len();
+        let mut best = f64::INFINITY;
+        for _ in 0..10 {
+            self.chain
+                .residual(t_law, &self.q, &self.qd, &self.qdd, &mut self.res);
+            self.counters.rhs += 1;
+            let r = self.res.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            if !(r < 0.5 * best) {
+                break;
+            }
+            best = r;
+            self.qdd1.copy_from_slice(&self.qdd);
+            self.delta.copy_from_slice(&self.res);
+            self.matrix.solve_in_place(&mut self.delta);
+            let (mut big, mut amax) = (0.0f64, 0.0f64);
+            for i in 0..n {
+                self.qdd[i] -= self.delta[i];
+                big = big.max(self.delta[i].abs());
+                amax = amax.max(self.qdd[i].abs());
+            }
+            if !big.is_finite() {
+                break;
+            }
+            if big <= 1e-12 * amax.max(1e-12) {
+                self.qdd1.copy_from_slice(&self.qdd);
+                break;
+            }
         }
-        if self.qdd.iter().any(|x| !x.is_finite()) {
+        self.qdd.copy_from_slice(&self.qdd1);
+        if !best.is_finite() || self.qdd.iter().any(|x| !x.is_finite()) {
             return Err(FemError::Numerical {
                 t: self.t,
                 message: "could not compute a consistent initial acceleration".into(),

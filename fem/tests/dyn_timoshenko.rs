@@ -650,3 +650,63 @@ fn sys_timoshenko_rigid_rotation_kinetic_energy_is_the_rigid_inertia() {
         assert!((t - exact).abs() < 1e-13 * exact, "{t} vs {exact}");
     }
 }
+
+#[test]
+#[ignore]
+fn study_barhorst_mesh_convergence() {
+    // Run with: cargo test --release -p fem --test dyn_timoshenko -- --ignored --nocapture
+    // study_barhorst_mesh_convergence
+    let mut sc = data::load_scene("barhorst-case1-timoshenko").unwrap();
+    sc.contacts.clear();
+    let runs: Vec<RunResult> = [2usize, 4, 8, 16]
+        .iter()
+        .map(|&n| {
+            let start = std::time::Instant::now();
+            let r = sim(&sc, &settings(n, Some(5e-4), 0.15, None));
+            eprintln!(
+                "n_el {n}: closure {:.2e}, {:.2} s",
+                r.ledger.relative_closure(),
+                start.elapsed().as_secs_f64()
+            );
+            r
+        })
+        .collect();
+    for ch in ["link2.tip_deflection", "link2.tip_y"] {
+        let d: Vec<f64> = (0..3)
+            .map(|k| max_diff(&runs[k], &runs[k + 1], ch))
+            .collect();
+        eprintln!(
+            "{ch}: successive differences {d:?}, ratios {:.2} {:.2}",
+            d[0] / d[1],
+            d[1] / d[2]
+        );
+    }
+}
+
+#[test]
+fn dyn_cantilever_timoshenko_step_load_conserves_energy_and_peaks_at_twice_static() {
+    // Fixed hub (prescribed), step tip load P: the linear Timoshenko cantilever oscillates
+    // between 0 and about twice the static deflection P L³/3EI + P L/κGA (exact in the
+    // element: end-loaded solution is cubic v, quadratic ψ). Trapezoidal rule on a linear
+    // system: the ledger closes to round-off. With and without rotary inertia (massless ψ).
+    for rot in [true, false] {
+        let mut sc = data::load_scene("cantilever-timoshenko").unwrap();
+        sc.links[0].rotary_inertia = rot;
+        let l = &sc.links[0];
+        let p = sc.statics.as_ref().unwrap().tip_force.unwrap();
+        let stat = p * l.length.powi(3) / (3.0 * l.bending_stiffness)
+            + p * l.length / l.shear_stiffness.unwrap();
+        let r = sim(&sc, &settings(8, Some(2e-6), 1.3e-3, None));
+        let c = r.ledger.relative_closure();
+        let v = channel(&r, "link1.tip_deflection");
+        let vmax = v.iter().fold(0.0f64, |a, b| a.max(*b));
+        eprintln!(
+            "rotary inertia {rot}: closure {c:.2e}, peak {vmax:.6e} = {:.4}× static {stat:.6e}",
+            vmax / stat
+        );
+        assert!(c < 1e-9, "closure {c}");
+        // The first mode carries ~all of the static shape: the peak is 2× static within the
+        // higher modes' share (a few %).
+        assert!((vmax / stat - 2.0).abs() < 0.1, "{}", vmax / stat);
+    }
+}
