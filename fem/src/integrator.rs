@@ -323,7 +323,8 @@ impl Integrator {
                 .residual(t_law, &self.q, &self.qd, &self.qdd, &mut self.res);
             self.counters.rhs += 1;
             let r = self.res.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-            if !(r < 0.5 * best) {
+            // Stop once a pass no longer halves the residual (or it is not finite).
+            if r.is_nan() || r >= 0.5 * best {
                 break;
             }
             best = r;
