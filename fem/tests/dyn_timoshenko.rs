@@ -710,3 +710,32 @@ fn dyn_cantilever_timoshenko_step_load_conserves_energy_and_peaks_at_twice_stati
         assert!((vmax / stat - 2.0).abs() < 0.1, "{}", vmax / stat);
     }
 }
+
+#[test]
+fn dyn_spin_up_timoshenko_tends_to_the_euler_spin_up() {
+    // Prescribed hub with foreshortening (centrifugal stiffening through s = −½∫v′²): the
+    // Timoshenko spin-up tends to the Euler one as O(EI/(κGA L²)), ~10× per decade.
+    let base = data::load_scene("spin-up").unwrap();
+    let st = settings(8, None, 6.0, None);
+    let euler = sim(&base, &st);
+    let peak = channel(&euler, "link1.tip_deflection")
+        .iter()
+        .fold(0.0f64, |a, b| a.max(b.abs()));
+    let mut diffs = Vec::new();
+    for ratio in [1e3, 1e4] {
+        let mut sc = base.clone();
+        make_timoshenko(&mut sc, ratio, 0.0);
+        let r = sim(&sc, &st);
+        let d = max_diff(&r, &euler, "link1.tip_deflection");
+        eprintln!(
+            "spin-up κGA = {ratio:.0e}·EI/L²: tip deflection diff {d:.3e} of {peak:.3e}, closure \
+             {:.2e} (Euler {:.2e})",
+            r.ledger.relative_closure(),
+            euler.ledger.relative_closure()
+        );
+        diffs.push(d);
+    }
+    let r = diffs[0] / diffs[1];
+    eprintln!("  ratio per decade: {r:.2}");
+    assert!((5.0..20.0).contains(&r), "ratio {r}");
+}
