@@ -2,8 +2,20 @@
 //!
 //! Link i carries a frame (angle φᵢ, origin Rᵢ). A material point at x has local position
 //! p(x) = (x + w(x), v(x)) with w = u (axial field), w = s = −½∫₀ˣ v′² (foreshortening) or w = 0,
-//! and inertial position r = Rᵢ + A(φᵢ) p. Frames: φ₁ = θ₁, R₁ = 0; φᵢ₊₁ = φᵢ + vᵢ′(Lᵢ) + θᵢ₊₁,
-//! Rᵢ₊₁ = rᵢ(Lᵢ) (scenes.md joint convention).
+//! and inertial position r = Rᵢ + A(φᵢ) p. Frames: φ₁ = θ₁, R₁ = 0; φᵢ₊₁ = φᵢ + βᵢ(Lᵢ) + θᵢ₊₁,
+//! Rᵢ₊₁ = rᵢ(Lᵢ) (scenes.md joint convention), with β the section angle relative to the frame:
+//! v′ for Euler–Bernoulli links, the section rotation ψ for Timoshenko (`shear`) links.
+//!
+//! Elements: Hermite cubic v (DOFs v, v′ per node), or for `shear` links the Timoshenko element
+//! of [`crate::element::timoshenko`]: cubic Lagrange v, quadratic ψ, DOFs (v, ψ) per node plus
+//! v(⅓), v(⅔), ψ(½) per element (global, numbered just before the element's end node so the band
+//! stays 2·dpn + 2 wide). Its strain energy ½∫EI ψ′² + ½∫κGA(v′ − ψ)² is locking-free (the
+//! Kirchhoff subspace is the C¹ cubics) and reduces to the Hermite cubic as κGA → ∞; the
+//! foreshortening and membrane strain use the centre-line slope v′ (quartic v′²: integrated
+//! exactly). Kelvin–Voigt acts on the curvature (β′) only. Section rotary inertia adds
+//! ½∫ρI(φ̇ + β̇)² (angle linear in q: mass only). The "tip slope" column of J that an ancestor
+//! link contributes is β(L), so the per-point Jacobian columns (joint, tip slope, tip v, tip u
+//! per ancestor) are the same for both element kinds.
 //!
 //! With T = ½Σ m|ṙ|² (Gauss quadrature of ρA, tip masses, tip and hub inertias) and
 //! V = U_elastic + U_joint − Σ m g·r, Lagrange's equations are exactly
@@ -24,6 +36,7 @@ use crate::band::BorderedBand;
 use crate::element::euler_bernoulli as eb;
 use crate::element::hermite::{dot4, hermite};
 use crate::element::quadrature::gauss01;
+use crate::element::timoshenko as timo;
 use crate::error::FemError;
 
 /// Index value meaning "no DOF" (clamped node or prescribed joint).
@@ -101,6 +114,19 @@ impl JointModel {
     }
 }
 
+/// Local DOFs per element at most (Timoshenko: v₁, ψ₁, v₂, ψ₂, v(⅓), v(⅔), ψ(½)).
+pub const MAXE: usize = timo::NDOF;
+
+/// Σ aₖ dₖ over the first `ne` entries (same summation order as [`dot4`] for ne = 4).
+#[inline]
+fn dotn(a: &[f64; MAXE], d: &[f64; MAXE], ne: usize) -> f64 {
+    let mut s = 0.0;
+    for k in 0..ne {
+        s += a[k] * d[k];
+    }
+    s
+}
+
 /// One link with its element mesh and DOF map.
 #[derive(Debug, Clone)]
 pub struct LinkModel {
@@ -113,62 +139,112 @@ pub struct LinkModel {
     pub ea: f64,
     pub axial: bool,
     pub foreshortening: bool,
-    /// Kelvin–Voigt γ (bending moment γ v̇″).
+    /// Timoshenko link (`shear`): cubic v, quadratic ψ, three interior DOFs per element.
+    pub shear: bool,
+    /// Local DOFs per element: 4 (Hermite cubic) or 7 (Timoshenko).
+    pub ne: usize,
+    /// Section rotary inertia ρI when `rotary_inertia` is on (else 0).
+    pub rho_i: f64,
+    /// Kelvin–Voigt γ (bending moment γ v̇″, or γ ψ̇′ for a Timoshenko link).
     pub kelvin_voigt: f64,
     pub tip_mass: f64,
     pub tip_inertia: f64,
     pub hub_inertia: f64,
     pub joint: JointModel,
-    /// Global DOF of v, v′ and u at node k = 0..=n (node 0 clamped: [`NONE`]).
+    /// Global DOF of v, slope and u at node k = 0..=n (node 0 clamped: [`NONE`]). The slope is
+    /// v′ for an Euler–Bernoulli link and the section rotation ψ for a Timoshenko link.
     pub v_dof: Vec<usize>,
     pub r_dof: Vec<usize>,
     pub u_dof: Vec<usize>,
-    /// Element bending stiffness (same for all elements of the link).
-    pub k_el: [[f64; 4]; 4],
+    /// Timoshenko interior DOFs (v(⅓), v(⅔), ψ(½)) of element e at 3e..3e+3 (empty otherwise).
+    pub int_dof: Vec<usize>,
+    /// Element stiffness (same for all elements of the link), first `ne` rows/columns used:
+    /// ∫EI v″² (Euler–Bernoulli) or ∫EI ψ′² + κGA(v′ − ψ)² (Timoshenko).
+    pub k_el: [[f64; MAXE]; MAXE],
+    /// Bending part ∫EI (section angle)′² of `k_el` (Kelvin–Voigt acts on it only).
+    pub kb_el: [[f64; MAXE]; MAXE],
 }
 
 impl LinkModel {
-    fn elem_dofs(&self, e: usize) -> [usize; 4] {
-        [
-            self.v_dof[e],
-            self.r_dof[e],
-            self.v_dof[e + 1],
-            self.r_dof[e + 1],
-        ]
+    fn elem_dofs(&self, e: usize) -> [usize; MAXE] {
+        let mut d = [NONE; MAXE];
+        d[0] = self.v_dof[e];
+        d[1] = self.r_dof[e];
+        d[2] = self.v_dof[e + 1];
+        d[3] = self.r_dof[e + 1];
+        if self.shear {
+            d[4..7].copy_from_slice(&self.int_dof[3 * e..3 * e + 3]);
+        }
+        d
+    }
+
+    /// Shape functions at local coordinate ξ of an element: (v, section angle).
+    fn shapes_at(&self, xi: f64) -> ([f64; MAXE], [f64; MAXE]) {
+        let (mut n, mut b) = ([0.0; MAXE], [0.0; MAXE]);
+        if self.shear {
+            let s = timo::shapes(xi, self.h);
+            n = s.v;
+            b = s.th;
+        } else {
+            let s = hermite(xi, self.h);
+            n[..4].copy_from_slice(&s.n);
+            b[..4].copy_from_slice(&s.dn);
+        }
+        (n, b)
     }
 }
 
 /// Quadrature tables shared by all elements of one link (they all have length h).
 #[derive(Debug, Clone)]
 struct LinkTables {
-    /// Main Gauss points: ξ, weight·h, N, N′.
+    /// Main Gauss points: ξ, weight·h, v shapes N, their x-derivatives N′ and the section
+    /// angle shapes B (B = N′ for Euler–Bernoulli, the ψ shapes for Timoshenko).
     xi: [f64; NG],
     wh: [f64; NG],
-    n: [[f64; 4]; NG],
-    dn: [[f64; 4]; NG],
+    n: [[f64; MAXE]; NG],
+    dn: [[f64; MAXE]; NG],
+    b: [[f64; MAXE]; NG],
     /// Sub-interval points: weight·h and N′ (NSUB × NSG).
     sub_wh: [[f64; NSG]; NSUB],
-    sub_dn: [[[f64; 4]; NSG]; NSUB],
+    sub_dn: [[[f64; MAXE]; NSG]; NSUB],
 }
 
 impl LinkTables {
-    fn new(h: f64) -> Self {
+    fn new(h: f64, shear: bool) -> Self {
         let (p, w) = gauss01(NG);
         let (ps, ws) = gauss01(NSG);
         let mut t = LinkTables {
             xi: [0.0; NG],
             wh: [0.0; NG],
-            n: [[0.0; 4]; NG],
-            dn: [[0.0; 4]; NG],
+            n: [[0.0; MAXE]; NG],
+            dn: [[0.0; MAXE]; NG],
+            b: [[0.0; MAXE]; NG],
             sub_wh: [[0.0; NSG]; NSUB],
-            sub_dn: [[[0.0; 4]; NSG]; NSUB],
+            sub_dn: [[[0.0; MAXE]; NSG]; NSUB],
+        };
+        // (N, N′, B) at ξ.
+        let at = |xi: f64| {
+            let (mut n, mut dn, mut b) = ([0.0; MAXE], [0.0; MAXE], [0.0; MAXE]);
+            if shear {
+                let s = timo::shapes(xi, h);
+                n = s.v;
+                dn = s.dv;
+                b = s.th;
+            } else {
+                let s = hermite(xi, h);
+                n[..4].copy_from_slice(&s.n);
+                dn[..4].copy_from_slice(&s.dn);
+                b[..4].copy_from_slice(&s.dn);
+            }
+            (n, dn, b)
         };
         for g in 0..NG {
-            let s = hermite(p[g], h);
+            let (n, dn, b) = at(p[g]);
             t.xi[g] = p[g];
             t.wh[g] = w[g] * h;
-            t.n[g] = s.n;
-            t.dn[g] = s.dn;
+            t.n[g] = n;
+            t.dn[g] = dn;
+            t.b[g] = b;
         }
         for j in 0..NSUB {
             let a = if j == 0 { 0.0 } else { p[j - 1] };
@@ -176,7 +252,7 @@ impl LinkTables {
             for k in 0..NSG {
                 let xi = a + (b - a) * ps[k];
                 t.sub_wh[j][k] = ws[k] * (b - a) * h;
-                t.sub_dn[j][k] = hermite(xi, h).dn;
+                t.sub_dn[j][k] = at(xi).1;
             }
         }
         t
@@ -208,6 +284,32 @@ pub struct FrameState {
     pub subtree_moment: f64,
     /// Subtree resultant force (inertial coordinates, d'Alembert sign).
     pub subtree_force: [f64; 2],
+}
+
+/// Element-averaged membrane strain of an extensible Timoshenko element,
+/// ε̄ = (u₂ − u₁)/h + (1/2h)∫v′² (the same locking-free averaged strain as the Euler–Bernoulli
+/// von Kármán element, with the Timoshenko v′; Gauss-4 integrates the quartic v′² exactly), and
+/// its gradient with respect to (u₁, u₂, element DOFs).
+fn membrane(
+    tb: &LinkTables,
+    h: f64,
+    u: [f64; 2],
+    d: &[f64; MAXE],
+    ne: usize,
+) -> (f64, [f64; MAXE + 2]) {
+    let mut half_int = 0.0;
+    let mut g = [0.0; MAXE + 2];
+    g[0] = -1.0 / h;
+    g[1] = 1.0 / h;
+    for k in 0..NG {
+        let dn = &tb.dn[k];
+        let vp = dotn(dn, d, ne);
+        half_int += tb.wh[k] * 0.5 * vp * vp;
+        for a in 0..ne {
+            g[2 + a] += tb.wh[k] / h * vp * dn[a];
+        }
+    }
+    ((u[1] - u[0]) / h + half_int / h, g)
 }
 
 /// The assembled chain model with preallocated work buffers.
@@ -325,26 +427,36 @@ impl Chain {
         let mut next = 0usize;
         let mut models = Vec::with_capacity(nl);
         for (i, l) in links.iter().enumerate() {
-            if l.shear {
-                return Err(FemError::unsupported(format!(
-                    "fem run: Timoshenko shear in dynamics (link {}) is not implemented; modes and \
-                     statics support it",
-                    i + 1
-                )));
-            }
-            if l.rotary_inertia {
-                return Err(FemError::unsupported(format!(
-                    "fem run: section rotary inertia in dynamics (link {}) is not implemented",
-                    i + 1
-                )));
+            if n_el == 0 {
+                return Err(FemError::unsupported(
+                    "fem run: a link needs at least one element".to_string(),
+                ));
             }
             let h = l.length / n_el as f64;
             let has_child = i + 1 < nl;
             let mut v_dof = vec![NONE; n_el + 1];
             let mut r_dof = vec![NONE; n_el + 1];
             let mut u_dof = vec![NONE; n_el + 1];
+            // Timoshenko interior DOFs only exist (are allocated) for shear links.
+            let mut int_dof = if l.shear {
+                vec![NONE; 3 * n_el]
+            } else {
+                Vec::new()
+            };
             let interior_nodes = if has_child { n_el - 1 } else { n_el };
-            for k in 1..=interior_nodes {
+            // Element e's interior DOFs precede node e + 1: every element's DOFs stay within
+            // one contiguous window (the band).
+            for e in 0..n_el {
+                if l.shear {
+                    for k in 0..3 {
+                        int_dof[3 * e + k] = next + k;
+                    }
+                    next += 3;
+                }
+                let k = e + 1;
+                if k > interior_nodes {
+                    continue;
+                }
                 v_dof[k] = next;
                 r_dof[k] = next + 1;
                 next += 2;
@@ -353,6 +465,21 @@ impl Chain {
                     next += 1;
                 }
             }
+            let (k_el, kb_el) = if l.shear {
+                // support::check_planar guarantees κGA for shear links.
+                let kga = l.shear_stiffness.unwrap_or(0.0);
+                (
+                    timo::stiffness(l.bending_stiffness, kga, h),
+                    timo::stiffness(l.bending_stiffness, 0.0, h),
+                )
+            } else {
+                let k4 = eb::bending_stiffness(l.bending_stiffness, h);
+                let mut k = [[0.0; MAXE]; MAXE];
+                for a in 0..4 {
+                    k[a][..4].copy_from_slice(&k4[a]);
+                }
+                (k, k)
+            };
             let j = &l.joint;
             models.push(LinkModel {
                 length: l.length,
@@ -367,6 +494,13 @@ impl Chain {
                 },
                 axial: l.axial,
                 foreshortening: l.foreshortening,
+                shear: l.shear,
+                ne: if l.shear { timo::NDOF } else { 4 },
+                rho_i: if l.rotary_inertia {
+                    l.rotary_inertia_per_length.unwrap_or(0.0)
+                } else {
+                    0.0
+                },
                 kelvin_voigt: l.kelvin_voigt.unwrap_or(0.0),
                 tip_mass: l.tip_mass.unwrap_or(0.0),
                 tip_inertia: l.tip_inertia.unwrap_or(0.0),
@@ -384,7 +518,9 @@ impl Chain {
                 v_dof,
                 r_dof,
                 u_dof,
-                k_el: eb::bending_stiffness(l.bending_stiffness, h),
+                int_dof,
+                k_el,
+                kb_el,
             });
         }
         let n_interior = next;
@@ -406,12 +542,19 @@ impl Chain {
                 next += 1;
             }
         }
-        let dpn_max = models
+        // Half-bandwidth: an element spans node e, (its interior DOFs,) node e + 1.
+        let half_bandwidth = models
             .iter()
-            .map(|m| if m.axial { 3 } else { 2 })
+            .map(|m| {
+                let dpn = if m.axial { 3 } else { 2 };
+                if m.shear { 2 * dpn + 2 } else { 2 * dpn - 1 }
+            })
             .max()
-            .unwrap_or(2);
-        let tables = models.iter().map(|m| LinkTables::new(m.h)).collect();
+            .unwrap_or(3);
+        let tables = models
+            .iter()
+            .map(|m| LinkTables::new(m.h, m.shear))
+            .collect();
         let force = models.iter().map(|m| vec![[0.0; 2]; m.n_el * NG]).collect();
         let pos: Vec<Vec<[f64; 2]>> = models.iter().map(|m| vec![[0.0; 2]; m.n_el * NG]).collect();
         let vel = pos.clone();
@@ -422,7 +565,7 @@ impl Chain {
             gravity: gravity.map_or([0.0, 0.0], |g| g.vector),
             ndof: next,
             n_interior,
-            half_bandwidth: 2 * dpn_max - 1,
+            half_bandwidth,
             frames: vec![FrameState::default(); nl],
             force,
             pos,
@@ -431,6 +574,138 @@ impl Chain {
             joint_torque: vec![0.0; nl],
             tip_load: 0.0,
             distributed_load: 0.0,
+        })
+    }
+
+    /// Whether some DOFs carry no mass: the section rotations ψ of a Timoshenko link without
+    /// rotary inertia (M is singular there; the stiffness determines them).
+    pub fn has_massless_dofs(&self) -> bool {
+        self.links.iter().any(|l| l.shear && l.rho_i == 0.0)
+    }
+
+    /// Basis of the massless directions (null space of M at a rest state) of the Timoshenko
+    /// links without rotary inertia, as sparse vectors (DOF, coefficient):
+    /// * every ψ DOF (interior and nodal), except the tip ψ(L) that turns a tip inertia, or a
+    ///   child whose joint is prescribed; a tip ψ(L) that carries a child on a free joint turns
+    ///   the child like its joint angle θ, so there the direction is e_ψ(L) − e_θ;
+    /// * for a free joint without hub inertia: turning the frame by α while v = −αx (and
+    ///   ψ(L) = −α, which keeps tip bodies and the child in place) moves no material point at
+    ///   v = 0: the frame angle is tied to the mass only through the root section, which has no
+    ///   inertia. (Euler–Bernoulli links have no such direction: v′(0) = 0 ties the frame to
+    ///   the mass.) Its stiffness is the shear and bending of the root element.
+    fn massless_directions(&self) -> Vec<Vec<(usize, f64)>> {
+        let mut dirs = Vec::new();
+        for (li, l) in self.links.iter().enumerate() {
+            if !l.shear || l.rho_i > 0.0 {
+                continue;
+            }
+            for e in 0..l.n_el {
+                dirs.push(vec![(l.int_dof[3 * e + 2], 1.0)]);
+            }
+            for k in 1..l.n_el {
+                dirs.push(vec![(l.r_dof[k], 1.0)]);
+            }
+            let tip = l.r_dof[l.n_el];
+            if l.tip_inertia == 0.0 {
+                match self.links.get(li + 1) {
+                    None => dirs.push(vec![(tip, 1.0)]),
+                    Some(c) if c.joint.dof != NONE => {
+                        dirs.push(vec![(tip, 1.0), (c.joint.dof, -1.0)]);
+                    }
+                    // A prescribed child joint: ψ(L) turns the child, it carries its mass.
+                    Some(_) => {}
+                }
+            }
+            if l.joint.dof != NONE && l.hub_inertia == 0.0 {
+                let mut d = vec![(l.joint.dof, 1.0)];
+                for k in 1..=l.n_el {
+                    if l.v_dof[k] != NONE {
+                        d.push((l.v_dof[k], -(k as f64) * l.h));
+                    }
+                }
+                for e in 0..l.n_el {
+                    for (j, at) in [(0, 1.0 / 3.0), (1, 2.0 / 3.0)] {
+                        d.push((l.int_dof[3 * e + j], -(e as f64 + at) * l.h));
+                    }
+                }
+                if tip != NONE {
+                    d.push((tip, -1.0));
+                }
+                dirs.push(d);
+            }
+        }
+        dirs
+    }
+
+    /// Makes a state consistent in the massless directions (see [`Chain::has_massless_dofs`]):
+    /// their equations Nᵀ R = 0 involve no acceleration — they are static balances (e.g. the
+    /// tip section of a link carries the next joint's spring moment, the root section the
+    /// joint's) that must hold from the start. Solves them by moving along those directions
+    /// (Newton, finite-difference Jacobian; once, at the start of a run — the stepper then keeps
+    /// them satisfied). Along the frame-rotation directions this shifts a joint angle by the
+    /// root shear rotation of the settled state, with the material points held in place.
+    /// No-op for chains without massless DOFs.
+    pub fn settle_massless(&mut self, t: f64, q: &mut [f64], qd: &[f64]) -> Result<(), FemError> {
+        if !self.has_massless_dofs() {
+            return Ok(());
+        }
+        let dirs = self.massless_directions();
+        let (n, nb) = (self.ndof, dirs.len());
+        let zero = vec![0.0; n];
+        let mut r = vec![0.0; n];
+        let mut f0 = vec![0.0; nb];
+        let mut col = vec![0.0; nb];
+        let mut lu = crate::band::DenseLu::new(nb);
+        let project = |r: &[f64], out: &mut [f64]| {
+            for (k, d) in dirs.iter().enumerate() {
+                out[k] = d.iter().map(|&(i, c)| c * r[i]).sum();
+            }
+        };
+        for _ in 0..20 {
+            self.residual(t, q, qd, &zero, &mut r);
+            project(&r, &mut f0);
+            // Forward differences with a step far below the rotations involved (linear at a
+            // rest state: the Newton step is then exact to the difference error).
+            let eps = 1e-7;
+            for k in 0..nb {
+                for &(i, c) in &dirs[k] {
+                    q[i] += eps * c;
+                }
+                self.residual(t, q, qd, &zero, &mut r);
+                for &(i, c) in &dirs[k] {
+                    q[i] -= eps * c;
+                }
+                project(&r, &mut col);
+                for i in 0..nb {
+                    col[i] = (col[i] - f0[i]) / eps;
+                }
+                lu.set_column(k, &col);
+            }
+            lu.factorize()?;
+            let mut dy = f0.clone();
+            lu.solve_in_place(&mut dy);
+            let mut big = 0.0f64;
+            for (k, d) in dirs.iter().enumerate() {
+                for &(i, c) in d {
+                    q[i] -= dy[k] * c;
+                }
+                big = big.max(dy[k].abs());
+            }
+            if !big.is_finite() {
+                break;
+            }
+            // Rotations: 1e-12 rad is far below any discretization error.
+            if big <= 1e-12 {
+                // Leave the chain's cached point data at the settled state.
+                self.residual(t, q, qd, &zero, &mut r);
+                return Ok(());
+            }
+        }
+        Err(FemError::Numerical {
+            t,
+            message: "could not make the massless section rotations (Timoshenko links without \
+                      rotary inertia) consistent with the initial state"
+                .into(),
         })
     }
 
@@ -460,13 +735,12 @@ impl Chain {
         if i == NONE { 0.0 } else { x[i] }
     }
 
-    fn elem_v(x: &[f64], dofs: &[usize; 4]) -> [f64; 4] {
-        [
-            Self::val(x, dofs[0]),
-            Self::val(x, dofs[1]),
-            Self::val(x, dofs[2]),
-            Self::val(x, dofs[3]),
-        ]
+    fn elem_v(x: &[f64], dofs: &[usize; MAXE]) -> [f64; MAXE] {
+        let mut d = [0.0; MAXE];
+        for (v, &i) in d.iter_mut().zip(dofs) {
+            *v = Self::val(x, i);
+        }
+        d
     }
 
     /// Forward pass: frame and tip kinematics of every link (no forces).
@@ -517,6 +791,7 @@ impl Chain {
             // Cumulative foreshortening s, ṡ, s̈ along the link.
             let (mut s, mut sd, mut sdd) = (0.0, 0.0, 0.0);
             let fs = l.foreshortening;
+            let ne = l.ne;
             for e in 0..l.n_el {
                 let dofs = l.elem_dofs(e);
                 let d = Self::elem_v(q, &dofs);
@@ -532,9 +807,9 @@ impl Chain {
                         for k in 0..NSG {
                             let dn = &tb.sub_dn[j][k];
                             let wgt = tb.sub_wh[j][k];
-                            let vp = dot4(dn, &d);
-                            let vpd = dot4(dn, &dd);
-                            let vpdd = dot4(dn, &ddd);
+                            let vp = dotn(dn, &d, ne);
+                            let vpd = dotn(dn, &dd, ne);
+                            let vpdd = dotn(dn, &ddd, ne);
                             s -= 0.5 * wgt * vp * vp;
                             sd -= wgt * vp * vpd;
                             sdd -= wgt * (vpd * vpd + vp * vpdd);
@@ -557,9 +832,9 @@ impl Chain {
                     } else {
                         (0.0, 0.0, 0.0)
                     };
-                    let p = [xa + xi * l.h + ax, dot4(n, &d)];
-                    let pd = [axd, dot4(n, &dd)];
-                    let pdd = [axdd, dot4(n, &ddd)];
+                    let p = [xa + xi * l.h + ax, dotn(n, &d, ne)];
+                    let pd = [axd, dotn(n, &dd, ne)];
+                    let pdd = [axdd, dotn(n, &ddd, ne)];
                     let a = add(
                         add(frame_acc, scale(dw, perp(p))),
                         add(scale(-w * w, p), add(scale(2.0 * w, perp(pd)), pdd)),
@@ -670,17 +945,18 @@ impl Chain {
             let mut f_sum = [0.0; 2];
             let mut m_sum = 0.0;
             let mut tail = f_tip[0];
+            let ne = l.ne;
             for e in (0..l.n_el).rev() {
                 let dofs = l.elem_dofs(e);
                 let d = Self::elem_v(q, &dofs);
-                let mut fe = [0.0; 4];
+                let mut fe = [0.0; MAXE];
                 let (mut fu0, mut fu1) = (0.0, 0.0);
                 for g in 0..NG {
                     let f = self.force[li][e * NG + g];
                     let p = self.pos[li][e * NG + g];
                     f_sum = add(f_sum, f);
                     m_sum += cross(p, f);
-                    for a in 0..4 {
+                    for a in 0..ne {
                         fe[a] += f[1] * tb.n[g][a];
                     }
                     if l.axial {
@@ -689,14 +965,27 @@ impl Chain {
                         fu1 += f[0] * xi;
                     }
                 }
+                // Section rotary inertia: moment density ρI(φ̈ + β̈) on the section angle
+                // φ + β(x) (β = v′ or ψ), which every upstream rotation turns by one.
+                if l.rho_i > 0.0 && parts.inertia {
+                    let ddd = Self::elem_v(qdd, &dofs);
+                    for g in 0..NG {
+                        let b = &tb.b[g];
+                        let mr = l.rho_i * tb.wh[g] * (fr.ddphi + dotn(b, &ddd, ne));
+                        m_sum += mr;
+                        for a in 0..ne {
+                            fe[a] += mr * b[a];
+                        }
+                    }
+                }
                 if l.foreshortening {
                     for j in (0..NSUB).rev() {
                         self.tail[li][e * NSUB + j] = tail;
                         for kk in 0..NSG {
                             let dn = &tb.sub_dn[j][kk];
-                            let vp = dot4(dn, &d);
+                            let vp = dotn(dn, &d, ne);
                             let c = -tail * tb.sub_wh[j][kk] * vp;
-                            for a in 0..4 {
+                            for a in 0..ne {
                                 fe[a] += c * dn[a];
                             }
                         }
@@ -706,7 +995,7 @@ impl Chain {
                     }
                 }
                 // Elastic forces.
-                if cons && l.axial {
+                if cons && l.axial && !l.shear {
                     let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
                     let fv = eb::von_karman_force(
                         l.ea,
@@ -720,18 +1009,29 @@ impl Chain {
                         fe[a] += fv[2 + a];
                     }
                 } else if cons {
-                    for a in 0..4 {
-                        fe[a] += dot4(&l.k_el[a], &d);
+                    for a in 0..ne {
+                        fe[a] += dotn(&l.k_el[a], &d, ne);
+                    }
+                    if l.axial {
+                        // Timoshenko: membrane part ½EA h ε̄² (see `membrane`).
+                        let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
+                        let (eps, gr) = membrane(tb, l.h, u, &d, ne);
+                        let nf = l.ea * l.h * eps;
+                        fu0 += nf * gr[0];
+                        fu1 += nf * gr[1];
+                        for a in 0..ne {
+                            fe[a] += nf * gr[2 + a];
+                        }
                     }
                 }
                 if l.kelvin_voigt > 0.0 && noncons {
                     let dd = Self::elem_v(qd, &dofs);
                     let c = l.kelvin_voigt / l.ei;
-                    for a in 0..4 {
-                        fe[a] += c * dot4(&l.k_el[a], &dd);
+                    for a in 0..ne {
+                        fe[a] += c * dotn(&l.kb_el[a], &dd, ne);
                     }
                 }
-                for a in 0..4 {
+                for a in 0..ne {
                     if dofs[a] != NONE {
                         res[dofs[a]] += fe[a];
                     }
@@ -789,7 +1089,7 @@ impl Chain {
         // Fixed-size buffer: no heap allocation per Newton matrix.
         let mut cols = [AncestorColumn::default(); MAX_COLUMNS];
         // Per-point column buffer, reused (filled up to the point's column count).
-        let mut jc = [ColumnAt::default(); 6 + MAX_COLUMNS];
+        let mut jc = [ColumnAt::default(); MAXE + 2 + MAX_COLUMNS];
         for li in 0..nl {
             let l = &self.links[li];
             let tb = &self.tables[li];
@@ -862,7 +1162,7 @@ impl Chain {
             // f = m(a − g). Adds c_a·M + c_v·C + c_q·K_inertial for all its columns, with
             // C = Σ m Jᵀ 2J̇ and K_inertial = Σ m[(∂J/∂q)ᵀ(a − g) + Jᵀ ∂a/∂q].
             let point = |s: &mut BorderedBand,
-                         jc: &mut [ColumnAt; 6 + MAX_COLUMNS],
+                         jc: &mut [ColumnAt; MAXE + 2 + MAX_COLUMNS],
                          m: f64,
                          p: [f64; 2],
                          pd: [f64; 2],
@@ -944,6 +1244,17 @@ impl Chain {
                     }
                 }
             };
+            // Rotation columns (upstream joints and tip slopes): they turn every section of
+            // this link by one.
+            let mut rot_dofs = [NONE; MAX_COLUMNS + 1];
+            let mut nr = 0;
+            for col in &cols[..ncols] {
+                if col.rotation {
+                    rot_dofs[nr] = col.dof;
+                    nr += 1;
+                }
+            }
+            let ne = l.ne;
             for e in 0..l.n_el {
                 let dofs = l.elem_dofs(e);
                 for g in 0..NG {
@@ -951,20 +1262,51 @@ impl Chain {
                     let p = self.pos[li][e * NG + g];
                     let xi = tb.xi[g];
                     let n = tb.n[g];
-                    let local = [
-                        (dofs[0], [0.0, n[0]]),
-                        (dofs[1], [0.0, n[1]]),
-                        (dofs[2], [0.0, n[2]]),
-                        (dofs[3], [0.0, n[3]]),
-                        (l.u_dof[e], [1.0 - xi, 0.0]),
-                        (l.u_dof[e + 1], [xi, 0.0]),
-                    ];
+                    // Translation columns of the point: the v shapes (the ψ DOFs of a
+                    // Timoshenko element do not move it), then u.
+                    let mut local = [(NONE, [0.0; 2]); MAXE + 2];
+                    let mut nloc = 0;
+                    for a in 0..ne {
+                        if l.shear && (a == 1 || a == 3 || a == 6) {
+                            continue;
+                        }
+                        local[nloc] = (dofs[a], [0.0, n[a]]);
+                        nloc += 1;
+                    }
+                    local[nloc] = (l.u_dof[e], [1.0 - xi, 0.0]);
+                    local[nloc + 1] = (l.u_dof[e + 1], [xi, 0.0]);
+                    nloc += 2;
                     let pd = self.vel[li][e * NG + g];
                     let f = self.force[li][e * NG + g];
-                    point(s, &mut jc, m, p, pd, f, &local);
+                    point(s, &mut jc, m, p, pd, f, &local[..nloc]);
+                }
+                // Section rotary inertia: the section angle is linear in q (J constant), so
+                // only the mass term c_a ρI w JᵀJ.
+                if l.rho_i > 0.0 && c.c_a != 0.0 {
+                    for g in 0..NG {
+                        let mw = c.c_a * l.rho_i * tb.wh[g];
+                        let b = &tb.b[g];
+                        let mut jr = [(NONE, 0.0); MAX_COLUMNS + 1 + MAXE];
+                        let mut nj = 0;
+                        for &dof in &rot_dofs[..nr] {
+                            jr[nj] = (dof, 1.0);
+                            nj += 1;
+                        }
+                        for a in 0..ne {
+                            if dofs[a] != NONE && b[a] != 0.0 {
+                                jr[nj] = (dofs[a], b[a]);
+                                nj += 1;
+                            }
+                        }
+                        for &(da, va) in &jr[..nj] {
+                            for &(db, vb) in &jr[..nj] {
+                                s.add(da, db, mw * va * vb);
+                            }
+                        }
+                    }
                 }
                 // Elastic tangent, Kelvin–Voigt, foreshortening geometric stiffness.
-                if l.axial {
+                if l.axial && !l.shear {
                     let d = Self::elem_v(q, &dofs);
                     let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
                     let kt = eb::von_karman_tangent(
@@ -989,40 +1331,69 @@ impl Chain {
                         }
                     }
                 } else {
-                    for a in 0..4 {
-                        for b in 0..4 {
+                    for a in 0..ne {
+                        for b in 0..ne {
                             if dofs[a] != NONE && dofs[b] != NONE {
                                 s.add(dofs[a], dofs[b], c.c_q * l.k_el[a][b]);
+                            }
+                        }
+                    }
+                    if l.axial {
+                        // Timoshenko membrane tangent EA h ggᵀ + EA ε̄ ∫N′N′ (v block).
+                        let d = Self::elem_v(q, &dofs);
+                        let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
+                        let (eps, gr) = membrane(tb, l.h, u, &d, ne);
+                        let mut all = [NONE; MAXE + 2];
+                        all[0] = l.u_dof[e];
+                        all[1] = l.u_dof[e + 1];
+                        all[2..2 + ne].copy_from_slice(&dofs[..ne]);
+                        for a in 0..ne + 2 {
+                            for b in 0..ne + 2 {
+                                if all[a] != NONE && all[b] != NONE {
+                                    s.add(all[a], all[b], c.c_q * l.ea * l.h * gr[a] * gr[b]);
+                                }
+                            }
+                        }
+                        let nf = l.ea * eps;
+                        for g in 0..NG {
+                            let dn = &tb.dn[g];
+                            let wgt = c.c_q * nf * tb.wh[g];
+                            for a in 0..ne {
+                                for b in 0..ne {
+                                    if dofs[a] != NONE && dofs[b] != NONE {
+                                        s.add(dofs[a], dofs[b], wgt * dn[a] * dn[b]);
+                                    }
+                                }
                             }
                         }
                     }
                 }
                 if l.kelvin_voigt > 0.0 {
                     let cf = l.kelvin_voigt / l.ei;
-                    for a in 0..4 {
-                        for b in 0..4 {
+                    for a in 0..ne {
+                        for b in 0..ne {
                             if dofs[a] != NONE && dofs[b] != NONE {
-                                s.add(dofs[a], dofs[b], c.c_v * cf * l.k_el[a][b]);
+                                s.add(dofs[a], dofs[b], c.c_v * cf * l.kb_el[a][b]);
                             }
                         }
                     }
                 }
                 if l.foreshortening {
-                    let mut kg = [[0.0; 4]; 4];
+                    let mut kg = [[0.0; MAXE]; MAXE];
                     for j in 0..NSUB {
                         let tl = self.tail[li][e * NSUB + j];
                         for kk in 0..NSG {
                             let dn = &tb.sub_dn[j][kk];
                             let wgt = -tl * tb.sub_wh[j][kk];
-                            for a in 0..4 {
-                                for b in 0..4 {
+                            for a in 0..ne {
+                                for b in 0..ne {
                                     kg[a][b] += wgt * dn[a] * dn[b];
                                 }
                             }
                         }
                     }
-                    for a in 0..4 {
-                        for b in 0..4 {
+                    for a in 0..ne {
+                        for b in 0..ne {
                             if dofs[a] != NONE && dofs[b] != NONE {
                                 s.add(dofs[a], dofs[b], c.c_q * kg[a][b]);
                             }
@@ -1037,15 +1408,7 @@ impl Chain {
                 let f = scale(l.tip_mass, sub(fr.a_tip, g_loc));
                 point(s, &mut jc, l.tip_mass, fr.p_tip, fr.dp_tip, f, &local);
             }
-            // Rotational inertias: tip (rotates with φᵢ + v′(L)) and hub (with φᵢ).
-            let mut rot_dofs = [NONE; MAX_COLUMNS + 1];
-            let mut nr = 0;
-            for col in &cols[..ncols] {
-                if col.rotation {
-                    rot_dofs[nr] = col.dof;
-                    nr += 1;
-                }
-            }
+            // Rotational inertias: tip (rotates with φᵢ + slope(L)) and hub (with φᵢ).
             if l.hub_inertia > 0.0 {
                 for a in 0..nr {
                     for b in 0..nr {
@@ -1092,6 +1455,7 @@ impl Chain {
             spring += 0.5 * l.joint.stiffness * (th - l.joint.set_point).powi(2);
             kin += 0.5 * l.hub_inertia * w * w;
             let (mut s, mut sd) = (0.0, 0.0);
+            let ne = l.ne;
             for e in 0..l.n_el {
                 let dofs = l.elem_dofs(e);
                 let d = Self::elem_v(q, &dofs);
@@ -1104,9 +1468,9 @@ impl Chain {
                         for k in 0..NSG {
                             let dn = &tb.sub_dn[j][k];
                             let wgt = tb.sub_wh[j][k];
-                            let vp = dot4(dn, &d);
+                            let vp = dotn(dn, &d, ne);
                             s -= 0.5 * wgt * vp * vp;
-                            sd -= wgt * vp * dot4(dn, &dd);
+                            sd -= wgt * vp * dotn(dn, &dd, ne);
                         }
                     }
                     if j == NG {
@@ -1123,14 +1487,19 @@ impl Chain {
                     } else {
                         (0.0, 0.0)
                     };
-                    let p = [xa + xi * l.h + ax, dot4(&tb.n[j], &d)];
-                    let pd = [axd, dot4(&tb.n[j], &dd)];
+                    let p = [xa + xi * l.h + ax, dotn(&tb.n[j], &d, ne)];
+                    let pd = [axd, dotn(&tb.n[j], &dd, ne)];
                     let v = add(dr0, rot(phi, add(scale(w, perp(p)), pd)));
                     let m = l.rho_a * tb.wh[j];
                     kin += 0.5 * m * dot(v, v);
                     grav -= m * dot(g_in, add(r0, rot(phi, p)));
+                    if l.rho_i > 0.0 {
+                        // ½ρI(φ̇ + β̇)², β the section angle relative to the frame.
+                        let om = w + dotn(&tb.b[j], &dd, ne);
+                        kin += 0.5 * l.rho_i * tb.wh[j] * om * om;
+                    }
                 }
-                if l.axial {
+                if l.axial && !l.shear {
                     strain += eb::von_karman_energy(
                         l.ea,
                         l.ei,
@@ -1138,8 +1507,12 @@ impl Chain {
                         &[u[0], u[1], d[0], d[1], d[2], d[3]],
                     );
                 } else {
-                    for a in 0..4 {
-                        strain += 0.5 * d[a] * dot4(&l.k_el[a], &d);
+                    for a in 0..ne {
+                        strain += 0.5 * d[a] * dotn(&l.k_el[a], &d, ne);
+                    }
+                    if l.axial {
+                        let (eps, _) = membrane(tb, l.h, u, &d, ne);
+                        strain += 0.5 * l.ea * l.h * eps * eps;
                     }
                 }
             }
@@ -1181,16 +1554,32 @@ impl Chain {
         };
         let mut p = self.tip_load * Self::val(qd, l.v_dof[l.n_el]);
         if self.distributed_load != 0.0 {
-            let (q0, h) = (self.distributed_load, l.h);
-            let fq = [
-                0.5 * q0 * h,
-                q0 * h * h / 12.0,
-                0.5 * q0 * h,
-                -q0 * h * h / 12.0,
-            ];
-            for e in 0..l.n_el {
-                let dd = Self::elem_v(qd, &l.elem_dofs(e));
-                p += dot4(&fq, &dd);
+            let q0 = self.distributed_load;
+            if l.shear {
+                // Consistent loads ∫q₀N of the Timoshenko v shapes (Gauss-4: exact).
+                let tb = &self.tables[self.links.len() - 1];
+                let mut fq = [0.0; MAXE];
+                for g in 0..NG {
+                    for a in 0..MAXE {
+                        fq[a] += q0 * tb.wh[g] * tb.n[g][a];
+                    }
+                }
+                for e in 0..l.n_el {
+                    let dd = Self::elem_v(qd, &l.elem_dofs(e));
+                    p += dotn(&fq, &dd, MAXE);
+                }
+            } else {
+                let h = l.h;
+                let fq = [
+                    0.5 * q0 * h,
+                    q0 * h * h / 12.0,
+                    0.5 * q0 * h,
+                    -q0 * h * h / 12.0,
+                ];
+                for e in 0..l.n_el {
+                    let dd = Self::elem_v(qd, &l.elem_dofs(e));
+                    p += dot4(&fq, &[dd[0], dd[1], dd[2], dd[3]]);
+                }
             }
         }
         p
@@ -1208,8 +1597,8 @@ impl Chain {
                 let c = l.kelvin_voigt / l.ei;
                 for e in 0..l.n_el {
                     let dd = Self::elem_v(qd, &l.elem_dofs(e));
-                    for a in 0..4 {
-                        pkv += c * dd[a] * dot4(&l.k_el[a], &dd);
+                    for a in 0..l.ne {
+                        pkv += c * dd[a] * dotn(&l.kb_el[a], &dd, l.ne);
                     }
                 }
             }
@@ -1262,7 +1651,7 @@ impl Chain {
             let d = Self::elem_v(q, &l.elem_dofs(e));
             for j in 0..NSUB {
                 for k in 0..NSG {
-                    let vp = dot4(&tb.sub_dn[j][k], &d);
+                    let vp = dotn(&tb.sub_dn[j][k], &d, l.ne);
                     s -= 0.5 * tb.sub_wh[j][k] * vp * vp;
                 }
             }
@@ -1276,7 +1665,7 @@ impl Chain {
         let e = ((x / l.h).floor() as usize).min(l.n_el - 1);
         let xi = ((x - e as f64 * l.h) / l.h).clamp(0.0, 1.0);
         let d = Self::elem_v(q, &l.elem_dofs(e));
-        dot4(&hermite(xi, l.h).n, &d)
+        dotn(&l.shapes_at(xi).0, &d, l.ne)
     }
 
     /// Axial tip displacement u(L) of link `li` (extensible links).
@@ -1298,7 +1687,8 @@ impl Chain {
                 return format!("joint {} angle", li + 1);
             }
             for k in 0..=l.n_el {
-                for (what, map) in [("v", &l.v_dof), ("v′", &l.r_dof), ("u", &l.u_dof)] {
+                let slope = if l.shear { "ψ" } else { "v′" };
+                for (what, map) in [("v", &l.v_dof), (slope, &l.r_dof), ("u", &l.u_dof)] {
                     if map[k] == dof {
                         return format!(
                             "link {} node {k} (x = {:.4}) {what}",
@@ -1307,6 +1697,18 @@ impl Chain {
                         );
                     }
                 }
+            }
+        }
+        for (li, l) in self.links.iter().enumerate() {
+            if let Some(p) = l.int_dof.iter().position(|&d| d == dof) {
+                let (e, k) = (p / 3, p % 3);
+                let (what, at) = [("v", 1.0 / 3.0), ("v", 2.0 / 3.0), ("ψ", 0.5)][k];
+                return format!(
+                    "link {} element {} interior {what} (x = {:.4})",
+                    li + 1,
+                    e + 1,
+                    (e as f64 + at) * l.h
+                );
             }
         }
         format!("dof {dof}")

@@ -4,26 +4,36 @@
 //! modes, linear statics and nonlinear dynamics.
 //!
 //! ## Governing equations
-//! Each link is a beam of length L clamped (v = v′ = 0, u = 0) to a frame that rotates with its
-//! joint. Per link, with ρA, EI (EA, κGA, ρI when switched on):
-//! * strain energy U = ½∫EI v″² (Euler–Bernoulli), ½∫EI θ′² + ½∫κGA(v′ − θ)² (Timoshenko),
-//!   plus ½∫EA(u′ + ½v′²)² with `axial` (von Kármán);
+//! Each link is a beam of length L clamped (v = v′ = 0, u = 0; Timoshenko: v = ψ = 0) to a
+//! frame that rotates with its joint. Per link, with ρA, EI (EA, κGA, ρI when switched on):
+//! * strain energy U = ½∫EI v″² (Euler–Bernoulli), ½∫EI ψ′² + ½∫κGA(v′ − ψ)² (Timoshenko,
+//!   `shear`: section rotation ψ relative to the frame), plus ½∫EA(u′ + ½v′²)² with `axial`
+//!   (von Kármán; element-averaged membrane strain);
 //! * `foreshortening` (inextensible): axial position x + s(x), s = −½∫₀ˣ v′², which carries the
 //!   centrifugal stiffening through the kinetic energy without axial DOFs;
-//! * kinetic energy T = ½∫ρA|ṙ|² + ½m_tip|ṙ_tip|² + ½J_tip(φ̇ + v̇′(L))² + ½J_hub φ̇², with
-//!   r = R + A(φ)(x + w, v) the inertial position and the frames chained by the joint convention
-//!   φᵢ₊₁ = φᵢ + vᵢ′(Lᵢ) + θᵢ₊₁, Rᵢ₊₁ = rᵢ(Lᵢ);
+//! * kinetic energy T = ½∫ρA|ṙ|² + ½m_tip|ṙ_tip|² + ½J_tip(φ̇ + β̇(L))² + ½J_hub φ̇²
+//!   (+ ½∫ρI(φ̇ + β̇)² with `rotary_inertia`), β the section angle relative to the frame (v′,
+//!   or ψ for Timoshenko), r = R + A(φ)(x + w, v) the inertial position (the foreshortening w
+//!   uses the centre-line slope v′) and the frames chained by the joint convention
+//!   φᵢ₊₁ = φᵢ + βᵢ(Lᵢ) + θᵢ₊₁, Rᵢ₊₁ = rᵢ(Lᵢ);
 //! * joints: torque −K(θ − θ₀) − Dθ̇ + τ(t), or prescribed θ(t) (the needed torque is reported);
-//!   Kelvin–Voigt bending moment γ v̇″ (dissipation ∫γ v̇″²); gravity −∫ρA g·r.
+//!   Kelvin–Voigt bending moment γ β̇′ (dissipation ∫γ β̇′², no shear damping); gravity
+//!   −∫ρA g·r.
 //!
 //! Lagrange's equations are R(q, q̇, q̈, t) = Σ m Jᵀ(r̈ − g) + ∂U/∂q + C q̇ − Q = 0 with
 //! J = ∂r/∂q ([`chain`]), evaluated in O(n) per link by a forward kinematic and a backward force
 //! pass. Discretization: Hermite-cubic v (+ linear u) per element ([`element`]), consistent mass
 //! by 4-point Gauss quadrature (frequency error O(h⁴)). Modes and statics ([`linear`]) also offer
 //! the hierarchical Hermite-quintic element (`discretization.element = "hermite-quintic"`: cubic
-//! plus two C¹ interior bubbles, frequency error O(h⁸)) and, for `shear` links, a Timoshenko
-//! element with cubic v and quadratic θ (locking-free, O(h⁴)); their interior DOFs are global
-//! DOFs, never condensed. Dynamics refuses both (`unsupported`).
+//! plus two C¹ interior bubbles, frequency error O(h⁸); dynamics refuses it). `shear` links use
+//! the Timoshenko element with cubic v and quadratic ψ (locking-free, O(h⁴)) in modes, statics
+//! and dynamics; its interior DOFs v(⅓), v(⅔), ψ(½) are global DOFs, never condensed.
+//!
+//! Timoshenko links without rotary inertia have massless directions (every ψ, and turning the
+//! frame against v = −αx when the hub has no inertia): their equations are static balances
+//! (a DAE). The run starts from a state that satisfies them (`Chain::settle_massless`: the ψ
+//! carry e.g. the next joint's spring moment from t = 0), the initial acceleration treats them
+//! as algebraic (`Integrator`), and central difference refuses such links.
 //!
 //! ## Time integration
 //! Default for chains whose joints are all free (torque/spring driven: `single-link`,
@@ -40,7 +50,9 @@
 //! configuration-dependent mass M(q) causes. Second order and symmetric. Cost per step 2.3–7×
 //! generalized-α's (≈ 12 residual-type passes per Newton iteration).
 //!
-//! Elsewhere (prescribed joint motion, extensible links), and on request: generalized-α
+//! Elsewhere (prescribed joint motion, extensible links, an undamped Timoshenko link without
+//! rotary inertia on a free joint without hub inertia — its almost massless frame direction
+//! stalls the midpoint Newton iteration), and on request: generalized-α
 //! (ρ∞ = 1, i.e. the trapezoidal rule, unless a link is extensible: ρ∞ = 0.9) with
 //! a constant-displacement predictor and Newton on q̈. Newton matrix (both implicit schemes): the
 //! analytic bordered-band matrix (mass, Coriolis C = Σm Jᵀ2J̇, inertial and elastic stiffness;

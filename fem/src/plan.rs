@@ -46,7 +46,7 @@ pub fn dof_plan(
                 "Euler–Bernoulli beam (Hermite quintic v: cubic + 2 C¹ bubbles; modes/statics only"
             }
             ElementKind::Timoshenko => {
-                "Timoshenko beam (cubic v, quadratic θ, interior DOFs global; modes/statics only"
+                "Timoshenko beam (cubic v, quadratic θ, interior DOFs global"
             }
         };
         let mut b = vec![format!(

@@ -68,13 +68,34 @@ pub fn default_rho_inf(scene: &Scene) -> f64 {
 /// is extensible — there its ledger closes to the Newton tolerance, where the trapezoidal rule
 /// leaves an O(h²) energy error through the configuration-dependent mass M(q); else
 /// generalized-α (prescribed joints are not supported by the midpoint scheme; extensible links
-/// keep ρ∞ = 0.9 numerical damping of the unresolved axial modes).
+/// keep ρ∞ = 0.9 numerical damping of the unresolved axial modes; undamped massless Timoshenko
+/// hubs: see [`undamped_massless_hub`]).
 pub fn default_method(scene: &Scene) -> Method {
-    if check_midpoint(scene).is_ok() && !scene.links.iter().any(|l| l.axial) {
+    if check_midpoint(scene).is_ok()
+        && !scene
+            .links
+            .iter()
+            .any(|l| l.axial || undamped_massless_hub(l))
+    {
         Method::EnergyMidpoint
     } else {
         Method::GeneralizedAlpha
     }
+}
+
+/// A Timoshenko link without rotary inertia on a free joint without hub inertia, with neither
+/// Kelvin–Voigt nor joint damping: turning its frame against v = −αx moves mass only O(v²)
+/// (chain::Chain::settle_massless), an undamped, almost massless and very stiff direction.
+/// The energy-midpoint Newton iteration stalls on it (measured: Timoshenko
+/// `two-link-free-undamped`, κGA = 100 EI/L², stopped at t = 0.32 s at the default step), while
+/// generalized-α runs it (closure 5e-6): such scenes default to generalized-α.
+fn undamped_massless_hub(l: &data::scene::Link) -> bool {
+    l.shear
+        && !l.rotary_inertia
+        && l.joint.prescribed.is_none()
+        && l.joint.hub_inertia.unwrap_or(0.0) == 0.0
+        && l.kelvin_voigt.unwrap_or(0.0) == 0.0
+        && l.joint.damping.unwrap_or(0.0) == 0.0
 }
 
 /// The energy-midpoint scheme needs every joint free: a prescribed joint would need the work
@@ -121,6 +142,19 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
             field: "time.safety_factor".into(),
             message: format!("must lie in (0, 1], got {safety}"),
         });
+    }
+    if method == Method::CentralDifference
+        && let Some(i) = scene
+            .links
+            .iter()
+            .position(|l| l.shear && !l.rotary_inertia)
+    {
+        return Err(FemError::unsupported(format!(
+            "fem central-difference: link {} is a Timoshenko link without `rotary_inertia`: \
+             its section rotations carry no mass (M is singular), which an explicit scheme \
+             cannot step; use generalized-alpha or energy-midpoint",
+            i + 1
+        )));
     }
     if rtol.is_some() && method == Method::CentralDifference {
         return Err(FemError::InvalidSettings {

@@ -50,12 +50,6 @@ pub fn check_planar(scene: &Scene) -> Result<(), FemError> {
                 i + 1
             )));
         }
-        if l.shear && (l.axial || l.foreshortening) {
-            return Err(FemError::unsupported(format!(
-                "fem: link {}: Timoshenko shear combined with geometric stiffening is not implemented",
-                i + 1
-            )));
-        }
     }
     Ok(())
 }
