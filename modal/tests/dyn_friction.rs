@@ -367,6 +367,42 @@ fn dyn_friction_euler_approaches_rigid_closed_form() {
 }
 
 #[test]
+fn dyn_friction_timoshenko_approaches_rigid_closed_form() {
+    // The Timoshenko model of the same arm (κGA = 1e4·EI/L², a stocky-ish section) with EI, EA
+    // and κGA scaled together ×10, ×100, ×1000: bending and shear compliance both ~ 1/scale, so
+    // the hub angle and the mean wall load must approach the rigid closed form monotonically,
+    // as the Euler model's do.
+    let mut errors = Vec::new();
+    for scale in [10.0, 100.0, 1000.0] {
+        let mut scene = arm();
+        let l = &mut scene.links[0];
+        l.shear = true;
+        l.shear_stiffness = Some(1e4 * l.bending_stiffness / (l.length * l.length) * scale);
+        l.bending_stiffness *= scale;
+        *l.axial_stiffness.as_mut().unwrap() *= scale;
+        let mut st = settings(3, 1e-6, Some(0.5));
+        st.discretization.basis = Some(data::Basis::Poly);
+        let (r, _) = simulate_detailed(&scene, &st).unwrap();
+        assert_eq!(r.verdict, StabilityVerdict::Completed);
+        assert!(r.ledger.relative_closure() < 1e-5);
+        let (e_theta, e_force) = rigid_errors(&scene, &r);
+        println!(
+            "timoshenko scale {scale}: max |θ − θ_rigid| {e_theta:.3e}, mean normal force error {e_force:.3e}, wall {:.2}s",
+            r.cost.wall_time_s
+        );
+        errors.push((e_theta, e_force));
+    }
+    assert!(
+        errors
+            .windows(2)
+            .all(|p| p[1].0 < p[0].0 && p[1].1 < p[0].1),
+        "angle and normal-force errors must fall monotonically: {errors:?}"
+    );
+    let (e_theta, e_force) = errors[2];
+    assert!(e_theta < 1e-3 && e_force < 0.05, "{errors:?}");
+}
+
+#[test]
 fn dyn_friction_simple_flexure_is_the_rigid_model() {
     // Inextensible link (foreshortening, no axial field): on the circle of radius L about its
     // hub it must stay straight, so modal refuses it and names the rigid model.
