@@ -24,6 +24,7 @@
 
 use crate::band::{BorderedBand, DenseLu};
 use crate::chain::{Chain, NONE, NewtonCoefficients};
+use crate::contact::{Contact, Post};
 use crate::error::FemError;
 use crate::midpoint::MidpointWork;
 use crate::settings::Method;
@@ -149,6 +150,8 @@ pub struct Integrator {
     pub length_scale: f64,
     /// Work buffers of the energy-consistent midpoint scheme (allocated only for that method).
     pub midpoint: Option<Box<MidpointWork>>,
+    /// The scene's tip contact (energy-midpoint only; None without contact, nothing allocated).
+    pub contact: Option<Box<Contact>>,
 }
 
 impl Integrator {
@@ -214,6 +217,7 @@ impl Integrator {
             rate_start: vec![0.0; nl],
             length_scale,
             midpoint: None,
+            contact: None,
         };
         if method == Method::EnergyMidpoint {
             it.midpoint = Some(Box::new(MidpointWork::new(n)));
@@ -359,7 +363,22 @@ impl Integrator {
                 return Ok(StopReason::Rejected);
             }
             Ok(err) => {
+                // Contact events are located inside the step: it may be shortened to h_acc.
+                let (h_acc, post) = if self.contact.is_some() {
+                    self.contact_after_trial(h)?
+                } else {
+                    (h, Post::None)
+                };
+                let (h, t1, t_law) = if h_acc < h {
+                    on_break = false;
+                    (h_acc, self.t + h_acc, self.t + h_acc)
+                } else {
+                    (h, t1, t_law)
+                };
                 self.accept(h, t1, t_law);
+                if self.contact.is_some() {
+                    self.contact_after_accept(post)?;
+                }
                 if self.adaptive.is_none() {
                     self.h = (2.0 * self.h).min(self.h_nominal);
                 }

@@ -72,6 +72,7 @@
 
 pub mod band;
 pub mod chain;
+pub mod contact;
 pub mod element;
 pub mod error;
 pub mod integrator;
