@@ -386,7 +386,7 @@ impl Integrator {
                 || self.slow_convergence;
             // Constrained steps shortened to locate an event are rare: refresh every iteration
             // (their impulsive multipliers make the quasi-Newton contraction poor).
-            let refresh = contact.is_some() && h < 0.5 * self.h_nominal;
+            let refresh = contact.is_some() && h < 0.999 * self.h_nominal;
             if (it == 0 && fresh) || it == 6 || it == 12 || it == 18 || refresh {
                 self.q1.copy_from_slice(&w.qbar);
                 self.qd1.copy_from_slice(&w.vbar);

@@ -329,6 +329,7 @@ fn ledger_terms(integ: &Integrator) -> (Vec<&'static str>, Vec<&'static str>, Ve
     }
     if integ.contact.is_some() {
         diss.push("impact");
+        diss.push("contact_projection");
     }
     (stored, inputs, diss)
 }
@@ -355,11 +356,12 @@ fn push_ledger(integ: &Integrator, ledger: &mut EnergyLedger) {
             _ => w.prescribed_motion,
         };
     }
-    let mut diss = [0.0; 3];
+    let mut diss = [0.0; 4];
     for (k, term) in ledger.dissipation.iter().enumerate() {
         diss[k] = match term.name.as_str() {
             "joint_damper" => w.joint_damper,
             "impact" => integ.contact.as_ref().map_or(0.0, |c| c.impact_loss),
+            "contact_projection" => integ.contact.as_ref().map_or(0.0, |c| c.projection_loss),
             _ => w.kelvin_voigt,
         };
     }
