@@ -38,6 +38,12 @@
 //! `two-link-free-undamped`). The correction term is not differentiated (quasi-Newton). The iterate is accepted at the point where the residual was evaluated, so the
 //! booked energies and works are those of the equations actually solved.
 //!
+//! Tip contact ([`crate::contact`]): in a constrained phase the momentum equation gains
+//! −∇̄g λ (∇̄g the discrete gradient of the gap, same metric and formula as for Φ) and the
+//! unknowns become (a, λ) with g(q₁) = 0, ∂q₁/∂a = h²/2; each iteration solves S twice
+//! (Schur complement of the border). Shortened steps that locate an event re-form the Newton
+//! matrix every iteration (impulsive multipliers spoil the quasi-Newton contraction).
+//!
 //! Adaptive steps (`rtol`): local error estimate e = (h²/12)(ā_k − ā_{k−1})·2h_k/(h_k + h_{k−1})
 //! (third-derivative term of the trapezoidal/midpoint family, from successive mean
 //! accelerations), step ratio 0.9·err^(−1/3) as for generalized-α.
@@ -447,9 +453,6 @@ impl Integrator {
             {
                 converged = true;
                 break;
-            }
-            if std::env::var("FEM_NEWTON_DEBUG").is_ok() && contact.is_some() {
-                eprintln!("it {it} h {h:.3e} dq {dq:.3e} tol {tol:.3e} gap {gap1:.3e} defect {defect:.3e} lam {lambda:.4e} dl {dlambda:.3e}");
             }
             last_defect = if dq <= tol { defect } else { f64::INFINITY };
             if it > 2 && dq > 10.0 * last {

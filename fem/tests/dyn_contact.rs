@@ -1,3 +1,4 @@
+#![allow(clippy::needless_range_loop)]
 //! Unilateral tip contact in the `energy-midpoint` scheme (issue 7, seed 000): the tip
 //! Jacobian, located events, the impact map, the constrained phase and its ledger, the resting
 //! normal force against statics computed from the same model, impulse convergence.
@@ -62,14 +63,21 @@ fn elem_tip_jacobian_matches_finite_differences_and_forward_velocity() {
             scale = scale.max(fd.abs());
         }
     }
-    assert!(worst <= 1e-8 * scale, "J vs FD: {worst:.3e} (scale {scale})");
+    assert!(
+        worst <= 1e-8 * scale,
+        "J vs FD: {worst:.3e} (scale {scale})"
+    );
     // J q̇ is the tip velocity of the residual's forward kinematic pass (to round-off).
     let qd: Vec<f64> = (0..n).map(|i| ((i as f64) * 0.37).cos()).collect();
     let zero = vec![0.0; n];
     let [_, v, _] = chain.tip_motion(0.0, 1, &q, &qd, &zero);
     for d in 0..2 {
         let jv: f64 = (0..n).map(|j| jac[d * n + j] * qd[j]).sum();
-        assert!((jv - v[d]).abs() <= 1e-12 * v[d].abs().max(1.0), "{jv} vs {}", v[d]);
+        assert!(
+            (jv - v[d]).abs() <= 1e-12 * v[d].abs().max(1.0),
+            "{jv} vs {}",
+            v[d]
+        );
     }
     // The convective term n̂·J̇q̇: d/dt (J q̇) along q(t) = q + t q̇ at fixed q̇ is J̇q̇.
     let dt = 1e-5;
@@ -82,10 +90,13 @@ fn elem_tip_jacobian_matches_finite_differences_and_forward_velocity() {
     let [_, _, a] = chain.tip_motion(0.0, 1, &q, &qd, &zero);
     for d in 0..2 {
         let fd = (jv[0][d] - jv[1][d]) / (2.0 * dt);
-        assert!((fd - a[d]).abs() <= 1e-6 * a[d].abs().max(1.0), "J̇q̇ {fd} vs {}", a[d]);
+        assert!(
+            (fd - a[d]).abs() <= 1e-6 * a[d].abs().max(1.0),
+            "J̇q̇ {fd} vs {}",
+            a[d]
+        );
     }
 }
-
 
 fn impacts(r: &RunResult) -> Vec<(f64, f64, f64, f64, f64)> {
     r.events
@@ -127,7 +138,11 @@ fn dyn_tipmass_impact_balances_momentum_and_loses_energy() {
     let r = sim(&sc, &settings(Some(8), Some(0.32)));
     let imp = impacts(&r);
     assert!(!imp.is_empty(), "no impact before t = 0.32");
-    for e in r.events.iter().filter(|e| matches!(e, Event::Impact { .. })) {
+    for e in r
+        .events
+        .iter()
+        .filter(|e| matches!(e, Event::Impact { .. }))
+    {
         let Event::Impact {
             t,
             momentum_residual,
@@ -139,16 +154,26 @@ fn dyn_tipmass_impact_balances_momentum_and_loses_energy() {
         else {
             unreachable!()
         };
-        assert!(*momentum_residual <= 1e-10, "t = {t}: residual {momentum_residual:.2e}");
+        assert!(
+            *momentum_residual <= 1e-10,
+            "t = {t}: residual {momentum_residual:.2e}"
+        );
         assert!(
             normal_velocity_after.abs() <= 1e-10 * speed_scale(e),
             "t = {t}: G q̇⁺ = {normal_velocity_after:.2e}"
         );
-        assert!(*kinetic_energy_lost >= 0.0, "t = {t}: ΔT = {kinetic_energy_lost:.3e}");
+        assert!(
+            *kinetic_energy_lost >= 0.0,
+            "t = {t}: ΔT = {kinetic_energy_lost:.3e}"
+        );
         assert!(*impulse > 0.0);
     }
     // The first impact: after free fall, the located gap is within its tolerance.
-    assert!(imp[0].0 > 0.28 && imp[0].0 < 0.29, "first impact at {}", imp[0].0);
+    assert!(
+        imp[0].0 > 0.28 && imp[0].0 < 0.29,
+        "first impact at {}",
+        imp[0].0
+    );
     let starts: Vec<f64> = r
         .events
         .iter()
@@ -158,7 +183,11 @@ fn dyn_tipmass_impact_balances_momentum_and_loses_energy() {
         })
         .collect();
     assert!(!starts.is_empty());
-    assert!(r.ledger.relative_closure() <= 1e-5, "{:.3e}", r.ledger.relative_closure());
+    assert!(
+        r.ledger.relative_closure() <= 1e-5,
+        "{:.3e}",
+        r.ledger.relative_closure()
+    );
 }
 
 #[test]
@@ -179,7 +208,11 @@ fn dyn_case1_switches_with_located_releases_and_a_closed_ledger() {
             _ => None,
         })
         .collect();
-    assert!(n_imp >= 3 && releases.len() >= 3, "{n_imp} impacts, {} releases", releases.len());
+    assert!(
+        n_imp >= 3 && releases.len() >= 3,
+        "{n_imp} impacts, {} releases",
+        releases.len()
+    );
     // Release: 0 ≥ λ ≥ −1e-8·W (W the weight, 2 × 1.764 × 32.17 × 2.5), or a bracket at the
     // time resolution where λ(h) is steeper than that.
     let weight = 1.764 * 5.0 * 32.17;
@@ -217,7 +250,14 @@ fn static_contact_force(chain: &mut Chain, q: &mut [f64], link: usize, y_line: f
     let residual = |chain: &mut Chain, x: &[f64], out: &mut Vec<f64>, jac: &mut Vec<f64>| {
         let (qq, lam) = (&x[..n], x[n]);
         let mut r = vec![0.0; n];
-        chain.residual_parts(0.0, qq, &zero, &zero, fem::chain::Parts::CONSERVATIVE, &mut r);
+        chain.residual_parts(
+            0.0,
+            qq,
+            &zero,
+            &zero,
+            fem::chain::Parts::CONSERVATIVE,
+            &mut r,
+        );
         let tip = chain.tip_jacobian(0.0, link, qq, jac);
         out.clear();
         for i in 0..n {
@@ -249,7 +289,9 @@ fn static_contact_force(chain: &mut Chain, q: &mut [f64], link: usize, y_line: f
             a[i][m] = -f[i];
         }
         for k in 0..m {
-            let p = (k..m).max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs())).unwrap();
+            let p = (k..m)
+                .max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))
+                .unwrap();
             a.swap(k, p);
             for i in k + 1..m {
                 let l = a[i][k] / a[k][k];
@@ -268,7 +310,10 @@ fn static_contact_force(chain: &mut Chain, q: &mut [f64], link: usize, y_line: f
         }
     }
     residual(chain, &x, &mut f, &mut jac);
-    assert!(f.iter().all(|v| v.abs() < 1e-8), "static Newton did not converge");
+    assert!(
+        f.iter().all(|v| v.abs() < 1e-8),
+        "static Newton did not converge"
+    );
     q.copy_from_slice(&x[..n]);
     x[n]
 }
@@ -295,7 +340,10 @@ fn dyn_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     let mut chain = Chain::new(&sc.links, sc.gravity.as_ref(), 4).unwrap();
     let stat = static_contact_force(&mut chain, &mut q, 1, -1.0);
     let rel = (dynamic - stat).abs() / stat;
-    assert!(rel < 1e-3, "resting force {dynamic} vs static {stat} ({rel:.2e})");
+    assert!(
+        rel < 1e-3,
+        "resting force {dynamic} vs static {stat} ({rel:.2e})"
+    );
     // Rigid straight arm (elbow and links rigid): moments about the hub,
     // N·(L₁ + L₂) = g(ρA L₁·L₁/2 + ρA L₂·(L₁ + L₂/2)), independent of the arm angle.
     let (l1, l2) = (sc.links[0].length, sc.links[1].length);
@@ -324,31 +372,58 @@ fn conv_tipmass_first_impulse_converges_with_elements() {
     }
     println!("impulses {first:?}");
     let (d1, d2) = (first[0] - first[1], first[1] - first[2]);
-    assert!(d1 > 0.0 && d2 > 0.0 && d2 < 0.7 * d1, "not monotone/convergent: {first:?}");
+    assert!(
+        d1 > 0.0 && d2 > 0.0 && d2 < 0.7 * d1,
+        "not monotone/convergent: {first:?}"
+    );
     let extrapolated = first[2] - d2 * d2 / (d1 - d2);
-    assert!((extrapolated - 2.457).abs() < 0.02 * 2.457, "extrapolated {extrapolated}");
+    assert!(
+        (extrapolated - 2.457).abs() < 0.02 * 2.457,
+        "extrapolated {extrapolated}"
+    );
 }
 
 #[test]
 #[ignore]
 fn explore() {
     let sc = scene(&std::env::var("SC").unwrap_or("barhorst-case1-tipmass".into()));
-    let te: f64 = std::env::var("TE").map(|s| s.parse().unwrap()).unwrap_or(0.5);
+    let te: f64 = std::env::var("TE")
+        .map(|s| s.parse().unwrap())
+        .unwrap_or(0.5);
     let ne: Option<usize> = std::env::var("NE").ok().map(|s| s.parse().unwrap());
     let t0 = std::time::Instant::now();
     let r = FemBackend.simulate(&sc, &settings(ne, Some(te))).unwrap();
-    println!("wall {:.2}s verdict {:?} steps {}", t0.elapsed().as_secs_f64(), r.verdict, r.cost.steps);
+    println!(
+        "wall {:.2}s verdict {:?} steps {}",
+        t0.elapsed().as_secs_f64(),
+        r.verdict,
+        r.cost.steps
+    );
     for e in &r.events {
         match e {
-            Event::Impact { t, impulse, momentum_residual, normal_velocity_after, kinetic_energy_lost, velocity_before, .. } => {
+            Event::Impact {
+                t,
+                impulse,
+                momentum_residual,
+                normal_velocity_after,
+                kinetic_energy_lost,
+                velocity_before,
+                ..
+            } => {
                 let _ = velocity_before;
-                println!("impact t={t:.9} L={impulse:.6e} res={momentum_residual:.2e} vn+={normal_velocity_after:.2e} dKE={kinetic_energy_lost:.4e}")
+                println!(
+                    "impact t={t:.9} L={impulse:.6e} res={momentum_residual:.2e} vn+={normal_velocity_after:.2e} dKE={kinetic_energy_lost:.4e}"
+                )
             }
             other => println!("{other:?}"),
         }
     }
     println!("closure {:.3e}", r.ledger.relative_closure());
-    for c in ["contact1.max_gap", "contact1.max_normal_velocity", "contact1.normal_force"] {
+    for c in [
+        "contact1.max_gap",
+        "contact1.max_normal_velocity",
+        "contact1.normal_force",
+    ] {
         let v = channel(&r, c);
         println!("{c} last {:.4e}", v[v.len() - 1]);
     }
