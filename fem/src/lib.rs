@@ -65,8 +65,8 @@
 //! * Constrained phase: the midpoint step with the force ∇̄g λ (Gonzalez discrete gradient of g,
 //!   metric M(q̄)) and g(q₁) = 0, bordered Newton on (a, λ). The constraint does no work, so
 //!   the ledger closes to the Newton tolerance (measured 4e-11 on `barhorst-case1`, 0.45 s,
-//!   8 elements). |g| ≤ 1e-11·L; the O(h²) drift of G q̇ is projected out after every
-//!   constrained step (its O(h⁴) kinetic-energy loss booked `contact_projection`).
+//!   8 elements). |g| ≤ 1e-11·L; G q̇ drifts O(h²) (reported); an inward drift at a release
+//!   is projected out plastically (its kinetic-energy loss booked `contact_projection`).
 //! * Normal force (channel `contact1.normal_force`): λ = (G M⁻¹R(q, q̇, 0) − n̂·J̇q̇)/(G M⁻¹Gᵀ)
 //!   at the state; release where it crosses zero, located inside the step to
 //!   −1e-8·W ≤ λ ≤ 0 (W the weight) or a 1e-13 s bracket (event `release`).
