@@ -384,6 +384,32 @@ fn conv_tipmass_first_impulse_converges_with_elements() {
 }
 
 #[test]
+fn sys_contact_refusals_are_precise() {
+    use data::BackendError;
+    let sc = scene("barhorst-case1");
+    for (method, rtol) in [("generalized-alpha", None), ("energy-midpoint", Some(1e-4))] {
+        let mut st = settings(Some(4), Some(0.01));
+        st.time.method = Some(method.into());
+        st.time.rtol = rtol;
+        match FemBackend.simulate(&sc, &st) {
+            Err(BackendError::Unsupported(m)) => assert!(m.contains("contact"), "{m}"),
+            other => panic!("{method}: {other:?}"),
+        }
+    }
+    // Bilateral circle contact with friction (constrained arm): refused by name.
+    match FemBackend.simulate(&scene("constrained-arm"), &Settings::default()) {
+        Err(BackendError::Unsupported(m)) => assert!(!m.is_empty()),
+        other => panic!("{other:?}"),
+    }
+    // Without contact nothing is allocated and the DOF count is the chain's.
+    let free = scene("two-link-free");
+    let p = fem::run::prepare(&free, &settings(Some(4), Some(0.01))).unwrap();
+    assert!(p.integrator.contact.is_none());
+    let pc = fem::run::prepare(&sc, &settings(Some(4), Some(0.01))).unwrap();
+    assert_eq!(pc.integrator.chain.ndof, p.integrator.chain.ndof);
+}
+
+#[test]
 #[ignore]
 fn explore() {
     let sc = scene(&std::env::var("SC").unwrap_or("barhorst-case1-tipmass".into()));
