@@ -360,8 +360,9 @@ fn dyn_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
 
 #[test]
 fn conv_tipmass_first_impulse_converges_with_elements() {
-    // The first impact (t ≈ 0.2835): measured 4, 8, 16 elements → 3.241, 2.850, 2.654
-    // (differences halve: first order; extrapolated 2.458, modal 2.456, fdm 2.458).
+    // The first impact (t ≈ 0.2835): measured 4, 8, 16, 32 elements → 3.2412, 2.8497,
+    // 2.6540, 2.5562 (differences halve: first order; extrapolated 2.4584, modal 2.456,
+    // fdm 2.458). 32 elements take 2 s, so the test stops at 16.
     let sc = scene("barhorst-case1-tipmass");
     let mut first = Vec::new();
     for n in [4, 8, 16] {
