@@ -365,7 +365,20 @@ impl Integrator {
             Ok(err) => {
                 // Contact events are located inside the step: it may be shortened to h_acc.
                 let (h_acc, post) = if self.contact.is_some() {
-                    self.contact_after_trial(h)?
+                    match self.contact_after_trial(h) {
+                        Ok(x) => x,
+                        // A shortened or constrained re-solve did not converge: retry the
+                        // stretch with a quarter step from the (possibly post-impact) start.
+                        Err(FemError::Runaway { .. }) if h > 1e-6 * self.h_nominal => {
+                            self.counters.rejected += 1;
+                            self.h = 0.25 * h;
+                            if let Some(w) = self.midpoint.as_mut() {
+                                w.restart();
+                            }
+                            return Ok(StopReason::Rejected);
+                        }
+                        Err(e) => return Err(e),
+                    }
                 } else {
                     (h, Post::None)
                 };
