@@ -1713,4 +1713,106 @@ impl Chain {
         }
         format!("dof {dof}")
     }
+
+    // ---- Tip kinematics for contact ([`crate::contact`]) ----
+
+    /// Inertial position of the tip of link `li` and its Jacobian J = ∂r_tip/∂q, written as two
+    /// rows (x: `jac[..n]`, y: `jac[n..2n]`, n = [`Chain::ndof`]). Exact, from the chain's own
+    /// frame recursion (the same one [`Chain::tip_positions`] evaluates): every DOF either turns
+    /// the frames downstream of it about a frame origin Rₖ — the joint angle θₖ about Rₖ and the
+    /// tip rotation of link k about Rₖ₊₁, column ẑ × (r − R) — or moves the tip of link k in
+    /// its own frame: v(L) along A(φₖ)ŷ, u(L) along A(φₖ)x̂ and, with foreshortening, every
+    /// transverse DOF d along A(φₖ)x̂ with ∂s(L)/∂d = −∫ v′ N′ (the quadrature of s). O(n).
+    pub fn tip_jacobian(&self, t: f64, li: usize, q: &[f64], jac: &mut [f64]) -> [f64; 2] {
+        let n = self.ndof;
+        jac[..2 * n].iter_mut().for_each(|x| *x = 0.0);
+        let mut origin = [[0.0; 2]; MAX_LINKS];
+        let mut angle = [0.0; MAX_LINKS];
+        let mut parent: Option<(f64, [f64; 2])> = None;
+        let mut r = [0.0; 2];
+        for k in 0..=li {
+            let l = &self.links[k];
+            let th = match l.joint.prescribed_at(t) {
+                Some((a, _, _)) => a,
+                None => q[l.joint.dof],
+            };
+            let (phi, r0) = match parent {
+                None => (th, [0.0, 0.0]),
+                Some((pp, rr)) => (pp + th, rr),
+            };
+            let m = l.n_el;
+            let ax = if l.axial {
+                Self::val(q, l.u_dof[m])
+            } else if l.foreshortening {
+                self.foreshortening_at_tip(k, q)
+            } else {
+                0.0
+            };
+            r = add(r0, rot(phi, [l.length + ax, Self::val(q, l.v_dof[m])]));
+            origin[k] = r0;
+            angle[k] = phi;
+            parent = Some((phi + Self::val(q, l.r_dof[m]), r));
+        }
+        let put = |jac: &mut [f64], dof: usize, c: [f64; 2]| {
+            if dof != NONE {
+                jac[dof] += c[0];
+                jac[n + dof] += c[1];
+            }
+        };
+        for k in 0..=li {
+            let l = &self.links[k];
+            let m = l.n_el;
+            put(jac, l.joint.dof, perp(sub(r, origin[k])));
+            if k < li {
+                put(jac, l.r_dof[m], perp(sub(r, origin[k + 1])));
+            }
+            put(jac, l.v_dof[m], rot(angle[k], [0.0, 1.0]));
+            let ex = rot(angle[k], [1.0, 0.0]);
+            if l.axial {
+                put(jac, l.u_dof[m], ex);
+            } else if l.foreshortening {
+                let tb = &self.tables[k];
+                for e in 0..l.n_el {
+                    let dofs = l.elem_dofs(e);
+                    let d = Self::elem_v(q, &dofs);
+                    let mut ds = [0.0; 4];
+                    for j in 0..NSUB {
+                        for kk in 0..NSG {
+                            let dn = &tb.sub_dn[j][kk];
+                            let c = -tb.sub_wh[j][kk] * dot4(dn, &d);
+                            for a in 0..4 {
+                                ds[a] += c * dn[a];
+                            }
+                        }
+                    }
+                    for a in 0..4 {
+                        put(jac, dofs[a], scale(ds[a], ex));
+                    }
+                }
+            }
+        }
+        r
+    }
+
+    /// Tip of link `li`: inertial position, velocity and acceleration at (q, q̇, q̈) from the
+    /// forward kinematic pass of the residual (exact for every element the pass handles). With
+    /// q̈ = 0 the acceleration is the convective term J̇q̇. Overwrites the point data of the
+    /// last residual call (call [`Chain::residual`] again before [`Chain::newton_matrix`]).
+    pub fn tip_motion(
+        &mut self,
+        t: f64,
+        li: usize,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+    ) -> [[f64; 2]; 3] {
+        self.forward(t, q, qd, qdd, Parts::INERTIA);
+        let fr = self.frames[li];
+        let r = add(fr.r, rot(fr.phi, fr.p_tip));
+        let v = add(
+            fr.dr,
+            rot(fr.phi, add(scale(fr.dphi, perp(fr.p_tip)), fr.dp_tip)),
+        );
+        [r, v, rot(fr.phi, fr.a_tip)]
+    }
 }

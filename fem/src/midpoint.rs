@@ -38,11 +38,18 @@
 //! `two-link-free-undamped`). The correction term is not differentiated (quasi-Newton). The iterate is accepted at the point where the residual was evaluated, so the
 //! booked energies and works are those of the equations actually solved.
 //!
+//! Tip contact ([`crate::contact`]): in a constrained phase the momentum equation gains
+//! −∇̄g λ (∇̄g the discrete gradient of the gap, same metric and formula as for Φ) and the
+//! unknowns become (a, λ) with g(q₁) = 0, ∂q₁/∂a = h²/2; each iteration solves S twice
+//! (Schur complement of the border). Shortened steps that locate an event re-form the Newton
+//! matrix every iteration (impulsive multipliers spoil the quasi-Newton contraction).
+//!
 //! Adaptive steps (`rtol`): local error estimate e = (h²/12)(ā_k − ā_{k−1})·2h_k/(h_k + h_{k−1})
 //! (third-derivative term of the trapezoidal/midpoint family, from successive mean
 //! accelerations), step ratio 0.9·err^(−1/3) as for generalized-α.
 
 use crate::chain::{Chain, NONE, NewtonCoefficients, Parts};
+use crate::contact::Contact;
 use crate::error::FemError;
 use crate::integrator::{Integrator, JacobianKind, Works};
 
@@ -230,7 +237,11 @@ impl Integrator {
                 message: "energy-midpoint work buffers missing".into(),
             });
         };
-        let result = self.midpoint_solve(&mut w, h, t1, t_law);
+        // The tip contact, when constrained, borders the Newton system (see `crate::contact`).
+        let mut contact = self.contact.take();
+        let active = contact.as_deref_mut().filter(|c| c.constrained);
+        let result = self.midpoint_solve(&mut w, active, h, t1, t_law);
+        self.contact = contact;
         self.midpoint = Some(w);
         result
     }
@@ -238,6 +249,7 @@ impl Integrator {
     fn midpoint_solve(
         &mut self,
         w: &mut MidpointWork,
+        mut contact: Option<&mut Contact>,
         h: f64,
         t1: f64,
         t_law: f64,
@@ -255,6 +267,12 @@ impl Integrator {
         let v0_pot = s0 + sp0 + g0;
         let scale0 = k0.abs() + s0.abs() + sp0.abs() + g0.abs();
         let mut passes = 2usize;
+        // Constrained phase: g(q₀) and the multiplier's start value (the last step's).
+        let g0 = contact
+            .as_ref()
+            .map_or(0.0, |c| c.gap_at(&self.chain, t0, &self.q));
+        let mut lambda = contact.as_ref().map_or(0.0, |c| c.step_lambda);
+        let mut gap1 = 0.0;
         // Predictor: the previous step's mean acceleration; zero after a (re)start, where the
         // point acceleration of a released pre-loaded spring is a mesh-dependent spike.
         for i in 0..n {
@@ -347,12 +365,35 @@ impl Integrator {
                     + corr * w.w_dq[i]
                     + w.minus_q[i];
             }
+            if let Some(c) = contact.as_deref_mut() {
+                // Constraint force ∇̄g λ with ∇̄g the discrete gradient of the gap in the same
+                // metric: Δqᵀ∇̄g = g(q₁) − g(q₀), so the constraint does no work.
+                let mut g_mid = std::mem::take(&mut c.g_mid);
+                let mut g_end = std::mem::take(&mut c.g_end);
+                c.gradient(&self.chain, t_mid, &w.qbar, &mut g_mid);
+                gap1 = c.gradient(&self.chain, t1, &self.q1, &mut g_end);
+                let gd = dot(&g_mid, &w.dq);
+                let corr_g = if denom > 0.0 {
+                    (gap1 - g0 - gd) / denom
+                } else {
+                    0.0
+                };
+                for i in 0..n {
+                    c.g_bar[i] = g_mid[i] + corr_g * w.w_dq[i];
+                    w.res[i] -= lambda * c.g_bar[i];
+                }
+                c.g_mid = g_mid;
+                c.g_end = g_end;
+            }
             self.counters.newton += 1;
             // Newton matrix at (q̄, v̄, a): a full residual there fills the chain's point data.
             let fresh = self.jacobian == JacobianKind::Banded
                 || self.matrix_h != h
                 || self.slow_convergence;
-            if (it == 0 && fresh) || it == 6 || it == 12 || it == 18 {
+            // Constrained steps shortened to locate an event are rare: refresh every iteration
+            // (their impulsive multipliers make the quasi-Newton contraction poor).
+            let refresh = contact.is_some() && h < 0.999 * self.h_nominal;
+            if (it == 0 && fresh) || it == 6 || it == 12 || it == 18 || refresh {
                 self.q1.copy_from_slice(&w.qbar);
                 self.qd1.copy_from_slice(&w.vbar);
                 self.chain
@@ -366,8 +407,26 @@ impl Integrator {
                     self.qd1[i] = self.qd[i] + h * self.qdd1[i];
                 }
             }
-            self.delta.copy_from_slice(&w.res);
-            self.solve_matrix();
+            let mut dlambda = 0.0;
+            if let Some(c) = contact.as_deref_mut() {
+                // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (h²/2) ∇g(q₁)·δa = g(q₁)
+                // (∂q₁/∂a = h²/2), by the Schur complement with two solves of S.
+                self.delta.copy_from_slice(&c.g_bar);
+                self.solve_matrix();
+                c.s_inv_g.copy_from_slice(&self.delta);
+                self.delta.copy_from_slice(&w.res);
+                self.solve_matrix();
+                let half_h2 = 0.5 * h * h;
+                let cx = half_h2 * dot(&c.g_end, &self.delta);
+                let cy = half_h2 * dot(&c.g_end, &c.s_inv_g);
+                dlambda = (gap1 - cx) / cy;
+                for i in 0..n {
+                    self.delta[i] += c.s_inv_g[i] * dlambda;
+                }
+            } else {
+                self.delta.copy_from_slice(&w.res);
+                self.solve_matrix();
+            }
             let big = max_abs(&self.delta);
             let dq = big * c.c_q;
             if !dq.is_finite() {
@@ -384,7 +443,9 @@ impl Integrator {
             // update is far below tolerance.
             let defect = (h * dot(&w.vbar, &w.res)).abs();
             let e_scale = scale0 + scale1 + dot(&w.minus_q, &w.dq).abs();
+            let on_surface = gap1.abs() <= self.newton_tol;
             if dq <= tol
+                && on_surface
                 && (defect <= ENERGY_TOL * e_scale
                     || defect >= 0.5 * last_defect
                     || dq <= 1e-4 * tol
@@ -402,6 +463,10 @@ impl Integrator {
             for i in 0..n {
                 self.qdd1[i] -= self.delta[i];
             }
+            lambda -= dlambda;
+        }
+        if let Some(c) = contact.filter(|_| converged) {
+            c.step_lambda = lambda;
         }
         self.counters.rhs += passes;
         // See the module docs: the linear contraction makes > 3 iterations normal here.

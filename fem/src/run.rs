@@ -9,6 +9,7 @@ use data::{
 };
 
 use crate::chain::{Chain, NONE};
+use crate::contact::Contact;
 use crate::error::FemError;
 use crate::integrator::{Adaptive, Integrator, StopReason};
 use crate::settings::{self, Method};
@@ -186,7 +187,33 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
         })
         .fold(0.0f64, f64::max);
     let h_rule = 2.0 * std::f64::consts::PI / (STEPS_PER_PERIOD * omega1);
+    let contact = Contact::from_scene(scene, &chain)?;
+    if contact.is_some() {
+        if method != Method::EnergyMidpoint {
+            return Err(FemError::unsupported(format!(
+                "fem: contact is implemented for `energy-midpoint` only (scene `{}`; method {:?})",
+                scene.name, method
+            )));
+        }
+        if rtol.is_some() {
+            return Err(FemError::unsupported(
+                "fem: contact with adaptive stepping (`time.rtol`) is not implemented; events \
+                 are located inside fixed steps",
+            ));
+        }
+    }
     let mut integ = Integrator::new(chain, method, h_rule.min(out), default_rho_inf(scene))?;
+    if let Some(mut c) = contact {
+        let (t0, q0) = (integ.t, integ.q.clone());
+        c.gap = c.gap_at(&integ.chain, t0, &q0);
+        if c.gap < -c.gap_tol {
+            return Err(FemError::InvalidSettings {
+                field: "contact".into(),
+                message: format!("the tip starts {:.3e} inside the surface", -c.gap),
+            });
+        }
+        integ.contact = Some(Box::new(c));
+    }
     let h_nominal = match method {
         Method::GeneralizedAlpha | Method::EnergyMidpoint => {
             let h = dt_user.unwrap_or_else(|| fit(h_rule.min(out), out));
@@ -254,9 +281,27 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
             specs.push((channel::field_deflection(k, s), "length"));
         }
     }
-    let _ = scene;
+    if !scene.contacts.is_empty() {
+        specs.push((channel::contact_normal_force(1), "force"));
+        specs.push((channel::contact_phase(1), "1"));
+        // Not standard channels: gap (constraint violation when constrained), normal tip velocity
+        // G q̇, and the running maxima of |g| and |G q̇| over constrained step ends (drift).
+        specs.push((GAP_CHANNEL.to_string(), "length"));
+        specs.push((NORMAL_VELOCITY_CHANNEL.to_string(), "length/time"));
+        specs.push((MAX_GAP_CHANNEL.to_string(), "length"));
+        specs.push((MAX_NORMAL_VELOCITY_CHANNEL.to_string(), "length/time"));
+    }
     specs
 }
+
+/// Gap of the tip contact (negative: penetration).
+pub const GAP_CHANNEL: &str = "contact1.gap";
+/// Normal tip velocity G q̇ of the contact.
+pub const NORMAL_VELOCITY_CHANNEL: &str = "contact1.normal_velocity";
+/// Running max |g| over the ends of constrained steps (position drift).
+pub const MAX_GAP_CHANNEL: &str = "contact1.max_gap";
+/// Running max |G q̇| over the ends of constrained steps (velocity drift, O(h²)).
+pub const MAX_NORMAL_VELOCITY_CHANNEL: &str = "contact1.max_normal_velocity";
 
 /// Samples the observables at the integrator's current state into `buf`.
 fn sample(integ: &Integrator, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<f64>) {
@@ -279,10 +324,19 @@ fn sample(integ: &Integrator, stations: usize, tips: &mut [[f64; 2]], buf: &mut 
             buf.push(ch.deflection(i, &integ.q, x));
         }
     }
+    if let Some(c) = integ.contact.as_deref() {
+        buf.push(c.lambda);
+        buf.push(if c.constrained { 1.0 } else { 0.0 });
+        buf.push(c.gap);
+        buf.push(c.normal_velocity);
+        buf.push(c.max_gap);
+        buf.push(c.max_normal_velocity);
+    }
 }
 
 /// Names of the ledger terms the scene needs.
-fn ledger_terms(chain: &Chain) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
+fn ledger_terms(integ: &Integrator) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
+    let chain = &integ.chain;
     let mut stored = vec!["kinetic", "strain"];
     if chain.links.iter().any(|l| l.joint.stiffness > 0.0) {
         stored.push("joint_spring");
@@ -306,6 +360,10 @@ fn ledger_terms(chain: &Chain) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'s
     }
     if chain.links.iter().any(|l| l.kelvin_voigt > 0.0) {
         diss.push("kelvin_voigt");
+    }
+    if integ.contact.is_some() {
+        diss.push("impact");
+        diss.push("contact_projection");
     }
     (stored, inputs, diss)
 }
@@ -332,12 +390,13 @@ fn push_ledger(integ: &Integrator, ledger: &mut EnergyLedger) {
             _ => w.prescribed_motion,
         };
     }
-    let mut diss = [0.0; 2];
+    let mut diss = [0.0; 4];
     for (k, term) in ledger.dissipation.iter().enumerate() {
-        diss[k] = if term.name == "joint_damper" {
-            w.joint_damper
-        } else {
-            w.kelvin_voigt
+        diss[k] = match term.name.as_str() {
+            "joint_damper" => w.joint_damper,
+            "impact" => integ.contact.as_ref().map_or(0.0, |c| c.impact_loss),
+            "contact_projection" => integ.contact.as_ref().map_or(0.0, |c| c.projection_loss),
+            _ => w.kelvin_voigt,
         };
     }
     let (ni, nd) = (ledger.inputs.len(), ledger.dissipation.len());
@@ -356,7 +415,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
     } = prepare(scene, settings)?;
     let specs = channel_specs(scene, &integ.chain, stations);
     let mut obs = Observables::with_channels(&specs);
-    let (s, i, d) = ledger_terms(&integ.chain);
+    let (s, i, d) = ledger_terms(&integ);
     let mut ledger = EnergyLedger::new(&s, &i, &d);
     let mut events = Vec::new();
     let mut tips = vec![[0.0; 2]; integ.chain.links.len()];
@@ -371,7 +430,11 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         integ.set_stop(t_stop);
         loop {
             let h_before = integ.h;
-            match integ.step() {
+            let stepped = integ.step();
+            if let Some(c) = integ.contact.as_deref_mut() {
+                events.append(&mut c.events);
+            }
+            match stepped {
                 Ok(StopReason::ReachedStop) => break,
                 Ok(StopReason::Stepped) => {}
                 Ok(StopReason::Rejected) => {

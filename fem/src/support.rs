@@ -4,7 +4,7 @@ use data::{Family, Scene};
 
 use crate::error::FemError;
 
-/// Planar chains without contact; every other family or feature is refused by name.
+/// Planar chains (with unilateral line contact); every other family or feature is refused by name.
 pub fn check_planar(scene: &Scene) -> Result<(), FemError> {
     match scene.family() {
         Family::PlanarChain => {}
@@ -15,13 +15,9 @@ pub fn check_planar(scene: &Scene) -> Result<(), FemError> {
             )));
         }
     }
-    if !scene.contacts.is_empty() {
-        return Err(FemError::unsupported(format!(
-            "fem: contact (scene `{}`: tip of `{}` against a rigid surface) is not implemented yet; \
-             the stepper stops on events so it can be added",
-            scene.name, scene.contacts[0].link
-        )));
-    }
+    // Unilateral frictionless line contact is implemented (`crate::contact`); the rest is
+    // refused there by name.
+    crate::contact::check(scene)?;
     if scene.links.is_empty() {
         return Err(FemError::unsupported("fem: scene has no links".to_string()));
     }
