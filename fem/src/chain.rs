@@ -1775,17 +1775,18 @@ impl Chain {
                 for e in 0..l.n_el {
                     let dofs = l.elem_dofs(e);
                     let d = Self::elem_v(q, &dofs);
-                    let mut ds = [0.0; 4];
+                    let ne = l.ne;
+                    let mut ds = [0.0; MAXE];
                     for j in 0..NSUB {
                         for kk in 0..NSG {
                             let dn = &tb.sub_dn[j][kk];
-                            let c = -tb.sub_wh[j][kk] * dot4(dn, &d);
-                            for a in 0..4 {
+                            let c = -tb.sub_wh[j][kk] * dotn(dn, &d, ne);
+                            for a in 0..ne {
                                 ds[a] += c * dn[a];
                             }
                         }
                     }
-                    for a in 0..4 {
+                    for a in 0..ne {
                         put(jac, dofs[a], scale(ds[a], ex));
                     }
                 }
