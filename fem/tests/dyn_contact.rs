@@ -319,11 +319,11 @@ fn static_contact_force(chain: &mut Chain, q: &mut [f64], link: usize, y_line: f
 }
 
 #[test]
-#[ignore]
 fn dyn_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     // The scene's full 10 s at 4 elements per link (the last impact is at ≈ 1.1 s; at 4 s the
-    // arm still moves, |q̇|∞ ≈ 0.1): ≈ 10 s of wall time, hence ignored in CI. Run with
-    // `cargo test --release -p fem --test dyn_contact -- --ignored dyn_stiff_elbow`.
+    // arm still moves, |q̇|∞ ≈ 0.1): 20 000 steps, 2.2 s measured in release (6.7 s on a
+    // loaded machine). Measured: resting 141.0215 lbf, static 140.9840 (2.7e-4), rigid arm
+    // 141.8697 (0.62 %), |q̇|∞ = 1.5e-3 at 10 s.
     let sc = scene("barhorst-case1-stiff-elbow");
     let st = settings(Some(4), None);
     let mut p = fem::run::prepare(&sc, &st).unwrap();
