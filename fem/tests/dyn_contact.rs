@@ -37,7 +37,14 @@ fn bent_state(chain: &Chain) -> Vec<f64> {
 
 #[test]
 fn elem_tip_jacobian_matches_finite_differences_and_forward_velocity() {
-    let sc = scene("barhorst-case1");
+    // Hermite-cubic Euler links, and Timoshenko links (cubic v, quadratic ψ, interior DOFs;
+    // the next frame turns with ψ(L)).
+    for name in ["barhorst-case1", "barhorst-case1-timoshenko"] {
+        check_tip_jacobian(&scene(name));
+    }
+}
+
+fn check_tip_jacobian(sc: &Scene) {
     let mut chain = Chain::new(&sc.links, sc.gravity.as_ref(), 6).unwrap();
     let n = chain.ndof;
     let q = bent_state(&chain);
