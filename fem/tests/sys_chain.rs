@@ -4,6 +4,8 @@
 // Index loops mirror the matrix formulas being checked.
 #![allow(clippy::needless_range_loop)]
 
+mod common;
+
 use fem::chain::{Chain, NewtonCoefficients};
 
 /// A chain with every effect switched on (tip masses and inertias, hub inertia, gravity,
@@ -112,45 +114,7 @@ fn sys_newton_matrix_is_the_residual_derivative() {
         ("single-link", true, 0.1),
     ] {
         let (mut ch, q, qd, qdd) = setup(name, 3, fs);
-        let n = ch.ndof;
-        let mut r0 = vec![0.0; n];
-        ch.residual(0.3, &q, &qd, &qdd, &mut r0);
-        let mut s = ch.new_matrix();
-        ch.newton_matrix(&q, c, &mut s);
-        let eps = 1e-6;
-        let mut worst = 0.0f64;
-        let mut scale = 0.0f64;
-        for j in 0..n {
-            let mut col = vec![0.0; n];
-            for (k, coef) in [(0, c.c_a), (1, c.c_v), (2, c.c_q)] {
-                let (mut a, mut b, mut cc) = (q.clone(), qd.clone(), qdd.clone());
-                let (mut a2, mut b2, mut cc2) = (q.clone(), qd.clone(), qdd.clone());
-                match k {
-                    0 => {
-                        cc[j] += eps;
-                        cc2[j] -= eps
-                    }
-                    1 => {
-                        b[j] += eps;
-                        b2[j] -= eps
-                    }
-                    _ => {
-                        a[j] += eps;
-                        a2[j] -= eps
-                    }
-                }
-                let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
-                ch.residual(0.3, &a, &b, &cc, &mut rp);
-                ch.residual(0.3, &a2, &b2, &cc2, &mut rm);
-                for i in 0..n {
-                    col[i] += coef * (rp[i] - rm[i]) / (2.0 * eps);
-                }
-            }
-            for i in 0..n {
-                scale = scale.max(col[i].abs());
-                worst = worst.max((col[i] - s.get(i, j)).abs());
-            }
-        }
+        let (worst, scale) = common::newton_matrix_fd_error(&mut ch, &q, &qd, &qdd, c);
         assert!(
             worst < tol * scale,
             "{name} fs={fs}: {worst:.3e} of {scale:.3e}"

@@ -76,27 +76,10 @@ fn random_state(chain: &Chain, scale: f64, seed: u64) -> Vec<f64> {
     q
 }
 
+/// Symmetric positive definite, by faer's Cholesky factorization of the row-major n × n `m`.
 fn is_spd(m: &[f64], n: usize) -> bool {
-    let mut a = m.to_vec();
-    for j in 0..n {
-        let mut d = a[j * n + j];
-        for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k];
-        }
-        if d <= 0.0 {
-            return false;
-        }
-        let d = d.sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / d;
-        }
-    }
-    true
+    let a = faer::Mat::<f64>::from_fn(n, n, |i, j| m[i * n + j]);
+    a.llt(faer::Side::Lower).is_ok()
 }
 
 /// ½∫EI ψ'² + ½∫κGA (v' − ψ)² of link i evaluated from the fields (independent of the

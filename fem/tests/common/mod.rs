@@ -177,3 +177,49 @@ pub fn timoshenko_omega(
     };
     roots(det, 1.0, w_max, 200_000, count)
 }
+
+/// Largest |S − ∂R/∂(q̈, q̇, q) combined with the coefficients of `c`| over the Newton matrix S
+/// of `ch` at (q, q̇, q̈), by central differences of the residual (ε = 1e-6), and the largest
+/// |entry| of the finite-difference matrix: (worst, scale).
+pub fn newton_matrix_fd_error(
+    ch: &mut fem::chain::Chain,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    c: fem::chain::NewtonCoefficients,
+) -> (f64, f64) {
+    let n = ch.ndof;
+    // The Newton matrix uses the point data of the last residual pass: evaluate it at the state.
+    let mut r0 = vec![0.0; n];
+    ch.residual(0.3, q, qd, qdd, &mut r0);
+    let mut s = ch.new_matrix();
+    ch.newton_matrix(q, c, &mut s);
+    let eps = 1e-6;
+    let mut worst = 0.0f64;
+    let mut scale = 0.0f64;
+    let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
+    for j in 0..n {
+        let mut col = vec![0.0; n];
+        for (k, coef) in [(0, c.c_a), (1, c.c_v), (2, c.c_q)] {
+            let (mut a, mut b, mut cc) = (q.to_vec(), qd.to_vec(), qdd.to_vec());
+            let (mut a2, mut b2, mut cc2) = (q.to_vec(), qd.to_vec(), qdd.to_vec());
+            let (plus, minus) = match k {
+                0 => (&mut cc[j], &mut cc2[j]),
+                1 => (&mut b[j], &mut b2[j]),
+                _ => (&mut a[j], &mut a2[j]),
+            };
+            *plus += eps;
+            *minus -= eps;
+            ch.residual(0.3, &a, &b, &cc, &mut rp);
+            ch.residual(0.3, &a2, &b2, &cc2, &mut rm);
+            for i in 0..n {
+                col[i] += coef * (rp[i] - rm[i]) / (2.0 * eps);
+            }
+        }
+        for i in 0..n {
+            scale = scale.max(col[i].abs());
+            worst = worst.max((col[i] - s.get(i, j)).abs());
+        }
+    }
+    (worst, scale)
+}
