@@ -204,8 +204,7 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
     }
     let mut integ = Integrator::new(chain, method, h_rule.min(out), default_rho_inf(scene))?;
     if let Some(mut c) = contact {
-        let (t0, q0) = (integ.t, integ.q.clone());
-        c.gap = c.gap_at(&integ.chain, t0, &q0);
+        c.gap = c.gap_at(&integ.chain, integ.t, &integ.q);
         if c.gap < -c.gap_tol {
             return Err(FemError::InvalidSettings {
                 field: "contact".into(),
