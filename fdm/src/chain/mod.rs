@@ -94,9 +94,9 @@ pub struct TwoLinkChain {
     init: [(f64, f64); 2],
     field_stations: usize,
     /// highest angular frequency of the linearized chain at t = 0 (power iteration)
-    omega_max: f64,
+    pub omega_max: f64,
     /// fastest damping rate of the linearized chain at t = 0 (power iteration on −∂a/∂q̇)
-    kappa_max: f64,
+    pub kappa_max: f64,
     /// clamp half-cell rotary inertias ρA h³/24 of links 1 and 2
     jc: [f64; 2],
     /// q-slots of the clamp ghost deflections x₁, x₂ (station 1 of each link is the chord
