@@ -4,7 +4,9 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use data::{Backend, BackendError, Event, RunResult, Scene, Settings, StabilityVerdict, load_scene};
+use data::{
+    Backend, BackendError, Event, RunResult, Scene, Settings, StabilityVerdict, load_scene,
+};
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
 use fdm::chain::contact::simulate;
@@ -72,7 +74,9 @@ fn elem_timoshenko_energy_gradient_matches_finite_differences() {
     let tf: &TimoFields = sys.timoshenko().unwrap();
     let n = sys.dofs();
     let (q, _) = state(n);
-    let z: Vec<f64> = (0..tf.nz()).map(|i| 0.01 * (1.3 * i as f64).cos()).collect();
+    let z: Vec<f64> = (0..tf.nz())
+        .map(|i| 0.01 * (1.3 * i as f64).cos())
+        .collect();
     let (mut gq, mut gz) = (vec![0.0; n], vec![0.0; tf.nz()]);
     tf.gradient_at(&q, &z, &mut gq, &mut gz);
     let e = |q: &[f64], z: &[f64]| {
@@ -88,7 +92,11 @@ fn elem_timoshenko_energy_gradient_matches_finite_differences() {
         qm[i] -= h;
         let fd = (e(&qp, &z) - e(&qm, &z)) / (2.0 * h);
         // the unused ghost slots carry no energy
-        let expect = if i == 1 + 8 || i == 1 + 8 + 8 { 0.0 } else { fd };
+        let expect = if i == 1 + 8 || i == 1 + 8 + 8 {
+            0.0
+        } else {
+            fd
+        };
         assert!((fd - expect).abs() <= 1e-6 * scale, "slot {i}: {fd}");
         worst = worst.max((gq[i] - fd).abs());
     }
@@ -100,7 +108,10 @@ fn elem_timoshenko_energy_gradient_matches_finite_differences() {
         let fd = (e(&q, &zp) - e(&q, &zm)) / (2.0 * h);
         worst = worst.max((gz[i] - fd).abs());
     }
-    println!("∂U/∂(q, z) against central differences: {:.2e} of {scale:.2e}", worst);
+    println!(
+        "∂U/∂(q, z) against central differences: {:.2e} of {scale:.2e}",
+        worst
+    );
     assert!(worst <= 1e-6 * scale, "{worst:e}");
 }
 
@@ -156,7 +167,11 @@ fn elem_timoshenko_condensed_forces_are_minus_condensed_gradients() {
     assert!(worst <= 1e-6 * scale, "{worst:e}");
     // the power of the damping force is 2D_c (the ledger's dissipation)
     let p: f64 = (0..n).map(|i| (f1[i] - f0[i]) * v[i]).sum();
-    assert!((p + 2.0 * dc(&v)).abs() <= 1e-10 * dc(&v), "{p} vs {}", 2.0 * dc(&v));
+    assert!(
+        (p + 2.0 * dc(&v)).abs() <= 1e-10 * dc(&v),
+        "{p} vs {}",
+        2.0 * dc(&v)
+    );
 }
 
 #[test]
@@ -182,7 +197,10 @@ fn conv_timoshenko_cantilever_tip_deflection_second_order() {
         println!(
             "r = {r}: v(L) = {v:.12e}, error {err:.4e} (predicted {predicted:.4e}), ψ(L) {psi:.12e}"
         );
-        assert!((err - predicted).abs() <= 1e-9 * exact, "{err} vs {predicted}");
+        assert!(
+            (err - predicted).abs() <= 1e-9 * exact,
+            "{err} vs {predicted}"
+        );
         assert!((psi - p * len * len / (2.0 * ei)).abs() <= 1e-10 * psi.abs());
         errs.push(err.abs());
     }
@@ -207,7 +225,10 @@ fn dyn_timoshenko_free_swing_closes_the_ledger() {
     let out = run_chain(&sc, &s);
     assert_eq!(out.verdict, StabilityVerdict::Completed);
     let c = out.ledger.relative_closure();
-    println!("two-link-free (Timoshenko): closure {c:.3e}, {} steps", out.cost.steps);
+    println!(
+        "two-link-free (Timoshenko): closure {c:.3e}, {} steps",
+        out.cost.steps
+    );
     assert!(c < 1e-5, "{c:e}");
     // undamped: the velocity form's bounded O((ωτ)²) energy error of the shear modes the
     // impulsive start excites (measured 1.0e-2 / 2.4e-3 / 6.1e-4 at safety 1 / ½ / ¼)
@@ -247,7 +268,10 @@ fn dyn_timoshenko_case1_impacts_and_ledger() {
         {
             impacts += 1;
             assert!(*momentum_residual < 1e-12, "{momentum_residual:e}");
-            assert!(normal_velocity_after.abs() < 1e-12, "{normal_velocity_after:e}");
+            assert!(
+                normal_velocity_after.abs() < 1e-12,
+                "{normal_velocity_after:e}"
+            );
             assert!(*kinetic_energy_lost >= -1e-12, "{kinetic_energy_lost:e}");
         }
     }
@@ -276,7 +300,10 @@ fn first_impact(scene: &Scene, stations: usize) -> f64 {
 #[test]
 fn conv_timoshenko_case1_first_impact_second_order_in_space() {
     let scene = load_scene("barhorst-case1-timoshenko").unwrap();
-    let t: Vec<f64> = [11, 21, 41].iter().map(|&n| first_impact(&scene, n)).collect();
+    let t: Vec<f64> = [11, 21, 41]
+        .iter()
+        .map(|&n| first_impact(&scene, n))
+        .collect();
     let order = ((t[0] - t[1]) / (t[1] - t[2])).log2();
     let extrapolated = t[2] - (t[1] - t[2]) / 3.0;
     println!("first impact {t:?}: observed order {order:.3}, Richardson {extrapolated:.8}");
@@ -345,5 +372,8 @@ fn prop_timoshenko_unsupported_switches_are_typed_errors() {
     let plan = FdmBackend
         .dof_plan(&base, &Default::default())
         .expect("plan");
-    assert!(plan.builds.iter().any(|b| b.contains("Timoshenko")), "{plan:?}");
+    assert!(
+        plan.builds.iter().any(|b| b.contains("Timoshenko")),
+        "{plan:?}"
+    );
 }

@@ -36,6 +36,11 @@
 //! clamp-rotation modes with their joint-damper ratio. Gravity: V_g of the lumped masses
 //! ([`TwoLinkChain`]'s `gravity_potential`). Tip contact: [`contact`]. Observables: joint angles/rates (clamp angles),
 //! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame.
+//!
+//! **Timoshenko links** (`shear` on both links): [`timoshenko`] — ψ at the stations replaces the
+//! clamp ghost (the clamp section's turn from the chord is ψ₀), ψ is massless in the chord
+//! frames and condensed; the ghost slots of q stay in place, unused (zero force, a decoupled
+//! unit mass), so the mass solve and the contact code are shared unchanged.
 
 // Index loops over parallel buffers (q, v, a, columns of M) read like the formulas.
 #![allow(clippy::needless_range_loop)]
@@ -828,9 +833,8 @@ impl TwoLinkChain {
             // condensed ψ (chain::timoshenko): −∂U_c/∂q − ∂D_c/∂q̇, no torque laws (refused)
             let (pw, [th, thd]) = tf.forces(q, v, out);
             let j = &self.joints;
-            self.torques = [0, 1].map(|k| {
-                -j[k].stiffness * (th[k] - j[k].set_point) - j[k].damping * thd[k]
-            });
+            self.torques =
+                [0, 1].map(|k| -j[k].stiffness * (th[k] - j[k].set_point) - j[k].damping * thd[k]);
             self.power = [0.0, pw[0], pw[1]];
             let qk = std::mem::take(&mut self.qk);
             self.gravity_potential(&qk, Some(out));

@@ -191,7 +191,7 @@ impl TimoFields {
         let mut mult = vec![0.0; nz - 1];
         piv[0] = a[0];
         for i in 0..nz - 1 {
-            if !(piv[i] > 0.0) {
+            if piv[i].is_nan() || piv[i] <= 0.0 {
                 return Err(FdmError::Numerical {
                     t: 0.0,
                     message: format!("Timoshenko ψ stiffness not positive definite (pivot {i})"),
@@ -200,7 +200,7 @@ impl TimoFields {
             mult[i] = b[i] / piv[i];
             piv[i + 1] = a[i + 1] - mult[i] * b[i];
         }
-        if !(piv[nz - 1] > 0.0) {
+        if piv[nz - 1].is_nan() || piv[nz - 1] <= 0.0 {
             return Err(FdmError::Numerical {
                 t: 0.0,
                 message: "Timoshenko ψ stiffness not positive definite (last pivot)".into(),
@@ -263,10 +263,7 @@ impl TimoFields {
     /// Joint angles (Θ₁, Θ₂) = (θ + ψ¹₀, β + ψ²₀ − θ − ψ¹_r) of (q, z) — or their rates of
     /// (q̇, ż).
     pub fn joints_of(&self, q: &[f64], z: &[f64]) -> [f64; 2] {
-        [
-            q[TH] + z[0],
-            q[BE] + z[self.zo(1)] - q[TH] - z[self.r[0]],
-        ]
+        [q[TH] + z[0], q[BE] + z[self.zo(1)] - q[TH] - z[self.r[0]]]
     }
 
     /// Value of the quadratic form `c` at (q, z); adds `sign` × its gradients into `gq` (θ, β
