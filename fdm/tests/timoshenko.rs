@@ -350,6 +350,38 @@ fn dyn_timoshenko_stiff_shear_limit_is_the_euler_chain() {
 }
 
 #[test]
+fn elem_timoshenko_top_frequency_is_the_shear_sawtooth() {
+    // The condensed operator's Fourier symbol ω²(u) = 16u² EI κGA/(h⁴ρA(κGA(1 − u) + 4EIu/h²)),
+    // u = sin²(kh/2), peaks at u = 1 with 4κGA/(ρA h²) (module docs: the step bound). On the
+    // finite chord-frame grid (v₀ = v_r = 0) the top mode is j = r − 1, u = sin²(π(r−1)/(2r)):
+    // the coupled chain's power-iteration ω_max (2 % margin removed) of the finer link (link 2,
+    // h = 0.1) must match that value and stay below the bound, for soft and stiff shear.
+    for kga in [1.0e6, 1.0e8] {
+        let sc = sheared("barhorst-case1", kga);
+        let sys = TwoLinkChain::from_scene(&sc, Some(21)).unwrap();
+        let (l2, r) = (&sc.links[1], 20.0);
+        let h = l2.length / r;
+        let (ei, rho_a) = (l2.bending_stiffness, l2.mass_per_length);
+        let sawtooth = 2.0 / h * (kga / rho_a).sqrt();
+        let u = (std::f64::consts::PI * (r - 1.0) / (2.0 * r)).sin().powi(2);
+        let b4 = 4.0 * ei / (h * h);
+        let grid = sawtooth * (u * u * b4 / (kga * (1.0 - u) + u * b4)).sqrt();
+        let measured = sys.omega_max / 1.02;
+        let b = sys.bound(0.0);
+        println!(
+            "κGA {kga:e}: ω_max {measured:.5e} vs grid top {grid:.5e} ({:.2e} apart), sup \
+             2/h·√(κGA/ρA) {sawtooth:.5e}; bound {:.4e} ({})",
+            measured / grid - 1.0,
+            b.sigma,
+            sys.describe(&b)
+        );
+        assert!((measured / grid - 1.0).abs() < 2e-3, "{measured} vs {grid}");
+        assert!(measured <= sawtooth);
+        assert!(b.sigma <= h * (rho_a / kga).sqrt() * (1.0 + 1e-12));
+    }
+}
+
+#[test]
 fn prop_timoshenko_unsupported_switches_are_typed_errors() {
     let base = load_scene("barhorst-case1-timoshenko").unwrap();
     let s = settings(11, 0.01);

@@ -43,11 +43,14 @@
 //! Without damping on z (γ = 0 and no joint dampers) z is algebraic: z = z₀(y) =
 //! −K_zz⁻¹(K_zy y + b), one tridiagonal solve, and the condensed potential U_c(y) =
 //! U(y, z₀(y)) has ∂U_c/∂y = ∂U/∂y at z₀ (the ∂U/∂z term vanishes): exact.
-//! With damping, ż = −C⁻¹(∂U/∂z + ...) is a first-order relaxation whose rates are the
-//! eigenvalues of C⁻¹K_zz: ≥ EI/γ = 2.5·10⁴ s⁻¹ for barhorst-case1-timoshenko (pure-bending ψ
-//! shapes), ~κGA h²/γ … κGA L/D_j ≥ 10⁵ s⁻¹ for the rest — all far above the step rate 1/τ
-//! (τ ≈ 2e-4 s) and the mechanics' frequencies (≲ 10³ rad/s). Explicit integration of z would
-//! need τ ≤ 2/rate_max, and an implicit one-step of z breaks the exact ledger; z is instead
+//! With damping, C ż = −∂U/∂z − (cross terms in ẏ) is a first-order relaxation whose rates are
+//! the eigenvalues of C⁻¹K_zz (C the ψ block of D): the bending part of K_zz is (EI/γ)× the
+//! Kelvin–Voigt part of C, so shapes with a curvature rate relax at ≥ EI/γ = 2.5·10⁴ s⁻¹
+//! (barhorst-case1-timoshenko); shapes without one (uniform ψ per link) are damped by the joint
+//! dampers alone, at ~κGA L/(D₁ + D₂) ≈ 7.5·10⁴ s⁻¹, and are algebraic where C has no term.
+//! All are far above the mechanics' frequencies (≲ 10³ rad/s) and ≳ 1/τ (τ ≈ 3e-5 s):
+//! explicit integration of z would need τ ≤ 2/rate_max (unbounded where C is singular), and an
+//! implicit one-step of z breaks the exact ledger; z is instead
 //! carried on its **slow manifold** (as the modal backend does): z = z₀(y) + z₁ with
 //! z₁ = −K_zz⁻¹ ∂D/∂ż(ẏ, ż₀), ż₀ = Jẏ, J = −K_zz⁻¹K_zy. Substituting into the y equation,
 //! −K_yz z₁ = −Jᵀ∂D/∂ż, so to first order in (frequency/relaxation rate)
@@ -55,14 +58,14 @@
 //! M(y)ÿ = f − ∂U_c/∂y − ∂D_c/∂ẏ,   D_c(ẏ) = D(ẏ, Jẏ),   ∂D_c/∂ẏ = ∂D/∂ẏ + Jᵀ∂D/∂ż,
 //!
 //! a Lagrangian system with the condensed Rayleigh function: exact without damping, error
-//! O(ω/rate) relative in the damping forces only (≈ 1e-2 of the Kelvin–Voigt force at 250 Hz
-//! against 2.5e4 s⁻¹). The ledger is exact in its own terms: strain U(y, z₀), joint springs at
+//! O(ω/rate) relative in the damping forces only (≤ 1 % for ω ≤ 250 rad/s against
+//! 2.5·10⁴ s⁻¹; the next term is −K_zz⁻¹C ż₁). The ledger is exact in its own terms: strain U(y, z₀), joint springs at
 //! Θ(y, z₀), dissipation 2D_c = Σγh(Δż₀/h)² + D₁Θ̇₁² + D₂Θ̇₂² at ż₀ = Jẏ. Jᵀg = −K_yz K_zz⁻¹g.
 //! Per force evaluation: three tridiagonal solves (z₀, ż₀, K_zz⁻¹∂D/∂ż) and four O(n) passes
 //! of the energy gradient: linear cost, no allocation.
 //!
-//! **Step bound.** The shear sawtooth vᵢ = (−1)ⁱa has ψ̄ ≡ 0 for every ψ sawtooth, so ψ
-//! cannot relieve it; for the Fourier mode e^{ikx} the condensed operator is
+//! **Step bound.** The v sawtooth vᵢ = (−1)ⁱa has an alternating Δv/h, while every ψ̄ of a
+//! smooth or sawtooth ψ is smooth or zero, so ψ cannot relieve its shear; for the Fourier mode e^{ikx} the condensed operator is
 //! ω²(k) = A⁴ EI κGA / (ρA(κGA c² + EI A²)), A = 2 sin(kh/2)/h, c = cos(kh/2), increasing
 //! in sin²(kh/2) for every EI, κGA (its derivative ∝ u(2 + u(α − 1)) > 0, α = 4EI/(h²κGA)),
 //! so ω²_max = 4κGA/(ρA h²) at kh = π: σ² = h² ρA/κGA (the condensed operator's 2/ω_max,
