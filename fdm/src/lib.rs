@@ -125,9 +125,12 @@
 //!   (1.3e-4 at the default step: the velocity form's energy error in the impact-excited shear
 //!   waves is ~first order near the bound); damped free swing 3.8e-5/9.0e-6/2.2e-6 at safety
 //!   1/½/¼; κGA → ∞ approaches the Euler chain. Refused: `rotary_inertia`, mixed
-//!   Euler/Timoshenko chains, torque laws with shear, single Timoshenko links and beams.
+//!   Euler/Timoshenko chains, torque laws with shear, single floating Timoshenko links, beam
+//!   modes with shear. **Statics** of the clamped Timoshenko cantilever
+//!   (`cantilever-timoshenko`) use the same cell energy ([`beam`]): tip force error exactly
+//!   −PLh²/(12EI) with ψ(L) exact; distributed load v(L) exact, ψ(L) O(h²).
 //! * Unsupported (precise `Unsupported` messages): chains of more than two links, axial
-//!   fields, shear outside the two-link chain, tip inertia, gravity on beams, contact with
+//!   fields, shear outside the two-link chain and cantilever statics, tip inertia, gravity on beams, contact with
 //!   friction, circles or bilateral mode, contact with the two-step scheme, 3-D and mobile
 //!   scenes.
 

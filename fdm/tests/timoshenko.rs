@@ -189,7 +189,7 @@ fn conv_timoshenko_cantilever_tip_deflection_second_order() {
     let mut errs = Vec::new();
     for r in [5, 10, 20, 40, 80] {
         let h = len / r as f64;
-        let (v, psi) = TimoFields::cantilever_tip(len, ei, kga, r, p);
+        let (v, psi) = TimoFields::cantilever_statics(len, ei, kga, r, p, 0.0);
         let err = v - exact;
         // discrete solution: exact midpoint moments, ψ exact at the stations, v the
         // trapezoidal sum of ψ̄ + P/κGA: error −PLh²/(12EI) exactly
@@ -207,6 +207,55 @@ fn conv_timoshenko_cantilever_tip_deflection_second_order() {
     for w in errs.windows(2) {
         let order = (w[0] / w[1]).log2();
         assert!((order - 2.0).abs() < 0.01, "observed order {order}");
+    }
+}
+
+#[test]
+fn sys_timoshenko_cantilever_statics_through_the_backend() {
+    // `flexverify statics cantilever-timoshenko --backend fdm`: tip force (the scene's) and a
+    // distributed load, against PL³/3EI + PL/κGA and qL⁴/8EI + qL²/2κGA; order 2 for both
+    let base = load_scene("cantilever-timoshenko").unwrap();
+    let l = &base.links[0];
+    let (len, ei, kga) = (l.length, l.bending_stiffness, l.shear_stiffness.unwrap());
+    let p = base.statics.as_ref().unwrap().tip_force.unwrap();
+    let q = 250.0;
+    let mut dist = base.clone();
+    if let Some(st) = dist.statics.as_mut() {
+        st.tip_force = None;
+        st.distributed_load = Some(q);
+    }
+    let cases = [
+        (
+            &base,
+            p * len.powi(3) / (3.0 * ei) + p * len / kga,
+            p * len * len / (2.0 * ei),
+        ),
+        (
+            &dist,
+            q * len.powi(4) / (8.0 * ei) + q * len * len / (2.0 * kga),
+            q * len.powi(3) / (6.0 * ei),
+        ),
+    ];
+    for (k, (scene, v_exact, psi_exact)) in cases.into_iter().enumerate() {
+        let mut errs = Vec::new();
+        for n in [11, 21, 41, 81] {
+            let mut s = Settings::default();
+            s.discretization.stations = Some(n);
+            let r = FdmBackend.statics(scene, &s).expect("statics");
+            let (ev, ep) = (
+                (r.tip_deflection - v_exact) / v_exact,
+                (r.tip_rotation - psi_exact) / psi_exact,
+            );
+            println!("load {k}, {n} stations: v(L) rel. error {ev:.3e}, ψ(L) {ep:.3e}");
+            // tip force: ψ(L) exact, v(L) O(h²); distributed: v(L) exact (the lumped load and
+            // the trapezoid errors cancel), ψ(L) O(h²)
+            errs.push(ev.abs().max(ep.abs()));
+            assert!(ev.abs().min(ep.abs()) < 1e-10, "{ev:e} {ep:e}");
+        }
+        for w in errs.windows(2) {
+            let order = (w[0] / w[1]).log2();
+            assert!((order - 2.0).abs() < 0.1, "load {k}: order {order}");
+        }
     }
 }
 

@@ -453,11 +453,19 @@ impl TimoFields {
         self.h[link] * (rho_a / self.elastic.shear[link]).sqrt()
     }
 
-    /// Static tip deflection of a clamped Timoshenko cantilever (v₀ = ψ₀ = 0, free end) of
-    /// the same discrete energy under a tip load P: the chain's cell energy on r cells, solved
-    /// as a banded system (v, ψ interleaved, half-bandwidth 3). For the convergence checks;
-    /// allocates. Returns (v(L), ψ(L)).
-    pub fn cantilever_tip(length: f64, ei: f64, kga: f64, r: usize, load: f64) -> (f64, f64) {
+    /// Static tip response of a clamped Timoshenko cantilever (v₀ = ψ₀ = 0, free end) of the
+    /// same discrete energy under a tip force P and a distributed load q (lumped: qh at the
+    /// interior stations, qh/2 at the tip): the chain's cell energy on r cells, solved as a
+    /// banded system (v, ψ interleaved, half-bandwidth 3). Returns (v(L), ψ(L)). Allocates
+    /// (statics, not a step loop).
+    pub fn cantilever_statics(
+        length: f64,
+        ei: f64,
+        kga: f64,
+        r: usize,
+        tip: f64,
+        dist: f64,
+    ) -> (f64, f64) {
         let h = length / r as f64;
         // unknowns (v_i, ψ_i), i = 1…r ↦ 2(i−1), 2(i−1)+1
         let n = 2 * r;
@@ -488,7 +496,10 @@ impl TimoFields {
             }
         }
         let mut f = vec![0.0; n];
-        f[2 * (r - 1)] = load;
+        for i in 1..=r {
+            f[2 * (i - 1)] = dist * h * if i == r { 0.5 } else { 1.0 };
+        }
+        f[2 * (r - 1)] += tip;
         // banded Gaussian elimination (SPD: no pivoting)
         for p in 0..n {
             let d = k[p][bw];
