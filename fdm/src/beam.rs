@@ -268,6 +268,9 @@ pub fn statics(
     settings: &Settings,
     s: &FdmSettings,
 ) -> Result<StaticResult, FdmError> {
+    if scene.links.len() == 1 && scene.links[0].shear {
+        return timoshenko_statics(scene, settings, s);
+    }
     let clock = std::time::Instant::now();
     let c = Cantilever::from_scene(scene, s.stations)?;
     let st = scene
@@ -290,6 +293,63 @@ pub fn statics(
         cost: Cost {
             wall_time_s: clock.elapsed().as_secs_f64(),
             dofs: c.dofs(),
+            factorizations: 1,
+            ..Cost::default()
+        },
+    })
+}
+
+/// Statics of a clamped Timoshenko cantilever (`cantilever-timoshenko`): the two-link chain's
+/// discrete energy Σ ½EI(Δψ/h)²h + Σ ½κGA(Δv/h − ψ̄)²h on the link ([`crate::chain::timoshenko`]),
+/// v₀ = ψ₀ = 0, tip force and lumped distributed load. Reported rotation: ψ(L) (the convention's
+/// "slope"). Section rotary inertia does not enter statics (accepted); axial fields, tip
+/// inertia, gravity and contact are refused as for the Euler beam.
+fn timoshenko_statics(
+    scene: &Scene,
+    settings: &Settings,
+    s: &FdmSettings,
+) -> Result<StaticResult, FdmError> {
+    let clock = std::time::Instant::now();
+    let l = &scene.links[0];
+    if !matches!(l.joint.prescribed, Some(PrescribedMotion::Fixed)) {
+        return Err(FdmError::Unsupported(format!(
+            "fdm: statics of the Timoshenko link `{}` need a fixed clamp",
+            scene.name
+        )));
+    }
+    FdmError::check_switches(
+        &format!("`{}`", scene.name),
+        "Timoshenko beam statics",
+        &[
+            ("axial", l.axial),
+            ("tip_inertia", l.tip_inertia.is_some()),
+            ("gravity", scene.gravity.is_some()),
+            ("contact", !scene.contacts.is_empty()),
+        ],
+    )?;
+    let kga = crate::chain::timoshenko::shear_stiffness(&scene.name, l)?;
+    let st = scene
+        .statics
+        .as_ref()
+        .ok_or_else(|| FdmError::Unsupported(format!("`{}` has no [statics] loads", scene.name)))?;
+    let n = s.stations.unwrap_or(DEFAULT_STATIONS);
+    let (v, psi) = crate::chain::timoshenko::TimoFields::cantilever_statics(
+        l.length,
+        l.bending_stiffness,
+        kga,
+        n - 1,
+        st.tip_force.unwrap_or(0.0),
+        st.distributed_load.unwrap_or(0.0),
+    );
+    Ok(StaticResult {
+        backend: BackendKind::Fdm,
+        scene: scene.name.clone(),
+        settings: settings.clone(),
+        tip_deflection: v,
+        tip_rotation: psi,
+        cost: Cost {
+            wall_time_s: clock.elapsed().as_secs_f64(),
+            dofs: 2 * (n - 1),
             factorizations: 1,
             ..Cost::default()
         },

@@ -36,6 +36,11 @@
 //! clamp-rotation modes with their joint-damper ratio. Gravity: V_g of the lumped masses
 //! ([`TwoLinkChain`]'s `gravity_potential`). Tip contact: [`contact`]. Observables: joint angles/rates (clamp angles),
 //! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame.
+//!
+//! **Timoshenko links** (`shear` on both links): [`timoshenko`] — ψ at the stations replaces the
+//! clamp ghost (the clamp section's turn from the chord is ψ₀), ψ is massless in the chord
+//! frames and condensed; the ghost slots of q stay in place, unused (zero force, a decoupled
+//! unit mass), so the mass solve and the contact code are shared unchanged.
 
 // Index loops over parallel buffers (q, v, a, columns of M) read like the formulas.
 #![allow(clippy::needless_range_loop)]
@@ -43,6 +48,7 @@
 pub mod contact;
 pub mod dual;
 pub mod kinetic;
+pub mod timoshenko;
 
 use data::scene::{Link, TorqueLaw};
 use data::{DofPlan, RunResult, Scene, Settings, channel};
@@ -54,6 +60,10 @@ use crate::settings::{FdmSettings, Method};
 use contact::TipContact;
 use dual::Dual;
 use kinetic::{BE, ChainInertia, TH, seg_energy, seg_grad};
+use timoshenko::TimoFields;
+
+/// Bound sites ≥ this are the Timoshenko links' shear bounds.
+const SHEAR_SITE: usize = 10;
 
 /// Default stations per link.
 pub const DEFAULT_STATIONS: usize = 21;
@@ -89,9 +99,9 @@ pub struct TwoLinkChain {
     init: [(f64, f64); 2],
     field_stations: usize,
     /// highest angular frequency of the linearized chain at t = 0 (power iteration)
-    omega_max: f64,
+    pub omega_max: f64,
     /// fastest damping rate of the linearized chain at t = 0 (power iteration on −∂a/∂q̇)
-    kappa_max: f64,
+    pub kappa_max: f64,
     /// clamp half-cell rotary inertias ρA h³/24 of links 1 and 2
     jc: [f64; 2],
     /// q-slots of the clamp ghost deflections x₁, x₂ (station 1 of each link is the chord
@@ -126,6 +136,9 @@ pub struct TwoLinkChain {
     /// scratch of the constraint: G = ∂g/∂q and M⁻¹Gᵀ
     grow: Vec<f64>,
     minv_g: Vec<f64>,
+    /// Timoshenko links (`shear` on both): the condensed section rotations ([`timoshenko`]);
+    /// the ghost slots are then unused (held at zero with a unit dummy mass)
+    timo: Option<TimoFields>,
 }
 
 fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
@@ -134,8 +147,6 @@ fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
         "chain",
         &[
             ("axial", l.axial),
-            ("shear", l.shear),
-            ("rotary_inertia", l.rotary_inertia),
             ("tip_inertia", l.tip_inertia.is_some()),
             ("prescribed joint", l.joint.prescribed.is_some()),
         ],
@@ -154,6 +165,36 @@ impl TwoLinkChain {
         }
         for l in &scene.links {
             check_link(scene, l)?;
+        }
+        let shear = scene.links[0].shear;
+        if scene.links[1].shear != shear {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: `{}` mixes a Timoshenko (`shear`) and an Euler link; the finite-difference \
+                 chain needs both links of one model",
+                scene.name
+            )));
+        }
+        for l in &scene.links {
+            if l.rotary_inertia {
+                return Err(FdmError::Unsupported(format!(
+                    "fdm: `{}` (link `{}`) switches on rotary_inertia — the finite-difference \
+                     chain has no section inertia: {}",
+                    scene.name,
+                    l.name,
+                    if l.shear {
+                        "its Timoshenko ψ is massless and condensed (chain::timoshenko)"
+                    } else {
+                        "Euler links carry only the lumped masses"
+                    }
+                )));
+            }
+            if l.shear && l.joint.torque.is_some() {
+                return Err(FdmError::Unsupported(format!(
+                    "fdm: `{}` (link `{}`): an applied joint torque law with Timoshenko links \
+                     is not implemented (the condensed ψ would follow the torque's rate)",
+                    scene.name, l.name
+                )));
+            }
         }
         if scene.links[1].joint.hub_inertia.unwrap_or(0.0) != 0.0 {
             return Err(FdmError::Unsupported(format!(
@@ -184,7 +225,37 @@ impl TwoLinkChain {
         // Rotary inertia ρA h³/24 of the half cell at each clamp: its section turns with the
         // clamp tangent (module docs). O(h³): the O(h²) convergence is unaffected.
         let clamp = |l: &Link, h: f64| l.mass_per_length * h.powi(3) / 24.0;
-        let jc = [clamp(&scene.links[0], h1), clamp(&scene.links[1], h2)];
+        // Timoshenko: the clamp section's turn is ψ₀ (massless, condensed), no ghost inertia
+        let jc = if shear {
+            [0.0; 2]
+        } else {
+            [clamp(&scene.links[0], h1), clamp(&scene.links[1], h2)]
+        };
+        let timo = if shear {
+            let mut lk = [(0, 0.0, 0.0, 0.0, 0.0); 2];
+            for (k, (l, (r, h))) in scene.links.iter().zip([(r1, h1), (r2, h2)]).enumerate() {
+                lk[k] = (
+                    r,
+                    h,
+                    l.bending_stiffness,
+                    timoshenko::shear_stiffness(&scene.name, l)?,
+                    l.kelvin_voigt.unwrap_or(0.0),
+                );
+            }
+            let jt = |l: &Link| {
+                (
+                    l.joint.stiffness.unwrap_or(0.0),
+                    l.joint.damping.unwrap_or(0.0),
+                    l.joint.set_point.unwrap_or(0.0),
+                )
+            };
+            Some(TimoFields::new(
+                lk,
+                [jt(&scene.links[0]), jt(&scene.links[1])],
+            )?)
+        } else {
+            None
+        };
         let inertia = ChainInertia {
             hub: scene.links[0].joint.hub_inertia.unwrap_or(0.0),
             l1: scene.links[0].length,
@@ -263,12 +334,18 @@ impl TwoLinkChain {
             lambda: 0.0,
             grow: vec![0.0; nd],
             minv_g: vec![0.0; nd],
+            timo,
         };
         // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
         // built once here, `accel` refreshes only the θ and β columns.
         for k in 0..2 {
             let mut col = std::mem::take(&mut chain.cols[2 + k]);
-            chain.add_clamp(k, -chain.jc[k] / (2.0 * chain.hs[k]), &mut col);
+            if chain.timo.is_some() {
+                // unused slot: a decoupled unit mass with no force keeps it at rest at zero
+                col[chain.slots[k]] = 1.0;
+            } else {
+                chain.add_clamp(k, -chain.jc[k] / (2.0 * chain.hs[k]), &mut col);
+            }
             chain.cols[2 + k] = col;
         }
         chain.omega_max = chain.top_frequency();
@@ -363,10 +440,17 @@ impl TwoLinkChain {
         let mut plan = DofPlan::default();
         plan.add("link-1 tip-chord angle θ", 1);
         plan.add("link-2 tip-chord angle β", 1);
-        plan.add(
-            "clamp ghost deflections x₁, x₂ (clamp turn against the chord)",
-            2,
-        );
+        if self.timo.is_some() {
+            plan.add(
+                "unused ghost slots (Timoshenko: held at zero, decoupled unit mass)",
+                2,
+            );
+        } else {
+            plan.add(
+                "clamp ghost deflections x₁, x₂ (clamp turn against the chord)",
+                2,
+            );
+        }
         plan.add(
             "link 1 transverse v at stations 1…r−1 (tip-chord frame: v₀ = v_r = 0)",
             self.inertia.r1 - 1,
@@ -378,6 +462,13 @@ impl TwoLinkChain {
         if self.inertia.fs1 || self.inertia.fs2 {
             plan.builds
                 .push("foreshortening (inertial axial-load) stiffening".into());
+        }
+        if let Some(t) = &self.timo {
+            plan.builds.push(format!(
+                "Timoshenko shear ½κGA(Δv/h − ψ̄)² and bending ½EI(Δψ/h)²: {} massless section \
+                 rotations ψ condensed on their slow manifold (tridiagonal solve per evaluation)",
+                t.nz()
+            ));
         }
         if self.any_kv() {
             plan.builds.push("Kelvin–Voigt damping".into());
@@ -400,7 +491,50 @@ impl TwoLinkChain {
         q[BE] = self.init[0].0 + self.init[1].0;
         v[TH] = self.init[0].1;
         v[BE] = self.init[0].1 + self.init[1].1;
+        if let Some(t) = &self.timo {
+            // The condensed sections turn with the elbow spring's load: set the chord angles
+            // so that the joint angles Θ₁ = θ + ψ¹₀, Θ₂ = β + ψ²₀ − θ − ψ¹_r (and their rates)
+            // are the scene's. ∂Θ/∂(θ, β) is 1 up to the ψ response (≪ 1): fixed point.
+            for (x, rate) in [(&mut q, false), (&mut v, true)] {
+                let want = [
+                    if rate { self.init[0].1 } else { self.init[0].0 },
+                    if rate { self.init[1].1 } else { self.init[1].0 },
+                ];
+                for _ in 0..50 {
+                    let th = t.joint_angles(x, rate);
+                    let d = [want[0] - th[0], want[1] - th[1]];
+                    x[TH] += d[0];
+                    x[BE] += d[0] + d[1];
+                    if d[0].abs().max(d[1].abs()) <= 1e-16 * (1.0 + want[0].abs()) {
+                        break;
+                    }
+                }
+            }
+        }
         (q, v)
+    }
+
+    /// Joint angles (θ₁, θ₂) at q: the clamp angle of link 1 and the elbow (Euler: clamp
+    /// tangents and the tip slope; Timoshenko: clamp sections and link 1's tip section on the
+    /// condensed ψ).
+    pub fn joint_angles(&self, q: &[f64]) -> [f64; 2] {
+        match &self.timo {
+            Some(t) => t.joint_angles(q, false),
+            None => [self.clamp_angle(q, 0), self.elbow(q)],
+        }
+    }
+
+    /// Joint rates (θ̇₁, θ̇₂) at q̇ (both models: linear in q̇ alone).
+    pub fn joint_rates(&self, v: &[f64]) -> [f64; 2] {
+        match &self.timo {
+            Some(t) => t.joint_angles(v, true),
+            None => [self.clamp_angle(v, 0), self.elbow(v)],
+        }
+    }
+
+    /// The condensed Timoshenko fields, if the links are Timoshenko links.
+    pub fn timoshenko(&self) -> Option<&TimoFields> {
+        self.timo.as_ref()
     }
 
     /// Tip slope ψ of link 1 and the stencil (indices into q, weights).
@@ -652,6 +786,12 @@ impl TwoLinkChain {
     /// end at the *predicted* velocity; its ledger takes the powers at the final one (the
     /// overdamped clamp-rotation modes make the two differ at O(1) near the step bound).
     pub(super) fn powers_at(&mut self, t: f64, v: &[f64], out: &mut [f64]) {
+        if let Some(tf) = &self.timo {
+            let pw = tf.powers(v);
+            self.power = [0.0, pw[0], pw[1]];
+            self.powers(out);
+            return;
+        }
         self.vk.copy_from_slice(v);
         for s in self.slots {
             self.vk[s] = 0.0;
@@ -689,6 +829,18 @@ impl TwoLinkChain {
     /// Generalized forces Q − ∂V/∂q − ∂D/∂q̇ into `out`; sets the powers.
     fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
+        if let Some(tf) = &self.timo {
+            // condensed ψ (chain::timoshenko): −∂U_c/∂q − ∂D_c/∂q̇, no torque laws (refused)
+            let (pw, [th, thd]) = tf.forces(q, v, out);
+            let j = &self.joints;
+            self.torques =
+                [0, 1].map(|k| -j[k].stiffness * (th[k] - j[k].set_point) - j[k].damping * thd[k]);
+            self.power = [0.0, pw[0], pw[1]];
+            let qk = std::mem::take(&mut self.qk);
+            self.gravity_potential(&qk, Some(out));
+            self.qk = qk;
+            return;
+        }
         let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
         let mut p_kv = 0.0;
         for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
@@ -819,6 +971,27 @@ impl System for TwoLinkChain {
         // ζ of the top mode: at least the Kelvin–Voigt ζ of that frequency, and at least
         // κ_max/(2ω_max) — the fastest damping rate as if it sat on the top frequency
         // (conservative: for ζ ≫ 1 the factor gives τ → 1/κ_max, the overdamped limit).
+        if let Some(t) = &self.timo {
+            // Timoshenko (chain::timoshenko): the coupled chain's ω_max with the fastest
+            // damping rate, and per link the condensed operator's 2/ω_max = h√(ρA/κGA)
+            let zeta = self.kappa_max / (2.0 * self.omega_max);
+            let mut best = Bound {
+                sigma: 0.9 * 2.0 / self.omega_max * damped_step_factor(zeta),
+                kind: BoundKind::Transverse,
+                site: 2,
+            };
+            for (k, lp) in self.links.iter().enumerate() {
+                let s = t.shear_bound(k, lp.rho_a);
+                if s < best.sigma {
+                    best = Bound {
+                        sigma: s,
+                        kind: BoundKind::Transverse,
+                        site: SHEAR_SITE + k,
+                    };
+                }
+            }
+            return best;
+        }
         let zeta = self
             .links
             .iter()
@@ -868,7 +1041,12 @@ impl System for TwoLinkChain {
     }
 
     fn describe(&self, b: &Bound) -> String {
-        if b.site >= 3 {
+        if b.site >= SHEAR_SITE {
+            format!(
+                "link {} shear sawtooth of the condensed Timoshenko operator (σ = h√(ρA/κGA))",
+                b.site - SHEAR_SITE + 1
+            )
+        } else if b.site >= 3 {
             format!(
                 "clamp-rotation mode of link {} (ghost node against J_c)",
                 b.site - 2
@@ -913,21 +1091,19 @@ impl System for TwoLinkChain {
         }
         // chord-frame deflections (station 1 at zero)
         let (vs, ws) = (&qk[ine.iv()], &qk[ine.iw()]);
-        let th1 = self.clamp_angle(q, 0);
-        let th2 = self.elbow(q);
+        let [th1, th2] = self.joint_angles(q);
+        let [th1d, th2d] = self.joint_rates(v);
         let j = &self.joints;
         // joint torques: applied law + spring + damper at this state
-        let tau1 = j[0].torque(t)
-            - j[0].stiffness * (th1 - j[0].set_point)
-            - j[0].damping * self.clamp_angle(v, 0);
-        let tau2 =
-            j[1].torque(t) - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * self.elbow(v);
+        let tau1 = j[0].torque(t) - j[0].stiffness * (th1 - j[0].set_point) - j[0].damping * th1d;
+        let tau2 = j[1].torque(t) - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * th2d;
         out[0] = th1;
-        out[1] = self.clamp_angle(v, 0);
+        out[1] = th1d;
         out[2] = tau1;
         out[3] = th2;
-        out[4] = self.elbow(v);
+        out[4] = th2d;
         out[5] = tau2;
+        let turns = self.timo.as_ref().map(|t| t.clamp_turns(q));
         let s1 = if ine.fs1 {
             seg_energy(vs, ine.h1, None)
         } else {
@@ -952,7 +1128,11 @@ impl System for TwoLinkChain {
         {
             // deflections reported in the clamp-tangent frame, turned by
             // ε = (u₁ − x)/(2h) from the chord: u − Xε (small angle)
-            let turn = -(us[0] - q[self.slots[l]]) / (2.0 * h);
+            // (Timoshenko: the clamp section is turned by ψ₀ from the chord)
+            let turn = match turns {
+                Some(z) => -z[l],
+                None => -(us[0] - q[self.slots[l]]) / (2.0 * h),
+            };
             out[k] = tip.0;
             out[k + 1] = tip.1;
             out[k + 2] = us[us.len() - 1] + self.links[l].length * turn;
@@ -1019,8 +1199,14 @@ impl System for TwoLinkChain {
             strain += c * ((u1 + x).powi(2) / 4.0 - u1 * u1) / (h * h * h);
         }
         let j = &self.joints;
-        let spring = 0.5 * j[0].stiffness * (self.clamp_angle(q, 0) - j[0].set_point).powi(2)
+        let mut spring = 0.5 * j[0].stiffness * (self.clamp_angle(q, 0) - j[0].set_point).powi(2)
             + 0.5 * j[1].stiffness * (self.elbow(q) - j[1].set_point).powi(2);
+        if let Some(t) = &self.timo {
+            // condensed U(y, z₀(y)): strain (bending + shear) and joint springs
+            let parts = t.energies(q);
+            strain = parts.links;
+            spring = parts.joints;
+        }
         out[..3].copy_from_slice(&[ke, strain, spring]);
         if self.gravity.is_some() {
             out[3] = self.gravity_potential(&qk, None);
@@ -1036,6 +1222,9 @@ impl System for TwoLinkChain {
         match i {
             TH => "link-1 tip-chord angle θ".into(),
             BE => "link-2 tip-chord angle β".into(),
+            _ if self.timo.is_some() && self.slots.contains(&i) => {
+                "unused ghost slot (Timoshenko: the clamp turn is the condensed ψ₀)".into()
+            }
             _ if i == self.slots[0] => "link 1 clamp ghost deflection x₁ = v₋₁".into(),
             _ if i == self.slots[1] => "link 2 clamp ghost deflection x₂ = w₋₁".into(),
             _ if ine.iv().contains(&i) => {
