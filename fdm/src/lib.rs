@@ -121,9 +121,9 @@
 //!   Measured (tests/timoshenko.rs): cantilever tip deflection error exactly −PLh²/(12EI)
 //!   (order 2.00 against PL³/3EI + PL/κGA, ψ(L) exact); first impact of case 1 O(h²)
 //!   (0.2807200/0.2805833/0.2805490/0.2805404 at 11/21/41/81 stations; modal poly 6 modes
-//!   0.2805348); momentum residual ≤ 1e-14; case-1 ledger 7.5e-6 over 0.4 s at safety 0.1
-//!   (1.3e-4 at the default step: the velocity form's energy error in the impact-excited shear
-//!   waves is ~first order near the bound); damped free swing 3.8e-5/9.0e-6/2.2e-6 at safety
+//!   0.2805348); momentum residual ≤ 1e-14; case-1 ledger 7.5e-6 over 0.4 s at safety 0.1,
+//!   the default for Timoshenko chains with contact (1.3e-4 at safety 1: the velocity form's
+//!   energy error in the impact-excited shear waves is ~first order near the bound); damped free swing 3.8e-5/9.0e-6/2.2e-6 at safety
 //!   1/½/¼; κGA → ∞ approaches the Euler chain. Refused: `rotary_inertia`, mixed
 //!   Euler/Timoshenko chains, torque laws with shear, single floating Timoshenko links, beam
 //!   modes with shear. **Statics** of the clamped Timoshenko cantilever
