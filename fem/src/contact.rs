@@ -128,6 +128,21 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
             i + 1
         )));
     }
+    if let Some(i) = scene
+        .links
+        .iter()
+        .position(|l| l.shear && !l.rotary_inertia && l.kelvin_voigt.unwrap_or(0.0) <= 0.0)
+    {
+        return Err(FemError::unsupported(format!(
+            "fem: contact with Timoshenko link {} (`{}`) without `rotary_inertia` and without \
+             Kelvin–Voigt damping: its section rotations are then algebraic (∂V/∂ψ = 0) and ψ̇ \
+             jumps with the massive velocities at an impact; that condensation is not \
+             implemented (only the damped case, where ψ̇ follows the massless balance \
+             Nᵀ(∂V/∂q + C q̇) = 0); set `kelvin_voigt` > 0 or `rotary_inertia`",
+            i + 1,
+            scene.links[i].name
+        )));
+    }
     if !scene.links.iter().any(|l| l.name == c.link) {
         return Err(FemError::InvalidSettings {
             field: "contact.link".into(),
@@ -177,6 +192,20 @@ pub struct Contact {
     pub(crate) g_end: Vec<f64>,
     pub(crate) s_inv_g: Vec<f64>,
     mass: DenseLu,
+    /// Exactly massless directions N (Timoshenko sections without rotary inertia, see
+    /// [`Chain::exact_massless_directions`]; empty otherwise), by DOF: (direction, coefficient).
+    massless: Vec<Vec<(usize, f64)>>,
+    /// All massless directions of [`Chain::massless_directions`] (the exact ones and the
+    /// frame directions of mass O(s²)): the regularization M + μ N Nᵀ, by DOF.
+    reg_dirs: Vec<Vec<(usize, f64)>>,
+    dof_dirs: Vec<Vec<(usize, f64)>>,
+    /// LU of NᵀCN (C the constant damping matrix), formed at the first use.
+    damping: Option<DenseLu>,
+    /// Mass scale μ of the regularization M + μNNᵀ.
+    mass_scale: f64,
+    z_res: Vec<f64>,
+    /// Consistent velocity of the last state-force evaluation.
+    qd_c: Vec<f64>,
     zero: Vec<f64>,
     unit: Vec<f64>,
     col: Vec<f64>,
@@ -216,6 +245,15 @@ impl Contact {
         let weight = mass * if g > 0.0 { g } else { 1.0 };
         let n = chain.ndof;
         let z = vec![0.0; n];
+        let massless = chain.exact_massless_directions();
+        let reg_dirs = chain.massless_directions();
+        let mut dof_dirs = vec![Vec::new(); if reg_dirs.is_empty() { 0 } else { n }];
+        for (k, d) in reg_dirs.iter().enumerate() {
+            for &(i, c) in d {
+                dof_dirs[i].push((k, c));
+            }
+        }
+        let nz = massless.len();
         Ok(Some(Contact {
             link,
             normal: [normal[0] / len, normal[1] / len],
@@ -240,6 +278,13 @@ impl Contact {
             g_end: z.clone(),
             s_inv_g: z.clone(),
             mass: DenseLu::new(n),
+            massless,
+            reg_dirs,
+            dof_dirs,
+            damping: None,
+            mass_scale: 0.0,
+            z_res: vec![0.0; nz],
+            qd_c: if nz > 0 { z.clone() } else { Vec::new() },
             zero: z.clone(),
             unit: z.clone(),
             col: z.clone(),
@@ -273,10 +318,27 @@ impl Contact {
     /// factorizes it (dense LU).
     fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<(), FemError> {
         let n = chain.ndof;
+        if !self.reg_dirs.is_empty() && self.mass_scale == 0.0 {
+            // μ: the largest diagonal mass (any positive scale works: see `massless_docs`).
+            for j in 0..n {
+                self.unit[j] = 1.0;
+                chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
+                self.unit[j] = 0.0;
+                self.mass_scale = self.mass_scale.max(self.col[j].abs());
+            }
+        }
         for j in 0..n {
             self.unit[j] = 1.0;
             chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
             self.unit[j] = 0.0;
+            // M + μ N Nᵀ: regular, and equal to M on the massive subspace (module docs).
+            if !self.reg_dirs.is_empty() {
+                for &(k, cj) in &self.dof_dirs[j] {
+                    for &(i, ci) in &self.reg_dirs[k] {
+                        self.col[i] += self.mass_scale * ci * cj;
+                    }
+                }
+            }
             self.mass.set_column(j, &self.col);
         }
         self.mass.factorize().map_err(|e| match e {
@@ -289,6 +351,83 @@ impl Contact {
         })
     }
 
+    /// Makes `qd` consistent with the massless balances Nᵀ R(q, q̇, 0) = 0 by changing it along
+    /// N only (no kinetic energy, no tip velocity changes: M N = 0, G N = 0). Nᵀ R has no
+    /// inertial part and is affine in q̇ through the constant damping C (Kelvin–Voigt, joint
+    /// dampers), so one solve with NᵀCN is exact. Returns the residual passes used. No-op
+    /// without massless directions.
+    pub fn make_consistent(
+        &mut self,
+        chain: &mut Chain,
+        t: f64,
+        q: &[f64],
+        qd: &mut [f64],
+    ) -> Result<usize, FemError> {
+        let nz = self.massless.len();
+        if nz == 0 {
+            return Ok(0);
+        }
+        let mut passes = 1;
+        if self.damping.is_none() {
+            // NᵀCN column by column: C N e_k = R_nc(q, N e_k) − R_nc(q, 0) (exact, affine).
+            let mut lu = DenseLu::new(nz);
+            chain.residual_parts(
+                t,
+                q,
+                &self.zero,
+                &self.zero,
+                Parts::NONCONSERVATIVE,
+                &mut self.tmp,
+            );
+            let mut col = vec![0.0; nz];
+            for k in 0..nz {
+                for &(i, c) in &self.massless[k] {
+                    self.unit[i] = c;
+                }
+                chain.residual_parts(
+                    t,
+                    q,
+                    &self.unit,
+                    &self.zero,
+                    Parts::NONCONSERVATIVE,
+                    &mut self.col,
+                );
+                for &(i, _) in &self.massless[k] {
+                    self.unit[i] = 0.0;
+                }
+                for (kk, d) in self.massless.iter().enumerate() {
+                    col[kk] = d
+                        .iter()
+                        .map(|&(i, c)| c * (self.col[i] - self.tmp[i]))
+                        .sum();
+                }
+                lu.set_column(k, &col);
+            }
+            passes += nz + 1;
+            lu.factorize().map_err(|_| {
+                FemError::unsupported(
+                    "fem: contact with massless section rotations whose damping NᵀCN is \
+                     singular (a massless direction without Kelvin–Voigt or joint damping): \
+                     the algebraic condensation is not implemented",
+                )
+            })?;
+            self.damping = Some(lu);
+        }
+        chain.residual(t, q, qd, &self.zero, &mut self.tmp);
+        for (k, d) in self.massless.iter().enumerate() {
+            self.z_res[k] = d.iter().map(|&(i, c)| c * self.tmp[i]).sum();
+        }
+        if let Some(lu) = &self.damping {
+            lu.solve_in_place(&mut self.z_res);
+        }
+        for (k, d) in self.massless.iter().enumerate() {
+            for &(i, c) in d {
+                qd[i] -= c * self.z_res[k];
+            }
+        }
+        Ok(passes)
+    }
+
     /// Normal force of the constrained dynamics at (q, q̇) (module docs); also sets G (in
     /// `g_end`), M⁻¹Gᵀ, the gap and the normal velocity. Returns (λ, G M⁻¹Gᵀ, passes).
     pub fn state_force(
@@ -298,7 +437,17 @@ impl Contact {
         q: &[f64],
         qd: &[f64],
     ) -> Result<(f64, f64, usize), FemError> {
-        let n = chain.ndof;
+        let mut n = chain.ndof;
+        // Massless directions: λ from the velocity that satisfies their balances (the
+        // stepper's end velocity there is not determined by its equations; module docs).
+        let mut qd_c = std::mem::take(&mut self.qd_c);
+        let qd = if qd_c.is_empty() {
+            qd
+        } else {
+            qd_c.copy_from_slice(qd);
+            n += self.make_consistent(chain, t, q, &mut qd_c)?;
+            &qd_c[..]
+        };
         self.factor_mass(chain, t, q)?;
         let mut g_row = std::mem::take(&mut self.g_end);
         self.gap = self.gradient(chain, t, q, &mut g_row);
@@ -313,6 +462,7 @@ impl Contact {
         let conv = self.normal[0] * a[0] + self.normal[1] * a[1];
         let lambda = (dot(&g_row, &self.tmp) - conv) / gmg;
         self.g_end = g_row;
+        self.qd_c = qd_c;
         Ok((lambda, gmg, n + 2))
     }
 
@@ -326,6 +476,9 @@ impl Contact {
         qd: &mut [f64],
     ) -> Result<Option<Event>, FemError> {
         let n = chain.ndof;
+        // Massless directions (module docs): q̇⁻ consistent with their balances first (changes
+        // neither the kinetic energy nor G q̇).
+        self.make_consistent(chain, t, q, qd)?;
         self.factor_mass(chain, t, q)?;
         let mut g_row = std::mem::take(&mut self.g_end);
         self.gap = self.gradient(chain, t, q, &mut g_row);
@@ -349,6 +502,9 @@ impl Contact {
         for i in 0..n {
             qd[i] += self.minv_gt[i] * impulse;
         }
+        // The massless balances hold after the jump too: Nᵀ C Δq̇ = 0 fixes its N-component
+        // (zero kinetic energy, no mass product, no normal velocity).
+        self.make_consistent(chain, t, q, qd)?;
         // Independent mass product of the velocity jump (not the factorized matrix). The jump
         // is the increment applied, M⁻¹GᵀΛ: the difference of the stored velocities would add
         // their rounding (|q̇|·1e-16), which dominates for grazing impacts with tiny Λ.
@@ -356,10 +512,19 @@ impl Contact {
             self.unit[i] = self.minv_gt[i] * impulse;
         }
         chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
+        // Massive-block balance: M Δq̇ − GᵀΛ ∈ span N, the N-part being −μN NᵀΔq̇ (module
+        // docs; zero along the exactly massless directions).
+        self.tmp.copy_from_slice(&self.col);
+        for d in &self.reg_dirs {
+            let w: f64 = d.iter().map(|&(i, c)| c * self.unit[i]).sum();
+            for &(i, c) in d {
+                self.tmp[i] += self.mass_scale * c * w;
+            }
+        }
         self.unit.iter_mut().for_each(|x| *x = 0.0);
         let (mut res2, mut mom2) = (0.0, 0.0);
         for i in 0..n {
-            let r = self.col[i] - g_row[i] * impulse;
+            let r = self.tmp[i] - g_row[i] * impulse;
             res2 += r * r;
             mom2 += self.col[i] * self.col[i];
         }
@@ -411,6 +576,7 @@ impl Contact {
             for i in 0..qd.len() {
                 qd[i] -= self.minv_gt[i] * vn / gmg;
             }
+            self.make_consistent(chain, t, q, qd)?;
             loss = ke0 - chain.energies(t, q, qd)[0];
         }
         self.normal_velocity = dot(&g_row, qd);
