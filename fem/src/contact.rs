@@ -634,6 +634,14 @@ impl Integrator {
                     .map(|(l, _, passes)| {
                         self.counters.rhs += passes;
                         c.lambda = l;
+                        if std::env::var("FEMDBG").is_ok() {
+                            eprintln!(
+                                "DBG t1={t1:.9} h={:.3e} lam={l:.6e} step_lam={:.6e} gqd={:.3e}",
+                                t1 - self.t,
+                                c.step_lambda,
+                                c.normal_velocity
+                            );
+                        }
                         l
                     })
             }
