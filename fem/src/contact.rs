@@ -166,6 +166,9 @@ pub struct Contact {
     pub lambda: f64,
     /// Multiplier of the last constrained step (its mean normal force), the Newton unknown.
     pub step_lambda: f64,
+    /// Multiplier of the last accepted constrained step (the state force at a contact start):
+    /// the release event function's value at the step start.
+    pub accepted_lambda: f64,
     /// Gap and normal tip velocity G q̇ at the current state.
     pub gap: f64,
     pub normal_velocity: f64,
@@ -261,6 +264,7 @@ impl Contact {
             constrained: false,
             lambda: 0.0,
             step_lambda: 0.0,
+            accepted_lambda: 0.0,
             gap: 0.0,
             normal_velocity: 0.0,
             impact_loss: 0.0,
@@ -634,9 +638,11 @@ impl Integrator {
                     .map(|(l, _, passes)| {
                         self.counters.rhs += passes;
                         c.lambda = l;
+                        let l_state = l;
+                        let l = c.step_lambda;
                         if std::env::var("FEMDBG").is_ok() {
                             eprintln!(
-                                "DBG t1={t1:.9} h={:.3e} lam={l:.6e} step_lam={:.6e} gqd={:.3e}",
+                                "DBG t1={t1:.9} h={:.3e} lam={l_state:.6e} step_lam={:.6e} gqd={:.3e}",
                                 t1 - self.t,
                                 c.step_lambda,
                                 c.normal_velocity
@@ -782,6 +788,7 @@ impl Integrator {
             if let Ok((l, _, _)) = res {
                 c.lambda = l;
                 c.step_lambda = l.max(0.0);
+                c.accepted_lambda = l;
             }
             self.contact = Some(c);
             res?;
@@ -802,13 +809,27 @@ impl Integrator {
             }
         }
         // Constrained: the normal force at the step end decides.
-        let lam0 = self.contact_mut().lambda;
+        let lam0 = self.contact_mut().accepted_lambda;
         let lam1 = self.event_value(Watch::Force, t1)?;
         if lam1 > 0.0 {
             return Ok((h, Post::None));
         }
         let tol_f = self.contact_mut().force_tol;
         if lam0 > 0.0 {
+            // The step multiplier jumps at h = 0⁺ from the last step's mean to about the
+            // index-1 force of the start state; where that is already non-positive the root is
+            // the step start itself (below h_min the multiplier is dominated by the Newton
+            // tolerance of g, ∝ tol/h²): release after the step h_min (module docs).
+            let h_min = 1e-6 * h;
+            let f_min = self.trial(Watch::Force, h_min)?;
+            if f_min <= 0.0 {
+                return Ok((
+                    h_min,
+                    Post::Release {
+                        time_tolerance: h_min,
+                    },
+                ));
+            }
             let (hs, width) = self.locate(Watch::Force, h, lam0, lam1, tol_f)?;
             return Ok((
                 hs,
@@ -845,10 +866,14 @@ impl Integrator {
             // release the velocity is projected onto G q̇ = 0 if the tip moves inward (module
             // docs).
             c.drift_velocity = c.normal_velocity;
+            c.accepted_lambda = c.step_lambda;
             c.max_gap = c.max_gap.max(c.gap.abs());
             c.max_normal_velocity = c.max_normal_velocity.max(c.drift_velocity.abs());
-            if matches!(post, Post::Release { .. }) {
-                let loss = c.project(&mut self.chain, t, &self.q, &mut self.qd, true)?;
+            if matches!(post, Post::Release { .. } | Post::None) {
+                // Drift control: G q̇ = 0 at the start of every constrained step, so that the
+                // step multiplier (the release event function) stays finite as h → 0.
+                let inward_only = post != Post::None;
+                let loss = c.project(&mut self.chain, t, &self.q, &mut self.qd, inward_only)?;
                 self.counters.rhs += self.chain.ndof + 1;
                 c.projection_loss += loss;
             }
@@ -861,7 +886,7 @@ impl Integrator {
                 c.push(Event::Release {
                     t,
                     contact: 1,
-                    normal_force: c.lambda,
+                    normal_force: c.step_lambda,
                     time_tolerance,
                 });
                 c.constrained = false;
@@ -883,6 +908,7 @@ impl Integrator {
                     c.constrained = true;
                     c.lambda = l;
                     c.step_lambda = l;
+                    c.accepted_lambda = l;
                 } else {
                     c.lambda = 0.0;
                 }
