@@ -15,32 +15,77 @@
 //! ends is at the Newton tolerance (1e-11·L; measured ≤ 1.4e-14 ft). G q̇ at the step ends is
 //! not enforced by the scheme and drifts O(h²) (measured ≤ 1e-2 ft/s right after impacts on
 //! `barhorst-case1`, against tip speeds of several ft/s), reported as the running max
-//! `contact1.max_normal_velocity` (|g|: `contact1.max_gap`). At a release an inward drift
-//! (G q̇ < 0) is removed by the plastic projection q̇ ← q̇ − M⁻¹Gᵀ(G q̇)/(G M⁻¹Gᵀ), so that
-//! free flight does not start into the surface; its kinetic-energy loss ½(G q̇)²/(G M⁻¹Gᵀ)
-//! is booked as the ledger dissipation `contact_projection`.
+//! `contact1.max_normal_velocity` (|g|: `contact1.max_gap`). Drift control: after every
+//! accepted constrained step the velocity is projected onto G q̇ = 0 by the plastic projection
+//! q̇ ← q̇ − M⁻¹Gᵀ(G q̇)/(G M⁻¹Gᵀ) (at a release only an inward drift G q̇ < 0, so that free
+//! flight does not start into the surface); its kinetic-energy loss ½(G q̇)²/(G M⁻¹Gᵀ) is
+//! booked as the ledger dissipation `contact_projection`. Each step thus starts with
+//! G q̇₀ = 0, which keeps its multiplier finite as h → 0 (release location, below).
 //!
-//! **Normal force at a state** (channel `contact1.normal_force`, release event function), the
-//! index-1 value of the constrained dynamics M q̈ + R(q, q̇, 0) = Gᵀλ, G q̈ + n̂·J̇q̇ = 0:
+//! **Normal force at a state** (channel `contact1.normal_force`; also decides whether a tip
+//! stays on the surface after an impact), the index-1 value of the constrained dynamics
+//! M q̈ + R(q, q̇, 0) = Gᵀλ, G q̈ + n̂·J̇q̇ = 0:
 //!   λ = (G M⁻¹R(q, q̇, 0) − n̂·J̇q̇) / (G M⁻¹Gᵀ),
 //! with M(q) assembled column by column from exact mass products and factorized by dense LU.
-//! Positive λ pushes the tip to the free side. (The Newton multiplier of a step is its mean
-//! normal force; it is the predictor of the next step only.)
+//! Positive λ pushes the tip to the free side.
+//!
+//! **Step multiplier** λ̄: the Newton multiplier of a constrained step, its mean normal force
+//! (impulse/h): the constraint force the scheme actually applies. It is the release event
+//! function (below): why not the state force λ. After an impact the state force contains the
+//! highest mesh frequencies of the constrained chain (the point impact excites them; the
+//! symmetric midpoint scheme does not damp them), with amplitudes comparable to its mean.
+//! Measured on `barhorst-case1-timoshenko` (8 elements): at the default step (0.5 ms) λ at
+//! consecutive step ends went +2723, +685, +2085, …, −33 lbf while the step multipliers were
+//! all positive (+2437, +1704, +1385, …, +779); at h = 20 µs the same λ(t) is a smooth
+//! oscillation of period ≈ 0.35 ms = the shear-wave transit time of one element
+//! (h_el/√(κGA/ρA) = 0.25/753 s), i.e. a mesh mode, aliased by the 0.5 ms step. Releasing on
+//! the sampled λ therefore released, re-contacted one step later (grazing) and so on: 83
+//! releases in 0.5 s (76 with rotary inertia ρI = 1e-3), against 11 (10) with the step
+//! multiplier. The release rule is thus the discrete complementarity 0 ≤ λ̄ ⊥ g(q₁) ≥ 0 of
+//! the scheme itself. (Its start value is the last step's multiplier, or the state force at a
+//! contact start.)
+//!
+//! **Massless section rotations** (Timoshenko links without rotary inertia). The directions N
+//! of [`Chain::exact_massless_directions`] (every ψ DOF, and e_ψ(L) − e_θ(child) for a tip
+//! section that carries a child) have M N = 0 and G N = 0 at every q, identified
+//! structurally from the kinematics (no material point depends on ψ, a child frame only on
+//! ψ(L) + θ): robust, unlike a numerical zero test on M, whose rows for ψ(L) are not zero
+//! (ψ(L) + θ carries the child). Their equations of motion carry no inertia:
+//! Nᵀ(∂V/∂q + C q̇ − Q) = 0 with C the constant damping (Kelvin–Voigt on ψ′, joint dampers).
+//! With Kelvin–Voigt, NᵀCN is regular and these balances fix the N-component of q̇ from q and
+//! the rest of q̇ ([`Contact::make_consistent`]; exact in one solve since they are affine in
+//! q̇); positions do not jump at an impact, so these balances hold on both sides and the jump
+//! satisfies Nᵀ C Δq̇ = 0 while the massive block obeys M Δq̇ = GᵀΛ. The energy-midpoint step
+//! solves these rows at the midpoint (∂V/∂ψ(q̄) + C v̄ = 0, an implicit-midpoint rule for a
+//! first-order equation): the end velocity v₁ = 2v̄ − v₀ there is not determined by them and
+//! alternates from step to step — it never feeds back into the positions (M N = 0), but the
+//! state force and the impact must not use it: both start by making q̇ consistent.
+//! Without Kelvin–Voigt the rotations are algebraic (∂V/∂ψ = 0) and ψ̇ jumps with the massive
+//! velocities (condensation q̇ = C q̇_m): refused with `unsupported`.
+//! Operators M⁻¹ become (M + μNNᵀ)⁻¹ (μ the largest diagonal mass), exactly M⁻¹ on the
+//! massive subspace since Gᵀ, R ⊥ N: the solution has no N-component, Λ, λ and the kinetic
+//! energy are those of the massive block. The frame directions of a free joint without hub
+//! inertia (turn the frame by α with v = −αx; [`Chain::massless_directions`]) move the points
+//! by α·s(x) only, mass ∫ρA s² ~ 1e-8 of the link's: kept massive in M they took velocity
+//! jumps of 1.5e5 (rad/s) at the first impact of `barhorst-case1-timoshenko` and stalled the
+//! next step. They are regularized the same way (μ added along them): their velocity does
+//! not jump at an impact (the modal backend removes this direction from its basis) and the
+//! impulse their O(s) mass would need is neglected. The momentum residual reported is that of
+//! the massive block, ‖M Δq̇ + μN NᵀΔq̇ − GᵀΛ‖/‖M Δq̇‖ (the μ-term vanishes on the exact
+//! directions).
 //!
 //! **Events**, located INSIDE the step by re-solving it with a shortened step h* (Illinois
 //! secant on the step length, other bracket points where Newton fails): contact start when
-//! |g(q₁(h*))| ≤ [`GAP_TOL`]·L (L the longest link); release when the normal force at the end
+//! |g(q₁(h*))| ≤ [`GAP_TOL`]·L (L the longest link); release when the step multiplier λ̄(h*)
 //! of the shortened step lies in [−[`FORCE_TOL`]·W, 0] (W the chain's weight, or its mass times
-//! 1 length/time² without gravity), or — where λ(h) is steeper than that allows — when the
+//! 1 length/time² without gravity), or — where λ̄(h) is steeper than that allows — when the
 //! bracket is below [`TIME_TOL`]·max(t, 1) (the event's `time_tolerance` is the final bracket
-//! width; the release side λ ≤ 0 is the one accepted). Limitation, measured on
-//! `barhorst-case1` (16 elements, 3 s): 39 of 80 releases meet the force tolerance; the other
-//! 41 end on a bracket below 1e-12 s, most of them just after a step start where λ(h) jumps
-//! between h = 0 and h = 0⁺ by up to ~1e-3 lbf (largest |λ| at a release 7.8e-3 lbf =
-//! 2.7e-5·W). The jump persisted with the drift velocity projected out and with the start
-//! gap's Newton residual exempted (both tried); its size is consistent with the evaluation
-//! noise of λ (Newton tolerance 1e-11·L times the element stiffness), so those releases are
-//! located to the step boundary rather than inside the step.
+//! width; the release side λ̄ ≤ 0 is the one accepted). A shortened step removes only the
+//! share (h/h_nominal)² of the start gap (see [`crate::midpoint`]), so λ̄(h) is continuous in h
+//! and tends, as h → 0⁺, to about the state force λ at the step start — which can differ
+//! from the last step's mean λ̄. Where λ̄ is already non-positive after h_min = 1e-5·h the
+//! root is the step start itself: the release follows that h_min step (time tolerance h_min,
+//! the event's force is that λ̄, not near zero). The event's `normal_force` is λ̄.
 //!
 //! **Impact** (perfectly plastic, positions unchanged): M(q̇⁺ − q̇⁻) = GᵀΛ, G q̇⁺ = 0, so
 //! Λ = −G q̇⁻ / (G M⁻¹Gᵀ), q̇⁺ = q̇⁻ + M⁻¹GᵀΛ. The momentum residual
@@ -55,7 +100,7 @@
 //! the step start, the normal velocity (if inward) is removed by the impact map, and the step
 //! is re-solved constrained — the discrete complementarity choice, since g(q₁) grows
 //! monotonically with λ. Such a constrained phase lasts at least that one step; at its end the
-//! tip is released if the normal force there is not positive. Every event therefore advances
+//! tip is released if its step multiplier is not positive. Every event therefore advances
 //! time by at least one step; [`MAX_EVENTS`] bounds a Zeno-like accumulation. On fine meshes
 //! (16 elements) the normal force after an impact oscillates at the unresolved mesh
 //! frequencies, and the tip makes micro-bounces (release, grazing contact one step later):
@@ -63,7 +108,8 @@
 //! times are not converged quantities.
 //!
 //! Refused with `unsupported`: circle surfaces, bilateral contact, friction, more than one
-//! contact, contact with prescribed joint motion, and contact with any method other than
+//! contact, contact with prescribed joint motion, contact on Timoshenko links without rotary
+//! inertia and without Kelvin–Voigt damping (above), and contact with any method other than
 //! `energy-midpoint` or with adaptive stepping (`time.rtol`).
 
 use data::Event;
@@ -323,7 +369,8 @@ impl Contact {
     fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<(), FemError> {
         let n = chain.ndof;
         if !self.reg_dirs.is_empty() && self.mass_scale == 0.0 {
-            // μ: the largest diagonal mass (any positive scale works: see `massless_docs`).
+            // μ: the largest diagonal mass (any positive scale works on the exact directions;
+            // module docs).
             for j in 0..n {
                 self.unit[j] = 1.0;
                 chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
@@ -638,17 +685,8 @@ impl Integrator {
                     .map(|(l, _, passes)| {
                         self.counters.rhs += passes;
                         c.lambda = l;
-                        let l_state = l;
-                        let l = c.step_lambda;
-                        if std::env::var("FEMDBG").is_ok() {
-                            eprintln!(
-                                "DBG t1={t1:.9} h={:.3e} lam={l_state:.6e} step_lam={:.6e} gqd={:.3e}",
-                                t1 - self.t,
-                                c.step_lambda,
-                                c.normal_velocity
-                            );
-                        }
-                        l
+                        // The release event function is the step multiplier (module docs).
+                        c.step_lambda
                     })
             }
         };
@@ -672,19 +710,21 @@ impl Integrator {
         }
     }
 
-    /// Illinois secant on the step length for the root of the event function F (F(0) = f0 > 0,
+    /// Illinois secant on the step length for the root of the event function F (F(a0) = f0 > 0,
     /// F(h) = f1 ≤ 0, F decreasing through the root), to |F| ≤ tol on the non-positive side or
     /// a bracket narrower than [`TIME_TOL`]. Leaves the accepted trial solved in q₁, q̇₁ and
     /// returns (h*, bracket width).
+    #[allow(clippy::too_many_arguments)]
     fn locate(
         &mut self,
         watch: Watch,
+        a0: f64,
         h: f64,
         f0: f64,
         f1: f64,
         tol: f64,
     ) -> Result<(f64, f64), FemError> {
-        let (mut a, mut fa, mut b, mut fb) = (0.0, f0, h, f1);
+        let (mut a, mut fa, mut b, mut fb) = (a0, f0, h, f1);
         let mut side = 0i32;
         let mut last_b_solved = true;
         for _ in 0..MAX_SECANT {
@@ -734,7 +774,16 @@ impl Integrator {
             }
         }
         if !last_b_solved {
-            self.trial(watch, b)?;
+            let mut fb = self.trial(watch, b)?;
+            // The re-solved bracket end can land on the other side by the Newton noise of the
+            // event function (for the step multiplier ∝ tol/h² at tiny h): widen towards the
+            // full step, where F(h) ≤ 0 was measured, until it does not.
+            let (width, mut k) = (b - a, 0);
+            while fb > 0.0 && b < h && k < 20 {
+                b = (b + width * 4f64.powi(k)).min(h);
+                fb = self.trial(watch, b)?;
+                k += 1;
+            }
         }
         Ok((b, b - a))
     }
@@ -761,7 +810,7 @@ impl Integrator {
                 return Ok((h, Post::None));
             }
             if g0 > tol_g {
-                let (hs, width) = self.locate(Watch::Gap, h, g0, g1, tol_g)?;
+                let (hs, width) = self.locate(Watch::Gap, 0.0, h, g0, g1, tol_g)?;
                 return Ok((
                     hs,
                     Post::Impact {
@@ -818,9 +867,10 @@ impl Integrator {
         if lam0 > 0.0 {
             // The step multiplier jumps at h = 0⁺ from the last step's mean to about the
             // index-1 force of the start state; where that is already non-positive the root is
-            // the step start itself (below h_min the multiplier is dominated by the Newton
-            // tolerance of g, ∝ tol/h²): release after the step h_min (module docs).
-            let h_min = 1e-6 * h;
+            // the step start itself (below h_min = 1e-5·h the multiplier's Newton noise, ∝
+            // tol/h², reaches ~1 lbf on barhorst-case1-timoshenko): release after the step
+            // h_min (module docs).
+            let h_min = 1e-5 * h;
             let f_min = self.trial(Watch::Force, h_min)?;
             if f_min <= 0.0 {
                 return Ok((
@@ -830,7 +880,8 @@ impl Integrator {
                     },
                 ));
             }
-            let (hs, width) = self.locate(Watch::Force, h, lam0, lam1, tol_f)?;
+            // Roots below h_min are not sought (the multiplier's noise grows like 1/h² there).
+            let (hs, width) = self.locate(Watch::Force, h_min, h, f_min, lam1, tol_f)?;
             return Ok((
                 hs,
                 Post::Release {

@@ -765,7 +765,11 @@ impl Integrator {
                     // q̇ and q below their round-off, and the columns of massless directions
                     // (no mass, only damping and stiffness) vanish: a singular matrix.
                     let vmax = self.qd1.iter().fold(1.0f64, |a, b| a.max(b.abs()));
-                    let floor = if c.c_v > 0.0 { 1e-8 * vmax / c.c_v } else { 0.0 };
+                    let floor = if c.c_v > 0.0 {
+                        1e-8 * vmax / c.c_v
+                    } else {
+                        0.0
+                    };
                     (1e-7 * amax).max(floor)
                 };
                 let Some(dense) = self.dense.as_mut() else {

@@ -40,7 +40,8 @@
 //!
 //! Tip contact ([`crate::contact`]): in a constrained phase the momentum equation gains
 //! −∇̄g λ (∇̄g the discrete gradient of the gap, same metric and formula as for Φ) and the
-//! unknowns become (a, λ) with g(q₁) = 0, ∂q₁/∂a = h²/2; each iteration solves S twice
+//! unknowns become (a, λ) with g(q₁) = 0 (a step shortened to h < h_nominal aims at
+//! (1 − (h/h_nominal)²)·g(q₀) instead: λ finite as h → 0), ∂q₁/∂a = h²/2; each iteration solves S twice
 //! (Schur complement of the border). Shortened steps that locate an event re-form the Newton
 //! matrix every iteration (impulsive multipliers spoil the quasi-Newton contraction).
 //!
