@@ -72,7 +72,9 @@
 //! not jump at an impact (the modal backend removes this direction from its basis) and the
 //! impulse their O(s) mass would need is neglected. The momentum residual reported is that of
 //! the massive block, ‖M Δq̇ + μN NᵀΔq̇ − GᵀΛ‖/‖M Δq̇‖ (the μ-term vanishes on the exact
-//! directions).
+//! directions); the neglected part is itself at round-off: ‖M Δq̇ − GᵀΛ‖/‖M Δq̇‖ without
+//! the μ-term measured 5.4e-12, 3.9e-12, 5.1e-12, 1.9e-11 at the first impact of
+//! `barhorst-case1-timoshenko` with 4, 8, 16, 32 elements.
 //!
 //! **Events**, located INSIDE the step by re-solving it with a shortened step h* (Illinois
 //! secant on the step length, other bracket points where Newton fails): contact start when
