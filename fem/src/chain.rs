@@ -593,7 +593,22 @@ impl Chain {
     ///   v = 0: the frame angle is tied to the mass only through the root section, which has no
     ///   inertia. (Euler–Bernoulli links have no such direction: v′(0) = 0 ties the frame to
     ///   the mass.) Its stiffness is the shear and bending of the root element.
-    fn massless_directions(&self) -> Vec<Vec<(usize, f64)>> {
+    pub fn massless_directions(&self) -> Vec<Vec<(usize, f64)>> {
+        self.massless_directions_with(true)
+    }
+
+    /// The directions of [`Chain::massless_directions`] that carry no mass at EVERY q (M N = 0
+    /// exactly): the section rotations ψ and the pairs e_ψ(L) − e_θ(child). No material point
+    /// depends on ψ (the foreshortening uses the centre-line slope v′) and a child frame only
+    /// on ψ(L) + θ(child), so their rows and columns of M vanish identically — a structural
+    /// fact of the kinematics, not a numerical zero test. The frame directions (turning the
+    /// frame against v = −αx) are left out: they move the points by α·s(x) (the
+    /// foreshortening), so they carry the mass ∫ρA s² > 0 away from v = 0.
+    pub fn exact_massless_directions(&self) -> Vec<Vec<(usize, f64)>> {
+        self.massless_directions_with(false)
+    }
+
+    fn massless_directions_with(&self, frames: bool) -> Vec<Vec<(usize, f64)>> {
         let mut dirs = Vec::new();
         for (li, l) in self.links.iter().enumerate() {
             if !l.shear || l.rho_i > 0.0 {
@@ -616,7 +631,7 @@ impl Chain {
                     Some(_) => {}
                 }
             }
-            if l.joint.dof != NONE && l.hub_inertia == 0.0 {
+            if frames && l.joint.dof != NONE && l.hub_inertia == 0.0 {
                 let mut d = vec![(l.joint.dof, 1.0)];
                 for k in 1..=l.n_el {
                     if l.v_dof[k] != NONE {

@@ -15,32 +15,79 @@
 //! ends is at the Newton tolerance (1e-11·L; measured ≤ 1.4e-14 ft). G q̇ at the step ends is
 //! not enforced by the scheme and drifts O(h²) (measured ≤ 1e-2 ft/s right after impacts on
 //! `barhorst-case1`, against tip speeds of several ft/s), reported as the running max
-//! `contact1.max_normal_velocity` (|g|: `contact1.max_gap`). At a release an inward drift
-//! (G q̇ < 0) is removed by the plastic projection q̇ ← q̇ − M⁻¹Gᵀ(G q̇)/(G M⁻¹Gᵀ), so that
-//! free flight does not start into the surface; its kinetic-energy loss ½(G q̇)²/(G M⁻¹Gᵀ)
-//! is booked as the ledger dissipation `contact_projection`.
+//! `contact1.max_normal_velocity` (|g|: `contact1.max_gap`). Drift control: after every
+//! accepted constrained step the velocity is projected onto G q̇ = 0 by the plastic projection
+//! q̇ ← q̇ − M⁻¹Gᵀ(G q̇)/(G M⁻¹Gᵀ) (at a release only an inward drift G q̇ < 0, so that free
+//! flight does not start into the surface); its kinetic-energy loss ½(G q̇)²/(G M⁻¹Gᵀ) is
+//! booked as the ledger dissipation `contact_projection`. Each step thus starts with
+//! G q̇₀ = 0, which keeps its multiplier finite as h → 0 (release location, below).
 //!
-//! **Normal force at a state** (channel `contact1.normal_force`, release event function), the
-//! index-1 value of the constrained dynamics M q̈ + R(q, q̇, 0) = Gᵀλ, G q̈ + n̂·J̇q̇ = 0:
+//! **Normal force at a state** (channel `contact1.normal_force`; also decides whether a tip
+//! stays on the surface after an impact), the index-1 value of the constrained dynamics
+//! M q̈ + R(q, q̇, 0) = Gᵀλ, G q̈ + n̂·J̇q̇ = 0:
 //!   λ = (G M⁻¹R(q, q̇, 0) − n̂·J̇q̇) / (G M⁻¹Gᵀ),
 //! with M(q) assembled column by column from exact mass products and factorized by dense LU.
-//! Positive λ pushes the tip to the free side. (The Newton multiplier of a step is its mean
-//! normal force; it is the predictor of the next step only.)
+//! Positive λ pushes the tip to the free side.
+//!
+//! **Step multiplier** λ̄: the Newton multiplier of a constrained step, its mean normal force
+//! (impulse/h): the constraint force the scheme actually applies. It is the release event
+//! function (below): why not the state force λ. After an impact the state force contains the
+//! highest mesh frequencies of the constrained chain (the point impact excites them; the
+//! symmetric midpoint scheme does not damp them), with amplitudes comparable to its mean.
+//! Measured on `barhorst-case1-timoshenko` (8 elements): at the default step (0.5 ms) λ at
+//! consecutive step ends went +2723, +685, +2085, …, −33 lbf while the step multipliers were
+//! all positive (+2437, +1704, +1385, …, +779); at h = 20 µs the same λ(t) is a smooth
+//! oscillation of period ≈ 0.35 ms = the shear-wave transit time of one element
+//! (h_el/√(κGA/ρA) = 0.25/753 s), i.e. a mesh mode, aliased by the 0.5 ms step. Releasing on
+//! the sampled λ therefore released, re-contacted one step later (grazing) and so on: 83
+//! releases in 0.5 s (76 with rotary inertia ρI = 1e-3), against 11 (10) with the step
+//! multiplier. The release rule is thus the discrete complementarity 0 ≤ λ̄ ⊥ g(q₁) ≥ 0 of
+//! the scheme itself. (Its start value is the last step's multiplier, or the state force at a
+//! contact start.)
+//!
+//! **Massless section rotations** (Timoshenko links without rotary inertia). The directions N
+//! of [`Chain::exact_massless_directions`] (every ψ DOF, and e_ψ(L) − e_θ(child) for a tip
+//! section that carries a child) have M N = 0 and G N = 0 at every q, identified
+//! structurally from the kinematics (no material point depends on ψ, a child frame only on
+//! ψ(L) + θ): robust, unlike a numerical zero test on M, whose rows for ψ(L) are not zero
+//! (ψ(L) + θ carries the child). Their equations of motion carry no inertia:
+//! Nᵀ(∂V/∂q + C q̇ − Q) = 0 with C the constant damping (Kelvin–Voigt on ψ′, joint dampers).
+//! With Kelvin–Voigt, NᵀCN is regular and these balances fix the N-component of q̇ from q and
+//! the rest of q̇ ([`Contact::make_consistent`]; exact in one solve since they are affine in
+//! q̇); positions do not jump at an impact, so these balances hold on both sides and the jump
+//! satisfies Nᵀ C Δq̇ = 0 while the massive block obeys M Δq̇ = GᵀΛ. The energy-midpoint step
+//! solves these rows at the midpoint (∂V/∂ψ(q̄) + C v̄ = 0, an implicit-midpoint rule for a
+//! first-order equation): the end velocity v₁ = 2v̄ − v₀ there is not determined by them and
+//! alternates from step to step — it never feeds back into the positions (M N = 0), but the
+//! state force and the impact must not use it: both start by making q̇ consistent.
+//! Without Kelvin–Voigt the rotations are algebraic (∂V/∂ψ = 0) and ψ̇ jumps with the massive
+//! velocities (condensation q̇ = C q̇_m): refused with `unsupported`.
+//! Operators M⁻¹ become (M + μNNᵀ)⁻¹ (μ the largest diagonal mass), exactly M⁻¹ on the
+//! massive subspace since Gᵀ, R ⊥ N: the solution has no N-component, Λ, λ and the kinetic
+//! energy are those of the massive block. The frame directions of a free joint without hub
+//! inertia (turn the frame by α with v = −αx; [`Chain::massless_directions`]) move the points
+//! by α·s(x) only, mass ∫ρA s² ~ 1e-8 of the link's: kept massive in M they took velocity
+//! jumps of 1.5e5 (rad/s) at the first impact of `barhorst-case1-timoshenko` and stalled the
+//! next step. They are regularized the same way (μ added along them): their velocity does
+//! not jump at an impact (the modal backend removes this direction from its basis) and the
+//! impulse their O(s) mass would need is neglected. The momentum residual reported is that of
+//! the massive block, ‖M Δq̇ + μN NᵀΔq̇ − GᵀΛ‖/‖M Δq̇‖ (the μ-term vanishes on the exact
+//! directions); the neglected part is itself at round-off: ‖M Δq̇ − GᵀΛ‖/‖M Δq̇‖ without
+//! the μ-term measured 5.4e-12, 3.9e-12, 5.1e-12, 1.9e-11 at the first impact of
+//! `barhorst-case1-timoshenko` with 4, 8, 16, 32 elements.
 //!
 //! **Events**, located INSIDE the step by re-solving it with a shortened step h* (Illinois
 //! secant on the step length, other bracket points where Newton fails): contact start when
-//! |g(q₁(h*))| ≤ [`GAP_TOL`]·L (L the longest link); release when the normal force at the end
+//! |g(q₁(h*))| ≤ [`GAP_TOL`]·L (L the longest link); release when the step multiplier λ̄(h*)
 //! of the shortened step lies in [−[`FORCE_TOL`]·W, 0] (W the chain's weight, or its mass times
-//! 1 length/time² without gravity), or — where λ(h) is steeper than that allows — when the
+//! 1 length/time² without gravity), or — where λ̄(h) is steeper than that allows — when the
 //! bracket is below [`TIME_TOL`]·max(t, 1) (the event's `time_tolerance` is the final bracket
-//! width; the release side λ ≤ 0 is the one accepted). Limitation, measured on
-//! `barhorst-case1` (16 elements, 3 s): 39 of 80 releases meet the force tolerance; the other
-//! 41 end on a bracket below 1e-12 s, most of them just after a step start where λ(h) jumps
-//! between h = 0 and h = 0⁺ by up to ~1e-3 lbf (largest |λ| at a release 7.8e-3 lbf =
-//! 2.7e-5·W). The jump persisted with the drift velocity projected out and with the start
-//! gap's Newton residual exempted (both tried); its size is consistent with the evaluation
-//! noise of λ (Newton tolerance 1e-11·L times the element stiffness), so those releases are
-//! located to the step boundary rather than inside the step.
+//! width; the release side λ̄ ≤ 0 is the one accepted). A shortened step removes only the
+//! share (h/h_nominal)² of the start gap (see [`crate::midpoint`]), so λ̄(h) is continuous in h
+//! and tends, as h → 0⁺, to about the state force λ at the step start — which can differ
+//! from the last step's mean λ̄. Where λ̄ is already non-positive after h_min = 1e-5·h the
+//! root is the step start itself: the release follows that h_min step (time tolerance h_min,
+//! the event's force is that λ̄, not near zero). The event's `normal_force` is λ̄.
 //!
 //! **Impact** (perfectly plastic, positions unchanged): M(q̇⁺ − q̇⁻) = GᵀΛ, G q̇⁺ = 0, so
 //! Λ = −G q̇⁻ / (G M⁻¹Gᵀ), q̇⁺ = q̇⁻ + M⁻¹GᵀΛ. The momentum residual
@@ -55,7 +102,7 @@
 //! the step start, the normal velocity (if inward) is removed by the impact map, and the step
 //! is re-solved constrained — the discrete complementarity choice, since g(q₁) grows
 //! monotonically with λ. Such a constrained phase lasts at least that one step; at its end the
-//! tip is released if the normal force there is not positive. Every event therefore advances
+//! tip is released if its step multiplier is not positive. Every event therefore advances
 //! time by at least one step; [`MAX_EVENTS`] bounds a Zeno-like accumulation. On fine meshes
 //! (16 elements) the normal force after an impact oscillates at the unresolved mesh
 //! frequencies, and the tip makes micro-bounces (release, grazing contact one step later):
@@ -63,7 +110,8 @@
 //! times are not converged quantities.
 //!
 //! Refused with `unsupported`: circle surfaces, bilateral contact, friction, more than one
-//! contact, contact with prescribed joint motion, and contact with any method other than
+//! contact, contact with prescribed joint motion, contact on Timoshenko links without rotary
+//! inertia and without Kelvin–Voigt damping (above), and contact with any method other than
 //! `energy-midpoint` or with adaptive stepping (`time.rtol`).
 
 use data::Event;
@@ -128,6 +176,21 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
             i + 1
         )));
     }
+    if let Some(i) = scene
+        .links
+        .iter()
+        .position(|l| l.shear && !l.rotary_inertia && l.kelvin_voigt.unwrap_or(0.0) <= 0.0)
+    {
+        return Err(FemError::unsupported(format!(
+            "fem: contact with Timoshenko link {} (`{}`) without `rotary_inertia` and without \
+             Kelvin–Voigt damping: its section rotations are then algebraic (∂V/∂ψ = 0) and ψ̇ \
+             jumps with the massive velocities at an impact; that condensation is not \
+             implemented (only the damped case, where ψ̇ follows the massless balance \
+             Nᵀ(∂V/∂q + C q̇) = 0); set `kelvin_voigt` > 0 or `rotary_inertia`",
+            i + 1,
+            scene.links[i].name
+        )));
+    }
     if !scene.links.iter().any(|l| l.name == c.link) {
         return Err(FemError::InvalidSettings {
             field: "contact.link".into(),
@@ -151,6 +214,9 @@ pub struct Contact {
     pub lambda: f64,
     /// Multiplier of the last constrained step (its mean normal force), the Newton unknown.
     pub step_lambda: f64,
+    /// Multiplier of the last accepted constrained step (the state force at a contact start):
+    /// the release event function's value at the step start.
+    pub accepted_lambda: f64,
     /// Gap and normal tip velocity G q̇ at the current state.
     pub gap: f64,
     pub normal_velocity: f64,
@@ -177,6 +243,20 @@ pub struct Contact {
     pub(crate) g_end: Vec<f64>,
     pub(crate) s_inv_g: Vec<f64>,
     mass: DenseLu,
+    /// Exactly massless directions N (Timoshenko sections without rotary inertia, see
+    /// [`Chain::exact_massless_directions`]; empty otherwise), by DOF: (direction, coefficient).
+    massless: Vec<Vec<(usize, f64)>>,
+    /// All massless directions of [`Chain::massless_directions`] (the exact ones and the
+    /// frame directions of mass O(s²)): the regularization M + μ N Nᵀ, by DOF.
+    reg_dirs: Vec<Vec<(usize, f64)>>,
+    dof_dirs: Vec<Vec<(usize, f64)>>,
+    /// LU of NᵀCN (C the constant damping matrix), formed at the first use.
+    damping: Option<DenseLu>,
+    /// Mass scale μ of the regularization M + μNNᵀ.
+    mass_scale: f64,
+    z_res: Vec<f64>,
+    /// Consistent velocity of the last state-force evaluation.
+    qd_c: Vec<f64>,
     zero: Vec<f64>,
     unit: Vec<f64>,
     col: Vec<f64>,
@@ -216,6 +296,15 @@ impl Contact {
         let weight = mass * if g > 0.0 { g } else { 1.0 };
         let n = chain.ndof;
         let z = vec![0.0; n];
+        let massless = chain.exact_massless_directions();
+        let reg_dirs = chain.massless_directions();
+        let mut dof_dirs = vec![Vec::new(); if reg_dirs.is_empty() { 0 } else { n }];
+        for (k, d) in reg_dirs.iter().enumerate() {
+            for &(i, c) in d {
+                dof_dirs[i].push((k, c));
+            }
+        }
+        let nz = massless.len();
         Ok(Some(Contact {
             link,
             normal: [normal[0] / len, normal[1] / len],
@@ -223,6 +312,7 @@ impl Contact {
             constrained: false,
             lambda: 0.0,
             step_lambda: 0.0,
+            accepted_lambda: 0.0,
             gap: 0.0,
             normal_velocity: 0.0,
             impact_loss: 0.0,
@@ -240,6 +330,13 @@ impl Contact {
             g_end: z.clone(),
             s_inv_g: z.clone(),
             mass: DenseLu::new(n),
+            massless,
+            reg_dirs,
+            dof_dirs,
+            damping: None,
+            mass_scale: 0.0,
+            z_res: vec![0.0; nz],
+            qd_c: if nz > 0 { z.clone() } else { Vec::new() },
             zero: z.clone(),
             unit: z.clone(),
             col: z.clone(),
@@ -273,10 +370,28 @@ impl Contact {
     /// factorizes it (dense LU).
     fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<(), FemError> {
         let n = chain.ndof;
+        if !self.reg_dirs.is_empty() && self.mass_scale == 0.0 {
+            // μ: the largest diagonal mass (any positive scale works on the exact directions;
+            // module docs).
+            for j in 0..n {
+                self.unit[j] = 1.0;
+                chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
+                self.unit[j] = 0.0;
+                self.mass_scale = self.mass_scale.max(self.col[j].abs());
+            }
+        }
         for j in 0..n {
             self.unit[j] = 1.0;
             chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
             self.unit[j] = 0.0;
+            // M + μ N Nᵀ: regular, and equal to M on the massive subspace (module docs).
+            if !self.reg_dirs.is_empty() {
+                for &(k, cj) in &self.dof_dirs[j] {
+                    for &(i, ci) in &self.reg_dirs[k] {
+                        self.col[i] += self.mass_scale * ci * cj;
+                    }
+                }
+            }
             self.mass.set_column(j, &self.col);
         }
         self.mass.factorize().map_err(|e| match e {
@@ -289,6 +404,83 @@ impl Contact {
         })
     }
 
+    /// Makes `qd` consistent with the massless balances Nᵀ R(q, q̇, 0) = 0 by changing it along
+    /// N only (no kinetic energy, no tip velocity changes: M N = 0, G N = 0). Nᵀ R has no
+    /// inertial part and is affine in q̇ through the constant damping C (Kelvin–Voigt, joint
+    /// dampers), so one solve with NᵀCN is exact. Returns the residual passes used. No-op
+    /// without massless directions.
+    pub fn make_consistent(
+        &mut self,
+        chain: &mut Chain,
+        t: f64,
+        q: &[f64],
+        qd: &mut [f64],
+    ) -> Result<usize, FemError> {
+        let nz = self.massless.len();
+        if nz == 0 {
+            return Ok(0);
+        }
+        let mut passes = 1;
+        if self.damping.is_none() {
+            // NᵀCN column by column: C N e_k = R_nc(q, N e_k) − R_nc(q, 0) (exact, affine).
+            let mut lu = DenseLu::new(nz);
+            chain.residual_parts(
+                t,
+                q,
+                &self.zero,
+                &self.zero,
+                Parts::NONCONSERVATIVE,
+                &mut self.tmp,
+            );
+            let mut col = vec![0.0; nz];
+            for k in 0..nz {
+                for &(i, c) in &self.massless[k] {
+                    self.unit[i] = c;
+                }
+                chain.residual_parts(
+                    t,
+                    q,
+                    &self.unit,
+                    &self.zero,
+                    Parts::NONCONSERVATIVE,
+                    &mut self.col,
+                );
+                for &(i, _) in &self.massless[k] {
+                    self.unit[i] = 0.0;
+                }
+                for (kk, d) in self.massless.iter().enumerate() {
+                    col[kk] = d
+                        .iter()
+                        .map(|&(i, c)| c * (self.col[i] - self.tmp[i]))
+                        .sum();
+                }
+                lu.set_column(k, &col);
+            }
+            passes += nz + 1;
+            lu.factorize().map_err(|_| {
+                FemError::unsupported(
+                    "fem: contact with massless section rotations whose damping NᵀCN is \
+                     singular (a massless direction without Kelvin–Voigt or joint damping): \
+                     the algebraic condensation is not implemented",
+                )
+            })?;
+            self.damping = Some(lu);
+        }
+        chain.residual(t, q, qd, &self.zero, &mut self.tmp);
+        for (k, d) in self.massless.iter().enumerate() {
+            self.z_res[k] = d.iter().map(|&(i, c)| c * self.tmp[i]).sum();
+        }
+        if let Some(lu) = &self.damping {
+            lu.solve_in_place(&mut self.z_res);
+        }
+        for (k, d) in self.massless.iter().enumerate() {
+            for &(i, c) in d {
+                qd[i] -= c * self.z_res[k];
+            }
+        }
+        Ok(passes)
+    }
+
     /// Normal force of the constrained dynamics at (q, q̇) (module docs); also sets G (in
     /// `g_end`), M⁻¹Gᵀ, the gap and the normal velocity. Returns (λ, G M⁻¹Gᵀ, passes).
     pub fn state_force(
@@ -298,7 +490,17 @@ impl Contact {
         q: &[f64],
         qd: &[f64],
     ) -> Result<(f64, f64, usize), FemError> {
-        let n = chain.ndof;
+        let mut n = chain.ndof;
+        // Massless directions: λ from the velocity that satisfies their balances (the
+        // stepper's end velocity there is not determined by its equations; module docs).
+        let mut qd_c = std::mem::take(&mut self.qd_c);
+        let qd = if qd_c.is_empty() {
+            qd
+        } else {
+            qd_c.copy_from_slice(qd);
+            n += self.make_consistent(chain, t, q, &mut qd_c)?;
+            &qd_c[..]
+        };
         self.factor_mass(chain, t, q)?;
         let mut g_row = std::mem::take(&mut self.g_end);
         self.gap = self.gradient(chain, t, q, &mut g_row);
@@ -313,6 +515,7 @@ impl Contact {
         let conv = self.normal[0] * a[0] + self.normal[1] * a[1];
         let lambda = (dot(&g_row, &self.tmp) - conv) / gmg;
         self.g_end = g_row;
+        self.qd_c = qd_c;
         Ok((lambda, gmg, n + 2))
     }
 
@@ -326,6 +529,9 @@ impl Contact {
         qd: &mut [f64],
     ) -> Result<Option<Event>, FemError> {
         let n = chain.ndof;
+        // Massless directions (module docs): q̇⁻ consistent with their balances first (changes
+        // neither the kinetic energy nor G q̇).
+        self.make_consistent(chain, t, q, qd)?;
         self.factor_mass(chain, t, q)?;
         let mut g_row = std::mem::take(&mut self.g_end);
         self.gap = self.gradient(chain, t, q, &mut g_row);
@@ -349,6 +555,9 @@ impl Contact {
         for i in 0..n {
             qd[i] += self.minv_gt[i] * impulse;
         }
+        // The massless balances hold after the jump too: Nᵀ C Δq̇ = 0 fixes its N-component
+        // (zero kinetic energy, no mass product, no normal velocity).
+        self.make_consistent(chain, t, q, qd)?;
         // Independent mass product of the velocity jump (not the factorized matrix). The jump
         // is the increment applied, M⁻¹GᵀΛ: the difference of the stored velocities would add
         // their rounding (|q̇|·1e-16), which dominates for grazing impacts with tiny Λ.
@@ -356,10 +565,19 @@ impl Contact {
             self.unit[i] = self.minv_gt[i] * impulse;
         }
         chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
+        // Massive-block balance: M Δq̇ − GᵀΛ ∈ span N, the N-part being −μN NᵀΔq̇ (module
+        // docs; zero along the exactly massless directions).
+        self.tmp.copy_from_slice(&self.col);
+        for d in &self.reg_dirs {
+            let w: f64 = d.iter().map(|&(i, c)| c * self.unit[i]).sum();
+            for &(i, c) in d {
+                self.tmp[i] += self.mass_scale * c * w;
+            }
+        }
         self.unit.iter_mut().for_each(|x| *x = 0.0);
         let (mut res2, mut mom2) = (0.0, 0.0);
         for i in 0..n {
-            let r = self.col[i] - g_row[i] * impulse;
+            let r = self.tmp[i] - g_row[i] * impulse;
             res2 += r * r;
             mom2 += self.col[i] * self.col[i];
         }
@@ -411,6 +629,7 @@ impl Contact {
             for i in 0..qd.len() {
                 qd[i] -= self.minv_gt[i] * vn / gmg;
             }
+            self.make_consistent(chain, t, q, qd)?;
             loss = ke0 - chain.energies(t, q, qd)[0];
         }
         self.normal_velocity = dot(&g_row, qd);
@@ -468,7 +687,8 @@ impl Integrator {
                     .map(|(l, _, passes)| {
                         self.counters.rhs += passes;
                         c.lambda = l;
-                        l
+                        // The release event function is the step multiplier (module docs).
+                        c.step_lambda
                     })
             }
         };
@@ -492,19 +712,21 @@ impl Integrator {
         }
     }
 
-    /// Illinois secant on the step length for the root of the event function F (F(0) = f0 > 0,
+    /// Illinois secant on the step length for the root of the event function F (F(a0) = f0 > 0,
     /// F(h) = f1 ≤ 0, F decreasing through the root), to |F| ≤ tol on the non-positive side or
     /// a bracket narrower than [`TIME_TOL`]. Leaves the accepted trial solved in q₁, q̇₁ and
     /// returns (h*, bracket width).
+    #[allow(clippy::too_many_arguments)]
     fn locate(
         &mut self,
         watch: Watch,
+        a0: f64,
         h: f64,
         f0: f64,
         f1: f64,
         tol: f64,
     ) -> Result<(f64, f64), FemError> {
-        let (mut a, mut fa, mut b, mut fb) = (0.0, f0, h, f1);
+        let (mut a, mut fa, mut b, mut fb) = (a0, f0, h, f1);
         let mut side = 0i32;
         let mut last_b_solved = true;
         for _ in 0..MAX_SECANT {
@@ -554,7 +776,16 @@ impl Integrator {
             }
         }
         if !last_b_solved {
-            self.trial(watch, b)?;
+            let mut fb = self.trial(watch, b)?;
+            // The re-solved bracket end can land on the other side by the Newton noise of the
+            // event function (for the step multiplier ∝ tol/h² at tiny h): widen towards the
+            // full step, where F(h) ≤ 0 was measured, until it does not.
+            let (width, mut k) = (b - a, 0);
+            while fb > 0.0 && b < h && k < 20 {
+                b = (b + width * 4f64.powi(k)).min(h);
+                fb = self.trial(watch, b)?;
+                k += 1;
+            }
         }
         Ok((b, b - a))
     }
@@ -581,7 +812,7 @@ impl Integrator {
                 return Ok((h, Post::None));
             }
             if g0 > tol_g {
-                let (hs, width) = self.locate(Watch::Gap, h, g0, g1, tol_g)?;
+                let (hs, width) = self.locate(Watch::Gap, 0.0, h, g0, g1, tol_g)?;
                 return Ok((
                     hs,
                     Post::Impact {
@@ -608,6 +839,7 @@ impl Integrator {
             if let Ok((l, _, _)) = res {
                 c.lambda = l;
                 c.step_lambda = l.max(0.0);
+                c.accepted_lambda = l;
             }
             self.contact = Some(c);
             res?;
@@ -628,14 +860,30 @@ impl Integrator {
             }
         }
         // Constrained: the normal force at the step end decides.
-        let lam0 = self.contact_mut().lambda;
+        let lam0 = self.contact_mut().accepted_lambda;
         let lam1 = self.event_value(Watch::Force, t1)?;
         if lam1 > 0.0 {
             return Ok((h, Post::None));
         }
         let tol_f = self.contact_mut().force_tol;
         if lam0 > 0.0 {
-            let (hs, width) = self.locate(Watch::Force, h, lam0, lam1, tol_f)?;
+            // The step multiplier jumps at h = 0⁺ from the last step's mean to about the
+            // index-1 force of the start state; where that is already non-positive the root is
+            // the step start itself (below h_min = 1e-5·h the multiplier's Newton noise, ∝
+            // tol/h², reaches ~1 lbf on barhorst-case1-timoshenko): release after the step
+            // h_min (module docs).
+            let h_min = 1e-5 * h;
+            let f_min = self.trial(Watch::Force, h_min)?;
+            if f_min <= 0.0 {
+                return Ok((
+                    h_min,
+                    Post::Release {
+                        time_tolerance: h_min,
+                    },
+                ));
+            }
+            // Roots below h_min are not sought (the multiplier's noise grows like 1/h² there).
+            let (hs, width) = self.locate(Watch::Force, h_min, h, f_min, lam1, tol_f)?;
             return Ok((
                 hs,
                 Post::Release {
@@ -671,10 +919,14 @@ impl Integrator {
             // release the velocity is projected onto G q̇ = 0 if the tip moves inward (module
             // docs).
             c.drift_velocity = c.normal_velocity;
+            c.accepted_lambda = c.step_lambda;
             c.max_gap = c.max_gap.max(c.gap.abs());
             c.max_normal_velocity = c.max_normal_velocity.max(c.drift_velocity.abs());
-            if matches!(post, Post::Release { .. }) {
-                let loss = c.project(&mut self.chain, t, &self.q, &mut self.qd, true)?;
+            if matches!(post, Post::Release { .. } | Post::None) {
+                // Drift control: G q̇ = 0 at the start of every constrained step, so that the
+                // step multiplier (the release event function) stays finite as h → 0.
+                let inward_only = post != Post::None;
+                let loss = c.project(&mut self.chain, t, &self.q, &mut self.qd, inward_only)?;
                 self.counters.rhs += self.chain.ndof + 1;
                 c.projection_loss += loss;
             }
@@ -687,7 +939,7 @@ impl Integrator {
                 c.push(Event::Release {
                     t,
                     contact: 1,
-                    normal_force: c.lambda,
+                    normal_force: c.step_lambda,
                     time_tolerance,
                 });
                 c.constrained = false;
@@ -709,6 +961,7 @@ impl Integrator {
                     c.constrained = true;
                     c.lambda = l;
                     c.step_lambda = l;
+                    c.accepted_lambda = l;
                 } else {
                     c.lambda = 0.0;
                 }

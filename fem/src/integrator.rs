@@ -760,7 +760,20 @@ impl Integrator {
                 let eps = if c.c_v == 0.0 && c.c_q == 0.0 {
                     1e3 * amax
                 } else {
-                    1e-7 * amax
+                    // Floor: the velocity perturbation c_v·ε stays above 1e-8 of the velocity
+                    // scale. Steps shortened to locate an event (h → 1e-13 s) otherwise perturb
+                    // q̇ and q below their round-off, and the columns of massless directions
+                    // (no mass, only damping and stiffness) vanish: a singular matrix.
+                    let vmax = self.qd1.iter().fold(1.0f64, |a, b| a.max(b.abs()));
+                    // Only there (h < 1e-3 h_nominal): on regular steps the floor moved
+                    // measured trajectories (Newton's accepted iterate depends on the matrix
+                    // within the tolerance: conv_timoshenko_stiff_shear_recovers_the_euler_chain).
+                    let floor = if c.c_v > 0.0 && c.c_v < 0.5e-3 * self.h_nominal {
+                        1e-8 * vmax / c.c_v
+                    } else {
+                        0.0
+                    };
+                    (1e-7 * amax).max(floor)
                 };
                 let Some(dense) = self.dense.as_mut() else {
                     return Ok(());

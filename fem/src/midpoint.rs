@@ -40,7 +40,8 @@
 //!
 //! Tip contact ([`crate::contact`]): in a constrained phase the momentum equation gains
 //! −∇̄g λ (∇̄g the discrete gradient of the gap, same metric and formula as for Φ) and the
-//! unknowns become (a, λ) with g(q₁) = 0, ∂q₁/∂a = h²/2; each iteration solves S twice
+//! unknowns become (a, λ) with g(q₁) = 0 (a step shortened to h < h_nominal aims at
+//! (1 − (h/h_nominal)²)·g(q₀) instead: λ finite as h → 0), ∂q₁/∂a = h²/2; each iteration solves S twice
 //! (Schur complement of the border). Shortened steps that locate an event re-form the Newton
 //! matrix every iteration (impulsive multipliers spoil the quasi-Newton contraction).
 //!
@@ -273,6 +274,12 @@ impl Integrator {
             .map_or(0.0, |c| c.gap_at(&self.chain, t0, &self.q));
         let mut lambda = contact.as_ref().map_or(0.0, |c| c.step_lambda);
         let mut gap1 = 0.0;
+        // Target of g(q₁): 0 for a full step; a step shortened to h removes only the share
+        // (h/h_nominal)² of the start gap (≤ the Newton tolerance), so that the multiplier
+        // stays finite as h → 0 (it would carry g(q₀)/h² otherwise; ∝ 2g(q₀)/h_nominal² now)
+        // and is continuous in h, as the release event function (`crate::contact`) needs.
+        let r = (h / self.h_nominal).min(1.0);
+        let gap_target = g0 * (1.0 - r * r);
         // Predictor: the previous step's mean acceleration; zero after a (re)start, where the
         // point acceleration of a released pre-loaded spring is a mesh-dependent spike.
         for i in 0..n {
@@ -419,7 +426,7 @@ impl Integrator {
                 let half_h2 = 0.5 * h * h;
                 let cx = half_h2 * dot(&c.g_end, &self.delta);
                 let cy = half_h2 * dot(&c.g_end, &c.s_inv_g);
-                dlambda = (gap1 - cx) / cy;
+                dlambda = (gap1 - gap_target - cx) / cy;
                 for i in 0..n {
                     self.delta[i] += c.s_inv_g[i] * dlambda;
                 }
@@ -443,7 +450,7 @@ impl Integrator {
             // update is far below tolerance.
             let defect = (h * dot(&w.vbar, &w.res)).abs();
             let e_scale = scale0 + scale1 + dot(&w.minus_q, &w.dq).abs();
-            let on_surface = gap1.abs() <= self.newton_tol;
+            let on_surface = (gap1 - gap_target).abs() <= self.newton_tol;
             if dq <= tol
                 && on_surface
                 && (defect <= ENERGY_TOL * e_scale

@@ -21,21 +21,6 @@ pub fn check_planar(scene: &Scene) -> Result<(), FemError> {
     if scene.links.is_empty() {
         return Err(FemError::unsupported("fem: scene has no links".to_string()));
     }
-    if !scene.contacts.is_empty()
-        && let Some(i) = scene
-            .links
-            .iter()
-            .position(|l| l.shear && !l.rotary_inertia)
-    {
-        return Err(FemError::unsupported(format!(
-            "fem: contact with Timoshenko link {} (`{}`) without `rotary_inertia`: its section \
-                 rotations carry no mass, so the impact map M(q̇⁺ − q̇⁻) = GᵀΛ is singular in fem's \
-                 coordinates; set `rotary_inertia = true` with `rotary_inertia_per_length` \
-                 (ρI), or use the modal backend, which condenses the massless rotations",
-            i + 1,
-            scene.links[i].name
-        )));
-    }
     for (i, l) in scene.links.iter().enumerate() {
         if l.axial && l.foreshortening {
             return Err(FemError::unsupported(format!(
