@@ -311,6 +311,53 @@ impl Event {
     }
 }
 
+/// Contact episodes `(start, end)` of a run's events (`end` None: in contact at the end).
+/// A contact phase starts at an `Impact` or `ContactStart` and ends at the next `Release`; a
+/// start followed by another start without a release in between (an impact immediately
+/// followed by free flight, which backends do not record as a release) is a phase of zero
+/// length. Phases separated by a free flight shorter than `min_flight` form one episode.
+pub fn contact_episodes(events: &[Event], min_flight: f64) -> Vec<(f64, Option<f64>)> {
+    let mut phases: Vec<(f64, Option<f64>)> = Vec::new();
+    let mut open: Option<f64> = None;
+    let mut times: Vec<(f64, bool)> = events
+        .iter()
+        .filter_map(|e| match e {
+            Event::Impact { t, .. } | Event::ContactStart { t, .. } => Some((*t, false)),
+            Event::Release { t, .. } => Some((*t, true)),
+            _ => None,
+        })
+        .collect();
+    times.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for (t, release) in times {
+        match (release, open) {
+            (false, None) => open = Some(t),
+            // The impact of a contact start at the same instant, or a silent release.
+            (false, Some(s)) => {
+                if t > s {
+                    phases.push((s, Some(s)));
+                    open = Some(t);
+                }
+            }
+            (true, Some(s)) => {
+                phases.push((s, Some(t)));
+                open = None;
+            }
+            (true, None) => {}
+        }
+    }
+    if let Some(s) = open {
+        phases.push((s, None));
+    }
+    let mut episodes: Vec<(f64, Option<f64>)> = Vec::new();
+    for (s, e) in phases {
+        match episodes.last_mut() {
+            Some(last) if last.1.is_some_and(|prev_end| s - prev_end < min_flight) => last.1 = e,
+            _ => episodes.push((s, e)),
+        }
+    }
+    episodes
+}
+
 /// Work counters reported with every result.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Cost {

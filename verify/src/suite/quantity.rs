@@ -26,6 +26,15 @@ pub enum Quantity {
     ImpactTime { n: usize },
     /// Time of the n-th release (normal force through zero).
     ReleaseTime { n: usize },
+    /// Start (first contact) or end (last release) of the n-th contact episode, where contact
+    /// phases separated by a free flight shorter than `min_flight` seconds (micro-bounces) belong
+    /// to one episode. Unlike `impact_timeN`, this does not depend on how many micro-bounces a
+    /// resolution produces.
+    Episode {
+        n: usize,
+        min_flight: f64,
+        end: bool,
+    },
 }
 
 /// Which backend analysis a quantity needs.
@@ -72,6 +81,29 @@ impl Quantity {
                 )),
             }
         };
+        for (prefix, end) in [("episode_start", false), ("episode_end", true)] {
+            if let Some(rest) = t.strip_prefix(prefix) {
+                let (num, flight) = rest.split_once(':').ok_or_else(|| {
+                    format!(
+                        "`{text}`: expected {prefix}N:F (F = shortest free flight, in seconds, \
+                         that separates two contact episodes)"
+                    )
+                })?;
+                let min_flight: f64 = flight
+                    .parse()
+                    .map_err(|_| format!("`{text}`: `{flight}` is not a duration"))?;
+                if !(min_flight.is_finite() && min_flight > 0.0) {
+                    return Err(format!(
+                        "`{text}`: the flight duration must be finite and > 0"
+                    ));
+                }
+                return Ok(Quantity::Episode {
+                    n: nth(num, "contact episode")?,
+                    min_flight,
+                    end,
+                });
+            }
+        }
         if let Some(rest) = t.strip_prefix("impact_time") {
             return Ok(Quantity::ImpactTime {
                 n: nth(rest, "impact")?,
@@ -125,7 +157,7 @@ impl Quantity {
         Err(format!(
             "unknown quantity `{text}`; expected freqN, axial_freqN, bending_freqN, tip_static, \
              CHANNEL@T, peak:CHANNEL, history:CHANNEL, ledger_closure, max_momentum_residual, \
-             impulseN, impact_timeN or release_timeN"
+             impulseN, impact_timeN, release_timeN, episode_startN:F or episode_endN:F"
         ))
     }
 
@@ -247,6 +279,20 @@ impl Quantity {
                 releases.get(n - 1).copied().ok_or_else(|| {
                     format!("release {n} was asked for; the run had {}", releases.len())
                 })
+            }
+            Quantity::Episode { n, min_flight, end } => {
+                let episodes = data::results::contact_episodes(&r.events, *min_flight);
+                let (start, stop) = episodes.get(n - 1).copied().ok_or_else(|| {
+                    format!(
+                        "contact episode {n} was asked for; the run had {} (free flights \
+                         shorter than {min_flight} s merged)",
+                        episodes.len()
+                    )
+                })?;
+                if !*end {
+                    return Ok(start);
+                }
+                stop.ok_or_else(|| format!("contact episode {n} lasts to the end of the run"))
             }
             _ => Err("not a run quantity".into()),
         }
