@@ -83,7 +83,7 @@
 //! * Normal force (channel `contact1.normal_force`): λ = (G M⁻¹R(q, q̇, 0) − n̂·J̇q̇)/(G M⁻¹Gᵀ)
 //!   at the state. Release where λ crosses zero, located inside the step (state force at the
 //!   end of the re-solved shortened step) to −1e-8·W ≤ λ ≤ 0 (W the weight) or a 1e-13 s
-//!   bracket (event `release`); measured |λ| ≤ 1.7e-7·W on `barhorst-case1`. The force carries
+//!   bracket (event `release`); measured |λ| ≤ 1.5e-5·W on `barhorst-case1` (3 s). The force carries
 //!   unresolved mesh frequencies after impacts: micro-bounces of the discretized model
 //!   ([`contact`]).
 //! * Timoshenko links without rotary inertia: the massless directions (every ψ, ψ(L) − θ of
