@@ -9,25 +9,7 @@ use fdm::chain::TwoLinkChain;
 use fdm::chain::dual::Dual;
 use fdm::integrator::System;
 
-/// A deflected, moving state (foreshortening sums nonzero, every coupling active).
-fn state(sys: &TwoLinkChain) -> (Vec<f64>, Vec<f64>) {
-    let n = sys.dofs();
-    let q: Vec<f64> = (0..n)
-        .map(|i| match i {
-            0 => 0.7,
-            1 => 1.9,
-            _ => 0.02 * (0.9 * i as f64).sin() + 0.004 * i as f64,
-        })
-        .collect();
-    let v: Vec<f64> = (0..n)
-        .map(|i| match i {
-            0 => 1.3,
-            1 => -0.8,
-            _ => 0.3 * (1.7 * i as f64).cos(),
-        })
-        .collect();
-    (q, v)
-}
+mod common;
 
 #[test]
 fn elem_chain_momenta_and_gradient_are_derivatives_of_the_kinetic_energy() {
@@ -35,7 +17,7 @@ fn elem_chain_momenta_and_gradient_are_derivatives_of_the_kinetic_energy() {
     let sys = TwoLinkChain::from_scene(&scene, Some(9)).unwrap();
     let ine = &sys.inertia;
     let n = sys.dofs();
-    let (q, v) = state(&sys);
+    let (q, v) = common::moving_chain_state(sys.dofs());
     let mut p = vec![Dual::default(); n];
     ine.momenta(&q, &v, &v, &mut p);
     let mut g = vec![0.0; n];
@@ -97,7 +79,7 @@ fn elem_chain_forces_are_minus_potential_gradients() {
     scene.links[1].joint.set_point = Some(0.3);
     let mut sys = TwoLinkChain::from_scene(&scene, Some(9)).unwrap();
     let n = sys.dofs();
-    let (q, _) = state(&sys);
+    let (q, _) = common::moving_chain_state(sys.dofs());
     let v = vec![0.0; n];
     let mut a = vec![0.0; n];
     sys.accel(0.0, &q, &v, &mut a);
@@ -105,7 +87,7 @@ fn elem_chain_forces_are_minus_potential_gradients() {
     let mut ma = vec![0.0; n];
     sys.momenta(&q, &a, &mut ma);
     // and the chain's momenta are ∂T/∂q̇ of its kinetic energy (ghost slots, clamp inertias)
-    let (qm, vm) = state(&sys);
+    let (qm, vm) = common::moving_chain_state(sys.dofs());
     let mut pm = vec![0.0; n];
     sys.momenta(&qm, &vm, &mut pm);
     let ke = |v: &[f64]| {

@@ -8,6 +8,9 @@ use fdm::chain::contact::{ContactReport, EVENT_TIME_TOLERANCE, simulate};
 use fdm::integrator::System;
 use fdm::settings::FdmSettings;
 
+mod common;
+use common::channel;
+
 fn settings(stations: usize, t_end: f64) -> Settings {
     let mut s = Settings::default();
     s.discretization.stations = Some(stations);
@@ -21,15 +24,6 @@ fn run(scene: &str, stations: usize, t_end: f64) -> (RunResult, ContactReport) {
     let (r, rep) = simulate(&scene, &s, &FdmSettings::from_settings(&s).unwrap()).unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed, "{:?}", r.verdict);
     (r, rep)
-}
-
-fn channel<'a>(r: &'a RunResult, name: &str) -> &'a [f64] {
-    &r.observables
-        .channels
-        .iter()
-        .find(|c| c.name == name)
-        .unwrap_or_else(|| panic!("no channel {name}"))
-        .values
 }
 
 fn impacts(r: &RunResult) -> Vec<(f64, f64, f64, f64, f64)> {

@@ -14,6 +14,9 @@ use fdm::chain::timoshenko::TimoFields;
 use fdm::integrator::System;
 use fdm::settings::FdmSettings;
 
+mod common;
+use common::channel;
+
 fn settings(stations: usize, t_end: f64) -> Settings {
     let mut s = Settings::default();
     s.discretization.stations = Some(stations);
@@ -31,34 +34,6 @@ fn sheared(name: &str, kga: f64) -> Scene {
     sc
 }
 
-fn channel<'a>(r: &'a RunResult, name: &str) -> &'a [f64] {
-    &r.observables
-        .channels
-        .iter()
-        .find(|c| c.name == name)
-        .unwrap_or_else(|| panic!("no channel {name}"))
-        .values
-}
-
-/// A deflected, moving chain state (every coupling active).
-fn state(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let q = (0..n)
-        .map(|i| match i {
-            0 => 0.7,
-            1 => 1.9,
-            _ => 0.02 * (0.9 * i as f64).sin() + 0.004 * i as f64,
-        })
-        .collect();
-    let v = (0..n)
-        .map(|i| match i {
-            0 => 1.3,
-            1 => -0.8,
-            _ => 0.3 * (1.7 * i as f64).cos(),
-        })
-        .collect();
-    (q, v)
-}
-
 fn chain_with_springs() -> TwoLinkChain {
     // case 1 has K₁ = 0: give joint 1 a spring and a set-point so every term is exercised
     let mut sc = load_scene("barhorst-case1-timoshenko").unwrap();
@@ -73,7 +48,7 @@ fn elem_timoshenko_energy_gradient_matches_finite_differences() {
     let sys = chain_with_springs();
     let tf: &TimoFields = sys.timoshenko().unwrap();
     let n = sys.dofs();
-    let (q, _) = state(n);
+    let (q, _) = common::moving_chain_state(n);
     let z: Vec<f64> = (0..tf.nz())
         .map(|i| 0.01 * (1.3 * i as f64).cos())
         .collect();
@@ -120,7 +95,7 @@ fn elem_timoshenko_condensed_forces_are_minus_condensed_gradients() {
     let sys = chain_with_springs();
     let tf = sys.timoshenko().unwrap();
     let n = sys.dofs();
-    let (q, v) = state(n);
+    let (q, v) = common::moving_chain_state(n);
     // z₀(q) makes ∂U/∂z vanish (the condensation)
     let z0 = tf.rotations(&q);
     let (mut gq, mut gz) = (vec![0.0; n], vec![0.0; tf.nz()]);
@@ -334,9 +309,11 @@ fn dyn_timoshenko_case1_impacts_and_ledger() {
     assert!(channel(&r, "contact1.gap").iter().all(|g| *g > -1e-9));
 }
 
-/// (first impact, first release) times of case 1.
+/// (first impact, first release) times of case 1 at the stability step (safety 1; the default
+/// for Timoshenko contact chains is 0.1, an energy-accuracy choice).
 fn first_events(scene: &Scene, stations: usize, t_end: f64) -> (f64, f64) {
-    let s = settings(stations, t_end);
+    let mut s = settings(stations, t_end);
+    s.time.safety_factor = Some(1.0);
     let (r, _) = simulate(scene, &s, &FdmSettings::from_settings(&s).unwrap()).unwrap();
     let impact = r.events.iter().find_map(|e| match e {
         Event::Impact { t, .. } => Some(*t),
@@ -352,7 +329,10 @@ fn first_events(scene: &Scene, stations: usize, t_end: f64) -> (f64, f64) {
 #[test]
 fn conv_timoshenko_case1_first_impact_and_release_second_order_in_space() {
     // first impact at 11/21/41 stations (measured 0.28072005, 0.28058326, 0.28054901: order
-    // 2.00); first release at 21/41/81 (0.30171559, 0.30191809, 0.30196694: order 2.05)
+    // 2.00); first release at 21/41/81 (0.30171559, 0.30191809, 0.30196694: order 2.05). The
+    // step scales with h (τ = σ ∝ h), so this is the space-time ladder of the scheme. At safety
+    // 0.1 the release ladder reads 0.30172878, 0.30194001, 0.30196340 (apparent order 3.2: the
+    // spatial part alone is not yet asymptotic at these grids; not asserted).
     let scene = load_scene("barhorst-case1-timoshenko").unwrap();
     let t: Vec<f64> = [11, 21, 41]
         .iter()
