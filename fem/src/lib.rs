@@ -109,6 +109,7 @@ pub mod chain;
 pub mod contact;
 pub mod element;
 pub mod error;
+pub mod friction;
 pub mod integrator;
 pub mod linear;
 pub mod midpoint;
@@ -118,6 +119,7 @@ pub mod run;
 pub mod settings;
 pub mod statics;
 pub mod support;
+pub mod wall;
 
 use std::time::Instant;
 
