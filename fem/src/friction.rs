@@ -74,6 +74,8 @@ pub const VT_TOL: f64 = 1e-10;
 /// Largest |v_t| (relative to the longest link, per unit time) at the end of a first step of a
 /// slide for the Coulomb stick test; a faster tip slides on in its direction of motion.
 pub const STICK_VT_TOL: f64 = 1e-8;
+/// Shortest trial step of the event location, relative to the step being located.
+pub const MIN_TRIAL: f64 = 1e-3;
 /// Secant iterations at most per located switch.
 const MAX_SECANT: usize = 80;
 
@@ -556,18 +558,15 @@ impl Integrator {
             b.stick_tangent = held.tangent;
             b.step_lambda_t = held.lambda_t;
         }
-        self.record_state(if sticking { Some(held) } else { None })
+        self.record_state()
     }
 
     /// Forces at the current state for the current phase (recomputed unless given), stored in
     /// the contact; Painlevé stop; the event function for the next step.
-    fn record_state(&mut self, held: Option<Forces>) -> Result<(), FemError> {
+    fn record_state(&mut self) -> Result<(), FemError> {
         let t = self.t;
         let sticking = sticking(self.contact.as_deref().expect("contact"));
-        let fr = match held {
-            Some(f) => f,
-            None => self.contact_forces(false, t, sticking)?,
-        };
+        let fr = self.contact_forces(false, t, sticking)?;
         let c = self.contact.as_deref_mut().expect("contact");
         let b = c.bilateral.as_deref_mut().expect("bilateral");
         c.lambda = fr.lambda_n;
@@ -608,7 +607,8 @@ impl Integrator {
             }
             b.e0 = b.slip_dir * fr.vt;
         }
-        if c.step_lambda == 0.0 {
+        if b.fresh {
+            // Newton predictor of a new phase: the index-1 value.
             c.step_lambda = fr.lambda_n;
         }
         Ok(())
@@ -694,7 +694,11 @@ impl Integrator {
 
     /// Illinois secant on the step length for the zero of the event function (F(0) = f0 > 0,
     /// F(h) = f1 ≤ 0) to −tol ≤ F ≤ 0 or a bracket below [`TIME_TOL`]; leaves the accepted
-    /// trial solved and returns (h*, bracket width).
+    /// trial solved and returns (h*, bracket width). Trial steps are never shorter than
+    /// [`MIN_TRIAL`]·h: on a step of length h → 0 the constraint g(q₁) = 0, met only to the
+    /// Newton tolerance ε at q₀, takes a multiplier ~ε/h² and the event function jumps by
+    /// ~ε/h (measured: λ̄ = 5e12 N on a 7e-15 s trial). A root inside that first fraction is
+    /// returned as None: the switch is made at the step start.
     fn locate_switch(
         &mut self,
         kind: Switch,
@@ -702,10 +706,16 @@ impl Integrator {
         f0: f64,
         f1: f64,
         tol: f64,
-    ) -> Result<(f64, f64), FemError> {
-        let (mut a, mut fa, mut b, mut fb) = (0.0, f0, h, f1);
+    ) -> Result<Option<(f64, f64)>, FemError> {
+        let h_min = MIN_TRIAL * h;
+        let f_min = self.switch_trial(kind, h_min)?;
+        if f_min <= 0.0 {
+            return Ok(None);
+        }
+        let (mut a, mut fa, mut b, mut fb) = (h_min, f_min, h, f1);
+        let _ = f0;
         let mut side = 0i32;
-        let mut last_b_solved = true;
+        let mut last_b_solved = false;
         for _ in 0..MAX_SECANT {
             if b - a <= TIME_TOL * self.t.abs().max(1.0) {
                 break;
@@ -730,7 +740,7 @@ impl Integrator {
                 fb = fc;
                 last_b_solved = true;
                 if fc >= -tol {
-                    return Ok((b, b - a));
+                    return Ok(Some((b, b - a)));
                 }
                 if side == -1 {
                     fa *= 0.5;
@@ -749,7 +759,7 @@ impl Integrator {
         if !last_b_solved {
             self.switch_trial(kind, b)?;
         }
-        Ok((b, b - a))
+        Ok(Some((b, b - a)))
     }
 
     /// Bilateral counterpart of [`Integrator::contact_after_trial`]: the friction sign check,
@@ -798,33 +808,43 @@ impl Integrator {
             }
             self.bilateral_solve(h)?;
         }
-        let c = self.contact.as_deref_mut().expect("contact");
-        let b = c.bilateral.as_deref_mut().expect("bilateral");
-        let (kind, tol) = if b.sticking {
-            (Switch::Breakaway, force_tol)
-        } else {
-            (Switch::SlipStop, VT_TOL * self.length_scale)
-        };
-        let f0 = b.e0;
-        let located = !b.fresh && f0 > 0.0;
-        let f1 = self.switch_value(kind, t1)?;
-        if f1 > 0.0 {
-            return Ok((h, Post::None));
+        loop {
+            let c = self.contact.as_deref_mut().expect("contact");
+            let b = c.bilateral.as_deref_mut().expect("bilateral");
+            let (kind, tol) = if b.sticking {
+                (Switch::Breakaway, force_tol)
+            } else {
+                (Switch::SlipStop, VT_TOL * self.length_scale)
+            };
+            let f0 = b.e0;
+            let located = !b.fresh && f0 > 0.0;
+            let f1 = self.switch_value(kind, t1)?;
+            if f1 > 0.0 {
+                return Ok((h, Post::None));
+            }
+            let found = if located {
+                self.locate_switch(kind, h, f0, f1, tol)?
+            } else {
+                // First step of a phase: not shortened (the one-step rule, module docs), the
+                // switch is made at its end.
+                Some((h, 0.0))
+            };
+            let Some((h_acc, width)) = found else {
+                // The root lies within the first MIN_TRIAL of the step: switch at its start
+                // and re-solve the step in the new phase (whose first step is not shortened).
+                self.apply_switch(kind, true)?;
+                self.record_state()?;
+                self.bilateral_solve(h)?;
+                continue;
+            };
+            let b = self
+                .contact
+                .as_deref_mut()
+                .and_then(|c| c.bilateral.as_deref_mut())
+                .expect("bilateral");
+            b.pending = Some((kind, width, located));
+            return Ok((h_acc, Post::None));
         }
-        let (h_acc, width) = if located {
-            self.locate_switch(kind, h, f0, f1, tol)?
-        } else {
-            // First step of a phase: not shortened (the one-step rule, module docs), the
-            // switch is made at its end.
-            (h, 0.0)
-        };
-        let b = self
-            .contact
-            .as_deref_mut()
-            .and_then(|c| c.bilateral.as_deref_mut())
-            .expect("bilateral");
-        b.pending = Some((kind, width, located));
-        Ok((h_acc, Post::None))
     }
 
     /// Books the accepted step (friction work, tangential multiplier), applies a located
@@ -833,6 +853,12 @@ impl Integrator {
         let t = self.t;
         let c = self.contact.as_deref_mut().expect("contact");
         let b = c.bilateral.as_deref_mut().expect("bilateral");
+        if std::env::var("FEMFRIC_DEBUG").is_ok() {
+            eprintln!(
+                "accept t={t:.6} stick={} s={} fresh={} work={:.3e} pending={:?} lam={:.4e}",
+                b.sticking, b.slip_dir, b.fresh, b.pending_work, b.pending, c.step_lambda
+            );
+        }
         b.friction_work += b.pending_work;
         b.pending_work = 0.0;
         if b.sticking {
@@ -840,16 +866,25 @@ impl Integrator {
         }
         b.fresh = false;
         let Some((kind, _width, located)) = b.pending.take() else {
-            return self.record_state(None);
+            return self.record_state();
         };
-        let mu = b.mu;
-        b.fresh = true;
+        self.apply_switch(kind, located)?;
+        self.record_state()
+    }
+
+    /// Switch of `kind` at the current state (q, q̇ at t): the Coulomb test with the held-tip
+    /// forces (module docs), event, midpoint restart. `located`: the state is a located zero
+    /// of the event function (else the end of a first step, where a tip still moving slides
+    /// on in its direction of motion).
+    fn apply_switch(&mut self, kind: Switch, located: bool) -> Result<(), FemError> {
+        let t = self.t;
         let held = self.contact_forces(false, t, true)?;
+        let vt_tol = STICK_VT_TOL * self.length_scale;
         let c = self.contact.as_deref_mut().expect("contact");
         let b = c.bilateral.as_deref_mut().expect("bilateral");
-        // A stop found at the end of a first step (not located) with the tip still moving
-        // (now against s) is a reversal: slide on in the direction of motion.
-        let moving = !located && held.vt.abs() > STICK_VT_TOL * self.length_scale;
+        let mu = b.mu;
+        b.fresh = true;
+        let moving = !located && held.vt.abs() > vt_tol;
         let stick = kind == Switch::SlipStop
             && !moving
             && held.lambda_t.abs() <= mu * held.lambda_n.abs();
@@ -880,6 +915,7 @@ impl Integrator {
         if let Some(w) = self.midpoint.as_mut() {
             w.restart();
         }
-        self.record_state(if stick { Some(held) } else { None })
+        Ok(())
     }
+
 }
