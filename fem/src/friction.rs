@@ -98,7 +98,10 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
     {
         let first = scene.links.first().is_some_and(|f| f.name == l.name);
         let tol = 1e-12 * l.length;
-        if first && !l.axial && center[0].hypot(center[1]) <= tol && (radius - l.length).abs() <= tol
+        if first
+            && !l.axial
+            && center[0].hypot(center[1]) <= tol
+            && (radius - l.length).abs() <= tol
         {
             return Err(FemError::unsupported(format!(
                 "fem: bilateral circle of radius L about the hub for the inextensible link `{}` \
@@ -419,11 +422,7 @@ pub(crate) fn midpoint_terms(
     }
     b.g1 = v.gap1;
     b.h1 = h1;
-    if h1.abs() > v.gap1.abs() {
-        h1
-    } else {
-        v.gap1
-    }
+    if h1.abs() > v.gap1.abs() { h1 } else { v.gap1 }
 }
 
 /// Whether the contact is a sticking friction contact (two multipliers in Newton).
@@ -496,11 +495,7 @@ impl Integrator {
         self.with_bilateral(|s, c| {
             let link = c.link;
             let b = c.bilateral.as_deref_mut().expect("bilateral contact");
-            let (q, qd) = if end {
-                (&s.q1, &s.qd1)
-            } else {
-                (&s.q, &s.qd)
-            };
+            let (q, qd) = if end { (&s.q1, &s.qd1) } else { (&s.q, &s.qd) };
             let out = b.forces(&mut s.chain, link, t, q, qd, held);
             s.counters.rhs += s.chain.ndof + 2;
             out
@@ -850,15 +845,8 @@ impl Integrator {
     /// Books the accepted step (friction work, tangential multiplier), applies a located
     /// switch at the new state and records the forces there.
     pub(crate) fn bilateral_after_accept(&mut self) -> Result<(), FemError> {
-        let t = self.t;
         let c = self.contact.as_deref_mut().expect("contact");
         let b = c.bilateral.as_deref_mut().expect("bilateral");
-        if std::env::var("FEMFRIC_DEBUG").is_ok() {
-            eprintln!(
-                "accept t={t:.6} stick={} s={} fresh={} work={:.3e} pending={:?} lam={:.4e}",
-                b.sticking, b.slip_dir, b.fresh, b.pending_work, b.pending, c.step_lambda
-            );
-        }
         b.friction_work += b.pending_work;
         b.pending_work = 0.0;
         if b.sticking {
@@ -885,9 +873,8 @@ impl Integrator {
         let mu = b.mu;
         b.fresh = true;
         let moving = !located && held.vt.abs() > vt_tol;
-        let stick = kind == Switch::SlipStop
-            && !moving
-            && held.lambda_t.abs() <= mu * held.lambda_n.abs();
+        let stick =
+            kind == Switch::SlipStop && !moving && held.lambda_t.abs() <= mu * held.lambda_n.abs();
         if moving && kind == Switch::SlipStop {
             b.slip_dir = sign(held.vt);
             b.reversals += 1;
@@ -917,5 +904,4 @@ impl Integrator {
         }
         Ok(())
     }
-
 }

@@ -424,7 +424,10 @@ impl Integrator {
                 }
             }
             let mut dlambda = 0.0;
-            if let Some(c) = contact.as_deref_mut().filter(|c| crate::friction::sticking(c)) {
+            if let Some(c) = contact
+                .as_deref_mut()
+                .filter(|c| crate::friction::sticking(c))
+            {
                 // Sticking friction contact: two multipliers (crate::friction).
                 dlambda = self.stick_newton_update(c, &w.res, h);
             } else if let Some(c) = contact.as_deref_mut() {

@@ -215,7 +215,7 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
     let mut integ = Integrator::new(chain, method, h_rule.min(out), default_rho_inf(scene))?;
     if let Some(mut c) = contact {
         c.gap = c.gap_at(&integ.chain, integ.t, &integ.q);
-        if c.gap < -c.gap_tol {
+        if c.gap < -c.gap_tol && c.bilateral.is_none() {
             return Err(FemError::InvalidSettings {
                 field: "contact".into(),
                 message: format!("the tip starts {:.3e} inside the surface", -c.gap),
