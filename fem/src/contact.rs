@@ -62,9 +62,13 @@
 //! the point impact on an Euler–Bernoulli beam is singular (Szalai 2014) and these switching
 //! times are not converged quantities.
 //!
-//! Refused with `unsupported`: circle surfaces, bilateral contact, friction, more than one
-//! contact, contact with prescribed joint motion, and contact with any method other than
-//! `energy-midpoint` or with adaptive stepping (`time.rtol`).
+//! Bilateral contacts (circle or line wall, Coulomb friction, stick–slip) reuse the gap,
+//! gradient and bordered Newton of this module with the geometry of [`crate::wall`] and are
+//! driven by [`crate::friction`] (`Contact::bilateral`).
+//!
+//! Refused with `unsupported`: unilateral circle surfaces, friction on a unilateral contact,
+//! more than one contact, contact with prescribed joint motion, and contact with any method
+//! other than `energy-midpoint` or with adaptive stepping (`time.rtol`).
 
 use data::Event;
 use data::Scene;
