@@ -417,3 +417,43 @@ fn dyn_friction_explore_pendulum() {
     }
     println!("{:?}", stick_slips(&r));
 }
+
+/// Bilateral straight line through the tip, inclined 45° to the link (normal and tangent both
+/// mix the axial and the hub/bending directions).
+fn inclined(mu: f64) -> Scene {
+    let mut scene = arm();
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    scene.contacts[0].surface = data::scene::Surface::Line {
+        point: [1.0, 0.0],
+        normal: [-h, -h],
+    };
+    scene.contacts[0].friction = mu;
+    scene
+}
+
+#[test]
+fn dyn_friction_inclined_line_bilateral_ledger_closes() {
+    // The line geometry (κ = 0) through the same machinery as the circle.
+    let scene = inclined(0.3);
+    let r = sim(&scene, &settings(4, None, Some(0.2)));
+    assert!(*channel(&r, "contact1.max_gap").last().unwrap() <= 1e-11);
+    assert!(
+        r.ledger.relative_closure() < 1e-8,
+        "{}",
+        r.ledger.relative_closure()
+    );
+    assert!(*friction_ledger(&r).last().unwrap() > 0.0);
+    let (n, ft, phase) = (
+        channel(&r, "contact1.normal_force"),
+        channel(&r, FRICTION_FORCE_CHANNEL),
+        channel(&r, "contact1.phase"),
+    );
+    for k in 1..n.len() {
+        let cone = scene.contacts[0].friction * n[k].abs();
+        if phase[k] == 1.0 {
+            assert!((ft[k].abs() - cone).abs() <= 1e-12 * (1.0 + n[k].abs()));
+        } else {
+            assert!(ft[k].abs() <= cone * (1.0 + 1e-9) + 1e-9);
+        }
+    }
+}
