@@ -268,6 +268,12 @@ fn dyn_friction_stick_slip_pendulum_sticks_and_stays() {
     let (x, y) = (channel(&r, "link1.tip_x"), channel(&r, "link1.tip_y"));
     let w = friction_ledger(&r);
     let first = time.iter().position(|&t| t > t_stick).unwrap();
+    let (mut dr, mut dv) = (0.0f64, 0.0f64);
+    for k in first..time.len() {
+        dr = dr.max((x[k] - x[first]).abs().max((y[k] - y[first]).abs()));
+        dv = dv.max(vt[k].abs());
+    }
+    println!("stuck: max tip motion {dr:.3e} m, max |v_t| {dv:.3e} m/s");
     for k in 0..time.len() {
         if k < first {
             assert_eq!(phase[k], 1.0);
@@ -275,10 +281,10 @@ fn dyn_friction_stick_slip_pendulum_sticks_and_stays() {
             assert!(k == 0 || vt[k] < 0.0, "t {} v_t {}", time[k], vt[k]);
         } else {
             assert_eq!(phase[k], 2.0);
-            // Held: the tip does not move (Newton tolerance), v_t at the velocity drift of the
-            // position-level constraint.
-            assert!((x[k] - x[first]).abs() < 1e-10 && (y[k] - y[first]).abs() < 1e-10);
-            assert!(vt[k].abs() < 1e-6, "t {} v_t {}", time[k], vt[k]);
+            // Held: the tip does not move (Newton tolerance 1e-11 L; measured 3e-16 m), v_t at
+            // the velocity drift of the position-level constraint (measured 2.8e-11 m/s).
+            assert!((x[k] - x[first]).abs() < 1e-11 && (y[k] - y[first]).abs() < 1e-11);
+            assert!(vt[k].abs() < 1e-9, "t {} v_t {}", time[k], vt[k]);
             assert!(
                 ft[k].abs() < mu * nf[k].abs(),
                 "t {}: cone violated",
