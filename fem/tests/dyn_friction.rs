@@ -379,8 +379,9 @@ fn dyn_friction_refusals() {
     }
 }
 
+/// Rigid-limit errors over the full 2 s (4 elements; ×1000 takes ~5 s).
 #[test]
-#[ignore = "exploration: cargo test --release -p fem --test dyn_friction -- --ignored --nocapture"]
+#[ignore = "exploration: cargo test --release -p fem --test dyn_friction dyn_friction_explore -- --ignored --nocapture"]
 fn dyn_friction_explore() {
     let base = arm();
     for scale in [10.0, 100.0, 1000.0] {
@@ -388,8 +389,10 @@ fn dyn_friction_explore() {
     }
 }
 
+/// Samples of the pendulum's stuck phase (env DT, NE, MU): the micro-slips at the axial
+/// period with μ = 0.2.
 #[test]
-#[ignore = "exploration"]
+#[ignore = "exploration: DT=1e-4 MU=0.2 cargo test --release -p fem --test dyn_friction explore_pendulum -- --ignored --nocapture"]
 fn dyn_friction_explore_pendulum() {
     let mut scene = arm();
     pendulum(&mut scene);
