@@ -79,9 +79,8 @@
 //!
 //! Refused: the inextensible link (no axial field) on the circle of radius L about its own hub
 //! (it can stay on that circle only straight: the rigid model, gradient G = 0 and λ undefined).
-//! Timoshenko links without rotary inertia are refused for every contact by
-//! [`crate::support::check_planar`] (M is singular in the massless section rotations, and the
-//! index-1 forces need M⁻¹).
+//! Timoshenko links without rotary inertia are refused here (M is singular in the massless
+//! section rotations, and the index-1 forces need M⁻¹).
 
 use data::scene::{ContactMode, Surface};
 use data::{Event, Scene};
@@ -116,6 +115,23 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
             field: "contact.friction".into(),
             message: format!("the friction coefficient must be ≥ 0, got {}", c.friction),
         });
+    }
+    if let Some(i) = scene
+        .links
+        .iter()
+        .position(|l| l.shear && !l.rotary_inertia)
+    {
+        // The index-1 normal and held-tip forces and the Coulomb test use M⁻¹; the unilateral
+        // contact's condensation of massless sections is not carried over to the bilateral
+        // wall.
+        return Err(FemError::unsupported(format!(
+            "fem: bilateral (friction) contact with Timoshenko link {} (`{}`) without \
+             `rotary_inertia`: its section rotations carry no mass, so M is singular and the \
+             index-1 wall forces (G M⁻¹Gᵀ, G M⁻¹Tᵀ, T M⁻¹Tᵀ) are undefined; set \
+             `rotary_inertia = true` with `rotary_inertia_per_length`",
+            i + 1,
+            scene.links[i].name
+        )));
     }
     if let (Some(l), Surface::Circle { center, radius }) =
         (scene.links.iter().find(|l| l.name == c.link), &c.surface)
