@@ -623,7 +623,7 @@ impl Integrator {
         self.record_state()
     }
 
-    /// Forces at the current state for the current phase (recomputed unless given), stored in
+    /// Index-1 forces at the current state for the current phase, stored in
     /// the contact; Painlevé stop; the event function for the next step.
     fn record_state(&mut self) -> Result<(), FemError> {
         let t = self.t;
