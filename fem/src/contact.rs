@@ -116,10 +116,15 @@
 //! the point impact on an Euler–Bernoulli beam is singular (Szalai 2014) and these switching
 //! times are not converged quantities.
 //!
-//! Refused with `unsupported`: circle surfaces, bilateral contact, friction, more than one
-//! contact, contact with prescribed joint motion, contact on Timoshenko links without rotary
-//! inertia and without Kelvin–Voigt damping (above), and contact with any method other than
-//! `energy-midpoint` or with adaptive stepping (`time.rtol`).
+//! Bilateral contacts (circle or line wall, Coulomb friction, stick–slip) reuse the gap,
+//! gradient and bordered Newton of this module with the geometry of [`crate::wall`] and are
+//! driven by [`crate::friction`] (`Contact::bilateral`).
+//!
+//! Refused with `unsupported`: unilateral circle surfaces, friction on a unilateral contact,
+//! more than one contact, contact with prescribed joint motion, contact on Timoshenko links
+//! without rotary inertia and without Kelvin–Voigt damping (above; for a bilateral wall:
+//! without rotary inertia), and contact with any method other than `energy-midpoint` or with
+//! adaptive stepping (`time.rtol`).
 
 use data::Event;
 use data::Scene;
@@ -153,23 +158,21 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
     let Some(c) = scene.contacts.first() else {
         return Ok(());
     };
-    if c.mode == ContactMode::Bilateral {
+    // Bilateral contacts (line or circle, with or without friction): `crate::friction`.
+    let bilateral = c.mode == ContactMode::Bilateral;
+    crate::friction::check(scene)?;
+    if let (false, Surface::Circle { .. }) = (bilateral, &c.surface) {
         return Err(FemError::unsupported(format!(
-            "fem: bilateral contact (scene `{}`, constrained arm) is not implemented; only \
-             unilateral line contact",
+            "fem: unilateral contact with a circular surface (scene `{}`) is not implemented; \
+             unilateral contact is implemented for a straight line, circles for bilateral \
+             contacts",
             scene.name
         )));
     }
-    if let Surface::Circle { .. } = c.surface {
+    if !bilateral && c.friction != 0.0 {
         return Err(FemError::unsupported(format!(
-            "fem: circular contact surface (scene `{}`) is not implemented; only a straight line",
-            scene.name
-        )));
-    }
-    if c.friction != 0.0 {
-        return Err(FemError::unsupported(format!(
-            "fem: Coulomb friction (μ = {}) in contact (scene `{}`) is not implemented; only \
-             frictionless contact",
+            "fem: Coulomb friction (μ = {}) in a unilateral contact (scene `{}`) is not \
+             implemented (impacts with friction); friction is implemented for bilateral contacts",
             c.friction, scene.name
         )));
     }
@@ -240,6 +243,9 @@ pub struct Contact {
     /// Events since the driver last drained them, and the total count.
     pub events: Vec<Event>,
     pub n_events: usize,
+    /// Bilateral contact (circle or line wall, Coulomb friction, stick–slip): None for the
+    /// unilateral line contact of this module.
+    pub bilateral: Option<Box<crate::friction::Bilateral>>,
     pub(crate) jac: Vec<f64>,
     /// ∇g(q̄), ∇̄g, ∇g(q₁) and S⁻¹∇̄g of the constrained Newton iteration.
     pub(crate) g_mid: Vec<f64>,
@@ -280,8 +286,14 @@ impl Contact {
             .iter()
             .position(|l| l.name == c.link)
             .unwrap_or(0);
-        let Surface::Line { point, normal } = c.surface else {
-            return Err(FemError::unsupported("fem: only line contact surfaces"));
+        let bilateral = crate::friction::Bilateral::from_scene(c, chain.ndof)?;
+        let (point, normal) = match c.surface {
+            Surface::Line { point, normal } => (point, normal),
+            // The circle's normal depends on the tip position: `bilateral.wall` has it.
+            Surface::Circle { .. } if bilateral.is_some() => ([0.0; 2], [0.0, 1.0]),
+            Surface::Circle { .. } => {
+                return Err(FemError::unsupported("fem: only line contact surfaces"));
+            }
         };
         let len = normal[0].hypot(normal[1]);
         if !(len > 0.0 && len.is_finite()) {
@@ -327,6 +339,7 @@ impl Contact {
             force_tol: FORCE_TOL * weight,
             events: Vec::new(),
             n_events: 0,
+            bilateral,
             jac: vec![0.0; 2 * n],
             g_mid: z.clone(),
             g_bar: z.clone(),
@@ -356,6 +369,9 @@ impl Contact {
     }
 
     fn gap_of(&self, r: [f64; 2]) -> f64 {
+        if let Some(b) = self.bilateral.as_deref() {
+            return b.wall.gap(r);
+        }
         self.normal[0] * (r[0] - self.point[0]) + self.normal[1] * (r[1] - self.point[1])
     }
 
@@ -363,8 +379,13 @@ impl Contact {
     pub fn gradient(&mut self, chain: &Chain, t: f64, q: &[f64], out: &mut [f64]) -> f64 {
         let n = chain.ndof;
         let r = chain.tip_jacobian(t, self.link, q, &mut self.jac);
+        // A circle's normal is that at the tip (crate::wall); a line's is fixed.
+        let normal = match self.bilateral.as_deref() {
+            Some(b) => b.wall.frame(r).normal,
+            None => self.normal,
+        };
         for i in 0..n {
-            out[i] = self.normal[0] * self.jac[i] + self.normal[1] * self.jac[n + i];
+            out[i] = normal[0] * self.jac[i] + normal[1] * self.jac[n + i];
         }
         self.gap_of(r)
     }
@@ -795,6 +816,9 @@ impl Integrator {
     /// Event handling after a converged trial step of length h (state in q₁, q̇₁): returns the
     /// step length to accept (the trial for it solved) and what to do after accepting it.
     pub(crate) fn contact_after_trial(&mut self, h: f64) -> Result<(f64, Post), FemError> {
+        if self.contact_mut().bilateral.is_some() {
+            return self.bilateral_after_trial(h);
+        }
         let (t0, t1) = (self.t, self.t + h);
         let c = self.contact_mut();
         if c.n_events >= MAX_EVENTS {
@@ -889,6 +913,9 @@ impl Integrator {
     /// Records the drift of an accepted constrained step and applies the located event at the
     /// new state.
     pub(crate) fn contact_after_accept(&mut self, post: Post) -> Result<(), FemError> {
+        if self.contact_mut().bilateral.is_some() {
+            return self.bilateral_after_accept();
+        }
         let t = self.t;
         let Some(mut c) = self.contact.take() else {
             return Ok(());

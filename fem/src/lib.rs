@@ -83,17 +83,37 @@
 //! * Normal force (channel `contact1.normal_force`): λ = (G M⁻¹R(q, q̇, 0) − n̂·J̇q̇)/(G M⁻¹Gᵀ)
 //!   at the state. Release where λ crosses zero, located inside the step (state force at the
 //!   end of the re-solved shortened step) to −1e-8·W ≤ λ ≤ 0 (W the weight) or a 1e-13 s
-//!   bracket (event `release`); measured |λ| ≤ 1.5e-5·W on `barhorst-case1` (3 s). The force carries
-//!   unresolved mesh frequencies after impacts: micro-bounces of the discretized model
-//!   ([`contact`]).
+//!   bracket (event `release`); measured |λ| ≤ 1.5e-5·W on `barhorst-case1` (3 s). The force
+//!   carries unresolved mesh frequencies after impacts: micro-bounces of the discretized
+//!   model ([`contact`]).
 //! * Timoshenko links without rotary inertia: the massless directions (every ψ, ψ(L) − θ of
 //!   the child) follow their balances Nᵀ(∂V/∂q + C q̇) = 0 (Kelvin–Voigt required), the impact
 //!   map and the normal force act on the massive block ([`contact`]).
 //! * Phase channel `contact1.phase` (0 free, 1 constrained); `contact1.gap`,
 //!   `contact1.normal_velocity`, running maxima `contact1.max_gap`, `contact1.max_normal_velocity`.
-//! * Refused (`unsupported`): bilateral, circle surface, friction, several contacts, prescribed
-//!   joints, other methods, adaptive steps, massless Timoshenko sections without Kelvin–Voigt.
-//!   Without contact nothing is allocated.
+//! * Refused (`unsupported`): unilateral circle surfaces, friction on unilateral contacts,
+//!   several contacts, prescribed joints, other methods, adaptive steps, massless Timoshenko
+//!   sections without Kelvin–Voigt. Without contact nothing is allocated.
+//!
+//! ## Bilateral wall with Coulomb friction (seed 001, `constrained-arm`)
+//! [`friction`] with the geometry in [`wall`] (circle g = R − |r_tip − c|, n̂ = −(r − c)/|r − c|,
+//! t̂ counter-clockwise, κ = 1/|r − c|; or a line). The tip is on the wall from t = 0 and never
+//! released (λ of either sign); the scene's default method becomes `energy-midpoint`.
+//! * Constraint as in the constrained phase above (discrete gradient, g(q₁) = 0 in Newton):
+//!   |g| at round-off (measured 3.3e-16 m), channel `contact1.gap` / `contact1.max_gap`.
+//! * Sliding: friction −μ s σ λ̄ T(q̄)ᵀ in the step (T = t̂ᵀJ, σ = sign λ fixed per step, step
+//!   re-solved if λ̄ comes out with the other sign, stop if that is inconsistent too); the ledger
+//!   books D = μ s σ λ̄ ΔqᵀT(q̄) (term `friction`, channel `contact1.friction_work`), exactly
+//!   the work of the applied friction force, so the ledger closes to the Newton tolerance
+//!   (measured 4.3e-11 on the scene); D − μ∫|λ||v_t| dt is O(h²) (tested).
+//! * Index-1 forces from the dense M(q): sliding λ(GM⁻¹Gᵀ − μsσGM⁻¹Tᵀ) = GM⁻¹R − n̂·J̇q̇ + κv_t²
+//!   (Painlevé GM⁻¹Gᵀ ≤ μ|GM⁻¹Tᵀ| stops the run), held tip: 2 × 2 with GM⁻¹Gᵀ, GM⁻¹Tᵀ, TM⁻¹Tᵀ.
+//! * Stick–slip: s·v_t = 0 and μ|λ_n| − |λ_t| = 0 located inside the step (secant on the step
+//!   length), Coulomb cone test at the stop, stick = second constraint t̂_s·(r − p_s) = 0 with
+//!   its own discrete gradient (no work), same test at t = 0; events `StickSlip`; phase channel
+//!   1 sliding / 2 sticking; no-chattering rule in [`friction`].
+//! * Refused: the inextensible link on the circle of radius L about its hub (simple flexure =
+//!   the rigid model), Timoshenko links without rotary inertia (M singular).
 //!
 //! The scene's `[statics]` loads (tip force, uniform load on the last link) act as step loads
 //! in `simulate`; their work is the ledger input `applied_load`.
@@ -102,7 +122,8 @@
 //! [`element`] (element operators, tested alone) → [`linear`] (assembled linear link: modes,
 //! statics) and [`chain`] (nonlinear floating-frame system) → [`band`] (bordered-band solver,
 //! linear cost per step) → [`integrator`] (generalized-α / central difference, `step()`) and
-//! [`midpoint`] (energy-midpoint step, bordered by [`contact`] when the tip is on the surface) →
+//! [`midpoint`] (energy-midpoint step, bordered by [`contact`] when the tip is on the surface, and
+//! by [`friction`] for the bilateral wall) →
 //! [`run`] (observables, energy ledger, cost).
 //!
 //! ## Public API
@@ -117,6 +138,7 @@ pub mod chain;
 pub mod contact;
 pub mod element;
 pub mod error;
+pub mod friction;
 pub mod integrator;
 pub mod linear;
 pub mod midpoint;
@@ -126,6 +148,7 @@ pub mod run;
 pub mod settings;
 pub mod statics;
 pub mod support;
+pub mod wall;
 
 use std::time::Instant;
 

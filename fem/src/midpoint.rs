@@ -391,6 +391,22 @@ impl Integrator {
                 }
                 c.g_mid = g_mid;
                 c.g_end = g_end;
+                if c.bilateral.is_some() {
+                    // Friction (sliding) or the tangential stick constraint: crate::friction.
+                    let view = crate::friction::StepView {
+                        it,
+                        t: [t0, t_mid, t1],
+                        q0: &self.q,
+                        q1: &self.q1,
+                        qbar: &w.qbar,
+                        dq: &w.dq,
+                        w_dq: &w.w_dq,
+                        denom,
+                        lambda,
+                        gap1,
+                    };
+                    gap1 = crate::friction::midpoint_terms(c, &self.chain, &view, &mut w.res);
+                }
             }
             self.counters.newton += 1;
             // Newton matrix at (q̄, v̄, a): a full residual there fills the chain's point data.
@@ -415,7 +431,13 @@ impl Integrator {
                 }
             }
             let mut dlambda = 0.0;
-            if let Some(c) = contact.as_deref_mut() {
+            if let Some(c) = contact
+                .as_deref_mut()
+                .filter(|c| crate::friction::sticking(c))
+            {
+                // Sticking friction contact: two multipliers (crate::friction).
+                dlambda = self.stick_newton_update(c, &w.res, h);
+            } else if let Some(c) = contact.as_deref_mut() {
                 // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (h²/2) ∇g(q₁)·δa = g(q₁)
                 // (∂q₁/∂a = h²/2), by the Schur complement with two solves of S.
                 self.delta.copy_from_slice(&c.g_bar);

@@ -97,5 +97,6 @@ pub fn dof_plan(
     if scene.gravity.is_some() {
         plan.builds.push("gravity".into());
     }
+    plan.builds.extend(crate::friction::describe(scene));
     Ok(plan)
 }

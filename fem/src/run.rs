@@ -70,8 +70,18 @@ pub fn default_rho_inf(scene: &Scene) -> f64 {
 /// leaves an O(h²) energy error through the configuration-dependent mass M(q); else
 /// generalized-α (prescribed joints are not supported by the midpoint scheme; extensible links
 /// keep ρ∞ = 0.9 numerical damping of the unresolved axial modes; undamped massless Timoshenko
-/// hubs: see [`undamped_massless_hub`]).
+/// hubs: see [`undamped_massless_hub`]). A bilateral contact (seed 001's wall, always
+/// constrained) takes `energy-midpoint` even with extensible links: contact is implemented on
+/// that scheme only, and its ledger closure is the friction-work check.
 pub fn default_method(scene: &Scene) -> Method {
+    if check_midpoint(scene).is_ok()
+        && scene
+            .contacts
+            .iter()
+            .any(|c| c.mode == data::scene::ContactMode::Bilateral)
+    {
+        return Method::EnergyMidpoint;
+    }
     if check_midpoint(scene).is_ok()
         && !scene
             .links
@@ -205,13 +215,15 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
     let mut integ = Integrator::new(chain, method, h_rule.min(out), default_rho_inf(scene))?;
     if let Some(mut c) = contact {
         c.gap = c.gap_at(&integ.chain, integ.t, &integ.q);
-        if c.gap < -c.gap_tol {
+        if c.gap < -c.gap_tol && c.bilateral.is_none() {
             return Err(FemError::InvalidSettings {
                 field: "contact".into(),
                 message: format!("the tip starts {:.3e} inside the surface", -c.gap),
             });
         }
         integ.contact = Some(Box::new(c));
+        // Bilateral wall: on the surface from t = 0, initial Coulomb test (crate::friction).
+        integ.bilateral_start()?;
     }
     let h_nominal = match method {
         Method::GeneralizedAlpha | Method::EnergyMidpoint => {
@@ -289,6 +301,12 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
         specs.push((NORMAL_VELOCITY_CHANNEL.to_string(), "length/time"));
         specs.push((MAX_GAP_CHANNEL.to_string(), "length"));
         specs.push((MAX_NORMAL_VELOCITY_CHANNEL.to_string(), "length/time"));
+        if scene.contacts[0].friction > 0.0 {
+            // Friction contact (crate::friction): slip velocity, tangential force, work.
+            specs.push((SLIP_VELOCITY_CHANNEL.to_string(), "length/time"));
+            specs.push((FRICTION_FORCE_CHANNEL.to_string(), "force"));
+            specs.push((FRICTION_WORK_CHANNEL.to_string(), "energy"));
+        }
     }
     specs
 }
@@ -301,6 +319,13 @@ pub const NORMAL_VELOCITY_CHANNEL: &str = "contact1.normal_velocity";
 pub const MAX_GAP_CHANNEL: &str = "contact1.max_gap";
 /// Running max |G q̇| over the ends of constrained steps (velocity drift, O(h²)).
 pub const MAX_NORMAL_VELOCITY_CHANNEL: &str = "contact1.max_normal_velocity";
+
+/// Tangential tip velocity v_t = t̂·ṙ_tip of a friction contact.
+pub const SLIP_VELOCITY_CHANNEL: &str = "contact1.slip_velocity";
+/// Tangential force on the tip along t̂ (friction force sliding, holding force sticking).
+pub const FRICTION_FORCE_CHANNEL: &str = "contact1.friction_force";
+/// Cumulative friction work (the ledger's `friction` term).
+pub const FRICTION_WORK_CHANNEL: &str = "contact1.friction_work";
 
 /// Samples the observables at the integrator's current state into `buf`.
 fn sample(integ: &Integrator, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<f64>) {
@@ -325,11 +350,16 @@ fn sample(integ: &Integrator, stations: usize, tips: &mut [[f64; 2]], buf: &mut 
     }
     if let Some(c) = integ.contact.as_deref() {
         buf.push(c.lambda);
-        buf.push(if c.constrained { 1.0 } else { 0.0 });
+        buf.push(crate::friction::phase(c));
         buf.push(c.gap);
         buf.push(c.normal_velocity);
         buf.push(c.max_gap);
         buf.push(c.max_normal_velocity);
+        if let Some(b) = c.bilateral.as_deref().filter(|b| b.has_friction()) {
+            buf.push(b.slip_velocity);
+            buf.push(b.friction_force);
+            buf.push(b.friction_work);
+        }
     }
 }
 
@@ -360,9 +390,15 @@ fn ledger_terms(integ: &Integrator) -> (Vec<&'static str>, Vec<&'static str>, Ve
     if chain.links.iter().any(|l| l.kelvin_voigt > 0.0) {
         diss.push("kelvin_voigt");
     }
-    if integ.contact.is_some() {
-        diss.push("impact");
-        diss.push("contact_projection");
+    match integ.contact.as_deref().map(|c| c.bilateral.as_deref()) {
+        // A bilateral wall has no impacts or releases; friction work when μ > 0.
+        Some(Some(b)) if b.has_friction() => diss.push("friction"),
+        Some(Some(_)) => {}
+        Some(None) => {
+            diss.push("impact");
+            diss.push("contact_projection");
+        }
+        None => {}
     }
     (stored, inputs, diss)
 }
@@ -395,6 +431,11 @@ fn push_ledger(integ: &Integrator, ledger: &mut EnergyLedger) {
             "joint_damper" => w.joint_damper,
             "impact" => integ.contact.as_ref().map_or(0.0, |c| c.impact_loss),
             "contact_projection" => integ.contact.as_ref().map_or(0.0, |c| c.projection_loss),
+            "friction" => integ
+                .contact
+                .as_deref()
+                .and_then(|c| c.bilateral.as_deref())
+                .map_or(0.0, |b| b.friction_work),
             _ => w.kelvin_voigt,
         };
     }

@@ -405,9 +405,13 @@ fn sys_contact_refusals_are_precise() {
             other => panic!("{method}: {other:?}"),
         }
     }
-    // Bilateral circle contact with friction (constrained arm): refused by name.
-    match FemBackend.simulate(&scene("constrained-arm"), &Settings::default()) {
-        Err(BackendError::Unsupported(m)) => assert!(!m.is_empty()),
+    // A unilateral circle contact (the constrained arm's wall made unilateral, frictionless):
+    // refused by name (bilateral circles are `fem::friction`, tests/dyn_friction.rs).
+    let mut arm = scene("constrained-arm");
+    arm.contacts[0].mode = data::scene::ContactMode::Unilateral;
+    arm.contacts[0].friction = 0.0;
+    match FemBackend.simulate(&arm, &Settings::default()) {
+        Err(BackendError::Unsupported(m)) => assert!(m.contains("circular"), "{m}"),
         other => panic!("{other:?}"),
     }
     // Without contact nothing is allocated and the DOF count is the chain's.

@@ -1,0 +1,974 @@
+//! Bilateral tip contact with Coulomb friction and stick–slip (seed 001, scene
+//! `constrained-arm`) for the `energy-midpoint` scheme.
+//!
+//! **Constraint.** The tip of the named link stays on the wall ([`crate::wall`]) for all time:
+//! g(q) = 0 from t = 0 (the scene starts on the wall, checked), never released, multiplier λ
+//! (the normal force, positive pushing the tip to the free side) of either sign. The midpoint
+//! step carries it exactly as the unilateral constrained phase of [`crate::contact`]: force
+//! λ̄∇̄g with ∇̄g the Gonzalez discrete gradient of g (metric M(q̄)), and g(q₁) = 0 in the
+//! bordered Newton iteration; so Δqᵀ∇̄g = g(q₁) − g(q₀) and the wall does no work. |g| at the
+//! step ends is at the Newton tolerance (channel `contact1.gap`, running max
+//! `contact1.max_gap`).
+//!
+//! **Coulomb friction while sliding** in direction s = ±1 (of t̂, counter-clockwise on a
+//! circle): generalized force −μ s |λ| Tᵀ, T = t̂ᵀJ. In the step it is −μ s σ λ̄ T(q̄)ᵀ with λ̄
+//! the step's multiplier and σ = sign λ fixed for the step (the index-1 sign at the step
+//! start). If the converged λ̄ has the other sign the step is re-solved with σ flipped; if that
+//! too is inconsistent the discrete problem has no Coulomb solution and the run stops
+//! (Painlevé-type diagnostic). With σ fixed the friction force is linear in λ̄, so it simply
+//! changes the border of the Newton system to ∇̄g − μ s σ T(q̄). The energy identity of the
+//! scheme then gives E₁ − E₀ = W_applied − D with D = μ s σ λ̄ ΔqᵀT(q̄) = −Δqᵀ(friction force
+//! of the step), which is exactly what the ledger books as `friction` (channel
+//! `contact1.friction_work`): the ledger closes to the Newton tolerance. D approximates
+//! ∫μ|λ||v_t| dt to second order (Δq = h v̄).
+//!
+//! **Index-1 forces at a state** (channels, event functions, phase decisions), from the dense
+//! M(q) (exact mass products, LU), R(q, q̇, 0) and the tip's convective acceleration a_c = J̇q̇:
+//! * sliding: λ (G M⁻¹Gᵀ − μ s σ G M⁻¹Tᵀ) = G M⁻¹R − n̂·a_c + κ v_t². If
+//!   G M⁻¹Gᵀ ≤ μ|G M⁻¹Tᵀ| (Painlevé: no or several λ) the run stops with that diagnosis;
+//!   otherwise both brackets are positive and σ = sign of the right-hand side;
+//! * tip held (stick, and the cone test): [[GM⁻¹Gᵀ, GM⁻¹Tᵀ], [TM⁻¹Gᵀ, TM⁻¹Tᵀ]] (λ_n, λ_t) =
+//!   (G M⁻¹R − n̂·a_c + κ v_t², T M⁻¹R − t̂·a_c), λ_t the tangential force along t̂.
+//!
+//! **Stick–slip.** While sliding, the event function is s·v_t (v_t = T q̇); its zero is located
+//! INSIDE the step by an Illinois secant on the step length (each trial a re-solved midpoint
+//! step) to |v_t| ≤ [`VT_TOL`]·L per unit time on the far side, or a bracket below
+//! [`crate::contact::TIME_TOL`] (trial steps ≥ [`MIN_TRIAL`]·h, rule 4 below). There the
+//! Coulomb cone test with the held-tip forces decides:
+//! stick if |λ_t| ≤ μ|λ_n|, else slide on in direction s = −sign λ_t (a reversal when s
+//! changes; counted, not an event). While sticking, the tip is held at the stick point p_s by
+//! the second constraint t̂_s·(r_tip − p_s) = 0, carried like g (discrete gradient, second
+//! multiplier, 2 × 2 Schur complement in Newton), so it does no work either; the event function
+//! is μ|λ_n| − |λ_t| (held-tip forces at the step end), located the same way; slip resumes in
+//! direction −sign λ_t. The same cone test is made at t = 0 (the run starts at rest).
+//!
+//! **No chattering** (the rules; each switch advances time):
+//! 1. A phase entered at a switch keeps its first step whole: that step is never shortened,
+//!    and if the event function of the new phase is not positive at its end the switch is made
+//!    there. So every switch is followed by at least one full step, and
+//!    [`crate::contact::MAX_EVENTS`] bounds the count.
+//! 2. Discrete consistency of the first slide step: if the tip moved against s over it (the
+//!    booked friction work D < 0 — the friction force would have pushed the tip along), that
+//!    step is re-solved with the tip held at its start position (a stick event at the step
+//!    start; counted in `inconsistent_slides`). Seen at t = 0 on the scene: the index-1 test
+//!    at rest says slip, but the first discrete step of the flexible link moves its tip
+//!    backwards (non-minimum-phase response to the hub torque).
+//! 3. A stop found at the end of a first slide step (not located) with the tip still moving
+//!    faster than [`STICK_VT_TOL`]·L per unit time is a reversal: the tip slides on in its
+//!    direction of motion (no stick test on a moving tip).
+//! 4. Located switches never use trial steps shorter than [`MIN_TRIAL`] of the step: on a
+//!    step of length h → 0 the constraint g(q₁) = 0, met only to the Newton tolerance at q₀,
+//!    takes a multiplier ~ε/h² (measured 5e12 N on a 7e-15 s trial, which then booked negative
+//!    friction work). A root within that first fraction is taken at the step start: the
+//!    switch is applied there and the step re-solved in the new phase.
+//!
+//! Events: `data::Event::StickSlip` (`sticking` true at a stick, false at slip onset,
+//! including t = 0); reversals are counted, not recorded (as in `modal`).
+//!
+//! Channels: `contact1.phase` 1 sliding, 2 sticking (modal's numbering: 0 would be free flight,
+//! which a bilateral contact never has), `contact1.normal_force` (index-1 λ_n),
+//! `contact1.slip_velocity` (v_t), `contact1.friction_force` (tangential force along t̂:
+//! −μ s|λ| sliding, λ_t sticking), `contact1.friction_work` (= ledger `friction`).
+//!
+//! **Measured** (`constrained-arm`, Euler model, 16 elements): ledger closure 4.3e-11, max |g|
+//! 3.3e-16 m, ~100–150 switches in 2 s; θ(2 s) 7.57e-3 / 8.91e-3 / 9.35e-3 / 9.39e-3 rad at
+//! dt = 1e-3 / 5e-4 / 2.5e-4 / 1.25e-4 s (modal, polynomial basis, 6 modes: 9.45e-3);
+//! friction work 5.30e-3 J (modal 5.33e-3); switch times at dt = 2.5e-4 within ~1e-3 s of
+//! modal's (first stick 0.02477 / 0.02469 s). EI, EA ×1000: θ(2) = 3.744224 rad (rigid closed
+//! form 3.737974, modal 3.744224).
+//!
+//! Refused: the inextensible link (no axial field) on the circle of radius L about its own hub
+//! (it can stay on that circle only straight: the rigid model, gradient G = 0 and λ undefined).
+//! Timoshenko links without rotary inertia are refused here (M is singular in the massless
+//! section rotations, and the index-1 forces need M⁻¹).
+
+use data::scene::{ContactMode, Surface};
+use data::{Event, Scene};
+
+use crate::band::DenseLu;
+use crate::chain::{Chain, MAX_LINKS, Parts};
+use crate::contact::{Contact, MAX_EVENTS, Post, TIME_TOL};
+use crate::error::FemError;
+use crate::integrator::Integrator;
+use crate::wall::{Wall, row_along, rows};
+
+/// Slip-velocity tolerance of a located stop, relative to the longest link (per unit time).
+pub const VT_TOL: f64 = 1e-10;
+/// Largest |v_t| (relative to the longest link, per unit time) at the end of a first step of a
+/// slide for the Coulomb stick test; a faster tip slides on in its direction of motion.
+pub const STICK_VT_TOL: f64 = 1e-8;
+/// Shortest trial step of the event location, relative to the step being located.
+pub const MIN_TRIAL: f64 = 1e-3;
+/// Secant iterations at most per located switch.
+const MAX_SECANT: usize = 80;
+
+/// Refuses what the bilateral contact does not model (called from [`crate::contact::check`]).
+pub fn check(scene: &Scene) -> Result<(), FemError> {
+    let Some(c) = scene.contacts.first() else {
+        return Ok(());
+    };
+    if c.mode != ContactMode::Bilateral {
+        return Ok(());
+    }
+    if !(c.friction >= 0.0 && c.friction.is_finite()) {
+        return Err(FemError::InvalidSettings {
+            field: "contact.friction".into(),
+            message: format!("the friction coefficient must be ≥ 0, got {}", c.friction),
+        });
+    }
+    if let Some(i) = scene
+        .links
+        .iter()
+        .position(|l| l.shear && !l.rotary_inertia)
+    {
+        // The index-1 normal and held-tip forces and the Coulomb test use M⁻¹; the unilateral
+        // contact's condensation of massless sections is not carried over to the bilateral
+        // wall.
+        return Err(FemError::unsupported(format!(
+            "fem: bilateral (friction) contact with Timoshenko link {} (`{}`) without \
+             `rotary_inertia`: its section rotations carry no mass, so M is singular and the \
+             index-1 wall forces (G M⁻¹Gᵀ, G M⁻¹Tᵀ, T M⁻¹Tᵀ) are undefined; set \
+             `rotary_inertia = true` with `rotary_inertia_per_length`",
+            i + 1,
+            scene.links[i].name
+        )));
+    }
+    if let (Some(l), Surface::Circle { center, radius }) =
+        (scene.links.iter().find(|l| l.name == c.link), &c.surface)
+    {
+        let first = scene.links.first().is_some_and(|f| f.name == l.name);
+        let tol = 1e-12 * l.length;
+        if first
+            && !l.axial
+            && center[0].hypot(center[1]) <= tol
+            && (radius - l.length).abs() <= tol
+        {
+            return Err(FemError::unsupported(format!(
+                "fem: bilateral circle of radius L about the hub for the inextensible link `{}` \
+                 (simple flexure): its tip can stay at radius L only while the link is straight, \
+                 so the model degenerates to the rigid link (constraint gradient zero, normal \
+                 force undetermined); use `axial = true` (Euler model) or the rigid closed form",
+                l.name
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The `describe` line of a bilateral contact (None otherwise).
+pub fn describe(scene: &Scene) -> Option<String> {
+    let c = scene.contacts.first()?;
+    if c.mode != ContactMode::Bilateral {
+        return None;
+    }
+    let friction = if c.friction > 0.0 {
+        format!(
+            "Coulomb friction μ = {} (friction work booked per step), located stick–slip events, \
+             tip held by a second discrete-gradient constraint while sticking",
+            c.friction
+        )
+    } else {
+        "frictionless".to_string()
+    };
+    Some(format!(
+        "contact1: bilateral tip contact of `{}` on the {} wall (g = 0 for all time in the \
+         energy-midpoint step, discrete-gradient constraint force, multiplier λ = normal force); \
+         {friction}",
+        c.link,
+        match c.surface {
+            Surface::Circle { .. } => "circular",
+            Surface::Line { .. } => "straight",
+        }
+    ))
+}
+
+/// Which event function a step is watched by.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Switch {
+    /// Sliding: s·v_t reaches zero.
+    SlipStop,
+    /// Sticking: μ|λ_n| − |λ_t| reaches zero.
+    Breakaway,
+}
+
+/// Index-1 forces and tip kinematics at a state.
+#[derive(Debug, Clone, Copy, Default)]
+struct Forces {
+    lambda_n: f64,
+    /// Tangential force along t̂ (friction force sliding, holding force sticking).
+    lambda_t: f64,
+    vt: f64,
+    vn: f64,
+    gap: f64,
+    tip: [f64; 2],
+    tangent: [f64; 2],
+    /// G M⁻¹Gᵀ ≤ μ|G M⁻¹Tᵀ| (sliding only).
+    painleve: bool,
+    gmg: f64,
+    gmt: f64,
+}
+
+/// State of the bilateral (friction) contact; lives in [`Contact::bilateral`].
+#[derive(Debug, Clone)]
+pub struct Bilateral {
+    pub wall: Wall,
+    pub mu: f64,
+    pub sticking: bool,
+    /// Sliding direction s = ±1 along t̂.
+    pub slip_dir: f64,
+    /// Sign of λ used in the friction term of the current step.
+    pub sigma: f64,
+    pub stick_point: [f64; 2],
+    pub stick_tangent: [f64; 2],
+    /// Tangential force along t̂ and slip velocity v_t at the current state.
+    pub friction_force: f64,
+    pub slip_velocity: f64,
+    /// Cumulative friction work (ledger `friction`).
+    pub friction_work: f64,
+    /// Slip reversals (v_t crossed zero and the cone test sent the tip back, no stick).
+    pub reversals: usize,
+    /// First slide steps re-solved as stick steps (the tip moved against s).
+    pub inconsistent_slides: usize,
+    /// Largest |t̂_s·(r − p_s)| and |v_t| at the ends of stick steps (tangential drift).
+    pub max_stick_offset: f64,
+    pub max_stick_velocity: f64,
+    /// Smallest (G M⁻¹Gᵀ − μ|G M⁻¹Tᵀ|)/(G M⁻¹Gᵀ) met while sliding (Painlevé margin).
+    pub min_painleve_margin: f64,
+    /// Tangential multiplier of the last accepted stick step (Newton predictor).
+    step_lambda_t: f64,
+    lt_iter: f64,
+    lt_eval: f64,
+    dlt_pending: f64,
+    g1: f64,
+    h1: f64,
+    pending_work: f64,
+    /// Switch found by the last trial: kind, bracket width, located inside the step.
+    pending: Option<(Switch, f64, bool)>,
+    /// Event function at the start of the current step.
+    e0: f64,
+    /// The current step is the first of its phase (not shortened by an event; module docs).
+    fresh: bool,
+    jac: Vec<f64>,
+    g_row: Vec<f64>,
+    t_row: Vec<f64>,
+    h_bar: Vec<f64>,
+    h_end: Vec<f64>,
+    s_inv_h: Vec<f64>,
+    minv_g: Vec<f64>,
+    minv_t: Vec<f64>,
+    minv_r: Vec<f64>,
+    mass: DenseLu,
+    zero: Vec<f64>,
+    unit: Vec<f64>,
+    col: Vec<f64>,
+}
+
+/// The midpoint iterate seen by [`midpoint_terms`].
+pub(crate) struct StepView<'a> {
+    pub it: usize,
+    /// t₀, t_mid, t₁.
+    pub t: [f64; 3],
+    pub q0: &'a [f64],
+    pub q1: &'a [f64],
+    pub qbar: &'a [f64],
+    pub dq: &'a [f64],
+    /// M(q̄)Δq and ΔqᵀM(q̄)Δq (the Gonzalez metric).
+    pub w_dq: &'a [f64],
+    pub denom: f64,
+    /// Normal multiplier of this iterate and g(q₁).
+    pub lambda: f64,
+    pub gap1: f64,
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn sign(x: f64) -> f64 {
+    if x < 0.0 { -1.0 } else { 1.0 }
+}
+
+impl Bilateral {
+    /// The bilateral contact of the scene (None for a unilateral one), for `n` DOFs.
+    pub fn from_scene(c: &data::scene::Contact, n: usize) -> Result<Option<Box<Self>>, FemError> {
+        if c.mode != ContactMode::Bilateral {
+            return Ok(None);
+        }
+        let wall = Wall::from_surface(&c.surface)?;
+        let z = vec![0.0; n];
+        Ok(Some(Box::new(Bilateral {
+            wall,
+            mu: c.friction,
+            sticking: false,
+            slip_dir: 1.0,
+            sigma: 1.0,
+            stick_point: [0.0; 2],
+            stick_tangent: [0.0; 2],
+            friction_force: 0.0,
+            slip_velocity: 0.0,
+            friction_work: 0.0,
+            reversals: 0,
+            inconsistent_slides: 0,
+            max_stick_offset: 0.0,
+            max_stick_velocity: 0.0,
+            min_painleve_margin: f64::INFINITY,
+            step_lambda_t: 0.0,
+            lt_iter: 0.0,
+            lt_eval: 0.0,
+            dlt_pending: 0.0,
+            g1: 0.0,
+            h1: 0.0,
+            pending_work: 0.0,
+            pending: None,
+            e0: 0.0,
+            fresh: true,
+            jac: vec![0.0; 2 * n],
+            g_row: z.clone(),
+            t_row: z.clone(),
+            h_bar: z.clone(),
+            h_end: z.clone(),
+            s_inv_h: z.clone(),
+            minv_g: z.clone(),
+            minv_t: z.clone(),
+            minv_r: z.clone(),
+            mass: DenseLu::new(n),
+            zero: z.clone(),
+            unit: z.clone(),
+            col: z,
+        })))
+    }
+
+    /// Whether the contact has Coulomb friction (and hence stick–slip).
+    pub fn has_friction(&self) -> bool {
+        self.mu > 0.0
+    }
+
+    /// M(q) column by column from exact mass products, factorized (dense LU).
+    fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<(), FemError> {
+        for j in 0..q.len() {
+            self.unit[j] = 1.0;
+            chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
+            self.unit[j] = 0.0;
+            self.mass.set_column(j, &self.col);
+        }
+        self.mass.factorize().map_err(|e| match e {
+            FemError::Singular { pivot, .. } => FemError::Singular {
+                what: "mass".into(),
+                pivot,
+                t,
+            },
+            other => other,
+        })
+    }
+
+    /// Index-1 forces at (q, q̇) (module docs): the held-tip pair when `held`, else the sliding
+    /// normal force with the current s (σ chosen consistently).
+    fn forces(
+        &mut self,
+        chain: &mut Chain,
+        link: usize,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        held: bool,
+    ) -> Result<Forces, FemError> {
+        self.factor_mass(chain, t, q)?;
+        let r = chain.tip_jacobian(t, link, q, &mut self.jac);
+        let f = self.wall.frame(r);
+        rows(&f, &self.jac, &mut self.g_row, &mut self.t_row);
+        self.minv_g.copy_from_slice(&self.g_row);
+        self.mass.solve_in_place(&mut self.minv_g);
+        self.minv_t.copy_from_slice(&self.t_row);
+        self.mass.solve_in_place(&mut self.minv_t);
+        chain.residual(t, q, qd, &self.zero, &mut self.minv_r);
+        self.mass.solve_in_place(&mut self.minv_r);
+        let [_, v, a] = chain.tip_motion(t, link, q, qd, &self.zero);
+        let vt = f.tangent[0] * v[0] + f.tangent[1] * v[1];
+        let vn = f.normal[0] * v[0] + f.normal[1] * v[1];
+        let conv_n = f.normal[0] * a[0] + f.normal[1] * a[1] - f.curvature * vt * vt;
+        let conv_t = f.tangent[0] * a[0] + f.tangent[1] * a[1];
+        let gmg = dot(&self.g_row, &self.minv_g);
+        let gmt = dot(&self.g_row, &self.minv_t);
+        let tmt = dot(&self.t_row, &self.minv_t);
+        let rn = dot(&self.g_row, &self.minv_r) - conv_n;
+        let rt = dot(&self.t_row, &self.minv_r) - conv_t;
+        let mut out = Forces {
+            vt,
+            vn,
+            gap: f.gap,
+            tip: r,
+            tangent: f.tangent,
+            gmg,
+            gmt,
+            ..Forces::default()
+        };
+        if held {
+            let det = gmg * tmt - gmt * gmt;
+            out.lambda_n = (tmt * rn - gmt * rt) / det;
+            out.lambda_t = (gmg * rt - gmt * rn) / det;
+        } else {
+            let m = self.mu * gmt.abs();
+            out.painleve = self.mu > 0.0 && gmg <= m;
+            let sigma = if rn == 0.0 { self.sigma } else { sign(rn) };
+            out.lambda_n = rn / (gmg - self.mu * self.slip_dir * sigma * gmt);
+            out.lambda_t = -self.mu * self.slip_dir * out.lambda_n.abs();
+        }
+        if !(out.lambda_n.is_finite() && out.lambda_t.is_finite()) {
+            return Err(FemError::Runaway {
+                t,
+                what: "non-finite contact force".into(),
+                location: Some("contact1".into()),
+                why: format!(
+                    "the constraint rows are degenerate (G M⁻¹Gᵀ = {gmg:.3e}, T M⁻¹Tᵀ = {tmt:.3e})"
+                ),
+                remedy: "check that the wall is not redundant with the link kinematics".into(),
+            });
+        }
+        Ok(out)
+    }
+}
+
+/// Friction and stick terms of one midpoint Newton iterate (called from the energy-midpoint
+/// step after the normal constraint force; module docs). Sliding: adds the friction force to
+/// the residual and folds −μsσT(q̄) into the border ∇̄g. Sticking: adds −λ_t∇̄h of the
+/// tangential constraint h = t̂_s·(r − p_s). Returns the constraint value that Newton must drive
+/// to tolerance (g(q₁), or the larger of g(q₁), h(q₁) when sticking).
+pub(crate) fn midpoint_terms(
+    c: &mut Contact,
+    chain: &Chain,
+    v: &StepView<'_>,
+    res: &mut [f64],
+) -> f64 {
+    let link = c.link;
+    let Some(b) = c.bilateral.as_deref_mut() else {
+        return v.gap1;
+    };
+    b.pending_work = 0.0;
+    if b.mu == 0.0 {
+        return v.gap1;
+    }
+    let [t0, t_mid, t1] = v.t;
+    let n = res.len();
+    let r = chain.tip_jacobian(t_mid, link, v.qbar, &mut b.jac);
+    if !b.sticking {
+        let f = b.wall.frame(r);
+        row_along(f.tangent, &b.jac, &mut b.t_row);
+        let k = b.mu * b.slip_dir * b.sigma;
+        for i in 0..n {
+            res[i] += k * v.lambda * b.t_row[i];
+            c.g_bar[i] -= k * b.t_row[i];
+        }
+        b.pending_work = k * v.lambda * dot(v.dq, &b.t_row);
+        return v.gap1;
+    }
+    if v.it == 0 {
+        b.lt_iter = b.step_lambda_t;
+    } else {
+        b.lt_iter -= b.dlt_pending;
+    }
+    b.dlt_pending = 0.0;
+    b.lt_eval = b.lt_iter;
+    let ts = b.stick_tangent;
+    let ps = b.stick_point;
+    row_along(ts, &b.jac, &mut b.h_bar);
+    let r1 = chain.tip_jacobian(t1, link, v.q1, &mut b.jac);
+    row_along(ts, &b.jac, &mut b.h_end);
+    let mut tips = [[0.0; 2]; MAX_LINKS];
+    chain.tip_positions(t0, v.q0, &mut tips[..chain.links.len()]);
+    let r0 = tips[link];
+    let h0 = ts[0] * (r0[0] - ps[0]) + ts[1] * (r0[1] - ps[1]);
+    let h1 = ts[0] * (r1[0] - ps[0]) + ts[1] * (r1[1] - ps[1]);
+    let corr = if v.denom > 0.0 {
+        (h1 - h0 - dot(&b.h_bar, v.dq)) / v.denom
+    } else {
+        0.0
+    };
+    for i in 0..n {
+        b.h_bar[i] += corr * v.w_dq[i];
+        res[i] -= b.lt_iter * b.h_bar[i];
+    }
+    b.g1 = v.gap1;
+    b.h1 = h1;
+    if h1.abs() > v.gap1.abs() { h1 } else { v.gap1 }
+}
+
+/// Whether the contact is a sticking friction contact (two multipliers in Newton).
+pub(crate) fn sticking(c: &Contact) -> bool {
+    c.bilateral.as_deref().is_some_and(|b| b.sticking)
+}
+
+/// Phase channel value: 2 sticking, 1 constrained (sliding), 0 free.
+pub fn phase(c: &Contact) -> f64 {
+    if sticking(c) {
+        2.0
+    } else if c.constrained {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+impl Integrator {
+    /// Newton update of a stick step: S δa − ∇̄g δλ_n − ∇̄h δλ_t = F with
+    /// (h²/2)∇g(q₁)·δa = g(q₁), (h²/2)∇h(q₁)·δa = h(q₁), by the 2 × 2 Schur complement (three
+    /// solves of S). Leaves δa in `delta`, stores δλ_t for the next iterate, returns δλ_n.
+    pub(crate) fn stick_newton_update(&mut self, c: &mut Contact, res: &[f64], h: f64) -> f64 {
+        let Some(b) = c.bilateral.as_deref_mut() else {
+            return 0.0;
+        };
+        let n = res.len();
+        self.delta.copy_from_slice(&c.g_bar);
+        self.solve_matrix();
+        c.s_inv_g.copy_from_slice(&self.delta);
+        self.delta.copy_from_slice(&b.h_bar);
+        self.solve_matrix();
+        b.s_inv_h.copy_from_slice(&self.delta);
+        self.delta.copy_from_slice(res);
+        self.solve_matrix();
+        let hh = 0.5 * h * h;
+        let a11 = hh * dot(&c.g_end, &c.s_inv_g);
+        let a12 = hh * dot(&c.g_end, &b.s_inv_h);
+        let a21 = hh * dot(&b.h_end, &c.s_inv_g);
+        let a22 = hh * dot(&b.h_end, &b.s_inv_h);
+        let r1 = b.g1 - hh * dot(&c.g_end, &self.delta);
+        let r2 = b.h1 - hh * dot(&b.h_end, &self.delta);
+        let det = a11 * a22 - a12 * a21;
+        let dn = (a22 * r1 - a12 * r2) / det;
+        let dt = (a11 * r2 - a21 * r1) / det;
+        for i in 0..n {
+            self.delta[i] += c.s_inv_g[i] * dn + b.s_inv_h[i] * dt;
+        }
+        b.dlt_pending = dt;
+        dn
+    }
+
+    fn with_bilateral<R>(
+        &mut self,
+        f: impl FnOnce(&mut Self, &mut Contact) -> Result<R, FemError>,
+    ) -> Result<R, FemError> {
+        let Some(mut c) = self.contact.take() else {
+            return Err(FemError::Numerical {
+                t: self.t,
+                message: "bilateral contact missing".into(),
+            });
+        };
+        let out = f(self, &mut c);
+        self.contact = Some(c);
+        out
+    }
+
+    /// Index-1 forces at (q, q̇) (`end`: the trial end q₁, q̇₁ at t₁; else the current state).
+    fn contact_forces(&mut self, end: bool, t: f64, held: bool) -> Result<Forces, FemError> {
+        self.with_bilateral(|s, c| {
+            let link = c.link;
+            let b = c.bilateral.as_deref_mut().expect("bilateral contact");
+            let (q, qd) = if end { (&s.q1, &s.qd1) } else { (&s.q, &s.qd) };
+            let out = b.forces(&mut s.chain, link, t, q, qd, held);
+            s.counters.rhs += s.chain.ndof + 2;
+            out
+        })
+    }
+
+    /// Sets up the bilateral contact at t = 0: the tip must start on the wall; forces, and the
+    /// Coulomb test that decides the initial phase (module docs).
+    pub fn bilateral_start(&mut self) -> Result<(), FemError> {
+        let t = self.t;
+        let Some(c) = self.contact.as_deref_mut() else {
+            return Ok(());
+        };
+        if c.bilateral.is_none() {
+            return Ok(());
+        }
+        c.constrained = true;
+        c.gap = c.gap_at(&self.chain, t, &self.q);
+        if c.gap.abs() > c.gap_tol {
+            return Err(FemError::InvalidSettings {
+                field: "contact".into(),
+                message: format!(
+                    "the tip starts {:.3e} off the surface of the bilateral contact (tolerance \
+                     {:.1e})",
+                    c.gap, c.gap_tol
+                ),
+            });
+        }
+        let mu = c.bilateral.as_deref().map_or(0.0, |b| b.mu);
+        let vt_tol = VT_TOL * self.length_scale;
+        let held = self.contact_forces(false, t, true)?;
+        let c = self.contact.as_deref_mut().expect("contact");
+        let b = c.bilateral.as_deref_mut().expect("bilateral");
+        let mut sticking = false;
+        if mu > 0.0 {
+            if held.vt.abs() <= vt_tol && held.lambda_t.abs() <= mu * held.lambda_n.abs() {
+                sticking = true;
+            } else {
+                b.slip_dir = if held.vt.abs() > vt_tol {
+                    sign(held.vt)
+                } else {
+                    -sign(held.lambda_t)
+                };
+            }
+            c.n_events += 1;
+            c.events.push(Event::StickSlip {
+                t,
+                contact: 1,
+                sticking,
+            });
+        }
+        if sticking {
+            b.sticking = true;
+            b.stick_point = held.tip;
+            b.stick_tangent = held.tangent;
+            b.step_lambda_t = held.lambda_t;
+        }
+        self.record_state()
+    }
+
+    /// Index-1 forces at the current state for the current phase, stored in
+    /// the contact; Painlevé stop; the event function for the next step.
+    fn record_state(&mut self) -> Result<(), FemError> {
+        let t = self.t;
+        let sticking = sticking(self.contact.as_deref().expect("contact"));
+        let fr = self.contact_forces(false, t, sticking)?;
+        let c = self.contact.as_deref_mut().expect("contact");
+        let b = c.bilateral.as_deref_mut().expect("bilateral");
+        c.lambda = fr.lambda_n;
+        c.gap = fr.gap;
+        c.normal_velocity = fr.vn;
+        c.max_gap = c.max_gap.max(fr.gap.abs());
+        c.max_normal_velocity = c.max_normal_velocity.max(fr.vn.abs());
+        b.friction_force = fr.lambda_t;
+        b.slip_velocity = fr.vt;
+        if b.sticking {
+            let (ts, ps) = (b.stick_tangent, b.stick_point);
+            let off = ts[0] * (fr.tip[0] - ps[0]) + ts[1] * (fr.tip[1] - ps[1]);
+            b.max_stick_offset = b.max_stick_offset.max(off.abs());
+            b.max_stick_velocity = b.max_stick_velocity.max(fr.vt.abs());
+            b.e0 = b.mu * fr.lambda_n.abs() - fr.lambda_t.abs();
+        } else {
+            if b.mu > 0.0 {
+                b.min_painleve_margin = b
+                    .min_painleve_margin
+                    .min((fr.gmg - b.mu * fr.gmt.abs()) / fr.gmg);
+                if fr.painleve {
+                    return Err(FemError::Runaway {
+                        t,
+                        what: "Painlevé paradox of the friction contact".into(),
+                        location: Some("contact1".into()),
+                        why: format!(
+                            "G M⁻¹Gᵀ = {:.4e} ≤ μ|G M⁻¹Tᵀ| = {:.4e}: the sliding normal force \
+                             has no or several solutions",
+                            fr.gmg,
+                            b.mu * fr.gmt.abs()
+                        ),
+                        remedy: "no consistent Coulomb solution in this model; reduce μ".into(),
+                    });
+                }
+                if fr.lambda_n != 0.0 {
+                    b.sigma = sign(fr.lambda_n);
+                }
+            }
+            b.e0 = b.slip_dir * fr.vt;
+        }
+        if b.fresh {
+            // Newton predictor of a new phase: the index-1 value.
+            c.step_lambda = fr.lambda_n;
+        }
+        Ok(())
+    }
+
+    /// Re-solves the current step of length h (phase as set); a Newton failure is an error.
+    fn bilateral_solve(&mut self, h: f64) -> Result<(), FemError> {
+        let t1 = self.t + h;
+        if let Some(e) = self.midpoint_step(h, t1, t1)?
+            && e.is_infinite()
+        {
+            return Err(FemError::Runaway {
+                t: self.t,
+                what: format!("Newton failed on a friction-contact step (h = {h:.3e})"),
+                location: Some("contact1".into()),
+                why: "the re-solved step did not converge".into(),
+                remedy: "reduce --dt".into(),
+            });
+        }
+        self.sigma_check(h)
+    }
+
+    /// Sliding: the converged mean multiplier must have the sign σ the friction term assumed;
+    /// else the step is re-solved once with σ flipped (module docs).
+    fn sigma_check(&mut self, h: f64) -> Result<(), FemError> {
+        let c = self.contact.as_deref_mut().expect("contact");
+        let tiny = c.force_tol;
+        let lam = c.step_lambda;
+        let b = c.bilateral.as_deref_mut().expect("bilateral");
+        if b.sticking || b.mu == 0.0 || lam * b.sigma >= 0.0 || lam.abs() <= tiny {
+            return Ok(());
+        }
+        b.sigma = -b.sigma;
+        let t1 = self.t + h;
+        let failed = matches!(self.midpoint_step(h, t1, t1)?, Some(e) if e.is_infinite());
+        let c = self.contact.as_deref_mut().expect("contact");
+        let lam2 = c.step_lambda;
+        let sigma = c.bilateral.as_deref().map_or(1.0, |b| b.sigma);
+        if failed || (lam2 * sigma < 0.0 && lam2.abs() > tiny) {
+            return Err(FemError::Runaway {
+                t: self.t,
+                what: "no consistent Coulomb solution of the friction step".into(),
+                location: Some("contact1".into()),
+                why: format!(
+                    "the step's normal multiplier changes sign with the assumed friction sign \
+                     (λ̄ = {lam:.4e} with σ = {:.0}, {lam2:.4e} with σ = {sigma:.0}): \
+                     Painlevé-type inconsistency",
+                    -sigma
+                ),
+                remedy: "reduce --dt; if it persists the model has no Coulomb solution".into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Event function of `kind` at the end of the trial step just solved.
+    fn switch_value(&mut self, kind: Switch, t1: f64) -> Result<f64, FemError> {
+        match kind {
+            Switch::SlipStop => self.with_bilateral(|s, c| {
+                let link = c.link;
+                let b = c.bilateral.as_deref_mut().expect("bilateral");
+                let r = s.chain.tip_jacobian(t1, link, &s.q1, &mut b.jac);
+                let f = b.wall.frame(r);
+                row_along(f.tangent, &b.jac, &mut b.t_row);
+                Ok(b.slip_dir * dot(&b.t_row, &s.qd1))
+            }),
+            Switch::Breakaway => {
+                let fr = self.contact_forces(true, t1, true)?;
+                let mu = self
+                    .contact
+                    .as_deref()
+                    .and_then(|c| c.bilateral.as_deref())
+                    .map_or(0.0, |b| b.mu);
+                Ok(mu * fr.lambda_n.abs() - fr.lambda_t.abs())
+            }
+        }
+    }
+
+    fn switch_trial(&mut self, kind: Switch, h: f64) -> Result<f64, FemError> {
+        self.bilateral_solve(h)?;
+        self.switch_value(kind, self.t + h)
+    }
+
+    /// Illinois secant on the step length for the zero of the event function (F(0) = f0 > 0,
+    /// F(h) = f1 ≤ 0) to −tol ≤ F ≤ 0 or a bracket below [`TIME_TOL`]; leaves the accepted
+    /// trial solved and returns (h*, bracket width). Trial steps are never shorter than
+    /// [`MIN_TRIAL`]·h: on a step of length h → 0 the constraint g(q₁) = 0, met only to the
+    /// Newton tolerance ε at q₀, takes a multiplier ~ε/h² and the event function jumps by
+    /// ~ε/h (measured: λ̄ = 5e12 N on a 7e-15 s trial). A root inside that first fraction is
+    /// returned as None: the switch is made at the step start.
+    fn locate_switch(
+        &mut self,
+        kind: Switch,
+        h: f64,
+        f0: f64,
+        f1: f64,
+        tol: f64,
+    ) -> Result<Option<(f64, f64)>, FemError> {
+        let h_min = MIN_TRIAL * h;
+        let f_min = self.switch_trial(kind, h_min)?;
+        if f_min <= 0.0 {
+            return Ok(None);
+        }
+        let (mut a, mut fa, mut b, mut fb) = (h_min, f_min, h, f1);
+        let _ = f0;
+        let mut side = 0i32;
+        let mut last_b_solved = false;
+        for _ in 0..MAX_SECANT {
+            if b - a <= TIME_TOL * self.t.abs().max(1.0) {
+                break;
+            }
+            let margin = 1e-6 * (b - a);
+            let mut c = b - fb * (b - a) / (fb - fa);
+            if !c.is_finite() {
+                c = 0.5 * (a + b);
+            }
+            c = c.clamp(a + margin, b - margin);
+            let mut fc = self.switch_trial(kind, c);
+            for frac in [0.5, 0.75, 0.25, 0.9] {
+                if fc.is_ok() {
+                    break;
+                }
+                c = a + frac * (b - a);
+                fc = self.switch_trial(kind, c);
+            }
+            let fc = fc?;
+            if fc <= 0.0 {
+                b = c;
+                fb = fc;
+                last_b_solved = true;
+                if fc >= -tol {
+                    return Ok(Some((b, b - a)));
+                }
+                if side == -1 {
+                    fa *= 0.5;
+                }
+                side = -1;
+            } else {
+                a = c;
+                fa = fc;
+                last_b_solved = false;
+                if side == 1 {
+                    fb *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        if !last_b_solved {
+            self.switch_trial(kind, b)?;
+        }
+        Ok(Some((b, b - a)))
+    }
+
+    /// Bilateral counterpart of [`Integrator::contact_after_trial`]: the friction sign check,
+    /// then the stick–slip event of the phase, located inside the step.
+    pub(crate) fn bilateral_after_trial(&mut self, h: f64) -> Result<(f64, Post), FemError> {
+        let t1 = self.t + h;
+        let c = self.contact.as_deref_mut().expect("contact");
+        if c.n_events >= MAX_EVENTS {
+            return Err(FemError::Runaway {
+                t: self.t,
+                what: format!("{} stick–slip events", c.n_events),
+                location: Some("contact1".into()),
+                why: "stick–slip transitions accumulate".into(),
+                remedy: "shorten t_end or add damping".into(),
+            });
+        }
+        self.sigma_check(h)?;
+        let t0 = self.t;
+        let c = self.contact.as_deref_mut().expect("contact");
+        let force_tol = c.force_tol;
+        let b = c.bilateral.as_deref_mut().expect("bilateral");
+        b.pending = None;
+        if b.mu == 0.0 {
+            return Ok((h, Post::None));
+        }
+        if !b.sticking && b.fresh && b.pending_work < 0.0 {
+            // First step of a slide whose tip moved against s: friction would have done
+            // negative work. The discrete Coulomb choice: the tip sticks for this step (held
+            // at its start position; the held-tip constraint does no work).
+            let held = self.contact_forces(false, t0, true)?;
+            let c = self.contact.as_deref_mut().expect("contact");
+            let b = c.bilateral.as_deref_mut().expect("bilateral");
+            b.sticking = true;
+            b.stick_point = held.tip;
+            b.stick_tangent = held.tangent;
+            b.step_lambda_t = held.lambda_t;
+            b.inconsistent_slides += 1;
+            c.n_events += 1;
+            c.events.push(Event::StickSlip {
+                t: t0,
+                contact: 1,
+                sticking: true,
+            });
+            if let Some(w) = self.midpoint.as_mut() {
+                w.restart();
+            }
+            self.bilateral_solve(h)?;
+        }
+        loop {
+            let c = self.contact.as_deref_mut().expect("contact");
+            let b = c.bilateral.as_deref_mut().expect("bilateral");
+            let (kind, tol) = if b.sticking {
+                (Switch::Breakaway, force_tol)
+            } else {
+                (Switch::SlipStop, VT_TOL * self.length_scale)
+            };
+            let f0 = b.e0;
+            let located = !b.fresh && f0 > 0.0;
+            let f1 = self.switch_value(kind, t1)?;
+            if f1 > 0.0 {
+                return Ok((h, Post::None));
+            }
+            let found = if located {
+                self.locate_switch(kind, h, f0, f1, tol)?
+            } else {
+                // First step of a phase: not shortened (the one-step rule, module docs), the
+                // switch is made at its end.
+                Some((h, 0.0))
+            };
+            let Some((h_acc, width)) = found else {
+                // The root lies within the first MIN_TRIAL of the step: switch at its start
+                // and re-solve the step in the new phase (whose first step is not shortened).
+                self.apply_switch(kind, true)?;
+                self.record_state()?;
+                self.bilateral_solve(h)?;
+                continue;
+            };
+            let b = self
+                .contact
+                .as_deref_mut()
+                .and_then(|c| c.bilateral.as_deref_mut())
+                .expect("bilateral");
+            b.pending = Some((kind, width, located));
+            return Ok((h_acc, Post::None));
+        }
+    }
+
+    /// Books the accepted step (friction work, tangential multiplier), applies a located
+    /// switch at the new state and records the forces there.
+    pub(crate) fn bilateral_after_accept(&mut self) -> Result<(), FemError> {
+        let c = self.contact.as_deref_mut().expect("contact");
+        let b = c.bilateral.as_deref_mut().expect("bilateral");
+        b.friction_work += b.pending_work;
+        b.pending_work = 0.0;
+        if b.sticking {
+            b.step_lambda_t = b.lt_eval;
+        }
+        b.fresh = false;
+        let Some((kind, _width, located)) = b.pending.take() else {
+            return self.record_state();
+        };
+        self.apply_switch(kind, located)?;
+        self.record_state()
+    }
+
+    /// Switch of `kind` at the current state (q, q̇ at t): the Coulomb test with the held-tip
+    /// forces (module docs), event, midpoint restart. `located`: the state is a located zero
+    /// of the event function (else the end of a first step, where a tip still moving slides
+    /// on in its direction of motion).
+    fn apply_switch(&mut self, kind: Switch, located: bool) -> Result<(), FemError> {
+        let t = self.t;
+        let held = self.contact_forces(false, t, true)?;
+        let vt_tol = STICK_VT_TOL * self.length_scale;
+        let c = self.contact.as_deref_mut().expect("contact");
+        let b = c.bilateral.as_deref_mut().expect("bilateral");
+        let mu = b.mu;
+        b.fresh = true;
+        let moving = !located && held.vt.abs() > vt_tol;
+        let stick =
+            kind == Switch::SlipStop && !moving && held.lambda_t.abs() <= mu * held.lambda_n.abs();
+        if moving && kind == Switch::SlipStop {
+            b.slip_dir = sign(held.vt);
+            b.reversals += 1;
+        } else if stick {
+            b.sticking = true;
+            b.stick_point = held.tip;
+            b.stick_tangent = held.tangent;
+            b.step_lambda_t = held.lambda_t;
+        } else {
+            let s = -sign(held.lambda_t);
+            if kind == Switch::SlipStop && s != b.slip_dir {
+                b.reversals += 1;
+            }
+            b.slip_dir = s;
+            b.sticking = false;
+        }
+        if kind == Switch::Breakaway || stick {
+            c.n_events += 1;
+            c.events.push(Event::StickSlip {
+                t,
+                contact: 1,
+                sticking: stick,
+            });
+        }
+        if let Some(w) = self.midpoint.as_mut() {
+            w.restart();
+        }
+        Ok(())
+    }
+}
