@@ -8,8 +8,11 @@ use modal::simulate::{FinalState, simulate_detailed};
 
 fn settings(modes: usize, rtol: f64, t_end: Option<f64>) -> Settings {
     Settings {
+        // The clamped-free basis these tests were measured with (the default for contact
+        // scenes is `poly`, see modal::setup::default_basis).
         discretization: Discretization {
             modes: Some(modes),
+            basis: Some(data::Basis::ClampedFree),
             ..Default::default()
         },
         time: TimeStepping {
@@ -401,5 +404,31 @@ fn dyn_contact_convective_tip_acceleration_matches_finite_differences() {
     // Central difference: truncation O(ε²·|q̇|³·|∂³r|) ~ 1e-9 relative, round-off ~1e-11/ε.
     for k in 0..2 {
         assert!((c[k] - fd[k]).abs() <= 1e-6 * scale, "{c:?} vs {fd:?}");
+    }
+}
+
+#[test]
+fn sys_default_basis_is_poly_for_contact_scenes_only() {
+    // Tip loads converge slowly in the clamped-free functions (zero end force, shear and
+    // moment): contact scenes default to the polynomial basis (modal::setup::default_basis).
+    for name in [
+        "barhorst-case1",
+        "barhorst-case1-timoshenko",
+        "constrained-arm",
+    ] {
+        let scene = load_scene(name).unwrap();
+        assert_eq!(
+            modal::setup::default_basis(&scene),
+            data::Basis::Poly,
+            "{name}"
+        );
+    }
+    for name in ["cantilever", "two-link-free", "single-link"] {
+        let scene = load_scene(name).unwrap();
+        assert_eq!(
+            modal::setup::default_basis(&scene),
+            data::Basis::ClampedFree,
+            "{name}"
+        );
     }
 }

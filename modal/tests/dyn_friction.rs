@@ -14,8 +14,11 @@ use modal::simulate::{
 
 fn settings(modes: usize, rtol: f64, t_end: Option<f64>) -> Settings {
     Settings {
+        // The clamped-free basis these tests were measured with (the default for contact
+        // scenes is `poly`, see modal::setup::default_basis).
         discretization: Discretization {
             modes: Some(modes),
+            basis: Some(data::Basis::ClampedFree),
             ..Default::default()
         },
         time: TimeStepping {
