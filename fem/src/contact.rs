@@ -692,6 +692,18 @@ enum Watch {
     Force,
 }
 
+/// Outcome of [`Integrator::illinois_on_step`]: the step length h reached (the bracket end
+/// b ≥ root, or an accepted trial), the width of the bracket that holds the root, whether the
+/// event function met its tolerance at h (`exact`, trial solved) and whether the last solved
+/// trial is h.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Located {
+    pub h: f64,
+    pub width: f64,
+    pub exact: bool,
+    pub solved: bool,
+}
+
 impl Integrator {
     fn contact_mut(&mut self) -> &mut Contact {
         self.contact
@@ -735,23 +747,24 @@ impl Integrator {
         }
     }
 
-    /// Illinois secant on the step length for the root of the event function F (F(a0) = f0 > 0,
-    /// F(h) = f1 ≤ 0, F decreasing through the root), to |F| ≤ tol on the non-positive side or
-    /// a bracket narrower than [`TIME_TOL`]. Leaves the accepted trial solved in q₁, q̇₁ and
-    /// returns (h*, bracket width).
+    /// Illinois secant on the step length for the root of an event function F(h), each value a
+    /// re-solved shortened step (`trial`): F(a) = fa > 0, F(b) = fb ≤ 0, F decreasing through
+    /// the root. Stops at a trial with −tol ≤ F ≤ 0 (or 0 < F ≤ tol when `accept_positive`),
+    /// which is left solved (`Located::exact`), or when the bracket is narrower than
+    /// [`TIME_TOL`]·max(t, 1); `b_solved` says whether the last trial solved is b (true on
+    /// entry if F(b) was the last evaluation). A trial whose Newton iteration fails is replaced
+    /// by other points of the bracket (its midpoint, then its quarter points).
     #[allow(clippy::too_many_arguments)]
-    fn locate(
+    pub(crate) fn illinois_on_step(
         &mut self,
-        watch: Watch,
-        a0: f64,
-        h: f64,
-        f0: f64,
-        f1: f64,
+        (mut a, mut fa): (f64, f64),
+        (mut b, mut fb): (f64, f64),
         tol: f64,
-    ) -> Result<(f64, f64), FemError> {
-        let (mut a, mut fa, mut b, mut fb) = (a0, f0, h, f1);
+        accept_positive: bool,
+        mut b_solved: bool,
+        mut trial: impl FnMut(&mut Self, f64) -> Result<f64, FemError>,
+    ) -> Result<Located, FemError> {
         let mut side = 0i32;
-        let mut last_b_solved = true;
         for _ in 0..MAX_SECANT {
             if b - a <= TIME_TOL * self.t.abs().max(1.0) {
                 break;
@@ -762,55 +775,93 @@ impl Integrator {
                 c = 0.5 * (a + b);
             }
             c = c.clamp(a + margin, b - margin);
-            // A trial whose Newton iteration fails is replaced by other points of the bracket
-            // (its midpoint, then its quarter points): the full step converged.
-            let mut fc = self.trial(watch, c);
+            let mut fc = trial(self, c);
             for frac in [0.5, 0.75, 0.25, 0.9] {
                 if fc.is_ok() {
                     break;
                 }
                 c = a + frac * (b - a);
-                fc = self.trial(watch, c);
+                fc = trial(self, c);
             }
             let fc = fc?;
             if fc <= 0.0 {
                 b = c;
                 fb = fc;
-                last_b_solved = true;
+                b_solved = true;
                 if fc >= -tol {
-                    return Ok((b, b - a));
+                    return Ok(Located {
+                        h: b,
+                        width: b - a,
+                        exact: true,
+                        solved: true,
+                    });
                 }
                 if side == -1 {
                     fa *= 0.5;
                 }
                 side = -1;
             } else {
-                if watch == Watch::Gap && fc <= tol {
-                    // Either side of the gap root is a contact start within tolerance.
-                    return Ok((c, b - a));
+                if accept_positive && fc <= tol {
+                    // The root lies in [c, b].
+                    return Ok(Located {
+                        h: c,
+                        width: b - c,
+                        exact: true,
+                        solved: true,
+                    });
                 }
                 a = c;
                 fa = fc;
-                last_b_solved = false;
+                b_solved = false;
                 if side == 1 {
                     fb *= 0.5;
                 }
                 side = 1;
             }
         }
-        if !last_b_solved {
+        Ok(Located {
+            h: b,
+            width: b - a,
+            exact: false,
+            solved: b_solved,
+        })
+    }
+
+    /// Locates the root of a unilateral event function (gap or normal force) inside the step
+    /// [a0, h] (F(a0) = f0 > 0, F(h) = f1 ≤ 0): to |F| ≤ tol (either side for the gap, the
+    /// non-positive side for the force) or a bracket narrower than [`TIME_TOL`]. Leaves the
+    /// accepted trial solved in q₁, q̇₁ and returns (h*, bracket width).
+    fn locate(
+        &mut self,
+        watch: Watch,
+        a0: f64,
+        h: f64,
+        f0: f64,
+        f1: f64,
+        tol: f64,
+    ) -> Result<(f64, f64), FemError> {
+        let loc =
+            self.illinois_on_step((a0, f0), (h, f1), tol, watch == Watch::Gap, true, |s, c| {
+                s.trial(watch, c)
+            })?;
+        let (width, mut b) = (loc.width, loc.h);
+        if loc.exact {
+            return Ok((b, width));
+        }
+        if !loc.solved {
             let mut fb = self.trial(watch, b)?;
             // The re-solved bracket end can land on the other side by the Newton noise of the
             // event function: widen towards the full step, where F(h) ≤ 0 was measured, until
             // it does not.
-            let (width, mut k) = (b - a, 0);
+            let mut k = 0;
             while fb > 0.0 && b < h && k < 20 {
                 b = (b + width * 4f64.powi(k)).min(h);
                 fb = self.trial(watch, b)?;
                 k += 1;
             }
+            return Ok((b, b - (loc.h - width)));
         }
-        Ok((b, b - a))
+        Ok((b, width))
     }
 
     /// Event handling after a converged trial step of length h (state in q₁, q̇₁): returns the

@@ -87,7 +87,7 @@ use data::{Event, Scene};
 
 use crate::band::DenseLu;
 use crate::chain::{Chain, MAX_LINKS, Parts};
-use crate::contact::{Contact, MAX_EVENTS, Post, TIME_TOL};
+use crate::contact::{Contact, MAX_EVENTS, Post};
 use crate::error::FemError;
 use crate::integrator::Integrator;
 use crate::wall::{Wall, row_along, rows};
@@ -99,8 +99,6 @@ pub const VT_TOL: f64 = 1e-10;
 pub const STICK_VT_TOL: f64 = 1e-8;
 /// Shortest trial step of the event location, relative to the step being located.
 pub const MIN_TRIAL: f64 = 1e-3;
-/// Secant iterations at most per located switch.
-const MAX_SECANT: usize = 80;
 
 /// Refuses what the bilateral contact does not model (called from [`crate::contact::check`]).
 pub fn check(scene: &Scene) -> Result<(), FemError> {
@@ -754,9 +752,10 @@ impl Integrator {
         self.switch_value(kind, self.t + h)
     }
 
-    /// Illinois secant on the step length for the zero of the event function (F(0) = f0 > 0,
-    /// F(h) = f1 ≤ 0) to −tol ≤ F ≤ 0 or a bracket below [`TIME_TOL`]; leaves the accepted
-    /// trial solved and returns (h*, bracket width). Trial steps are never shorter than
+    /// Zero of the event function inside the step (F(0) > 0, F(h) = f1 ≤ 0) by
+    /// [`Integrator::illinois_on_step`], to −tol ≤ F ≤ 0 or a bracket below
+    /// [`crate::contact::TIME_TOL`]; leaves the accepted trial solved and returns
+    /// (h*, bracket width). Trial steps are never shorter than
     /// [`MIN_TRIAL`]·h: on a step of length h → 0 the constraint g(q₁) = 0, met only to the
     /// Newton tolerance ε at q₀, takes a multiplier ~ε/h² and the event function jumps by
     /// ~ε/h (measured: λ̄ = 5e12 N on a 7e-15 s trial). A root inside that first fraction is
@@ -765,7 +764,6 @@ impl Integrator {
         &mut self,
         kind: Switch,
         h: f64,
-        f0: f64,
         f1: f64,
         tol: f64,
     ) -> Result<Option<(f64, f64)>, FemError> {
@@ -774,54 +772,13 @@ impl Integrator {
         if f_min <= 0.0 {
             return Ok(None);
         }
-        let (mut a, mut fa, mut b, mut fb) = (h_min, f_min, h, f1);
-        let _ = f0;
-        let mut side = 0i32;
-        let mut last_b_solved = false;
-        for _ in 0..MAX_SECANT {
-            if b - a <= TIME_TOL * self.t.abs().max(1.0) {
-                break;
-            }
-            let margin = 1e-6 * (b - a);
-            let mut c = b - fb * (b - a) / (fb - fa);
-            if !c.is_finite() {
-                c = 0.5 * (a + b);
-            }
-            c = c.clamp(a + margin, b - margin);
-            let mut fc = self.switch_trial(kind, c);
-            for frac in [0.5, 0.75, 0.25, 0.9] {
-                if fc.is_ok() {
-                    break;
-                }
-                c = a + frac * (b - a);
-                fc = self.switch_trial(kind, c);
-            }
-            let fc = fc?;
-            if fc <= 0.0 {
-                b = c;
-                fb = fc;
-                last_b_solved = true;
-                if fc >= -tol {
-                    return Ok(Some((b, b - a)));
-                }
-                if side == -1 {
-                    fa *= 0.5;
-                }
-                side = -1;
-            } else {
-                a = c;
-                fa = fc;
-                last_b_solved = false;
-                if side == 1 {
-                    fb *= 0.5;
-                }
-                side = 1;
-            }
+        let loc = self.illinois_on_step((h_min, f_min), (h, f1), tol, false, false, |s, c| {
+            s.switch_trial(kind, c)
+        })?;
+        if !loc.solved {
+            self.switch_trial(kind, loc.h)?;
         }
-        if !last_b_solved {
-            self.switch_trial(kind, b)?;
-        }
-        Ok(Some((b, b - a)))
+        Ok(Some((loc.h, loc.width)))
     }
 
     /// Bilateral counterpart of [`Integrator::contact_after_trial`]: the friction sign check,
@@ -885,7 +842,7 @@ impl Integrator {
                 return Ok((h, Post::None));
             }
             let found = if located {
-                self.locate_switch(kind, h, f0, f1, tol)?
+                self.locate_switch(kind, h, f1, tol)?
             } else {
                 // First step of a phase: not shortened (the one-step rule, module docs), the
                 // switch is made at its end.
