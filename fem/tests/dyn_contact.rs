@@ -7,6 +7,8 @@ use data::{Backend, Event, RunResult, Scene, Settings, StabilityVerdict};
 use fem::FemBackend;
 use fem::chain::Chain;
 
+mod common;
+
 fn scene(name: &str) -> Scene {
     data::catalog::load_scene(name).unwrap()
 }
@@ -202,19 +204,7 @@ fn dyn_case1_switches_with_located_releases_and_a_closed_ledger() {
     let sc = scene("barhorst-case1");
     let r = sim(&sc, &settings(Some(8), Some(0.45)));
     let n_imp = impacts(&r).len();
-    let releases: Vec<(f64, f64, f64)> = r
-        .events
-        .iter()
-        .filter_map(|e| match e {
-            Event::Release {
-                t,
-                normal_force,
-                time_tolerance,
-                ..
-            } => Some((*t, *normal_force, *time_tolerance)),
-            _ => None,
-        })
-        .collect();
+    let releases = common::releases(&r);
     assert!(
         n_imp >= 3 && releases.len() >= 3,
         "{n_imp} impacts, {} releases",
@@ -223,14 +213,7 @@ fn dyn_case1_switches_with_located_releases_and_a_closed_ledger() {
     // Release (event function: the index-1 normal force λ at the end of the shortened step):
     // 0 ≥ λ ≥ −1e-8·W (W the weight, 1.764 × 5 × 32.17), or a bracket at the time resolution
     // (1e-13·max(t, 1)) where λ(h) is steeper than that.
-    let weight = 1.764 * 5.0 * 32.17;
-    for (t, l, tt) in &releases {
-        assert!(*l <= 0.0, "release at {t} with λ = {l}");
-        assert!(
-            l.abs() <= fem::contact::FORCE_TOL * weight || *tt <= 1e-12,
-            "release at {t}: λ = {l:.3e}, bracket {tt:.1e}"
-        );
-    }
+    common::assert_releases_located(&releases, 1.764 * 5.0 * 32.17);
     let closure = r.ledger.relative_closure();
     assert!(closure <= 1e-5, "ledger closure {closure:.3e}");
     // Constraint drift: |g| at every sample in a constrained phase within the gap tolerance.

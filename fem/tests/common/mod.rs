@@ -223,3 +223,32 @@ pub fn newton_matrix_fd_error(
     }
     (worst, scale)
 }
+
+/// The release events of a run: (time, normal force λ at the release, time tolerance).
+pub fn releases(r: &data::RunResult) -> Vec<(f64, f64, f64)> {
+    r.events
+        .iter()
+        .filter_map(|e| match e {
+            data::Event::Release {
+                t,
+                normal_force,
+                time_tolerance,
+                ..
+            } => Some((*t, *normal_force, *time_tolerance)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Every release located where the index-1 normal force crosses zero (event function at the end
+/// of the shortened step): 0 ≥ λ ≥ −FORCE_TOL·W (W the chain's weight), or a bracket at the time
+/// resolution (1e-13·max(t, 1) ≤ 1e-12 s here) where λ(h) is steeper than that.
+pub fn assert_releases_located(releases: &[(f64, f64, f64)], weight: f64) {
+    for (t, l, tt) in releases {
+        assert!(*l <= 0.0, "release at {t} with λ = {l}");
+        assert!(
+            l.abs() <= fem::contact::FORCE_TOL * weight || *tt <= 1e-12,
+            "release at {t}: λ = {l:.3e}, bracket {tt:.1e}"
+        );
+    }
+}
