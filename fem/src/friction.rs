@@ -70,12 +70,14 @@
 //! `contact1.slip_velocity` (v_t), `contact1.friction_force` (tangential force along t̂:
 //! −μ s|λ| sliding, λ_t sticking), `contact1.friction_work` (= ledger `friction`).
 //!
-//! **Measured** (`constrained-arm`, Euler model, 16 elements): ledger closure 4.3e-11, max |g|
+//! **Measured** (`constrained-arm`, Euler model, 16 elements): ledger closure 8.4e-11, max |g|
 //! 3.3e-16 m, ~100–150 switches in 2 s; θ(2 s) 7.57e-3 / 8.91e-3 / 9.35e-3 / 9.39e-3 rad at
-//! dt = 1e-3 / 5e-4 / 2.5e-4 / 1.25e-4 s (modal, polynomial basis, 6 modes: 9.45e-3);
+//! dt = 1e-3 / 5e-4 / 2.5e-4 / 1.25e-4 s (modal, polynomial basis, 6 modes: 9.45e-3): the wall
+//! load is carried by the axial field, so the default step resolves the first axial mode
+//! ([`crate::run::axial_wall_step`]: 1.25e-4 s here, against 1e-3 s from the bending rule);
 //! friction work 5.30e-3 J (modal 5.33e-3); switch times at dt = 2.5e-4 within ~1e-3 s of
-//! modal's (first stick 0.02477 / 0.02469 s). EI, EA ×1000: θ(2) = 3.744224 rad (rigid closed
-//! form 3.737974, modal 3.744224).
+//! modal's (first stick 0.02477 / 0.02469 s). EI, EA ×1000: θ(2) = 3.744241 rad (rigid closed
+//! form 3.737974, modal 3.744246).
 //!
 //! Refused: the inextensible link (no axial field) on the circle of radius L about its own hub
 //! (it can stay on that circle only straight: the rigid model, gradient G = 0 and λ undefined).

@@ -25,6 +25,26 @@ pub const DEFAULT_SAFETY: f64 = 0.9;
 /// `two-link-free` the joint angle at 2 s was 19 % off and the ledger closed to 0.15 only.
 pub const STEPS_PER_PERIOD: f64 = 40.0;
 
+/// Steps per period of the first axial mode of an extensible link whose tip is held by a
+/// bilateral wall (see [`axial_wall_step`]).
+pub const STEPS_PER_AXIAL_PERIOD: f64 = 16.0;
+
+/// Default-step bound for a bilateral wall on an extensible link: the wall load is carried by
+/// the link's axial field (both ends held: ω_ax = π·sqrt(EA/ρA)/L), which the bending rule
+/// alone leaves unresolved. Measured on `constrained-arm` (ω_ax = 3142 rad/s, bending rule 1 ms):
+/// θ(2 s) = 7.57e-3, 8.91e-3, 9.35e-3, 9.39e-3 rad at 2, 4, 8, 16 steps per axial period
+/// (1e-3 … 1.25e-4 s): 16 steps leave ~0.1 % (second order) against 19 % at the bending rule.
+pub fn axial_wall_step(scene: &Scene) -> Option<f64> {
+    let c = scene
+        .contacts
+        .iter()
+        .find(|c| c.mode == data::scene::ContactMode::Bilateral)?;
+    let link = scene.links.iter().find(|l| l.name == c.link && l.axial)?;
+    let ea = link.axial_stiffness?;
+    let omega_ax = std::f64::consts::PI * (ea / link.mass_per_length).sqrt() / link.length;
+    Some(2.0 * std::f64::consts::PI / (STEPS_PER_AXIAL_PERIOD * omega_ax))
+}
+
 /// Root of tan x = tanh x near 3.93 (first flexible pinned-free eigenvalue), by bisection on
 /// sin x cosh x − cos x sinh x, scaled by e^{−x} to stay O(1).
 pub fn pinned_free_beta1() -> f64 {
@@ -196,7 +216,8 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
             beta1 * beta1 * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt()
         })
         .fold(0.0f64, f64::max);
-    let h_rule = 2.0 * std::f64::consts::PI / (STEPS_PER_PERIOD * omega1);
+    let h_rule = (2.0 * std::f64::consts::PI / (STEPS_PER_PERIOD * omega1))
+        .min(axial_wall_step(scene).unwrap_or(f64::INFINITY));
     let contact = Contact::from_scene(scene, &chain)?;
     if contact.is_some() {
         if method != Method::EnergyMidpoint {
@@ -566,5 +587,20 @@ mod default_step_tests {
         let x = clamped_free_beta1();
         assert!((x.cos() * x.cosh() + 1.0).abs() < 1e-12, "{x}");
         assert!(x > 1.87 && x < 1.88);
+    }
+
+    #[test]
+    fn sys_default_step_resolves_the_axial_mode_under_a_bilateral_wall() {
+        // constrained-arm: EA = 1e6, ρA = 1, L = 1 → ω_ax = π·1000 rad/s, 16 steps a period.
+        let scene = data::load_scene("constrained-arm").expect("catalog scene");
+        let h = axial_wall_step(&scene).expect("bilateral wall on an axial link");
+        assert!((h - 1.0 / 8000.0).abs() < 1e-15, "{h}");
+        let p = prepare(&scene, &Settings::default()).expect("prepare");
+        assert_eq!(p.h_nominal, 1.0 / 8000.0);
+        // No bilateral wall (unilateral Barhorst surface, free chains): the bending rule only.
+        for name in ["barhorst-case1", "single-link", "cantilever-axial"] {
+            let scene = data::load_scene(name).expect("catalog scene");
+            assert!(axial_wall_step(&scene).is_none(), "{name}");
+        }
     }
 }

@@ -124,7 +124,8 @@ fn elem_circle_gap_gradient_matches_finite_differences() {
 
 #[test]
 fn dyn_friction_arm_constraint_ledger_and_coulomb_law() {
-    // The scene itself (Euler model: axial field on), 8 elements, default step (1e-3 s).
+    // The scene itself (Euler model: axial field on), 8 elements, default step (1.25e-4 s:
+    // 16 steps per period of the axial mode that carries the wall load).
     // It slides at t = 0 (no normal load at rest), then sticks and slips many times.
     let scene = arm();
     let r = sim(&scene, &settings(8, None, None));
