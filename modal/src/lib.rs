@@ -62,6 +62,7 @@ pub mod error;
 pub mod integrate;
 pub mod model;
 pub mod modes;
+pub mod newton;
 pub mod rocket;
 pub mod setup;
 pub mod simulate;
