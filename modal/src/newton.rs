@@ -143,9 +143,9 @@ impl ChainNewton {
                 }
             }
         }
-        for i in 0..nf {
-            xv[i] = self.tmp[i];
-            xq[i] += c * self.tmp[i];
+        xv.copy_from_slice(&self.tmp);
+        for (q, v) in xq.iter_mut().zip(&self.tmp) {
+            *q += c * v;
         }
         for (r, v) in xw.iter_mut().enumerate().take(self.ns) {
             *v += c * dot(&self.p[r * nf..(r + 1) * nf], xv);
