@@ -27,6 +27,22 @@ pub trait OdeRhs {
     fn jacobian(&mut self, _t: f64, _y: &[f64], _jac: &mut [f64]) -> bool {
         false
     }
+    /// Structured linear algebra for implicit methods, preferred over [`Self::jacobian`]:
+    /// linearize at (t, y) and return `true` if supported. Then [`Self::newton_factor`]
+    /// factors I − c·J of that linearization and [`Self::newton_solve`] applies its inverse.
+    /// Meant for systems whose Jacobian is cheap and well conditioned in factored form but not
+    /// as a dense matrix (the modal chain: M(q)⁻¹K has entries ~10¹⁴ in the polynomial
+    /// coordinates while M + cD + c²K factors stably).
+    fn newton_linearize(&mut self, _t: f64, _y: &[f64]) -> bool {
+        false
+    }
+    /// Factors I − c·J of the last linearization; `false` if it cannot (the caller falls back
+    /// to a dense Jacobian).
+    fn newton_factor(&mut self, _c: f64) -> bool {
+        false
+    }
+    /// x ← (I − c·J)⁻¹ x with the last factorization.
+    fn newton_solve(&mut self, _x: &mut [f64]) {}
 }
 
 /// Mixed error tolerance: component i is scaled by atol + rtol·max(|yᵢ(t)|, |yᵢ(t+h)|).
@@ -54,6 +70,9 @@ pub struct StepStats {
     pub jacobian_evals: usize,
     pub factorizations: usize,
     pub newton_iters: usize,
+    /// Implicit methods: rejected attempts whose Newton iteration failed (diverged, converged
+    /// too slowly, or went non-finite); the rest of `rejected` failed the error test.
+    pub newton_failures: usize,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Error)]

@@ -1,5 +1,6 @@
 //! TR-BDF2: an L-stable, stiffly accurate ESDIRK method of order 2 with an embedded
-//! 3rd-order estimate (Hosea & Shampine 1996), simplified Newton with a dense LU (faer).
+//! 3rd-order estimate (Hosea & Shampine 1996), simplified Newton on one factorization of
+//! I − h d J shared by both implicit stages.
 //!
 //! Tableau (γ = 2 − √2, d = γ/2, w = √2/4):
 //! ```text
@@ -10,6 +11,61 @@
 //!     |  w  w  d        (stiffly accurate: y₁ = z₃)
 //!     | (1−w)/3  (3w+1)/3  d/3   (embedded, order 3)
 //! ```
+//!
+//! **Linear algebra.** In order of preference: the right-hand side's own factored iteration
+//! matrix ([`OdeRhs::newton_linearize`], the modal chain's Cholesky of M + cD + c²K, see
+//! [`crate::newton`]); a dense LU (faer) of its analytic Jacobian ([`OdeRhs::jacobian`]);
+//! a dense LU of forward differences (dim extra evaluations).
+//!
+//! **Newton control** (Hairer & Wanner, *Solving ODEs II*, IV.8): rate θ, η = θ/(1 − θ),
+//! converged at η‖Δz‖ ≤ 0.03 (error-tolerance units), the first update judged with the
+//! previous η; divergence at θ ≥ 0.99, early failure when η‖Δz‖θ^left ≥ 0.03. After a failure
+//! an old Jacobian is refreshed and the same step retried; with a fresh one h is halved
+//! (divergence) or cut by 0.8·ratio^(−1/(4+left)) (too slow). A cheap (analytic or
+//! factored) Jacobian is also refreshed after any step whose rate exceeded 0.1; a difference
+//! Jacobian only on failure. [`Sdirk::state_changed`] (a projection moved y, f unchanged) keeps
+//! Jacobian and factorization; [`Sdirk::reset`] (discontinuity) drops them.
+//!
+//! **Noise floor.** An iteration that stops contracting (θ ≥ 0.99 or too slow) from its second
+//! update on, with its last two updates both ≤ 1 error-tolerance unit, is accepted: the stage
+//! is then within the tolerance and the error test judges the step. Measured on
+//! `barhorst-case1-tipmass` (poly basis, rtol 1e-6, atol 1e-8): right after the impact,
+//! perturbing a stage value by 4 ulps moves the Newton update by 1e-2–1e-1 tolerance units at
+//! 16 modes per link and ~1–3 at 20 — the evaluation's round-off (M(q) has condition
+//! 10¹³–10¹⁷ at 12–24 modes in the polynomial coordinates: a hub rotation undone by the
+//! clamped polynomials carries almost no kinetic energy), not a Jacobian error (the spectral
+//! radius of the simplified-Newton error operator with the structured Jacobian, against
+//! central differences, was 1e-9–1e-5 at those points). In stiff directions that noise does
+//! not shrink with h, so rejecting such iterations cut h to 1e-11 s without ever converging.
+//! Where the floor exceeds the tolerance (20–24 modes at atol ≤ 1e-8 after the impact, or at
+//! atol 1e-9–1e-10 before it) the steps stay small: choose atol above the floor. The error
+//! test has the same limit and no cure here: a stage's noise δz in a stiff component enters the
+//! estimate as h·E·δz/(hd), independent of h, and the (I − hdJ)⁻¹ filter damps it only once
+//! hd|λ| ≫ 1, so a rejection makes the next estimate *worse*; right after the impact at 24
+//! modes (|f| ~ 1e10) h went to 1e-14 s at atol 1e-8 (free flight to 0.28 s took 12 s, the
+//! first 50 ns after the impact over a minute). Only better-conditioned coordinates would
+//! remove the floor.
+//!
+//! **Measured** (that scene, rtol 1e-6, atol 1e-8, t_end 0.29 s: free flight to the impact at
+//! 0.2835 s, then 6.5 ms sliding on the surface with a drift projection after every step).
+//! Before (forward-difference Jacobian; a full reset after each projection, so one Jacobian
+//! per constrained step; first iterate accepted only at ‖Δz‖ ≤ 3e-5, later ones on the plain
+//! ratio; h/4 after a failure) the free flight cost ~2700 steps and 1–2 Jacobians at 12–20
+//! modes and everything else happened after the impact: 14 modes 2339 Newton divergences
+//! *with a fresh Jacobian* (forward-difference columns off by O(1)–5× against central
+//! differences: increments 1.5e-10 against f's round-off).
+//!
+//! | modes | before: wall, steps, rejected, Jacobians | after: wall, steps, rejected (Newton), Jacobians | first impulse after |
+//! | --- | --- | --- | --- |
+//! | 12 | 7.5 s, 5901, 484, 3189 | 1.6 s, 5837, 441 (9), 9 | 2.68064526 |
+//! | 14 | 23 s, 8305, 2836, 5601 | 3.1 s, 6197, 540 (11), 17 | 2.62835256 |
+//! | 16 | 730 s, 114 780, 123 549, — | 5.6 s, 6662, 990 (74), 303 | 2.59256634 |
+//! | 20 | — | 56 s, 22 716, 12 324 (7938), 17 066 | 2.54810473 |
+//! | 24 | — | 554 s, 117 650, 73 793 (43 860), 105 927 | 2.52257135 |
+//!
+//! At atol 1e-6 (above the floor): 24 modes 50 s, 10 880 steps, first impulse 2.52253906
+//! (1.3e-5 from atol 1e-8). 12 modes against Dormand–Prince (2.680647262): 7.5e-7 at
+//! rtol 1e-6, 3.5e-8 at rtol 1e-8 / atol 1e-10.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::{factor, solve};
@@ -32,8 +88,60 @@ const E3: f64 = 2.0 * D / 3.0;
 
 const SAFETY: f64 = 0.9;
 const MAX_NEWTON: usize = 8;
-/// Newton stops when the scaled update is below this fraction of the error tolerance.
+/// Newton stops when the estimated iteration error η‖Δz‖ is below this fraction of the error
+/// tolerance (η = θ/(1 − θ), θ the observed contraction rate).
 const NEWTON_TOL: f64 = 0.03;
+/// A contraction rate at or above this is divergence.
+const THETA_DIVERGE: f64 = 0.99;
+/// An analytic Jacobian is refreshed at the next step once a step's rate exceeded this.
+const THETA_REFRESH: f64 = 0.1;
+/// Noise-floor acceptance: an iteration that stops contracting at update index ≥ this (0-based:
+/// from the second update on) while its last two updates are both at most [`NOISE_ACCEPT`] (in
+/// units of the error tolerance) is taken as converged.
+const NOISE_ITERS: usize = 1;
+const NOISE_ACCEPT: f64 = 1.0;
+
+/// Why a stage's Newton iteration was abandoned.
+#[derive(Debug, Clone, Copy)]
+enum NewtonFail {
+    /// Non-finite update or θ ≥ [`THETA_DIVERGE`] (or the iteration budget ran out).
+    Diverged,
+    /// Contracting, but the predicted error after the remaining iterations, η‖Δz‖θ^left,
+    /// is `ratio` times the Newton tolerance.
+    Slow { ratio: f64, left: usize },
+}
+
+/// The iteration matrix I − h d J: factored by the right-hand side ([`OdeRhs::newton_factor`])
+/// or as a dense LU of the Jacobian.
+struct IterationMatrix {
+    structured: bool,
+    lu: Mat<f64>,
+    perm_fwd: Vec<usize>,
+    perm_inv: Vec<usize>,
+    mem: MemBuffer,
+}
+
+impl IterationMatrix {
+    /// x ← (I − h d J)⁻¹ x.
+    fn solve<F: OdeRhs>(&mut self, f: &mut F, x: &mut [f64]) {
+        if self.structured {
+            f.newton_solve(x);
+            return;
+        }
+        let n = x.len();
+        let perm = PermRef::new_checked(&self.perm_fwd, &self.perm_inv, n);
+        let rhs = MatMut::from_column_major_slice_mut(x, n, 1);
+        solve::solve_in_place_with_conj(
+            self.lu.as_ref(),
+            self.lu.as_ref(),
+            perm,
+            Conj::No,
+            rhs,
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+        );
+    }
+}
 
 /// Implicit adaptive TR-BDF2 integrator (see the module docs).
 pub struct Sdirk {
@@ -54,12 +162,17 @@ pub struct Sdirk {
     /// Jacobian is from the current step's start point.
     jac_fresh: bool,
     have_jac: bool,
-    /// Iteration matrix I − h d J (LU factors in place) and the h it was built for.
-    lu: Mat<f64>,
+    /// The right-hand side supplied the Jacobian ([`OdeRhs::jacobian`]): cheap to refresh.
+    jac_analytic: bool,
+    /// Start the next step with a fresh Jacobian (the last one contracted slowly).
+    jac_refresh: bool,
+    /// η = θ/(1 − θ) of the last Newton iteration, carried to the next stage's first test.
+    eta: f64,
+    /// Largest contraction rate θ observed in the current step's iterations.
+    theta_step: f64,
+    /// Iteration matrix I − h d J and the h it was built for.
+    iter: IterationMatrix,
     lu_h: f64,
-    perm_fwd: Vec<usize>,
-    perm_inv: Vec<usize>,
-    mem: MemBuffer,
     // Dense output (cubic Hermite).
     t_prev: f64,
     h_last: f64,
@@ -93,11 +206,18 @@ impl Sdirk {
             jac: vec![0.0; dim * dim],
             jac_fresh: false,
             have_jac: false,
-            lu: Mat::zeros(dim, dim),
+            jac_analytic: false,
+            jac_refresh: false,
+            eta: 1.0,
+            theta_step: 0.0,
+            iter: IterationMatrix {
+                structured: false,
+                lu: Mat::zeros(dim, dim),
+                perm_fwd: vec![0; dim],
+                perm_inv: vec![0; dim],
+                mem,
+            },
             lu_h: f64::NAN,
-            perm_fwd: vec![0; dim],
-            perm_inv: vec![0; dim],
-            mem,
             t_prev: 0.0,
             h_last: 0.0,
             y_prev: z(),
@@ -114,78 +234,96 @@ impl Sdirk {
         self.h_last
     }
 
+    /// The state was moved outside the integrator by a small amount (a projection onto a
+    /// constraint manifold) while the right-hand side stayed the same: forget the FSAL stage,
+    /// keep the Jacobian and its factorization.
+    pub fn state_changed(&mut self) {
+        self.have_f1 = false;
+    }
+
     /// Forget the FSAL stage and the Jacobian (after a discontinuity).
     pub fn reset(&mut self) {
         self.have_f1 = false;
         self.have_jac = false;
         self.lu_h = f64::NAN;
+        self.eta = 1.0;
     }
 
     fn update_jacobian<F: OdeRhs>(&mut self, f: &mut F, t: f64, y: &[f64]) {
-        let n = y.len();
         self.stats.jacobian_evals += 1;
-        if !f.jacobian(t, y, &mut self.jac) {
-            // Forward differences around (t, y) with f(t, y) = f1.
-            self.work.copy_from_slice(y);
-            for j in 0..n {
-                let yj = y[j];
-                let dy = f64::EPSILON.sqrt()
-                    * yj.abs()
-                        .max(self.tol.atol / self.tol.rtol.max(1e-300))
-                        .max(1e-8);
-                self.work[j] = yj + dy;
-                f.eval(t, &self.work, &mut self.delta);
-                self.stats.rhs_evals += 1;
-                for i in 0..n {
-                    self.jac[j * n + i] = (self.delta[i] - self.f1[i]) / dy;
-                }
-                self.work[j] = yj;
-            }
+        self.iter.structured = f.newton_linearize(t, y);
+        self.jac_analytic = self.iter.structured || f.jacobian(t, y, &mut self.jac);
+        if !self.jac_analytic {
+            self.difference_jacobian(f, t, y);
         }
         self.have_jac = true;
         self.jac_fresh = true;
+        self.jac_refresh = false;
         self.lu_h = f64::NAN;
     }
 
-    fn factorize(&mut self, h: f64) {
+    /// Forward differences around (t, y) with f(t, y) = f1.
+    fn difference_jacobian<F: OdeRhs>(&mut self, f: &mut F, t: f64, y: &[f64]) {
+        let n = y.len();
+        self.work.copy_from_slice(y);
+        for j in 0..n {
+            let yj = y[j];
+            let dy = f64::EPSILON.sqrt()
+                * yj.abs()
+                    .max(self.tol.atol / self.tol.rtol.max(1e-300))
+                    .max(1e-8);
+            self.work[j] = yj + dy;
+            f.eval(t, &self.work, &mut self.delta);
+            self.stats.rhs_evals += 1;
+            for i in 0..n {
+                self.jac[j * n + i] = (self.delta[i] - self.f1[i]) / dy;
+            }
+            self.work[j] = yj;
+        }
+    }
+
+    /// Factors I − h d J. A structured factorization that fails (the right-hand side's
+    /// matrix is not definite) falls back to the dense Jacobian at the step start (t, y).
+    fn factorize<F: OdeRhs>(&mut self, f: &mut F, t: f64, y: &[f64], h: f64) {
+        self.stats.factorizations += 1;
+        self.lu_h = h;
+        if self.iter.structured {
+            if f.newton_factor(h * D) {
+                return;
+            }
+            self.iter.structured = false;
+            if !f.jacobian(t, y, &mut self.jac) {
+                self.difference_jacobian(f, t, y);
+            }
+        }
         let n = self.f1.len();
         let hd = h * D;
         for j in 0..n {
             for i in 0..n {
                 let id = if i == j { 1.0 } else { 0.0 };
-                self.lu[(i, j)] = id - hd * self.jac[j * n + i];
+                self.iter.lu[(i, j)] = id - hd * self.jac[j * n + i];
             }
         }
         factor::lu_in_place(
-            self.lu.as_mut(),
-            &mut self.perm_fwd,
-            &mut self.perm_inv,
+            self.iter.lu.as_mut(),
+            &mut self.iter.perm_fwd,
+            &mut self.iter.perm_inv,
             Par::Seq,
-            MemStack::new(&mut self.mem),
+            MemStack::new(&mut self.iter.mem),
             Default::default(),
-        );
-        self.stats.factorizations += 1;
-        self.lu_h = h;
-    }
-
-    /// x ← (I − h d J)⁻¹ x.
-    fn lu_solve(lu: &Mat<f64>, fwd: &[usize], inv: &[usize], mem: &mut MemBuffer, x: &mut [f64]) {
-        let n = x.len();
-        let perm = PermRef::new_checked(fwd, inv, n);
-        let rhs = MatMut::from_column_major_slice_mut(x, n, 1);
-        solve::solve_in_place_with_conj(
-            lu.as_ref(),
-            lu.as_ref(),
-            perm,
-            Conj::No,
-            rhs,
-            Par::Seq,
-            MemStack::new(mem),
         );
     }
 
     /// Solves z = base + h d f(tz, z) by simplified Newton from the guess in `self.z`;
-    /// returns the stage derivative in `fout`. Err(()) on divergence.
+    /// returns the stage derivative in `f2` (`which` = 2) or `f3`.
+    ///
+    /// Convergence control after Hairer & Wanner (*Solving ODEs II*, IV.8): θ = ‖Δzₖ‖/‖Δzₖ₋₁‖
+    /// (geometric mean of the last two ratios from the third iterate on), η = θ/(1 − θ),
+    /// converged when η‖Δz‖ ≤ [`NEWTON_TOL`]; the first update is judged with the η of the
+    /// previous iteration (η ← max(η, ε)^0.8). Divergence: θ ≥ [`THETA_DIVERGE`]; too slow:
+    /// η‖Δz‖θ^left ≥ [`NEWTON_TOL`] (the remaining iterations cannot reach it). An iteration
+    /// that stalls from update [`NOISE_ITERS`] on with its last two updates ≤ [`NOISE_ACCEPT`]
+    /// is taken as converged to the evaluation's noise floor (see the module docs).
     fn newton<F: OdeRhs>(
         &mut self,
         f: &mut F,
@@ -193,10 +331,12 @@ impl Sdirk {
         h: f64,
         y_scale: &[f64],
         which: u8,
-    ) -> Result<(), ()> {
+    ) -> Result<(), NewtonFail> {
         let n = self.z.len();
         let hd = h * D;
-        let mut prev_norm = f64::INFINITY;
+        self.eta = self.eta.max(f64::EPSILON).powf(0.8);
+        let mut prev_norm = 0.0;
+        let mut thq_old = 0.0;
         for it in 0..MAX_NEWTON {
             f.eval(tz, &self.z, &mut self.work);
             self.stats.rhs_evals += 1;
@@ -204,33 +344,45 @@ impl Sdirk {
             for i in 0..n {
                 self.delta[i] = self.rhs_base[i] + hd * self.work[i] - self.z[i];
             }
-            Self::lu_solve(
-                &self.lu,
-                &self.perm_fwd,
-                &self.perm_inv,
-                &mut self.mem,
-                &mut self.delta,
-            );
+            self.iter.solve(f, &mut self.delta);
             let mut acc = 0.0;
             for i in 0..n {
-                self.z[i] += self.delta[i];
-                let sc = self.tol.atol + self.tol.rtol * y_scale[i].abs().max(self.z[i].abs());
+                let sc = self.tol.atol
+                    + self.tol.rtol * y_scale[i].abs().max((self.z[i] + self.delta[i]).abs());
                 acc += (self.delta[i] / sc).powi(2);
             }
             let norm = (acc / n.max(1) as f64).sqrt();
             if !norm.is_finite() {
-                return Err(());
+                return Err(NewtonFail::Diverged);
             }
-            let rate = norm / prev_norm;
-            if it > 0 && rate >= 0.9 {
-                return Err(());
+            let mut converged = self.eta * norm <= NEWTON_TOL || norm <= 1e-12;
+            if it > 0 && !converged {
+                let thq = norm / prev_norm;
+                let theta = if it == 1 { thq } else { (thq * thq_old).sqrt() };
+                thq_old = thq;
+                self.theta_step = self.theta_step.max(theta);
+                let left = MAX_NEWTON - 1 - it;
+                let eta = theta / (1.0 - theta);
+                let ratio = eta * norm * theta.powi(left as i32) / NEWTON_TOL;
+                if theta >= THETA_DIVERGE || ratio >= 1.0 {
+                    if it >= NOISE_ITERS && norm <= NOISE_ACCEPT && prev_norm <= NOISE_ACCEPT {
+                        // Stalled within the error tolerance: the noise floor (module docs).
+                        self.eta = 1.0;
+                        converged = true;
+                    } else if theta >= THETA_DIVERGE {
+                        return Err(NewtonFail::Diverged);
+                    } else {
+                        return Err(NewtonFail::Slow { ratio, left });
+                    }
+                } else {
+                    self.eta = eta;
+                    converged = eta * norm <= NEWTON_TOL;
+                }
             }
-            let converged = if it == 0 {
-                norm <= 1e-3 * NEWTON_TOL
-            } else {
-                rate / (1.0 - rate) * norm <= NEWTON_TOL
-            };
-            if converged || norm <= 1e-12 {
+            for i in 0..n {
+                self.z[i] += self.delta[i];
+            }
+            if converged {
                 // Stage derivative from the stage relation (exact for the converged iterate).
                 let fout = if which == 2 {
                     &mut self.f2
@@ -242,9 +394,9 @@ impl Sdirk {
                 }
                 return Ok(());
             }
-            prev_norm = norm;
+            prev_norm = norm.max(f64::MIN_POSITIVE);
         }
-        Err(())
+        Err(NewtonFail::Diverged)
     }
 
     /// Advances one accepted step, never past `t_stop`.
@@ -290,34 +442,46 @@ impl Sdirk {
         h = h.min(self.h_max);
         let h_min = min_step(*t, span);
         self.jac_fresh = false;
-        if !self.have_jac {
+        if !self.have_jac || self.jac_refresh {
             self.update_jacobian(f, *t, y);
         }
+        self.theta_step = 0.0;
         loop {
             let (h_try, clipped) = clip_step(h, span, h_min, *t)?;
             if self.lu_h != h_try {
-                self.factorize(h_try);
+                self.factorize(f, *t, y, h_try);
             }
-            // Stage 2 (trapezoidal to t + γh).
+            // Stage 2 (trapezoidal to t + γh), predicted by the explicit Euler step. (The
+            // linearly implicit predictor y + (I − hdJ)⁻¹γh f₁ was measured worse on the
+            // contact chain: 173 against 15 Newton failures at 14 modes per link.)
             for i in 0..n {
                 self.rhs_base[i] = y[i] + h_try * D * self.f1[i];
                 self.z[i] = y[i] + GAMMA * h_try * self.f1[i];
             }
-            let mut ok = self.newton(f, *t + GAMMA * h_try, h_try, y, 2).is_ok();
-            if ok {
+            let mut res = self.newton(f, *t + GAMMA * h_try, h_try, y, 2);
+            if res.is_ok() {
                 // Stage 3 (BDF2 to t + h), predicted by extrapolating the stage-2 slope.
                 for i in 0..n {
                     self.rhs_base[i] = y[i] + h_try * W * (self.f1[i] + self.f2[i]);
                     self.z[i] = self.rhs_base[i] + h_try * D * self.f2[i];
                 }
-                ok = self.newton(f, *t + h_try, h_try, y, 3).is_ok();
+                res = self.newton(f, *t + h_try, h_try, y, 3);
             }
-            if !ok {
+            if let Err(fail) = res {
                 self.stats.rejected += 1;
+                self.stats.newton_failures += 1;
                 if !self.jac_fresh {
+                    // A Jacobian from an earlier step: refresh it, retry the same step.
                     self.update_jacobian(f, *t, y);
                 } else {
-                    h = 0.25 * h_try;
+                    h = match fail {
+                        NewtonFail::Diverged => 0.5 * h_try,
+                        // Hairer & Wanner's reduction for an iteration that would not converge
+                        // within the budget: the rate scales like h.
+                        NewtonFail::Slow { ratio, left } => {
+                            0.8 * h_try * ratio.clamp(1e-4, 20.0).powf(-1.0 / (4.0 + left as f64))
+                        }
+                    };
                     if h < h_min {
                         return Err(IntegrateError::NewtonFailed { t: *t });
                     }
@@ -329,13 +493,7 @@ impl Sdirk {
                 self.err[i] = h_try * (E1 * self.f1[i] + E2 * self.f2[i] + E3 * self.f3[i]);
             }
             // Filter the estimate through (I − h d J)⁻¹: keeps it bounded on stiff components.
-            Self::lu_solve(
-                &self.lu,
-                &self.perm_fwd,
-                &self.perm_inv,
-                &mut self.mem,
-                &mut self.err,
-            );
+            self.iter.solve(f, &mut self.err);
             let err = error_norm(&self.tol, y, &self.y_new, &self.err);
             if !err.is_finite() {
                 self.stats.rejected += 1;
@@ -357,6 +515,8 @@ impl Sdirk {
                 f.eval(*t, y, &mut self.f1);
                 self.stats.rhs_evals += 1;
                 self.stats.steps += 1;
+                // A cheap (analytic) Jacobian is refreshed once the iteration slows down.
+                self.jac_refresh = self.jac_analytic && self.theta_step > THETA_REFRESH;
                 let mut h_next = h_try * fac;
                 // Keep the factorization when the change would be small.
                 if (0.9..=1.3).contains(&(h_next / h_try)) {

@@ -550,6 +550,74 @@ impl Chain {
         cholesky_substitute(&self.mff, self.free.len(), b);
     }
 
+    /// Tangents of the elastic, Kelvin–Voigt and joint spring/damper forces at q: writes
+    /// K_t = −∂F/∂q and D_t = −∂F/∂q̇ of those terms (N × N row-major, overwritten). They are
+    /// the stiff part of the force side: the bending block K, D of every link
+    /// ([`super::section`]), the axial stiffness K_a with the von Kármán tangent
+    /// (∂/∂a, ∂/∂b of ½Σ aₖ bᵀT3ₖ b + ⅛T4(b,b,b,b): T3ₖb couples a and b, Σ aₖT3ₖ + 3/2 G(b)
+    /// the b block), and the joint spring and damper of each free joint. Inertial (M(q), the
+    /// convective and centrifugal terms), gravity and contact terms are left out: they are
+    /// bounded by the rigid-body rates, not by the Ritz frequencies. No allocation.
+    pub fn elastic_tangent(&self, q: &[f64], kt: &mut [f64], dt: &mut [f64]) {
+        let n = self.n;
+        kt.iter_mut().for_each(|v| *v = 0.0);
+        dt.iter_mut().for_each(|v| *v = 0.0);
+        for (i, link) in self.links.iter().enumerate() {
+            let nbc = link.nbc();
+            let sec = &link.section;
+            for r in 0..nbc {
+                let row = link.b0 + r;
+                for c in 0..nbc {
+                    kt[row * n + link.b0 + c] = sec.kbc[r * nbc + c];
+                    if !sec.dbc.is_empty() {
+                        dt[row * n + link.b0 + c] = sec.dbc[r * nbc + c];
+                    }
+                }
+            }
+            let (na, nb) = (link.na(), link.nb());
+            if na > 0 {
+                let ints = &link.ints;
+                let a = &q[link.a0..link.a0 + na];
+                let b = &q[link.b0..link.b0 + nb];
+                let nn = nb * nb;
+                for r in 0..na {
+                    for c in 0..na {
+                        kt[(link.a0 + r) * n + link.a0 + c] = ints.ka[r * na + c];
+                    }
+                }
+                for k in 0..na {
+                    let t = &ints.t3[k * nn..(k + 1) * nn];
+                    for (p, row) in t.chunks_exact(nb).enumerate() {
+                        let tb = dot(row, b);
+                        kt[(link.a0 + k) * n + link.b0 + p] += tb;
+                        kt[(link.b0 + p) * n + link.a0 + k] += tb;
+                        for (m, &tv) in row.iter().enumerate() {
+                            kt[(link.b0 + p) * n + link.b0 + m] += a[k] * tv;
+                        }
+                    }
+                }
+                // 3/2 G with G_pm = Σ_ij b_i b_j T4_ijpm (T4 is fully symmetric).
+                for (ij, row) in ints.t4.chunks_exact(nn).enumerate() {
+                    let c = 1.5 * b[ij / nb] * b[ij % nb];
+                    if c != 0.0 {
+                        for p in 0..nb {
+                            let krow = &mut kt[(link.b0 + p) * n + link.b0..][..nb];
+                            for (kv, t) in krow.iter_mut().zip(&row[p * nb..(p + 1) * nb]) {
+                                *kv += c * t;
+                            }
+                        }
+                    }
+                }
+            }
+            let j = &self.joints[i];
+            if j.prescribed.is_none() {
+                let th = link.theta;
+                kt[th * n + th] += j.stiffness;
+                dt[th * n + th] += j.damping;
+            }
+        }
+    }
+
     /// M(q) of the last evaluation (row-major N × N).
     pub fn mass_matrix(&self) -> &[f64] {
         &self.mass
@@ -563,6 +631,14 @@ impl Chain {
 
 /// In-place Cholesky solve of the SPD system A x = b (A row-major n × n, overwritten).
 pub(crate) fn cholesky_solve(a: &mut [f64], n: usize, b: &mut [f64]) -> Result<(), SingularMass> {
+    cholesky_factor(a, n)?;
+    cholesky_substitute(a, n, b);
+    Ok(())
+}
+
+/// In-place Cholesky factorization A = L Lᵀ of the SPD matrix A (row-major n × n; L is left in
+/// the lower triangle).
+pub(crate) fn cholesky_factor(a: &mut [f64], n: usize) -> Result<(), SingularMass> {
     for j in 0..n {
         let mut d = a[j * n + j];
         for k in 0..j {
@@ -581,12 +657,11 @@ pub(crate) fn cholesky_solve(a: &mut [f64], n: usize, b: &mut [f64]) -> Result<(
             a[i * n + j] = s / d;
         }
     }
-    cholesky_substitute(a, n, b);
     Ok(())
 }
 
 /// Forward/back substitution with the lower Cholesky factor stored in `a` (row-major n × n).
-fn cholesky_substitute(a: &[f64], n: usize, b: &mut [f64]) {
+pub(crate) fn cholesky_substitute(a: &[f64], n: usize, b: &mut [f64]) {
     for i in 0..n {
         let mut s = b[i];
         for k in 0..i {

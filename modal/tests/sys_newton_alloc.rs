@@ -1,0 +1,65 @@
+//! TR-BDF2 on the modal chain performs no heap allocation per step (counting global
+//! allocator; a binary of its own so that no other test allocates meanwhile).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use modal::integrate::{Sdirk, Tolerances};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn sys_implicit_chain_steps_do_not_allocate() {
+    // TR-BDF2 on the modal chain goes through the factored Newton linear algebra
+    // (ChainRhs::newton_linearize / newton_factor / newton_solve): no allocation either.
+    faer::set_global_parallelism(faer::Par::Seq);
+    let scene = data::load_scene("barhorst-case1-tipmass").unwrap();
+    let disc = data::Discretization {
+        modes: Some(4),
+        ..Default::default()
+    };
+    let chain = modal::setup::build_chain(&scene, &disc).unwrap();
+    let mut f = modal::simulate::ChainRhs::new(chain);
+    let mut y = f.initial_state();
+    let dim = y.len();
+    let tol = Tolerances {
+        rtol: 1e-8,
+        atol: 1e-10,
+    };
+    let mut s = Sdirk::new(dim, tol, None, None);
+    let mut out = vec![0.0; dim];
+    let mut t = 0.0;
+    s.step(&mut f, &mut t, &mut y, 0.2).unwrap();
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    while t < 0.2 {
+        s.step(&mut f, &mut t, &mut y, 0.2).unwrap();
+        s.dense(t, &mut out);
+    }
+    s.state_changed();
+    s.step(&mut f, &mut t, &mut y, 0.25).unwrap();
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let st = *s.stats();
+    assert!(
+        st.steps > 50 && st.factorizations > 1 && st.jacobian_evals >= 1,
+        "{st:?}"
+    );
+    assert_eq!(
+        after - before,
+        0,
+        "Sdirk on the chain allocated during stepping"
+    );
+}
