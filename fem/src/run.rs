@@ -11,7 +11,7 @@ use data::{
 use crate::chain::{Chain, NONE};
 use crate::contact::Contact;
 use crate::error::FemError;
-use crate::integrator::{Adaptive, Integrator, StopReason};
+use crate::integrator::{Adaptive, Integrator, Rejection, StopReason};
 use crate::settings::{self, Method};
 use crate::support::check_planar;
 
@@ -242,6 +242,12 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
                 message: format!("the tip starts {:.3e} inside the surface", -c.gap),
             });
         }
+        if c.bilateral.is_none() {
+            // Impacts, releases and grazing contacts (crate::contact, crate::massless).
+            integ.enable_unilateral_contact()?;
+            // The integrator's operators are formed: no allocation at the first impact.
+            c.massless = integ.massless.as_deref().cloned();
+        }
         integ.contact = Some(Box::new(c));
         // Bilateral wall: on the surface from t = 0, initial Coulomb test (crate::friction).
         integ.bilateral_start()?;
@@ -411,6 +417,9 @@ fn ledger_terms(integ: &Integrator) -> (Vec<&'static str>, Vec<&'static str>, Ve
     if chain.links.iter().any(|l| l.kelvin_voigt > 0.0) {
         diss.push("kelvin_voigt");
     }
+    if integ.massless.as_deref().is_some_and(|m| m.project) {
+        diss.push("numerical_massless");
+    }
     match integ.contact.as_deref().map(|c| c.bilateral.as_deref()) {
         // A bilateral wall has no impacts or releases; friction work when μ > 0.
         Some(Some(b)) if b.has_friction() => diss.push("friction"),
@@ -446,10 +455,11 @@ fn push_ledger(integ: &Integrator, ledger: &mut EnergyLedger) {
             _ => w.prescribed_motion,
         };
     }
-    let mut diss = [0.0; 4];
+    let mut diss = [0.0; 6];
     for (k, term) in ledger.dissipation.iter().enumerate() {
         diss[k] = match term.name.as_str() {
             "joint_damper" => w.joint_damper,
+            "numerical_massless" => w.numerical_massless,
             "impact" => integ.contact.as_ref().map_or(0.0, |c| c.impact_loss),
             "contact_projection" => integ.contact.as_ref().map_or(0.0, |c| c.projection_loss),
             "friction" => integ
@@ -502,10 +512,16 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
                     events.push(Event::StepRejected {
                         t: integ.t,
                         dt: h_before,
-                        reason: if integ.adaptive.is_some() {
-                            "local error estimate above tolerance or Newton failure".into()
-                        } else {
-                            "Newton iteration failed; retried with a quarter step".into()
+                        reason: match (integ.last_rejection, integ.adaptive.is_some()) {
+                            (Rejection::ContactRefine, _) => {
+                                "grazing contact undetermined at this step; retried with a \
+                                 quarter step"
+                                    .into()
+                            }
+                            (_, true) => {
+                                "local error estimate above tolerance or Newton failure".into()
+                            }
+                            _ => "Newton iteration failed; retried with a quarter step".into(),
                         },
                     });
                 }
@@ -547,6 +563,11 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         sample(&integ, stations, &mut tips, &mut buf);
         obs.push(integ.t, &buf);
         push_ledger(&integ, &mut ledger);
+    }
+    if let Some(c) = integ.contact.as_deref_mut() {
+        // A release located at the last step is reported with the run.
+        c.flush_pending();
+        events.append(&mut c.events);
     }
     let c = integ.counters;
     let _ = h_nominal;

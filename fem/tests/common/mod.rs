@@ -242,12 +242,16 @@ pub fn releases(r: &data::RunResult) -> Vec<(f64, f64, f64)> {
 
 /// Every release located where the index-1 normal force crosses zero (event function at the end
 /// of the shortened step): 0 ≥ λ ≥ −FORCE_TOL·W (W the chain's weight), or a bracket at the time
-/// resolution (1e-13·max(t, 1) ≤ 1e-12 s here) where λ(h) is steeper than that.
+/// resolution (1e-13·max(t, 1) ≤ 1e-12 s here) where λ(h) is steeper than that — with λ still
+/// within 1e-6·W there (before the normal force was evaluated at the projected velocity, such
+/// brackets met jumps of λ up to 1.5e-5·W on `barhorst-case1`, and the grazing rule released
+/// at λ of −19 to −227 lbf with a zero bracket on `barhorst-case1-timoshenko`).
 pub fn assert_releases_located(releases: &[(f64, f64, f64)], weight: f64) {
     for (t, l, tt) in releases {
         assert!(*l <= 0.0, "release at {t} with λ = {l}");
         assert!(
-            l.abs() <= fem::contact::FORCE_TOL * weight || *tt <= 1e-12,
+            l.abs() <= fem::contact::FORCE_TOL * weight
+                || (*tt <= 1e-12 && l.abs() <= 1e-6 * weight),
             "release at {t}: λ = {l:.3e}, bracket {tt:.1e}"
         );
     }
