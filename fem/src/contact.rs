@@ -127,6 +127,7 @@
 //!   λ ≤ 0) and ends below it, with no flight above the gap tolerance at its end;
 //! * a constrained step whose start force is not positive and whose end force is not positive
 //!   either (no zero crossing to locate).
+//!
 //! Both are retried with a quarter step ([`Post::Refine`], event `step-rejected` "grazing
 //! contact undetermined at this step"), down to [`REFINE_MIN`] of the nominal step: shorter
 //! steps resolve the flight after a release (then a contact start located at a positive-gap
