@@ -36,9 +36,12 @@
 //!   the step falls (whole scene, 16 elements: 2.26, 2.84, 3.86 ft·lbf at 5e-4, 2.5e-4,
 //!   1.25e-4 s), while the sum of the two with the impact losses stays at 23.21, 23.17, 22.95
 //!   ft·lbf and the contact episodes move by ≤ 5e-4 of the time. The split is not a converged
-//!   quantity. (A backward-Euler half step from the midpoint onto the damped balance
-//!   Nᵀ(∇V + C q̇) = 0, which would not move it, was tried: not a discrete gradient either, it
-//!   fed energy into a growing mode within 1e-3 s of free fall at 8 elements, dt = 2.5e-5.)
+//!   quantity. (Tried and dropped: ending the step on the damped balance Nᵀ(∇V + C q̇) = 0 by a
+//!   backward-Euler half step from the midpoint, which would not move it — not a discrete
+//!   gradient, it fed energy into a growing mode within 1e-3 s of free fall at 8 elements,
+//!   dt = 2.5e-5; and the same target clamped so that the strain energy never rises (the point
+//!   between static and damped balance with V = V(q₁)) — the free flight after the first
+//!   contact episode then needed steps of 1e-6 s (Newton failures above), 8 elements.)
 //! * **Consistent rates**: the end rates along every exact direction are set from the balances
 //!   at the end state, Nᵀ(∇V(q₁) + C q̇₁ − Q) = 0, affine in q̇ (one solve with NᵀCN,
 //!   [`Massless::make_consistent`]); the kinetic energy does not change (M N = 0). The
