@@ -9,7 +9,7 @@ use crate::backend::{BackendKind, Settings};
 
 /// Standard observable channel names. Link and joint indices are 1-based, as in the papers.
 pub mod channel {
-    /// Joint angle θᵢ (frame angle of link i relative to its parent) [rad].
+    /// Joint angle θᵢ (frame angle of link i relative to its parent) \[rad\].
     pub fn joint_angle(i: usize) -> String {
         format!("joint{i}.angle")
     }

@@ -128,7 +128,7 @@
 //! * a constrained step whose start force is not positive and whose end force is not positive
 //!   either (no zero crossing to locate).
 //!
-//! Both are retried with a quarter step ([`Post::Refine`], event `step-rejected` "grazing
+//! Both are retried with a quarter step (`Post::Refine`, event `step-rejected` "grazing
 //! contact undetermined at this step"), down to [`REFINE_MIN`] of the nominal step: shorter
 //! steps resolve the flight after a release (then a contact start located at a positive-gap
 //! bracket) or the return to the surface. At the shortest step a free step that still enters
@@ -277,7 +277,7 @@ pub struct Contact {
     /// Largest |g| and |G q̇| at the ends of constrained steps (constraint drift).
     pub max_gap: f64,
     pub max_normal_velocity: f64,
-    /// Absolute event tolerances: gap [length] and normal force [force].
+    /// Absolute event tolerances: gap \[length\] and normal force \[force\].
     pub gap_tol: f64,
     pub force_tol: f64,
     /// Events since the driver last drained them, and the total count.

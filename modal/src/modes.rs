@@ -16,7 +16,7 @@ use faer::{Mat, Side};
 use crate::error::ModalError;
 use crate::setup::{Purpose, build_chain_for};
 
-/// Natural frequencies [Hz], ascending. A statically unstable (divergent) mode is reported as
+/// Natural frequencies \[Hz\], ascending. A statically unstable (divergent) mode is reported as
 /// −sqrt(−λ)/2π.
 pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, ModalError> {
     let wall = Instant::now();
@@ -150,7 +150,7 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
 }
 
 /// The same analysis with the hub joint turning at the constant rate Ω (overrides the scene's
-/// hub law): rotating-beam frequencies [Hz] for the λ studies.
+/// hub law): rotating-beam frequencies \[Hz\] for the λ studies.
 pub fn rotating_modes(
     scene: &Scene,
     settings: &Settings,

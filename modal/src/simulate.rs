@@ -359,7 +359,7 @@ impl OdeRhs for ChainRhs {
     /// ∂q̈/∂q = −P M⁻¹K_t, ∂q̈/∂q̇ = −P M⁻¹D_t with M = M(q) at y (its Cholesky factor from the
     /// evaluation), K_t, D_t the elastic/Kelvin–Voigt/joint tangents
     /// ([`Chain::elastic_tangent`]) and P the constraint projection of the contact phase
-    /// ([`constrain_column`]); the power rows are exact for the joint dampers (2dθ̇), the
+    /// (`constrain_column`); the power rows are exact for the joint dampers (2dθ̇), the
     /// Kelvin–Voigt dissipation (2Dẋ) and applied torques (τ(t)), zero for the prescribed-motion
     /// and friction powers. What it leaves out — ∂M/∂q·q̈, gravity, centrifugal and gyroscopic
     /// terms, the convective constraint terms — is bounded by the rigid-body rates, while the

@@ -83,10 +83,10 @@ pub struct Joint {
     /// Torsional damper D: torque −D θ̇.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub damping: Option<f64>,
-    /// Spring set-point θ₀ [rad].
+    /// Spring set-point θ₀ \[rad\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub set_point: Option<f64>,
-    /// Initial joint angle [rad].
+    /// Initial joint angle \[rad\].
     #[serde(default)]
     pub initial_angle: f64,
     /// Initial joint rate [rad/time].

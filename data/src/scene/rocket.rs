@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 pub struct Rocket {
     /// Standard gravity g used both as the field strength and to turn weights into masses.
     pub gravity: f64,
-    /// Launch angle θ₀ of the body axis from the horizontal [deg].
+    /// Launch angle θ₀ of the body axis from the horizontal \[deg\].
     pub launch_angle_deg: f64,
     /// Young's modulus E (same for both stages).
     pub youngs_modulus: f64,
@@ -24,7 +24,7 @@ pub struct Rocket {
     pub exit_pressure: f64,
     /// Port (flow) area A_f of the stage-1 grain.
     pub port_area: f64,
-    /// Nozzle misalignment angle γ [deg] (0 = aligned).
+    /// Nozzle misalignment angle γ \[deg\] (0 = aligned).
     #[serde(default)]
     pub nozzle_angle_deg: f64,
     /// Stages from aft to nose; the first one burns.

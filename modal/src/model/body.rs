@@ -11,7 +11,7 @@
 //!        + 2ω[−(Cb)ᵀȧ + (Φₓ + Cᵀa)ᵀḃ] + ȧᵀM_ψȧ + ḃᵀM_φḃ  (+ 2ΔT when f = 1)
 //!
 //! where ΔT = ½∫ρA[ω²s² + 2ω(vṡ − sv̇) + ṡ²] completes it to the exact kinetic energy of the
-//! inextensible link ([`exact_inextensible_terms`]; needs the tensors ∫ρA S⊗S and ∫ρA φ⊗S, so
+//! inextensible link (`exact_inextensible_terms`; needs the tensors ∫ρA S⊗S and ∫ρA φ⊗S, so
 //! a right-hand side costs O(n⁴) per link with foreshortening, O(n²) otherwise). The truncated
 //! form is not positive definite in the stiff direction "turn an inertia-free hub frame and
 //! counter-bend the link", which made two-link runs fail.

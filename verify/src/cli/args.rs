@@ -40,7 +40,7 @@ pub enum Command {
         #[command(flatten)]
         opts: CommonOpts,
     },
-    /// Linear static response to the scene's [statics] loads.
+    /// Linear static response to the scene's `[statics]` loads.
     Statics {
         scene: String,
         #[command(flatten)]
