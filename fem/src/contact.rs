@@ -80,7 +80,7 @@
 //! v′(0) = 0): the impact map is M Δq̇ = GᵀΛ + R_f with R_f = −μN_f N_fᵀΔq̇ the reaction that
 //! holds the frame directions' velocity. The momentum residual reported is that of this
 //! balance, ‖M Δq̇ − R_f − GᵀΛ‖/‖M Δq̇‖ (round-off; the μ-term vanishes on the exact
-//! directions). The reaction itself, ‖R_f‖/‖M Δq̇‖ ([`Contact::max_frame_reaction`]), is
+//! directions). The reaction itself, ‖R_f‖/‖M Δq̇‖, is
 //! not at round-off once the links are deflected: 5.4e-12 at the first impact, up to 5.6e-6 at
 //! later ones (4 elements, 0.3 s); it does work where the frame directions move, so the impact
 //! loss is booked as the evaluated kinetic energy difference (below). The same directions are
@@ -287,12 +287,6 @@ pub struct Contact {
     /// been stepped, and withdrawn when the tip turns out not to leave the surface (module
     /// docs, "Grazing").
     pending_release: Option<Event>,
-    /// Releases withdrawn that way, and grazing contacts released after the shortest step.
-    pub withdrawn_releases: usize,
-    pub grazing_releases: usize,
-    /// Largest reaction along the frame directions at an impact, relative to the momentum
-    /// change ‖M Δq̇ − GᵀΛ‖/‖M Δq̇‖ (module docs).
-    pub max_frame_reaction: f64,
     /// Bilateral contact (circle or line wall, Coulomb friction, stick–slip): None for the
     /// unilateral line contact of this module.
     pub bilateral: Option<Box<crate::friction::Bilateral>>,
@@ -386,9 +380,6 @@ impl Contact {
             events: Vec::new(),
             n_events: 0,
             pending_release: None,
-            withdrawn_releases: 0,
-            grazing_releases: 0,
-            max_frame_reaction: 0.0,
             bilateral,
             jac: vec![0.0; 2 * n],
             g_mid: z.clone(),
@@ -612,15 +603,6 @@ impl Contact {
         // closure to 4.7e-5 when the formula was booked).
         let ke_before = chain.energies(t, q, &velocity_before)[0];
         let loss = ke_before - chain.energies(t, q, qd)[0];
-        // Size of that reaction relative to the momentum change (diagnostic).
-        let mut react2 = 0.0;
-        for i in 0..n {
-            let r = self.col[i] - g_row[i] * impulse;
-            react2 += r * r;
-        }
-        if mom2 > 0.0 {
-            self.max_frame_reaction = self.max_frame_reaction.max((react2 / mom2).sqrt());
-        }
         self.impact_loss += loss;
         self.normal_velocity = dot(&g_row, qd);
         self.g_end = g_row;
@@ -928,9 +910,7 @@ impl Integrator {
                 return Ok((h, Post::Refine));
             }
             let mut c = self.contact.take().expect("contact");
-            if c.pending_release.take().is_some() {
-                c.withdrawn_releases += 1;
-            } else {
+            if c.pending_release.take().is_none() {
                 c.push(Event::ContactStart {
                     t: t0,
                     contact: 1,
@@ -1009,7 +989,6 @@ impl Integrator {
                     .into(),
             });
         }
-        c.grazing_releases += 1;
         Ok((h, Post::Release { time_tolerance: h }))
     }
 

@@ -26,7 +26,6 @@ use crate::band::{BorderedBand, DenseLu};
 use crate::chain::{Chain, NONE, NewtonCoefficients};
 use crate::contact::{Contact, Post};
 use crate::error::FemError;
-use crate::massless::Massless;
 use crate::midpoint::MidpointWork;
 use crate::settings::Method;
 
@@ -167,9 +166,6 @@ pub struct Integrator {
     pub midpoint: Option<Box<MidpointWork>>,
     /// The scene's tip contact (energy-midpoint only; None without contact, nothing allocated).
     pub contact: Option<Box<Contact>>,
-    /// Exactly massless directions, projected onto their balance and given consistent rates
-    /// after every step of a unilateral contact run ([`crate::massless`]; None otherwise).
-    pub massless: Option<Box<Massless>>,
     /// Why the last rejected step was rejected.
     pub last_rejection: Rejection,
     /// A unilateral tip contact is stepped (impacts, releases, grazing): the Newton matrix is
@@ -243,7 +239,6 @@ impl Integrator {
             length_scale,
             midpoint: None,
             contact: None,
-            massless: None,
             last_rejection: Rejection::Newton,
             unilateral_contact: false,
         };
@@ -262,25 +257,43 @@ impl Integrator {
         Ok(it)
     }
 
-    /// Switches on the stepping of a unilateral tip contact (energy-midpoint): the massless
-    /// directions (if any, with Kelvin–Voigt) are projected onto their balance and given
-    /// consistent rates after every step ([`crate::massless`]), and the Newton matrix and
-    /// iteration are those of `unilateral_contact`. Forms the operators here (nothing is
-    /// allocated in the step loop).
+    /// Switches on the stepping of the scene's unilateral tip contact (set in `self.contact`;
+    /// energy-midpoint): the contact's massless directions (if any, with Kelvin–Voigt) are
+    /// projected onto their balance and given consistent rates after every step
+    /// ([`crate::massless`]), and the Newton matrix and iteration are those of
+    /// `unilateral_contact`. Forms the operators here (nothing is allocated in the step loop).
     pub fn enable_unilateral_contact(&mut self) -> Result<(), FemError> {
         self.unilateral_contact = true;
-        if self.method == Method::EnergyMidpoint
-            && let Some(mut ml) = Massless::new(&self.chain)
-        {
-            self.counters.rhs += ml.form(&mut self.chain, self.t, &self.q);
-            if ml.damped(&mut self.chain, self.t, &self.q) {
-                ml.project = true;
-                self.counters.rhs +=
-                    ml.make_consistent(&mut self.chain, self.t, &self.q, &mut self.qd)?;
-            }
-            self.massless = Some(Box::new(ml));
+        if self.method != Method::EnergyMidpoint {
+            return Ok(());
+        }
+        let Some(ml) = self
+            .contact
+            .as_deref_mut()
+            .and_then(|c| c.massless.as_mut())
+        else {
+            return Ok(());
+        };
+        self.counters.rhs += ml.form(&mut self.chain, self.t, &self.q);
+        if ml.damped(&mut self.chain, self.t, &self.q) {
+            ml.project = true;
+            self.counters.rhs +=
+                ml.make_consistent(&mut self.chain, self.t, &self.q, &mut self.qd)?;
         }
         Ok(())
+    }
+
+    /// Rejects a fixed step of length `h`: the stretch is retried with a quarter step (grown
+    /// back afterwards). `restart` drops the midpoint predictor — where the stretch's start
+    /// state may have changed (an impact applied while locating an event).
+    fn retry_quarter_step(&mut self, h: f64, why: Rejection, restart: bool) -> StopReason {
+        self.counters.rejected += 1;
+        self.last_rejection = why;
+        self.h = 0.25 * h;
+        if restart && let Some(w) = self.midpoint.as_mut() {
+            w.restart();
+        }
+        StopReason::Rejected
     }
 
     /// Sets the next time the stepper must land on.
@@ -476,10 +489,7 @@ impl Integrator {
         match result {
             Ok(Some(err)) if self.adaptive.is_none() && err.is_infinite() => {
                 // Fixed step: Newton failed; retry this stretch with quarter steps, then grow back.
-                self.counters.rejected += 1;
-                self.last_rejection = Rejection::Newton;
-                self.h = 0.25 * h;
-                return Ok(StopReason::Rejected);
+                return Ok(self.retry_quarter_step(h, Rejection::Newton, false));
             }
             Ok(Some(err)) if self.adaptive.is_some() && err > 1.0 => {
                 self.counters.rejected += 1;
@@ -509,13 +519,7 @@ impl Integrator {
                                 && location.as_deref()
                                     != Some(crate::contact::GRAZING_LOCATION) =>
                         {
-                            self.counters.rejected += 1;
-                            self.last_rejection = Rejection::Newton;
-                            self.h = 0.25 * h;
-                            if let Some(w) = self.midpoint.as_mut() {
-                                w.restart();
-                            }
-                            return Ok(StopReason::Rejected);
+                            return Ok(self.retry_quarter_step(h, Rejection::Newton, true));
                         }
                         Err(e) => return Err(e),
                     }
@@ -525,13 +529,7 @@ impl Integrator {
                 if post == Post::Refine {
                     // The contact phase over this step is undetermined at this length
                     // (crate::contact, grazing): retry the stretch with a quarter step.
-                    self.counters.rejected += 1;
-                    self.last_rejection = Rejection::ContactRefine;
-                    self.h = 0.25 * h;
-                    if let Some(w) = self.midpoint.as_mut() {
-                        w.restart();
-                    }
-                    return Ok(StopReason::Rejected);
+                    return Ok(self.retry_quarter_step(h, Rejection::ContactRefine, true));
                 }
                 let (h, t1, t_law) = if h_acc < h {
                     on_break = false;

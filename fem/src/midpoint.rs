@@ -267,8 +267,41 @@ impl Integrator {
         let active = contact.as_deref_mut().filter(|c| c.constrained);
         let result = self.midpoint_solve(&mut w, active, h, t1, t_law);
         self.contact = contact;
+        // A converged fixed step (contact runs are fixed-step: run.rs refuses `rtol`).
+        let result = match result {
+            Ok(None) => self.end_on_massless_balance(&mut w, h, t1).map(|()| None),
+            other => other,
+        };
         self.midpoint = Some(w);
         result
+    }
+
+    /// Contact runs with massless section rotations ([`crate::massless`]): the end positions
+    /// projected onto their balance (strain energy removed booked), the end rates, which the
+    /// step does not determine, set from the balances, and the mean acceleration with them.
+    fn end_on_massless_balance(
+        &mut self,
+        w: &mut MidpointWork,
+        h: f64,
+        t1: f64,
+    ) -> Result<(), FemError> {
+        let Some(ml) = self
+            .contact
+            .as_deref_mut()
+            .and_then(|c| c.massless.as_mut())
+            .filter(|m| m.project)
+        else {
+            return Ok(());
+        };
+        let (removed, p) = ml.project_balance(&mut self.chain, t1, &mut self.q1);
+        w.pending.numerical_massless = removed;
+        self.counters.rhs +=
+            p + ml.make_consistent(&mut self.chain, t1, &self.q1, &mut self.qd1)?;
+        for i in 0..self.q1.len() {
+            self.qdd1[i] = (self.qd1[i] - self.qd[i]) / h;
+        }
+        self.a1.copy_from_slice(&self.qdd1);
+        Ok(())
     }
 
     fn midpoint_solve(
@@ -616,18 +649,6 @@ impl Integrator {
             let total = -dot(&w.minus_q, &w.dq);
             pending.applied_load =
                 total - pending.applied_torque + pending.joint_damper + pending.kelvin_voigt;
-        }
-        // Contact runs with massless section rotations (crate::massless): the end positions
-        // projected onto their balance (strain energy removed booked), the end rates, which the
-        // step does not determine, set from the balances, and the mean acceleration with them.
-        if let Some(ml) = self.massless.as_deref_mut().filter(|m| m.project) {
-            let (removed, p) = ml.project_balance(&mut self.chain, t1, &mut self.q1);
-            pending.numerical_massless = removed;
-            self.counters.rhs +=
-                p + ml.make_consistent(&mut self.chain, t1, &self.q1, &mut self.qd1)?;
-            for i in 0..n {
-                self.qdd1[i] = (self.qd1[i] - self.qd[i]) / h;
-            }
         }
         w.pending = pending;
         // q̈ slot holds the mean acceleration ā (predictor and error estimate of the next step).

@@ -242,13 +242,12 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
                 message: format!("the tip starts {:.3e} inside the surface", -c.gap),
             });
         }
-        if c.bilateral.is_none() {
+        let unilateral = c.bilateral.is_none();
+        integ.contact = Some(Box::new(c));
+        if unilateral {
             // Impacts, releases and grazing contacts (crate::contact, crate::massless).
             integ.enable_unilateral_contact()?;
-            // The integrator's operators are formed: no allocation at the first impact.
-            c.massless = integ.massless.as_deref().cloned();
         }
-        integ.contact = Some(Box::new(c));
         // Bilateral wall: on the surface from t = 0, initial Coulomb test (crate::friction).
         integ.bilateral_start()?;
     }
@@ -417,7 +416,12 @@ fn ledger_terms(integ: &Integrator) -> (Vec<&'static str>, Vec<&'static str>, Ve
     if chain.links.iter().any(|l| l.kelvin_voigt > 0.0) {
         diss.push("kelvin_voigt");
     }
-    if integ.massless.as_deref().is_some_and(|m| m.project) {
+    if integ
+        .contact
+        .as_deref()
+        .and_then(|c| c.massless.as_ref())
+        .is_some_and(|m| m.project)
+    {
         diss.push("numerical_massless");
     }
     match integ.contact.as_deref().map(|c| c.bilateral.as_deref()) {

@@ -211,9 +211,9 @@ fn dyn_case1_switches_with_located_releases_and_a_closed_ledger() {
         releases.len()
     );
     // Release (event function: the index-1 normal force λ at the end of the shortened step):
-    // 0 ≥ λ ≥ −1e-8·W (W the weight, 1.764 × 5 × 32.17), or a bracket at the time resolution
-    // (1e-13·max(t, 1)) where λ(h) is steeper than that.
-    common::assert_releases_located(&releases, 1.764 * 5.0 * 32.17);
+    // 0 ≥ λ ≥ −1e-8·W (W the weight), or a bracket at the time resolution (1e-13·max(t, 1))
+    // where λ(h) is steeper than that.
+    common::assert_releases_located(&releases, common::weight(&sc));
     let closure = r.ledger.relative_closure();
     assert!(closure <= 1e-5, "ledger closure {closure:.3e}");
     // Constraint drift: |g| at every sample in a constrained phase within the gap tolerance.
