@@ -163,6 +163,14 @@ impl ContactState {
         self.mu > 0.0
     }
 
+    /// μsσ of sliding friction at the last evaluation (s the sliding direction, σ = sign λ):
+    /// the tangential force −μs|λ| = −μsσλ rides on λ, so the contact force acts along
+    /// Gᵀ − μsσTᵀ.
+    pub fn sliding_friction_slope(&self) -> f64 {
+        let sigma = if self.lambda >= 0.0 { 1.0 } else { -1.0 };
+        self.mu * self.slip_dir * sigma
+    }
+
     /// Gap, unit normal, tangent and curvature at the tip position r.
     pub fn set_geometry(&mut self, r: [f64; 2]) {
         match self.wall {

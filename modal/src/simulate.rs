@@ -336,8 +336,7 @@ fn constrain_column(c: &ContactState, x: &mut [f64]) {
         }
     } else if c.bilateral && c.mu > 0.0 {
         let gmt = dot(&c.g_row, &c.minv_tt);
-        let sigma = if c.lambda >= 0.0 { 1.0 } else { -1.0 };
-        let ms = c.mu * c.slip_dir * sigma;
+        let ms = c.sliding_friction_slope();
         let a = gx / (c.gmg - ms * gmt);
         for k in 0..x.len() {
             x[k] -= (c.minv_gt[k] - ms * c.minv_tt[k]) * a;
@@ -439,8 +438,7 @@ impl OdeRhs for ChainRhs {
                 lin.rows = 2;
             } else if c.bilateral && c.mu > 0.0 {
                 // The friction force −μ s|λ| rides on λ (see `solve`): W = Gᵀ − μsσTᵀ.
-                let sigma = if c.lambda >= 0.0 { 1.0 } else { -1.0 };
-                let ms = c.mu * c.slip_dir * sigma;
+                let ms = c.sliding_friction_slope();
                 for k in 0..nf {
                     lin.w[k] -= ms * c.t_row[k];
                 }

@@ -95,10 +95,9 @@ const NEWTON_TOL: f64 = 0.03;
 const THETA_DIVERGE: f64 = 0.99;
 /// An analytic Jacobian is refreshed at the next step once a step's rate exceeded this.
 const THETA_REFRESH: f64 = 0.1;
-/// Noise-floor acceptance: an iteration that stops contracting at update index ≥ this (0-based:
-/// from the second update on) while its last two updates are both at most [`NOISE_ACCEPT`] (in
-/// units of the error tolerance) is taken as converged.
-const NOISE_ITERS: usize = 1;
+/// Noise-floor acceptance: an iteration that stops contracting (judged from the second update
+/// on) while its last two updates are both at most this (in units of the error tolerance) is
+/// taken as converged.
 const NOISE_ACCEPT: f64 = 1.0;
 
 /// Why a stage's Newton iteration was abandoned.
@@ -322,7 +321,7 @@ impl Sdirk {
     /// converged when η‖Δz‖ ≤ [`NEWTON_TOL`]; the first update is judged with the η of the
     /// previous iteration (η ← max(η, ε)^0.8). Divergence: θ ≥ [`THETA_DIVERGE`]; too slow:
     /// η‖Δz‖θ^left ≥ [`NEWTON_TOL`] (the remaining iterations cannot reach it). An iteration
-    /// that stalls from update [`NOISE_ITERS`] on with its last two updates ≤ [`NOISE_ACCEPT`]
+    /// that stalls from the second update on with its last two updates ≤ [`NOISE_ACCEPT`]
     /// is taken as converged to the evaluation's noise floor (see the module docs).
     fn newton<F: OdeRhs>(
         &mut self,
@@ -345,13 +344,10 @@ impl Sdirk {
                 self.delta[i] = self.rhs_base[i] + hd * self.work[i] - self.z[i];
             }
             self.iter.solve(f, &mut self.delta);
-            let mut acc = 0.0;
             for i in 0..n {
-                let sc = self.tol.atol
-                    + self.tol.rtol * y_scale[i].abs().max((self.z[i] + self.delta[i]).abs());
-                acc += (self.delta[i] / sc).powi(2);
+                self.z[i] += self.delta[i];
             }
-            let norm = (acc / n.max(1) as f64).sqrt();
+            let norm = error_norm(&self.tol, y_scale, &self.z, &self.delta);
             if !norm.is_finite() {
                 return Err(NewtonFail::Diverged);
             }
@@ -365,7 +361,7 @@ impl Sdirk {
                 let eta = theta / (1.0 - theta);
                 let ratio = eta * norm * theta.powi(left as i32) / NEWTON_TOL;
                 if theta >= THETA_DIVERGE || ratio >= 1.0 {
-                    if it >= NOISE_ITERS && norm <= NOISE_ACCEPT && prev_norm <= NOISE_ACCEPT {
+                    if norm <= NOISE_ACCEPT && prev_norm <= NOISE_ACCEPT {
                         // Stalled within the error tolerance: the noise floor (module docs).
                         self.eta = 1.0;
                         converged = true;
@@ -378,9 +374,6 @@ impl Sdirk {
                     self.eta = eta;
                     converged = eta * norm <= NEWTON_TOL;
                 }
-            }
-            for i in 0..n {
-                self.z[i] += self.delta[i];
             }
             if converged {
                 // Stage derivative from the stage relation (exact for the converged iterate).
