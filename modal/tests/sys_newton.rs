@@ -104,8 +104,16 @@ fn sys_structured_jacobian_is_exact_at_rest_free_and_constrained() {
 
 #[test]
 fn sys_factored_newton_solve_solves_the_dense_system() {
-    for constrained in [false, true] {
-        let (mut rhs, y) = rest_rhs(4, constrained);
+    // At rest, and at a moving, deflected state (joint rates and modal velocities nonzero:
+    // the power rows 2dθ̇ of the joint dampers and the velocity-dependent terms enter both the
+    // dense J and the factored path).
+    for (constrained, moving) in [(false, false), (true, false), (false, true), (true, true)] {
+        let (mut rhs, mut y) = rest_rhs(4, constrained);
+        if moving {
+            for (i, v) in y.iter_mut().enumerate() {
+                *v = 1e-2 * ((i + 1) as f64).sin();
+            }
+        }
         let n = y.len();
         let j = structured_jacobian(&mut rhs, &y);
         assert!(rhs.newton_linearize(0.0, &y));
@@ -127,7 +135,7 @@ fn sys_factored_newton_solve_solves_the_dense_system() {
             // formula gives O(1) residuals, round-off ~1e-9 relative.
             assert!(
                 worst < 1e-7 * scale,
-                "constrained {constrained}, c {c}: residual {worst:.3e}"
+                "constrained {constrained}, moving {moving}, c {c}: residual {worst:.3e}"
             );
         }
     }
