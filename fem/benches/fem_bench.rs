@@ -1,7 +1,8 @@
 //! Criterion benches: assembly (residual + Newton matrix), one generalized-α step, the full
 //! 20 s spin-up for 4–64 elements, and the full 3 s `single-link` run at default settings with
-//! energy-midpoint (the default there) and generalized-α.
-//! Run: `CARGO_TARGET_DIR=/work/targets/fem cargo bench -p fem --bench fem_bench -- --quick`
+//! energy-midpoint (the default there) and generalized-α; whole default runs of the arms
+//! (`two-link-free-undamped` 10 s, `barhorst-case1` 3 s).
+//! Run: `cargo bench -p fem --bench fem_bench -- --quick` (one group: append its name, e.g. `arms`).
 
 use std::hint::black_box;
 
@@ -88,5 +89,20 @@ fn single_link(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, assembly, one_step, spin_up, single_link);
+/// The seed scenes at default settings, whole runs: the free two-link arm (10 s) and the
+/// Barhorst impact case (3 s). These set the cost a user meets on the arms.
+fn arms(c: &mut Criterion) {
+    let mut g = c.benchmark_group("arms-default");
+    g.sample_size(10);
+    for name in ["two-link-free-undamped", "barhorst-case1"] {
+        let sc = data::load_scene(name).unwrap();
+        let st = Settings::default();
+        g.bench_function(name, |b| {
+            b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, assembly, one_step, spin_up, single_link, arms);
 criterion_main!(benches);

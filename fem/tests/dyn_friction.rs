@@ -380,54 +380,6 @@ fn dyn_friction_refusals() {
     }
 }
 
-/// Rigid-limit errors over the full 2 s (4 elements; ×1000 takes ~5 s).
-#[test]
-#[ignore = "exploration: cargo test --release -p fem --test dyn_friction dyn_friction_explore -- --ignored --nocapture"]
-fn dyn_friction_explore() {
-    let base = arm();
-    for scale in [10.0, 100.0, 1000.0] {
-        rigid_error(&base, scale, 4, 2.0);
-    }
-}
-
-/// Samples of the pendulum's stuck phase (env DT, NE, MU): the micro-slips at the axial
-/// period with μ = 0.2.
-#[test]
-#[ignore = "exploration: DT=1e-4 MU=0.2 cargo test --release -p fem --test dyn_friction explore_pendulum -- --ignored --nocapture"]
-fn dyn_friction_explore_pendulum() {
-    let mut scene = arm();
-    pendulum(&mut scene);
-    scene.simulation.output_interval = 5e-4;
-    let dt: f64 = std::env::var("DT")
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(5e-4);
-    let ne: usize = std::env::var("NE").map(|s| s.parse().unwrap()).unwrap_or(4);
-    if let Ok(m) = std::env::var("MU") {
-        scene.contacts[0].friction = m.parse().unwrap();
-    }
-    let r = sim(&scene, &settings(ne, Some(dt), Some(1.0)));
-    let (nf, ft, vt, ph) = (
-        channel(&r, "contact1.normal_force"),
-        channel(&r, FRICTION_FORCE_CHANNEL),
-        channel(&r, SLIP_VELOCITY_CHANNEL),
-        channel(&r, "contact1.phase"),
-    );
-    for k in 0..nf.len() {
-        let t = r.observables.time[k];
-        if t > 0.88 && t < 0.95 {
-            println!(
-                "{t:.4} ph {} N {:.5} Ft {:.5} ratio {:.4} vt {:.3e}",
-                ph[k],
-                nf[k],
-                ft[k],
-                ft[k] / nf[k],
-                vt[k]
-            );
-        }
-    }
-    println!("{:?}", stick_slips(&r));
-}
-
 /// Bilateral straight line through the tip, inclined 45° to the link (normal and tangent both
 /// mix the axial and the hub/bending directions).
 fn inclined(mu: f64) -> Scene {

@@ -158,32 +158,3 @@ fn dyn_midpoint_adaptive_step_meets_its_tolerance() {
     // 1414 rejected steps; the step controller is generalized-α's, which rejects as often).
     assert!(c < 1e-9, "closure {c}");
 }
-
-/// Cost study against generalized-α at default settings (prints numbers for the report).
-/// Run: `CARGO_TARGET_DIR=/work/targets/fem cargo test --release -p fem --test dyn_midpoint
-/// study_midpoint_cost -- --ignored --nocapture --test-threads=1`
-#[test]
-#[ignore]
-fn study_midpoint_cost() {
-    for name in ["single-link", "two-link-free", "two-link-free-undamped"] {
-        let sc = data::load_scene(name).unwrap();
-        for m in ["energy-midpoint", "generalized-alpha"] {
-            let t0 = std::time::Instant::now();
-            let r = FemBackend
-                .simulate(&sc, &settings(None, None, None, m))
-                .unwrap();
-            let c = r.cost;
-            eprintln!(
-                "{name} {m}: closure {:.3e}, steps {}, Newton/step {:.2}, passes/step {:.1}, \
-                 factorizations {}, wall {:.2} s ({:.1} µs/step)",
-                r.ledger.relative_closure(),
-                c.steps,
-                c.newton_iterations as f64 / c.steps as f64,
-                c.rhs_evaluations as f64 / c.steps as f64,
-                c.factorizations,
-                t0.elapsed().as_secs_f64(),
-                1e6 * t0.elapsed().as_secs_f64() / c.steps as f64
-            );
-        }
-    }
-}

@@ -326,35 +326,3 @@ fn dyn_cantilever_step_load_overshoots_the_static_deflection() {
         r.ledger.relative_closure()
     );
 }
-
-/// Accuracy/cost study of the benchmark target (not a check; prints numbers for the report).
-/// Run: `CARGO_TARGET_DIR=/work/targets/fem cargo test --release -p fem --test dyn_runs
-/// study_spin_up_accuracy -- --ignored --nocapture`
-#[test]
-#[ignore]
-fn study_spin_up_accuracy() {
-    let fine_dt = run("spin-up", 8, Some(1e-4), None, None).unwrap();
-    let fine_mesh = run("spin-up", 64, Some(1e-4), None, None).unwrap();
-    for name in ["spin-up", "spin-up-axial"] {
-        let t0 = std::time::Instant::now();
-        let r = run(name, 8, Some(1e-2), None, None).unwrap();
-        let wall = t0.elapsed();
-        let tip = channel(&r, "link1.tip_deflection");
-        let d = |x: &RunResult| {
-            tip.iter()
-                .zip(channel(x, "link1.tip_deflection"))
-                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
-        };
-        let p = peak(channel(&fine_mesh, "link1.tip_deflection"));
-        eprintln!(
-            "{name}: 8 el, dt 1e-2: wall {wall:?} (cost.wall {:.4} s), peak {:.6}; max |Δ| vs spin-up (foreshortening) 8 el dt 1e-4: {:.3e} ({:.2e} of peak), vs 64 el dt 1e-4: {:.3e} ({:.2e} of peak); {:?}",
-            r.cost.wall_time_s,
-            peak(tip),
-            d(&fine_dt),
-            d(&fine_dt) / p,
-            d(&fine_mesh),
-            d(&fine_mesh) / p,
-            r.cost
-        );
-    }
-}

@@ -506,42 +506,6 @@ fn dyn_timoshenko_undamped_massless_hub_defaults_to_generalized_alpha() {
 }
 
 #[test]
-#[ignore]
-fn study_undamped() {
-    // Run with: cargo test --release -p fem --test dyn_timoshenko -- --ignored --nocapture study_undamped
-    for (name, hub, kv, method) in [
-        (
-            "two-link-free-undamped",
-            0.0,
-            0.0,
-            Some("generalized-alpha"),
-        ),
-        ("two-link-free-undamped", 1e-2, 0.0, None),
-        ("two-link-free-undamped", 0.0, 0.2, None),
-        ("two-link-free", 0.0, 0.2, Some("generalized-alpha")),
-    ] {
-        for dt in [None, Some(1e-4), Some(3e-5)] {
-            let mut sc = data::load_scene(name).unwrap();
-            make_timoshenko(&mut sc, 100.0, 0.0);
-            for l in sc.links.iter_mut() {
-                l.kelvin_voigt = (kv > 0.0).then_some(kv);
-                l.joint.hub_inertia = (hub > 0.0).then_some(hub);
-            }
-            let mut st = settings(4, dt, 0.5, method);
-            st.time.method = method.map(str::to_string);
-            let r = FemBackend.simulate(&sc, &st).unwrap();
-            eprintln!(
-                "{name} hub {hub} kv {kv} {method:?} dt {dt:?}: {:?} closure {:.2e} steps {} rejected {}",
-                r.verdict,
-                r.ledger.relative_closure(),
-                r.cost.steps,
-                r.events.len()
-            );
-        }
-    }
-}
-
-#[test]
 fn dyn_constrained_arm_timoshenko_axial_runs_without_contact() {
     // The extensible constrained arm with shear on, wall removed: torque-driven spin-up of an
     // axial + Timoshenko link (generalized-α, ρ∞ = 0.9 by default for extensible links). Its
@@ -610,38 +574,6 @@ fn sys_timoshenko_rigid_rotation_kinetic_energy_is_the_rigid_inertia() {
         eprintln!("shear {shear}: T = {t:.15e}, rigid {exact:.15e}");
         // Gauss quadrature of polynomials of degree ≤ 2: exact to round-off.
         assert!((t - exact).abs() < 1e-13 * exact, "{t} vs {exact}");
-    }
-}
-
-#[test]
-#[ignore]
-fn study_barhorst_mesh_convergence() {
-    // Run with: cargo test --release -p fem --test dyn_timoshenko -- --ignored --nocapture
-    // study_barhorst_mesh_convergence
-    let mut sc = data::load_scene("barhorst-case1-timoshenko").unwrap();
-    sc.contacts.clear();
-    let runs: Vec<RunResult> = [2usize, 4, 8, 16]
-        .iter()
-        .map(|&n| {
-            let start = std::time::Instant::now();
-            let r = sim(&sc, &settings(n, Some(5e-4), 0.15, None));
-            eprintln!(
-                "n_el {n}: closure {:.2e}, {:.2} s",
-                r.ledger.relative_closure(),
-                start.elapsed().as_secs_f64()
-            );
-            r
-        })
-        .collect();
-    for ch in ["link2.tip_deflection", "link2.tip_y"] {
-        let d: Vec<f64> = (0..3)
-            .map(|k| max_diff(&runs[k], &runs[k + 1], ch))
-            .collect();
-        eprintln!(
-            "{ch}: successive differences {d:?}, ratios {:.2} {:.2}",
-            d[0] / d[1],
-            d[1] / d[2]
-        );
     }
 }
 

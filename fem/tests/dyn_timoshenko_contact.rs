@@ -409,40 +409,6 @@ fn dyn_timoshenko_contact_runs_past_the_former_stop_without_newton_failures() {
 }
 
 #[test]
-#[ignore = "study (minutes): cargo test --release -p fem --test dyn_timoshenko_contact \
-            study_timoshenko_contact_full_runs -- --ignored --nocapture"]
-fn study_timoshenko_contact_full_runs() {
-    // The whole scene (3 s) at 8 and 16 elements and the default step, 8 elements at halved
-    // and quartered steps; episodes against modal (poly, 6 modes): (0.28053, 0.30855),
-    // (0.35725, 0.38858), (0.40023, 0.93509), (1.13223, 1.15031), (1.1795, 1.1959),
-    // (1.2181, 1.81501), (1.95341, 1.96049), (1.97632, –).
-    let sc = scene();
-    let weight = common::weight(&sc);
-    for (n, dt) in [(8, None), (8, Some(2.5e-4)), (8, Some(1.25e-4)), (16, None)] {
-        let mut st = settings(n, 3.0);
-        st.time.dt = dt;
-        let start = std::time::Instant::now();
-        let r = sim(&sc, &st);
-        let (grazing, worst) = check_releases(&r, weight);
-        let max_res = impacts(&r).iter().fold(0.0f64, |a, x| a.max(x.1));
-        eprintln!(
-            "{n} el, dt {dt:?}: {:.1} s wall, {} steps, {} rejected, {} events, {} releases \
-             ({grazing} grazing, |λ| ≤ {worst:.2e}), momentum ≤ {max_res:.1e}, ledger {:.2e}",
-            start.elapsed().as_secs_f64(),
-            r.cost.steps,
-            r.cost.rejected_steps,
-            r.events.len(),
-            common::releases(&r).len(),
-            r.ledger.relative_closure()
-        );
-        eprintln!(
-            "  episodes {:?}",
-            data::results::contact_episodes(&r.events, 0.01)
-        );
-    }
-}
-
-#[test]
 fn dyn_timoshenko_contact_whole_scene_completes_with_the_seven_contact_episodes() {
     // The whole scene (3 s) at 8 elements and the default step (~25 s release build): it used
     // to stop at 0.51 s. Every impact balanced, every release located, the ledger closed, and
