@@ -1,4 +1,4 @@
-//! `flexverify stability`: stiff and extreme cases (verification.md §9).
+//! The stability suite (`flexverify stability`): stiff and extreme cases (verification.md §9).
 //!
 //! For every case and backend the verdict is one of
 //! * `bounded` — reached t_end, every output finite, energy ledger closed to 1e-3 relative;
@@ -13,15 +13,15 @@
 
 use std::path::Path;
 
-use data::cases::{SuiteName, scene_with_overrides, stability_cases};
+use data::cases::{scene_with_overrides, stability_cases};
 use data::{BackendError, BackendKind, StabilityVerdict, channel};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::cli::CliError;
-use crate::cli::args::Suite;
-use crate::output::{Format, csv_table, text_table, write_atomic};
+use crate::error::Error;
+use crate::output::{Column, csv_table, fitted_table, text_table, wrap, write_atomic};
 use crate::registry::backend;
+use crate::suite::Suite;
 
 /// Ledger closure accepted for a `bounded` verdict: 1e-3 relative is far above any
 /// integrator error at default tolerances and far below a silent blow-up.
@@ -224,22 +224,24 @@ fn judge(case: &data::cases::StabilityCase, kind: BackendKind) -> Vec<Verdict> {
     out
 }
 
-pub fn run_stability(suite: Suite) -> Result<Vec<Verdict>, CliError> {
-    let cases = stability_cases().map_err(|e| CliError::Input(format!("error: {e}")))?;
+/// Judges every case of the suite on each of its backends (in parallel; verdicts in case
+/// order).
+pub fn run_stability(suite: Suite) -> Result<Vec<Verdict>, Error> {
+    let cases = stability_cases()?;
     let jobs: Vec<_> = cases
         .iter()
-        .filter(|c| suite == Suite::Full || c.suite == SuiteName::Quick)
+        .filter(|c| suite.includes(c.suite))
         .flat_map(|c| c.backends.iter().map(move |k| (c, *k)))
         .collect();
     Ok(jobs.par_iter().flat_map(|(c, k)| judge(c, *k)).collect())
 }
 
-pub fn command(suite: Suite, format: Format, out: Option<&Path>) -> Result<(), CliError> {
-    let verdicts = run_stability(suite)?;
-    let header = [
-        "#", "case", "scene", "backend", "verdict", "wall [s]", "detail",
-    ];
-    let rows: Vec<Vec<String>> = verdicts
+const HEADER: [&str; 7] = [
+    "#", "case", "scene", "backend", "verdict", "wall [s]", "detail",
+];
+
+fn rows(verdicts: &[Verdict]) -> Vec<Vec<String>> {
+    verdicts
         .iter()
         .enumerate()
         .map(|(i, v)| {
@@ -253,44 +255,55 @@ pub fn command(suite: Suite, format: Format, out: Option<&Path>) -> Result<(), C
                 v.detail.clone(),
             ]
         })
-        .collect();
-    match format {
-        Format::Table => {
-            // Details are long diagnostics: list them under the table, keyed by row number.
-            let short: Vec<Vec<String>> = rows.iter().map(|r| r[..6].to_vec()).collect();
-            print!("{}", text_table(&header[..6], &short));
-            for r in &rows {
-                println!("  [{}] {}", r[0], r[6]);
-            }
-        }
-        Format::Csv => print!("{}", csv_table(&header, &rows)),
-        Format::Json => println!("{}", serde_json::to_string_pretty(&verdicts).expect("json")),
+        .collect()
+}
+
+/// The verdicts at full width; details (long diagnostics) listed under the table, keyed by
+/// row number.
+pub fn wide_table(verdicts: &[Verdict]) -> String {
+    let rows = rows(verdicts);
+    let short: Vec<Vec<String>> = rows.iter().map(|r| r[..6].to_vec()).collect();
+    let mut s = text_table(&HEADER[..6], &short);
+    for r in &rows {
+        s.push_str(&format!("  [{}] {}\n", r[0], r[6]));
     }
-    if let Some(dir) = out {
-        write_atomic(
-            dir,
-            "stability.json",
-            serde_json::to_string_pretty(&verdicts)
-                .expect("json")
-                .as_bytes(),
-        )?;
-        write_atomic(dir, "stability.csv", csv_table(&header, &rows).as_bytes())?;
+    s
+}
+
+/// The verdicts for a terminal of `width` columns: case ids cut with `…` only if needed,
+/// details wrapped.
+pub fn terminal_table(verdicts: &[Verdict], width: usize) -> String {
+    let rows = rows(verdicts);
+    let columns = [
+        Column::right("#"),
+        Column::left("case").elastic(),
+        Column::left("scene"),
+        Column::left("backend"),
+        Column::left("verdict"),
+        Column::right("wall [s]"),
+    ];
+    let short: Vec<Vec<String>> = rows.iter().map(|r| r[..6].to_vec()).collect();
+    let mut s = fitted_table(&columns, &short, width).to_string();
+    for r in &rows {
+        s.push_str(&wrap(&format!("  [{}] {}", r[0], r[6]), width, 6));
+        s.push('\n');
     }
-    let failures: Vec<&Verdict> = verdicts.iter().filter(|v| v.failure).collect();
-    if failures.is_empty() {
-        Ok(())
-    } else {
-        Err(CliError::Failed(
-            failures
-                .iter()
-                .map(|v| {
-                    format!(
-                        "FAILED {} ({}): {} — {}",
-                        v.case, v.backend, v.verdict, v.detail
-                    )
-                })
-                .collect::<Vec<_>>()
-                .join("\n"),
-        ))
-    }
+    s
+}
+
+/// The verdicts as CSV.
+pub fn csv(verdicts: &[Verdict]) -> String {
+    csv_table(&HEADER, &rows(verdicts))
+}
+
+/// The verdicts as JSON.
+pub fn json(verdicts: &[Verdict]) -> String {
+    serde_json::to_string_pretty(verdicts).expect("serializable verdicts")
+}
+
+/// Writes `stability.json` and `stability.csv` into `dir`.
+pub fn write_all(dir: &Path, verdicts: &[Verdict]) -> std::io::Result<()> {
+    write_atomic(dir, "stability.json", json(verdicts).as_bytes())?;
+    write_atomic(dir, "stability.csv", csv(verdicts).as_bytes())?;
+    Ok(())
 }

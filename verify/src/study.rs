@@ -1,19 +1,32 @@
-//! `flexverify converge` and `flexverify recommend`: refinement ladders, observed orders,
-//! Richardson references and work-precision (error against wall time).
+//! Refinement studies (`flexverify converge`, `flexverify recommend`, the full suite's
+//! ladders): refinement ladders, observed orders, Richardson references and work-precision
+//! (error against wall time).
 //!
 //! Ladders are run sequentially so that the wall times are not distorted by sharing cores.
 
-use data::{BackendKind, Scene, Settings, load_scene};
+use std::path::Path;
+
+use data::{BackendKind, Scene, Settings};
 use serde::Serialize;
 
-use crate::cli::CliError;
-use crate::cli::args::{CommonOpts, Refine};
-use crate::output::{Format, csv_table, text_table, write_atomic};
+use crate::error::Error;
+use crate::output::{Column, csv_table, fitted_table, text_table, wrap, write_atomic};
 use crate::plot::{Series, plot};
+use crate::progress::{Progress, Silent};
 use crate::suite::evaluate::{falling_prefix, fit_order, measure, richardson};
 use crate::suite::quantity::Quantity;
 use crate::suite::reference::{analytic_value, default_analytic_id};
 use crate::suite::run_cache::{RunCache, compute};
+
+/// What a study refines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Refine {
+    /// Elements, stations or modes (the backend's space discretization).
+    Space,
+    /// The time step.
+    Time,
+}
 
 /// One rung of a refinement ladder.
 #[derive(Debug, Clone, Serialize)]
@@ -145,20 +158,43 @@ pub fn run_study(
     kinds: &[BackendKind],
     base: &Settings,
     rung_budget_s: Option<f64>,
-) -> Result<Study, CliError> {
-    let q = Quantity::parse(quantity, scene)
-        .map_err(|e| CliError::Input(format!("error: --quantity: {e}")))?;
+) -> Result<Study, Error> {
+    run_study_with_progress(scene, quantity, refine, kinds, base, rung_budget_s, &Silent)
+}
+
+/// [`run_study`], reporting each rung to `progress`.
+pub fn run_study_with_progress(
+    scene: &Scene,
+    quantity: &str,
+    refine: Refine,
+    kinds: &[BackendKind],
+    base: &Settings,
+    rung_budget_s: Option<f64>,
+    progress: &dyn Progress,
+) -> Result<Study, Error> {
+    let q = Quantity::parse(quantity, scene).map_err(|reason| Error::InvalidQuantity {
+        quantity: quantity.to_string(),
+        reason: reason.to_string(),
+    })?;
     let cache = RunCache::default();
     let mut ladders = Vec::new();
-    for &kind in kinds {
-        let rungs_spec = match refine {
-            Refine::Space => space_ladder(kind, base),
-            Refine::Time => time_ladder(base, scene),
-        };
+    let specs: Vec<_> = kinds
+        .iter()
+        .map(|&kind| {
+            let spec = match refine {
+                Refine::Space => space_ladder(kind, base),
+                Refine::Time => time_ladder(base, scene),
+            };
+            (kind, spec)
+        })
+        .collect();
+    progress.begin(specs.iter().map(|(_, s)| s.len()).sum(), "rungs");
+    for (kind, rungs_spec) in specs {
         let mut rungs: Vec<Rung> = Vec::new();
         let mut note = None;
         let rungs_total = rungs_spec.len();
         for (settings, h, label) in rungs_spec {
+            progress.start(&format!("{} {quantity}: {kind} {label}", scene.name));
             // A full-suite ladder stops once a rung costs more than the budget: the next
             // rung would cost several times more.
             if let (Some(budget), Some(last)) = (rung_budget_s, rungs.last())
@@ -167,17 +203,21 @@ pub fn run_study(
                 break;
             }
             match measure(&cache, scene, kind, &settings, &q) {
-                Ok((value, peak, wall)) => rungs.push(Rung {
-                    wall_time_s: min_wall_time(scene, kind, &settings, &q, wall),
-                    backend: kind,
-                    discretization: label,
-                    h,
-                    value,
-                    error: None,
-                    settings,
-                    peak,
-                }),
+                Ok((value, peak, wall)) => {
+                    rungs.push(Rung {
+                        wall_time_s: min_wall_time(scene, kind, &settings, &q, wall),
+                        backend: kind,
+                        discretization: label,
+                        h,
+                        value,
+                        error: None,
+                        settings,
+                        peak,
+                    });
+                    progress.advance();
+                }
                 Err(e) => {
+                    progress.advance();
                     // Coarse rungs may be rejected (too few elements for the scene); only a
                     // failure after a success ends the ladder.
                     if rungs.is_empty() && !e.contains("unsupported") {
@@ -263,6 +303,7 @@ pub fn run_study(
             l.observed_order = fit_order(&h[..keep], &e[..keep]);
         }
     }
+    progress.finish();
     Ok(Study {
         scene: scene.name.clone(),
         quantity: quantity.to_string(),
@@ -289,7 +330,14 @@ fn rows(study: &Study) -> Vec<Vec<String>> {
     rows
 }
 
-pub fn write_study(dir: &std::path::Path, study: &Study) -> Result<(), CliError> {
+/// Header of the study's CSV (the wide table says `wall [s]`).
+const CSV_HEADER: [&str; 5] = ["backend", "discretization", "value", "error", "wall_s"];
+
+/// Writes the study as JSON and CSV and draws its convergence and work-precision plots into
+/// `dir`. Returns a note for each plot that could not be drawn (the data files are written
+/// regardless).
+pub fn write_study(dir: &Path, study: &Study) -> Result<Vec<String>, Error> {
+    let mut notes = Vec::new();
     let stem = format!(
         "converge-{}-{}",
         study.scene,
@@ -302,15 +350,7 @@ pub fn write_study(dir: &std::path::Path, study: &Study) -> Result<(), CliError>
             .expect("json")
             .as_bytes(),
     )?;
-    write_atomic(
-        dir,
-        &format!("{stem}.csv"),
-        csv_table(
-            &["backend", "discretization", "value", "error", "wall_s"],
-            &rows(study),
-        )
-        .as_bytes(),
-    )?;
+    write_atomic(dir, &format!("{stem}.csv"), csv(study).as_bytes())?;
     let conv: Vec<(String, Vec<(f64, f64)>)> = study
         .ladders
         .iter()
@@ -349,7 +389,7 @@ pub fn write_study(dir: &std::path::Path, study: &Study) -> Result<(), CliError>
         &series,
         true,
     ) {
-        eprintln!("note: convergence plot not drawn: {e}");
+        notes.push(format!("convergence plot not drawn: {e}"));
     }
     let work: Vec<(String, Vec<(f64, f64)>)> = study
         .ladders
@@ -380,106 +420,140 @@ pub fn write_study(dir: &std::path::Path, study: &Study) -> Result<(), CliError>
         &series,
         true,
     ) {
-        eprintln!("note: work-precision plot not drawn: {e}");
+        notes.push(format!("work-precision plot not drawn: {e}"));
     }
-    Ok(())
+    Ok(notes)
 }
 
-pub fn converge_command(
-    scene: &str,
+/// A study for `converge`: [`run_study_with_progress`] without a rung budget, failing when no
+/// backend measured the quantity on any rung.
+pub fn converge(
+    scene: &Scene,
     quantity: &str,
     refine: Refine,
-    opts: &CommonOpts,
-) -> Result<(), CliError> {
-    let scene = load_scene(scene)?;
-    let study = run_study(
-        &scene,
-        quantity,
-        refine,
-        &opts.backend.kinds(),
-        &opts.settings(),
-        None,
-    )?;
+    kinds: &[BackendKind],
+    base: &Settings,
+    progress: &dyn Progress,
+) -> Result<Study, Error> {
+    let study = run_study_with_progress(scene, quantity, refine, kinds, base, None, progress)?;
     if study.ladders.iter().all(|l| l.rungs.is_empty()) {
-        let notes: Vec<String> = study
-            .ladders
-            .iter()
-            .filter_map(|l| l.note.clone())
-            .collect();
-        return Err(CliError::Unsupported(format!(
-            "unsupported: no backend produced `{quantity}`:\n{}",
-            notes.join("\n")
-        )));
+        return Err(Error::QuantityNotProduced {
+            quantity: quantity.to_string(),
+            notes: study
+                .ladders
+                .iter()
+                .filter_map(|l| l.note.clone())
+                .collect(),
+        });
     }
-    if let Some(dir) = &opts.out {
-        write_study(dir, &study)?;
-        eprintln!("wrote the study and its plots to {}", dir.display());
-    }
-    match opts.format {
-        Format::Json => println!("{}", serde_json::to_string_pretty(&study).expect("json")),
-        Format::Csv => print!(
-            "{}",
-            csv_table(
-                &["backend", "discretization", "value", "error", "wall_s"],
-                &rows(&study)
-            )
-        ),
-        Format::Table => {
-            println!(
-                "{} {} ({} refinement); reference: {} {}",
-                study.scene,
-                study.quantity,
-                study.refine,
-                study.reference.map_or("-".into(), |r| format!("{r:.12e}")),
-                study.reference_label
-            );
-            print!(
-                "{}",
-                text_table(
-                    &["backend", "discretization", "value", "error", "wall [s]"],
-                    &rows(&study)
-                )
-            );
-            for l in &study.ladders {
-                println!(
-                    "{}: observed order {}{}{}",
-                    l.backend,
-                    l.observed_order.map_or("-".into(), |p| format!("{p:.2}")),
-                    if l.monotone_from_above {
-                        ", monotone from above"
-                    } else {
-                        ""
-                    },
-                    l.note
-                        .as_ref()
-                        .map_or(String::new(), |n| format!(" (ladder ended: {n})"))
-                );
-            }
-        }
-    }
-    Ok(())
+    Ok(study)
 }
 
-pub fn recommend_command(
-    scene_name: &str,
+/// The study's rungs as CSV.
+pub fn csv(study: &Study) -> String {
+    csv_table(&CSV_HEADER, &rows(study))
+}
+
+/// The study as JSON.
+pub fn json(study: &Study) -> String {
+    serde_json::to_string_pretty(study).expect("serializable study")
+}
+
+fn heading(study: &Study) -> String {
+    format!(
+        "{} {} ({} refinement); reference: {} {}",
+        study.scene,
+        study.quantity,
+        study.refine,
+        study.reference.map_or("-".into(), |r| format!("{r:.12e}")),
+        study.reference_label
+    )
+}
+
+fn ladder_summary(l: &Ladder) -> String {
+    format!(
+        "{}: observed order {}{}{}",
+        l.backend,
+        l.observed_order.map_or("-".into(), |p| format!("{p:.2}")),
+        if l.monotone_from_above {
+            ", monotone from above"
+        } else {
+            ""
+        },
+        l.note
+            .as_ref()
+            .map_or(String::new(), |n| format!(" (ladder ended: {n})"))
+    )
+}
+
+/// Heading, every rung, and each ladder's observed order, lines at full length.
+pub fn wide_table(study: &Study) -> String {
+    let mut s = format!("{}\n", heading(study));
+    s.push_str(&text_table(
+        &["backend", "discretization", "value", "error", "wall [s]"],
+        &rows(study),
+    ));
+    for l in &study.ladders {
+        s.push_str(&ladder_summary(l));
+        s.push('\n');
+    }
+    s
+}
+
+/// [`wide_table`] for a terminal of `width` columns (long lines wrapped).
+pub fn terminal_table(study: &Study, width: usize) -> String {
+    let columns = [
+        Column::left("backend"),
+        Column::left("discretization").elastic(),
+        Column::right("value"),
+        Column::right("error"),
+        Column::right("wall [s]"),
+    ];
+    let mut s = format!("{}\n", wrap(&heading(study), width, 4));
+    s.push_str(&fitted_table(&columns, &rows(study), width).to_string());
+    for l in &study.ladders {
+        s.push_str(&wrap(&ladder_summary(l), width, 4));
+        s.push('\n');
+    }
+    s
+}
+
+/// The cheapest measured discretization meeting a tolerance.
+#[derive(Debug, Clone, Serialize)]
+pub struct Recommendation {
+    pub scene: String,
+    pub quantity: String,
+    pub tolerance: f64,
+    /// The chosen rung: the smallest wall time among those with error ≤ tolerance.
+    pub rung: Rung,
+    pub reference: f64,
+    pub reference_label: String,
+    /// The `flexverify` arguments that re-run the chosen discretization and print the quantity
+    /// (e.g. `run spin-up --backend modal --modes 1 --t-end 15`).
+    pub rerun: String,
+    /// How many measured rungs meet the tolerance, of how many measured.
+    pub meeting: usize,
+    pub measured: usize,
+}
+
+/// The cheapest backend and space discretization whose measured error on `quantity` is at
+/// most `tol`, from a space-refinement study of `kinds`.
+pub fn recommend(
+    scene: &Scene,
     quantity: &str,
     tol: f64,
-    opts: &CommonOpts,
-) -> Result<(), CliError> {
-    let scene = load_scene(scene_name)?;
-    let study = run_study(
-        &scene,
-        quantity,
-        Refine::Space,
-        &opts.backend.kinds(),
-        &opts.settings(),
-        None,
-    )?;
+    kinds: &[BackendKind],
+    base: &Settings,
+    progress: &dyn Progress,
+) -> Result<Recommendation, Error> {
+    let study =
+        run_study_with_progress(scene, quantity, Refine::Space, kinds, base, None, progress)?;
     let Some(reference) = study.reference else {
-        return Err(CliError::Failed(format!(
-            "no reference could be established for `{quantity}` on `{}`: {}",
-            scene.name, study.reference_label
-        )));
+        return Err(Error::NoReference {
+            quantity: quantity.to_string(),
+            scene: scene.name.clone(),
+            why: study.reference_label,
+        });
     };
     let candidates: Vec<&Rung> = study
         .ladders
@@ -490,54 +564,201 @@ pub fn recommend_command(
     let best = candidates
         .iter()
         .min_by(|a, b| a.wall_time_s.total_cmp(&b.wall_time_s));
-    match best {
-        Some(r) => {
-            let flag = r.discretization.replace('=', " ");
-            println!(
-                "recommended: {} with {} — value {:.10e}, measured error {:.3e} ≤ {tol:.1e} against {} = {reference:.10e}, wall time {:.3e} s",
-                r.backend,
-                r.discretization,
+    let Some(r) = best else {
+        let best_err = study
+            .ladders
+            .iter()
+            .flat_map(|l| l.rungs.iter())
+            .filter_map(|r| Some((r.error?, r)))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        return Err(Error::ToleranceNotMet {
+            tolerance: tol,
+            best: best_err.map(|(e, r)| (r.backend, r.discretization.clone(), e)),
+            reference_label: study.reference_label,
+        });
+    };
+    let flag = r.discretization.replace('=', " ");
+    // Ending the re-run at the quantity's time makes its final value the quantity.
+    let parsed = Quantity::parse(quantity, scene);
+    let until = match parsed {
+        Ok(Quantity::At { t, .. }) => format!(" --t-end {t}"),
+        _ => String::new(),
+    };
+    let what = match parsed {
+        Ok(Quantity::Frequency { .. }) => "modes",
+        Ok(Quantity::StaticTip) => "statics",
+        _ => "run",
+    };
+    Ok(Recommendation {
+        scene: scene.name.clone(),
+        quantity: quantity.to_string(),
+        tolerance: tol,
+        rung: (*r).clone(),
+        reference,
+        reference_label: study.reference_label.clone(),
+        rerun: format!(
+            "{what} {} --backend {} --{flag}{until}",
+            scene.name, r.backend
+        ),
+        meeting: candidates.len(),
+        measured: study.ladders.iter().map(|l| l.rungs.len()).sum(),
+    })
+}
+
+impl Recommendation {
+    fn counts(&self) -> String {
+        format!(
+            "({} of {} measured discretizations meet the tolerance)",
+            self.meeting, self.measured
+        )
+    }
+
+    /// The recommendation in three lines at full length.
+    pub fn wide_text(&self) -> String {
+        let r = &self.rung;
+        format!(
+            "recommended: {} with {} — value {:.10e}, measured error {:.3e} ≤ {:.1e} against {} = {:.10e}, wall time {:.3e} s\nre-run: flexverify {}\n{}\n",
+            r.backend,
+            r.discretization,
+            r.value,
+            r.error.unwrap_or(f64::NAN),
+            self.tolerance,
+            self.reference_label,
+            self.reference,
+            r.wall_time_s,
+            self.rerun,
+            self.counts()
+        )
+    }
+
+    /// The recommendation for a terminal of `width` columns: one fact per line.
+    pub fn terminal_text(&self, width: usize) -> String {
+        let r = &self.rung;
+        let lines = [
+            format!("recommended: {} with {}", r.backend, r.discretization),
+            format!(
+                "  value {:.10e}, measured error {:.3e} ≤ {:.1e}",
                 r.value,
                 r.error.unwrap_or(f64::NAN),
-                study.reference_label,
-                r.wall_time_s
-            );
-            // Ending the re-run at the quantity's time makes its final value the quantity.
-            let parsed = Quantity::parse(quantity, &scene);
-            let until = match parsed {
-                Ok(Quantity::At { t, .. }) => format!(" --t-end {t}"),
-                _ => String::new(),
-            };
-            let what = match parsed {
-                Ok(Quantity::Frequency { .. }) => "modes",
-                Ok(Quantity::StaticTip) => "statics",
-                _ => "run",
-            };
-            println!(
-                "re-run: flexverify {what} {} --backend {} --{flag}{until}",
-                scene.name, r.backend
-            );
-            println!(
-                "({} of {} measured discretizations meet the tolerance)",
-                candidates.len(),
-                study.ladders.iter().map(|l| l.rungs.len()).sum::<usize>()
-            );
-            Ok(())
+                self.tolerance
+            ),
+            format!(
+                "  against {} = {:.10e}",
+                self.reference_label, self.reference
+            ),
+            format!("  wall time {:.3e} s", r.wall_time_s),
+            format!("re-run: flexverify {}", self.rerun),
+            self.counts(),
+        ];
+        lines.iter().map(|l| wrap(l, width, 4) + "\n").collect()
+    }
+}
+
+/// Per-rung wall-time budget of the full suite's ladders.
+pub const FULL_RUNG_BUDGET_S: f64 = 10.0;
+
+/// The quantity a scene's refinement ladder follows in the full suite.
+pub fn ladder_quantity(scene: &Scene) -> Option<String> {
+    use data::scene::PrescribedMotion;
+    if let Some(_r) = &scene.rocket {
+        return Some(format!("rocket.vY@{}", scene.simulation.t_end));
+    }
+    let first = scene.links.first()?;
+    let t = scene.simulation.t_end;
+    Some(match first.joint.prescribed {
+        Some(PrescribedMotion::Fixed) | Some(PrescribedMotion::ConstantRate { .. }) => {
+            "freq1".into()
         }
-        None => {
-            let best_err = study
-                .ladders
-                .iter()
-                .flat_map(|l| l.rungs.iter())
-                .filter_map(|r| Some((r.error?, r)))
-                .min_by(|a, b| a.0.total_cmp(&b.0));
-            Err(CliError::Failed(match best_err {
-                Some((e, r)) => format!(
-                    "no measured discretization meets {tol:.1e}: the best is {} {} with error {e:.3e} (against {})",
-                    r.backend, r.discretization, study.reference_label
-                ),
-                None => "no discretization could be measured".into(),
-            }))
+        Some(PrescribedMotion::SpinUp { .. }) => format!("tip_deflection@{t}"),
+        None => format!("joint1.angle@{t}"),
+    })
+}
+
+/// The full suite's survey: every catalog scene through every rung of each backend's space
+/// ladder (a rung costing more than [`FULL_RUNG_BUDGET_S`] ends its ladder). With `out`, each
+/// study with a measured rung is written to `out/ladders` as soon as it is done (so an
+/// interrupted survey keeps what it finished). Returns the studies and the plot notes of
+/// [`write_study`].
+pub fn full_suite_ladders(
+    out: Option<&Path>,
+    progress: &dyn Progress,
+) -> Result<(Vec<Study>, Vec<String>), Error> {
+    let mut studies = Vec::new();
+    let mut notes = Vec::new();
+    for name in data::catalog_names() {
+        let scene = data::load_scene(name)?;
+        let Some(q) = ladder_quantity(&scene) else {
+            continue;
+        };
+        let study = run_study_with_progress(
+            &scene,
+            &q,
+            Refine::Space,
+            &BackendKind::ALL,
+            &Settings::default(),
+            Some(FULL_RUNG_BUDGET_S),
+            progress,
+        )?;
+        if let Some(dir) = out
+            && study.ladders.iter().any(|l| !l.rungs.is_empty())
+        {
+            notes.extend(write_study(&dir.join("ladders"), &study)?);
+        }
+        studies.push(study);
+    }
+    Ok((studies, notes))
+}
+
+const SURVEY_HEADER: [&str; 7] = [
+    "scene",
+    "quantity",
+    "backend",
+    "rungs",
+    "finest value",
+    "order",
+    "note",
+];
+
+fn survey_rows(studies: &[Study]) -> Vec<Vec<String>> {
+    let mut rows = Vec::new();
+    for study in studies {
+        for l in &study.ladders {
+            rows.push(vec![
+                study.scene.clone(),
+                study.quantity.clone(),
+                l.backend.to_string(),
+                l.rungs.len().to_string(),
+                l.rungs
+                    .last()
+                    .map_or("-".into(), |r| format!("{:.9e}", r.value)),
+                l.observed_order.map_or("-".into(), |p| format!("{p:.2}")),
+                l.note
+                    .clone()
+                    .unwrap_or_default()
+                    .chars()
+                    .take(90)
+                    .collect(),
+            ]);
         }
     }
+    rows
+}
+
+/// One line per scene and backend of the full suite's survey, at full width.
+pub fn survey_wide_table(studies: &[Study]) -> String {
+    text_table(&SURVEY_HEADER, &survey_rows(studies))
+}
+
+/// [`survey_wide_table`] for a terminal of `width` columns (notes cut with `…`).
+pub fn survey_terminal_table(studies: &[Study], width: usize) -> String {
+    let columns = [
+        Column::left("scene"),
+        Column::left("quantity"),
+        Column::left("backend"),
+        Column::right("rungs"),
+        Column::right("finest value"),
+        Column::right("order"),
+        Column::left("note").elastic(),
+    ];
+    fitted_table(&columns, &survey_rows(studies), width).to_string()
 }

@@ -266,3 +266,51 @@ fn cli_run_contact_scene_writes_the_switching_history() {
         std::fs::read_to_string(dir.join("barhorst-case1-tipmass-modal-observables.csv")).unwrap();
     assert!(obs.lines().next().unwrap().contains("contact1.phase"));
 }
+
+#[test]
+fn cli_default_outputs_fit_120_columns() {
+    let commands: [&[&str]; 9] = [
+        &["verify", "--filter", "cantilever"],
+        &["scenes"],
+        &["describe", "constrained-arm"],
+        &["modes", "cantilever"],
+        &["run", "spin-up"],
+        &[
+            "run",
+            "barhorst-case1-tipmass",
+            "--backend",
+            "modal",
+            "--modes",
+            "2",
+            "--t-end",
+            "0.6",
+        ],
+        &["converge", "cantilever", "--quantity", "freq1"],
+        &[
+            "recommend",
+            "cantilever",
+            "--quantity",
+            "freq1",
+            "--tol",
+            "1e-6",
+        ],
+        &["stability"],
+    ];
+    for args in commands {
+        let (code, out, err) = flexverify(args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        assert!(!out.trim().is_empty(), "{args:?}: no output");
+        for line in out.lines() {
+            assert!(
+                line.chars().count() <= 120,
+                "{args:?}: {} characters:\n{line}",
+                line.chars().count()
+            );
+        }
+    }
+    // `--format wide` keeps every column at full width (the check kind, scene, reference …).
+    let (code, wide, _) = flexverify(&["verify", "--filter", "cantilever", "--format", "wide"]);
+    assert_eq!(code, 0);
+    assert!(wide.lines().any(|l| l.contains("analytic:clamped-free")));
+    assert!(wide.lines().any(|l| l.chars().count() > 120), "{wide}");
+}

@@ -1,8 +1,12 @@
-//! Argument definitions (clap derive).
+//! Argument definitions (clap derive). The library's selectors ([`Format`], [`Suite`],
+//! [`Refine`]) know nothing of clap; their command-line spellings are defined here.
 
+use clap::builder::PossibleValue;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use crate::output::Format;
+pub use crate::output::Format;
+pub use crate::study::Refine;
+pub use crate::suite::Suite;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -99,17 +103,42 @@ pub enum Command {
     },
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Suite {
-    Quick,
-    Full,
+impl ValueEnum for Format {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[Format::Table, Format::Wide, Format::Json, Format::Csv]
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(match self {
+            Format::Table => PossibleValue::new("table").help("a table that fits 120 columns"),
+            Format::Wide => PossibleValue::new("wide").help("every column at full width"),
+            Format::Json => PossibleValue::new("json"),
+            Format::Csv => PossibleValue::new("csv"),
+        })
+    }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Refine {
-    Space,
-    Time,
+impl ValueEnum for Suite {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[Suite::Quick, Suite::Full]
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(match self {
+            Suite::Quick => "quick",
+            Suite::Full => "full",
+        }))
+    }
+}
+
+impl ValueEnum for Refine {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[Refine::Space, Refine::Time]
+    }
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(match self {
+            Refine::Space => "space",
+            Refine::Time => "time",
+        }))
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -5,8 +5,8 @@ use data::{BackendError, BackendKind, Scene, StabilityVerdict, load_scene};
 use super::CliError;
 use super::args::{Cli, Command, CommonOpts};
 use crate::output::{
-    Format, SWITCHING_HEADER, csv_table, ledger_csv, observables_csv, switching_rows, text_table,
-    write_atomic,
+    Column, Format, SWITCHING_HEADER, TERMINAL_WIDTH, csv_table, fitted_table, ledger_csv,
+    observables_csv, switching_rows, text_table, wrap, write_atomic,
 };
 use crate::registry::backend;
 
@@ -22,21 +22,21 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             filter,
             format,
             out,
-        } => crate::suite::command(suite, filter.as_deref(), format, out.as_deref()),
+        } => super::checks::verify(suite, filter.as_deref(), format, out.as_deref()),
         Command::Converge {
             scene,
             quantity,
             refine,
             opts,
-        } => crate::study::converge_command(&scene, &quantity, refine, &opts),
+        } => super::studies::converge(&scene, &quantity, refine, &opts),
         Command::Recommend {
             scene,
             quantity,
             tol,
             opts,
-        } => crate::study::recommend_command(&scene, &quantity, tol, &opts),
+        } => super::studies::recommend(&scene, &quantity, tol, &opts),
         Command::Stability { suite, format, out } => {
-            crate::stability::command(suite, format, out.as_deref())
+            super::checks::stability(suite, format, out.as_deref())
         }
     }
 }
@@ -65,7 +65,18 @@ fn scenes(format: Format) -> Result<(), CliError> {
     let header = ["scene", "family", "description"];
     match format {
         Format::Table => {
-            // Left-aligned listing reads better than the right-aligned numeric table.
+            // Left-aligned listing reads better than the right-aligned numeric table; long
+            // descriptions are cut to the terminal width.
+            let columns = [
+                Column::left(""),
+                Column::left(""),
+                Column::left("").elastic(),
+            ];
+            for line in fitted_table(&columns, &rows, TERMINAL_WIDTH).rows {
+                println!("{line}");
+            }
+        }
+        Format::Wide => {
             let w0 = rows.iter().map(|r| r[0].len()).max().unwrap_or(5);
             let w1 = rows.iter().map(|r| r[1].len()).max().unwrap_or(6);
             for r in &rows {
@@ -159,20 +170,29 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
             print!("{}", csv_table(&["section", "item", "value"], &rows));
             Ok(())
         }
-        Format::Table => {
-            println!("scene    {} — {}", scene.name, scene.description);
-            println!("family   {}", scene.family());
-            println!("units    {}", scene.units);
-            println!(
+        Format::Table | Format::Wide => {
+            // Each line is built whole, then wrapped to the terminal unless `wide`.
+            let mut text = String::new();
+            macro_rules! say {
+                ($($arg:tt)*) => {{
+                    text.push_str(&format!($($arg)*));
+                    text.push('\n');
+                }};
+            }
+            say!("scene    {} — {}", scene.name, scene.description);
+            say!("family   {}", scene.family());
+            say!("units    {}", scene.units);
+            say!(
                 "run      t_end = {}, output every {}",
-                scene.simulation.t_end, scene.simulation.output_interval
+                scene.simulation.t_end,
+                scene.simulation.output_interval
             );
-            println!("physics");
+            say!("physics");
             for (k, v) in &flags {
-                println!("  {:<18} {}", k, if *v { "on" } else { "off" });
+                say!("  {:<18} {}", k, if *v { "on" } else { "off" });
             }
             for (i, l) in scene.links.iter().enumerate() {
-                println!(
+                say!(
                     "link {} `{}`: L = {}, ρA = {}, EI = {}{}{}",
                     i + 1,
                     l.name,
@@ -186,7 +206,7 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 );
             }
             for (i, c) in scene.contacts.iter().enumerate() {
-                println!(
+                say!(
                     "contact {}: tip of `{}` against {:?} ({:?}, μ = {})",
                     i + 1,
                     c.link,
@@ -195,23 +215,31 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                     c.friction
                 );
             }
-            println!("degrees of freedom");
+            say!("degrees of freedom");
             for p in &plans {
                 match &p.plan {
                     Some(plan) => {
-                        println!("  {}: {} DOFs", p.backend, plan.total());
+                        say!("  {}: {} DOFs", p.backend, plan.total());
                         for g in &plan.groups {
-                            println!("      {:>6}  {}", g.count, g.what);
+                            say!("      {:>6}  {}", g.count, g.what);
                         }
                         for b in &plan.builds {
-                            println!("      builds: {b}");
+                            say!("      builds: {b}");
                         }
                     }
-                    None => println!(
+                    None => say!(
                         "  {}: {}",
                         p.backend,
                         p.unsupported.as_deref().unwrap_or("unsupported")
                     ),
+                }
+            }
+            if opts.format == Format::Wide {
+                print!("{text}");
+            } else {
+                for line in text.lines() {
+                    let indent = line.len() - line.trim_start().len();
+                    println!("{}", wrap(line, TERMINAL_WIDTH, indent + 4));
                 }
             }
             Ok(())
@@ -279,7 +307,8 @@ fn modes(name: &str, count: usize, opts: &CommonOpts) -> Result<(), CliError> {
         .collect();
     let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
     match opts.format {
-        Format::Table => print!("{}", text_table(&header, &rows)),
+        // At most four columns of numbers: the full table fits a terminal.
+        Format::Table | Format::Wide => print!("{}", text_table(&header, &rows)),
         Format::Csv => print!("{}", csv_table(&header, &rows)),
         Format::Json => print_json(&results.iter().map(|(_, r)| r).collect::<Vec<_>>())?,
     }
@@ -303,7 +332,8 @@ fn statics(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
         .collect();
     let header = ["backend", "tip deflection", "tip rotation", "dofs"];
     match opts.format {
-        Format::Table => print!("{}", text_table(&header, &rows)),
+        // At most four columns of numbers: the full table fits a terminal.
+        Format::Table | Format::Wide => print!("{}", text_table(&header, &rows)),
         Format::Csv => print!("{}", csv_table(&header, &rows)),
         Format::Json => print_json(&results.iter().map(|(_, r)| r).collect::<Vec<_>>())?,
     }
@@ -354,7 +384,8 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 print!("{}", observables_csv(&r.observables));
             }
         }
-        Format::Table => {
+        Format::Table | Format::Wide => {
+            let wide = opts.format == Format::Wide;
             let header = [
                 "backend",
                 "verdict",
@@ -388,7 +419,12 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                     ]
                 })
                 .collect();
-            print!("{}", text_table(&header, &rows));
+            if wide {
+                print!("{}", text_table(&header, &rows));
+            } else {
+                let columns = header.map(Column::right);
+                print!("{}", fitted_table(&columns, &rows, TERMINAL_WIDTH));
+            }
             // Final values of every channel, one column per backend.
             let mut names: Vec<String> = Vec::new();
             for (_, r) in &results {
@@ -415,12 +451,35 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 .collect();
             let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
             println!();
-            print!("{}", text_table(&header, &rows));
+            if wide {
+                print!("{}", text_table(&header, &rows));
+            } else {
+                let mut columns: Vec<Column> = header.iter().map(|h| Column::right(h)).collect();
+                columns[0] = Column::left(header[0]).elastic();
+                print!("{}", fitted_table(&columns, &rows, TERMINAL_WIDTH));
+            }
             if !scene.contacts.is_empty() {
+                // The terminal table names the columns briefly; `--format wide` and the
+                // switching CSV spell them out.
+                let short = [
+                    "t",
+                    "event",
+                    "contact",
+                    "impulse",
+                    "KE lost",
+                    "momentum res.",
+                    "normal force",
+                    "t tol.",
+                ]
+                .map(Column::right);
                 for (k, r) in &results {
                     let rows = switching_rows(&r.events);
                     println!("\n{k}: {} switching events", rows.len());
-                    print!("{}", text_table(&SWITCHING_HEADER, &rows));
+                    if wide {
+                        print!("{}", text_table(&SWITCHING_HEADER, &rows));
+                    } else {
+                        print!("{}", fitted_table(&short, &rows, TERMINAL_WIDTH));
+                    }
                 }
             }
         }
@@ -429,8 +488,16 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
         let closure = r.ledger.relative_closure();
         if closure > LEDGER_WARNING {
             eprintln!(
-                "warning: {k}: the energy ledger closes only to {closure:.2e} (relative); the time \
-                 step is too coarse for this scene — refine --dt (or --rtol) and compare"
+                "{}",
+                wrap(
+                    &format!(
+                        "warning: {k}: the energy ledger closes only to {closure:.2e} \
+                         (relative); the time step is too coarse for this scene — refine --dt \
+                         (or --rtol) and compare"
+                    ),
+                    TERMINAL_WIDTH,
+                    4
+                )
             );
         }
     }

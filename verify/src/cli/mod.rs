@@ -1,11 +1,15 @@
-//! The `flexverify` command line: argument definitions and dispatch.
+//! The `flexverify` command line: argument definitions, dispatch, printing, and the mapping of
+//! library errors to exit statuses. The only module that knows clap and the terminal.
 //!
 //! Exit status: 0 success; 1 a verification check failed (or output could not be written);
 //! 2 bad input (scene file, arguments); 3 unsupported (a backend or subcommand cannot do what
 //! was asked); 4 a run stopped early with a diagnostic (its partial results are still written).
 
 pub mod args;
+mod checks;
 mod commands;
+mod progress;
+mod studies;
 
 pub use args::{Cli, Command, CommonOpts};
 
@@ -50,6 +54,24 @@ impl From<data::BackendError> for CliError {
             data::BackendError::InvalidSettings { .. }
             | data::BackendError::StabilityBound { .. } => CliError::Input(format!("error: {e}")),
             data::BackendError::Numerical { .. } => CliError::Failed(format!("error: {e}")),
+        }
+    }
+}
+
+impl From<crate::Error> for CliError {
+    fn from(e: crate::Error) -> Self {
+        use crate::Error as E;
+        match e {
+            E::Backend(e) => e.into(),
+            E::Io(e) => e.into(),
+            E::InvalidQuantity { reason, .. } => {
+                CliError::Input(format!("error: --quantity: {reason}"))
+            }
+            E::Scene(_) | E::Cases(_) | E::NoCaseMatches { .. } => {
+                CliError::Input(format!("error: {e}"))
+            }
+            E::QuantityNotProduced { .. } => CliError::Unsupported(format!("unsupported: {e}")),
+            E::NoReference { .. } | E::ToleranceNotMet { .. } => CliError::Failed(e.to_string()),
         }
     }
 }

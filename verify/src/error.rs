@@ -1,0 +1,72 @@
+//! The library's error type: every way a verification, study or stability request can fail
+//! before it produces results. A failed *check* is not an error — it is an [`Outcome`] or a
+//! [`Verdict`] with its status — and neither is a run that stopped early (its result carries
+//! the diagnostic).
+//!
+//! [`Outcome`]: crate::suite::evaluate::Outcome
+//! [`Verdict`]: crate::stability::Verdict
+
+use thiserror::Error;
+
+/// Why a library call produced no result.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// A scene name or file could not be loaded (unknown name, malformed or invalid file).
+    #[error(transparent)]
+    Scene(#[from] data::LoadError),
+    /// The embedded case files do not parse (a defect of the build, reported with its place).
+    #[error(transparent)]
+    Cases(#[from] data::SceneError),
+    /// A backend refused the request or failed numerically.
+    #[error(transparent)]
+    Backend(#[from] data::BackendError),
+    /// No verification case is selected by the suite and filter.
+    #[error("no verification case matches (suite {suite}, filter {filter:?})")]
+    NoCaseMatches {
+        /// The suite's name (`Quick`, `Full`).
+        suite: String,
+        filter: Option<String>,
+    },
+    /// A quantity expression does not parse or does not exist in the scene.
+    #[error("quantity `{quantity}`: {reason}")]
+    InvalidQuantity { quantity: String, reason: String },
+    /// No backend could measure the quantity on any rung of its ladder.
+    #[error("no backend produced `{quantity}`:\n{}", notes.join("\n"))]
+    QuantityNotProduced {
+        quantity: String,
+        /// Each ladder's reason for ending (unsupported, stopped run, …).
+        notes: Vec<String>,
+    },
+    /// Neither an analytic value nor a converged ladder gives a reference.
+    #[error("no reference could be established for `{quantity}` on `{scene}`: {why}")]
+    NoReference {
+        quantity: String,
+        scene: String,
+        why: String,
+    },
+    /// No measured discretization meets a requested tolerance.
+    #[error("{}", tolerance_not_met(*tolerance, best.as_ref(), reference_label))]
+    ToleranceNotMet {
+        tolerance: f64,
+        /// The most accurate measured rung: (backend, discretization, error).
+        best: Option<(data::BackendKind, String, f64)>,
+        reference_label: String,
+    },
+    /// A result file could not be written.
+    #[error("cannot write output: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+fn tolerance_not_met(
+    tol: f64,
+    best: Option<&(data::BackendKind, String, f64)>,
+    reference_label: &str,
+) -> String {
+    match best {
+        Some((backend, discretization, e)) => format!(
+            "no measured discretization meets {tol:.1e}: the best is {backend} {discretization} \
+             with error {e:.3e} (against {reference_label})"
+        ),
+        None => "no discretization could be measured".into(),
+    }
+}

@@ -1,0 +1,151 @@
+//! The `verify` library used without its command line: cases, studies and errors through the
+//! public API, results inspected as values.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use data::{BackendKind, Settings, load_scene};
+use verify::Error;
+use verify::output::TERMINAL_WIDTH;
+use verify::progress::{Progress, Silent};
+use verify::study::{Refine, converge, recommend};
+use verify::suite::evaluate::Status;
+use verify::suite::{Suite, report, run_cases, run_cases_with_progress};
+
+/// Counts what a library call reports.
+#[derive(Default)]
+struct Counter {
+    total: AtomicUsize,
+    started: AtomicUsize,
+    advanced: AtomicUsize,
+    finished: AtomicUsize,
+}
+
+impl Progress for Counter {
+    fn begin(&self, total: usize, _unit: &str) {
+        self.total.fetch_add(total, Ordering::Relaxed);
+    }
+    fn start(&self, _item: &str) {
+        self.started.fetch_add(1, Ordering::Relaxed);
+    }
+    fn advance(&self) {
+        self.advanced.fetch_add(1, Ordering::Relaxed);
+    }
+    fn finish(&self) {
+        self.finished.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+#[test]
+fn lib_one_quick_case_runs_and_its_outcome_is_inspected() {
+    let id = "freq-cantilever-fem16-mode1";
+    let progress = Counter::default();
+    let (cases, outcomes, _cache) =
+        run_cases_with_progress(Suite::Quick, Some(id), &progress).expect("the case runs");
+    assert_eq!(cases.len(), 1);
+    assert_eq!(outcomes.len(), 1);
+    let o = &outcomes[0];
+    assert_eq!(o.id, id);
+    assert_eq!(o.status, Status::Pass, "{}", o.message);
+    assert!(
+        o.reference_label.starts_with("analytic:"),
+        "{}",
+        o.reference_label
+    );
+    // The outcome's error is what its value and reference say, and within its tolerance.
+    let (value, reference) = (o.value.unwrap(), o.reference.unwrap());
+    let error = o.error.unwrap();
+    assert!(((value - reference).abs() / reference.abs() - error).abs() <= 1e-12 * error);
+    assert!(error <= o.tolerance);
+    // One case: one begin of one item, one start, one advance, one finish.
+    assert_eq!(progress.total.load(Ordering::Relaxed), 1);
+    assert_eq!(progress.started.load(Ordering::Relaxed), 1);
+    assert_eq!(progress.advanced.load(Ordering::Relaxed), 1);
+    assert_eq!(progress.finished.load(Ordering::Relaxed), 1);
+}
+
+#[test]
+fn lib_bad_requests_are_typed_errors() {
+    assert!(matches!(
+        run_cases(Suite::Quick, Some("no-such-case")),
+        Err(Error::NoCaseMatches { .. })
+    ));
+    let scene = load_scene("cantilever").unwrap();
+    let kinds = [BackendKind::Fem];
+    let settings = Settings::default();
+    assert!(matches!(
+        converge(&scene, "freq0x", Refine::Space, &kinds, &settings, &Silent),
+        Err(Error::InvalidQuantity { .. })
+    ));
+    assert!(matches!(
+        load_scene("no-such-scene").map_err(Error::from),
+        Err(Error::Scene(_))
+    ));
+    // A tolerance no discretization meets names the best one measured.
+    match recommend(
+        &scene,
+        "freq1",
+        1e-30,
+        &[BackendKind::Fdm],
+        &settings,
+        &Silent,
+    ) {
+        Err(Error::ToleranceNotMet {
+            best: Some((backend, _, error)),
+            ..
+        }) => {
+            assert_eq!(backend, BackendKind::Fdm);
+            assert!(error > 1e-30);
+        }
+        other => panic!("expected ToleranceNotMet, got {other:?}"),
+    }
+}
+
+#[test]
+fn lib_converge_reports_every_rung_and_the_fem_order() {
+    let scene = load_scene("cantilever").unwrap();
+    let progress = Counter::default();
+    let study = converge(
+        &scene,
+        "freq1",
+        Refine::Space,
+        &[BackendKind::Fem],
+        &Settings::default(),
+        &progress,
+    )
+    .unwrap();
+    let rungs = study.ladders[0].rungs.len();
+    assert!(rungs >= 4);
+    assert_eq!(progress.total.load(Ordering::Relaxed), rungs);
+    assert_eq!(progress.advanced.load(Ordering::Relaxed), rungs);
+    // Hermite cubics: frequency error O(h⁴).
+    let order = study.ladders[0].observed_order.unwrap();
+    assert!((order - 4.0).abs() < 0.3, "{order}");
+}
+
+#[test]
+fn lib_terminal_table_cuts_only_long_case_ids() {
+    let (_, outcomes, _) = run_cases(Suite::Quick, Some("static-cantilever")).unwrap();
+    let mut long = outcomes[0].clone();
+    long.id = format!("{}-{}", long.id, "x".repeat(150));
+    long.status = Status::Fail;
+    let mut all = outcomes.clone();
+    all.push(long.clone());
+    let table = report::terminal_table(&all, TERMINAL_WIDTH);
+    let row = table
+        .lines()
+        .find(|l| l.starts_with("FAIL ") && l.contains('…'))
+        .unwrap_or_else(|| panic!("no cut FAIL row:\n{table}"));
+    assert!(row.chars().count() <= TERMINAL_WIDTH, "{row}");
+    // The error, tolerance and wall time survive the cut.
+    assert!(
+        row.contains(&format!("{:.2e}", long.error.unwrap())),
+        "{row}"
+    );
+    assert!(row.contains(&format!("{:.1e}", long.tolerance)), "{row}");
+    // Short ids are not cut, and the failing group comes first.
+    for o in &outcomes {
+        assert!(table.contains(&o.id), "{} cut:\n{table}", o.id);
+    }
+    let first_group = table.lines().nth(3).unwrap();
+    assert!(first_group.contains("1 FAILED"), "{table}");
+}
