@@ -100,15 +100,28 @@ pub fn modes_per_link(disc: &Discretization) -> Result<usize, ModalError> {
     Ok(n)
 }
 
-/// The default basis: `clamped-free`, or `poly` for a scene with a tip contact. The
-/// clamped-free functions all have zero end moment, shear and (axial) end force, so a tip load
-/// — the wall force, the friction force, or the child link's load — converges slowly in them:
-/// `constrained-arm` θ(2 s) with clamped-free 3 / 6 modes 2.21 / 4.50e-2 rad, with poly
-/// 3 / 4 / 6 / 8 modes 1.43e-2 / 1.014e-2 / 9.447e-3 / 9.460e-3 (fem: 9.39e-3); the
-/// `barhorst-case1` first impact at 6 modes is 2e-4 early with clamped-free, 1e-7 off fem
-/// with poly.
+/// The default basis: `poly` for a scene whose links carry a tip load — a child link (any
+/// chain of more than one link), a tip mass or inertia, or a tip contact — else
+/// `clamped-free`. The clamped-free
+/// functions all have zero end moment, shear and (axial) end force, so a tip load converges
+/// slowly in them. Measured on `two-link-free` (10 s, 20 Hz low-passed joint-1 angle, largest
+/// difference; fixed-step TR-BDF2 at h = 2.5e-4, whose own error is 2e-6): against fem
+/// (16 elements, energy-midpoint) clamped-free 4 / 6 / 8 modes 4.4e-4 / 2.7e-4 / 2.0e-4 rad,
+/// poly 4 / 6 / 8 / 10 / 12 modes 2.9e-4 / 1.5e-5 / 4.0e-5 / 4.0e-6 / 9.5e-6; against poly 12
+/// poly 6 / 8 / 10 are 2.5e-5 / 4.9e-5 / 5.5e-6. `single-link` (tip mass, 3 s, Dormand–Prince
+/// at the default tolerance) against poly 12: clamped-free 6 / 12 modes 7.7e-3 / 9.4e-4 rad,
+/// poly 4 / 6 / 8 modes 1.5e-2 / 3.9e-4 / 5.2e-6. `constrained-arm` θ(2 s) with clamped-free
+/// 3 / 6 modes 2.21 / 4.50e-2 rad, with poly 3 / 4 / 6 / 8 modes 1.43e-2 / 1.014e-2 /
+/// 9.447e-3 / 9.460e-3 (fem: 9.39e-3); the `barhorst-case1` first impact at 6 modes is 2e-4
+/// early with clamped-free, 1e-7 off fem with poly.
 pub fn default_basis(scene: &Scene) -> Basis {
-    if scene.contacts.is_empty() {
+    let tip_loaded = scene.links.len() > 1
+        || !scene.contacts.is_empty()
+        || scene
+            .links
+            .iter()
+            .any(|l| l.tip_mass.is_some_and(|m| m > 0.0) || l.tip_inertia.is_some_and(|j| j > 0.0));
+    if !tip_loaded {
         Basis::ClampedFree
     } else {
         Basis::Poly

@@ -348,27 +348,6 @@ fn dyn_contact_dof_plan_and_unsupported_variants() {
     }
 }
 
-/// Study helper: full run of any contact scene with the event list printed. Run with e.g.
-/// `SCENE=barhorst-case1 MODES=6 TEND=3 CARGO_TARGET_DIR=/work/targets/modal cargo test
-/// --release -p modal --test dyn_contact explore -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn dyn_contact_explore() {
-    let name = std::env::var("SCENE").unwrap();
-    let modes: usize = std::env::var("MODES").unwrap().parse().unwrap();
-    let t_end: Option<f64> = std::env::var("TEND").ok().map(|s| s.parse().unwrap());
-    let scene = load_scene(&name).unwrap();
-    let mut st = settings(modes, 1e-9, t_end);
-    if std::env::var("BASIS").is_ok() {
-        st.discretization.basis = Some(data::Basis::TipMass);
-    }
-    let (r, f) = simulate_detailed(&scene, &st).unwrap();
-    summary(&r);
-    println!("{:?}", f.contact);
-    let nf = r.observables.get("contact1.normal_force").unwrap();
-    println!("final λ {:?}", nf.values.last());
-}
-
 #[test]
 fn dyn_contact_convective_tip_acceleration_matches_finite_differences() {
     // Ġq̇ of the constraint: c(q, q̇) = Σₖ ∂J/∂qₖ q̇ₖ q̇ against a central difference of J(q) q̇
@@ -408,13 +387,18 @@ fn dyn_contact_convective_tip_acceleration_matches_finite_differences() {
 }
 
 #[test]
-fn sys_default_basis_is_poly_for_contact_scenes_only() {
+fn sys_default_basis_is_poly_for_tip_loaded_links() {
     // Tip loads converge slowly in the clamped-free functions (zero end force, shear and
-    // moment): contact scenes default to the polynomial basis (modal::setup::default_basis).
+    // moment): contact scenes, tip masses and chains (each link but the last carries the next
+    // one at its tip) default to the polynomial basis (modal::setup::default_basis).
     for name in [
         "barhorst-case1",
         "barhorst-case1-timoshenko",
         "constrained-arm",
+        "two-link-free",
+        "two-link-free-undamped",
+        "single-link",
+        "cantilever-tip-mass",
     ] {
         let scene = load_scene(name).unwrap();
         assert_eq!(
@@ -423,7 +407,7 @@ fn sys_default_basis_is_poly_for_contact_scenes_only() {
             "{name}"
         );
     }
-    for name in ["cantilever", "two-link-free", "single-link"] {
+    for name in ["cantilever", "spin-up", "rotating-beam"] {
         let scene = load_scene(name).unwrap();
         assert_eq!(
             modal::setup::default_basis(&scene),

@@ -92,40 +92,6 @@ fn print_summary(r: &RunResult, f: &FinalState) {
     );
 }
 
-/// Study helper: `MODES=3 SCALE=10 GRAVITY=1 TEND=2 cargo test --release -p modal --test
-/// dyn_friction explore -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn dyn_friction_explore() {
-    let env = |k: &str| std::env::var(k).ok();
-    let modes: usize = env("MODES").map_or(3, |s| s.parse().unwrap());
-    let t_end: Option<f64> = env("TEND").map(|s| s.parse().unwrap());
-    let rtol: f64 = env("RTOL").map_or(1e-8, |s| s.parse().unwrap());
-    let mut scene = arm();
-    if let Some(s) = env("SCALE") {
-        let s: f64 = s.parse().unwrap();
-        scene.links[0].bending_stiffness *= s;
-        *scene.links[0].axial_stiffness.as_mut().unwrap() *= s;
-    }
-    if env("FLEXURE").is_some() {
-        scene.links[0].axial = false;
-        scene.links[0].foreshortening = true;
-    }
-    if env("GRAVITY").is_some() {
-        pendulum(&mut scene);
-    }
-    if let Some(kv) = env("KV") {
-        scene.links[0].kelvin_voigt = Some(kv.parse().unwrap());
-    }
-    let mut st = settings(modes, rtol, t_end);
-    st.time.method = env("METHOD");
-    if env("POLY").is_some() {
-        st.discretization.basis = Some(data::Basis::Poly);
-    }
-    let (r, f) = simulate_detailed(&scene, &st).unwrap();
-    print_summary(&r, &f);
-}
-
 /// The arm in a vertical plane without hub torque, released from rest 0.5 rad beside the
 /// bottom: a pendulum whose tip slides on the wall with friction until it sticks.
 fn pendulum(scene: &mut Scene) {

@@ -365,42 +365,6 @@ fn dyn_timoshenko_barhorst_impacts_and_ledger() {
     assert!(closure <= 1e-5, "ledger closure {closure:.3e}");
 }
 
-/// Switching times of barhorst-case1-timoshenko in the first 0.5 s against the number of modes
-/// per field (issue 7). Long: run with
-/// `cargo test --release -p modal --test dyn_timoshenko -- --ignored --nocapture switching`
-/// (env `TIMO_MODES=2,3,4,6` and `TIMO_SCENE=barhorst-case1-timoshenko` select the ladder and
-/// the scene, e.g. `barhorst-case1` for the Euler comparison).
-#[test]
-#[ignore]
-fn dyn_timoshenko_switching_times_vs_modes() {
-    let name =
-        std::env::var("TIMO_SCENE").unwrap_or_else(|_| "barhorst-case1-timoshenko".to_string());
-    let ladder: Vec<usize> = std::env::var("TIMO_MODES")
-        .unwrap_or_else(|_| "2,3,4,6".to_string())
-        .split(',')
-        .map(|v| v.trim().parse().unwrap())
-        .collect();
-    let scene = load_scene(&name).unwrap();
-    println!("{name}");
-    for basis in [Basis::Poly, Basis::ClampedFree] {
-        for &n in &ladder {
-            let (r, _) =
-                simulate_detailed(&scene, &run_settings(n, Some(basis), 1e-8, Some(0.5))).unwrap();
-            let sw: Vec<String> = switching(&r)
-                .iter()
-                .map(|(t, k)| format!("{k}{t:.6}"))
-                .collect();
-            println!(
-                "{basis:?} n={n}: {} | closure {:.2e} steps {} wall {:.2}s",
-                sw.join(" "),
-                r.ledger.relative_closure(),
-                r.cost.steps,
-                r.cost.wall_time_s
-            );
-        }
-    }
-}
-
 /// constrained-arm with a Timoshenko link of slenderness λ = L/r (EI and EA kept, κGA =
 /// (κG/E)·EI/r² with the steel-like κG/E = (5/6)/2.6): section radius of gyration r = L/λ.
 fn timoshenko_arm(lambda: f64) -> Scene {
@@ -490,35 +454,6 @@ fn dyn_timoshenko_rotary_inertia_chain_impact_and_ledger() {
         }
     }
     assert!(r.ledger.relative_closure() <= 1e-5);
-}
-
-/// Cost of the v'(0) = 0 basis used with a free joint and massless sections: the stocky
-/// cantilever without rotary inertia, clamped either by a prescribed joint (root-shear basis,
-/// exponentially convergent reference) or by a free joint with a very stiff spring (v'(0) = 0
-/// basis). Run with
-/// `cargo test --release -p modal --test dyn_timoshenko -- --ignored --nocapture root_shear`.
-#[test]
-#[ignore]
-fn conv_timoshenko_root_shear_basis_study() {
-    let mut clamped = load_scene("cantilever-timoshenko").unwrap();
-    clamped.links[0].rotary_inertia = false;
-    let reference = freqs(&clamped, 16, Basis::Poly, 3);
-    let mut sprung = clamped.clone();
-    sprung.links[0].joint.prescribed = None;
-    // Root compliance 1/K ≪ the beam's (L/EI ≈ 6e-4): the spring error is ~1e-7.
-    sprung.links[0].joint.stiffness = Some(1e10);
-    for basis in [Basis::Poly, Basis::ClampedFree] {
-        for n in [2, 4, 6, 8, 12, 16] {
-            // Eigenvalues below the solver's round-off floor (1e-12 λ_max, reported as 0) are
-            // dropped: the stiff spring mode sets λ_max.
-            let f: Vec<f64> = freqs(&sprung, n, basis, 6)
-                .into_iter()
-                .filter(|v| *v > 0.0)
-                .collect();
-            let e: Vec<f64> = f.iter().zip(&reference).map(|(a, b)| (a - b) / b).collect();
-            println!("{basis:?} n={n:2}: v'(0) = 0 basis rel errors {e:?}");
-        }
-    }
 }
 
 #[test]

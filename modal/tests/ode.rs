@@ -386,3 +386,78 @@ fn ode_sdirk_stiff_kelvin_voigt_chain_with_kicks_keeps_rejections_bounded() {
         assert!(st.jacobian_evals * 10 <= st.steps, "{st:?}");
     }
 }
+
+/// Runs `s` on the oscillator with frequency `omega` to `t_end`; returns the final state.
+fn run_oscillator(s: &mut Sdirk, omega: f64, t_end: f64) -> [f64; 2] {
+    let mut f = Oscillator { omega };
+    let (mut t, mut y) = (0.0, [1.0, 0.0]);
+    while t < t_end {
+        s.step(&mut f, &mut t, &mut y, t_end).unwrap();
+    }
+    y
+}
+
+#[test]
+fn ode_fixed_step_trbdf2_is_the_uncontrolled_adaptive_method() {
+    // Without the error test the fixed-step mode takes exactly the steps of the adaptive
+    // method whose tolerance never rejects and whose h_max is the step: same bits.
+    let h = 0.05;
+    let tol = Tolerances::default();
+    let fixed = run_oscillator(&mut Sdirk::fixed_step(2, tol, h), 1.0, 10.0);
+    let free = run_oscillator(&mut Sdirk::new(2, NO_CONTROL, Some(h), Some(h)), 1.0, 10.0);
+    // NO_CONTROL also loosens the Newton test: compare against the fixed step at the same
+    // Newton tolerance for bit identity, and to the Newton tolerance otherwise.
+    let fixed_loose = run_oscillator(&mut Sdirk::fixed_step(2, NO_CONTROL, h), 1.0, 10.0);
+    assert_eq!(fixed_loose, free);
+    let e = exact(1.0, 10.0);
+    let err = (fixed[0] - e[0]).hypot(fixed[1] - e[1]);
+    assert!(
+        err < 1e-2 && err > 1e-6,
+        "second-order error at h = 0.05: {err}"
+    );
+}
+
+#[test]
+fn conv_ode_trapezoid_order_two_and_oscillator_energy_conserved() {
+    let tol = Tolerances::default();
+    let hs = [0.2, 0.1, 0.05, 0.025];
+    let es: Vec<f64> = hs
+        .iter()
+        .map(|&h| {
+            let y = run_oscillator(&mut Sdirk::trapezoidal(2, tol, h), 1.0, 10.0);
+            let e = exact(1.0, 10.0);
+            (y[0] - e[0]).hypot(y[1] - e[1])
+        })
+        .collect();
+    let p = observed_order(&hs, &es);
+    assert!((p - 2.0).abs() < 0.1, "observed order {p}: {es:?}");
+    // The trapezoidal rule keeps the quadratic invariant ω²y² + y'² of a linear oscillator,
+    // also far beyond resolution (hω = 100): no numerical damping.
+    for (omega, h) in [(1.0, 0.1), (1000.0, 0.1)] {
+        let y = run_oscillator(&mut Sdirk::trapezoidal(2, tol, h), omega, 5.0);
+        let energy = omega * omega * y[0] * y[0] + y[1] * y[1];
+        let rel = (energy - omega * omega).abs() / (omega * omega);
+        assert!(rel < 1e-6, "ω = {omega}: relative energy change {rel:e}");
+    }
+}
+
+#[test]
+fn ode_fixed_step_trbdf2_damps_what_the_step_does_not_resolve() {
+    // L-stability: at hω = 100 the TR-BDF2 amplification factor is ~1e-2 per step, so the
+    // unresolved oscillation is gone after a few steps; a resolved one (hω = 0.01) keeps its
+    // amplitude to the method's O((hω)⁴) damping per step.
+    let tol = Tolerances::default();
+    let amp = |y: [f64; 2], omega: f64| (y[0] * y[0] + y[1] * y[1] / (omega * omega)).sqrt();
+    let fast = run_oscillator(&mut Sdirk::fixed_step(2, tol, 0.1), 1000.0, 1.0);
+    assert!(
+        amp(fast, 1000.0) < 1e-6,
+        "unresolved amplitude {}",
+        amp(fast, 1000.0)
+    );
+    let slow = run_oscillator(&mut Sdirk::fixed_step(2, tol, 0.01), 1.0, 10.0);
+    assert!(
+        (amp(slow, 1.0) - 1.0).abs() < 1e-6,
+        "resolved amplitude {}",
+        amp(slow, 1.0)
+    );
+}

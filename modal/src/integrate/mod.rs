@@ -7,6 +7,9 @@
 //!   coefficient, so one LU factorization of I − hγ/2·J serves both implicit stages. Embedded
 //!   3rd-order error estimate (filtered by the same factorization for stiff components),
 //!   cubic Hermite dense output, simplified Newton with a finite-difference or analytic Jacobian.
+//!   Also as a fixed-step method ([`Sdirk::fixed_step`], no error test: L-stable damping of
+//!   what the step does not resolve) and, on the same Newton machinery, the fixed-step
+//!   trapezoidal rule ([`Sdirk::trapezoidal`], no damping).
 //!
 //! Both keep all work arrays in the struct: a step performs no heap allocation.
 

@@ -146,6 +146,10 @@ impl IterationMatrix {
 pub struct Sdirk {
     tol: Tolerances,
     h_max: f64,
+    /// Fixed step size ([`Sdirk::fixed_step`]): no error test; `tol` scales only the Newton test.
+    fixed: Option<f64>,
+    /// With `fixed`: one trapezoidal stage over the whole step instead of TR + BDF2.
+    trapezoid: bool,
     h: Option<f64>,
     have_f1: bool,
     f1: Vec<f64>,
@@ -191,6 +195,8 @@ impl Sdirk {
         Sdirk {
             tol,
             h_max: h_max.unwrap_or(f64::INFINITY),
+            fixed: None,
+            trapezoid: false,
             h: h_init,
             have_f1: false,
             f1: z(),
@@ -223,6 +229,30 @@ impl Sdirk {
             f_prev: z(),
             stats: StepStats::default(),
         }
+    }
+
+    /// TR-BDF2 with the fixed step `h` (steps are only shortened to land on `t_stop`, or halved
+    /// for one attempt when Newton fails with a fresh Jacobian). Without the error test the
+    /// step is set by the dynamics the caller wants resolved, not by the fastest component:
+    /// L-stability damps what the step does not resolve (|hλ| → ∞: R → 0), so an undamped
+    /// high-frequency Ritz mode neither limits the step nor grows. `tol` scales the Newton
+    /// convergence test only.
+    pub fn fixed_step(dim: usize, tol: Tolerances, h: f64) -> Self {
+        let mut s = Self::new(dim, tol, Some(h), Some(h));
+        s.fixed = Some(h);
+        s
+    }
+
+    /// The trapezoidal rule y₁ = y₀ + h/2 (f(y₀) + f(y₁)) with the fixed step `h`, on the same
+    /// Newton machinery (its iteration matrix I − (h/2)J is this integrator's I − h'dJ with
+    /// h' = h/(2d)). A-stable with |R(iω)| = 1: undamped oscillations keep their amplitude at
+    /// any step (a mode with hω ≫ 1 is carried at a wrong, high frequency, not damped), and
+    /// its quadratic invariants of linear systems are conserved. Second order; cubic Hermite
+    /// dense output.
+    pub fn trapezoidal(dim: usize, tol: Tolerances, h: f64) -> Self {
+        let mut s = Self::fixed_step(dim, tol, h);
+        s.trapezoid = true;
+        s
     }
 
     pub fn stats(&self) -> &StepStats {
@@ -413,7 +443,7 @@ impl Sdirk {
         if !self.f1.iter().all(|v| v.is_finite()) {
             return Err(IntegrateError::NonFinite { t: *t });
         }
-        let mut h = match self.h {
+        let mut h = match self.fixed.or(self.h) {
             Some(h) => h,
             None => {
                 let h = initial_step(
@@ -441,8 +471,27 @@ impl Sdirk {
         self.theta_step = 0.0;
         loop {
             let (h_try, clipped) = clip_step(h, span, h_min, *t)?;
-            if self.lu_h != h_try {
-                self.factorize(f, *t, y, h_try);
+            // The stage coefficient is h_stage·d: h for TR-BDF2, h/2 for the trapezoidal rule.
+            let h_stage = if self.trapezoid {
+                h_try / (2.0 * D)
+            } else {
+                h_try
+            };
+            if self.lu_h != h_stage {
+                self.factorize(f, *t, y, h_stage);
+            }
+            if self.trapezoid {
+                for i in 0..n {
+                    self.rhs_base[i] = y[i] + 0.5 * h_try * self.f1[i];
+                    self.z[i] = y[i] + h_try * self.f1[i];
+                }
+                if let Err(fail) = self.newton(f, *t + h_try, h_stage, y, 3) {
+                    h = self.after_newton_failure(f, *t, y, h, h_try, h_min, fail)?;
+                    continue;
+                }
+                self.y_new.copy_from_slice(&self.z);
+                self.accept(f, t, y, h_try, clipped, t_stop);
+                return Ok(());
             }
             // Stage 2 (trapezoidal to t + γh), predicted by the explicit Euler step. (The
             // linearly implicit predictor y + (I − hdJ)⁻¹γh f₁ was measured worse on the
@@ -461,33 +510,21 @@ impl Sdirk {
                 res = self.newton(f, *t + h_try, h_try, y, 3);
             }
             if let Err(fail) = res {
-                self.stats.rejected += 1;
-                self.stats.newton_failures += 1;
-                if !self.jac_fresh {
-                    // A Jacobian from an earlier step: refresh it, retry the same step.
-                    self.update_jacobian(f, *t, y);
-                } else {
-                    h = match fail {
-                        NewtonFail::Diverged => 0.5 * h_try,
-                        // Hairer & Wanner's reduction for an iteration that would not converge
-                        // within the budget: the rate scales like h.
-                        NewtonFail::Slow { ratio, left } => {
-                            0.8 * h_try * ratio.clamp(1e-4, 20.0).powf(-1.0 / (4.0 + left as f64))
-                        }
-                    };
-                    if h < h_min {
-                        return Err(IntegrateError::NewtonFailed { t: *t });
-                    }
-                }
+                h = self.after_newton_failure(f, *t, y, h, h_try, h_min, fail)?;
                 continue;
             }
             self.y_new.copy_from_slice(&self.z);
-            for i in 0..n {
-                self.err[i] = h_try * (E1 * self.f1[i] + E2 * self.f2[i] + E3 * self.f3[i]);
-            }
-            // Filter the estimate through (I − h d J)⁻¹: keeps it bounded on stiff components.
-            self.iter.solve(f, &mut self.err);
-            let err = error_norm(&self.tol, y, &self.y_new, &self.err);
+            let err = if self.fixed.is_some() {
+                0.0
+            } else {
+                for i in 0..n {
+                    self.err[i] = h_try * (E1 * self.f1[i] + E2 * self.f2[i] + E3 * self.f3[i]);
+                }
+                // Filter the estimate through (I − h d J)⁻¹: keeps it bounded on stiff
+                // components.
+                self.iter.solve(f, &mut self.err);
+                error_norm(&self.tol, y, &self.y_new, &self.err)
+            };
             if !err.is_finite() {
                 self.stats.rejected += 1;
                 h = shrink_after_blowup(h_try, h_min, *t)?;
@@ -496,20 +533,7 @@ impl Sdirk {
             // Error of order h³.
             let fac = (SAFETY * err.max(1e-10).powf(-1.0 / 3.0)).clamp(0.2, 5.0);
             if err <= 1.0 {
-                self.t_prev = *t;
-                self.h_last = h_try;
-                self.y_prev.copy_from_slice(y);
-                self.f_prev.copy_from_slice(&self.f1);
-                *t = if clipped { t_stop } else { *t + h_try };
-                y.copy_from_slice(&self.y_new);
-                // f(t₁, y₁) evaluated afresh rather than taken from the stage relation: the
-                // relation divides the Newton residual by h·d, which at loose tolerances feeds
-                // a wrong slope into the next step (seen as blow-up on stiff axial fields).
-                f.eval(*t, y, &mut self.f1);
-                self.stats.rhs_evals += 1;
-                self.stats.steps += 1;
-                // A cheap (analytic) Jacobian is refreshed once the iteration slows down.
-                self.jac_refresh = self.jac_analytic && self.theta_step > THETA_REFRESH;
+                self.accept(f, t, y, h_try, clipped, t_stop);
                 let mut h_next = h_try * fac;
                 // Keep the factorization when the change would be small.
                 if (0.9..=1.3).contains(&(h_next / h_try)) {
@@ -521,6 +545,66 @@ impl Sdirk {
             self.stats.rejected += 1;
             h = h_try * fac.min(0.9);
         }
+    }
+
+    /// Handles a failed stage iteration; returns the step to try next. An old Jacobian is
+    /// refreshed and the same step retried; with a fresh one the step is cut.
+    #[allow(clippy::too_many_arguments)]
+    fn after_newton_failure<F: OdeRhs>(
+        &mut self,
+        f: &mut F,
+        t: f64,
+        y: &[f64],
+        h: f64,
+        h_try: f64,
+        h_min: f64,
+        fail: NewtonFail,
+    ) -> Result<f64, IntegrateError> {
+        self.stats.rejected += 1;
+        self.stats.newton_failures += 1;
+        if !self.jac_fresh {
+            // A Jacobian from an earlier step: refresh it, retry the same step.
+            self.update_jacobian(f, t, y);
+            return Ok(h);
+        }
+        let h = match fail {
+            NewtonFail::Diverged => 0.5 * h_try,
+            // Hairer & Wanner's reduction for an iteration that would not converge within the
+            // budget: the rate scales like h.
+            NewtonFail::Slow { ratio, left } => {
+                0.8 * h_try * ratio.clamp(1e-4, 20.0).powf(-1.0 / (4.0 + left as f64))
+            }
+        };
+        if h < h_min {
+            return Err(IntegrateError::NewtonFailed { t });
+        }
+        Ok(h)
+    }
+
+    /// Commits the step to `y_new`: dense-output data, t, y and f(t₁, y₁).
+    fn accept<F: OdeRhs>(
+        &mut self,
+        f: &mut F,
+        t: &mut f64,
+        y: &mut [f64],
+        h_try: f64,
+        clipped: bool,
+        t_stop: f64,
+    ) {
+        self.t_prev = *t;
+        self.h_last = h_try;
+        self.y_prev.copy_from_slice(y);
+        self.f_prev.copy_from_slice(&self.f1);
+        *t = if clipped { t_stop } else { *t + h_try };
+        y.copy_from_slice(&self.y_new);
+        // f(t₁, y₁) evaluated afresh rather than taken from the stage relation: the relation
+        // divides the Newton residual by h·d, which at loose tolerances feeds a wrong slope
+        // into the next step (seen as blow-up on stiff axial fields).
+        f.eval(*t, y, &mut self.f1);
+        self.stats.rhs_evals += 1;
+        self.stats.steps += 1;
+        // A cheap (analytic) Jacobian is refreshed once the iteration slows down.
+        self.jac_refresh = self.jac_analytic && self.theta_step > THETA_REFRESH;
     }
 
     /// Cubic Hermite interpolation inside the last accepted step: writes y(t_out).

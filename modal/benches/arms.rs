@@ -1,0 +1,54 @@
+//! Criterion benches of the Barhorst arm without contact (issue 16), 10 s each, at the default
+//! settings (basis, modes, method and step chosen by the backend) and, for the undamped arm,
+//! at fixed-step TR-BDF2 (h = 2.5e-4), the cheapest configuration measured within 3e-4 rad of
+//! the converged low-passed joint-1 angle there.
+//!
+//! Run: `cargo bench -p modal --bench arms`. The undamped default is the explicit method with
+//! 6 poly modes, ~1.7e5 Dormand–Prince steps per simulated second (clamped-free: 1.0e5), about
+//! a minute a run on an idle 2-core machine: its 10 samples take ~10 minutes.
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use data::{Backend, Settings, TimeStepping, load_scene};
+use modal::ModalBackend;
+
+fn arms(c: &mut Criterion) {
+    let mut group = c.benchmark_group("arm 10 s");
+    group.sample_size(10);
+    let damped = load_scene("two-link-free").unwrap();
+    group.bench_function("two-link-free default", |b| {
+        b.iter(|| {
+            black_box(
+                ModalBackend
+                    .simulate(&damped, &Settings::default())
+                    .unwrap(),
+            )
+        })
+    });
+    let undamped = load_scene("two-link-free-undamped").unwrap();
+    let fixed = Settings {
+        time: TimeStepping {
+            method: Some("trbdf2-fixed".into()),
+            dt: Some(2.5e-4),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    group.bench_function("two-link-free-undamped trbdf2-fixed 2.5e-4", |b| {
+        b.iter(|| black_box(ModalBackend.simulate(&undamped, &fixed).unwrap()))
+    });
+    group.bench_function("two-link-free-undamped default", |b| {
+        b.iter(|| {
+            black_box(
+                ModalBackend
+                    .simulate(&undamped, &Settings::default())
+                    .unwrap(),
+            )
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, arms);
+criterion_main!(benches);
