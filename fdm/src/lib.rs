@@ -89,7 +89,7 @@
 //!   from the drift velocities v_{j±½} ([`integrator`]): at the predicted velocity the
 //!   foreshortening couplings turned the unresolved bending waves into a bias growing with
 //!   the number of stations (1 s mean of joint 2 on `two-link-free-undamped`: 0.681, 0.665,
-//!   0.636 at 21/41/81 stations against fem's 0.697; now 0.6972, 0.6969, 0.6968, and the 20 Hz
+//!   0.636 at 21/41/81 stations against fem's 0.6968; now 0.6972, 0.6969, 0.6969, and the 20 Hz
 //!   low-passed joint-1 history over 10 s differs 2.0e-2, 6.1e-3 between 21/41 and 41/81 stations).
 //!   Measured (tests/chain.rs): undamped 10 s energy error bounded (no drift), O(τ²); damped ledger closure 6.3e-6 (with the κ_max bound below); joint angles O(h²)
 //!   (orders 1.99, 1.91); rigid limit within 0.5 % of the swing. Step bound: 0.9 × 2/ω_max of
