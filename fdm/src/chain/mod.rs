@@ -54,7 +54,9 @@ use data::scene::{Link, TorqueLaw};
 use data::{DofPlan, RunResult, Scene, Settings, channel};
 
 use crate::error::FdmError;
-use crate::integrator::{Bound, BoundKind, StepControl, System, damped_step_factor, integrate};
+use crate::integrator::{
+    Bound, BoundKind, DriftVelocities, StepControl, System, damped_step_factor, integrate,
+};
 use crate::link::{FloatingLink, sample_field};
 use crate::settings::{FdmSettings, Method};
 use contact::TipContact;
@@ -826,6 +828,22 @@ impl TwoLinkChain {
         self.powers(out);
     }
 
+    /// rhs += scale·(∂T/∂q − (∂p/∂q)q̇) at the chord copies (`qk`, `vk`) of the last
+    /// [`Self::chord`]; `scratch` (length n) is overwritten. The clamp inertias are constant
+    /// and the chord-frame T does not see the ghost slots.
+    fn add_inertia_terms(&mut self, scale: f64, scratch: &mut [f64], rhs: &mut [f64]) {
+        self.inertia.grad_q(&self.qk, &self.vk, scratch);
+        self.inertia
+            .momenta(&self.qk, &self.vk, &self.vk, &mut self.p);
+        for s in self.slots {
+            scratch[s] = 0.0;
+            self.p[s] = Dual::default();
+        }
+        for i in 0..rhs.len() {
+            rhs[i] += scale * (scratch[i] - self.p[i].du);
+        }
+    }
+
     /// Generalized forces Q − ∂V/∂q − ∂D/∂q̇ into `out`; sets the powers.
     fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 0.0);
@@ -904,18 +922,7 @@ impl System for TwoLinkChain {
         let mut rhs = std::mem::take(&mut self.rhs);
         self.chord(q, v);
         self.forces(t, q, v, &mut rhs);
-        // + ∂T/∂q − (∂p/∂q)q̇ (a holds ∂T/∂q temporarily); the clamp inertias are constant
-        // and the chord-frame T does not see the ghost slots
-        self.inertia.grad_q(&self.qk, &self.vk, a);
-        self.inertia
-            .momenta(&self.qk, &self.vk, &self.vk, &mut self.p);
-        for s in self.slots {
-            a[s] = 0.0;
-            self.p[s] = Dual::default();
-        }
-        for i in 0..n {
-            rhs[i] += a[i] - self.p[i].du;
-        }
+        self.add_inertia_terms(1.0, a, &mut rhs);
         self.build_columns();
         self.solve_mass(&rhs, a);
         self.rhs = rhs;
@@ -936,6 +943,37 @@ impl System for TwoLinkChain {
             }
             self.lambda = lam;
         }
+    }
+
+    fn accel_split(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        inertia: DriftVelocities,
+        a: &mut [f64],
+    ) {
+        let mut rhs = std::mem::take(&mut self.rhs);
+        self.chord(q, v);
+        self.forces(t, q, v, &mut rhs);
+        // −Γ from the drift velocities (integrator docs): (1 + w)Γ[v_{j+½}] − wΓ[v_{j−½}]
+        self.chord(q, inertia.current);
+        self.add_inertia_terms(1.0 + inertia.w, a, &mut rhs);
+        if inertia.w != 0.0 {
+            self.chord(q, inertia.previous);
+            self.add_inertia_terms(-inertia.w, a, &mut rhs);
+        }
+        if self.constrained {
+            // the constrained phase runs in the contact driver (`accel`); keep Ġq̇ at `v`
+            self.chord(q, v);
+            self.rhs = rhs;
+            self.accel(t, q, v, a);
+            return;
+        }
+        self.build_columns();
+        self.solve_mass(&rhs, a);
+        self.rhs = rhs;
+        self.lambda = 0.0;
     }
 
     fn powers(&self, out: &mut [f64]) {
