@@ -6,6 +6,7 @@
 
 pub mod analytic;
 pub mod cli;
+pub mod coverage;
 pub mod output;
 pub mod plot;
 pub mod registry;

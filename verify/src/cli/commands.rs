@@ -35,6 +35,7 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             tol,
             opts,
         } => crate::study::recommend_command(&scene, &quantity, tol, &opts),
+        Command::Coverage { format } => crate::coverage::command(format),
         Command::Stability { suite, format, out } => {
             crate::stability::command(suite, format, out.as_deref())
         }
