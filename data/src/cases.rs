@@ -180,7 +180,8 @@ case_files!(
     "rocket",
     "convergence",
     "friction",
-    "contact"
+    "contact",
+    "histories"
 );
 
 /// Parses a case file with located errors.

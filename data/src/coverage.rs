@@ -14,7 +14,8 @@
 //! ```
 //!
 //! `backends` names the backends the gap is about: a `cross-history` exception applies to every
-//! backend pair that contains all of them, a `convergence` exception to each backend listed.
+//! pair of listed backends (a single listed backend: to every pair that contains it), a
+//! `convergence` exception to each backend listed.
 //! An exception that no longer matches a gap is an error of the coverage check (the list only
 //! shrinks).
 

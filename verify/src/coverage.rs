@@ -415,9 +415,10 @@ pub fn analyse(
                 let applies = x.scene == gap.scene
                     && x.missing == gap.missing
                     && match gap.missing {
-                        MissingCheck::CrossHistory => {
-                            x.backends.iter().all(|b| gap.backends.contains(b))
-                        }
+                        MissingCheck::CrossHistory => match x.backends.as_slice() {
+                            [one] => gap.backends.contains(one),
+                            listed => gap.backends.iter().all(|b| listed.contains(b)),
+                        },
                         MissingCheck::Convergence => x.backends.contains(&gap.backends[0]),
                     };
                 if applies {
