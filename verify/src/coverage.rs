@@ -534,17 +534,39 @@ pub fn report(c: &Coverage) -> String {
     }
     let mut out = pad_table(&header, &rows);
     let gaps: Vec<&Gap> = c.scenes.iter().flat_map(|s| &s.gaps).collect();
-    if !gaps.is_empty() {
-        out.push_str("\ngaps (GAP: not covered and not listed; exc: listed in data/cases/coverage-exceptions.toml)\n");
-        for g in gaps {
-            out.push_str(&format!(
-                "  {:<4} {:<28} {:<13} {:<10} {}\n",
-                if g.excused_by.is_some() { "exc" } else { "GAP" },
-                g.scene,
-                g.missing.name(),
-                names(&g.backends),
-                g.excused_by.as_deref().unwrap_or("")
-            ));
+    let gap_line = |g: &Gap| {
+        format!(
+            "  {:<28} {:<13} {}\n",
+            g.scene,
+            g.missing.name(),
+            names(&g.backends)
+        )
+    };
+    let open: Vec<&&Gap> = gaps.iter().filter(|g| g.excused_by.is_none()).collect();
+    if !open.is_empty() {
+        out.push_str(
+            "\nGAP: not covered by a row and not listed in data/cases/coverage-exceptions.toml\n",
+        );
+        for g in open {
+            out.push_str(&gap_line(g));
+        }
+    }
+    // Listed gaps grouped by their reason, each reason printed once.
+    let mut reasons: Vec<&str> = Vec::new();
+    for g in &gaps {
+        if let Some(r) = g.excused_by.as_deref()
+            && !reasons.contains(&r)
+        {
+            reasons.push(r);
+        }
+    }
+    if !reasons.is_empty() {
+        out.push_str("\nexc: listed gaps (data/cases/coverage-exceptions.toml), by reason\n");
+    }
+    for r in reasons {
+        out.push_str(&format!("- {r}\n"));
+        for g in gaps.iter().filter(|g| g.excused_by.as_deref() == Some(r)) {
+            out.push_str(&gap_line(g));
         }
     }
     for (x, why) in &c.stale_exceptions {
