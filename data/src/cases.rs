@@ -20,7 +20,17 @@
 //! `axial_freqN` / `bending_freqN` (N-th of that kind), `tip_static` (static tip deflection),
 //! `CHANNEL@T` (observable at time T; `tip_deflection`, `tip_x`, `tip_y` alias the last link's
 //! channel), `peak:CHANNEL` (max |value| over the run), `ledger_closure` (relative energy-ledger
-//! residual), `max_momentum_residual` (impacts).
+//! residual), `max_momentum_residual` (impacts), `impulseN`, `impact_timeN`, `release_timeN`,
+//! `episode_startN:F` / `episode_endN:F` (contact events), and whole histories compared with a
+//! reference backend's over the run, error max_t |a(t) − b(t)| / max_t |b(t)|:
+//! * `history:CHANNEL` — the raw history; CHANNEL is an observable or `energy.NAME`, a term of
+//!   the energy ledger (`energy.kinetic`, `energy.strain`, `energy.joint_damper`, …;
+//!   `energy.total` is the stored sum);
+//! * `lowpassF:history:CHANNEL` — both histories first put on one uniform grid and low-passed
+//!   at F Hz (e.g. `lowpass20:history:joint1.angle`) by a zero-phase forward–backward
+//!   second-order Butterworth filter (filtfilt: gain 1 at 0 Hz, ½ at F, no lag; ends extended
+//!   by odd reflection, constants kept exactly); F must lie below the Nyquist frequency of the
+//!   output interval. Design and edge handling: `verify::suite::filter`.
 
 use serde::{Deserialize, Serialize};
 
@@ -180,7 +190,8 @@ case_files!(
     "rocket",
     "convergence",
     "friction",
-    "contact"
+    "contact",
+    "histories"
 );
 
 /// Parses a case file with located errors.

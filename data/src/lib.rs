@@ -13,6 +13,7 @@
 pub mod backend;
 pub mod cases;
 pub mod catalog;
+pub mod coverage;
 pub mod error;
 pub mod locate;
 pub mod reader;

@@ -15,6 +15,7 @@
 
 pub mod analytic;
 pub mod cli;
+pub mod coverage;
 pub mod error;
 pub mod output;
 pub mod plot;

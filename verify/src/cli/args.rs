@@ -92,6 +92,12 @@ pub enum Command {
         #[command(flatten)]
         opts: CommonOpts,
     },
+    /// Which backends run each catalog scene and which checks (row ids) cover it; fails on a
+    /// gap not listed in data/cases/coverage-exceptions.toml.
+    Coverage {
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+    },
     /// Stiff and extreme cases: each backend's verdict.
     Stability {
         #[arg(long, value_enum, default_value_t = Suite::Quick)]

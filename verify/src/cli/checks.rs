@@ -103,3 +103,26 @@ pub fn stability(suite: Suite, format: Format, out: Option<&Path>) -> Result<(),
         ))
     }
 }
+
+/// `flexverify coverage`: the coverage report; a gap not listed in
+/// `data/cases/coverage-exceptions.toml`, or a listed exception that rows now cover, fails.
+pub fn coverage(format: Format) -> Result<(), CliError> {
+    let c = crate::coverage::analyse_embedded().map_err(|e| CliError::Input(e.to_string()))?;
+    match format {
+        Format::Json => println!(
+            "{}",
+            serde_json::to_string_pretty(&c)
+                .map_err(|e| CliError::Failed(format!("error: cannot serialize: {e}")))?
+        ),
+        _ => print!("{}", crate::coverage::report(&c)),
+    }
+    let unexcused = c.unexcused().count();
+    if unexcused + c.stale_exceptions.len() > 0 {
+        return Err(CliError::Failed(format!(
+            "coverage: {unexcused} gap(s) not listed in data/cases/coverage-exceptions.toml, {} \
+             stale exception(s)",
+            c.stale_exceptions.len()
+        )));
+    }
+    Ok(())
+}

@@ -35,6 +35,7 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             tol,
             opts,
         } => super::studies::recommend(&scene, &quantity, tol, &opts),
+        Command::Coverage { format } => super::checks::coverage(format),
         Command::Stability { suite, format, out } => {
             super::checks::stability(suite, format, out.as_deref())
         }

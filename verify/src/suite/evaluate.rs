@@ -305,7 +305,10 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
     }
 
     if let (
-        Quantity::History { channel },
+        Quantity::History {
+            channel,
+            lowpass_hz,
+        },
         Reference::Backend {
             backend,
             settings: ref_settings,
@@ -319,32 +322,20 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
         };
         let a = run(case.backend, &settings)?;
         let b = run(*backend, &ref_settings.to_settings())?;
-        let ca = a
-            .observables
-            .get(channel)
-            .ok_or_else(|| format!("{}: no channel `{channel}`", case.backend))?;
-        let cb = b
-            .observables
-            .get(channel)
-            .ok_or_else(|| format!("{backend}: no channel `{channel}`"))?;
-        let peak = cb.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let mut worst = 0.0f64;
-        for (t, va) in a.observables.time.iter().zip(&ca.values) {
-            if let Some(vb) = data::results::interpolate(&b.observables.time, &cb.values, *t) {
-                worst = worst.max((va - vb).abs());
-            }
-        }
+        let d = super::history::compare(&a, &b, channel, *lowpass_hz)
+            .map_err(|e| format!("{} vs {backend}: {e}", case.backend))?;
         out.wall_time_s += a.cost.wall_time_s + b.cost.wall_time_s;
-        out.value = Some(worst);
-        out.reference = Some(peak);
+        out.value = Some(d.max_abs_diff);
+        out.reference = Some(d.reference_peak);
         out.reference_label = format!(
-            "history of {backend}({}), error = max|Δ| / its peak",
-            settings_label(ref_settings)
+            "history of {backend}({}){}, error = max|Δ| / its peak",
+            settings_label(ref_settings),
+            lowpass_hz.map_or(String::new(), |f| format!(", both low-passed at {f} Hz"))
         );
-        if peak <= 0.0 {
+        if d.reference_peak <= 0.0 {
             return Err("the reference history is identically zero".into());
         }
-        out.error = Some(worst / peak);
+        out.error = Some(d.max_abs_diff / d.reference_peak);
         return Ok(());
     }
 

@@ -4,6 +4,8 @@
 //! returned in case order, so results are identical with or without threads.
 
 pub mod evaluate;
+pub mod filter;
+pub mod history;
 pub mod plots;
 pub mod quantity;
 pub mod reference;

@@ -40,15 +40,8 @@ fn run(
 }
 
 fn series_of(r: &RunResult, channel: &str) -> Option<Vec<(f64, f64)>> {
-    let c = r.observables.get(channel)?;
-    Some(
-        r.observables
-            .time
-            .iter()
-            .copied()
-            .zip(c.values.iter().copied())
-            .collect(),
-    )
+    let (t, v) = super::history::series(r, channel)?;
+    Some(t.iter().copied().zip(v.iter().copied()).collect())
 }
 
 /// Draws what can be drawn for each case; returns the number of plots written.
@@ -65,7 +58,7 @@ pub fn draw_all(dir: &Path, cases: &[Case], outcomes: &[Outcome], cache: &RunCac
         let stem = format!("case-{}", case.id);
         let ok = match (&q, &case.reference) {
             (
-                Quantity::History { channel },
+                Quantity::History { channel, .. },
                 Reference::Backend {
                     backend,
                     settings: rs,

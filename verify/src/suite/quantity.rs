@@ -13,9 +13,13 @@ pub enum Quantity {
     At { channel: String, t: f64 },
     /// max |channel| over the run.
     Peak { channel: String },
-    /// The whole time history of a channel; compared with another backend's history as
-    /// max_t |a(t) − b(t)| / max_t |b(t)|.
-    History { channel: String },
+    /// The whole time history of a channel (or of an energy-ledger term, `energy.NAME`);
+    /// compared with another backend's history as max_t |a(t) − b(t)| / max_t |b(t)|, after a
+    /// zero-phase low-pass with cut-off `lowpass_hz` when given (see [`super::filter`]).
+    History {
+        channel: String,
+        lowpass_hz: Option<f64>,
+    },
     /// Relative energy-ledger closure.
     LedgerClosure,
     /// Largest impact momentum residual (an error when the run had no impact).
@@ -135,7 +139,25 @@ impl Quantity {
             _ => {}
         }
         if let Some(c) = t.strip_prefix("history:") {
-            return Ok(Quantity::History { channel: alias(c) });
+            return Ok(Quantity::History {
+                channel: alias(c),
+                lowpass_hz: None,
+            });
+        }
+        if let Some(rest) = t.strip_prefix("lowpass") {
+            let (hz, c) = rest
+                .split_once(":history:")
+                .ok_or_else(|| format!("`{text}`: expected lowpassF:history:CHANNEL (F in Hz)"))?;
+            let f: f64 = hz
+                .parse()
+                .map_err(|_| format!("`{text}`: `{hz}` is not a cut-off frequency in Hz"))?;
+            if !(f.is_finite() && f > 0.0) {
+                return Err(format!("`{text}`: the cut-off must be finite and > 0 Hz"));
+            }
+            return Ok(Quantity::History {
+                channel: alias(c),
+                lowpass_hz: Some(f),
+            });
         }
         if let Some(c) = t.strip_prefix("peak:") {
             return Ok(Quantity::Peak { channel: alias(c) });
@@ -156,7 +178,7 @@ impl Quantity {
         }
         Err(format!(
             "unknown quantity `{text}`; expected freqN, axial_freqN, bending_freqN, tip_static, \
-             CHANNEL@T, peak:CHANNEL, history:CHANNEL, ledger_closure, max_momentum_residual, \
+             CHANNEL@T, peak:CHANNEL, history:CHANNEL, lowpassF:history:CHANNEL, ledger_closure, max_momentum_residual, \
              impulseN, impact_timeN, release_timeN, episode_startN:F or episode_endN:F"
         ))
     }
@@ -228,9 +250,14 @@ impl Quantity {
                     )
                 })
             }
-            Quantity::Peak { channel } | Quantity::History { channel } => {
+            Quantity::Peak { channel } => {
                 let c = r.observables.get(channel).ok_or_else(|| missing(channel))?;
                 Ok(c.values.iter().fold(0.0f64, |m, v| m.max(v.abs())))
+            }
+            Quantity::History { channel, .. } => {
+                let (_, values) =
+                    super::history::series(r, channel).ok_or_else(|| missing(channel))?;
+                Ok(values.iter().fold(0.0f64, |m, v| m.max(v.abs())))
             }
             Quantity::LedgerClosure => Ok(r.ledger.relative_closure()),
             Quantity::MaxMomentumResidual => {
@@ -301,12 +328,12 @@ impl Quantity {
     /// Scale of the reference time history for `relative-to-peak` norms.
     pub fn peak_scale(&self, r: &RunResult) -> Option<f64> {
         match self {
-            Quantity::At { channel, .. }
-            | Quantity::Peak { channel }
-            | Quantity::History { channel } => r
+            Quantity::At { channel, .. } | Quantity::Peak { channel } => r
                 .observables
                 .get(channel)
                 .map(|c| c.values.iter().fold(0.0f64, |m, v| m.max(v.abs()))),
+            Quantity::History { channel, .. } => super::history::series(r, channel)
+                .map(|(_, v)| v.iter().fold(0.0f64, |m, v| m.max(v.abs()))),
             _ => None,
         }
     }

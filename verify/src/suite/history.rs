@@ -1,0 +1,114 @@
+//! Whole-history comparison of two runs (`history:` and `lowpassF:history:` quantities).
+//!
+//! A history is an observable channel (`data::channel`) or an energy-ledger term addressed as
+//! `energy.NAME` (a stored, input or dissipation term of `data::EnergyLedger`, e.g.
+//! `energy.kinetic`, `energy.strain`, `energy.joint_damper`; `energy.total` is the sum of the
+//! stored terms). The error of run `a` against run `b` is
+//!
+//! ```text
+//! max_t |a(t) − b(t)| / max_t |b(t)|
+//! ```
+//!
+//! over the output times of `a` (b linearly interpolated). With a low-pass cut-off f_c both
+//! histories are first interpolated onto one uniform grid of as many samples as `a` has over
+//! a's span, then filtered by the zero-phase Butterworth of [`super::filter`], and compared on
+//! that grid.
+
+use std::borrow::Cow;
+
+use data::RunResult;
+
+use super::filter::{lowpass_zero_phase, resample_uniform};
+
+/// Prefix of energy-ledger terms in history channel names.
+pub const ENERGY_PREFIX: &str = "energy.";
+
+/// (times, values) of a channel or ledger term of a run.
+pub fn series<'a>(r: &'a RunResult, channel: &str) -> Option<(&'a [f64], Cow<'a, [f64]>)> {
+    if let Some(term) = channel.strip_prefix(ENERGY_PREFIX) {
+        let l = &r.ledger;
+        if term == "total" {
+            let total: Vec<f64> = (0..l.time.len()).map(|k| l.total(k)).collect();
+            return Some((&l.time, Cow::Owned(total)));
+        }
+        return l
+            .stored
+            .iter()
+            .chain(&l.inputs)
+            .chain(&l.dissipation)
+            .find(|t| t.name == term)
+            .map(|t| (l.time.as_slice(), Cow::Borrowed(t.values.as_slice())));
+    }
+    r.observables.get(channel).map(|c| {
+        (
+            r.observables.time.as_slice(),
+            Cow::Borrowed(c.values.as_slice()),
+        )
+    })
+}
+
+/// Largest deviation of `a` from `b` and the peak |b| over the compared samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HistoryDeviation {
+    pub max_abs_diff: f64,
+    pub reference_peak: f64,
+}
+
+/// Compares the histories of `channel` in two runs (see the module docs).
+pub fn compare(
+    a: &RunResult,
+    b: &RunResult,
+    channel: &str,
+    lowpass_hz: Option<f64>,
+) -> Result<HistoryDeviation, String> {
+    let (ta, va) = series(a, channel).ok_or_else(|| format!("no channel `{channel}`"))?;
+    let (tb, vb) = series(b, channel).ok_or_else(|| format!("no channel `{channel}`"))?;
+    let Some(fc) = lowpass_hz else {
+        let mut worst = 0.0f64;
+        for (t, x) in ta.iter().zip(va.iter()) {
+            if let Some(y) = data::results::interpolate(tb, &vb, *t) {
+                worst = worst.max((x - y).abs());
+            }
+        }
+        return Ok(HistoryDeviation {
+            max_abs_diff: worst,
+            reference_peak: vb.iter().fold(0.0f64, |m, v| m.max(v.abs())),
+        });
+    };
+    // Common span: the filter needs both histories on one uniform grid.
+    let t0 = ta[0].max(tb[0]);
+    let t1 = ta[ta.len() - 1].min(tb[tb.len() - 1]);
+    if t1 <= t0 {
+        return Err("the two histories do not overlap in time".into());
+    }
+    let inside = ta.iter().filter(|t| **t >= t0 && **t <= t1).count().max(3);
+    let on_grid = |t: &[f64], v: &[f64]| -> Result<Vec<f64>, String> {
+        let (span_t, span_v): (Vec<f64>, Vec<f64>) = t
+            .iter()
+            .zip(v)
+            .filter(|(s, _)| **s >= t0 && **s <= t1)
+            .map(|(s, x)| (*s, *x))
+            .chain([t0, t1].into_iter().filter_map(|s| {
+                // The span ends themselves, so that both grids cover [t0, t1] exactly.
+                data::results::interpolate(t, v, s).map(|x| (s, x))
+            }))
+            .unzip();
+        let mut pts: Vec<(f64, f64)> = span_t.into_iter().zip(span_v).collect();
+        pts.sort_by(|p, q| p.0.total_cmp(&q.0));
+        pts.dedup_by(|p, q| p.0 == q.0);
+        let (ts, vs): (Vec<f64>, Vec<f64>) = pts.into_iter().unzip();
+        let (dt, _, uniform) = resample_uniform(&ts, &vs, inside).map_err(|e| e.to_string())?;
+        lowpass_zero_phase(&uniform, dt, fc).map_err(|e| e.to_string())
+    };
+    let fa = on_grid(ta, &va)?;
+    let fb = on_grid(tb, &vb)?;
+    let max_abs_diff = fa
+        .iter()
+        .zip(&fb)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    let reference_peak = fb.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    Ok(HistoryDeviation {
+        max_abs_diff,
+        reference_peak,
+    })
+}
