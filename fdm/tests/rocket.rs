@@ -626,3 +626,102 @@ fn dyn_rocket_thrust_along_the_mean_axis_leaves_no_lateral_drift() {
     );
     assert!(drift.abs() < 0.2 * tilted.abs(), "{drift:e} vs {tilted:e}");
 }
+
+#[test]
+fn dyn_rocket_constant_thrust_quasi_static_compression_matches_closed_form() {
+    // Constant thrust T on the straight free-free case with constant mass (burn rate ×1e-6,
+    // exhaust velocity ×1e6: same thrust, mass change 1e-7 of itself), chamber pressure off.
+    // Quasi-statically every section accelerates at a = T/M, so the axial force is
+    // N(x) = −a·(mass ahead of x, case and discrete masses), u(L) − u(0) = ∫N/EA dx, and each
+    // discrete mass lags its attachment by M_j a / k_u (the coupling springs carry nothing:
+    // all three masses are equal and equally attached). The dynamic response oscillates about
+    // this (step load); its mean over the run differs from it by at most 1/(ω₁T) ≈ 5e-3 of the
+    // static value (ω₁ ≈ 2π·340 rad/s, the lowest axial frequency, T = 0.1 s).
+    let mut scene = load_scene("rocket").unwrap();
+    {
+        let r = scene.rocket.as_mut().unwrap();
+        r.stages[0].burn_rate *= 1e-6;
+        r.exhaust_velocity *= 1e6;
+        r.chamber_pressure = 0.0;
+        r.initial_shape = data::scene::InitialShape::Straight;
+    }
+    let r = scene.rocket.as_ref().unwrap();
+    let g = r.gravity;
+    let len = r.length();
+    let thrust = r.stages[0].burn_rate / g * r.stages[0].length * r.exhaust_velocity;
+    let m_total = r
+        .stages
+        .iter()
+        .map(|s| s.weight_per_length * s.length)
+        .sum::<f64>()
+        / g
+        + r.discrete_masses.iter().map(|m| m.weight).sum::<f64>() / g;
+    let acc = thrust / m_total;
+    // ∫₀^x N/EA by the midpoint rule on a fine grid (exact between the few kinks)
+    let n = 150_000;
+    let dx = len / n as f64;
+    let mut stage_start = vec![0.0];
+    for s in &r.stages {
+        stage_start.push(stage_start.last().unwrap() + s.length);
+    }
+    let stage_of = |x: f64| {
+        (0..r.stages.len())
+            .find(|&k| x < stage_start[k + 1])
+            .unwrap()
+    };
+    let mass_ahead = |x: f64| {
+        let mut m = 0.0;
+        for (k, s) in r.stages.iter().enumerate() {
+            let (a, b) = (stage_start[k], stage_start[k + 1]);
+            m += s.weight_per_length / g * (b - x.max(a)).max(0.0);
+        }
+        m + r
+            .discrete_masses
+            .iter()
+            .filter(|d| d.position > x)
+            .map(|d| d.weight / g)
+            .sum::<f64>()
+    };
+    let mut u_rel = 0.0; // u(x) − u(0)
+    let mut u_at_mass = vec![0.0; r.discrete_masses.len()];
+    for i in 0..n {
+        let x = (i as f64 + 0.5) * dx;
+        let s = &r.stages[stage_of(x)];
+        u_rel += -acc * mass_ahead(x) / (r.youngs_modulus * s.area) * dx;
+        for (j, d) in r.discrete_masses.iter().enumerate() {
+            if (x + 0.5 * dx - d.position).abs() < 0.25 * dx {
+                u_at_mass[j] = u_rel;
+            }
+        }
+    }
+    let out = run(&scene, "report");
+    let o = &out.observables;
+    let nf = scene.simulation.field_stations;
+    let u0 = ch(o, "rocket.u@0");
+    let span: Vec<f64> = ch(o, &format!("rocket.u@{}", nf - 1))
+        .iter()
+        .zip(u0)
+        .map(|(a, b)| a - b)
+        .collect();
+    let e = (mean(&span) - u_rel) / u_rel;
+    eprintln!(
+        "u(L) − u(0): mean {:.5e}, closed form {u_rel:.5e} ({e:+.2e})",
+        mean(&span)
+    );
+    assert!(e.abs() < 1e-2, "{e:e}");
+    for (j, d) in r.discrete_masses.iter().enumerate() {
+        let rel: Vec<f64> = ch(o, &format!("rocket.mass{}.u", j + 1))
+            .iter()
+            .zip(u0)
+            .map(|(a, b)| a - b)
+            .collect();
+        let exact = u_at_mass[j] - d.weight / g * acc / d.axial_stiffness;
+        let e = (mean(&rel) - exact) / exact;
+        eprintln!(
+            "mass {} − u(0): mean {:.5e}, closed form {exact:.5e} ({e:+.2e})",
+            j + 1,
+            mean(&rel)
+        );
+        assert!(e.abs() < 1e-2, "mass {}: {e:e}", j + 1);
+    }
+}
