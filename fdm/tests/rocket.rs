@@ -527,3 +527,201 @@ fn prop_rocket_split_satisfies_5_37_exactly() {
         );
     }
 }
+
+/// Weighted least-squares line c₀ + c₁x of the scene's initial w(x, 0) with the case's ignition
+/// mass per length (stepped, discrete masses excluded), by a fine trapezoid rule.
+fn rigid_part_of_initial_shape(scene: &Scene) -> (f64, f64) {
+    let r = scene.rocket.as_ref().unwrap();
+    let len = r.length();
+    let n = 30_000;
+    let mass_at = |x: f64| {
+        let mut a = 0.0;
+        for s in &r.stages {
+            if x <= a + s.length {
+                return s.weight_per_length / r.gravity;
+            }
+            a += s.length;
+        }
+        r.stages.last().unwrap().weight_per_length / r.gravity
+    };
+    let (mut s0, mut s1, mut s2, mut r0, mut r1) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for i in 0..=n {
+        let x = len * i as f64 / n as f64;
+        let wq = if i == 0 || i == n { 0.5 } else { 1.0 } * mass_at(x);
+        let w0 = r.initial_shape.deflection(x, len);
+        s0 += wq;
+        s1 += wq * x;
+        s2 += wq * x * x;
+        r0 += wq * w0;
+        r1 += wq * x * w0;
+    }
+    let det = s0 * s2 - s1 * s1;
+    ((s2 * r0 - s1 * r1) / det, (s0 * r1 - s1 * r0) / det)
+}
+
+#[test]
+fn sys_rocket_initial_shape_is_elastic_with_respect_to_ignition_mass() {
+    let scene = load_scene("rocket").unwrap();
+    let r = scene.rocket.as_ref().unwrap();
+    let (_, f) = settings("report");
+    let sys = fdm::rocket::build(&scene, &f).unwrap();
+    let (q, _) = sys.initial_state(&r.initial_shape);
+    let m = &sys.model;
+    let w = &q[sys.w_range()];
+    let (mut mw, mut mxw, mut scale) = (0.0, 0.0, 0.0);
+    for (i, wi) in w.iter().enumerate() {
+        let (x, mi) = (i as f64 * m.h, m.station_mass(i, m.m1(0.0)));
+        mw += mi * wi;
+        mxw += mi * x * wi;
+        scale += mi * wi.abs();
+    }
+    // exact up to round-off of sums of ~100 terms
+    assert!(mw.abs() < 1e-12 * scale, "Σm₀w = {mw:e}");
+    assert!(mxw.abs() < 1e-12 * scale * m.length, "Σm₀xw = {mxw:e}");
+    // what was removed is a straight line close to the continuous rigid part of w(x, 0)
+    let (c0, c1) = rigid_part_of_initial_shape(&scene);
+    assert!(
+        c0.abs() > 1e-6 && c1.abs() > 1e-8,
+        "the stepped case has a rigid part"
+    );
+    for (i, wi) in w.iter().enumerate() {
+        let x = i as f64 * m.h;
+        let removed = r.initial_shape.deflection(x, m.length) - wi;
+        // lumped (trapezoid, h = 2 in) vs continuous weights: O(h²) of the ~5e-6 line
+        assert!(
+            (removed - (c0 + c1 * x)).abs() < 2e-2 * c0.abs(),
+            "station {i}: removed {removed:e}, line {:e}",
+            c0 + c1 * x
+        );
+    }
+}
+
+#[test]
+fn dyn_rocket_thrust_along_the_mean_axis_leaves_no_lateral_drift() {
+    // The thrust acts along the body axis. If the body axis is not the case's mean axis (the
+    // initial shape's rigid part, slope c₁ of a few 1e-8 rad, left in the elastic field), the
+    // thrust is tilted by c₁ and the mass centre drifts sideways by ½(T/M)c₁t², 1e-5 in at
+    // 0.1 s — as large as the elastic deflections themselves. With the rigid part removed the
+    // drift is only what the bending vibration (w' of 1e-6 at the nozzle, averaging out) leaves.
+    let scene = load_scene("rocket").unwrap();
+    let r = scene.rocket.as_ref().unwrap();
+    let out = run(&scene, "report");
+    let o = &out.observables;
+    let x = ch(o, "rocket.X");
+    let t_end = *o.time.last().unwrap();
+    let drift = x.last().unwrap() - x[0];
+    let g = r.gravity;
+    let flow = r.stages[0].burn_rate / g * r.stages[0].length;
+    let m0 = r
+        .stages
+        .iter()
+        .map(|s| s.weight_per_length * s.length)
+        .sum::<f64>()
+        / g
+        + r.discrete_masses.iter().map(|m| m.weight).sum::<f64>() / g;
+    let (_, c1) = rigid_part_of_initial_shape(&scene);
+    let tilted = 0.5 * flow * r.exhaust_velocity / m0 * c1 * t_end * t_end;
+    eprintln!(
+        "lateral drift {drift:.3e} in; a thrust tilted by c₁ = {c1:.3e} would give {tilted:.3e}"
+    );
+    assert!(drift.abs() < 0.2 * tilted.abs(), "{drift:e} vs {tilted:e}");
+}
+
+#[test]
+fn dyn_rocket_constant_thrust_quasi_static_compression_matches_closed_form() {
+    // Constant thrust T on the straight free-free case with constant mass (burn rate ×1e-6,
+    // exhaust velocity ×1e6: same thrust, mass change 1e-7 of itself), chamber pressure off.
+    // Quasi-statically every section accelerates at a = T/M, so the axial force is
+    // N(x) = −a·(mass ahead of x, case and discrete masses), u(L) − u(0) = ∫N/EA dx, and each
+    // discrete mass lags its attachment by M_j a / k_u (the coupling springs carry nothing:
+    // all three masses are equal and equally attached). The dynamic response oscillates about
+    // this (step load); its mean over the run differs from it by at most 1/(ω₁T) ≈ 5e-3 of the
+    // static value (ω₁ ≈ 2π·340 rad/s, the lowest axial frequency, T = 0.1 s).
+    let mut scene = load_scene("rocket").unwrap();
+    {
+        let r = scene.rocket.as_mut().unwrap();
+        r.stages[0].burn_rate *= 1e-6;
+        r.exhaust_velocity *= 1e6;
+        r.chamber_pressure = 0.0;
+        r.initial_shape = data::scene::InitialShape::Straight;
+    }
+    let r = scene.rocket.as_ref().unwrap();
+    let g = r.gravity;
+    let len = r.length();
+    let thrust = r.stages[0].burn_rate / g * r.stages[0].length * r.exhaust_velocity;
+    let m_total = r
+        .stages
+        .iter()
+        .map(|s| s.weight_per_length * s.length)
+        .sum::<f64>()
+        / g
+        + r.discrete_masses.iter().map(|m| m.weight).sum::<f64>() / g;
+    let acc = thrust / m_total;
+    // ∫₀^x N/EA by the midpoint rule on a fine grid (exact between the few kinks)
+    let n = 150_000;
+    let dx = len / n as f64;
+    let mut stage_start = vec![0.0];
+    for s in &r.stages {
+        stage_start.push(stage_start.last().unwrap() + s.length);
+    }
+    let stage_of = |x: f64| {
+        (0..r.stages.len())
+            .find(|&k| x < stage_start[k + 1])
+            .unwrap()
+    };
+    let mass_ahead = |x: f64| {
+        let mut m = 0.0;
+        for (k, s) in r.stages.iter().enumerate() {
+            let (a, b) = (stage_start[k], stage_start[k + 1]);
+            m += s.weight_per_length / g * (b - x.max(a)).max(0.0);
+        }
+        m + r
+            .discrete_masses
+            .iter()
+            .filter(|d| d.position > x)
+            .map(|d| d.weight / g)
+            .sum::<f64>()
+    };
+    let mut u_rel = 0.0; // u(x) − u(0)
+    let mut u_at_mass = vec![0.0; r.discrete_masses.len()];
+    for i in 0..n {
+        let x = (i as f64 + 0.5) * dx;
+        let s = &r.stages[stage_of(x)];
+        u_rel += -acc * mass_ahead(x) / (r.youngs_modulus * s.area) * dx;
+        for (j, d) in r.discrete_masses.iter().enumerate() {
+            if (x + 0.5 * dx - d.position).abs() < 0.25 * dx {
+                u_at_mass[j] = u_rel;
+            }
+        }
+    }
+    let out = run(&scene, "report");
+    let o = &out.observables;
+    let nf = scene.simulation.field_stations;
+    let u0 = ch(o, "rocket.u@0");
+    let span: Vec<f64> = ch(o, &format!("rocket.u@{}", nf - 1))
+        .iter()
+        .zip(u0)
+        .map(|(a, b)| a - b)
+        .collect();
+    let e = (mean(&span) - u_rel) / u_rel;
+    eprintln!(
+        "u(L) − u(0): mean {:.5e}, closed form {u_rel:.5e} ({e:+.2e})",
+        mean(&span)
+    );
+    assert!(e.abs() < 1e-2, "{e:e}");
+    for (j, d) in r.discrete_masses.iter().enumerate() {
+        let rel: Vec<f64> = ch(o, &format!("rocket.mass{}.u", j + 1))
+            .iter()
+            .zip(u0)
+            .map(|(a, b)| a - b)
+            .collect();
+        let exact = u_at_mass[j] - d.weight / g * acc / d.axial_stiffness;
+        let e = (mean(&rel) - exact) / exact;
+        eprintln!(
+            "mass {} − u(0): mean {:.5e}, closed form {exact:.5e} ({e:+.2e})",
+            j + 1,
+            mean(&rel)
+        );
+        assert!(e.abs() < 1e-2, "mass {}: {e:e}", j + 1);
+    }
+}

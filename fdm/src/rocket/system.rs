@@ -14,6 +14,15 @@
 //! ṗ_i = F_x,i/m_i − (A_x,i without ṗ). These satisfy 5.37 exactly (their momentum and moment
 //! about O vanish by construction), so the split is not an approximation here.
 //! Mass-loss terms F_M (3.43) cancel the ṁ part of d/dt(∂L/∂q̇) and do not appear.
+//!
+//! Initial shape and outputs. The scene's w(x, 0) is an elastic shape: its rigid-body part with
+//! respect to the case's ignition mass m₀ is removed (see [`RocketSystem::initial_state`]).
+//! The elastic channels `rocket.u@k`, `rocket.w@k`, `rocket.mass{j}.u/.w` are displacements
+//! relative to the case's mean axis with respect to m₀ (the frame in which Σm₀u = Σm₀w =
+//! Σm₀xw = 0 over the case stations, discrete masses excluded), and `rocket.theta` is the angle
+//! of that axis; this is the definition of the modal backend, whose elastic modes are
+//! m₀-orthogonal to the rigid motions, so the channels do not depend on how either backend
+//! fixes its body frame. `rocket.X/Y` are the inertial mass centre of case and discrete masses.
 
 use std::ops::Range;
 
@@ -75,14 +84,25 @@ impl RocketSystem {
         3 + 2 * n + nm..3 + 2 * n + 2 * nm
     }
 
-    /// Initial state: rest, attitude θ₀, transverse shape w(x, 0) (report §5.3).
+    /// Initial state: rest, attitude θ₀, transverse shape w(x, 0) (report §5.3) taken as an
+    /// *elastic* shape: its rigid-body part with respect to the case's ignition mass (the
+    /// weighted least-squares line c₀ + c₁x with the lumped station masses, discrete masses
+    /// excluded) is removed, so that ∑mᵢwᵢ = ∑mᵢxᵢwᵢ = 0 and the body axis is the case's mean
+    /// axis. The report's shapes satisfy this for a uniform case; for the stepped case the line
+    /// is about 5e-6 in offset and 1e-7 rad in slope, enough to shift the thrust line (which
+    /// follows the body axis) and the initial stretch of the discrete masses' springs (they
+    /// start at U = W = 0).
     pub fn initial_state(&self, shape: &data::scene::InitialShape) -> (Vec<f64>, Vec<f64>) {
         let n = self.dofs();
         let mut q = vec![0.0; n];
         q[ITH] = self.model.theta0;
+        let m = &self.model;
+        let fit = mean_axis(m, |i| (0.0, shape.deflection(i as f64 * m.h, m.length)));
+        let (c0, c1) = (fit.offset, fit.slope);
         let wr = self.w_range();
         for (i, k) in wr.enumerate() {
-            q[k] = shape.deflection(i as f64 * self.model.h, self.model.length);
+            let x = i as f64 * m.h;
+            q[k] = shape.deflection(x, m.length) - (c0 + c1 * x);
         }
         (q, vec![0.0; n])
     }
@@ -398,25 +418,30 @@ impl System for RocketSystem {
         let vby = ss + tt * cx;
         out[0] = c * cx - s * cy;
         out[1] = s * cx + c * cy;
-        out[2] = th;
+        // Elastic channels are reported relative to the case's mean axis (ignition mass), the
+        // frame-invariant definition shared with the modal backend, whose elastic modes are
+        // m₀-orthogonal to the rigid motions; θ is the angle of that axis.
+        let (u, w) = (&q[self.u_range()], &q[self.w_range()]);
+        let axis = mean_axis(&self.model, |i| (u[i], w[i]));
+        out[2] = th + axis.slope;
         out[3] = mt;
         out[4] = c * vbx - s * vby;
         out[5] = s * vbx + c * vby;
         let mut o = 6;
-        let (u, w) = (&q[self.u_range()], &q[self.w_range()]);
         let nf = self.field_stations;
         for k in 0..nf {
-            out[o] = self.interp(u, k as f64 * self.model.length / (nf - 1) as f64);
+            out[o] = self.interp(u, k as f64 * self.model.length / (nf - 1) as f64) - axis.axial;
             o += 1;
         }
         for k in 0..nf {
-            out[o] = self.interp(w, k as f64 * self.model.length / (nf - 1) as f64);
+            let x = k as f64 * self.model.length / (nf - 1) as f64;
+            out[o] = self.interp(w, x) - axis.at(x);
             o += 1;
         }
         let (mu, mw) = (&q[self.mu_range()], &q[self.mw_range()]);
-        for k in 0..self.model.masses.len() {
-            out[o] = mu[k];
-            out[o + 1] = mw[k];
+        for (k, at) in self.model.masses.iter().enumerate() {
+            out[o] = mu[k] - axis.axial;
+            out[o + 1] = mw[k] - axis.at(at.x);
             o += 2;
         }
     }
@@ -507,6 +532,44 @@ impl System for RocketSystem {
 
     fn damped(&self) -> bool {
         self.model.damped()
+    }
+}
+
+/// Mean axis of the case with respect to its ignition mass m₀ (lumped station masses, discrete
+/// masses excluded): the mass-weighted mean of u and the weighted least-squares line of w.
+#[derive(Debug, Clone, Copy)]
+pub struct MeanAxis {
+    pub axial: f64,
+    pub offset: f64,
+    pub slope: f64,
+}
+
+impl MeanAxis {
+    /// Transverse position of the mean axis at x.
+    pub fn at(&self, x: f64) -> f64 {
+        self.offset + self.slope * x
+    }
+}
+
+/// [`MeanAxis`] of the station field `field(i) = (u_i, w_i)`.
+pub fn mean_axis(m: &RocketModel, field: impl Fn(usize) -> (f64, f64)) -> MeanAxis {
+    let m1 = m.m1(0.0);
+    let (mut s0, mut s1, mut s2, mut ru, mut r0, mut r1) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for i in 0..m.stations {
+        let (x, mi) = (i as f64 * m.h, m.station_mass(i, m1));
+        let (u, w) = field(i);
+        s0 += mi;
+        s1 += mi * x;
+        s2 += mi * x * x;
+        ru += mi * u;
+        r0 += mi * w;
+        r1 += mi * x * w;
+    }
+    let det = s0 * s2 - s1 * s1;
+    MeanAxis {
+        axial: ru / s0,
+        offset: (s2 * r0 - s1 * r1) / det,
+        slope: (s0 * r1 - s1 * r0) / det,
     }
 }
 

@@ -64,7 +64,10 @@
 //! mass centre through the body as stage 1 burns). `rocket.theta`: the frame angle θ.
 //! `rocket.u@k`, `rocket.w@k`: elastic u, w at `simulation.field_stations` equally spaced
 //! stations, k = 0 at the aft end. `rocket.mass{j}.u/.w`: u_j, w_j (body-frame displacement of
-//! mass j from its station x_j, as in the report).
+//! mass j from its station x_j, as in the report). Because the modes are m₀-orthogonal to the
+//! rigid motions, the body frame is the case's mean axis with respect to its ignition mass
+//! (∫m₀u = ∫m₀w = ∫m₀xw = 0) and θ its angle: the frame-invariant definition the fdm backend
+//! also reports.
 //!
 //! ## Energy ledger (variable mass)
 //! stored: `kinetic` (½vᵀMv), `strain`, `gravity` (g ∫m R_Y), `discrete_spring`;
