@@ -66,6 +66,21 @@ impl CheckKind {
         CheckKind::Stability,
     ];
 
+    /// The short column heading of the coverage table (the table fits 120 columns).
+    pub fn column(self) -> &'static str {
+        match self {
+            CheckKind::Analytic => "analytic",
+            CheckKind::CrossHistory => "x-hist",
+            CheckKind::CrossPoint => "x-point",
+            CheckKind::Convergence => "conv",
+            CheckKind::LedgerClosure => "ledger",
+            CheckKind::LedgerTerms => "terms",
+            CheckKind::ImpactMomentum => "impact",
+            CheckKind::Frequencies => "freq",
+            CheckKind::Stability => "stab",
+        }
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             CheckKind::Analytic => "analytic",
@@ -501,7 +516,7 @@ fn pad_table(header: &[&str], rows: &[Vec<String>]) -> String {
 /// enforced kinds), the gaps with their exceptions, then every row id by scene and kind.
 pub fn report(c: &Coverage) -> String {
     let mut header = vec!["scene", "runs"];
-    header.extend(CheckKind::ALL.iter().map(|k| k.name()));
+    header.extend(CheckKind::ALL.iter().map(|k| k.column()));
     let mut rows = Vec::new();
     for s in &c.scenes {
         let mut r = vec![s.scene.clone(), names(&s.runners())];
@@ -577,6 +592,15 @@ pub fn report(c: &Coverage) -> String {
             names(&x.backends)
         ));
     }
+    out.push_str(&format!(
+        "\ncolumns: {}\n",
+        CheckKind::ALL
+            .iter()
+            .filter(|k| k.column() != k.name())
+            .map(|k| format!("{} = {}", k.column(), k.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
     out.push_str("\nrows by scene and kind (* = row on a modified scene, not counted for gaps)\n");
     for s in &c.scenes {
         out.push_str(&format!("{}\n", s.scene));
@@ -598,5 +622,7 @@ pub fn report(c: &Coverage) -> String {
             }
         }
     }
-    out
+    out.lines()
+        .map(|l| crate::output::wrap(l, crate::output::TERMINAL_WIDTH, 4) + "\n")
+        .collect()
 }

@@ -269,7 +269,7 @@ fn cli_run_contact_scene_writes_the_switching_history() {
 
 #[test]
 fn cli_default_outputs_fit_120_columns() {
-    let commands: [&[&str]; 9] = [
+    let commands: [&[&str]; 10] = [
         &["verify", "--filter", "cantilever"],
         &["scenes"],
         &["describe", "constrained-arm"],
@@ -295,6 +295,7 @@ fn cli_default_outputs_fit_120_columns() {
             "1e-6",
         ],
         &["stability"],
+        &["coverage"],
     ];
     for args in commands {
         let (code, out, err) = flexverify(args);
