@@ -5,6 +5,17 @@ use data::{Backend, BackendError, Observables, Scene, Settings, StabilityVerdict
 use fdm::integrator::System;
 use fdm::{FdmBackend, FdmSettings};
 
+/// Total mass at ignition: the stages' weight per length times length, plus the discrete
+/// masses, over g (the scene states weights).
+fn ignition_mass(r: &data::scene::Rocket) -> f64 {
+    (r.stages
+        .iter()
+        .map(|s| s.weight_per_length * s.length)
+        .sum::<f64>()
+        + r.discrete_masses.iter().map(|m| m.weight).sum::<f64>())
+        / r.gravity
+}
+
 fn settings(method: &str) -> (Settings, FdmSettings) {
     let mut s = Settings::default();
     s.time.method = Some(method.to_string());
@@ -140,13 +151,7 @@ fn dyn_rocket_rigid_translation_follows_the_rocket_equation_with_gravity() {
     let g = r.gravity;
     let l1 = r.stages[0].length;
     let k = r.stages[0].burn_rate / g * l1; // mass flow
-    let m0 = r
-        .stages
-        .iter()
-        .map(|s| s.weight_per_length * s.length)
-        .sum::<f64>()
-        / g
-        + r.discrete_masses.iter().map(|m| m.weight).sum::<f64>() / g;
+    let m0 = ignition_mass(r);
     let ve = r.exhaust_velocity;
     let o = &out.observables;
     let (vy, y, mass) = (ch(o, "rocket.vY"), ch(o, "rocket.Y"), ch(o, "rocket.mass"));
@@ -448,13 +453,7 @@ fn dyn_rocket_junction_between_stations_keeps_mass_and_rocket_equation() {
     assert!(matches!(out.verdict, StabilityVerdict::Completed));
     let g = r.gravity;
     let k = r.stages[0].burn_rate / g * r.stages[0].length;
-    let m0 = r
-        .stages
-        .iter()
-        .map(|s| s.weight_per_length * s.length)
-        .sum::<f64>()
-        / g
-        + r.discrete_masses.iter().map(|m| m.weight).sum::<f64>() / g;
+    let m0 = ignition_mass(r);
     let o = &out.observables;
     for (i, &t) in o.time.iter().enumerate() {
         let mt = m0 - k * t;
@@ -612,13 +611,7 @@ fn dyn_rocket_thrust_along_the_mean_axis_leaves_no_lateral_drift() {
     let drift = x.last().unwrap() - x[0];
     let g = r.gravity;
     let flow = r.stages[0].burn_rate / g * r.stages[0].length;
-    let m0 = r
-        .stages
-        .iter()
-        .map(|s| s.weight_per_length * s.length)
-        .sum::<f64>()
-        / g
-        + r.discrete_masses.iter().map(|m| m.weight).sum::<f64>() / g;
+    let m0 = ignition_mass(r);
     let (_, c1) = rigid_part_of_initial_shape(&scene);
     let tilted = 0.5 * flow * r.exhaust_velocity / m0 * c1 * t_end * t_end;
     eprintln!(
@@ -649,13 +642,7 @@ fn dyn_rocket_constant_thrust_quasi_static_compression_matches_closed_form() {
     let g = r.gravity;
     let len = r.length();
     let thrust = r.stages[0].burn_rate / g * r.stages[0].length * r.exhaust_velocity;
-    let m_total = r
-        .stages
-        .iter()
-        .map(|s| s.weight_per_length * s.length)
-        .sum::<f64>()
-        / g
-        + r.discrete_masses.iter().map(|m| m.weight).sum::<f64>() / g;
+    let m_total = ignition_mass(r);
     let acc = thrust / m_total;
     // ∫₀^x N/EA by the midpoint rule on a fine grid (exact between the few kinks)
     let n = 150_000;
