@@ -12,7 +12,7 @@ use serde::Serialize;
 use crate::error::Error;
 use crate::output::{Column, csv_table, fitted_table, text_table, wrap, write_atomic};
 use crate::plot::{Series, plot};
-use crate::progress::{Progress, Silent};
+use crate::progress::Progress;
 use crate::suite::evaluate::{falling_prefix, fit_order, measure, richardson};
 use crate::suite::quantity::Quantity;
 use crate::suite::reference::{analytic_value, default_analytic_id};
@@ -150,20 +150,9 @@ fn min_wall_time(
     best
 }
 
-/// Runs the ladders and fills errors against the best available reference.
+/// Runs the ladders and fills errors against the best available reference, reporting each
+/// rung to `progress`.
 pub fn run_study(
-    scene: &Scene,
-    quantity: &str,
-    refine: Refine,
-    kinds: &[BackendKind],
-    base: &Settings,
-    rung_budget_s: Option<f64>,
-) -> Result<Study, Error> {
-    run_study_with_progress(scene, quantity, refine, kinds, base, rung_budget_s, &Silent)
-}
-
-/// [`run_study`], reporting each rung to `progress`.
-pub fn run_study_with_progress(
     scene: &Scene,
     quantity: &str,
     refine: Refine,
@@ -425,7 +414,7 @@ pub fn write_study(dir: &Path, study: &Study) -> Result<Vec<String>, Error> {
     Ok(notes)
 }
 
-/// A study for `converge`: [`run_study_with_progress`] without a rung budget, failing when no
+/// A study for `converge`: [`run_study`] without a rung budget, failing when no
 /// backend measured the quantity on any rung.
 pub fn converge(
     scene: &Scene,
@@ -435,7 +424,7 @@ pub fn converge(
     base: &Settings,
     progress: &dyn Progress,
 ) -> Result<Study, Error> {
-    let study = run_study_with_progress(scene, quantity, refine, kinds, base, None, progress)?;
+    let study = run_study(scene, quantity, refine, kinds, base, None, progress)?;
     if study.ladders.iter().all(|l| l.rungs.is_empty()) {
         return Err(Error::QuantityNotProduced {
             quantity: quantity.to_string(),
@@ -546,8 +535,7 @@ pub fn recommend(
     base: &Settings,
     progress: &dyn Progress,
 ) -> Result<Recommendation, Error> {
-    let study =
-        run_study_with_progress(scene, quantity, Refine::Space, kinds, base, None, progress)?;
+    let study = run_study(scene, quantity, Refine::Space, kinds, base, None, progress)?;
     let Some(reference) = study.reference else {
         return Err(Error::NoReference {
             quantity: quantity.to_string(),
@@ -690,7 +678,7 @@ pub fn full_suite_ladders(
         let Some(q) = ladder_quantity(&scene) else {
             continue;
         };
-        let study = run_study_with_progress(
+        let study = run_study(
             &scene,
             &q,
             Refine::Space,

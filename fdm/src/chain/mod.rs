@@ -953,6 +953,11 @@ impl System for TwoLinkChain {
         inertia: DriftVelocities,
         a: &mut [f64],
     ) {
+        if self.constrained {
+            // the constrained phase runs in the contact driver (`accel`): Ġq̇ and Γ at `v`
+            self.accel(t, q, v, a);
+            return;
+        }
         let mut rhs = std::mem::take(&mut self.rhs);
         self.chord(q, v);
         self.forces(t, q, v, &mut rhs);
@@ -962,13 +967,6 @@ impl System for TwoLinkChain {
         if inertia.w != 0.0 {
             self.chord(q, inertia.previous);
             self.add_inertia_terms(-inertia.w, a, &mut rhs);
-        }
-        if self.constrained {
-            // the constrained phase runs in the contact driver (`accel`); keep Ġq̇ at `v`
-            self.chord(q, v);
-            self.rhs = rhs;
-            self.accel(t, q, v, a);
-            return;
         }
         self.build_columns();
         self.solve_mass(&rhs, a);
