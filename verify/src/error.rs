@@ -52,6 +52,19 @@ pub enum Error {
         best: Option<(data::BackendKind, String, f64)>,
         reference_label: String,
     },
+    /// The backends converge to answers further apart than the requested tolerance: no
+    /// discretization can be recommended until the model difference is explained.
+    #[error(
+        "no recommendation for `{quantity}` on `{scene}` at {tolerance:.1e}: {sentence}; \
+         compare the backends' models, or restrict --backend to one of them for its own \
+         convergence"
+    )]
+    ModelsDisagree {
+        quantity: String,
+        scene: String,
+        tolerance: f64,
+        sentence: String,
+    },
     /// A result file could not be written.
     #[error("cannot write output: {0}")]
     Io(#[from] std::io::Error),

@@ -62,6 +62,46 @@ pub struct Ladder {
     pub plateau_from: Option<String>,
     /// Why the ladder stopped early, if it did (unsupported, stopped run, …).
     pub note: Option<String>,
+    /// The ladder's own estimate of the converged value (its Richardson extrapolation).
+    pub estimate: Option<Estimate>,
+}
+
+/// Where a ladder says the quantity converges to: its Richardson extrapolation, with the
+/// distance of its finest rung from that value as the uncertainty (the finest rung's own error
+/// estimate, an upper bound on the extrapolation's once the ladder is asymptotic).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Estimate {
+    pub backend: BackendKind,
+    pub value: f64,
+    pub uncertainty: f64,
+}
+
+/// Two ladders whose estimates differ by more than their uncertainties allow: the backends
+/// converge to different answers, so neither may be scored against the other.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Disagreement {
+    pub first: Estimate,
+    pub second: Estimate,
+    /// |first − second| over the quantity's scale (the same scale the rung errors use).
+    pub relative_difference: f64,
+}
+
+impl Disagreement {
+    /// One sentence with both values, for tables and error messages.
+    pub fn sentence(&self) -> String {
+        let (a, b) = (self.first, self.second);
+        format!(
+            "the models disagree: {} converges to {:.10e} (± {:.1e}), {} to {:.10e} (± {:.1e}); \
+             the difference {:.3e} of the scale exceeds both error estimates",
+            a.backend,
+            a.value,
+            a.uncertainty,
+            b.backend,
+            b.value,
+            b.uncertainty,
+            self.relative_difference
+        )
+    }
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -72,6 +112,9 @@ pub struct Study {
     pub reference: Option<f64>,
     pub reference_label: String,
     pub ladders: Vec<Ladder>,
+    /// Set when no analytic value exists and two ladders converge to different answers; each
+    /// ladder's errors are then measured against its own estimate.
+    pub disagreement: Option<Disagreement>,
 }
 
 /// Default refinement ladder of a backend (space) as settings + h.
@@ -232,23 +275,46 @@ pub fn run_study(
         let hs: Vec<f64> = rungs.iter().map(|r| r.h).collect();
         let monotone_from_above =
             values.len() >= 2 && values.windows(2).all(|w| w[1] <= w[0] * (1.0 + 1e-13));
+        let extrapolation = richardson(&hs, &values, None);
+        let estimate = extrapolation
+            .zip(rungs.last())
+            .map(|((value, _), finest)| Estimate {
+                backend: kind,
+                value,
+                uncertainty: (finest.value - value).abs(),
+            });
         ladders.push(Ladder {
             backend: kind,
-            richardson: richardson(&hs, &values, None),
+            richardson: extrapolation,
             rungs,
             observed_order: None,
             plateau_from: None,
             monotone_from_above,
             note,
+            estimate,
         });
     }
+    let scale_of = |l: &Ladder, value: f64| match q {
+        Quantity::At { .. } => l.rungs.last().and_then(|r| r.peak).unwrap_or(value.abs()),
+        _ => value.abs(),
+    };
 
-    // Reference: analytic when the scene/quantity has one, else the Richardson value of the
-    // ladder whose last two rungs agree best (its own estimate of its error is smallest).
-    let (reference, reference_label) = match default_analytic_id(scene, &q)
-        .and_then(|id| analytic_value(&id, scene, &q).ok().map(|v| (v, id)))
-    {
+    // Reference: analytic when the scene/quantity has one; else, unless two ladders converge
+    // to different answers, the Richardson value of the ladder whose last two rungs agree best
+    // (its own estimate of its error is smallest).
+    let analytic = default_analytic_id(scene, &q)
+        .and_then(|id| analytic_value(&id, scene, &q).ok().map(|v| (v, id)));
+    let disagreement = if analytic.is_none() {
+        worst_disagreement(&ladders, scale_of)
+    } else {
+        None
+    };
+    let (reference, reference_label) = match analytic {
         Some((v, id)) => (Some(v), format!("analytic:{id}")),
+        None if disagreement.is_some() => (
+            None,
+            "each ladder against its own Richardson extrapolation (the models disagree)".into(),
+        ),
         None => {
             let best = ladders
                 .iter()
@@ -267,30 +333,26 @@ pub fn run_study(
             }
         }
     };
-    if let Some(r) = reference {
-        let relative_to_peak = matches!(q, Quantity::At { .. });
-        for l in &mut ladders {
-            let scale_peak = l.rungs.last().and_then(|r| r.peak);
-            for rung in &mut l.rungs {
-                let scale = if relative_to_peak {
-                    scale_peak.unwrap_or(r.abs())
-                } else {
-                    r.abs()
-                };
-                rung.error = (scale > 0.0).then(|| (rung.value - r).abs() / scale);
-            }
-            let (h, e): (Vec<f64>, Vec<f64>) = l
-                .rungs
-                .iter()
-                .filter_map(|r| Some((r.h, r.error?)))
-                .filter(|(_, e)| *e > 1e-13)
-                .unzip();
-            let keep = falling_prefix(&e);
-            if keep < e.len() {
-                l.plateau_from = Some(l.rungs[keep].discretization.clone());
-            }
-            l.observed_order = fit_order(&h[..keep], &e[..keep]);
+    for l in &mut ladders {
+        let own = l.estimate.map(|e| e.value);
+        let Some(r) = reference.or(disagreement.and(own)) else {
+            continue;
+        };
+        let scale = scale_of(&*l, r);
+        for rung in &mut l.rungs {
+            rung.error = (scale > 0.0).then(|| (rung.value - r).abs() / scale);
         }
+        let (h, e): (Vec<f64>, Vec<f64>) = l
+            .rungs
+            .iter()
+            .filter_map(|r| Some((r.h, r.error?)))
+            .filter(|(_, e)| *e > 1e-13)
+            .unzip();
+        let keep = falling_prefix(&e);
+        if keep < e.len() {
+            l.plateau_from = Some(l.rungs[keep].discretization.clone());
+        }
+        l.observed_order = fit_order(&h[..keep], &e[..keep]);
     }
     progress.finish();
     Ok(Study {
@@ -300,7 +362,42 @@ pub fn run_study(
         reference,
         reference_label,
         ladders,
+        disagreement,
     })
+}
+
+/// The pair of ladder estimates that differ most beyond their combined uncertainty (plus a
+/// round-off allowance of 1e-10 of the scale), if any pair does.
+fn worst_disagreement(
+    ladders: &[Ladder],
+    scale_of: impl Fn(&Ladder, f64) -> f64,
+) -> Option<Disagreement> {
+    let with_estimates: Vec<(&Ladder, Estimate)> = ladders
+        .iter()
+        .filter_map(|l| Some((l, l.estimate?)))
+        .collect();
+    let mut worst: Option<(f64, Disagreement)> = None;
+    for (i, &(la, a)) in with_estimates.iter().enumerate() {
+        for &(lb, b) in &with_estimates[i + 1..] {
+            let scale = scale_of(la, a.value).max(scale_of(lb, b.value));
+            if scale <= 0.0 {
+                continue;
+            }
+            let difference = (a.value - b.value).abs();
+            let excess = difference - a.uncertainty - b.uncertainty - 1e-10 * scale;
+            if excess > 0.0 && worst.is_none_or(|(e, _)| excess > e) {
+                worst = Some((
+                    excess,
+                    Disagreement {
+                        first: a,
+                        second: b,
+                        relative_difference: difference / scale,
+                    },
+                ));
+            }
+        }
+    }
+    worst.map(|(_, d)| d)
 }
 
 fn rows(study: &Study) -> Vec<Vec<String>> {
@@ -486,6 +583,10 @@ pub fn wide_table(study: &Study) -> String {
         s.push_str(&ladder_summary(l));
         s.push('\n');
     }
+    if let Some(d) = &study.disagreement {
+        s.push_str(&d.sentence());
+        s.push('\n');
+    }
     s
 }
 
@@ -502,6 +603,10 @@ pub fn terminal_table(study: &Study, width: usize) -> String {
     s.push_str(&fitted_table(&columns, &rows(study), width).to_string());
     for l in &study.ladders {
         s.push_str(&wrap(&ladder_summary(l), width, 4));
+        s.push('\n');
+    }
+    if let Some(d) = &study.disagreement {
+        s.push_str(&wrap(&d.sentence(), width, 4));
         s.push('\n');
     }
     s
@@ -536,23 +641,38 @@ pub fn recommend(
     progress: &dyn Progress,
 ) -> Result<Recommendation, Error> {
     let study = run_study(scene, quantity, Refine::Space, kinds, base, None, progress)?;
-    let Some(reference) = study.reference else {
+    // Models that converge to answers further apart than the tolerance cannot both meet it,
+    // and which one is right is not a question of discretization.
+    if let Some(d) = study.disagreement
+        && d.relative_difference > tol
+    {
+        return Err(Error::ModelsDisagree {
+            quantity: quantity.to_string(),
+            scene: scene.name.clone(),
+            tolerance: tol,
+            sentence: d.sentence(),
+        });
+    }
+    if study.reference.is_none() && study.disagreement.is_none() {
         return Err(Error::NoReference {
             quantity: quantity.to_string(),
             scene: scene.name.clone(),
             why: study.reference_label,
         });
-    };
-    let candidates: Vec<&Rung> = study
+    }
+    // Each rung with its ladder's reference (the study's, or its own estimate when the
+    // models disagree by less than the tolerance).
+    let candidates: Vec<(&Rung, f64)> = study
         .ladders
         .iter()
-        .flat_map(|l| l.rungs.iter())
-        .filter(|r| r.error.is_some_and(|e| e <= tol))
+        .filter_map(|l| Some((l, study.reference.or(l.estimate.map(|e| e.value))?)))
+        .flat_map(|(l, reference)| l.rungs.iter().map(move |r| (r, reference)))
+        .filter(|(r, _)| r.error.is_some_and(|e| e <= tol))
         .collect();
     let best = candidates
         .iter()
-        .min_by(|a, b| a.wall_time_s.total_cmp(&b.wall_time_s));
-    let Some(r) = best else {
+        .min_by(|a, b| a.0.wall_time_s.total_cmp(&b.0.wall_time_s));
+    let Some(&(r, reference)) = best else {
         let best_err = study
             .ladders
             .iter()
@@ -581,9 +701,16 @@ pub fn recommend(
         scene: scene.name.clone(),
         quantity: quantity.to_string(),
         tolerance: tol,
-        rung: (*r).clone(),
+        rung: r.clone(),
         reference,
-        reference_label: study.reference_label.clone(),
+        reference_label: match study.disagreement {
+            Some(d) if study.reference.is_none() => format!(
+                "{}'s own Richardson extrapolation (the backends converge {:.1e} apart, within \
+                 the tolerance)",
+                r.backend, d.relative_difference
+            ),
+            _ => study.reference_label.clone(),
+        },
         rerun: format!(
             "{what} {} --backend {} --{flag}{until}",
             scene.name, r.backend
@@ -749,4 +876,92 @@ pub fn survey_terminal_table(studies: &[Study], width: usize) -> String {
         Column::left("note").elastic(),
     ];
     fitted_table(&columns, &survey_rows(studies), width).to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ladder of `value(h) = limit + c h²` on h = 1/4, 1/8, 1/16.
+    fn ladder(backend: BackendKind, limit: f64, c: f64) -> Ladder {
+        let rungs: Vec<Rung> = [4.0, 8.0, 16.0]
+            .iter()
+            .map(|n: &f64| Rung {
+                backend,
+                discretization: format!("n={n}"),
+                h: 1.0 / n,
+                value: limit + c / (n * n),
+                error: None,
+                wall_time_s: 1.0,
+                settings: Settings::default(),
+                peak: None,
+            })
+            .collect();
+        let hs: Vec<f64> = rungs.iter().map(|r| r.h).collect();
+        let values: Vec<f64> = rungs.iter().map(|r| r.value).collect();
+        let extrapolation = richardson(&hs, &values, None);
+        let finest = rungs.last().unwrap().value;
+        Ladder {
+            backend,
+            estimate: extrapolation.map(|(value, _)| Estimate {
+                backend,
+                value,
+                uncertainty: (finest - value).abs(),
+            }),
+            richardson: extrapolation,
+            rungs,
+            observed_order: None,
+            plateau_from: None,
+            monotone_from_above: false,
+            note: None,
+        }
+    }
+
+    fn scale(_: &Ladder, v: f64) -> f64 {
+        v.abs()
+    }
+
+    #[test]
+    fn cross_ladders_converging_apart_are_reported_with_both_limits() {
+        // Two second-order ladders whose limits differ by 1e-3 relative, far beyond their
+        // finest rungs' distance from their extrapolations (c/256 = 4e-6).
+        let ladders = [
+            ladder(BackendKind::Fem, 1.0, 1e-3),
+            ladder(BackendKind::Fdm, 1.001, 1e-3),
+        ];
+        let d = worst_disagreement(&ladders, scale).expect("a disagreement");
+        assert!((d.first.value - 1.0).abs() < 1e-12, "{d:?}");
+        assert!((d.second.value - 1.001).abs() < 1e-12, "{d:?}");
+        assert!((d.relative_difference - 1e-3 / 1.001).abs() < 1e-12);
+        let sentence = d.sentence();
+        assert!(
+            sentence.contains("fem converges to 1.0000000000e0"),
+            "{sentence}"
+        );
+        assert!(sentence.contains("fdm to 1.0010000000e0"), "{sentence}");
+    }
+
+    #[test]
+    fn cross_ladders_within_their_estimates_are_not_flagged() {
+        // Limits 1e-6 apart, but each ladder's finest rung is still 4e-5 from its limit.
+        let ladders = [
+            ladder(BackendKind::Fem, 1.0, 1e-2),
+            ladder(BackendKind::Modal, 1.0 + 1e-6, -1e-2),
+        ];
+        assert!(worst_disagreement(&ladders, scale).is_none());
+        // One ladder alone cannot disagree.
+        assert!(worst_disagreement(&ladders[..1], scale).is_none());
+    }
+
+    #[test]
+    fn cross_the_worst_pair_is_reported() {
+        let ladders = [
+            ladder(BackendKind::Fem, 1.0, 1e-3),
+            ladder(BackendKind::Fdm, 1.01, 1e-3),
+            ladder(BackendKind::Modal, 1.0 + 1e-4, 1e-3),
+        ];
+        let d = worst_disagreement(&ladders, scale).unwrap();
+        assert_eq!(d.first.backend, BackendKind::Fem);
+        assert_eq!(d.second.backend, BackendKind::Fdm);
+    }
 }

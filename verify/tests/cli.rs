@@ -233,6 +233,55 @@ fn cli_recommend_names_a_discretization_that_a_rerun_confirms() {
 }
 
 #[test]
+fn cross_recommend_refuses_when_the_backends_converge_apart() {
+    // At the output interval as time step (the scene's coarsest fixed step), fem's space
+    // ladder converges to its O(h²) time-discretization answer while modal's adaptive
+    // integration does not share that error: the two limits differ by far more than either
+    // ladder's own error estimate, so neither may be scored against the other.
+    let scene = data::load_scene("spin-up").unwrap();
+    let dt = scene.simulation.output_interval.to_string();
+    let (code, out, err) = flexverify(&[
+        "recommend",
+        "spin-up",
+        "--quantity",
+        "tip_deflection@15",
+        "--tol",
+        "1e-6",
+        "--backend",
+        "fem,modal",
+        "--dt",
+        &dt,
+    ]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("the models disagree"), "{err}");
+    assert!(
+        err.contains("fem converges to") && err.contains("modal to"),
+        "{err}"
+    );
+    assert!(!out.contains("recommended:"), "{out}");
+    // `converge` reports the same two limits and scores each ladder against its own.
+    let (code, out, err) = flexverify(&[
+        "converge",
+        "spin-up",
+        "--quantity",
+        "tip_deflection@15",
+        "--backend",
+        "fem,modal",
+        "--dt",
+        &dt,
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let study: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(study["reference"].is_null(), "{out}");
+    let d = &study["disagreement"];
+    assert_eq!(d["first"]["backend"], "fem");
+    assert_eq!(d["second"]["backend"], "modal");
+    assert!(d["relative_difference"].as_f64().unwrap() > 1e-6);
+}
+
+#[test]
 fn cli_run_contact_scene_writes_the_switching_history() {
     let dir = std::env::temp_dir().join(format!("flexverify-cli-switch-{}", std::process::id()));
     let (code, out, err) = flexverify(&[

@@ -155,15 +155,22 @@ pub enum BackendChoice {
     All,
 }
 
-impl BackendChoice {
-    pub fn kinds(self) -> Vec<data::BackendKind> {
+impl CommonOpts {
+    /// The chosen backends, each once, in catalog order.
+    pub fn kinds(&self) -> Vec<data::BackendKind> {
         use data::BackendKind as K;
-        match self {
-            BackendChoice::Fem => vec![K::Fem],
-            BackendChoice::Fdm => vec![K::Fdm],
-            BackendChoice::Modal => vec![K::Modal],
-            BackendChoice::All => K::ALL.to_vec(),
-        }
+        let chosen = |k: K| {
+            self.backend.iter().any(|&c| {
+                c == BackendChoice::All
+                    || matches!(
+                        (c, k),
+                        (BackendChoice::Fem, K::Fem)
+                            | (BackendChoice::Fdm, K::Fdm)
+                            | (BackendChoice::Modal, K::Modal)
+                    )
+            })
+        };
+        K::ALL.into_iter().filter(|&k| chosen(k)).collect()
     }
 }
 
@@ -184,8 +191,9 @@ pub enum ElementChoice {
 /// Options shared by the scene commands.
 #[derive(Debug, Clone, Args)]
 pub struct CommonOpts {
-    #[arg(long, value_enum, default_value_t = BackendChoice::All)]
-    pub backend: BackendChoice,
+    /// One backend, a comma-separated list (`fem,modal`) or `all`.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "all")]
+    pub backend: Vec<BackendChoice>,
     /// FEM: elements per link.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub elements: Option<u32>,

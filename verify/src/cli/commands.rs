@@ -108,7 +108,7 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(name)?;
     let settings = opts.settings();
     let mut plans = Vec::new();
-    for kind in opts.backend.kinds() {
+    for kind in opts.kinds() {
         match backend(kind).dof_plan(&scene, &settings.discretization) {
             Ok(plan) => plans.push(BackendPlan {
                 backend: kind,
@@ -257,7 +257,7 @@ fn for_backends<T>(
 ) -> Result<Vec<(BackendKind, T)>, CliError> {
     let mut done = Vec::new();
     let mut unsupported = Vec::new();
-    for kind in opts.backend.kinds() {
+    for kind in opts.kinds() {
         match f(backend(kind).as_ref()) {
             Ok(v) => done.push((kind, v)),
             Err(BackendError::Unsupported(why)) => {

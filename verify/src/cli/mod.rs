@@ -71,7 +71,9 @@ impl From<crate::Error> for CliError {
                 CliError::Input(format!("error: {e}"))
             }
             E::QuantityNotProduced { .. } => CliError::Unsupported(format!("unsupported: {e}")),
-            E::NoReference { .. } | E::ToleranceNotMet { .. } => CliError::Failed(e.to_string()),
+            E::NoReference { .. } | E::ToleranceNotMet { .. } | E::ModelsDisagree { .. } => {
+                CliError::Failed(e.to_string())
+            }
         }
     }
 }

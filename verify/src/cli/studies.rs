@@ -20,7 +20,7 @@ pub fn converge(
         &scene,
         quantity,
         refine,
-        &opts.backend.kinds(),
+        &opts.kinds(),
         &opts.settings(),
         &bar,
     )?;
@@ -43,14 +43,8 @@ pub fn converge(
 pub fn recommend(scene: &str, quantity: &str, tol: f64, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(scene)?;
     let bar = Bar::new();
-    let recommendation = study::recommend(
-        &scene,
-        quantity,
-        tol,
-        &opts.backend.kinds(),
-        &opts.settings(),
-        &bar,
-    );
+    let recommendation =
+        study::recommend(&scene, quantity, tol, &opts.kinds(), &opts.settings(), &bar);
     bar.clear();
     let r = recommendation?;
     match opts.format {
