@@ -9,9 +9,9 @@ pub enum Quantity {
     Frequency { n: usize, kind: Option<String> },
     /// Static tip deflection of the last link.
     StaticTip,
-    /// Observable channel at time t.
+    /// A channel's (or an energy-ledger term's, `energy.NAME`) value at time t.
     At { channel: String, t: f64 },
-    /// max |channel| over the run.
+    /// max |channel| (or |ledger term|) over the run.
     Peak { channel: String },
     /// The whole time history of a channel (or of an energy-ledger term, `energy.NAME`);
     /// compared with another backend's history as max_t |a(t) − b(t)| / max_t |b(t)|, after a
@@ -242,19 +242,16 @@ impl Quantity {
         };
         match self {
             Quantity::At { channel, t } => {
-                r.observables.get(channel).ok_or_else(|| missing(channel))?;
-                r.observables.value_at(channel, *t).ok_or_else(|| {
+                let (times, values) =
+                    super::history::series(r, channel).ok_or_else(|| missing(channel))?;
+                data::results::interpolate(times, &values, *t).ok_or_else(|| {
                     format!(
                         "t = {t} is outside the run [0, {}]",
-                        r.observables.time.last().copied().unwrap_or(0.0)
+                        times.last().copied().unwrap_or(0.0)
                     )
                 })
             }
-            Quantity::Peak { channel } => {
-                let c = r.observables.get(channel).ok_or_else(|| missing(channel))?;
-                Ok(c.values.iter().fold(0.0f64, |m, v| m.max(v.abs())))
-            }
-            Quantity::History { channel, .. } => {
+            Quantity::Peak { channel } | Quantity::History { channel, .. } => {
                 let (_, values) =
                     super::history::series(r, channel).ok_or_else(|| missing(channel))?;
                 Ok(values.iter().fold(0.0f64, |m, v| m.max(v.abs())))
@@ -328,11 +325,9 @@ impl Quantity {
     /// Scale of the reference time history for `relative-to-peak` norms.
     pub fn peak_scale(&self, r: &RunResult) -> Option<f64> {
         match self {
-            Quantity::At { channel, .. } | Quantity::Peak { channel } => r
-                .observables
-                .get(channel)
-                .map(|c| c.values.iter().fold(0.0f64, |m, v| m.max(v.abs()))),
-            Quantity::History { channel, .. } => super::history::series(r, channel)
+            Quantity::At { channel, .. }
+            | Quantity::Peak { channel }
+            | Quantity::History { channel, .. } => super::history::series(r, channel)
                 .map(|(_, v)| v.iter().fold(0.0f64, |m, v| m.max(v.abs()))),
             _ => None,
         }
