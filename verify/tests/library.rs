@@ -149,3 +149,49 @@ fn lib_terminal_table_cuts_only_long_case_ids() {
     let first_group = table.lines().nth(3).unwrap();
     assert!(first_group.contains("1 FAILED"), "{table}");
 }
+
+#[test]
+fn lib_ledger_terms_are_point_and_peak_quantities() {
+    use verify::suite::quantity::Quantity;
+    let scene = load_scene("single-link").unwrap();
+    let mut settings = Settings::default();
+    settings.time.t_end = Some(0.5);
+    let run = verify::registry::backend(BackendKind::Fem)
+        .simulate(&scene, &settings)
+        .unwrap();
+    let ledger = &run.ledger;
+    let kinetic = ledger
+        .stored
+        .iter()
+        .find(|t| t.name == "kinetic")
+        .expect("a kinetic term");
+    // At a ledger sample the point quantity is that sample; between two it interpolates.
+    let k = ledger.time.len() / 2;
+    let at = |t: f64| {
+        Quantity::parse(&format!("energy.kinetic@{t}"), &scene)
+            .unwrap()
+            .from_run(&run)
+            .unwrap()
+    };
+    assert_eq!(at(ledger.time[k]), kinetic.values[k]);
+    let mid = 0.5 * (ledger.time[k] + ledger.time[k + 1]);
+    let expected = 0.5 * (kinetic.values[k] + kinetic.values[k + 1]);
+    assert!((at(mid) - expected).abs() <= 1e-15 * expected.abs());
+    let peak = Quantity::parse("peak:energy.kinetic", &scene)
+        .unwrap()
+        .from_run(&run)
+        .unwrap();
+    assert_eq!(
+        peak,
+        kinetic.values.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    );
+    // A term the scene does not build is named as missing, not read as zero.
+    let err = Quantity::parse("energy.impact@0.1", &scene)
+        .unwrap()
+        .from_run(&run)
+        .unwrap_err();
+    assert!(
+        err.contains("no ledger term `energy.impact`") && err.contains("energy.kinetic"),
+        "{err}"
+    );
+}

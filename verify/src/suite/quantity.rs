@@ -228,6 +228,20 @@ impl Quantity {
 
     pub fn from_run(&self, r: &RunResult) -> Result<f64, String> {
         let missing = |c: &str| {
+            if c.starts_with(super::history::ENERGY_PREFIX) {
+                let l = &r.ledger;
+                let terms: Vec<String> = l
+                    .stored
+                    .iter()
+                    .chain(&l.inputs)
+                    .chain(&l.dissipation)
+                    .map(|t| format!("energy.{}", t.name))
+                    .collect();
+                return format!(
+                    "no ledger term `{c}` in the run; available: energy.total, {}",
+                    terms.join(", ")
+                );
+            }
             let names: Vec<&str> = r
                 .observables
                 .channels
