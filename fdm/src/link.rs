@@ -27,9 +27,11 @@ use std::ops::Range;
 use data::scene::{PrescribedMotion, TorqueLaw};
 use data::{DofPlan, RunResult, Scene, Settings, channel};
 
+use crate::driver::{StepControl, integrate};
 use crate::error::FdmError;
-use crate::integrator::{Bound, BoundKind, StepControl, System, integrate};
+use crate::output::Outputs;
 use crate::settings::FdmSettings;
+use crate::system::{Bound, BoundKind, System};
 
 /// Default stations per link.
 pub const DEFAULT_STATIONS: usize = 41;
@@ -221,7 +223,7 @@ impl FloatingLink {
             } else {
                 0.0
             };
-            let sigma = 2.0 / om * crate::integrator::damped_step_factor(zeta);
+            let sigma = 2.0 / om * crate::system::damped_step_factor(zeta);
             if sigma < best.1 {
                 best = (k, sigma);
             }
@@ -462,6 +464,42 @@ impl System for FloatingLink {
         }
     }
 
+    fn stored_energies(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        let (th, rate, _) = self.hub_state(t, q, v);
+        let vr = self.vrange();
+        let (vs, vd) = (&q[vr.clone()], &v[vr]);
+        let mut ke = 0.5 * self.hub * rate * rate;
+        for k in 0..self.r {
+            let x = (k + 1) as f64 * self.h;
+            ke += 0.5 * self.m[k] * ((rate * vs[k]).powi(2) + (vd[k] + rate * x).powi(2));
+        }
+        if self.foreshortening {
+            ke -= rate * rate * self.phi(vs);
+        }
+        let strain = Self::bending_energy(self.h, self.ei, vs);
+        let spring = match &self.drive {
+            Drive::Torque {
+                stiffness,
+                set_point,
+                ..
+            } => 0.5 * stiffness * (th - set_point).powi(2),
+            Drive::Prescribed(_) => 0.0,
+        };
+        out.copy_from_slice(&[ke, strain, spring]);
+    }
+
+    fn monitored(&self) -> Range<usize> {
+        self.vrange()
+    }
+
+    fn damped(&self) -> bool {
+        // A free hub couples θ̇ to v̇ (İθ̇, θ̇² terms): velocity-dependent, like damping, for the
+        // two-step scheme's computational mode.
+        self.gamma > 0.0 || !self.prescribed()
+    }
+}
+
+impl Outputs for FloatingLink {
     fn describe(&self, b: &Bound) -> String {
         let rate = self.bound_rate.get();
         let k = b.site;
@@ -543,34 +581,6 @@ impl System for FloatingLink {
         )
     }
 
-    fn stored_energies(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-        let (th, rate, _) = self.hub_state(t, q, v);
-        let vr = self.vrange();
-        let (vs, vd) = (&q[vr.clone()], &v[vr]);
-        let mut ke = 0.5 * self.hub * rate * rate;
-        for k in 0..self.r {
-            let x = (k + 1) as f64 * self.h;
-            ke += 0.5 * self.m[k] * ((rate * vs[k]).powi(2) + (vd[k] + rate * x).powi(2));
-        }
-        if self.foreshortening {
-            ke -= rate * rate * self.phi(vs);
-        }
-        let strain = Self::bending_energy(self.h, self.ei, vs);
-        let spring = match &self.drive {
-            Drive::Torque {
-                stiffness,
-                set_point,
-                ..
-            } => 0.5 * stiffness * (th - set_point).powi(2),
-            Drive::Prescribed(_) => 0.0,
-        };
-        out.copy_from_slice(&[ke, strain, spring]);
-    }
-
-    fn monitored(&self) -> Range<usize> {
-        self.vrange()
-    }
-
     fn dof_name(&self, i: usize) -> String {
         if !self.prescribed() && i == 0 {
             "hub angle θ".into()
@@ -578,12 +588,6 @@ impl System for FloatingLink {
             let k = i - self.v0() + 1;
             format!("transverse v at station {k} (x = {:.4})", k as f64 * self.h)
         }
-    }
-
-    fn damped(&self) -> bool {
-        // A free hub couples θ̇ to v̇ (İθ̇, θ̇² terms): velocity-dependent, like damping, for the
-        // two-step scheme's computational mode.
-        self.gamma > 0.0 || !self.prescribed()
     }
 }
 
@@ -620,7 +624,6 @@ pub fn simulate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrator::System;
 
     #[test]
     fn elem_link_forces_are_minus_energy_gradients() {
@@ -752,7 +755,7 @@ mod tests {
     fn forced_run(omega: f64, ratio: f64) -> (data::StabilityVerdict, f64) {
         let (mut link, _) = spinning(omega, 41);
         let method = crate::settings::Method::Report;
-        let limit = method.bound_factor() * link.bound(1.0).sigma;
+        let limit = crate::method::stepper(method).bound_factor() * link.bound(1.0).sigma;
         let (q0, v0) = link.initial_state();
         let ctl = StepControl {
             method,

@@ -5,7 +5,7 @@ use data::{Backend, BackendError, Event, RunResult, Settings, StabilityVerdict, 
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
 use fdm::chain::contact::{ContactReport, EVENT_TIME_TOLERANCE, simulate};
-use fdm::integrator::System;
+use fdm::output::Outputs;
 use fdm::settings::FdmSettings;
 
 mod common;

@@ -2,7 +2,7 @@
 //! CARGO_TARGET_DIR=/work/targets/fdm cargo test --release -p fdm --test rocket
 
 use data::{Backend, BackendError, Observables, Scene, Settings, StabilityVerdict, load_scene};
-use fdm::integrator::System;
+use fdm::system::System;
 use fdm::{FdmBackend, FdmSettings};
 
 /// Total mass at ignition: the stages' weight per length times length, plus the discrete
@@ -23,7 +23,7 @@ fn settings(method: &str) -> (Settings, FdmSettings) {
     (s, f)
 }
 
-fn run(scene: &Scene, method: &str) -> fdm::integrator::Outcome {
+fn run(scene: &Scene, method: &str) -> fdm::output::Outcome {
     let (_, f) = settings(method);
     fdm::rocket::run_with(scene, &f, true).expect("run").1
 }

@@ -11,8 +11,9 @@ use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
 use fdm::chain::contact::simulate;
 use fdm::chain::timoshenko::TimoFields;
-use fdm::integrator::System;
+use fdm::output::Outputs;
 use fdm::settings::FdmSettings;
+use fdm::system::System;
 
 mod common;
 use common::channel;

@@ -48,9 +48,12 @@ use data::{Cost, Diagnostic, Event, RunResult, Scene, Settings, StabilityVerdict
 
 use super::TwoLinkChain;
 use super::kinetic::{BE, TH, seg_energy, seg_grad, seg_rate};
+use crate::driver::StepControl;
 use crate::error::FdmError;
-use crate::integrator::{Levels, Recorder, StepControl, System};
+use crate::method::Levels;
+use crate::output::{Outputs, Recorder};
 use crate::settings::{FdmSettings, Method};
+use crate::system::System;
 
 /// Default safety factor of a Timoshenko chain with contact (an accuracy choice, not a
 /// stability one). Impacts excite the condensed operator's shear waves near the step bound,
@@ -593,7 +596,7 @@ pub fn simulate(
     let (_, inp, dis) = sys.ledger_names();
     let np = inp.len() + dis.len();
     let i_impact = np - 1;
-    let mut rec = Recorder::new(&sys, &ctl);
+    let mut rec = Recorder::new(&sys, ctl.t_end, ctl.output_interval);
     let mut events = Vec::new();
     let mut cost = Cost {
         dofs: n,

@@ -53,12 +53,12 @@ pub mod timoshenko;
 use data::scene::{Link, TorqueLaw};
 use data::{DofPlan, RunResult, Scene, Settings, channel};
 
+use crate::driver::{StepControl, integrate};
 use crate::error::FdmError;
-use crate::integrator::{
-    Bound, BoundKind, DriftVelocities, StepControl, System, damped_step_factor, integrate,
-};
 use crate::link::{FloatingLink, sample_field};
+use crate::output::Outputs;
 use crate::settings::{FdmSettings, Method};
+use crate::system::{Bound, BoundKind, DriftVelocities, System, damped_step_factor};
 use contact::TipContact;
 use dual::Dual;
 use kinetic::{BE, ChainInertia, TH, seg_energy, seg_grad};
@@ -1076,6 +1076,52 @@ impl System for TwoLinkChain {
         best
     }
 
+    fn stored_energies(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        let ine = &self.inertia;
+        let mut qk = self.obs_scratch.borrow_mut();
+        let mut vk = self.obs_scratch_v.borrow_mut();
+        qk.copy_from_slice(q);
+        vk.copy_from_slice(v);
+        for s in self.slots {
+            qk[s] = 0.0;
+            vk[s] = 0.0;
+        }
+        let mut ke = ine.kinetic(&qk, &vk);
+        let mut strain = FloatingLink::bending_energy(ine.h1, self.links[0].ei, &qk[ine.iv()])
+            + FloatingLink::bending_energy(ine.h2, self.links[1].ei, &qk[ine.iw()]);
+        for k in 0..2 {
+            let (h, c) = (self.hs[k], self.links[k].ei);
+            let (u1, x) = (q[self.first(k)], q[self.slots[k]]);
+            ke += 0.5 * self.jc[k] * self.clamp_angle(v, k).powi(2);
+            // κ₀ = (u₁ + x)/h² instead of the single link's 2u₁/h²
+            strain += c * ((u1 + x).powi(2) / 4.0 - u1 * u1) / (h * h * h);
+        }
+        let j = &self.joints;
+        let mut spring = 0.5 * j[0].stiffness * (self.clamp_angle(q, 0) - j[0].set_point).powi(2)
+            + 0.5 * j[1].stiffness * (self.elbow(q) - j[1].set_point).powi(2);
+        if let Some(t) = &self.timo {
+            // condensed U(y, z₀(y)): strain (bending + shear) and joint springs
+            let parts = t.energies(q);
+            strain = parts.links;
+            spring = parts.joints;
+        }
+        out[..3].copy_from_slice(&[ke, strain, spring]);
+        if self.gravity.is_some() {
+            out[3] = self.gravity_potential(&qk, None);
+        }
+    }
+
+    fn monitored(&self) -> std::ops::Range<usize> {
+        2..self.dofs()
+    }
+
+    fn damped(&self) -> bool {
+        // free joints: velocity-coupled (gyroscopic) inertia forces, as the torque-driven link
+        true
+    }
+}
+
+impl Outputs for TwoLinkChain {
     fn describe(&self, b: &Bound) -> String {
         if b.site >= SHEAR_SITE {
             format!(
@@ -1214,45 +1260,6 @@ impl System for TwoLinkChain {
         (stored, inputs, diss)
     }
 
-    fn stored_energies(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-        let ine = &self.inertia;
-        let mut qk = self.obs_scratch.borrow_mut();
-        let mut vk = self.obs_scratch_v.borrow_mut();
-        qk.copy_from_slice(q);
-        vk.copy_from_slice(v);
-        for s in self.slots {
-            qk[s] = 0.0;
-            vk[s] = 0.0;
-        }
-        let mut ke = ine.kinetic(&qk, &vk);
-        let mut strain = FloatingLink::bending_energy(ine.h1, self.links[0].ei, &qk[ine.iv()])
-            + FloatingLink::bending_energy(ine.h2, self.links[1].ei, &qk[ine.iw()]);
-        for k in 0..2 {
-            let (h, c) = (self.hs[k], self.links[k].ei);
-            let (u1, x) = (q[self.first(k)], q[self.slots[k]]);
-            ke += 0.5 * self.jc[k] * self.clamp_angle(v, k).powi(2);
-            // κ₀ = (u₁ + x)/h² instead of the single link's 2u₁/h²
-            strain += c * ((u1 + x).powi(2) / 4.0 - u1 * u1) / (h * h * h);
-        }
-        let j = &self.joints;
-        let mut spring = 0.5 * j[0].stiffness * (self.clamp_angle(q, 0) - j[0].set_point).powi(2)
-            + 0.5 * j[1].stiffness * (self.elbow(q) - j[1].set_point).powi(2);
-        if let Some(t) = &self.timo {
-            // condensed U(y, z₀(y)): strain (bending + shear) and joint springs
-            let parts = t.energies(q);
-            strain = parts.links;
-            spring = parts.joints;
-        }
-        out[..3].copy_from_slice(&[ke, strain, spring]);
-        if self.gravity.is_some() {
-            out[3] = self.gravity_potential(&qk, None);
-        }
-    }
-
-    fn monitored(&self) -> std::ops::Range<usize> {
-        2..self.dofs()
-    }
-
     fn dof_name(&self, i: usize) -> String {
         let ine = &self.inertia;
         match i {
@@ -1272,11 +1279,6 @@ impl System for TwoLinkChain {
                 format!("link 2 w at station {k} (x = {:.4})", k as f64 * ine.h2)
             }
         }
-    }
-
-    fn damped(&self) -> bool {
-        // free joints: velocity-coupled (gyroscopic) inertia forces, as the torque-driven link
-        true
     }
 }
 

@@ -6,17 +6,15 @@ pub mod system;
 
 use data::{DofPlan, RunResult, Scene, Settings};
 
+use crate::driver::{StepControl, integrate};
 use crate::error::FdmError;
-use crate::integrator::{Outcome, StepControl, integrate};
+use crate::output::Outcome;
 use crate::settings::FdmSettings;
 use model::RocketModel;
 use system::RocketSystem;
 
 /// Default stations: h = 2 in over 150 in, as in the report.
 pub const DEFAULT_STATIONS: usize = 76;
-
-/// Relative step change logged as a `StepSizeChange` event.
-pub const LOG_CHANGE: f64 = 0.01;
 
 pub fn build(scene: &Scene, s: &FdmSettings) -> Result<RocketSystem, FdmError> {
     let r = scene
