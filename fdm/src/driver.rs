@@ -25,6 +25,7 @@ use std::time::Instant;
 use data::{Cost, Diagnostic, Event, StabilityVerdict};
 
 use crate::error::FdmError;
+use crate::events::{Events, NoEvents, Retake, finish_step};
 use crate::method::{StepState, Stepper, stepper};
 use crate::output::{Outcome, Outputs, Recorder};
 use crate::settings::{FdmSettings, Method};
@@ -128,13 +129,21 @@ pub fn integrate<S: Model>(
     v0: &[f64],
     ctl: &StepControl,
 ) -> Result<Outcome, FdmError> {
-    run(sys, stepper(ctl.method).as_mut(), q0, v0, ctl)
+    run(
+        sys,
+        stepper(ctl.method).as_mut(),
+        &mut NoEvents,
+        q0,
+        v0,
+        ctl,
+    )
 }
 
-/// Integrates from (q0, v0) at t = 0 to `ctl.t_end` with `method`.
-pub fn run<S: Model>(
+/// Integrates from (q0, v0) at t = 0 to `ctl.t_end` with `method`, consuming `events`.
+pub fn run<S: Model, E: Events<S>>(
     sys: &mut S,
     method: &mut dyn Stepper,
+    events: &mut E,
     q0: &[f64],
     v0: &[f64],
     ctl: &StepControl,
@@ -145,7 +154,7 @@ pub fn run<S: Model>(
     let np = inp.len() + dis.len();
     let factor = method.bound_factor();
     let mut rec = Recorder::new(sys, ctl.t_end, ctl.output_interval);
-    let mut events = Vec::new();
+    let mut log = Vec::new();
     let mut cost = Cost {
         dofs: n,
         ..Cost::default()
@@ -159,10 +168,13 @@ pub fn run<S: Model>(
     st.cur.v.copy_from_slice(v0);
 
     let mut t = 0.0;
+    events.begin(sys, &st.cur)?;
     sys.accel(t, &st.cur.q, &st.cur.v, &mut st.acc);
     sys.powers(&mut st.p_cur);
+    events.level_powers(sys, t, &st.cur.v, &mut st.p_cur);
     cost.rhs_evaluations += 1;
     let (mut tau, limit, _) = choose_step(sys, ctl, factor, t)?;
+    events.first_step(tau);
     let mut tau_logged = tau;
     let (mut tau_min, mut tau_max) = (tau, tau);
     rec.record(sys, t, &st.cur, &w_cur, t, &st.cur, &w_cur, tau, limit);
@@ -193,7 +205,7 @@ pub fn run<S: Model>(
     while !rec.done() {
         let (tau_next, limit_next, b) = choose_step(sys, ctl, factor, t)?;
         if ((tau_next - tau_logged) / tau_logged).abs() > ctl.log_change {
-            events.push(Event::StepSizeChange {
+            log.push(Event::StepSizeChange {
                 t,
                 from: tau_logged,
                 to: tau_next,
@@ -208,8 +220,11 @@ pub fn run<S: Model>(
         }
         tau_min = tau_min.min(tau_next);
         tau_max = tau_max.max(tau_next);
-        let t_new = t + tau_next;
-        method.predict(tau, tau_next, &mut st);
+        let tau_step = match events.step_factor(t) {
+            Some(f) if ctl.forced_dt.is_none() => tau_next * f,
+            _ => tau_next,
+        };
+        method.predict(tau, tau_step, &mut st);
         // Monitor the computational mode: |Δ²v| over the elastic coordinates.
         let mut d2 = 0.0f64;
         let mut vmax = 0.0f64;
@@ -244,7 +259,7 @@ pub fn run<S: Model>(
                     sys,
                     Growth {
                         t,
-                        tau: tau_next,
+                        tau: tau_step,
                         limit: limit_next,
                         parasitic,
                         finite,
@@ -262,25 +277,63 @@ pub fn run<S: Model>(
         peak_q = peak_q.max(qmax);
 
         // Accelerations at the new level.
-        method.complete(sys, t_new, tau, tau_next, &mut st);
+        finish_step(method, sys, t, tau, tau_step, &mut st);
         cost.rhs_evaluations += 1;
-        for k in 0..np {
-            w_new[k] = w_cur[k] + 0.5 * tau_next * (st.p_cur[k] + st.p_new[k]);
+        // An event inside the step: the step is re-taken up to it.
+        let mut retake = Retake {
+            method: &mut *method,
+            t,
+            tau_prev: tau,
+            evaluations: 0,
+        };
+        let located = events.locate(sys, t, tau_step, &mut st, &mut retake);
+        cost.rhs_evaluations += retake.evaluations;
+        let tau_taken = match located {
+            Err(stop) => {
+                verdict = stop;
+                break;
+            }
+            Ok(at) => at,
+        };
+        let tau_eff = tau_taken.unwrap_or(tau_step);
+        let t_new = t + tau_eff;
+        if tau_eff > 0.0 {
+            events.level_powers(sys, t_new, &st.next.v, &mut st.p_new);
         }
-        rec.record(
-            sys, t, &st.cur, &w_cur, t_new, &st.next, &w_new, tau_next, limit_next,
-        );
+        events.committed(sys, tau_eff);
+        for k in 0..np {
+            w_new[k] = w_cur[k] + 0.5 * tau_eff * (st.p_cur[k] + st.p_new[k]);
+        }
+        if tau_eff > 0.0 {
+            rec.record(
+                sys, t, &st.cur, &w_cur, t_new, &st.next, &w_new, tau_eff, limit_next,
+            );
+            cost.steps += 1;
+        }
         st.rotate();
         std::mem::swap(&mut w_cur, &mut w_new);
         t = t_new;
-        tau = tau_next;
-        cost.steps += 1;
+        tau = tau_eff;
+        if tau_taken.is_some() {
+            match events.apply(sys, t, &mut st, &mut w_cur, &mut log) {
+                Ok(evaluations) => cost.rhs_evaluations += evaluations,
+                Err(stop) => {
+                    verdict = stop;
+                    break;
+                }
+            }
+            // a reset starts a new history for the watch: no Δ²v across it
+            st.prev.q.copy_from_slice(&st.cur.q);
+            st.prev.v.copy_from_slice(&st.cur.v);
+            peak_v = peak_v.max(inf_norm(&st.cur.v[mon.clone()]));
+        }
+        events.settled(sys, &st.cur);
     }
     cost.wall_time_s = clock.elapsed().as_secs_f64();
     Ok(Outcome {
         observables: rec.obs,
         ledger: rec.ledger,
-        events,
+        events: log,
         cost,
         verdict,
         tau_min,

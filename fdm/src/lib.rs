@@ -1,5 +1,17 @@
 //! # fdm — the variable-step finite-difference scheme of the 1969 NASA report (seed 003 §5)
 //!
+//! ## Layout
+//! * **Model** — [`system::System`]: a semi-discrete q̇ = v, v̇ = a(t, q, v) (accelerations,
+//!   powers, stored energies, step bound, constraint projections). Implementations:
+//!   [`rocket::system`], [`link`], [`chain`]; [`beam`] for modes and statics.
+//!   [`ModelChoice`] classifies a scene once.
+//! * **Method** — [`method::Stepper`], one type per method ([`method::two_step`],
+//!   [`method::velocity_form`]); [`method::stepper`] maps `time.method` to its type.
+//! * **Events** — [`events::Events`]: located inside a step, applied as resets and constraint
+//!   switches ([`events::tip_contact`]).
+//! * **Driver and outputs** — [`driver::run`] (step choice, watch, ledger work) and
+//!   [`output`] (channel naming through [`output::Outputs`], sampling, result mapping).
+//!
 //! ## Rocket (`rocket`, `rocket-case2`, `rocket-launch-60`, `rocket-launch-75`)
 //! Continuous equations (report 5.2–5.8, re-derived, OCR typos removed): per unit length of the
 //! case, m A_x = ∂/∂x(EA(u' + ½w'²)) + f_u and m A_y = −∂²/∂x²(EI w'') + ∂/∂x(P w') + f_w, with
@@ -99,7 +111,7 @@
 //!   covered, but a chain spun at ≳ 100 rad/s would need the link's tension term (not done).
 //!   **Gravity** on the chain: V_g = −g·Σ m r over the lumped masses at the positions the
 //!   kinetic energy uses (foreshortening included), ledger term `gravity`. **Tip contact**
-//!   ([`chain::contact`]; `barhorst-case1`, `-case2`, `-case1-tipmass`, `-case1-stiff-elbow`):
+//!   ([`chain::contact`], its events [`events::tip_contact`]; `barhorst-case1`, `-case2`, `-case1-tipmass`, `-case1-stiff-elbow`):
 //!   link 2's tip against a fixed line, unilateral and frictionless. Contact start located on
 //!   the step's own drift (Illinois, 1e-10 s), impact M(q̇⁺ − q̇⁻) = GᵀΛ with the chain's own M
 //!   (loss booked as `impact`), constrained sliding M q̈ = f + Gᵀλ, Gq̈ + Ġq̇ = 0 with
@@ -143,6 +155,7 @@ pub mod beam;
 pub mod chain;
 pub mod driver;
 pub mod error;
+pub mod events;
 pub mod link;
 pub mod method;
 pub mod output;

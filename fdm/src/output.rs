@@ -1,5 +1,5 @@
 //! Driver outputs: the naming of a model's observables and ledger terms ([`Outputs`]), the
-//! sampling of a run at the output times ([`Recorder`]: linear interpolation between step
+//! sampling of a run at the output times (`Recorder`: linear interpolation between step
 //! levels, no allocation after construction) and the mapping to `data`'s result types
 //! ([`Outcome`]).
 

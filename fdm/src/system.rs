@@ -1,7 +1,7 @@
 //! The model side of the backend: a semi-discrete mechanical system q̇ = v, v̇ = a(t, q, v)
 //! (physics only: state layout, accelerations, powers, stored energies, the step bound of its
-//! spectrum). Time stepping lives in [`crate::method`], contact events in
-//! [`crate::chain::contact`], the loop in [`crate::driver`] and the output mapping in
+//! spectrum). Time stepping lives in [`crate::method`], events in [`crate::events`],
+//! the loop in [`crate::driver`] and the output mapping in
 //! [`crate::output`].
 //!
 //! **Step bound.** A model reports the report's σ = min_i σ_i (5.43–5.45) at time t: 2/ω_max
@@ -75,6 +75,16 @@ pub trait System {
     fn powers(&self, out: &mut [f64]);
     /// The report's step bound σ at time t (before the method factor and safety factor).
     fn bound(&self, t: f64) -> Bound;
+    /// Projects the positions of a new level onto the active holonomic constraints, before its
+    /// force evaluation (event objects switch constraints on and off: [`crate::events`]).
+    /// Default: no constraints.
+    fn project_position(&mut self, q: &mut [f64]) {
+        let _ = q;
+    }
+    /// Projects the step-end velocities onto the active constraints, after the final kick.
+    fn project_velocity(&mut self, v: &mut [f64]) {
+        let _ = v;
+    }
     /// Stored energies at (t, q, v), in the order of the ledger's stored terms.
     fn stored_energies(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]);
     /// Coordinates whose growth is monitored for the computational mode (elastic DOFs).

@@ -4,7 +4,8 @@
 use data::{Backend, BackendError, Event, RunResult, Settings, StabilityVerdict, load_scene};
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
-use fdm::chain::contact::{ContactReport, EVENT_TIME_TOLERANCE, simulate};
+use fdm::chain::contact::simulate;
+use fdm::events::tip_contact::{ContactReport, EVENT_TIME_TOLERANCE};
 use fdm::output::Outputs;
 use fdm::settings::FdmSettings;
 

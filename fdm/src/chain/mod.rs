@@ -138,6 +138,8 @@ pub struct TwoLinkChain {
     /// scratch of the constraint: G = ∂g/∂q and M⁻¹Gᵀ
     grow: Vec<f64>,
     minv_g: Vec<f64>,
+    /// (|g|, |Gq̇|, energy removed) of the last constrained step's projections
+    last_projection: [f64; 3],
     /// Timoshenko links (`shear` on both): the condensed section rotations ([`timoshenko`]);
     /// the ghost slots are then unused (held at zero with a unit dummy mass)
     timo: Option<TimoFields>,
@@ -336,6 +338,7 @@ impl TwoLinkChain {
             lambda: 0.0,
             grow: vec![0.0; nd],
             minv_g: vec![0.0; nd],
+            last_projection: [0.0; 3],
             timo,
         };
         // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
@@ -787,7 +790,7 @@ impl TwoLinkChain {
     /// writes them as [`System::powers`] does. The velocity form evaluates the forces of a step
     /// end at the *predicted* velocity; its ledger takes the powers at the final one (the
     /// overdamped clamp-rotation modes make the two differ at O(1) near the step bound).
-    pub(super) fn powers_at(&mut self, t: f64, v: &[f64], out: &mut [f64]) {
+    pub(crate) fn powers_at(&mut self, t: f64, v: &[f64], out: &mut [f64]) {
         if let Some(tf) = &self.timo {
             let pw = tf.powers(v);
             self.power = [0.0, pw[0], pw[1]];
@@ -972,6 +975,22 @@ impl System for TwoLinkChain {
         self.solve_mass(&rhs, a);
         self.rhs = rhs;
         self.lambda = 0.0;
+    }
+
+    /// On the surface g = 0 along M⁻¹Gᵀ while the tip is held ([`contact`]).
+    fn project_position(&mut self, q: &mut [f64]) {
+        if self.constrained {
+            self.last_projection[0] = self.project_onto_surface(q);
+        }
+    }
+
+    /// Onto Gq̇ = 0 along M⁻¹Gᵀ while the tip is held ([`contact`]).
+    fn project_velocity(&mut self, v: &mut [f64]) {
+        if self.constrained {
+            let (gv, energy) = self.remove_normal_velocity(v);
+            self.last_projection[1] = gv;
+            self.last_projection[2] = energy;
+        }
     }
 
     fn powers(&self, out: &mut [f64]) {
