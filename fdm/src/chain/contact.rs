@@ -41,6 +41,8 @@
 
 use data::scene::{ContactMode, Surface};
 use data::{Event, RunResult, Scene, Settings};
+use faer::Mat;
+use faer::prelude::Solve;
 
 use super::TwoLinkChain;
 use super::kinetic::{BE, TH, seg_energy, seg_grad, seg_rate};
@@ -359,7 +361,8 @@ impl TwoLinkChain {
     }
 
     /// Static equilibrium resting on the surface: −∂V/∂q + Gᵀλ = 0, g = 0 (V: strain, joint
-    /// springs, gravity), by Newton's method with a central-difference Jacobian from `q_guess`.
+    /// springs, gravity), by Newton's method with a central-difference Jacobian (faer's
+    /// partial-pivoting LU) from `q_guess`.
     /// Returns (q, λ). Allocates: for checks, not for the step loop.
     pub fn rest_on_surface(&mut self, q_guess: &[f64]) -> Result<(Vec<f64>, f64), FdmError> {
         if self.contact.is_none() {
@@ -383,7 +386,7 @@ impl TwoLinkChain {
         let mut x: Vec<f64> = q_guess.iter().copied().chain([0.0]).collect();
         let m = n + 1;
         let (mut r, mut rp, mut rm) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
-        let mut jac = vec![vec![0.0; m]; m];
+        let mut jac = Mat::<f64>::zeros(m, m);
         for _ in 0..50 {
             resid(self, &x, &mut r);
             for j in 0..m {
@@ -395,15 +398,18 @@ impl TwoLinkChain {
                 resid(self, &x, &mut rm);
                 x[j] = x0;
                 for i in 0..m {
-                    jac[i][j] = (rp[i] - rm[i]) / (2.0 * e);
+                    jac[(i, j)] = (rp[i] - rm[i]) / (2.0 * e);
                 }
             }
-            let dx = solve_dense(jac.clone(), r.iter().map(|v| -v).collect()).ok_or(
-                FdmError::Numerical {
+            let rhs = Mat::from_fn(m, 1, |i, _| -r[i]);
+            let sol = jac.partial_piv_lu().solve(&rhs);
+            let dx: Vec<f64> = (0..m).map(|i| sol[(i, 0)]).collect();
+            if !dx.iter().all(|v| v.is_finite()) {
+                return Err(FdmError::Numerical {
                     t: 0.0,
                     message: "singular Jacobian of the resting equilibrium".into(),
-                },
-            )?;
+                });
+            }
             let step = dx.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             for i in 0..m {
                 x[i] += dx[i];
@@ -419,32 +425,6 @@ impl TwoLinkChain {
             message: "Newton on the resting equilibrium did not converge in 50 iterations".into(),
         })
     }
-}
-
-/// Gaussian elimination with partial pivoting (small dense systems of the checks).
-fn solve_dense(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
-    let n = b.len();
-    for col in 0..n {
-        let piv = (col..n).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[piv][col] == 0.0 {
-            return None;
-        }
-        a.swap(col, piv);
-        b.swap(col, piv);
-        for row in col + 1..n {
-            let f = a[row][col] / a[col][col];
-            for k in col..n {
-                a[row][k] -= f * a[col][k];
-            }
-            b[row] -= f * b[col];
-        }
-    }
-    let mut x = vec![0.0; n];
-    for row in (0..n).rev() {
-        let s: f64 = (row + 1..n).map(|k| a[row][k] * x[k]).sum();
-        x[row] = (b[row] - s) / a[row][row];
-    }
-    Some(x)
 }
 
 /// Runs a two-link chain with its tip contact: the velocity form with every force at the
