@@ -166,3 +166,22 @@ impl Recorder {
         self.next >= self.times.len()
     }
 }
+
+/// Samples a link's deflection at `out.len()` equally spaced points over its `length`, linearly
+/// between the stations 0…r of step `h` (`at(i)`: deflection of station i).
+pub(crate) fn sample_field(
+    length: f64,
+    h: f64,
+    r: usize,
+    at: impl Fn(usize) -> f64,
+    out: &mut [f64],
+) {
+    let nf = out.len();
+    for (k, o) in out.iter_mut().enumerate() {
+        let x = k as f64 * length / (nf - 1) as f64;
+        let pos = (x / h).clamp(0.0, r as f64);
+        let i = (pos.floor() as usize).min(r - 1);
+        let al = pos - i as f64;
+        *o = at(i) * (1.0 - al) + at(i + 1) * al;
+    }
+}

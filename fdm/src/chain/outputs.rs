@@ -6,8 +6,7 @@ use data::channel;
 
 use super::kinetic::{BE, TH, seg_energy};
 use super::{SHEAR_SITE, TwoLinkChain};
-use crate::link::sample_field;
-use crate::output::Outputs;
+use crate::output::{Outputs, sample_field};
 use crate::system::Bound;
 
 impl Outputs for TwoLinkChain {
