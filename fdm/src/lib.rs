@@ -9,8 +9,9 @@
 //!   [`method::velocity_form`]); [`method::stepper`] maps `time.method` to its type.
 //! * **Events** — [`events::Events`]: located inside a step, applied as resets and constraint
 //!   switches ([`events::tip_contact`]).
-//! * **Driver and outputs** — [`driver::run`] (step choice, watch, ledger work) and
-//!   [`output`] (channel naming through [`output::Outputs`], sampling, result mapping).
+//! * **Driver and outputs** — [`driver::run`] (step choice, watch, ledger work),
+//!   [`output`] (channel naming through [`output::Outputs`], sampling, result mapping) and
+//!   [`runs`] (each model's run from the scene: model, method, events, step control).
 //!
 //! ## Rocket (`rocket`, `rocket-case2`, `rocket-launch-60`, `rocket-launch-75`)
 //! Continuous equations (report 5.2–5.8, re-derived, OCR typos removed): per unit length of the
@@ -160,6 +161,7 @@ pub mod link;
 pub mod method;
 pub mod output;
 pub mod rocket;
+pub mod runs;
 pub mod settings;
 pub mod system;
 
@@ -266,10 +268,10 @@ impl Backend for FdmBackend {
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
         let s = FdmSettings::from_settings(settings)?;
         Ok(match ModelChoice::of(scene)? {
-            ModelChoice::Rocket => rocket::simulate(scene, settings, &s)?,
+            ModelChoice::Rocket => runs::rocket(scene, settings, &s)?,
             ModelChoice::Cantilever => return Err(beam::simulate_unsupported(scene).into()),
-            ModelChoice::TwoLinkChain => chain::simulate(scene, settings, &s)?,
-            ModelChoice::SingleLink => link::simulate(scene, settings, &s)?,
+            ModelChoice::TwoLinkChain => runs::two_link_chain(scene, settings, &s)?,
+            ModelChoice::SingleLink => runs::single_link(scene, settings, &s)?,
         })
     }
 }

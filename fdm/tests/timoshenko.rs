@@ -9,9 +9,9 @@ use data::{
 };
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
-use fdm::chain::contact::simulate;
 use fdm::chain::timoshenko::TimoFields;
 use fdm::output::Outputs;
+use fdm::runs::two_link_chain_with_contact as simulate;
 use fdm::settings::FdmSettings;
 use fdm::system::System;
 

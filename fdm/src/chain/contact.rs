@@ -12,7 +12,7 @@
 //! Ġq̇ = Σ_ℓ [−nc(α)α̇²(L − S) − 2ns(α)α̇Ṡ − nc(α) h Σ ġ²] (differentiate g twice, drop G q̈).
 //!
 //! **Phases** (the velocity form, one step = kick–drift–kick; when each phase starts and ends
-//! is decided by the event object [`TipContactEvents`]):
+//! is decided by the event object [`crate::events::tip_contact::TipContactEvents`]):
 //! * free flight: M q̈ = f, until a contact start located inside a step;
 //! * impact (positions unchanged): M(q)(q̇⁺ − q̇⁻) = GᵀΛ, G q̇⁺ = 0 ⇒ Λ = −Gq̇⁻/(GM⁻¹Gᵀ),
 //!   q̇⁺ = q̇⁻ + M⁻¹GᵀΛ with the chain's own M (lumped diagonal + four full columns, the Schur
@@ -23,7 +23,8 @@
 //!   q projected onto g = 0 (Newton along M⁻¹Gᵀ, the M⁻¹ metric) *before* the force evaluation
 //!   of the step end, q̇ projected onto Gq̇ = 0 along M⁻¹Gᵀ after the final kick. The velocity
 //!   projection removes ½(Gq̇)²/(GM⁻¹Gᵀ) of kinetic energy: not booked in the ledger (it is
-//!   integration error and shows in the closure), reported in [`ContactReport`]. The
+//!   integration error and shows in the closure), reported in
+//!   [`crate::events::tip_contact::ContactReport`]. The
 //!   projections are the chain's [`System::project_position`] and
 //!   [`System::project_velocity`], active while the tip is held;
 //! * release when λ crosses zero from above, then free flight.
@@ -40,26 +41,15 @@
 #![allow(clippy::needless_range_loop)]
 
 use data::scene::{ContactMode, Surface};
-use data::{Event, RunResult, Scene, Settings};
+use data::{Event, Scene};
 use faer::Mat;
 use faer::prelude::Solve;
 
 use super::TwoLinkChain;
 use super::kinetic::{BE, TH, seg_energy, seg_grad, seg_rate};
-use crate::driver::{StepControl, run};
 use crate::error::FdmError;
-use crate::events::tip_contact::{ContactReport, TipContactEvents};
-use crate::method::VelocityForm;
 use crate::output::Outputs;
-use crate::settings::{FdmSettings, Method};
 use crate::system::System;
-
-/// Default safety factor of a Timoshenko chain with contact (an accuracy choice, not a
-/// stability one). Impacts excite the condensed operator's shear waves near the step bound,
-/// where the velocity-form step is only about first order in energy: at safety 1 the ledger of
-/// `barhorst-case1-timoshenko` closes to 1.3e-4 over 0.4 s, at 0.1 to 7.5e-6 (3 s: 3.9e-6,
-/// ~9 s wall), inside the issue's 1e-5. `time.safety_factor` overrides it.
-pub const TIMOSHENKO_CONTACT_SAFETY: f64 = 0.1;
 
 /// Relative gap (× L₁ + L₂) at which the contact-start location stops, and the tolerance of
 /// the position projection.
@@ -425,40 +415,4 @@ impl TwoLinkChain {
             message: "Newton on the resting equilibrium did not converge in 50 iterations".into(),
         })
     }
-}
-
-/// Runs a two-link chain with its tip contact: the velocity form with every force at the
-/// predicted velocity (its steps can be re-taken from the same level), the contact as events
-/// ([`TipContactEvents`]). Returns the run and the contact diagnostics.
-pub fn simulate(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<(RunResult, ContactReport), FdmError> {
-    if settings.time.method.is_some() && s.method != Method::VelocityForm {
-        return Err(FdmError::Unsupported(format!(
-            "fdm: contact with time.method = {}: only velocity-form restarts at a located \
-             event (the two-step scheme needs a second level there)",
-            s.method.name()
-        )));
-    }
-    let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
-    let (q0, v0) = sys.initial_state();
-    let mut ctl = StepControl::for_scene(scene, s, Method::VelocityForm, false, true);
-    if sys.timoshenko().is_some() && settings.time.safety_factor.is_none() {
-        ctl.safety = TIMOSHENKO_CONTACT_SAFETY;
-    }
-    // the step follows the refinement windows after each impact: no step-change events
-    ctl.log_change = f64::INFINITY;
-    let (_, inp, dis) = sys.ledger_names();
-    let mut events = TipContactEvents::new(&sys, inp.len() + dis.len());
-    let out = run(
-        &mut sys,
-        &mut VelocityForm::predicted(),
-        &mut events,
-        &q0,
-        &v0,
-        &ctl,
-    )?;
-    Ok((out.into_run_result(scene, settings), events.report))
 }

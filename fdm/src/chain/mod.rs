@@ -54,13 +54,11 @@ mod outputs;
 pub mod timoshenko;
 
 use data::scene::{Link, TorqueLaw};
-use data::{DofPlan, RunResult, Scene, Settings};
+use data::{DofPlan, Scene};
 
-use crate::driver::{StepControl, integrate};
 use crate::error::FdmError;
 use crate::link::FloatingLink;
 use crate::output::Outputs;
-use crate::settings::{FdmSettings, Method};
 use crate::system::{Bound, DriftVelocities, System};
 use contact::TipContact;
 use dual::Dual;
@@ -902,26 +900,4 @@ impl System for TwoLinkChain {
         // free joints: velocity-coupled (gyroscopic) inertia forces, as the torque-driven link
         true
     }
-}
-
-/// Runs a two-link chain. Default method (no `time.method`): the one-step velocity form — the
-/// free joints make the inertia forces velocity dependent and damping is on in the damped scene,
-/// both of which grow the two-step scheme's computational mode.
-pub fn simulate(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<RunResult, FdmError> {
-    if !scene.contacts.is_empty() {
-        return Ok(contact::simulate(scene, settings, s)?.0);
-    }
-    let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
-    let method = if settings.time.method.is_none() {
-        Method::VelocityForm
-    } else {
-        s.method
-    };
-    let (q0, v0) = sys.initial_state();
-    let ctl = StepControl::for_scene(scene, s, method, false, true);
-    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, settings))
 }

@@ -25,11 +25,9 @@
 use std::ops::Range;
 
 use data::scene::{PrescribedMotion, TorqueLaw};
-use data::{DofPlan, RunResult, Scene, Settings};
+use data::{DofPlan, Scene};
 
-use crate::driver::{StepControl, integrate};
 use crate::error::FdmError;
-use crate::settings::FdmSettings;
 use crate::system::{Bound, BoundKind, System};
 
 mod outputs;
@@ -498,17 +496,6 @@ impl System for FloatingLink {
         // two-step scheme's computational mode.
         self.gamma > 0.0 || !self.prescribed()
     }
-}
-
-pub fn simulate(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<RunResult, FdmError> {
-    let mut sys = FloatingLink::from_scene(scene, s.stations)?;
-    let (q0, v0) = sys.initial_state();
-    let ctl = StepControl::for_scene(scene, s, s.method, false, true);
-    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, settings))
 }
 
 #[cfg(test)]

@@ -1,4 +1,7 @@
 use super::*;
+use crate::driver::{StepControl, integrate};
+use crate::runs::single_link as simulate;
+use data::Settings;
 
 #[test]
 fn elem_link_forces_are_minus_energy_gradients() {
