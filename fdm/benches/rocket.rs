@@ -13,7 +13,7 @@ fn bench(c: &mut Criterion) {
         let s = FdmSettings::from_settings(&settings).expect("valid settings");
         c.bench_function(&format!("rocket_0.1s_76_stations_{label}"), |b| {
             b.iter(|| {
-                let (_, out) = fdm::rocket::run_with(&scene, &s, true).expect("run");
+                let (_, out) = fdm::runs::rocket_with(&scene, &s, true).expect("run");
                 std::hint::black_box(out.cost.steps)
             })
         });
@@ -26,7 +26,7 @@ fn bench(c: &mut Criterion) {
         let s = FdmSettings::from_settings(&settings).expect("valid settings");
         c.bench_function(&format!("rocket_0.01s_{n}_stations_velocity-form"), |b| {
             b.iter(|| {
-                let (_, out) = fdm::rocket::run_with(&scene, &s, true).expect("run");
+                let (_, out) = fdm::runs::rocket_with(&scene, &s, true).expect("run");
                 std::hint::black_box(out.cost.steps)
             })
         });

@@ -1,5 +1,18 @@
 //! # fdm — the variable-step finite-difference scheme of the 1969 NASA report (seed 003 §5)
 //!
+//! ## Layout
+//! * **Model** — [`system::System`]: a semi-discrete q̇ = v, v̇ = a(t, q, v) (accelerations,
+//!   powers, stored energies, step bound, constraint projections). Implementations:
+//!   [`rocket::system`], [`link`], [`chain`]; [`beam`] for modes and statics.
+//!   [`ModelChoice`] classifies a scene once.
+//! * **Method** — [`method::Stepper`], one type per method ([`method::two_step`],
+//!   [`method::velocity_form`]); [`method::stepper`] maps `time.method` to its type.
+//! * **Events** — [`events::Events`]: located inside a step, applied as resets and constraint
+//!   switches ([`events::tip_contact`]).
+//! * **Driver and outputs** — [`driver::run`] (step choice, watch, ledger work),
+//!   [`output`] (channel naming through [`output::Outputs`], sampling, result mapping) and
+//!   [`runs`] (each model's run from the scene: model, method, events, step control).
+//!
 //! ## Rocket (`rocket`, `rocket-case2`, `rocket-launch-60`, `rocket-launch-75`)
 //! Continuous equations (report 5.2–5.8, re-derived, OCR typos removed): per unit length of the
 //! case, m A_x = ∂/∂x(EA(u' + ½w'²)) + f_u and m A_y = −∂²/∂x²(EI w'') + ∂/∂x(P w') + f_w, with
@@ -21,7 +34,7 @@
 //!   The elastic accelerations satisfy 5.37 exactly, so the split loses nothing;
 //! * time: the two-step central difference 5.21/5.24–5.30 with (τ_j + τ_{j+1}) and steps from
 //!   σ² ≤ h² m/EA, σ² ≤ h⁴ m/(4EI) per segment (5.43–5.45), recomputed every step with the
-//!   masses of the new level as stage 1 burns ([`integrator`], which also states the start-up).
+//!   masses of the new level as stage 1 burns ([`driver`]; the start-up in [`method::two_step`]).
 //!
 //! **Stability finding.** The report's σ equals 2/ω_max of the discrete operator — the limit of
 //! the *one-step* second-order form. The two-step form 5.21 has roots ξ = iωτ ± √(1 − ω²τ²) and
@@ -86,7 +99,7 @@
 //!   strain, joint_spring | applied_torque | joint_damper, kelvin_voigt. **Default method:
 //!   velocity-form** (free joints make the inertia forces velocity dependent and damping is on;
 //!   the two-step scheme's parasitic root grows). The inertia terms quadratic in q̇ are taken
-//!   from the drift velocities v_{j±½} ([`integrator`]): at the predicted velocity the
+//!   from the drift velocities v_{j±½} ([`method::velocity_form`]): at the predicted velocity the
 //!   foreshortening couplings turned the unresolved bending waves into a bias growing with
 //!   the number of stations (1 s mean of joint 2 on `two-link-free-undamped`: 0.681, 0.665,
 //!   0.636 at 21/41/81 stations against fem's 0.6968; now 0.6972, 0.6969, 0.6969, and the 20 Hz
@@ -99,7 +112,7 @@
 //!   covered, but a chain spun at ≳ 100 rad/s would need the link's tension term (not done).
 //!   **Gravity** on the chain: V_g = −g·Σ m r over the lumped masses at the positions the
 //!   kinetic energy uses (foreshortening included), ledger term `gravity`. **Tip contact**
-//!   ([`chain::contact`]; `barhorst-case1`, `-case2`, `-case1-tipmass`, `-case1-stiff-elbow`):
+//!   ([`chain::contact`], its events [`events::tip_contact`]; `barhorst-case1`, `-case2`, `-case1-tipmass`, `-case1-stiff-elbow`):
 //!   link 2's tip against a fixed line, unilateral and frictionless. Contact start located on
 //!   the step's own drift (Illinois, 1e-10 s), impact M(q̇⁺ − q̇⁻) = GᵀΛ with the chain's own M
 //!   (loss booked as `impact`), constrained sliding M q̈ = f + Gᵀλ, Gq̈ + Ġq̇ = 0 with
@@ -141,11 +154,16 @@
 
 pub mod beam;
 pub mod chain;
+pub mod driver;
 pub mod error;
-pub mod integrator;
+pub mod events;
 pub mod link;
+pub mod method;
+pub mod output;
 pub mod rocket;
+pub mod runs;
 pub mod settings;
+pub mod system;
 
 use data::{
     Backend, BackendError, BackendKind, Discretization, DofPlan, Family, ModalResult, RunResult,
@@ -159,25 +177,43 @@ pub use settings::{FdmSettings, Method};
 #[derive(Debug, Clone, Copy, Default)]
 pub struct FdmBackend;
 
-fn is_rocket(scene: &Scene) -> bool {
-    scene.family() == Family::Rocket
+/// The model a scene becomes in this backend (the one place a scene is classified).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelChoice {
+    /// The two-stage variable-mass rocket ([`rocket`]).
+    Rocket,
+    /// One link clamped to the ground: modes and statics ([`beam`]).
+    Cantilever,
+    /// One link on a hub, prescribed or torque driven ([`link`]).
+    SingleLink,
+    /// Two links in series, with its tip contact if any ([`chain`]).
+    TwoLinkChain,
 }
 
-/// A single link clamped to the ground (the cantilever family).
-fn is_clamped(scene: &Scene) -> bool {
-    scene.links.len() == 1
-        && matches!(
-            scene.links[0].joint.prescribed,
-            Some(data::scene::PrescribedMotion::Fixed)
-        )
-}
-
-fn unsupported_family(scene: &Scene) -> FdmError {
-    FdmError::Unsupported(format!(
-        "fdm backend: {} scenes (`{}`) are not implemented",
-        scene.family(),
-        scene.name
-    ))
+impl ModelChoice {
+    /// The model of `scene`; `Unsupported` for families and chains this backend does not carry.
+    pub fn of(scene: &Scene) -> Result<Self, FdmError> {
+        match scene.family() {
+            Family::Rocket => Ok(ModelChoice::Rocket),
+            Family::PlanarChain => Ok(match scene.links.len() {
+                1 if matches!(
+                    scene.links[0].joint.prescribed,
+                    Some(data::scene::PrescribedMotion::Fixed)
+                ) =>
+                {
+                    ModelChoice::Cantilever
+                }
+                2 => ModelChoice::TwoLinkChain,
+                // more than two links: refused with the link model's precise message
+                _ => ModelChoice::SingleLink,
+            }),
+            _ => Err(FdmError::Unsupported(format!(
+                "fdm backend: {} scenes (`{}`) are not implemented",
+                scene.family(),
+                scene.name
+            ))),
+        }
+    }
 }
 
 impl Backend for FdmBackend {
@@ -190,19 +226,16 @@ impl Backend for FdmBackend {
             discretization: disc.clone(),
             ..Settings::default()
         })?;
-        if is_rocket(scene) {
-            return Ok(rocket::dof_plan(scene, s.stations)?);
-        }
-        if scene.family() == Family::PlanarChain {
-            if is_clamped(scene) {
-                return Ok(beam::dof_plan(scene, s.stations)?);
+        Ok(match ModelChoice::of(scene)? {
+            ModelChoice::Rocket => rocket::dof_plan(scene, s.stations)?,
+            ModelChoice::Cantilever => beam::dof_plan(scene, s.stations)?,
+            ModelChoice::TwoLinkChain => {
+                chain::TwoLinkChain::from_scene(scene, s.stations)?.dof_plan()
             }
-            if scene.links.len() == 2 {
-                return Ok(chain::TwoLinkChain::from_scene(scene, s.stations)?.dof_plan());
+            ModelChoice::SingleLink => {
+                link::FloatingLink::from_scene(scene, s.stations)?.dof_plan()
             }
-            return Ok(link::FloatingLink::from_scene(scene, s.stations)?.dof_plan());
-        }
-        Err(unsupported_family(scene).into())
+        })
     }
 
     fn modes(
@@ -212,16 +245,13 @@ impl Backend for FdmBackend {
         count: usize,
     ) -> Result<ModalResult, BackendError> {
         let s = FdmSettings::from_settings(settings)?;
-        if scene.family() == Family::PlanarChain {
-            return Ok(beam::modes(scene, settings, &s, count)?);
-        }
-        if is_rocket(scene) {
-            return Err(BackendError::Unsupported(
+        match ModelChoice::of(scene)? {
+            ModelChoice::Rocket => Err(BackendError::Unsupported(
                 "fdm modes of the rocket: the variable-mass body has no fixed modes; use `run`"
                     .into(),
-            ));
+            )),
+            _ => Ok(beam::modes(scene, settings, &s, count)?),
         }
-        Err(unsupported_family(scene).into())
     }
 
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
@@ -237,18 +267,11 @@ impl Backend for FdmBackend {
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
         let s = FdmSettings::from_settings(settings)?;
-        if is_rocket(scene) {
-            return Ok(rocket::simulate(scene, settings, &s)?);
-        }
-        if scene.family() == Family::PlanarChain {
-            if is_clamped(scene) {
-                return Err(beam::simulate_unsupported(scene).into());
-            }
-            if scene.links.len() == 2 {
-                return Ok(chain::simulate(scene, settings, &s)?);
-            }
-            return Ok(link::simulate(scene, settings, &s)?);
-        }
-        Err(unsupported_family(scene).into())
+        Ok(match ModelChoice::of(scene)? {
+            ModelChoice::Rocket => runs::rocket(scene, settings, &s)?,
+            ModelChoice::Cantilever => return Err(beam::simulate_unsupported(scene).into()),
+            ModelChoice::TwoLinkChain => runs::two_link_chain(scene, settings, &s)?,
+            ModelChoice::SingleLink => runs::single_link(scene, settings, &s)?,
+        })
     }
 }

@@ -8,7 +8,11 @@ use crate::error::FdmError;
 /// accuracy cost small while damping the computational mode by ≈ 4ν per step).
 pub const DEFAULT_ASSELIN_NU: f64 = 0.01;
 
-/// Time-integration method (`time.method`).
+/// Relative change of the step τ that is logged as a `StepSizeChange` event (the rocket's step
+/// follows the burning mass; 1 % changes mark the burn without flooding the event list).
+pub const STEP_LOG_CHANGE: f64 = 0.01;
+
+/// Time-integration method (`time.method`); [`crate::method::stepper`] gives its type.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
     /// The report's two-step central difference (5.21, 5.24–5.30):
@@ -62,28 +66,6 @@ impl Method {
             Method::VelocityForm => "velocity-form".into(),
         }
     }
-
-    /// Whether the method carries the two-step scheme's computational (parasitic) mode.
-    pub fn is_two_step(&self) -> bool {
-        !matches!(self, Method::VelocityForm)
-    }
-
-    /// Ratio of the method's stability limit to the report's σ (5.41–5.44).
-    ///
-    /// The report's σ equals 2/ω_max of the discrete operator (the limit of the one-step
-    /// second-order form). The two-step form 5.21 has amplification roots
-    /// ξ = iωτ ± √(1 − ω²τ²), |ξ| = 1 only for ωτ ≤ 1: it needs half of σ.
-    ///
-    /// The Robert–Asselin filter shrinks the two-step limit further: the filtered scheme's
-    /// characteristic equation ξ² − 2(ν + iωτ)ξ − (1 − 2ν − 2iνωτ) = 0 has both roots in the unit
-    /// disc only for ωτ ≲ 1 − ν (ν = 0.01: 0.99004; ν = 0.1: 0.9045), so its factor is ½(1 − ν).
-    pub fn bound_factor(&self) -> f64 {
-        match self {
-            Method::Report => 0.5,
-            Method::RobertAsselin { nu } => 0.5 * (1.0 - nu),
-            Method::VelocityForm => 1.0,
-        }
-    }
 }
 
 /// Validated settings.
@@ -94,6 +76,8 @@ pub struct FdmSettings {
     pub safety: f64,
     pub method: Method,
     pub t_end: Option<f64>,
+    /// Relative step change logged as an event ([`STEP_LOG_CHANGE`]).
+    pub step_log_change: f64,
 }
 
 impl FdmSettings {
@@ -133,6 +117,7 @@ impl FdmSettings {
             safety,
             method,
             t_end: s.time.t_end,
+            step_log_change: STEP_LOG_CHANGE,
         })
     }
 }

@@ -7,7 +7,7 @@ use data::{Backend, RunResult, Settings, StabilityVerdict, load_scene};
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
 use fdm::chain::dual::Dual;
-use fdm::integrator::System;
+use fdm::system::System;
 
 mod common;
 

@@ -4,8 +4,9 @@
 use data::{Backend, BackendError, Event, RunResult, Settings, StabilityVerdict, load_scene};
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
-use fdm::chain::contact::{ContactReport, EVENT_TIME_TOLERANCE, simulate};
-use fdm::integrator::System;
+use fdm::events::tip_contact::{ContactReport, EVENT_TIME_TOLERANCE};
+use fdm::output::Outputs;
+use fdm::runs::two_link_chain_with_contact as simulate;
 use fdm::settings::FdmSettings;
 
 mod common;

@@ -2,7 +2,7 @@
 //! CARGO_TARGET_DIR=/work/targets/fdm cargo test --release -p fdm --test rocket
 
 use data::{Backend, BackendError, Observables, Scene, Settings, StabilityVerdict, load_scene};
-use fdm::integrator::System;
+use fdm::system::System;
 use fdm::{FdmBackend, FdmSettings};
 
 /// Total mass at ignition: the stages' weight per length times length, plus the discrete
@@ -23,9 +23,9 @@ fn settings(method: &str) -> (Settings, FdmSettings) {
     (s, f)
 }
 
-fn run(scene: &Scene, method: &str) -> fdm::integrator::Outcome {
+fn run(scene: &Scene, method: &str) -> fdm::output::Outcome {
     let (_, f) = settings(method);
-    fdm::rocket::run_with(scene, &f, true).expect("run").1
+    fdm::runs::rocket_with(scene, &f, true).expect("run").1
 }
 
 fn ch<'a>(o: &'a Observables, name: &str) -> &'a [f64] {
@@ -357,7 +357,7 @@ fn dyn_rocket_report_two_step_at_the_reports_own_sigma_blows_up() {
     s.time.dt = Some(0.999 * sigma);
     s.time.t_end = Some(0.005);
     let f = FdmSettings::from_settings(&s).unwrap();
-    let (_, out) = fdm::rocket::run_with(&scene, &f, false).unwrap();
+    let (_, out) = fdm::runs::rocket_with(&scene, &f, false).unwrap();
     match &out.verdict {
         StabilityVerdict::Stopped { diagnostic } => {
             eprintln!("report at σ: {diagnostic}");
@@ -368,7 +368,7 @@ fn dyn_rocket_report_two_step_at_the_reports_own_sigma_blows_up() {
     }
     s.time.method = Some("velocity-form".into());
     let f = FdmSettings::from_settings(&s).unwrap();
-    let (_, out) = fdm::rocket::run_with(&scene, &f, true).unwrap();
+    let (_, out) = fdm::runs::rocket_with(&scene, &f, true).unwrap();
     assert!(matches!(out.verdict, StabilityVerdict::Completed));
 }
 

@@ -4,7 +4,10 @@
 
 use data::StabilityVerdict;
 use fdm::Method;
-use fdm::integrator::{Bound, BoundKind, StepControl, System, integrate};
+use fdm::driver::{StepControl, integrate};
+use fdm::method::stepper;
+use fdm::output::Outputs;
+use fdm::system::{Bound, BoundKind, System};
 
 const OMEGA: f64 = 2.0 * std::f64::consts::PI;
 const T_END: f64 = 2.0;
@@ -65,9 +68,11 @@ impl System for Oscillator {
     fn dofs(&self) -> usize {
         1
     }
+
     fn accel(&mut self, _t: f64, q: &[f64], v: &[f64], a: &mut [f64]) {
         a[0] = -OMEGA * OMEGA * q[0] - 2.0 * self.zeta * OMEGA * v[0];
     }
+
     fn powers(&self, _out: &mut [f64]) {}
     fn bound(&self, t: f64) -> Bound {
         Bound {
@@ -76,27 +81,36 @@ impl System for Oscillator {
             site: 0,
         }
     }
-    fn describe(&self, _b: &Bound) -> String {
-        "oscillator".into()
-    }
-    fn channels(&self) -> Vec<(String, &'static str)> {
-        vec![("q".into(), "1")]
-    }
-    fn observe(&self, _t: f64, q: &[f64], _v: &[f64], out: &mut [f64]) {
-        out[0] = q[0];
-    }
-    fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
-        (vec![], vec![], vec![])
-    }
+
     fn stored_energies(&self, _t: f64, _q: &[f64], _v: &[f64], _out: &mut [f64]) {}
     fn monitored(&self) -> std::ops::Range<usize> {
         0..1
     }
-    fn dof_name(&self, _i: usize) -> String {
-        "q".into()
-    }
+
     fn damped(&self) -> bool {
         self.zeta > 0.0
+    }
+}
+
+impl Outputs for Oscillator {
+    fn describe(&self, _b: &Bound) -> String {
+        "oscillator".into()
+    }
+
+    fn channels(&self) -> Vec<(String, &'static str)> {
+        vec![("q".into(), "1")]
+    }
+
+    fn observe(&self, _t: f64, q: &[f64], _v: &[f64], out: &mut [f64]) {
+        out[0] = q[0];
+    }
+
+    fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
+        (vec![], vec![], vec![])
+    }
+
+    fn dof_name(&self, _i: usize) -> String {
+        "q".into()
     }
 }
 
@@ -105,7 +119,7 @@ fn error(method: Method, schedule: Schedule, zeta: f64, base: f64) -> (f64, Stab
     let mut sys = Oscillator {
         zeta,
         base,
-        factor: method.bound_factor(),
+        factor: stepper(method).bound_factor(),
         schedule,
     };
     let ctl = StepControl {
@@ -209,7 +223,7 @@ fn dyn_damped_oscillator_parasitic_mode_detected_remedies_complete() {
         let mut sys = Oscillator {
             zeta,
             base: 1.0 / 400.0,
-            factor: method.bound_factor(),
+            factor: stepper(method).bound_factor(),
             schedule: Schedule::Constant,
         };
         let ctl = StepControl {

@@ -9,10 +9,11 @@ use data::{
 };
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
-use fdm::chain::contact::simulate;
 use fdm::chain::timoshenko::TimoFields;
-use fdm::integrator::System;
+use fdm::output::Outputs;
+use fdm::runs::two_link_chain_with_contact as simulate;
 use fdm::settings::FdmSettings;
+use fdm::system::System;
 
 mod common;
 use common::channel;

@@ -45,20 +45,21 @@
 // Index loops over parallel buffers (q, v, a, columns of M) read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
+mod bound;
 pub mod contact;
 pub mod dual;
 pub mod kinetic;
+mod mass;
+mod outputs;
 pub mod timoshenko;
 
 use data::scene::{Link, TorqueLaw};
-use data::{DofPlan, RunResult, Scene, Settings, channel};
+use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
-use crate::integrator::{
-    Bound, BoundKind, DriftVelocities, StepControl, System, damped_step_factor, integrate,
-};
-use crate::link::{FloatingLink, sample_field};
-use crate::settings::{FdmSettings, Method};
+use crate::link::FloatingLink;
+use crate::output::Outputs;
+use crate::system::{Bound, DriftVelocities, System};
 use contact::TipContact;
 use dual::Dual;
 use kinetic::{BE, ChainInertia, TH, seg_energy, seg_grad};
@@ -138,6 +139,8 @@ pub struct TwoLinkChain {
     /// scratch of the constraint: G = ∂g/∂q and M⁻¹Gᵀ
     grow: Vec<f64>,
     minv_g: Vec<f64>,
+    /// (|g|, |Gq̇|, energy removed) of the last constrained step's projections
+    last_projection: [f64; 3],
     /// Timoshenko links (`shear` on both): the condensed section rotations ([`timoshenko`]);
     /// the ghost slots are then unused (held at zero with a unit dummy mass)
     timo: Option<TimoFields>,
@@ -336,6 +339,7 @@ impl TwoLinkChain {
             lambda: 0.0,
             grow: vec![0.0; nd],
             minv_g: vec![0.0; nd],
+            last_projection: [0.0; 3],
             timo,
         };
         // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
@@ -353,79 +357,6 @@ impl TwoLinkChain {
         chain.omega_max = chain.top_frequency();
         chain.kappa_max = chain.top_damping_rate();
         Ok(chain)
-    }
-
-    /// Highest ω of the chain linearized about its initial state at rest: power iteration on
-    /// −∂a/∂q (columns by forward differences of the accelerations). Once per run, O(n²).
-    fn top_frequency(&mut self) -> f64 {
-        let (q0, _) = self.initial_state();
-        let rest = vec![0.0; self.dofs()];
-        self.top_frequency_at(0.0, &q0, &rest)
-    }
-
-    /// Fastest damping rate κ_max (largest |eigenvalue| of −∂a/∂q̇) at the initial state at
-    /// rest, 2 % margin. The joint dampers act on the clamp rotations with their tiny
-    /// half-cell inertia J_c: strongly overdamped modes whose velocity-form limit is τ ≤ 1/κ.
-    fn top_damping_rate(&mut self) -> f64 {
-        let (q0, _) = self.initial_state();
-        let rest = vec![0.0; self.dofs()];
-        1.02 * self.top_eigen(0.0, &q0, &rest, true)
-    }
-
-    /// Highest ω of the chain linearized in q about (q, q̇) (in the current contact phase):
-    /// power iteration on −∂a/∂q. O(n²) with n + 1 force evaluations; allocates.
-    fn top_frequency_at(&mut self, t: f64, q0: &[f64], v: &[f64]) -> f64 {
-        // power iteration approaches the top eigenvalue from below: 2 % margin on ω
-        1.02 * self.top_eigen(t, q0, v, false).sqrt()
-    }
-
-    /// Largest |eigenvalue| of −∂a/∂q (`wrt_v` false: ω²_max) or −∂a/∂q̇ (`wrt_v` true: the
-    /// fastest damping rate κ = c/m) at (q, q̇), by power iteration on a forward-difference
-    /// Jacobian (no margin).
-    fn top_eigen(&mut self, t: f64, q0: &[f64], v0: &[f64], wrt_v: bool) -> f64 {
-        let n = self.dofs();
-        let (q0, v) = (q0, v0);
-        let lambda = self.lambda;
-        let mut a0 = vec![0.0; n];
-        self.accel(t, q0, v, &mut a0);
-        let mut jac = vec![0.0; n * n];
-        let mut a = vec![0.0; n];
-        let mut q = q0.to_vec();
-        let mut vv = v.to_vec();
-        for j in 0..n {
-            let eps;
-            if wrt_v {
-                eps = 1e-7 * (1.0 + v[j].abs());
-                vv[j] = v[j] + eps;
-                self.accel(t, q0, &vv, &mut a);
-                vv[j] = v[j];
-            } else {
-                eps = 1e-7 * (1.0 + q0[j].abs());
-                q[j] = q0[j] + eps;
-                self.accel(t, &q, v, &mut a);
-                q[j] = q0[j];
-            }
-            for i in 0..n {
-                jac[i * n + j] = -(a[i] - a0[i]) / eps;
-            }
-        }
-        self.lambda = lambda;
-        let mut x: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
-        let mut y = vec![0.0; n];
-        let mut lam = 0.0;
-        for _ in 0..400 {
-            for i in 0..n {
-                y[i] = (0..n).map(|j| jac[i * n + j] * x[j]).sum();
-            }
-            lam = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            if lam == 0.0 || !lam.is_finite() {
-                break;
-            }
-            for i in 0..n {
-                x[i] = y[i] / lam;
-            }
-        }
-        lam.max(0.0)
     }
 
     fn any_law(&self) -> bool {
@@ -632,95 +563,6 @@ impl TwoLinkChain {
         }
     }
 
-    /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`; the ghost
-    /// columns are constant (built in `from_scene`).
-    fn build_columns(&mut self) {
-        let n = self.dofs();
-        let full = [TH, BE];
-        for (c, &idx) in full.iter().enumerate() {
-            self.cols[c].iter_mut().for_each(|x| *x = 0.0);
-            self.unit[idx] = 1.0;
-            self.inertia
-                .momenta(&self.qk, &self.zeros, &self.unit, &mut self.p);
-            self.unit[idx] = 0.0;
-            for i in 0..n {
-                self.cols[c][i] = self.p[i].re;
-            }
-            for s in self.slots {
-                self.cols[c][s] = 0.0;
-            }
-            // J_c e eᵀ: column of the frame angle gets J_c e (the ghost's −J_c e/(2h) is fixed)
-            let mut col = std::mem::take(&mut self.cols[c]);
-            self.add_clamp(c, self.jc[c], &mut col);
-            self.cols[c] = col;
-        }
-    }
-
-    /// The indices of the four full columns of M: θ, β and the ghosts x₁, x₂.
-    fn full(&self) -> [usize; 4] {
-        [TH, BE, self.slots[0], self.slots[1]]
-    }
-
-    /// out = M⁻¹ rhs with the columns of the last [`Self::build_columns`]: Schur complement
-    /// on {θ, β, x₁, x₂}; the rest of M is diagonal. O(n), no allocation.
-    fn solve_mass(&self, rhs: &[f64], out: &mut [f64]) {
-        let n = self.dofs();
-        let full = self.full();
-        let mut s = [[0.0; 4]; 4];
-        let mut b = [0.0; 4];
-        for r in 0..4 {
-            b[r] = rhs[full[r]];
-            for c in 0..4 {
-                s[r][c] = self.cols[c][full[r]];
-            }
-        }
-        for i in 0..n {
-            if full.contains(&i) {
-                continue;
-            }
-            let d = self.diag_mass(i);
-            for r in 0..4 {
-                let mri = self.cols[r][i];
-                b[r] -= mri * rhs[i] / d;
-                for c in 0..4 {
-                    s[r][c] -= mri * self.cols[c][i] / d;
-                }
-            }
-        }
-        let x = solve4(s, b);
-        for i in 0..n {
-            if let Some(k) = full.iter().position(|&f| f == i) {
-                out[i] = x[k];
-            } else {
-                let coupled: f64 = (0..4).map(|c| self.cols[c][i] * x[c]).sum();
-                out[i] = (rhs[i] - coupled) / self.diag_mass(i);
-            }
-        }
-    }
-
-    /// out = M x with the columns of the last [`Self::build_columns`] (M symmetric: full
-    /// column c also gives row c).
-    fn mass_mul(&self, x: &[f64], out: &mut [f64]) {
-        let n = self.dofs();
-        let full = self.full();
-        for i in 0..n {
-            if let Some(r) = full.iter().position(|&f| f == i) {
-                let mut acc = 0.0;
-                for j in 0..n {
-                    if let Some(c) = full.iter().position(|&f| f == j) {
-                        acc += self.cols[c][i] * x[j];
-                    } else {
-                        acc += self.cols[r][j] * x[j];
-                    }
-                }
-                out[i] = acc;
-            } else {
-                out[i] = self.diag_mass(i) * x[i]
-                    + (0..4).map(|c| self.cols[c][i] * x[full[c]]).sum::<f64>();
-            }
-        }
-    }
-
     pub fn total_energy(&self, q: &[f64], v: &[f64]) -> f64 {
         let mut e = [0.0; 4];
         let k = self.ledger_names().0.len();
@@ -787,7 +629,7 @@ impl TwoLinkChain {
     /// writes them as [`System::powers`] does. The velocity form evaluates the forces of a step
     /// end at the *predicted* velocity; its ledger takes the powers at the final one (the
     /// overdamped clamp-rotation modes make the two differ at O(1) near the step bound).
-    pub(super) fn powers_at(&mut self, t: f64, v: &[f64], out: &mut [f64]) {
+    pub(crate) fn powers_at(&mut self, t: f64, v: &[f64], out: &mut [f64]) {
         if let Some(tf) = &self.timo {
             let pw = tf.powers(v);
             self.power = [0.0, pw[0], pw[1]];
@@ -974,6 +816,22 @@ impl System for TwoLinkChain {
         self.lambda = 0.0;
     }
 
+    /// On the surface g = 0 along M⁻¹Gᵀ while the tip is held ([`contact`]).
+    fn project_position(&mut self, q: &mut [f64]) {
+        if self.constrained {
+            self.last_projection[0] = self.project_onto_surface(q);
+        }
+    }
+
+    /// Onto Gq̇ = 0 along M⁻¹Gᵀ while the tip is held ([`contact`]).
+    fn project_velocity(&mut self, v: &mut [f64]) {
+        if self.constrained {
+            let (gv, energy) = self.remove_normal_velocity(v);
+            self.last_projection[1] = gv;
+            self.last_projection[2] = energy;
+        }
+    }
+
     fn powers(&self, out: &mut [f64]) {
         let mut k = 0;
         if self.any_law() {
@@ -996,222 +854,7 @@ impl System for TwoLinkChain {
     }
 
     fn bound(&self, _t: f64) -> Bound {
-        // 5.44 per link (σ² = h⁴ρA/(4EI)) with the Kelvin–Voigt factor of the shortest wave
-        // (as for the single link); the smaller binds.
-        // The measured top frequency of the coupled chain (clamp-rotation modes included),
-        // with the Kelvin–Voigt ζ of that frequency; margin 0.9 for its drift with the
-        // configuration (the inertia depends on the angles and deflections). Measured at rest,
-        // it leaves out the centrifugal tension's string stiffness N/h² (see the single link's
-        // bound); the 0.9 covers a 23 % rise of ω_max², the tension adds N h²/(4EI) ≈ 1e-2 at
-        // the undamped scene's peak rate (θ̇₁ ≈ 22 rad/s, 21 stations).
-        // ζ of the top mode: at least the Kelvin–Voigt ζ of that frequency, and at least
-        // κ_max/(2ω_max) — the fastest damping rate as if it sat on the top frequency
-        // (conservative: for ζ ≫ 1 the factor gives τ → 1/κ_max, the overdamped limit).
-        if let Some(t) = &self.timo {
-            // Timoshenko (chain::timoshenko): the coupled chain's ω_max with the fastest
-            // damping rate, and per link the condensed operator's 2/ω_max = h√(ρA/κGA)
-            let zeta = self.kappa_max / (2.0 * self.omega_max);
-            let mut best = Bound {
-                sigma: 0.9 * 2.0 / self.omega_max * damped_step_factor(zeta),
-                kind: BoundKind::Transverse,
-                site: 2,
-            };
-            for (k, lp) in self.links.iter().enumerate() {
-                let s = t.shear_bound(k, lp.rho_a);
-                if s < best.sigma {
-                    best = Bound {
-                        sigma: s,
-                        kind: BoundKind::Transverse,
-                        site: SHEAR_SITE + k,
-                    };
-                }
-            }
-            return best;
-        }
-        let zeta = self
-            .links
-            .iter()
-            .map(|lp| lp.gamma * self.omega_max / (2.0 * lp.ei))
-            .fold(self.kappa_max / (2.0 * self.omega_max), f64::max);
-        let mut best = Bound {
-            sigma: 0.9 * 2.0 / self.omega_max * damped_step_factor(zeta),
-            kind: BoundKind::Transverse,
-            site: 2,
-        };
-        // The clamp-rotation modes (ghost x against J_c/(4h²), stiffness EI/(2h³) + K/(4h²))
-        // also carry the joint damper D/(4h²): ζ = c/(2√(k m)) can be large at tiny J_c.
-        for (k, lp) in self.links.iter().enumerate() {
-            let h = self.hs[k];
-            let m = self.jc[k] / (4.0 * h * h);
-            let stiff = lp.ei / (2.0 * h * h * h) + self.joints[k].stiffness / (4.0 * h * h);
-            let damp = lp.gamma / (2.0 * h * h * h) + self.joints[k].damping / (4.0 * h * h);
-            let w = (stiff / m).sqrt();
-            let zeta = damp / (2.0 * (stiff * m).sqrt());
-            let sig = 0.9 * 2.0 / w * damped_step_factor(zeta);
-            if sig < best.sigma {
-                best = Bound {
-                    sigma: sig,
-                    kind: BoundKind::Transverse,
-                    site: 3 + k,
-                };
-            }
-        }
-        for (k, lp) in self.links.iter().enumerate() {
-            let h = if k == 0 {
-                self.inertia.h1
-            } else {
-                self.inertia.h2
-            };
-            let sigma = (h.powi(4) * lp.rho_a / (4.0 * lp.ei)).sqrt();
-            let zeta = lp.gamma * (2.0 / sigma) / (2.0 * lp.ei);
-            let s = sigma * damped_step_factor(zeta);
-            if s < best.sigma {
-                best = Bound {
-                    sigma: s,
-                    kind: BoundKind::Transverse,
-                    site: k,
-                };
-            }
-        }
-        best
-    }
-
-    fn describe(&self, b: &Bound) -> String {
-        if b.site >= SHEAR_SITE {
-            format!(
-                "link {} shear sawtooth of the condensed Timoshenko operator (σ = h√(ρA/κGA))",
-                b.site - SHEAR_SITE + 1
-            )
-        } else if b.site >= 3 {
-            format!(
-                "clamp-rotation mode of link {} (ghost node against J_c)",
-                b.site - 2
-            )
-        } else if b.site == 2 {
-            "the coupled chain's highest mode (power iteration at t = 0)".into()
-        } else {
-            format!("link {} (uniform: every segment)", b.site + 1)
-        }
-    }
-
-    fn channels(&self) -> Vec<(String, &'static str)> {
-        let mut c = Vec::new();
-        for j in 1..=2 {
-            c.push((channel::joint_angle(j), "rad"));
-            c.push((channel::joint_rate(j), "rad/time"));
-            c.push((channel::joint_torque(j), "torque"));
-        }
-        for l in 1..=2 {
-            c.push((channel::tip_x(l), "length"));
-            c.push((channel::tip_y(l), "length"));
-            c.push((channel::tip_deflection(l), "length"));
-            for k in 0..self.field_stations {
-                c.push((channel::field_deflection(l, k), "length"));
-            }
-        }
-        if self.contact.is_some() {
-            c.push((channel::contact_normal_force(1), "force"));
-            c.push((channel::contact_phase(1), "1"));
-            // not a standard channel (as modal): the gap, negative = penetration
-            c.push(("contact1.gap".to_string(), "length"));
-        }
-        c
-    }
-
-    fn observe(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-        let ine = &self.inertia;
-        let mut qk = self.obs_scratch.borrow_mut();
-        qk.copy_from_slice(q);
-        for s in self.slots {
-            qk[s] = 0.0;
-        }
-        // chord-frame deflections (station 1 at zero)
-        let (vs, ws) = (&qk[ine.iv()], &qk[ine.iw()]);
-        let [th1, th2] = self.joint_angles(q);
-        let [th1d, th2d] = self.joint_rates(v);
-        let j = &self.joints;
-        // joint torques: applied law + spring + damper at this state
-        let tau1 = j[0].torque(t) - j[0].stiffness * (th1 - j[0].set_point) - j[0].damping * th1d;
-        let tau2 = j[1].torque(t) - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * th2d;
-        out[0] = th1;
-        out[1] = th1d;
-        out[2] = tau1;
-        out[3] = th2;
-        out[4] = th2d;
-        out[5] = tau2;
-        let turns = self.timo.as_ref().map(|t| t.clamp_turns(q));
-        let s1 = if ine.fs1 {
-            seg_energy(vs, ine.h1, None)
-        } else {
-            0.0
-        };
-        let s2 = if ine.fs2 {
-            seg_energy(ws, ine.h2, None)
-        } else {
-            0.0
-        };
-        let (c1, n1) = (q[TH].cos(), q[TH].sin());
-        let (c2, n2) = (q[BE].cos(), q[BE].sin());
-        let (x1, y1) = (self.links[0].length - s1, vs[ine.r1 - 1]);
-        let tip1 = (c1 * x1 - n1 * y1, n1 * x1 + c1 * y1);
-        let (x2, y2) = (self.links[1].length - s2, ws[ine.r2 - 1]);
-        let tip2 = (tip1.0 + c2 * x2 - n2 * y2, tip1.1 + n2 * x2 + c2 * y2);
-        let nf = self.field_stations;
-        let mut k = 6;
-        for (l, (tip, us, h)) in [(tip1, vs, ine.h1), (tip2, ws, ine.h2)]
-            .into_iter()
-            .enumerate()
-        {
-            // deflections reported in the clamp-tangent frame, turned by
-            // ε = (u₁ − x)/(2h) from the chord: u − Xε (small angle)
-            // (Timoshenko: the clamp section is turned by ψ₀ from the chord)
-            let turn = match turns {
-                Some(z) => -z[l],
-                None => -(us[0] - q[self.slots[l]]) / (2.0 * h),
-            };
-            out[k] = tip.0;
-            out[k + 1] = tip.1;
-            out[k + 2] = us[us.len() - 1] + self.links[l].length * turn;
-            k += 3;
-            let r = us.len();
-            let at = |i: usize| {
-                if i == 0 {
-                    0.0
-                } else {
-                    us[i - 1] + i as f64 * h * turn
-                }
-            };
-            sample_field(self.links[l].length, h, r, at, &mut out[k..k + nf]);
-            k += nf;
-        }
-        if let Some(ct) = &self.contact {
-            // λ of the last evaluation: the step end of the sampled interval (O(τ) in time)
-            out[k] = self.lambda;
-            out[k + 1] = if self.constrained { 1.0 } else { 0.0 };
-            out[k + 2] = ct.gap(self, &qk);
-        }
-    }
-
-    fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
-        let mut inputs = Vec::new();
-        if self.any_law() {
-            inputs.push("applied_torque");
-        }
-        let mut diss = Vec::new();
-        if self.any_damper() {
-            diss.push("joint_damper");
-        }
-        if self.any_kv() {
-            diss.push("kelvin_voigt");
-        }
-        if self.contact.is_some() {
-            diss.push("impact");
-        }
-        let mut stored = vec!["kinetic", "strain", "joint_spring"];
-        if self.gravity.is_some() {
-            stored.push("gravity");
-        }
-        (stored, inputs, diss)
+        self.step_bound()
     }
 
     fn stored_energies(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
@@ -1253,75 +896,8 @@ impl System for TwoLinkChain {
         2..self.dofs()
     }
 
-    fn dof_name(&self, i: usize) -> String {
-        let ine = &self.inertia;
-        match i {
-            TH => "link-1 tip-chord angle θ".into(),
-            BE => "link-2 tip-chord angle β".into(),
-            _ if self.timo.is_some() && self.slots.contains(&i) => {
-                "unused ghost slot (Timoshenko: the clamp turn is the condensed ψ₀)".into()
-            }
-            _ if i == self.slots[0] => "link 1 clamp ghost deflection x₁ = v₋₁".into(),
-            _ if i == self.slots[1] => "link 2 clamp ghost deflection x₂ = w₋₁".into(),
-            _ if ine.iv().contains(&i) => {
-                let k = i - 1;
-                format!("link 1 v at station {k} (x = {:.4})", k as f64 * ine.h1)
-            }
-            _ => {
-                let k = i - 1 - ine.r1;
-                format!("link 2 w at station {k} (x = {:.4})", k as f64 * ine.h2)
-            }
-        }
-    }
-
     fn damped(&self) -> bool {
         // free joints: velocity-coupled (gyroscopic) inertia forces, as the torque-driven link
         true
     }
-}
-
-/// Gaussian elimination with partial pivoting on a 4×4 system.
-fn solve4(mut a: [[f64; 4]; 4], mut b: [f64; 4]) -> [f64; 4] {
-    for col in 0..4 {
-        let piv = (col..4)
-            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
-            .unwrap_or(col);
-        a.swap(col, piv);
-        b.swap(col, piv);
-        for row in col + 1..4 {
-            let f = a[row][col] / a[col][col];
-            for k in col..4 {
-                a[row][k] -= f * a[col][k];
-            }
-            b[row] -= f * b[col];
-        }
-    }
-    let mut x = [0.0; 4];
-    for row in (0..4).rev() {
-        let s: f64 = (row + 1..4).map(|k| a[row][k] * x[k]).sum();
-        x[row] = (b[row] - s) / a[row][row];
-    }
-    x
-}
-
-/// Runs a two-link chain. Default method (no `time.method`): the one-step velocity form — the
-/// free joints make the inertia forces velocity dependent and damping is on in the damped scene,
-/// both of which grow the two-step scheme's computational mode.
-pub fn simulate(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<RunResult, FdmError> {
-    if !scene.contacts.is_empty() {
-        return Ok(contact::simulate(scene, settings, s)?.0);
-    }
-    let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
-    let method = if settings.time.method.is_none() {
-        Method::VelocityForm
-    } else {
-        s.method
-    };
-    let (q0, v0) = sys.initial_state();
-    let ctl = StepControl::for_scene(scene, s, method, false, true);
-    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, settings))
 }

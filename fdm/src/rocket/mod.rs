@@ -4,19 +4,15 @@ pub mod model;
 pub mod operators;
 pub mod system;
 
-use data::{DofPlan, RunResult, Scene, Settings};
+use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
-use crate::integrator::{Outcome, StepControl, integrate};
 use crate::settings::FdmSettings;
 use model::RocketModel;
 use system::RocketSystem;
 
 /// Default stations: h = 2 in over 150 in, as in the report.
 pub const DEFAULT_STATIONS: usize = 76;
-
-/// Relative step change logged as a `StepSizeChange` event.
-pub const LOG_CHANGE: f64 = 0.01;
 
 pub fn build(scene: &Scene, s: &FdmSettings) -> Result<RocketSystem, FdmError> {
     let r = scene
@@ -56,28 +52,4 @@ pub fn dof_plan(scene: &Scene, stations: Option<usize>) -> Result<DofPlan, FdmEr
         plan.builds.push("discrete dampers".into());
     }
     Ok(plan)
-}
-
-/// Runs the rocket with explicit control over the bound check (tests use `enforce_bound =
-/// false` to show what happens above the bound).
-pub fn run_with(
-    scene: &Scene,
-    s: &FdmSettings,
-    enforce_bound: bool,
-) -> Result<(RocketSystem, Outcome), FdmError> {
-    let mut sys = build(scene, s)?;
-    let r = scene.rocket.as_ref().expect("checked in build");
-    let (q0, v0) = sys.initial_state(&r.initial_shape);
-    let ctl = StepControl::for_scene(scene, s, s.method, true, enforce_bound);
-    let out = integrate(&mut sys, &q0, &v0, &ctl)?;
-    Ok((sys, out))
-}
-
-pub fn simulate(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<RunResult, FdmError> {
-    let (_, out) = run_with(scene, s, true)?;
-    Ok(out.into_run_result(scene, settings))
 }

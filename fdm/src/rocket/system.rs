@@ -28,9 +28,10 @@ use std::ops::Range;
 
 use data::channel;
 
-use crate::integrator::{Bound, BoundKind, System};
+use crate::output::Outputs;
 use crate::rocket::model::RocketModel;
 use crate::rocket::operators;
+use crate::system::{Bound, BoundKind, System};
 
 /// The rocket system with its per-step scratch (no allocation in `accel`).
 #[derive(Debug, Clone)]
@@ -352,7 +353,7 @@ impl System for RocketSystem {
         for (k, (at, (kk, cc))) in m.masses.iter().zip(spring_sums(m)).enumerate() {
             if kk > 0.0 {
                 let omega = (kk / at.mass).sqrt();
-                let f = crate::integrator::damped_step_factor(cc / (2.0 * at.mass * omega));
+                let f = crate::system::damped_step_factor(cc / (2.0 * at.mass * omega));
                 let s2 = 4.0 * at.mass / kk * f * f;
                 if s2 < best2 {
                     best2 = s2;
@@ -365,6 +366,60 @@ impl System for RocketSystem {
         best
     }
 
+    fn stored_energies(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        let m = &self.model;
+        let m1 = m.m1(t);
+        let (xo, yo, th) = (q[IX], q[IY], q[ITH]);
+        let (rr, ss, tt) = (v[IX], v[IY], v[ITH]);
+        let (u, w) = (&q[self.u_range()], &q[self.w_range()]);
+        let (p, qv) = (&v[self.u_range()], &v[self.w_range()]);
+        let (mu, mw) = (&q[self.mu_range()], &q[self.mw_range()]);
+        let (mp, mq) = (&v[self.mu_range()], &v[self.mw_range()]);
+        let (st, ct) = (th.sin(), th.cos());
+        let (mut ke, mut pe) = (0.0, 0.0);
+        let mut point = |mass: f64, rx: f64, ry: f64, pu: f64, qw: f64| {
+            let vx = rr - tt * (yo + ry) + pu;
+            let vy = ss + tt * (xo + rx) + qw;
+            ke += 0.5 * mass * (vx * vx + vy * vy);
+            pe += mass * m.g * (st * (xo + rx) + ct * (yo + ry));
+        };
+        for i in 0..m.stations {
+            point(
+                m.station_mass(i, m1),
+                i as f64 * m.h + u[i],
+                w[i],
+                p[i],
+                qv[i],
+            );
+        }
+        for (k, at) in m.masses.iter().enumerate() {
+            point(at.mass, at.x + mu[k], mw[k], mp[k], mq[k]);
+        }
+        let strain = operators::strain_energy(m.h, &m.ea, &m.ei_station, u, w);
+        let mut spring = 0.0;
+        for (k, at) in m.masses.iter().enumerate() {
+            let (i, al) = (at.station, at.alpha);
+            let uc = (1.0 - al) * u[i] + al * u[i + 1];
+            let wc = (1.0 - al) * w[i] + al * w[i + 1];
+            spring += 0.5 * at.ku * (mu[k] - uc).powi(2) + 0.5 * at.kw * (mw[k] - wc).powi(2);
+        }
+        for c in &m.couplings {
+            spring +=
+                0.5 * c.ku * (mu[c.a] - mu[c.b]).powi(2) + 0.5 * c.kw * (mw[c.a] - mw[c.b]).powi(2);
+        }
+        out.copy_from_slice(&[ke, strain, pe, spring]);
+    }
+
+    fn monitored(&self) -> Range<usize> {
+        3..self.dofs()
+    }
+
+    fn damped(&self) -> bool {
+        self.model.damped()
+    }
+}
+
+impl Outputs for RocketSystem {
     fn describe(&self, b: &Bound) -> String {
         let m = &self.model;
         match b.kind {
@@ -454,54 +509,6 @@ impl System for RocketSystem {
         )
     }
 
-    fn stored_energies(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-        let m = &self.model;
-        let m1 = m.m1(t);
-        let (xo, yo, th) = (q[IX], q[IY], q[ITH]);
-        let (rr, ss, tt) = (v[IX], v[IY], v[ITH]);
-        let (u, w) = (&q[self.u_range()], &q[self.w_range()]);
-        let (p, qv) = (&v[self.u_range()], &v[self.w_range()]);
-        let (mu, mw) = (&q[self.mu_range()], &q[self.mw_range()]);
-        let (mp, mq) = (&v[self.mu_range()], &v[self.mw_range()]);
-        let (st, ct) = (th.sin(), th.cos());
-        let (mut ke, mut pe) = (0.0, 0.0);
-        let mut point = |mass: f64, rx: f64, ry: f64, pu: f64, qw: f64| {
-            let vx = rr - tt * (yo + ry) + pu;
-            let vy = ss + tt * (xo + rx) + qw;
-            ke += 0.5 * mass * (vx * vx + vy * vy);
-            pe += mass * m.g * (st * (xo + rx) + ct * (yo + ry));
-        };
-        for i in 0..m.stations {
-            point(
-                m.station_mass(i, m1),
-                i as f64 * m.h + u[i],
-                w[i],
-                p[i],
-                qv[i],
-            );
-        }
-        for (k, at) in m.masses.iter().enumerate() {
-            point(at.mass, at.x + mu[k], mw[k], mp[k], mq[k]);
-        }
-        let strain = operators::strain_energy(m.h, &m.ea, &m.ei_station, u, w);
-        let mut spring = 0.0;
-        for (k, at) in m.masses.iter().enumerate() {
-            let (i, al) = (at.station, at.alpha);
-            let uc = (1.0 - al) * u[i] + al * u[i + 1];
-            let wc = (1.0 - al) * w[i] + al * w[i + 1];
-            spring += 0.5 * at.ku * (mu[k] - uc).powi(2) + 0.5 * at.kw * (mw[k] - wc).powi(2);
-        }
-        for c in &m.couplings {
-            spring +=
-                0.5 * c.ku * (mu[c.a] - mu[c.b]).powi(2) + 0.5 * c.kw * (mw[c.a] - mw[c.b]).powi(2);
-        }
-        out.copy_from_slice(&[ke, strain, pe, spring]);
-    }
-
-    fn monitored(&self) -> Range<usize> {
-        3..self.dofs()
-    }
-
     fn dof_name(&self, i: usize) -> String {
         let h = self.model.h;
         let (ur, wr, mur, mwr) = (
@@ -528,10 +535,6 @@ impl System for RocketSystem {
             _ if mwr.contains(&i) => format!("transverse W of discrete mass {}", i - mwr.start + 1),
             _ => format!("coordinate {i}"),
         }
-    }
-
-    fn damped(&self) -> bool {
-        self.model.damped()
     }
 }
 

@@ -25,11 +25,12 @@
 use std::ops::Range;
 
 use data::scene::{PrescribedMotion, TorqueLaw};
-use data::{DofPlan, RunResult, Scene, Settings, channel};
+use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
-use crate::integrator::{Bound, BoundKind, StepControl, System, integrate};
-use crate::settings::FdmSettings;
+use crate::system::{Bound, BoundKind, System};
+
+mod outputs;
 
 /// Default stations per link.
 pub const DEFAULT_STATIONS: usize = 41;
@@ -221,7 +222,7 @@ impl FloatingLink {
             } else {
                 0.0
             };
-            let sigma = 2.0 / om * crate::integrator::damped_step_factor(zeta);
+            let sigma = 2.0 / om * crate::system::damped_step_factor(zeta);
             if sigma < best.1 {
                 best = (k, sigma);
             }
@@ -462,87 +463,6 @@ impl System for FloatingLink {
         }
     }
 
-    fn describe(&self, b: &Bound) -> String {
-        let rate = self.bound_rate.get();
-        let k = b.site;
-        let w2 = rate * rate;
-        let tension = if self.foreshortening {
-            w2 * self.wseg[k]
-        } else {
-            0.0
-        };
-        format!(
-            "station {} (x = {:.4}), hub rate {:.4}: ω² = {:.4e} bending + {:.4e} tension (N = {:.4e}) − {:.4e} softening",
-            k + 1,
-            (k + 1) as f64 * self.h,
-            rate,
-            self.bend_row[k],
-            w2 * self.geo_row[k],
-            tension,
-            w2
-        )
-    }
-
-    fn channels(&self) -> Vec<(String, &'static str)> {
-        let mut c = vec![
-            (channel::joint_angle(1), "rad"),
-            (channel::joint_rate(1), "rad/time"),
-            (channel::joint_torque(1), "torque"),
-            (channel::tip_x(1), "length"),
-            (channel::tip_y(1), "length"),
-            (channel::tip_deflection(1), "length"),
-        ];
-        for k in 0..self.field_stations {
-            c.push((channel::field_deflection(1, k), "length"));
-        }
-        c
-    }
-
-    fn observe(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-        let (th, rate, _) = self.hub_state(t, q, v);
-        let vs = &q[self.vrange()];
-        let tip = vs[self.r - 1];
-        let s_tip = if self.foreshortening {
-            (0..self.r)
-                .map(|seg| {
-                    0.5 * self.h * ((Self::at(vs, seg + 1) - Self::at(vs, seg)) / self.h).powi(2)
-                })
-                .sum()
-        } else {
-            0.0
-        };
-        let (c, s) = (th.cos(), th.sin());
-        let xt = self.length - s_tip;
-        out[0] = th;
-        out[1] = rate;
-        // torque of the latest force evaluation (level t_{j+1}; within one step of t)
-        out[2] = self.torque;
-        out[3] = c * xt - s * tip;
-        out[4] = s * xt + c * tip;
-        out[5] = tip;
-        let nf = self.field_stations;
-        sample_field(
-            self.length,
-            self.h,
-            self.r,
-            |i| Self::at(vs, i),
-            &mut out[6..6 + nf],
-        );
-    }
-
-    fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
-        let input = if self.prescribed() {
-            "prescribed_motion"
-        } else {
-            "applied_torque"
-        };
-        (
-            vec!["kinetic", "strain", "joint_spring"],
-            vec![input],
-            vec!["joint_damper", "kelvin_voigt"],
-        )
-    }
-
     fn stored_energies(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
         let (th, rate, _) = self.hub_state(t, q, v);
         let vr = self.vrange();
@@ -571,15 +491,6 @@ impl System for FloatingLink {
         self.vrange()
     }
 
-    fn dof_name(&self, i: usize) -> String {
-        if !self.prescribed() && i == 0 {
-            "hub angle θ".into()
-        } else {
-            let k = i - self.v0() + 1;
-            format!("transverse v at station {k} (x = {:.4})", k as f64 * self.h)
-        }
-    }
-
     fn damped(&self) -> bool {
         // A free hub couples θ̇ to v̇ (İθ̇, θ̇² terms): velocity-dependent, like damping, for the
         // two-step scheme's computational mode.
@@ -587,237 +498,5 @@ impl System for FloatingLink {
     }
 }
 
-/// Samples a link's deflection at `out.len()` equally spaced points over its `length`, linearly
-/// between the stations 0…r of step `h` (`at(i)`: deflection of station i).
-pub(crate) fn sample_field(
-    length: f64,
-    h: f64,
-    r: usize,
-    at: impl Fn(usize) -> f64,
-    out: &mut [f64],
-) {
-    let nf = out.len();
-    for (k, o) in out.iter_mut().enumerate() {
-        let x = k as f64 * length / (nf - 1) as f64;
-        let pos = (x / h).clamp(0.0, r as f64);
-        let i = (pos.floor() as usize).min(r - 1);
-        let al = pos - i as f64;
-        *o = at(i) * (1.0 - al) + at(i + 1) * al;
-    }
-}
-
-pub fn simulate(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<RunResult, FdmError> {
-    let mut sys = FloatingLink::from_scene(scene, s.stations)?;
-    let (q0, v0) = sys.initial_state();
-    let ctl = StepControl::for_scene(scene, s, s.method, false, true);
-    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, settings))
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::integrator::System;
-
-    #[test]
-    fn elem_link_forces_are_minus_energy_gradients() {
-        let scene = data::load_scene("spin-up").unwrap();
-        let link = FloatingLink::from_scene(&scene, Some(9)).unwrap();
-        let h = link.h;
-        let vs: Vec<f64> = (1..=8)
-            .map(|i| 0.01 * (0.7 * i as f64).sin() + 0.002 * i as f64)
-            .collect();
-        let mut fb = vec![0.0; 8];
-        FloatingLink::add_bending(h, 3.0, &vs, &mut fb);
-        let mut fp = vec![0.0; 8];
-        link.add_phi(&vs, 1.0, &mut fp);
-        let eps = 1e-6;
-        for k in 0..8 {
-            let (mut a, mut b) = (vs.clone(), vs.clone());
-            a[k] += eps;
-            b[k] -= eps;
-            let db = (FloatingLink::bending_energy(h, 3.0, &a)
-                - FloatingLink::bending_energy(h, 3.0, &b))
-                / (2.0 * eps);
-            let dp = (link.phi(&a) - link.phi(&b)) / (2.0 * eps);
-            // quadratic energies: central differences are exact up to round-off (≈ 1e-10 here)
-            assert!(
-                (fb[k] + db).abs() < 1e-6 * (1.0 + db.abs()),
-                "bending {k}: {} vs {}",
-                fb[k],
-                -db
-            );
-            assert!(
-                (fp[k] - dp).abs() < 1e-6 * (1.0 + dp.abs()),
-                "phi {k}: {} vs {}",
-                fp[k],
-                dp
-            );
-        }
-        // and the bending energy equals the cantilever's ½ vᵀKv
-        let c =
-            crate::beam::Cantilever::from_scene(&data::load_scene("cantilever").unwrap(), Some(9))
-                .unwrap();
-        let k = c.stiffness();
-        let quad: f64 = (0..8)
-            .map(|i| (0..8).map(|j| 0.5 * vs[i] * k[(i, j)] * vs[j]).sum::<f64>())
-            .sum();
-        let e = FloatingLink::bending_energy(c.h, c.ei, &vs);
-        assert!(
-            (quad - e).abs() < 1e-12 * e.abs().max(1e-30),
-            "{quad} vs {e}"
-        );
-    }
-
-    /// The link of `spin-up` spun to a constant rate Ω after a 0.2 s ramp (the ramp's θ̈x load
-    /// seeds every wave, the sawtooth by round-off), with `stations` stations.
-    fn spinning(omega: f64, stations: usize) -> (FloatingLink, Scene) {
-        let mut scene = data::load_scene("spin-up").unwrap();
-        scene.links[0].joint.prescribed = Some(PrescribedMotion::SpinUp {
-            omega_s: omega,
-            t_s: 0.2,
-        });
-        let link = FloatingLink::from_scene(&scene, Some(stations)).unwrap();
-        (link, scene)
-    }
-
-    /// Top eigenvalue ω² of the linearized transverse operator −∂a/∂v at hub rate Ω (prescribed,
-    /// θ̈ = 0 after the ramp): dense M^{½}(−∂a/∂v)M^{−½}, symmetric, by faer.
-    fn top_omega2(link: &mut FloatingLink, t: f64) -> f64 {
-        use faer::{Mat, Side};
-        let n = link.dofs();
-        let zero = vec![0.0; n];
-        let (mut a0, mut a) = (vec![0.0; n], vec![0.0; n]);
-        link.accel(t, &zero, &zero, &mut a0);
-        let mut s = Mat::<f64>::zeros(n, n);
-        let mut q = zero.clone();
-        for j in 0..n {
-            q[j] = 1.0; // the forces are linear in v: unit columns are exact
-            link.accel(t, &q, &zero, &mut a);
-            q[j] = 0.0;
-            for i in 0..n {
-                s[(i, j)] = -(a[i] - a0[i]) * (link.m[i] / link.m[j]).sqrt();
-            }
-        }
-        let vals = s.self_adjoint_eigenvalues(Side::Lower).unwrap();
-        vals.iter().fold(f64::NEG_INFINITY, |m, &v| m.max(v))
-    }
-
-    #[test]
-    fn elem_link_bound_includes_centrifugal_tension_and_is_tight() {
-        // Ω = 60 rad/s on the 41-station spin-up link: the tension term 4N/(m h²) is ≈ 25 % of
-        // the bending term 16EI/(m h⁴) at the root, so the report's bending-only bound is wrong
-        // by ≈ 10 % in τ.
-        let omega = 60.0;
-        let (mut link, _) = spinning(omega, 41);
-        let t = 0.5; // after the ramp: θ̇ = Ω, θ̈ = 0
-        let b = link.bound(t);
-        assert_eq!(b.kind, BoundKind::TransverseTension);
-        let w_true = top_omega2(&mut link, t).sqrt();
-        let w_bound = 2.0 / b.sigma;
-        let rho_a = link.m[0] / link.h;
-        let w_report = (16.0 * link.ei / (rho_a * link.h.powi(4))).sqrt();
-        // closed form at the binding interior station: (16EI/h⁴ + 2(W_{k−1} + W_k)Ω²/h²)/ρA − Ω²
-        let k = b.site;
-        let w2_closed = (16.0 * link.ei / link.h.powi(4)
-            + 2.0 * (link.wseg[k] + link.wseg[k + 1]) * omega * omega / (link.h * link.h))
-            / rho_a
-            - omega * omega;
-        eprintln!(
-            "Ω = {omega}: ω_max true {w_true:.6e}, bound {w_bound:.6e} (station {}), bending-only {w_report:.6e}",
-            k + 1
-        );
-        // Gershgorin is a rigorous upper bound: ω_true ≤ ω_bound up to eigen-solver round-off
-        assert!(w_true <= w_bound * (1.0 + 1e-12), "{w_true} > {w_bound}");
-        // ...and tight: the sawtooth wave under a slowly varying N sits within 2 % of it (its
-        // envelope costs O((π/r)²) of the bending symbol and averages N over the wave)
-        assert!(w_bound < 1.02 * w_true, "{w_bound} vs {w_true}");
-        // the report's bending-only value misses the tension: below the true frequency
-        assert!(w_report < 0.95 * w_true, "{w_report} vs {w_true}");
-        // the per-station Gershgorin row at an interior station equals the closed form (same
-        // arithmetic up to summation order: 1e-12); stations 2…r−2 carry the full bending stencil
-        assert!((1..link.r - 2).contains(&k), "binding station {}", k + 1);
-        assert!(((w_bound * w_bound) / w2_closed - 1.0).abs() < 1e-12);
-        // at rest the bound is the report's 5.44 (the interior bending row is 16EI/(m h⁴))
-        let rest = link.bound(0.0);
-        assert_eq!(rest.kind, BoundKind::Transverse);
-        assert!((2.0 / rest.sigma / w_report - 1.0).abs() < 1e-12);
-    }
-
-    /// Runs the spinning link with a forced step `ratio` × the method's limit at full rate,
-    /// bypassing the forced-step check, and returns the verdict.
-    fn forced_run(omega: f64, ratio: f64) -> (data::StabilityVerdict, f64) {
-        let (mut link, _) = spinning(omega, 41);
-        let method = crate::settings::Method::Report;
-        let limit = method.bound_factor() * link.bound(1.0).sigma;
-        let (q0, v0) = link.initial_state();
-        let ctl = StepControl {
-            method,
-            safety: 1.0,
-            forced_dt: Some(ratio * limit),
-            t_end: 0.4,
-            output_interval: 0.01,
-            log_change: 1.0,
-            lookahead: false,
-            enforce_bound: false,
-        };
-        (
-            integrate(&mut link, &q0, &v0, &ctl).unwrap().verdict,
-            ratio * limit,
-        )
-    }
-
-    #[test]
-    fn dyn_link_tension_bound_is_sharp() {
-        // The two-step scheme is stable for ω_max τ ≤ 1 and the new limit (½σ) overestimates
-        // the true ω_max by < 2 % (elem_ test above): 0.95 × the limit at full rate runs to the
-        // end, 1.05 × grows without bound once the ramp brings the rate near Ω = 60 rad/s.
-        let omega = 60.0;
-        let (stable, _) = forced_run(omega, 0.95);
-        assert!(
-            matches!(stable, data::StabilityVerdict::Completed),
-            "0.95 × bound: {stable:?}"
-        );
-        let (unstable, dt) = forced_run(omega, 1.05);
-        match &unstable {
-            data::StabilityVerdict::Stopped { diagnostic } => {
-                eprintln!("1.05 × bound: {diagnostic}");
-                // it diverged only where the forced step exceeds the limit at the current rate
-                let (link, _) = spinning(omega, 41);
-                assert!(
-                    dt > 0.5 * link.bound(diagnostic.t).sigma,
-                    "t = {}",
-                    diagnostic.t
-                );
-            }
-            v => panic!("1.05 × bound should diverge: {v:?}"),
-        }
-        // The report's bending-only limit lies above 1.05 × the new one here, so a step it
-        // allows diverges: the test discriminates the two bounds.
-        let (link, _) = spinning(omega, 41);
-        let rho_a = link.m[0] / link.h;
-        let report = (link.h.powi(4) * rho_a / (4.0 * link.ei)).sqrt();
-        assert!(report > 1.05 * link.bound(1.0).sigma);
-        // Through the public path, the forced step is refused when the rate has grown enough,
-        // with the new kind and the station in the error.
-        let (_, scene) = spinning(omega, 41);
-        let mut s = Settings::default();
-        s.time.dt = Some(1.05 * 0.5 * link.bound(1.0).sigma);
-        s.time.t_end = Some(0.4);
-        let fs = crate::settings::FdmSettings::from_settings(&s).unwrap();
-        match simulate(&scene, &s, &fs) {
-            Err(FdmError::StabilityBound {
-                t, kind, location, ..
-            }) => {
-                eprintln!("refused at t = {t}: {kind} at {location}");
-                assert!(kind.contains("tension"));
-                assert!(location.contains("station"));
-                assert!(t > 0.0 && t <= 0.2);
-            }
-            other => panic!("expected a refusal: {other:?}"),
-        }
-    }
-}
+mod tests;

@@ -1,0 +1,171 @@
+//! The chain's observables and ledger terms: joint angles/rates (clamp angles), torques =
+//! law + spring + damper, tip positions, deflections in the clamp-tangent frame, the contact
+//! channels.
+
+use data::channel;
+
+use super::kinetic::{BE, TH, seg_energy};
+use super::{SHEAR_SITE, TwoLinkChain};
+use crate::output::{Outputs, sample_field};
+use crate::system::Bound;
+
+impl Outputs for TwoLinkChain {
+    fn describe(&self, b: &Bound) -> String {
+        if b.site >= SHEAR_SITE {
+            format!(
+                "link {} shear sawtooth of the condensed Timoshenko operator (σ = h√(ρA/κGA))",
+                b.site - SHEAR_SITE + 1
+            )
+        } else if b.site >= 3 {
+            format!(
+                "clamp-rotation mode of link {} (ghost node against J_c)",
+                b.site - 2
+            )
+        } else if b.site == 2 {
+            "the coupled chain's highest mode (power iteration at t = 0)".into()
+        } else {
+            format!("link {} (uniform: every segment)", b.site + 1)
+        }
+    }
+
+    fn channels(&self) -> Vec<(String, &'static str)> {
+        let mut c = Vec::new();
+        for j in 1..=2 {
+            c.push((channel::joint_angle(j), "rad"));
+            c.push((channel::joint_rate(j), "rad/time"));
+            c.push((channel::joint_torque(j), "torque"));
+        }
+        for l in 1..=2 {
+            c.push((channel::tip_x(l), "length"));
+            c.push((channel::tip_y(l), "length"));
+            c.push((channel::tip_deflection(l), "length"));
+            for k in 0..self.field_stations {
+                c.push((channel::field_deflection(l, k), "length"));
+            }
+        }
+        if self.contact.is_some() {
+            c.push((channel::contact_normal_force(1), "force"));
+            c.push((channel::contact_phase(1), "1"));
+            // not a standard channel (as modal): the gap, negative = penetration
+            c.push(("contact1.gap".to_string(), "length"));
+        }
+        c
+    }
+
+    fn observe(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        let ine = &self.inertia;
+        let mut qk = self.obs_scratch.borrow_mut();
+        qk.copy_from_slice(q);
+        for s in self.slots {
+            qk[s] = 0.0;
+        }
+        // chord-frame deflections (station 1 at zero)
+        let (vs, ws) = (&qk[ine.iv()], &qk[ine.iw()]);
+        let [th1, th2] = self.joint_angles(q);
+        let [th1d, th2d] = self.joint_rates(v);
+        let j = &self.joints;
+        // joint torques: applied law + spring + damper at this state
+        let tau1 = j[0].torque(t) - j[0].stiffness * (th1 - j[0].set_point) - j[0].damping * th1d;
+        let tau2 = j[1].torque(t) - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * th2d;
+        out[0] = th1;
+        out[1] = th1d;
+        out[2] = tau1;
+        out[3] = th2;
+        out[4] = th2d;
+        out[5] = tau2;
+        let turns = self.timo.as_ref().map(|t| t.clamp_turns(q));
+        let s1 = if ine.fs1 {
+            seg_energy(vs, ine.h1, None)
+        } else {
+            0.0
+        };
+        let s2 = if ine.fs2 {
+            seg_energy(ws, ine.h2, None)
+        } else {
+            0.0
+        };
+        let (c1, n1) = (q[TH].cos(), q[TH].sin());
+        let (c2, n2) = (q[BE].cos(), q[BE].sin());
+        let (x1, y1) = (self.links[0].length - s1, vs[ine.r1 - 1]);
+        let tip1 = (c1 * x1 - n1 * y1, n1 * x1 + c1 * y1);
+        let (x2, y2) = (self.links[1].length - s2, ws[ine.r2 - 1]);
+        let tip2 = (tip1.0 + c2 * x2 - n2 * y2, tip1.1 + n2 * x2 + c2 * y2);
+        let nf = self.field_stations;
+        let mut k = 6;
+        for (l, (tip, us, h)) in [(tip1, vs, ine.h1), (tip2, ws, ine.h2)]
+            .into_iter()
+            .enumerate()
+        {
+            // deflections reported in the clamp-tangent frame, turned by
+            // ε = (u₁ − x)/(2h) from the chord: u − Xε (small angle)
+            // (Timoshenko: the clamp section is turned by ψ₀ from the chord)
+            let turn = match turns {
+                Some(z) => -z[l],
+                None => -(us[0] - q[self.slots[l]]) / (2.0 * h),
+            };
+            out[k] = tip.0;
+            out[k + 1] = tip.1;
+            out[k + 2] = us[us.len() - 1] + self.links[l].length * turn;
+            k += 3;
+            let r = us.len();
+            let at = |i: usize| {
+                if i == 0 {
+                    0.0
+                } else {
+                    us[i - 1] + i as f64 * h * turn
+                }
+            };
+            sample_field(self.links[l].length, h, r, at, &mut out[k..k + nf]);
+            k += nf;
+        }
+        if let Some(ct) = &self.contact {
+            // λ of the last evaluation: the step end of the sampled interval (O(τ) in time)
+            out[k] = self.lambda;
+            out[k + 1] = if self.constrained { 1.0 } else { 0.0 };
+            out[k + 2] = ct.gap(self, &qk);
+        }
+    }
+
+    fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
+        let mut inputs = Vec::new();
+        if self.any_law() {
+            inputs.push("applied_torque");
+        }
+        let mut diss = Vec::new();
+        if self.any_damper() {
+            diss.push("joint_damper");
+        }
+        if self.any_kv() {
+            diss.push("kelvin_voigt");
+        }
+        if self.contact.is_some() {
+            diss.push("impact");
+        }
+        let mut stored = vec!["kinetic", "strain", "joint_spring"];
+        if self.gravity.is_some() {
+            stored.push("gravity");
+        }
+        (stored, inputs, diss)
+    }
+
+    fn dof_name(&self, i: usize) -> String {
+        let ine = &self.inertia;
+        match i {
+            TH => "link-1 tip-chord angle θ".into(),
+            BE => "link-2 tip-chord angle β".into(),
+            _ if self.timo.is_some() && self.slots.contains(&i) => {
+                "unused ghost slot (Timoshenko: the clamp turn is the condensed ψ₀)".into()
+            }
+            _ if i == self.slots[0] => "link 1 clamp ghost deflection x₁ = v₋₁".into(),
+            _ if i == self.slots[1] => "link 2 clamp ghost deflection x₂ = w₋₁".into(),
+            _ if ine.iv().contains(&i) => {
+                let k = i - 1;
+                format!("link 1 v at station {k} (x = {:.4})", k as f64 * ine.h1)
+            }
+            _ => {
+                let k = i - 1 - ine.r1;
+                format!("link 2 w at station {k} (x = {:.4})", k as f64 * ine.h2)
+            }
+        }
+    }
+}

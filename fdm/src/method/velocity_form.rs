@@ -1,0 +1,130 @@
+//! The one-step velocity (kick–drift–kick) form: v_{½} = v_j + ½τ a_j, q_{j+1} = q_j + τ v_{½},
+//! a_{j+1} = a(t_{j+1}, q_{j+1}, v_{½} + ½τ a_j) (predicted velocity for velocity-dependent
+//! forces), v_{j+1} = v_{½} + ½τ a_{j+1}. No computational mode; one force evaluation per step;
+//! stable to the model's σ = 2/ω_max (factor 1).
+//!
+//! **Inertia terms from the drift velocities** ([`VelocityForm::drift_split`], the default).
+//! Systems whose kinetic energy depends on q (the two-link chain) evaluate the inertia terms
+//! quadratic in q̇, Γ(q)[q̇, q̇] = (∂p/∂q)q̇ − ∂T/∂q, from the drift velocities
+//! ([`System::accel_split`]): Γ_{j+1} = (1 + w)Γ(q_{j+1})[v_{j+½}] − wΓ(q_{j+1})[v_{j−½}],
+//! w = τ_{j+1}/(τ_{j+1} + τ_j) (linear extrapolation from the half-step times to t_{j+1}:
+//! second order for resolved motion; the weights sum to 1, so the mean over an oscillation is
+//! that of Γ[v_{½}]). Why: a mode x = A cos Ωt of the scheme (sin(Ωτ/2) = ωτ/2) has
+//! ⟨v_{½}²⟩ = ω²⟨x²⟩ exactly — the virial balance of the continuous motion — whereas the
+//! full-step and predicted velocities give ⟨v²⟩ = ω²⟨x²⟩(1 − ω²τ²/4) and less. A quadratic
+//! form such as the foreshortening rate Ψ̈ = ∂Ψ·q̈ + q̇ᵀHq̇ then averages to zero over the
+//! unresolved grid-scale bending waves as it does in continuous time; with the predicted
+//! velocity every such wave leaves a mean bias ∝ (ωτ)² on the slow equations, and their sum
+//! grows like the number of stations (measured on `two-link-free-undamped`: the joint angles
+//! then move away from the converged answer as the grid is refined).
+//!
+//! **Restartable steps** ([`VelocityForm::predicted`]). With every force at the predicted
+//! velocity a step depends on level j alone, so a step can be re-taken from the same level with
+//! another length (event location: [`crate::chain::contact`]) and the drift positions
+//! q_j + s v_j + ½s² a_j of any length s need no force evaluation.
+
+// Index loops run over several parallel level buffers at once.
+#![allow(clippy::needless_range_loop)]
+
+use super::{StepState, Stepper};
+use crate::system::{DriftVelocities, System};
+
+/// The velocity form; where the velocity-quadratic inertia terms are evaluated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VelocityForm {
+    /// inertia terms from the drift velocities (else at the predicted velocity)
+    split: bool,
+    /// v_{j−½}, the previous step's drift velocity (valid once `have_drift_prev`)
+    drift_prev: Vec<f64>,
+    have_drift_prev: bool,
+}
+
+impl VelocityForm {
+    /// Inertia terms from the drift velocities v_{j±½} (module docs).
+    pub fn drift_split() -> Self {
+        VelocityForm {
+            split: true,
+            drift_prev: Vec::new(),
+            have_drift_prev: false,
+        }
+    }
+
+    /// Every force at the predicted velocity: a step depends on level j alone.
+    pub fn predicted() -> Self {
+        VelocityForm {
+            split: false,
+            drift_prev: Vec::new(),
+            have_drift_prev: false,
+        }
+    }
+}
+
+impl Stepper for VelocityForm {
+    fn bound_factor(&self) -> f64 {
+        1.0
+    }
+
+    fn has_computational_mode(&self) -> bool {
+        false
+    }
+
+    /// 2(1 − cos ωτ) at the limit ωτ = 2, plus margin.
+    fn parasitic_threshold(&self) -> f64 {
+        4.5
+    }
+
+    fn start(&mut self, _sys: &mut dyn System, _t: f64, _tau: f64, st: &mut StepState) -> usize {
+        self.drift_prev = vec![0.0; st.acc.len()];
+        self.have_drift_prev = false;
+        0
+    }
+
+    fn predict(&mut self, _tau_prev: f64, tau: f64, st: &mut StepState) {
+        let (cur, next) = (&st.cur, &mut st.next);
+        for i in 0..st.acc.len() {
+            let vh = cur.v[i] + 0.5 * tau * st.acc[i];
+            next.q[i] = cur.q[i] + tau * vh;
+            next.v[i] = vh; // half-step velocity until the kick of `complete`
+            st.pred[i] = vh + 0.5 * tau * st.acc[i]; // predicted v_{j+1}
+        }
+    }
+
+    fn predicted_velocity<'a>(&self, st: &'a StepState) -> &'a [f64] {
+        &st.pred
+    }
+
+    fn complete(
+        &mut self,
+        sys: &mut dyn System,
+        t_new: f64,
+        tau_prev: f64,
+        tau: f64,
+        st: &mut StepState,
+    ) {
+        if self.split {
+            // next.v holds the drift velocity v_{j+½}
+            let drift = DriftVelocities {
+                current: &st.next.v,
+                previous: if self.have_drift_prev {
+                    &self.drift_prev
+                } else {
+                    &st.next.v
+                },
+                w: if self.have_drift_prev {
+                    tau / (tau + tau_prev)
+                } else {
+                    0.0
+                },
+            };
+            sys.accel_split(t_new, &st.next.q, &st.pred, drift, &mut st.acc_next);
+            self.drift_prev.copy_from_slice(&st.next.v);
+            self.have_drift_prev = true;
+        } else {
+            sys.accel(t_new, &st.next.q, &st.pred, &mut st.acc_next);
+        }
+        sys.powers(&mut st.p_new);
+        for i in 0..st.acc.len() {
+            st.next.v[i] += 0.5 * tau * st.acc_next[i];
+        }
+    }
+}

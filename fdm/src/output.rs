@@ -1,0 +1,187 @@
+//! Driver outputs: the naming of a model's observables and ledger terms ([`Outputs`]), the
+//! sampling of a run at the output times (`Recorder`: linear interpolation between step
+//! levels, no allocation after construction) and the mapping to `data`'s result types
+//! ([`Outcome`]).
+
+use data::{Cost, EnergyLedger, Event, Observables, StabilityVerdict};
+
+use crate::method::Levels;
+use crate::system::{Bound, System};
+
+/// How a model's state is named and observed: channels, ledger terms, coordinate names.
+pub trait Outputs {
+    /// Observable channels (name, unit) sampled by [`Outputs::observe`].
+    fn channels(&self) -> Vec<(String, &'static str)>;
+    fn observe(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]);
+    /// Ledger term names: stored, inputs, dissipation (inputs/dissipation in the order of
+    /// [`System::powers`], stored in that of [`System::stored_energies`]).
+    fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>);
+    /// Human-readable location of a bound, e.g. "station 0, segment 0 (x = 0–2), stage 1".
+    fn describe(&self, b: &Bound) -> String;
+    /// Human-readable name of coordinate i (for diagnostics).
+    fn dof_name(&self, i: usize) -> String;
+}
+
+/// Everything a run produced.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    pub observables: Observables,
+    pub ledger: EnergyLedger,
+    pub events: Vec<Event>,
+    pub cost: Cost,
+    pub verdict: StabilityVerdict,
+    /// Smallest and largest step taken.
+    pub tau_min: f64,
+    pub tau_max: f64,
+}
+
+impl Outcome {
+    /// Wraps the run as the backend-neutral result of `scene` under `settings`.
+    pub(crate) fn into_run_result(
+        self,
+        scene: &data::Scene,
+        settings: &data::Settings,
+    ) -> data::RunResult {
+        data::RunResult {
+            backend: data::BackendKind::Fdm,
+            scene: scene.name.clone(),
+            settings: settings.clone(),
+            observables: self.observables,
+            ledger: self.ledger,
+            events: self.events,
+            cost: self.cost,
+            verdict: self.verdict,
+        }
+    }
+}
+
+/// Output recorder: samples at the output times by linear interpolation between levels.
+pub(crate) struct Recorder {
+    times: Vec<f64>,
+    next: usize,
+    pub(crate) obs: Observables,
+    pub(crate) ledger: EnergyLedger,
+    row: Vec<f64>,
+    stored: Vec<f64>,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    work: Vec<f64>,
+    n_in: usize,
+}
+
+impl Recorder {
+    /// Samples every `output_interval` from 0 to `t_end` (and at `t_end`).
+    pub(crate) fn new<S: System + Outputs + ?Sized>(
+        sys: &S,
+        t_end: f64,
+        output_interval: f64,
+    ) -> Self {
+        let n_out = (t_end / output_interval - 1e-9).ceil().max(0.0) as usize;
+        let mut times: Vec<f64> = (0..=n_out)
+            .map(|k| (k as f64 * output_interval).min(t_end))
+            .collect();
+        times.dedup();
+        let mut specs = sys.channels();
+        specs.push((data::channel::STEP_SIZE.to_string(), "time"));
+        specs.push((data::channel::STABILITY_BOUND.to_string(), "time"));
+        let mut obs = Observables::with_channels(&specs);
+        obs.time.reserve(times.len());
+        for c in &mut obs.channels {
+            c.values.reserve(times.len());
+        }
+        let (st, inp, dis) = sys.ledger_names();
+        let mut ledger = EnergyLedger::new(&st, &inp, &dis);
+        ledger.time.reserve(times.len());
+        for term in ledger
+            .stored
+            .iter_mut()
+            .chain(ledger.inputs.iter_mut())
+            .chain(ledger.dissipation.iter_mut())
+        {
+            term.values.reserve(times.len());
+        }
+        let n = sys.dofs();
+        Recorder {
+            times,
+            next: 0,
+            row: vec![0.0; specs.len()],
+            stored: vec![0.0; st.len()],
+            obs,
+            ledger,
+            q: vec![0.0; n],
+            v: vec![0.0; n],
+            work: vec![0.0; inp.len() + dis.len()],
+            n_in: inp.len(),
+        }
+    }
+
+    /// Records every output time in (t_a, t_b] (and t_a itself if it is the first sample).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn record<S: System + Outputs + ?Sized>(
+        &mut self,
+        sys: &S,
+        ta: f64,
+        a: &Levels,
+        wa: &[f64],
+        tb: f64,
+        b: &Levels,
+        wb: &[f64],
+        tau: f64,
+        bound: f64,
+    ) {
+        while self.next < self.times.len() {
+            let t = self.times[self.next];
+            if t > tb + 1e-12 * tb.abs().max(1e-30) {
+                break;
+            }
+            let s = if tb > ta {
+                ((t - ta) / (tb - ta)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            for i in 0..self.q.len() {
+                self.q[i] = a.q[i] + s * (b.q[i] - a.q[i]);
+                self.v[i] = a.v[i] + s * (b.v[i] - a.v[i]);
+            }
+            for i in 0..self.work.len() {
+                self.work[i] = wa[i] + s * (wb[i] - wa[i]);
+            }
+            let nc = self.row.len();
+            sys.observe(t, &self.q, &self.v, &mut self.row[..nc - 2]);
+            self.row[nc - 2] = tau;
+            self.row[nc - 1] = bound;
+            self.obs.push(t, &self.row);
+            sys.stored_energies(t, &self.q, &self.v, &mut self.stored);
+            self.ledger.push(
+                t,
+                &self.stored,
+                &self.work[..self.n_in],
+                &self.work[self.n_in..],
+            );
+            self.next += 1;
+        }
+    }
+
+    pub(crate) fn done(&self) -> bool {
+        self.next >= self.times.len()
+    }
+}
+
+/// Samples a link's deflection at `out.len()` equally spaced points over its `length`, linearly
+/// between the stations 0…r of step `h` (`at(i)`: deflection of station i).
+pub(crate) fn sample_field(
+    length: f64,
+    h: f64,
+    r: usize,
+    at: impl Fn(usize) -> f64,
+    out: &mut [f64],
+) {
+    let nf = out.len();
+    for (k, o) in out.iter_mut().enumerate() {
+        let x = k as f64 * length / (nf - 1) as f64;
+        let pos = (x / h).clamp(0.0, r as f64);
+        let i = (pos.floor() as usize).min(r - 1);
+        let al = pos - i as f64;
+        *o = at(i) * (1.0 - al) + at(i + 1) * al;
+    }
+}
