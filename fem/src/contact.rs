@@ -165,6 +165,7 @@ use crate::band::DenseLu;
 use crate::chain::{Chain, MAX_LINKS, Parts};
 use crate::error::FemError;
 use crate::integrator::Integrator;
+use crate::linalg::dot;
 use crate::massless::Massless;
 
 /// Gap tolerance of a located contact start, relative to the longest link.
@@ -662,10 +663,6 @@ impl Contact {
         self.n_events += 1;
         self.events.push(e);
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// What happens after the (possibly shortened) step is accepted.

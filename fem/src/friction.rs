@@ -92,6 +92,7 @@ use crate::chain::{Chain, MAX_LINKS, Parts};
 use crate::contact::{Contact, MAX_EVENTS, Post};
 use crate::error::FemError;
 use crate::integrator::Integrator;
+use crate::linalg::dot;
 use crate::wall::{Wall, row_along, rows};
 
 /// Slip-velocity tolerance of a located stop, relative to the longest link (per unit time).
@@ -278,10 +279,6 @@ pub(crate) struct StepView<'a> {
     /// Normal multiplier of this iterate and g(q₁).
     pub lambda: f64,
     pub gap1: f64,
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn sign(x: f64) -> f64 {

@@ -26,6 +26,7 @@ use crate::band::{BorderedBand, DenseLu};
 use crate::chain::{Chain, NONE, NewtonCoefficients};
 use crate::contact::{Contact, Post};
 use crate::error::FemError;
+use crate::linalg::{dot, max_abs};
 use crate::midpoint::MidpointWork;
 use crate::settings::Method;
 
@@ -388,7 +389,7 @@ impl Integrator {
             self.chain
                 .residual(t_law, &self.q, &self.qd, &self.qdd, &mut self.res);
             self.counters.rhs += 1;
-            let r = self.res.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            let r = max_abs(&self.res);
             // Stop once a pass no longer halves the residual (or it is not finite).
             if r.is_nan() || r >= 0.5 * best {
                 break;
@@ -725,8 +726,8 @@ impl Integrator {
             }
             last = dq;
             // Absolute tolerance, floored at the round-off level of the update itself.
-            let amax = self.qdd1.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-            let vmax = self.qd1.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            let amax = max_abs(&self.qdd1);
+            let vmax = max_abs(&self.qd1);
             iterations = it + 1;
             if dq <= self.newton_tol + 1e-13 * (c.c_q * amax + h * vmax) {
                 converged = true;
@@ -937,11 +938,11 @@ impl Integrator {
             mfac.solve_in_place(&mut y);
             // Rayleigh quotient xᵀK x / xᵀM x.
             kmat.matvec(&x, &mut mx);
-            let xkx: f64 = x.iter().zip(&mx).map(|(a, b)| a * b).sum();
+            let xkx = dot(&x, &mx);
             mmat.matvec(&x, &mut mx);
-            let xmx: f64 = x.iter().zip(&mx).map(|(a, b)| a * b).sum();
+            let xmx = dot(&x, &mx);
             let new = xkx / xmx;
-            let norm = y.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            let norm = max_abs(&y);
             if norm == 0.0 || !norm.is_finite() {
                 break;
             }

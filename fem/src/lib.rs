@@ -146,6 +146,7 @@ pub mod element;
 pub mod error;
 pub mod friction;
 pub mod integrator;
+pub mod linalg;
 pub mod linear;
 pub mod massless;
 pub mod midpoint;

@@ -76,6 +76,7 @@ use crate::chain::{Chain, NONE, NewtonCoefficients, Parts};
 use crate::contact::Contact;
 use crate::error::FemError;
 use crate::integrator::{Integrator, JacobianKind, Works};
+use crate::linalg::{dot, max_abs};
 
 /// Relative size of the finite-difference perturbation of q for Ṁ(x)x.
 pub const FD_STEP: f64 = 1e-5;
@@ -166,14 +167,6 @@ impl MidpointWork {
         self.have_prev = true;
         self.h_prev = h;
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-fn max_abs(a: &[f64]) -> f64 {
-    a.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 /// Scratch vectors and the output of [`add_kinetic_gradient`].
