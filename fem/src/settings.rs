@@ -13,7 +13,7 @@ pub const METHODS: [&str; 3] = ["energy-midpoint", "generalized-alpha", "central
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
     /// Energy-consistent implicit midpoint (discrete-gradient) scheme for free-joint chains:
-    /// the ledger closes to the Newton tolerance (see [`crate::midpoint`]).
+    /// the ledger closes to the Newton tolerance (see [`crate::method::energy_midpoint`]).
     EnergyMidpoint,
     /// Implicit generalized-α (Chung–Hulbert, Arnold–Brüls form) with Newton iterations.
     GeneralizedAlpha,
