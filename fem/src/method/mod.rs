@@ -12,7 +12,9 @@
 //! * [`central_difference`]: explicit central difference (velocity-Verlet form) under its
 //!   stability bound 2/ω_max;
 //! * [`energy_midpoint`]: the energy-consistent midpoint (discrete-gradient) scheme, the only
-//!   one that accepts a [`StepConstraint`].
+//!   one that accepts a [`StepConstraint`];
+//! * [`implicit_midpoint`]: the implicit midpoint rule (one-stage Gauss), fixed or adaptive
+//!   steps.
 //!
 //! Shared machinery: the Newton matrix S = c_a M + c_v C + c_q K and its solver
 //! ([`newton`]) and the consistent acceleration of a (re)start ([`start`]).
@@ -23,6 +25,7 @@
 pub mod central_difference;
 pub mod energy_midpoint;
 pub mod generalized_alpha;
+pub mod implicit_midpoint;
 pub mod newton;
 pub mod start;
 
@@ -198,5 +201,6 @@ pub fn stepper(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper> {
         Method::GeneralizedAlpha => Box::new(generalized_alpha::GeneralizedAlpha::new(rho_inf)),
         Method::CentralDifference => Box::new(central_difference::CentralDifference),
         Method::EnergyMidpoint => Box::new(energy_midpoint::EnergyMidpoint::new(n)),
+        Method::ImplicitMidpoint => Box::new(implicit_midpoint::ImplicitMidpoint),
     }
 }
