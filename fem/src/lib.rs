@@ -64,6 +64,9 @@
 //! (clamped-free on a prescribed joint, pinned-free on a free one), fitted to divide the output
 //! interval. Central difference: 2/ω_max by power iteration on the
 //! linearized K, M at t = 0; a user step above it is refused, the automatic step is 0.9× it.
+//! On request also the implicit midpoint rule `implicit-midpoint` (one-stage Gauss, second
+//! order, no numerical damping, works booked by the trapezoidal rule:
+//! [`method::implicit_midpoint`]).
 //!
 //! ## Contact (seed 000: impact, constrained sliding, release)
 //! Unilateral frictionless contact of the tip of a named link with a fixed line
