@@ -54,9 +54,9 @@ fn one_step(c: &mut Criterion) {
     let mut g = c.benchmark_group("step");
     for n in MESHES {
         let mut p = prepare(&sc, &settings(n, 1e-2)).unwrap();
-        p.integrator.set_stop(1e9);
+        p.driver.set_stop(1e9);
         g.bench_with_input(BenchmarkId::new("generalized-alpha", n), &n, |b, _| {
-            b.iter(|| black_box(p.integrator.step().unwrap()))
+            b.iter(|| black_box(p.driver.step().unwrap()))
         });
     }
     g.finish();

@@ -33,12 +33,12 @@
 //! frame against v = −αx when the hub has no inertia): their equations are static balances
 //! (a DAE). The run starts from a state that satisfies them (`Chain::settle_massless`: the ψ
 //! carry e.g. the next joint's spring moment from t = 0), the initial acceleration treats them
-//! as algebraic (`Integrator`), and central difference refuses such links.
+//! as algebraic ([`method::start`]), and central difference refuses such links.
 //!
 //! ## Time integration
 //! Default for chains whose joints are all free (torque/spring driven: `single-link`,
 //! `two-link-free`, `two-link-free-undamped`): the energy-consistent midpoint scheme
-//! `energy-midpoint` ([`midpoint`]). With E = ½vᵀM(q)v + V(q) and non-conservative forces Q,
+//! `energy-midpoint` ([`method::energy_midpoint`]). With E = ½vᵀM(q)v + V(q) and non-conservative forces Q,
 //!   q₁ − q₀ = h v̄,  M(q₁)v₁ − M(q₀)v₀ = −h ∇̄Φ + h Q(t_mid, q̄, v̄),  Φ = V − ½v₀ᵀM(q)v₁,
 //! with ∇̄ the Gonzalez discrete gradient (metric M(q̄)). Since v̄ᵀ(p₁ − p₀) = ΔT + Δ(½v₀ᵀMv₁)
 //! and Δqᵀ∇̄Φ = ΔΦ, every step satisfies E₁ − E₀ = Δqᵀ Q(t_mid, q̄, v̄) exactly (to the Newton
@@ -64,10 +64,13 @@
 //! (clamped-free on a prescribed joint, pinned-free on a free one), fitted to divide the output
 //! interval. Central difference: 2/ω_max by power iteration on the
 //! linearized K, M at t = 0; a user step above it is refused, the automatic step is 0.9× it.
+//! On request also the implicit midpoint rule `implicit-midpoint` (one-stage Gauss, second
+//! order, no numerical damping, works booked by the trapezoidal rule:
+//! [`method::implicit_midpoint`]).
 //!
 //! ## Contact (seed 000: impact, constrained sliding, release)
 //! Unilateral frictionless contact of the tip of a named link with a fixed line
-//! ([`contact`]), with the `energy-midpoint` scheme. Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q
+//! ([`events::contact`]), with the `energy-midpoint` scheme. Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q
 //! (exact, [`chain::Chain::tip_jacobian`]).
 //! * Detection inside the step: the step is re-solved shortened (Illinois secant on h) until
 //!   |g(q₁(h))| ≤ 1e-10·L (event `contact-start` with the bracket width as time tolerance).
@@ -85,16 +88,16 @@
 //!   inside the step (state force at the end of the re-solved shortened step) to
 //!   −1e-8·W ≤ λ ≤ 0 (W the weight) or a 1e-13 s bracket (event `release`); measured
 //!   |λ| ≤ 3.2e-7·W on `barhorst-case1` (3 s). The force carries unresolved mesh frequencies
-//!   after impacts: micro-bounces of the discretized model ([`contact`]). Grazing contacts
+//!   after impacts: micro-bounces of the discretized model ([`events::contact`]). Grazing contacts
 //!   whose phase the step ends do not determine are refined (quarter steps, down to 1e-5 of
-//!   the step), never released at an arbitrary force ([`contact`], "Grazing").
+//!   the step), never released at an arbitrary force ([`events::contact`], "Grazing").
 //! * Timoshenko links without rotary inertia: the massless directions (every ψ, ψ(L) − θ of
 //!   the child) follow their balances Nᵀ(∂V/∂q + C q̇) = 0 (Kelvin–Voigt required), the impact
-//!   map and the normal force act on the massive block ([`contact`]); every step ends with the
+//!   map and the normal force act on the massive block ([`events::contact`]); every step ends with the
 //!   section rotations projected onto their balance (the midpoint rule does not damp their
 //!   stiff relaxation; strain energy removed booked `numerical_massless`) and consistent rates
-//!   ([`massless`]). The Newton iteration of contact runs is hardened for impacts and short
-//!   steps ([`midpoint`]).
+//!   ([`events::massless`]). The Newton iteration of contact runs is hardened for impacts and short
+//!   steps ([`method::energy_midpoint`]).
 //! * Phase channel `contact1.phase` (0 free, 1 constrained); `contact1.gap`,
 //!   `contact1.normal_velocity`, running maxima `contact1.max_gap`, `contact1.max_normal_velocity`.
 //! * Refused (`unsupported`): unilateral circle surfaces, friction on unilateral contacts,
@@ -102,7 +105,7 @@
 //!   sections without Kelvin–Voigt. Without contact nothing is allocated.
 //!
 //! ## Bilateral wall with Coulomb friction (seed 001, `constrained-arm`)
-//! [`friction`] with the geometry in [`wall`] (circle g = R − |r_tip − c|, n̂ = −(r − c)/|r − c|,
+//! [`events::friction`] with the geometry in [`events::wall`] (circle g = R − |r_tip − c|, n̂ = −(r − c)/|r − c|,
 //! t̂ counter-clockwise, κ = 1/|r − c|; or a line). The tip is on the wall from t = 0 and never
 //! released (λ of either sign); the scene's default method becomes `energy-midpoint`.
 //! * Constraint as in the constrained phase above (discrete gradient, g(q₁) = 0 in Newton):
@@ -117,7 +120,7 @@
 //! * Stick–slip: s·v_t = 0 and μ|λ_n| − |λ_t| = 0 located inside the step (secant on the step
 //!   length), Coulomb cone test at the stop, stick = second constraint t̂_s·(r − p_s) = 0 with
 //!   its own discrete gradient (no work), same test at t = 0; events `StickSlip`; phase channel
-//!   1 sliding / 2 sticking; no-chattering rule in [`friction`].
+//!   1 sliding / 2 sticking; no-chattering rule in [`events::friction`].
 //! * Refused: the inextensible link on the circle of radius L about its hub (simple flexure =
 //!   the rigid model), Timoshenko links without rotary inertia (M singular).
 //!
@@ -125,12 +128,18 @@
 //! in `simulate`; their work is the ledger input `applied_load`.
 //!
 //! ## Layers
-//! [`element`] (element operators, tested alone) → [`linear`] (assembled linear link: modes,
-//! statics) and [`chain`] (nonlinear floating-frame system) → [`band`] (bordered-band solver,
-//! linear cost per step) → [`integrator`] (generalized-α / central difference, `step()`) and
-//! [`midpoint`] (energy-midpoint step, bordered by [`contact`] when the tip is on the surface, and
-//! by [`friction`] for the bilateral wall) →
-//! [`run`] (observables, energy ledger, cost).
+//! Each layer imports only the ones above it:
+//! 1. model: [`element`] (element operators, tested alone) → [`linear`] (assembled linear
+//!    link: modes, statics) and [`chain`] (nonlinear floating-frame system), [`band`]
+//!    (bordered-band solver, linear cost per step);
+//! 2. methods: [`method`] — one type per integration method behind
+//!    [`method::Stepper`] ([`method::generalized_alpha`], [`method::central_difference`],
+//!    [`method::energy_midpoint`]), the Newton system and the consistent start; a held
+//!    contact reaches a method only through [`method::StepConstraint`];
+//! 3. events: [`events`] — contact (gap, impact map, drift projection, normal force),
+//!    bilateral wall friction and stick constraint, massless-section balances;
+//! 4. driver: [`driver`] — step control, event location and resets, work booking;
+//! 5. outputs: [`run`] (observables, energy ledger, cost).
 //!
 //! ## Public API
 //! [`FemBackend`] implements [`data::Backend`].
@@ -141,21 +150,19 @@
 
 pub mod band;
 pub mod chain;
-pub mod contact;
+pub mod driver;
 pub mod element;
 pub mod error;
-pub mod friction;
-pub mod integrator;
+pub mod events;
+pub mod linalg;
 pub mod linear;
-pub mod massless;
-pub mod midpoint;
+pub mod method;
 pub mod modes;
 pub mod plan;
 pub mod run;
 pub mod settings;
 pub mod statics;
 pub mod support;
-pub mod wall;
 
 use std::time::Instant;
 

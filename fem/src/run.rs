@@ -9,9 +9,10 @@ use data::{
 };
 
 use crate::chain::{Chain, NONE};
-use crate::contact::Contact;
+use crate::driver::{Driver, Rejection, StopReason};
 use crate::error::FemError;
-use crate::integrator::{Adaptive, Integrator, Rejection, StopReason};
+use crate::events::contact::Contact;
+use crate::method::Adaptive;
 use crate::settings::{self, Method};
 use crate::support::check_planar;
 
@@ -147,7 +148,7 @@ fn check_midpoint(scene: &Scene) -> Result<(), FemError> {
 
 /// Everything `simulate` needs, built once (benches reuse it).
 pub struct Prepared {
-    pub integrator: Integrator,
+    pub driver: Driver,
     pub t_end: f64,
     pub output_interval: f64,
     pub stations: usize,
@@ -233,9 +234,9 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
             ));
         }
     }
-    let mut integ = Integrator::new(chain, method, h_rule.min(out), default_rho_inf(scene))?;
+    let mut integ = Driver::new(chain, method, h_rule.min(out), default_rho_inf(scene))?;
     if let Some(mut c) = contact {
-        c.gap = c.gap_at(&integ.chain, integ.t, &integ.q);
+        c.gap = c.gap_at(&integ.chain, integ.state.t, &integ.state.q);
         if c.gap < -c.gap_tol && c.bilateral.is_none() {
             return Err(FemError::InvalidSettings {
                 field: "contact".into(),
@@ -245,45 +246,44 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
         let unilateral = c.bilateral.is_none();
         integ.contact = Some(Box::new(c));
         if unilateral {
-            // Impacts, releases and grazing contacts (crate::contact, crate::massless).
+            // Impacts, releases and grazing contacts (crate::events::contact, crate::events::massless).
             integ.enable_unilateral_contact()?;
         }
-        // Bilateral wall: on the surface from t = 0, initial Coulomb test (crate::friction).
+        // Bilateral wall: on the surface from t = 0, initial Coulomb test (crate::events::friction).
         integ.bilateral_start()?;
     }
-    let h_nominal = match method {
-        Method::GeneralizedAlpha | Method::EnergyMidpoint => {
-            let h = dt_user.unwrap_or_else(|| fit(h_rule.min(out), out));
-            if let Some(rtol) = rtol {
-                integ.adaptive = Some(Adaptive {
-                    rtol,
-                    atol: atol.unwrap_or(rtol * 1e-3 * integ.length_scale),
+    // Explicit central difference: the step under its stability bound; the implicit methods:
+    // the user step or the default rule, adaptive with `rtol`.
+    let h_nominal = if method == Method::CentralDifference {
+        let (w, dof) = integ.max_frequency()?;
+        let bound = 2.0 / w;
+        let location = integ.chain.describe_dof(dof);
+        match dt_user {
+            Some(dt) if dt > bound => {
+                return Err(FemError::StabilityBound {
+                    dt,
+                    bound,
+                    bound_kind: "central-difference (2/ω_max)".into(),
+                    location,
                 });
             }
-            h
+            Some(dt) => dt,
+            None => fit(safety * bound, out),
         }
-        Method::CentralDifference => {
-            let (w, dof) = integ.max_frequency()?;
-            let bound = 2.0 / w;
-            let location = integ.chain.describe_dof(dof);
-            match dt_user {
-                Some(dt) if dt > bound => {
-                    return Err(FemError::StabilityBound {
-                        dt,
-                        bound,
-                        bound_kind: "central-difference (2/ω_max)".into(),
-                        location,
-                    });
-                }
-                Some(dt) => dt,
-                None => fit(safety * bound, out),
-            }
+    } else {
+        let h = dt_user.unwrap_or_else(|| fit(h_rule.min(out), out));
+        if let Some(rtol) = rtol {
+            integ.adaptive = Some(Adaptive {
+                rtol,
+                atol: atol.unwrap_or(rtol * 1e-3 * integ.length_scale),
+            });
         }
+        h
     };
     integ.h = h_nominal;
     integ.h_nominal = h_nominal;
     Ok(Prepared {
-        integrator: integ,
+        driver: integ,
         t_end,
         output_interval: out,
         stations: scene.simulation.field_stations.max(2),
@@ -328,7 +328,7 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
         specs.push((MAX_GAP_CHANNEL.to_string(), "length"));
         specs.push((MAX_NORMAL_VELOCITY_CHANNEL.to_string(), "length/time"));
         if scene.contacts[0].friction > 0.0 {
-            // Friction contact (crate::friction): slip velocity, tangential force, work.
+            // Friction contact (crate::events::friction): slip velocity, tangential force, work.
             specs.push((SLIP_VELOCITY_CHANNEL.to_string(), "length/time"));
             specs.push((FRICTION_FORCE_CHANNEL.to_string(), "force"));
             specs.push((FRICTION_WORK_CHANNEL.to_string(), "energy"));
@@ -353,30 +353,30 @@ pub const FRICTION_FORCE_CHANNEL: &str = "contact1.friction_force";
 /// Cumulative friction work (the ledger's `friction` term).
 pub const FRICTION_WORK_CHANNEL: &str = "contact1.friction_work";
 
-/// Samples the observables at the integrator's current state into `buf`.
-fn sample(integ: &Integrator, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<f64>) {
+/// Samples the observables at the driver's current state into `buf`.
+fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<f64>) {
     buf.clear();
     let ch = &integ.chain;
-    ch.tip_positions(integ.t, &integ.q, tips);
+    ch.tip_positions(integ.state.t, &integ.state.q, tips);
     for (i, l) in ch.links.iter().enumerate() {
-        let (th, rate) = ch.joint_state(i, integ.t, &integ.q, &integ.qd);
+        let (th, rate) = ch.joint_state(i, integ.state.t, &integ.state.q, &integ.state.qd);
         buf.push(th);
         buf.push(rate);
         buf.push(ch.joint_torque[i]);
         buf.push(tips[i][0]);
         buf.push(tips[i][1]);
-        buf.push(ch.tip_deflection(i, &integ.q));
+        buf.push(ch.tip_deflection(i, &integ.state.q));
         if l.axial {
-            buf.push(ch.tip_axial(i, &integ.q));
+            buf.push(ch.tip_axial(i, &integ.state.q));
         }
         for s in 0..stations {
             let x = l.length * s as f64 / (stations - 1) as f64;
-            buf.push(ch.deflection(i, &integ.q, x));
+            buf.push(ch.deflection(i, &integ.state.q, x));
         }
     }
     if let Some(c) = integ.contact.as_deref() {
         buf.push(c.lambda);
-        buf.push(crate::friction::phase(c));
+        buf.push(crate::events::friction::phase(c));
         buf.push(c.gap);
         buf.push(c.normal_velocity);
         buf.push(c.max_gap);
@@ -390,7 +390,7 @@ fn sample(integ: &Integrator, stations: usize, tips: &mut [[f64; 2]], buf: &mut 
 }
 
 /// Names of the ledger terms the scene needs.
-fn ledger_terms(integ: &Integrator) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
+fn ledger_terms(integ: &Driver) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
     let chain = &integ.chain;
     let mut stored = vec!["kinetic", "strain"];
     if chain.links.iter().any(|l| l.joint.stiffness > 0.0) {
@@ -437,8 +437,11 @@ fn ledger_terms(integ: &Integrator) -> (Vec<&'static str>, Vec<&'static str>, Ve
     (stored, inputs, diss)
 }
 
-fn push_ledger(integ: &Integrator, ledger: &mut EnergyLedger) {
-    let [kin, strain, spring, grav] = integ.chain.energies(integ.t, &integ.q, &integ.qd);
+fn push_ledger(integ: &Driver, ledger: &mut EnergyLedger) {
+    let [kin, strain, spring, grav] =
+        integ
+            .chain
+            .energies(integ.state.t, &integ.state.q, &integ.state.qd);
     let mut stored = [0.0; 4];
     let mut ns = 0;
     for term in &ledger.stored {
@@ -475,14 +478,14 @@ fn push_ledger(integ: &Integrator, ledger: &mut EnergyLedger) {
         };
     }
     let (ni, nd) = (ledger.inputs.len(), ledger.dissipation.len());
-    ledger.push(integ.t, &stored[..ns], &inputs[..ni], &diss[..nd]);
+    ledger.push(integ.state.t, &stored[..ns], &inputs[..ni], &diss[..nd]);
 }
 
 /// Runs a scene to t_end; early stops become a `Stopped` verdict with the output so far.
 pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
-        integrator: mut integ,
+        driver: mut integ,
         t_end,
         output_interval,
         stations,
@@ -514,7 +517,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
                 Ok(StopReason::Stepped) => {}
                 Ok(StopReason::Rejected) => {
                     events.push(Event::StepRejected {
-                        t: integ.t,
+                        t: integ.state.t,
                         dt: h_before,
                         reason: match (integ.last_rejection, integ.adaptive.is_some()) {
                             (Rejection::ContactRefine, _) => {
@@ -565,7 +568,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
             }
         }
         sample(&integ, stations, &mut tips, &mut buf);
-        obs.push(integ.t, &buf);
+        obs.push(integ.state.t, &buf);
         push_ledger(&integ, &mut ledger);
     }
     if let Some(c) = integ.contact.as_deref_mut() {

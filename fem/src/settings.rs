@@ -8,17 +8,24 @@ pub const DEFAULT_ELEMENTS: usize = 16;
 pub const MAX_ELEMENTS: usize = 20_000;
 
 /// Time-integration method names accepted in `time.method`.
-pub const METHODS: [&str; 3] = ["energy-midpoint", "generalized-alpha", "central-difference"];
+pub const METHODS: [&str; 4] = [
+    "energy-midpoint",
+    "generalized-alpha",
+    "central-difference",
+    "implicit-midpoint",
+];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
     /// Energy-consistent implicit midpoint (discrete-gradient) scheme for free-joint chains:
-    /// the ledger closes to the Newton tolerance (see [`crate::midpoint`]).
+    /// the ledger closes to the Newton tolerance (see [`crate::method::energy_midpoint`]).
     EnergyMidpoint,
     /// Implicit generalized-α (Chung–Hulbert, Arnold–Brüls form) with Newton iterations.
     GeneralizedAlpha,
     /// Explicit central difference (velocity-Verlet form) under its stability bound.
     CentralDifference,
+    /// Implicit midpoint rule (one-stage Gauss) with Newton iterations.
+    ImplicitMidpoint,
 }
 
 pub fn elements(disc: &data::Discretization) -> Result<usize, FemError> {
@@ -39,6 +46,7 @@ pub fn method(time: &data::TimeStepping, default: Method) -> Result<Method, FemE
         Some("energy-midpoint") => Ok(Method::EnergyMidpoint),
         Some("generalized-alpha") => Ok(Method::GeneralizedAlpha),
         Some("central-difference") => Ok(Method::CentralDifference),
+        Some("implicit-midpoint") => Ok(Method::ImplicitMidpoint),
         Some(other) => Err(FemError::InvalidSettings {
             field: "time.method".into(),
             message: format!("unknown method `{other}`; accepted: {}", METHODS.join(", ")),

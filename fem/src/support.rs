@@ -15,9 +15,9 @@ pub fn check_planar(scene: &Scene) -> Result<(), FemError> {
             )));
         }
     }
-    // Unilateral frictionless line contact is implemented (`crate::contact`); the rest is
+    // Unilateral frictionless line contact is implemented (`crate::events::contact`); the rest is
     // refused there by name.
-    crate::contact::check(scene)?;
+    crate::events::contact::check(scene)?;
     if scene.links.is_empty() {
         return Err(FemError::unsupported("fem: scene has no links".to_string()));
     }

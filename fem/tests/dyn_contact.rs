@@ -219,7 +219,7 @@ fn dyn_case1_switches_with_located_releases_and_a_closed_ledger() {
     // Constraint drift: |g| at every sample in a constrained phase within the gap tolerance.
     let phase = channel(&r, "contact1.phase");
     let gap = channel(&r, "contact1.gap");
-    let tol = fem::contact::GAP_TOL * 3.0;
+    let tol = fem::events::contact::GAP_TOL * 3.0;
     let mut constrained = 0;
     for (p, g) in phase.iter().zip(gap) {
         if *p == 1.0 {
@@ -318,16 +318,16 @@ fn dyn_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     let sc = scene("barhorst-case1-stiff-elbow");
     let st = settings(Some(4), None);
     let mut p = fem::run::prepare(&sc, &st).unwrap();
-    let integ = &mut p.integrator;
+    let integ = &mut p.driver;
     integ.set_stop(10.0);
-    while integ.step().unwrap() != fem::integrator::StopReason::ReachedStop {}
+    while integ.step().unwrap() != fem::driver::StopReason::ReachedStop {}
     let c = integ.contact.as_ref().unwrap();
     assert!(c.constrained, "not resting on the surface at 4 s");
     let dynamic = c.lambda;
-    let speed = integ.qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let speed = integ.state.qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     println!("|q̇|∞ at 10 s: {speed:.3e}");
     assert!(speed < 1e-2, "still moving: |q̇|∞ = {speed:.2e}");
-    let mut q = integ.q.clone();
+    let mut q = integ.state.q.clone();
     let mut chain = Chain::new(&sc.links, sc.gravity.as_ref(), 4).unwrap();
     let stat = static_contact_force(&mut chain, &mut q, 1, -1.0);
     let rel = (dynamic - stat).abs() / stat;
@@ -400,9 +400,9 @@ fn sys_contact_refusals_are_precise() {
     // Without contact nothing is allocated and the DOF count is the chain's.
     let free = scene("two-link-free");
     let p = fem::run::prepare(&free, &settings(Some(4), Some(0.01))).unwrap();
-    assert!(p.integrator.contact.is_none());
+    assert!(p.driver.contact.is_none());
     let pc = fem::run::prepare(&sc, &settings(Some(4), Some(0.01))).unwrap();
-    assert_eq!(pc.integrator.chain.ndof, p.integrator.chain.ndof);
+    assert_eq!(pc.driver.chain.ndof, p.driver.chain.ndof);
 }
 
 #[test]

@@ -8,7 +8,7 @@ use data::scene::{Gravity, TorqueLaw};
 use data::{Backend, BackendError, Event, RunResult, Scene, Settings, StabilityVerdict};
 use fem::FemBackend;
 use fem::chain::Chain;
-use fem::contact::Contact;
+use fem::events::contact::Contact;
 use fem::run::{FRICTION_FORCE_CHANNEL, FRICTION_WORK_CHANNEL, SLIP_VELOCITY_CHANNEL};
 
 fn arm() -> Scene {

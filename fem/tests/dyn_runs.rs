@@ -279,6 +279,32 @@ fn conv_generalized_alpha_is_second_order_in_time() {
 }
 
 #[test]
+fn conv_implicit_midpoint_is_second_order_in_time() {
+    // The implicit midpoint rule (one-stage Gauss) on the prescribed spin-up with stiffening:
+    // errors against a run at h/8 fall as h².
+    let method = Some("implicit-midpoint");
+    let reference = run("spin-up", 8, Some(6.25e-4), Some(16.0), method).unwrap();
+    assert_eq!(reference.verdict, StabilityVerdict::Completed);
+    let r = channel(&reference, "link1.tip_deflection");
+    let errs: Vec<f64> = [1e-2, 5e-3]
+        .iter()
+        .map(|&dt| {
+            let x = run("spin-up", 8, Some(dt), Some(16.0), method).unwrap();
+            channel(&x, "link1.tip_deflection")
+                .iter()
+                .zip(r)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+        })
+        .collect();
+    let order = (errs[0] / errs[1]).log2();
+    eprintln!("implicit midpoint on spin-up: max tip errors {errs:?}, observed order {order:.3}");
+    assert!(
+        (order - 2.0).abs() < 0.3,
+        "observed order {order} ({errs:?})"
+    );
+}
+
+#[test]
 fn dyn_adaptive_step_meets_its_tolerance() {
     let sc = data::load_scene("spin-up").unwrap();
     let mut st = Settings::default();

@@ -183,8 +183,8 @@ fn sys_timoshenko_mass_is_symmetric_and_kelvin_voigt_is_the_dissipation() {
         let n = ch.ndof;
         let t = 0.3;
         let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
-        let mx = fem::midpoint::mass_product(&mut ch, t, &q, &x);
-        let mv = fem::midpoint::mass_product(&mut ch, t, &q, &qd);
+        let mx = fem::method::energy_midpoint::mass_product(&mut ch, t, &q, &x);
+        let mv = fem::method::energy_midpoint::mass_product(&mut ch, t, &q, &qd);
         let xmv: f64 = x.iter().zip(&mv).map(|(a, b)| a * b).sum();
         let vmx: f64 = qd.iter().zip(&mx).map(|(a, b)| a * b).sum();
         let vmv: f64 = qd.iter().zip(&mv).map(|(a, b)| a * b).sum();

@@ -5,7 +5,7 @@
 use data::{Backend, Event, RunResult, Scene, Settings, StabilityVerdict};
 use fem::FemBackend;
 use fem::chain::{Chain, Parts};
-use fem::contact::Contact;
+use fem::events::contact::Contact;
 
 mod common;
 
@@ -204,16 +204,15 @@ fn sys_undamped_massless_sections_with_contact_are_refused() {
 /// An energy-midpoint integrator of the scene's chain in free fall at step h; `unilateral`
 /// attaches the scene's tip contact (far from the surface for the first 0.28 s) and switches
 /// on its stepping, with the massless projection of contact runs.
-fn integ_free(n_el: usize, h: f64, unilateral: bool) -> fem::integrator::Integrator {
+fn integ_free(n_el: usize, h: f64, unilateral: bool) -> fem::driver::Driver {
     let sc = scene();
     let chain = Chain::new(&sc.links, sc.gravity.as_ref(), n_el).unwrap();
     let mut it =
-        fem::integrator::Integrator::new(chain, fem::settings::Method::EnergyMidpoint, h, 1.0)
-            .unwrap();
+        fem::driver::Driver::new(chain, fem::settings::Method::EnergyMidpoint, h, 1.0).unwrap();
     it.h_nominal = h;
     if unilateral {
         let mut c = Contact::from_scene(&sc, &it.chain).unwrap().unwrap();
-        c.gap = c.gap_at(&it.chain, it.t, &it.q);
+        c.gap = c.gap_at(&it.chain, it.state.t, &it.state.q);
         it.contact = Some(Box::new(c));
         it.enable_unilateral_contact().unwrap();
     }
@@ -223,7 +222,7 @@ fn integ_free(n_el: usize, h: f64, unilateral: bool) -> fem::integrator::Integra
 
 #[test]
 fn dyn_massless_sections_relax_to_their_balance_with_a_booked_dissipation() {
-    // Hypothesis 2 of the robustness study (crate::massless): the midpoint rule steps the
+    // Hypothesis 2 of the robustness study (crate::events::massless): the midpoint rule steps the
     // stiff relaxation of the massless section rotations with the amplification
     // (1 − z/2)/(1 + z/2) → −1: a deviation of ψ from its balance flips sign every step instead
     // of decaying. Kick the interior ψ of link 2 off their balance (1e-3 rad) and compare
@@ -243,19 +242,19 @@ fn dyn_massless_sections_relax_to_their_balance_with_a_booked_dissipation() {
             .collect();
         assert!(dirs.len() >= 8);
         for &i in &dirs {
-            kicked.q[i] += 1e-3;
+            kicked.state.q[i] += 1e-3;
         }
         // Deviation from the balance: the elastic moments ∂V/∂ψ left at the section DOFs
         // (largest in size, with its sign), against the unkicked run's.
         let n = kicked.chain.ndof;
         let zero = vec![0.0; n];
-        let dev = |a: &mut fem::integrator::Integrator, b: &mut fem::integrator::Integrator| {
+        let dev = |a: &mut fem::driver::Driver, b: &mut fem::driver::Driver| {
             let (mut ra, mut rb) = (vec![0.0; n], vec![0.0; n]);
-            let t = a.t;
+            let t = a.state.t;
             a.chain
-                .residual_parts(t, &a.q, &zero, &zero, Parts::CONSERVATIVE, &mut ra);
+                .residual_parts(t, &a.state.q, &zero, &zero, Parts::CONSERVATIVE, &mut ra);
             b.chain
-                .residual_parts(t, &b.q, &zero, &zero, Parts::CONSERVATIVE, &mut rb);
+                .residual_parts(t, &b.state.q, &zero, &zero, Parts::CONSERVATIVE, &mut rb);
             dirs.iter()
                 .map(|&i| ra[i] - rb[i])
                 .fold(0.0f64, |m, x| if x.abs() > m.abs() { x } else { m })
@@ -264,7 +263,7 @@ fn dyn_massless_sections_relax_to_their_balance_with_a_booked_dissipation() {
         for _ in 0..3 {
             let e0: f64 = kicked
                 .chain
-                .energies(kicked.t, &kicked.q, &kicked.qd)
+                .energies(kicked.state.t, &kicked.state.q, &kicked.state.qd)
                 .iter()
                 .sum();
             let w0 = kicked.works;
@@ -274,7 +273,7 @@ fn dyn_massless_sections_relax_to_their_balance_with_a_booked_dissipation() {
             // E₁ − E₀ = −(damper + Kelvin–Voigt + numerical_massless) work.
             let e1: f64 = kicked
                 .chain
-                .energies(kicked.t, &kicked.q, &kicked.qd)
+                .energies(kicked.state.t, &kicked.state.q, &kicked.state.qd)
                 .iter()
                 .sum();
             let w1 = kicked.works;
@@ -317,8 +316,9 @@ fn dyn_massless_rates_are_consistent_after_every_step() {
     let mut r = vec![0.0; n];
     for _ in 0..20 {
         it.step().unwrap();
-        let t = it.t;
-        it.chain.residual(t, &it.q, &it.qd, &zero, &mut r);
+        let t = it.state.t;
+        it.chain
+            .residual(t, &it.state.q, &it.state.qd, &zero, &mut r);
         let scale = r.iter().fold(0.0f64, |a, b| a.max(b.abs()));
         for d in it.chain.exact_massless_directions() {
             let nr: f64 = d.iter().map(|&(i, c)| c * r[i]).sum();
@@ -345,17 +345,20 @@ fn dyn_short_steps_keep_the_newton_matrix_accurate() {
 
 /// Releases of a run (t, λ, bracket): every one located where λ crosses zero (helper in
 /// tests/common), except grazing contacts released at the end of the shortest step
-/// (crate::contact, "Grazing"), whose force must stay below the stated limit. Returns their
+/// (crate::events::contact, "Grazing"), whose force must stay below the stated limit. Returns their
 /// number and largest |λ|.
 fn check_releases(r: &RunResult, weight: f64) -> (usize, f64) {
-    let h_min = fem::contact::REFINE_MIN * 5e-4;
+    let h_min = fem::events::contact::REFINE_MIN * 5e-4;
     let (mut grazing, mut worst) = (0, 0.0f64);
     let located: Vec<_> = common::releases(r)
         .into_iter()
         .filter(|&(t, l, tt)| {
-            if tt > 1e-12 && tt <= 1.01 * h_min && l.abs() > fem::contact::FORCE_TOL * weight {
+            if tt > 1e-12
+                && tt <= 1.01 * h_min
+                && l.abs() > fem::events::contact::FORCE_TOL * weight
+            {
                 assert!(
-                    -l <= fem::contact::GRAZING_FORCE_LIMIT * weight,
+                    -l <= fem::events::contact::GRAZING_FORCE_LIMIT * weight,
                     "grazing release at {t}: λ = {l:.3e}"
                 );
                 grazing += 1;

@@ -135,8 +135,14 @@ fn sys_mass_product_and_kinetic_gradient_match_the_reported_kinetic_energy() {
         let (mut ch, q, x, _) = setup(name, 3, fs);
         let n = ch.ndof;
         let t = 0.3;
-        let mx = fem::midpoint::mass_product(&mut ch, t, &q, &x);
-        let dtdq = fem::midpoint::kinetic_gradient(&mut ch, t, &q, &x, fem::midpoint::FD_STEP);
+        let mx = fem::method::energy_midpoint::mass_product(&mut ch, t, &q, &x);
+        let dtdq = fem::method::energy_midpoint::kinetic_gradient(
+            &mut ch,
+            t,
+            &q,
+            &x,
+            fem::method::energy_midpoint::FD_STEP,
+        );
         let kinetic = |q: &[f64], x: &[f64]| ch.energies(t, q, x)[0];
         let t0 = kinetic(&q, &x);
         let half_xmx = 0.5 * x.iter().zip(&mx).map(|(a, b)| a * b).sum::<f64>();

@@ -250,7 +250,7 @@ pub fn assert_releases_located(releases: &[(f64, f64, f64)], weight: f64) {
     for (t, l, tt) in releases {
         assert!(*l <= 0.0, "release at {t} with λ = {l}");
         assert!(
-            l.abs() <= fem::contact::FORCE_TOL * weight
+            l.abs() <= fem::events::contact::FORCE_TOL * weight
                 || (*tt <= 1e-12 && l.abs() <= 1e-6 * weight),
             "release at {t}: λ = {l:.3e}, bracket {tt:.1e}"
         );

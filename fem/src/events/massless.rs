@@ -5,7 +5,7 @@
 //! relaxation of ψ towards its quasi-static balance at rates κGA/(γk²) + EI/γ (k the
 //! wavenumber), 2.5e4 to 5e7 1/s on `barhorst-case1-timoshenko`, far above 1/dt.
 //!
-//! The energy-midpoint scheme ([`crate::midpoint`]) solves these rows at the midpoint,
+//! The energy-midpoint scheme ([`crate::method::energy_midpoint`]) solves these rows at the midpoint,
 //! Nᵀ(∇V(q̄) + C v̄ − Q) = 0: an implicit-midpoint step of the relaxation, whose amplification
 //! (1 − z/2)/(1 + z/2) tends to −1 for z = rate·h ≫ 1. A deviation of ψ from its balance is not
 //! damped: the end value ψ₁ = 2ψ̄ − ψ₀ flips around the balance every step, and so does the

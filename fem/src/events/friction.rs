@@ -1,10 +1,10 @@
 //! Bilateral tip contact with Coulomb friction and stick–slip (seed 001, scene
 //! `constrained-arm`) for the `energy-midpoint` scheme.
 //!
-//! **Constraint.** The tip of the named link stays on the wall ([`crate::wall`]) for all time:
+//! **Constraint.** The tip of the named link stays on the wall ([`crate::events::wall`]) for all time:
 //! g(q) = 0 from t = 0 (the scene starts on the wall, checked), never released, multiplier λ
 //! (the normal force, positive pushing the tip to the free side) of either sign. The midpoint
-//! step carries it exactly as the unilateral constrained phase of [`crate::contact`]: force
+//! step carries it exactly as the unilateral constrained phase of [`crate::events::contact`]: force
 //! λ̄∇̄g with ∇̄g the Gonzalez discrete gradient of g (metric M(q̄)), and g(q₁) = 0 in the
 //! bordered Newton iteration; so Δqᵀ∇̄g = g(q₁) − g(q₀) and the wall does no work. |g| at the
 //! step ends is at the Newton tolerance (channel `contact1.gap`, running max
@@ -33,7 +33,7 @@
 //! **Stick–slip.** While sliding, the event function is s·v_t (v_t = T q̇); its zero is located
 //! INSIDE the step by an Illinois secant on the step length (each trial a re-solved midpoint
 //! step) to |v_t| ≤ [`VT_TOL`]·L per unit time on the far side, or a bracket below
-//! [`crate::contact::TIME_TOL`] (trial steps ≥ [`MIN_TRIAL`]·h, rule 4 below). There the
+//! [`crate::events::contact::TIME_TOL`] (trial steps ≥ [`MIN_TRIAL`]·h, rule 4 below). There the
 //! Coulomb cone test with the held-tip forces decides:
 //! stick if |λ_t| ≤ μ|λ_n|, else slide on in direction s = −sign λ_t (a reversal when s
 //! changes; counted, not an event). While sticking, the tip is held at the stick point p_s by
@@ -46,7 +46,7 @@
 //! 1. A phase entered at a switch keeps its first step whole: that step is never shortened,
 //!    and if the event function of the new phase is not positive at its end the switch is made
 //!    there. So every switch is followed by at least one full step, and
-//!    [`crate::contact::MAX_EVENTS`] bounds the count.
+//!    [`crate::events::contact::MAX_EVENTS`] bounds the count.
 //! 2. Discrete consistency of the first slide step: if the tip moved against s over it (the
 //!    booked friction work D < 0 — the friction force would have pushed the tip along), that
 //!    step is re-solved with the tip held at its start position (a stick event at the step
@@ -84,15 +84,16 @@
 //! Timoshenko links without rotary inertia are refused here (M is singular in the massless
 //! section rotations, and the index-1 forces need M⁻¹).
 
+use data::Scene;
 use data::scene::{ContactMode, Surface};
-use data::{Event, Scene};
 
 use crate::band::DenseLu;
 use crate::chain::{Chain, MAX_LINKS, Parts};
-use crate::contact::{Contact, MAX_EVENTS, Post};
 use crate::error::FemError;
-use crate::integrator::Integrator;
-use crate::wall::{Wall, row_along, rows};
+use crate::events::contact::Contact;
+use crate::events::wall::{Wall, row_along, rows};
+use crate::linalg::dot;
+use crate::method::{ConstraintView, NewtonSystem};
 
 /// Slip-velocity tolerance of a located stop, relative to the longest link (per unit time).
 pub const VT_TOL: f64 = 1e-10;
@@ -102,7 +103,7 @@ pub const STICK_VT_TOL: f64 = 1e-8;
 /// Shortest trial step of the event location, relative to the step being located.
 pub const MIN_TRIAL: f64 = 1e-3;
 
-/// Refuses what the bilateral contact does not model (called from [`crate::contact::check`]).
+/// Refuses what the bilateral contact does not model (called from [`crate::events::contact::check`]).
 pub fn check(scene: &Scene) -> Result<(), FemError> {
     let Some(c) = scene.contacts.first() else {
         return Ok(());
@@ -184,7 +185,7 @@ pub fn describe(scene: &Scene) -> Option<String> {
 
 /// Which event function a step is watched by.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Switch {
+pub(crate) enum Switch {
     /// Sliding: s·v_t reaches zero.
     SlipStop,
     /// Sticking: μ|λ_n| − |λ_t| reaches zero.
@@ -193,19 +194,19 @@ enum Switch {
 
 /// Index-1 forces and tip kinematics at a state.
 #[derive(Debug, Clone, Copy, Default)]
-struct Forces {
-    lambda_n: f64,
+pub(crate) struct Forces {
+    pub(crate) lambda_n: f64,
     /// Tangential force along t̂ (friction force sliding, holding force sticking).
-    lambda_t: f64,
-    vt: f64,
-    vn: f64,
-    gap: f64,
-    tip: [f64; 2],
-    tangent: [f64; 2],
+    pub(crate) lambda_t: f64,
+    pub(crate) vt: f64,
+    pub(crate) vn: f64,
+    pub(crate) gap: f64,
+    pub(crate) tip: [f64; 2],
+    pub(crate) tangent: [f64; 2],
     /// G M⁻¹Gᵀ ≤ μ|G M⁻¹Tᵀ| (sliding only).
-    painleve: bool,
-    gmg: f64,
-    gmt: f64,
+    pub(crate) painleve: bool,
+    pub(crate) gmg: f64,
+    pub(crate) gmt: f64,
 }
 
 /// State of the bilateral (friction) contact; lives in [`Contact::bilateral`].
@@ -235,56 +236,35 @@ pub struct Bilateral {
     /// Smallest (G M⁻¹Gᵀ − μ|G M⁻¹Tᵀ|)/(G M⁻¹Gᵀ) met while sliding (Painlevé margin).
     pub min_painleve_margin: f64,
     /// Tangential multiplier of the last accepted stick step (Newton predictor).
-    step_lambda_t: f64,
-    lt_iter: f64,
-    lt_eval: f64,
-    dlt_pending: f64,
-    g1: f64,
-    h1: f64,
-    pending_work: f64,
+    pub(crate) step_lambda_t: f64,
+    pub(crate) lt_iter: f64,
+    pub(crate) lt_eval: f64,
+    pub(crate) dlt_pending: f64,
+    pub(crate) g1: f64,
+    pub(crate) h1: f64,
+    pub(crate) pending_work: f64,
     /// Switch found by the last trial: kind, bracket width, located inside the step.
-    pending: Option<(Switch, f64, bool)>,
+    pub(crate) pending: Option<(Switch, f64, bool)>,
     /// Event function at the start of the current step.
-    e0: f64,
+    pub(crate) e0: f64,
     /// The current step is the first of its phase (not shortened by an event; module docs).
-    fresh: bool,
-    jac: Vec<f64>,
-    g_row: Vec<f64>,
-    t_row: Vec<f64>,
-    h_bar: Vec<f64>,
-    h_end: Vec<f64>,
-    s_inv_h: Vec<f64>,
-    minv_g: Vec<f64>,
-    minv_t: Vec<f64>,
-    minv_r: Vec<f64>,
-    mass: DenseLu,
-    zero: Vec<f64>,
-    unit: Vec<f64>,
-    col: Vec<f64>,
+    pub(crate) fresh: bool,
+    pub(crate) jac: Vec<f64>,
+    pub(crate) g_row: Vec<f64>,
+    pub(crate) t_row: Vec<f64>,
+    pub(crate) h_bar: Vec<f64>,
+    pub(crate) h_end: Vec<f64>,
+    pub(crate) s_inv_h: Vec<f64>,
+    pub(crate) minv_g: Vec<f64>,
+    pub(crate) minv_t: Vec<f64>,
+    pub(crate) minv_r: Vec<f64>,
+    pub(crate) mass: DenseLu,
+    pub(crate) zero: Vec<f64>,
+    pub(crate) unit: Vec<f64>,
+    pub(crate) col: Vec<f64>,
 }
 
-/// The midpoint iterate seen by [`midpoint_terms`].
-pub(crate) struct StepView<'a> {
-    pub it: usize,
-    /// t₀, t_mid, t₁.
-    pub t: [f64; 3],
-    pub q0: &'a [f64],
-    pub q1: &'a [f64],
-    pub qbar: &'a [f64],
-    pub dq: &'a [f64],
-    /// M(q̄)Δq and ΔqᵀM(q̄)Δq (the Gonzalez metric).
-    pub w_dq: &'a [f64],
-    pub denom: f64,
-    /// Normal multiplier of this iterate and g(q₁).
-    pub lambda: f64,
-    pub gap1: f64,
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-fn sign(x: f64) -> f64 {
+pub(crate) fn sign(x: f64) -> f64 {
     if x < 0.0 { -1.0 } else { 1.0 }
 }
 
@@ -363,7 +343,7 @@ impl Bilateral {
 
     /// Index-1 forces at (q, q̇) (module docs): the held-tip pair when `held`, else the sliding
     /// normal force with the current s (σ chosen consistently).
-    fn forces(
+    pub(crate) fn forces(
         &mut self,
         chain: &mut Chain,
         link: usize,
@@ -436,16 +416,17 @@ impl Bilateral {
 pub(crate) fn midpoint_terms(
     c: &mut Contact,
     chain: &Chain,
-    v: &StepView<'_>,
+    v: &ConstraintView<'_>,
+    gap1: f64,
     res: &mut [f64],
 ) -> f64 {
     let link = c.link;
     let Some(b) = c.bilateral.as_deref_mut() else {
-        return v.gap1;
+        return gap1;
     };
     b.pending_work = 0.0;
     if b.mu == 0.0 {
-        return v.gap1;
+        return gap1;
     }
     let [t0, t_mid, t1] = v.t;
     let n = res.len();
@@ -459,7 +440,7 @@ pub(crate) fn midpoint_terms(
             c.g_bar[i] -= k * b.t_row[i];
         }
         b.pending_work = k * v.lambda * dot(v.dq, &b.t_row);
-        return v.gap1;
+        return gap1;
     }
     if v.it == 0 {
         b.lt_iter = b.step_lambda_t;
@@ -487,9 +468,9 @@ pub(crate) fn midpoint_terms(
         b.h_bar[i] += corr * v.w_dq[i];
         res[i] -= b.lt_iter * b.h_bar[i];
     }
-    b.g1 = v.gap1;
+    b.g1 = gap1;
     b.h1 = h1;
-    if h1.abs() > v.gap1.abs() { h1 } else { v.gap1 }
+    if h1.abs() > gap1.abs() { h1 } else { gap1 }
 }
 
 /// Whether the contact is a sticking friction contact (two multipliers in Newton).
@@ -508,426 +489,40 @@ pub fn phase(c: &Contact) -> f64 {
     }
 }
 
-impl Integrator {
-    /// Newton update of a stick step: S δa − ∇̄g δλ_n − ∇̄h δλ_t = F with
-    /// (h²/2)∇g(q₁)·δa = g(q₁), (h²/2)∇h(q₁)·δa = h(q₁), by the 2 × 2 Schur complement (three
-    /// solves of S). Leaves δa in `delta`, stores δλ_t for the next iterate, returns δλ_n.
-    pub(crate) fn stick_newton_update(&mut self, c: &mut Contact, res: &[f64], h: f64) -> f64 {
-        let Some(b) = c.bilateral.as_deref_mut() else {
-            return 0.0;
-        };
-        let n = res.len();
-        self.delta.copy_from_slice(&c.g_bar);
-        self.solve_matrix();
-        c.s_inv_g.copy_from_slice(&self.delta);
-        self.delta.copy_from_slice(&b.h_bar);
-        self.solve_matrix();
-        b.s_inv_h.copy_from_slice(&self.delta);
-        self.delta.copy_from_slice(res);
-        self.solve_matrix();
-        let hh = 0.5 * h * h;
-        let a11 = hh * dot(&c.g_end, &c.s_inv_g);
-        let a12 = hh * dot(&c.g_end, &b.s_inv_h);
-        let a21 = hh * dot(&b.h_end, &c.s_inv_g);
-        let a22 = hh * dot(&b.h_end, &b.s_inv_h);
-        let r1 = b.g1 - hh * dot(&c.g_end, &self.delta);
-        let r2 = b.h1 - hh * dot(&b.h_end, &self.delta);
-        let det = a11 * a22 - a12 * a21;
-        let dn = (a22 * r1 - a12 * r2) / det;
-        let dt = (a11 * r2 - a21 * r1) / det;
-        for i in 0..n {
-            self.delta[i] += c.s_inv_g[i] * dn + b.s_inv_h[i] * dt;
-        }
-        b.dlt_pending = dt;
-        dn
+/// Newton update of a stick step: S δa − ∇̄g δλ_n − ∇̄h δλ_t = F with
+/// (h²/2)∇g(q₁)·δa = g(q₁), (h²/2)∇h(q₁)·δa = h(q₁), by the 2 × 2 Schur complement (three
+/// solves of S). Leaves δa in `delta`, stores δλ_t for the next iterate, returns δλ_n.
+pub(crate) fn stick_newton_update(
+    newton: &mut NewtonSystem,
+    c: &mut Contact,
+    res: &[f64],
+    h: f64,
+) -> f64 {
+    let Some(b) = c.bilateral.as_deref_mut() else {
+        return 0.0;
+    };
+    let n = res.len();
+    newton.delta.copy_from_slice(&c.g_bar);
+    newton.solve();
+    c.s_inv_g.copy_from_slice(&newton.delta);
+    newton.delta.copy_from_slice(&b.h_bar);
+    newton.solve();
+    b.s_inv_h.copy_from_slice(&newton.delta);
+    newton.delta.copy_from_slice(res);
+    newton.solve();
+    let hh = 0.5 * h * h;
+    let a11 = hh * dot(&c.g_end, &c.s_inv_g);
+    let a12 = hh * dot(&c.g_end, &b.s_inv_h);
+    let a21 = hh * dot(&b.h_end, &c.s_inv_g);
+    let a22 = hh * dot(&b.h_end, &b.s_inv_h);
+    let r1 = b.g1 - hh * dot(&c.g_end, &newton.delta);
+    let r2 = b.h1 - hh * dot(&b.h_end, &newton.delta);
+    let det = a11 * a22 - a12 * a21;
+    let dn = (a22 * r1 - a12 * r2) / det;
+    let dt = (a11 * r2 - a21 * r1) / det;
+    for i in 0..n {
+        newton.delta[i] += c.s_inv_g[i] * dn + b.s_inv_h[i] * dt;
     }
-
-    fn with_bilateral<R>(
-        &mut self,
-        f: impl FnOnce(&mut Self, &mut Contact) -> Result<R, FemError>,
-    ) -> Result<R, FemError> {
-        let Some(mut c) = self.contact.take() else {
-            return Err(FemError::Numerical {
-                t: self.t,
-                message: "bilateral contact missing".into(),
-            });
-        };
-        let out = f(self, &mut c);
-        self.contact = Some(c);
-        out
-    }
-
-    /// Index-1 forces at (q, q̇) (`end`: the trial end q₁, q̇₁ at t₁; else the current state).
-    fn contact_forces(&mut self, end: bool, t: f64, held: bool) -> Result<Forces, FemError> {
-        self.with_bilateral(|s, c| {
-            let link = c.link;
-            let b = c.bilateral.as_deref_mut().expect("bilateral contact");
-            let (q, qd) = if end { (&s.q1, &s.qd1) } else { (&s.q, &s.qd) };
-            let out = b.forces(&mut s.chain, link, t, q, qd, held);
-            s.counters.rhs += s.chain.ndof + 2;
-            out
-        })
-    }
-
-    /// Sets up the bilateral contact at t = 0: the tip must start on the wall; forces, and the
-    /// Coulomb test that decides the initial phase (module docs).
-    pub fn bilateral_start(&mut self) -> Result<(), FemError> {
-        let t = self.t;
-        let Some(c) = self.contact.as_deref_mut() else {
-            return Ok(());
-        };
-        if c.bilateral.is_none() {
-            return Ok(());
-        }
-        c.constrained = true;
-        c.gap = c.gap_at(&self.chain, t, &self.q);
-        if c.gap.abs() > c.gap_tol {
-            return Err(FemError::InvalidSettings {
-                field: "contact".into(),
-                message: format!(
-                    "the tip starts {:.3e} off the surface of the bilateral contact (tolerance \
-                     {:.1e})",
-                    c.gap, c.gap_tol
-                ),
-            });
-        }
-        let mu = c.bilateral.as_deref().map_or(0.0, |b| b.mu);
-        let vt_tol = VT_TOL * self.length_scale;
-        let held = self.contact_forces(false, t, true)?;
-        let c = self.contact.as_deref_mut().expect("contact");
-        let b = c.bilateral.as_deref_mut().expect("bilateral");
-        let mut sticking = false;
-        if mu > 0.0 {
-            if held.vt.abs() <= vt_tol && held.lambda_t.abs() <= mu * held.lambda_n.abs() {
-                sticking = true;
-            } else {
-                b.slip_dir = if held.vt.abs() > vt_tol {
-                    sign(held.vt)
-                } else {
-                    -sign(held.lambda_t)
-                };
-            }
-            c.n_events += 1;
-            c.events.push(Event::StickSlip {
-                t,
-                contact: 1,
-                sticking,
-            });
-        }
-        if sticking {
-            b.sticking = true;
-            b.stick_point = held.tip;
-            b.stick_tangent = held.tangent;
-            b.step_lambda_t = held.lambda_t;
-        }
-        self.record_state()
-    }
-
-    /// Index-1 forces at the current state for the current phase, stored in
-    /// the contact; Painlevé stop; the event function for the next step.
-    fn record_state(&mut self) -> Result<(), FemError> {
-        let t = self.t;
-        let sticking = sticking(self.contact.as_deref().expect("contact"));
-        let fr = self.contact_forces(false, t, sticking)?;
-        let c = self.contact.as_deref_mut().expect("contact");
-        let b = c.bilateral.as_deref_mut().expect("bilateral");
-        c.lambda = fr.lambda_n;
-        c.gap = fr.gap;
-        c.normal_velocity = fr.vn;
-        c.max_gap = c.max_gap.max(fr.gap.abs());
-        c.max_normal_velocity = c.max_normal_velocity.max(fr.vn.abs());
-        b.friction_force = fr.lambda_t;
-        b.slip_velocity = fr.vt;
-        if b.sticking {
-            let (ts, ps) = (b.stick_tangent, b.stick_point);
-            let off = ts[0] * (fr.tip[0] - ps[0]) + ts[1] * (fr.tip[1] - ps[1]);
-            b.max_stick_offset = b.max_stick_offset.max(off.abs());
-            b.max_stick_velocity = b.max_stick_velocity.max(fr.vt.abs());
-            b.e0 = b.mu * fr.lambda_n.abs() - fr.lambda_t.abs();
-        } else {
-            if b.mu > 0.0 {
-                b.min_painleve_margin = b
-                    .min_painleve_margin
-                    .min((fr.gmg - b.mu * fr.gmt.abs()) / fr.gmg);
-                if fr.painleve {
-                    return Err(FemError::Runaway {
-                        t,
-                        what: "Painlevé paradox of the friction contact".into(),
-                        location: Some("contact1".into()),
-                        why: format!(
-                            "G M⁻¹Gᵀ = {:.4e} ≤ μ|G M⁻¹Tᵀ| = {:.4e}: the sliding normal force \
-                             has no or several solutions",
-                            fr.gmg,
-                            b.mu * fr.gmt.abs()
-                        ),
-                        remedy: "no consistent Coulomb solution in this model; reduce μ".into(),
-                    });
-                }
-                if fr.lambda_n != 0.0 {
-                    b.sigma = sign(fr.lambda_n);
-                }
-            }
-            b.e0 = b.slip_dir * fr.vt;
-        }
-        if b.fresh {
-            // Newton predictor of a new phase: the index-1 value.
-            c.step_lambda = fr.lambda_n;
-        }
-        Ok(())
-    }
-
-    /// Re-solves the current step of length h (phase as set); a Newton failure is an error.
-    fn bilateral_solve(&mut self, h: f64) -> Result<(), FemError> {
-        let t1 = self.t + h;
-        if let Some(e) = self.midpoint_step(h, t1, t1)?
-            && e.is_infinite()
-        {
-            return Err(FemError::Runaway {
-                t: self.t,
-                what: format!("Newton failed on a friction-contact step (h = {h:.3e})"),
-                location: Some("contact1".into()),
-                why: "the re-solved step did not converge".into(),
-                remedy: "reduce --dt".into(),
-            });
-        }
-        self.sigma_check(h)
-    }
-
-    /// Sliding: the converged mean multiplier must have the sign σ the friction term assumed;
-    /// else the step is re-solved once with σ flipped (module docs).
-    fn sigma_check(&mut self, h: f64) -> Result<(), FemError> {
-        let c = self.contact.as_deref_mut().expect("contact");
-        let tiny = c.force_tol;
-        let lam = c.step_lambda;
-        let b = c.bilateral.as_deref_mut().expect("bilateral");
-        if b.sticking || b.mu == 0.0 || lam * b.sigma >= 0.0 || lam.abs() <= tiny {
-            return Ok(());
-        }
-        b.sigma = -b.sigma;
-        let t1 = self.t + h;
-        let failed = matches!(self.midpoint_step(h, t1, t1)?, Some(e) if e.is_infinite());
-        let c = self.contact.as_deref_mut().expect("contact");
-        let lam2 = c.step_lambda;
-        let sigma = c.bilateral.as_deref().map_or(1.0, |b| b.sigma);
-        if failed || (lam2 * sigma < 0.0 && lam2.abs() > tiny) {
-            return Err(FemError::Runaway {
-                t: self.t,
-                what: "no consistent Coulomb solution of the friction step".into(),
-                location: Some("contact1".into()),
-                why: format!(
-                    "the step's normal multiplier changes sign with the assumed friction sign \
-                     (λ̄ = {lam:.4e} with σ = {:.0}, {lam2:.4e} with σ = {sigma:.0}): \
-                     Painlevé-type inconsistency",
-                    -sigma
-                ),
-                remedy: "reduce --dt; if it persists the model has no Coulomb solution".into(),
-            });
-        }
-        Ok(())
-    }
-
-    /// Event function of `kind` at the end of the trial step just solved.
-    fn switch_value(&mut self, kind: Switch, t1: f64) -> Result<f64, FemError> {
-        match kind {
-            Switch::SlipStop => self.with_bilateral(|s, c| {
-                let link = c.link;
-                let b = c.bilateral.as_deref_mut().expect("bilateral");
-                let r = s.chain.tip_jacobian(t1, link, &s.q1, &mut b.jac);
-                let f = b.wall.frame(r);
-                row_along(f.tangent, &b.jac, &mut b.t_row);
-                Ok(b.slip_dir * dot(&b.t_row, &s.qd1))
-            }),
-            Switch::Breakaway => {
-                let fr = self.contact_forces(true, t1, true)?;
-                let mu = self
-                    .contact
-                    .as_deref()
-                    .and_then(|c| c.bilateral.as_deref())
-                    .map_or(0.0, |b| b.mu);
-                Ok(mu * fr.lambda_n.abs() - fr.lambda_t.abs())
-            }
-        }
-    }
-
-    fn switch_trial(&mut self, kind: Switch, h: f64) -> Result<f64, FemError> {
-        self.bilateral_solve(h)?;
-        self.switch_value(kind, self.t + h)
-    }
-
-    /// Zero of the event function inside the step (F(0) > 0, F(h) = f1 ≤ 0) by
-    /// [`Integrator::illinois_on_step`], to −tol ≤ F ≤ 0 or a bracket below
-    /// [`crate::contact::TIME_TOL`]; leaves the accepted trial solved and returns
-    /// (h*, bracket width). Trial steps are never shorter than
-    /// [`MIN_TRIAL`]·h: on a step of length h → 0 the constraint g(q₁) = 0, met only to the
-    /// Newton tolerance ε at q₀, takes a multiplier ~ε/h² and the event function jumps by
-    /// ~ε/h (measured: λ̄ = 5e12 N on a 7e-15 s trial). A root inside that first fraction is
-    /// returned as None: the switch is made at the step start.
-    fn locate_switch(
-        &mut self,
-        kind: Switch,
-        h: f64,
-        f1: f64,
-        tol: f64,
-    ) -> Result<Option<(f64, f64)>, FemError> {
-        let h_min = MIN_TRIAL * h;
-        let f_min = self.switch_trial(kind, h_min)?;
-        if f_min <= 0.0 {
-            return Ok(None);
-        }
-        let loc = self.illinois_on_step((h_min, f_min), (h, f1), tol, false, false, |s, c| {
-            s.switch_trial(kind, c)
-        })?;
-        if !loc.solved {
-            self.switch_trial(kind, loc.h)?;
-        }
-        Ok(Some((loc.h, loc.width)))
-    }
-
-    /// Bilateral counterpart of [`Integrator::contact_after_trial`]: the friction sign check,
-    /// then the stick–slip event of the phase, located inside the step.
-    pub(crate) fn bilateral_after_trial(&mut self, h: f64) -> Result<(f64, Post), FemError> {
-        let t1 = self.t + h;
-        let c = self.contact.as_deref_mut().expect("contact");
-        if c.n_events >= MAX_EVENTS {
-            return Err(FemError::Runaway {
-                t: self.t,
-                what: format!("{} stick–slip events", c.n_events),
-                location: Some("contact1".into()),
-                why: "stick–slip transitions accumulate".into(),
-                remedy: "shorten t_end or add damping".into(),
-            });
-        }
-        self.sigma_check(h)?;
-        let t0 = self.t;
-        let c = self.contact.as_deref_mut().expect("contact");
-        let force_tol = c.force_tol;
-        let b = c.bilateral.as_deref_mut().expect("bilateral");
-        b.pending = None;
-        if b.mu == 0.0 {
-            return Ok((h, Post::None));
-        }
-        if !b.sticking && b.fresh && b.pending_work < 0.0 {
-            // First step of a slide whose tip moved against s: friction would have done
-            // negative work. The discrete Coulomb choice: the tip sticks for this step (held
-            // at its start position; the held-tip constraint does no work).
-            let held = self.contact_forces(false, t0, true)?;
-            let c = self.contact.as_deref_mut().expect("contact");
-            let b = c.bilateral.as_deref_mut().expect("bilateral");
-            b.sticking = true;
-            b.stick_point = held.tip;
-            b.stick_tangent = held.tangent;
-            b.step_lambda_t = held.lambda_t;
-            b.inconsistent_slides += 1;
-            c.n_events += 1;
-            c.events.push(Event::StickSlip {
-                t: t0,
-                contact: 1,
-                sticking: true,
-            });
-            if let Some(w) = self.midpoint.as_mut() {
-                w.restart();
-            }
-            self.bilateral_solve(h)?;
-        }
-        loop {
-            let c = self.contact.as_deref_mut().expect("contact");
-            let b = c.bilateral.as_deref_mut().expect("bilateral");
-            let (kind, tol) = if b.sticking {
-                (Switch::Breakaway, force_tol)
-            } else {
-                (Switch::SlipStop, VT_TOL * self.length_scale)
-            };
-            let f0 = b.e0;
-            let located = !b.fresh && f0 > 0.0;
-            let f1 = self.switch_value(kind, t1)?;
-            if f1 > 0.0 {
-                return Ok((h, Post::None));
-            }
-            let found = if located {
-                self.locate_switch(kind, h, f1, tol)?
-            } else {
-                // First step of a phase: not shortened (the one-step rule, module docs), the
-                // switch is made at its end.
-                Some((h, 0.0))
-            };
-            let Some((h_acc, width)) = found else {
-                // The root lies within the first MIN_TRIAL of the step: switch at its start
-                // and re-solve the step in the new phase (whose first step is not shortened).
-                self.apply_switch(kind, true)?;
-                self.record_state()?;
-                self.bilateral_solve(h)?;
-                continue;
-            };
-            let b = self
-                .contact
-                .as_deref_mut()
-                .and_then(|c| c.bilateral.as_deref_mut())
-                .expect("bilateral");
-            b.pending = Some((kind, width, located));
-            return Ok((h_acc, Post::None));
-        }
-    }
-
-    /// Books the accepted step (friction work, tangential multiplier), applies a located
-    /// switch at the new state and records the forces there.
-    pub(crate) fn bilateral_after_accept(&mut self) -> Result<(), FemError> {
-        let c = self.contact.as_deref_mut().expect("contact");
-        let b = c.bilateral.as_deref_mut().expect("bilateral");
-        b.friction_work += b.pending_work;
-        b.pending_work = 0.0;
-        if b.sticking {
-            b.step_lambda_t = b.lt_eval;
-        }
-        b.fresh = false;
-        let Some((kind, _width, located)) = b.pending.take() else {
-            return self.record_state();
-        };
-        self.apply_switch(kind, located)?;
-        self.record_state()
-    }
-
-    /// Switch of `kind` at the current state (q, q̇ at t): the Coulomb test with the held-tip
-    /// forces (module docs), event, midpoint restart. `located`: the state is a located zero
-    /// of the event function (else the end of a first step, where a tip still moving slides
-    /// on in its direction of motion).
-    fn apply_switch(&mut self, kind: Switch, located: bool) -> Result<(), FemError> {
-        let t = self.t;
-        let held = self.contact_forces(false, t, true)?;
-        let vt_tol = STICK_VT_TOL * self.length_scale;
-        let c = self.contact.as_deref_mut().expect("contact");
-        let b = c.bilateral.as_deref_mut().expect("bilateral");
-        let mu = b.mu;
-        b.fresh = true;
-        let moving = !located && held.vt.abs() > vt_tol;
-        let stick =
-            kind == Switch::SlipStop && !moving && held.lambda_t.abs() <= mu * held.lambda_n.abs();
-        if moving && kind == Switch::SlipStop {
-            b.slip_dir = sign(held.vt);
-            b.reversals += 1;
-        } else if stick {
-            b.sticking = true;
-            b.stick_point = held.tip;
-            b.stick_tangent = held.tangent;
-            b.step_lambda_t = held.lambda_t;
-        } else {
-            let s = -sign(held.lambda_t);
-            if kind == Switch::SlipStop && s != b.slip_dir {
-                b.reversals += 1;
-            }
-            b.slip_dir = s;
-            b.sticking = false;
-        }
-        if kind == Switch::Breakaway || stick {
-            c.n_events += 1;
-            c.events.push(Event::StickSlip {
-                t,
-                contact: 1,
-                sticking: stick,
-            });
-        }
-        if let Some(w) = self.midpoint.as_mut() {
-            w.restart();
-        }
-        Ok(())
-    }
+    b.dlt_pending = dt;
+    dn
 }

@@ -38,18 +38,18 @@
 //! `two-link-free-undamped`). The correction term is not differentiated (quasi-Newton). The iterate is accepted at the point where the residual was evaluated, so the
 //! booked energies and works are those of the equations actually solved.
 //!
-//! Tip contact ([`crate::contact`]): in a constrained phase the momentum equation gains
+//! Tip contact ([`crate::events::contact`], through [`StepConstraint`]): in a constrained phase the momentum equation gains
 //! −∇̄g λ (∇̄g the discrete gradient of the gap, same metric and formula as for Φ) and the
 //! unknowns become (a, λ) with g(q₁) = 0 (a step shortened to h < h_nominal aims at
 //! (1 − (h/h_nominal)²)·g(q₀) instead: λ finite as h → 0), ∂q₁/∂a = h²/2; each iteration solves S twice
 //! (Schur complement of the border). Shortened steps that locate an event re-form the Newton
 //! matrix every iteration (impulsive multipliers spoil the quasi-Newton contraction).
 //!
-//! Runs with a unilateral tip contact (`Integrator::unilateral_contact`; other runs are
+//! Runs with a unilateral tip contact (`NewtonSystem::unilateral_contact`; other runs are
 //! unchanged) step through impacts, releases and grazing contacts, where the iteration starts
 //! far from the solution and at step lengths down to 1e-13 s. There:
 //! * the finite-difference Newton matrix perturbs q̇ by 1e-6 of its scale at every step length
-//!   (`Integrator::form_matrix`);
+//!   ([`crate::method::NewtonSystem::form`]);
 //! * a matrix formed at an earlier iterate or step is re-formed at the current iterate as soon
 //!   as an update is not 5× smaller than the previous one (where the update grew it is not
 //!   applied); the first update of such a fresh matrix may be larger than the stalled ones
@@ -73,9 +73,9 @@
 //! accelerations), step ratio 0.9·err^(−1/3) as for generalized-α.
 
 use crate::chain::{Chain, NONE, NewtonCoefficients, Parts};
-use crate::contact::Contact;
 use crate::error::FemError;
-use crate::integrator::{Integrator, JacobianKind, Works};
+use crate::linalg::{dot, max_abs};
+use crate::method::{ConstraintView, JacobianKind, StepConstraint, StepContext, Stepper, Works};
 
 /// Relative size of the finite-difference perturbation of q for Ṁ(x)x.
 pub const FD_STEP: f64 = 1e-5;
@@ -113,7 +113,7 @@ pub struct MidpointWork {
     qp: Vec<f64>,
     tmp: Vec<f64>,
     tmp2: Vec<f64>,
-    /// Whether the previous step's mean acceleration is in `Integrator::qdd` (else it holds
+    /// Whether the previous step's mean acceleration is in `StepState::qdd` (else it holds
     /// the point acceleration of a (re)start), and that step's length.
     have_prev: bool,
     h_prev: f64,
@@ -162,18 +162,9 @@ impl MidpointWork {
         works.applied_load += p.applied_load;
         works.joint_damper += p.joint_damper;
         works.kelvin_voigt += p.kelvin_voigt;
-        works.numerical_massless += p.numerical_massless;
         self.have_prev = true;
         self.h_prev = h;
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-fn max_abs(a: &[f64]) -> f64 {
-    a.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 /// Scratch vectors and the output of [`add_kinetic_gradient`].
@@ -247,95 +238,57 @@ pub fn mass_product(chain: &mut Chain, t: f64, q: &[f64], x: &[f64]) -> Vec<f64>
     out
 }
 
-impl Integrator {
-    /// One energy-midpoint step; returns the scaled error estimate when adaptive (infinite when
-    /// Newton failed).
-    pub(crate) fn midpoint_step(
-        &mut self,
-        h: f64,
-        t1: f64,
-        t_law: f64,
-    ) -> Result<Option<f64>, FemError> {
-        let Some(mut w) = self.midpoint.take() else {
-            return Err(FemError::Numerical {
-                t: self.t,
-                message: "energy-midpoint work buffers missing".into(),
-            });
-        };
-        // The tip contact, when constrained, borders the Newton system (see `crate::contact`).
-        let mut contact = self.contact.take();
-        let active = contact.as_deref_mut().filter(|c| c.constrained);
-        let result = self.midpoint_solve(&mut w, active, h, t1, t_law);
-        self.contact = contact;
-        // A converged fixed step (contact runs are fixed-step: run.rs refuses `rtol`).
-        let result = match result {
-            Ok(None) => self.end_on_massless_balance(&mut w, h, t1).map(|()| None),
-            other => other,
-        };
-        self.midpoint = Some(w);
-        result
-    }
+/// The energy-consistent midpoint scheme (module docs) with its work buffers.
+#[derive(Debug, Clone)]
+pub struct EnergyMidpoint {
+    pub work: MidpointWork,
+}
 
-    /// Contact runs with massless section rotations ([`crate::massless`]): the end positions
-    /// projected onto their balance (strain energy removed booked), the end rates, which the
-    /// step does not determine, set from the balances, and the mean acceleration with them.
-    fn end_on_massless_balance(
-        &mut self,
-        w: &mut MidpointWork,
-        h: f64,
-        t1: f64,
-    ) -> Result<(), FemError> {
-        let Some(ml) = self
-            .contact
-            .as_deref_mut()
-            .and_then(|c| c.massless.as_mut())
-            .filter(|m| m.project)
-        else {
-            return Ok(());
-        };
-        let (removed, p) = ml.project_balance(&mut self.chain, t1, &mut self.q1);
-        w.pending.numerical_massless = removed;
-        self.counters.rhs +=
-            p + ml.make_consistent(&mut self.chain, t1, &self.q1, &mut self.qd1)?;
-        for i in 0..self.q1.len() {
-            self.qdd1[i] = (self.qd1[i] - self.qd[i]) / h;
+impl EnergyMidpoint {
+    pub fn new(n: usize) -> Self {
+        EnergyMidpoint {
+            work: MidpointWork::new(n),
         }
-        self.a1.copy_from_slice(&self.qdd1);
-        Ok(())
     }
+}
 
-    fn midpoint_solve(
+impl Stepper for EnergyMidpoint {
+    /// One energy-midpoint step; returns the scaled error estimate when adaptive (infinite when
+    /// Newton failed). A held `constraint` borders the Newton system (module docs).
+    fn step(
         &mut self,
-        w: &mut MidpointWork,
-        mut contact: Option<&mut Contact>,
+        cx: &mut StepContext<'_>,
+        mut constraint: Option<&mut dyn StepConstraint>,
         h: f64,
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        let n = self.q.len();
-        let t0 = self.t;
+        let w = &mut self.work;
+        let st = &mut *cx.state;
+        let n = st.q.len();
+        let t0 = st.t;
         // Laws are sampled at the midpoint: exact work for piecewise-constant torques, since
         // steps land on their breakpoints.
         let t_mid = t0 + 0.5 * h;
-        let delta = FD_STEP * self.length_scale.max(1.0);
+        let delta = FD_STEP * cx.length_scale.max(1.0);
         // Start-of-step momentum and potential.
-        self.chain
-            .residual_parts(t_mid, &self.q, &w.zero, &self.qd, Parts::INERTIA, &mut w.p0);
-        let [k0, s0, sp0, g0] = self.chain.energies(t0, &self.q, &self.qd);
+        cx.chain
+            .residual_parts(t_mid, &st.q, &w.zero, &st.qd, Parts::INERTIA, &mut w.p0);
+        let [k0, s0, sp0, g0] = cx.chain.energies(t0, &st.q, &st.qd);
         let v0_pot = s0 + sp0 + g0;
         let scale0 = k0.abs() + s0.abs() + sp0.abs() + g0.abs();
         let mut passes = 2usize;
         // Constrained phase: g(q₀) and the multiplier's start value (the last step's).
-        let g0 = contact
+        let g0 = constraint
             .as_ref()
-            .map_or(0.0, |c| c.gap_at(&self.chain, t0, &self.q));
-        let mut lambda = contact.as_ref().map_or(0.0, |c| c.step_lambda);
+            .map_or(0.0, |c| c.value(cx.chain, t0, &st.q));
+        let mut lambda = constraint.as_ref().map_or(0.0, |c| c.multiplier());
         let mut gap1 = 0.0;
         // Target of g(q₁): 0 for a full step; a step shortened to h removes only the share
         // (h/h_nominal)² of the start gap (≤ the Newton tolerance), so that the multiplier
         // stays finite as h → 0 (it would carry g(q₀)/h² otherwise; ∝ 2g(q₀)/h_nominal² now)
-        // and is continuous in h, as the release event function (`crate::contact`) needs.
-        let r = (h / self.h_nominal).min(1.0);
+        // and is continuous in h, as the release event function (`crate::events::contact`) needs.
+        let r = (h / cx.h_nominal).min(1.0);
         let gap_target = g0 * (1.0 - r * r);
         // Predictor: the previous step's mean acceleration; zero after a (re)start, where the
         // point acceleration of a released pre-loaded spring is a mesh-dependent spike.
@@ -343,10 +296,10 @@ impl Integrator {
         // acceleration is close to the point value, which after an impact carries the mesh
         // modes (measured 5e6 at the tip node 2 µs after an impact, a predicted velocity
         // change of 1e3 ft/s over the next 0.43 ms step, which diverged).
-        let robust = self.unilateral_contact;
+        let robust = cx.newton.unilateral_contact;
         let predict = w.have_prev && (!robust || w.h_prev >= 0.1 * h);
         for i in 0..n {
-            self.qdd1[i] = if predict { self.qdd[i] } else { 0.0 };
+            st.qdd1[i] = if predict { st.qdd[i] } else { 0.0 };
         }
         let c = NewtonCoefficients {
             c_a: 1.0,
@@ -366,28 +319,22 @@ impl Integrator {
         let mut iterations = 0;
         for it in 0..MAX_ITERATIONS {
             for i in 0..n {
-                let a = self.qdd1[i];
-                w.vbar[i] = self.qd[i] + 0.5 * h * a;
+                let a = st.qdd1[i];
+                w.vbar[i] = st.qd[i] + 0.5 * h * a;
                 w.half_dv[i] = 0.5 * h * a;
                 w.dq[i] = h * w.vbar[i];
-                w.qbar[i] = self.q[i] + 0.5 * w.dq[i];
-                self.q1[i] = self.q[i] + w.dq[i];
-                self.qd1[i] = self.qd[i] + h * a;
+                w.qbar[i] = st.q[i] + 0.5 * w.dq[i];
+                st.q1[i] = st.q[i] + w.dq[i];
+                st.qd1[i] = st.qd[i] + h * a;
             }
             // Momentum and potential at the end point.
-            self.chain.residual_parts(
-                t_mid,
-                &self.q1,
-                &w.zero,
-                &self.qd1,
-                Parts::INERTIA,
-                &mut w.mv1,
-            );
-            let [k1, s1, sp1, g1] = self.chain.energies(t1, &self.q1, &self.qd1);
+            cx.chain
+                .residual_parts(t_mid, &st.q1, &w.zero, &st.qd1, Parts::INERTIA, &mut w.mv1);
+            let [k1, s1, sp1, g1] = cx.chain.energies(t1, &st.q1, &st.qd1);
             let v1_pot = s1 + sp1 + g1;
             let scale1 = k1.abs() + s1.abs() + sp1.abs() + g1.abs();
             // Forces at the midpoint.
-            self.chain.residual_parts(
+            cx.chain.residual_parts(
                 t_mid,
                 &w.qbar,
                 &w.zero,
@@ -395,7 +342,7 @@ impl Integrator {
                 Parts::CONSERVATIVE,
                 &mut w.grad_v,
             );
-            self.chain.residual_parts(
+            cx.chain.residual_parts(
                 t_mid,
                 &w.qbar,
                 &w.vbar,
@@ -414,14 +361,14 @@ impl Integrator {
                     tmp: &mut w.tmp,
                     tmp2: &mut w.tmp2,
                 };
-                passes += add_kinetic_gradient(&mut self.chain, t_mid, &w.qbar, x, delta, sign, s);
+                passes += add_kinetic_gradient(cx.chain, t_mid, &w.qbar, x, delta, sign, s);
             }
             // Metric W = M(q̄).
-            self.chain
+            cx.chain
                 .residual_parts(t_mid, &w.qbar, &w.zero, &w.dq, Parts::INERTIA, &mut w.w_dq);
             passes += 1;
-            let phi1 = v1_pot - 0.5 * dot(&self.qd, &w.mv1);
-            let phi0 = v0_pot - 0.5 * dot(&w.p0, &self.qd1);
+            let phi1 = v1_pot - 0.5 * dot(&st.qd, &w.mv1);
+            let phi0 = v0_pot - 0.5 * dot(&w.p0, &st.qd1);
             let mut grad_dq = 0.0;
             for i in 0..n {
                 grad_dq += (w.grad_v[i] - w.grad_g[i]) * w.dq[i];
@@ -442,47 +389,28 @@ impl Integrator {
                     + corr * w.w_dq[i]
                     + w.minus_q[i];
             }
-            if let Some(c) = contact.as_deref_mut() {
-                // Constraint force ∇̄g λ with ∇̄g the discrete gradient of the gap in the same
-                // metric: Δqᵀ∇̄g = g(q₁) − g(q₀), so the constraint does no work.
-                let mut g_mid = std::mem::take(&mut c.g_mid);
-                let mut g_end = std::mem::take(&mut c.g_end);
-                c.gradient(&self.chain, t_mid, &w.qbar, &mut g_mid);
-                gap1 = c.gradient(&self.chain, t1, &self.q1, &mut g_end);
-                let gd = dot(&g_mid, &w.dq);
-                let corr_g = if denom > 0.0 {
-                    (gap1 - g0 - gd) / denom
-                } else {
-                    0.0
+            if let Some(c) = constraint.as_deref_mut() {
+                // The constraint force (discrete gradient of g in the same metric: it does no
+                // work) and friction, from the constraint itself.
+                let view = ConstraintView {
+                    it,
+                    t: [t0, t_mid, t1],
+                    q0: &st.q,
+                    q1: &st.q1,
+                    qbar: &w.qbar,
+                    dq: &w.dq,
+                    w_dq: &w.w_dq,
+                    denom,
+                    g0,
+                    lambda,
                 };
-                for i in 0..n {
-                    c.g_bar[i] = g_mid[i] + corr_g * w.w_dq[i];
-                    w.res[i] -= lambda * c.g_bar[i];
-                }
-                c.g_mid = g_mid;
-                c.g_end = g_end;
-                if c.bilateral.is_some() {
-                    // Friction (sliding) or the tangential stick constraint: crate::friction.
-                    let view = crate::friction::StepView {
-                        it,
-                        t: [t0, t_mid, t1],
-                        q0: &self.q,
-                        q1: &self.q1,
-                        qbar: &w.qbar,
-                        dq: &w.dq,
-                        w_dq: &w.w_dq,
-                        denom,
-                        lambda,
-                        gap1,
-                    };
-                    gap1 = crate::friction::midpoint_terms(c, &self.chain, &view, &mut w.res);
-                }
+                gap1 = c.add_force(cx.chain, &view, &mut w.res);
             }
-            self.counters.newton += 1;
+            cx.counters.newton += 1;
             // Newton matrix at (q̄, v̄, a): a full residual there fills the chain's point data.
-            let fresh = self.jacobian == JacobianKind::Banded
-                || self.matrix_h != h
-                || self.slow_convergence;
+            let fresh = cx.newton.jacobian == JacobianKind::Banded
+                || cx.newton.matrix_h != h
+                || cx.newton.slow_convergence;
             // (With a unilateral contact: not where the last update was already within
             // tolerance and only the energy defect is being polished: a new finite-difference
             // matrix there only adds noise. Without: constrained steps shortened to locate an
@@ -490,59 +418,43 @@ impl Integrator {
             // quasi-Newton contraction poor; the unilateral contact refreshes stale matrices
             // instead, below.)
             let periodic = (it == 6 || it == 12 || it == 18) && (!robust || last > polish_tol);
-            let refresh = !robust && contact.is_some() && h < 0.999 * self.h_nominal;
+            let refresh = !robust && constraint.is_some() && h < 0.999 * cx.h_nominal;
             if (it == 0 && fresh) || periodic || refresh || force_refresh {
                 formed_it = Some(it);
                 forced_now = force_refresh;
                 force_refresh = false;
-                self.q1.copy_from_slice(&w.qbar);
-                self.qd1.copy_from_slice(&w.vbar);
-                self.chain
-                    .residual(t_mid, &self.q1, &self.qd1, &self.qdd1, &mut self.res);
+                st.q1.copy_from_slice(&w.qbar);
+                st.qd1.copy_from_slice(&w.vbar);
+                cx.chain
+                    .residual(t_mid, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
                 passes += 1;
-                if let Err(e) = self.form_matrix(c, t_mid, t1) {
+                if let Err(e) =
+                    cx.newton
+                        .form(cx.chain, st, cx.counters, cx.h_nominal, c, t_mid, t1)
+                {
                     // A singular matrix at an iterate far from the solution: a Newton failure
                     // (the caller retries shorter), unless the step is already tiny.
-                    if robust && h > 1e-6 * self.h_nominal && matches!(e, FemError::Singular { .. })
-                    {
+                    if robust && h > 1e-6 * cx.h_nominal && matches!(e, FemError::Singular { .. }) {
                         break;
                     }
                     return Err(e);
                 }
-                self.matrix_h = h;
-                self.slow_convergence = false;
+                cx.newton.matrix_h = h;
+                cx.newton.slow_convergence = false;
                 for i in 0..n {
-                    self.q1[i] = self.q[i] + w.dq[i];
-                    self.qd1[i] = self.qd[i] + h * self.qdd1[i];
+                    st.q1[i] = st.q[i] + w.dq[i];
+                    st.qd1[i] = st.qd[i] + h * st.qdd1[i];
                 }
             }
             let mut dlambda = 0.0;
-            if let Some(c) = contact
-                .as_deref_mut()
-                .filter(|c| crate::friction::sticking(c))
-            {
-                // Sticking friction contact: two multipliers (crate::friction).
-                dlambda = self.stick_newton_update(c, &w.res, h);
-            } else if let Some(c) = contact.as_deref_mut() {
-                // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (h²/2) ∇g(q₁)·δa = g(q₁)
-                // (∂q₁/∂a = h²/2), by the Schur complement with two solves of S.
-                self.delta.copy_from_slice(&c.g_bar);
-                self.solve_matrix();
-                c.s_inv_g.copy_from_slice(&self.delta);
-                self.delta.copy_from_slice(&w.res);
-                self.solve_matrix();
-                let half_h2 = 0.5 * h * h;
-                let cx = half_h2 * dot(&c.g_end, &self.delta);
-                let cy = half_h2 * dot(&c.g_end, &c.s_inv_g);
-                dlambda = (gap1 - gap_target - cx) / cy;
-                for i in 0..n {
-                    self.delta[i] += c.s_inv_g[i] * dlambda;
-                }
+            if let Some(c) = constraint.as_deref_mut() {
+                // Bordered Newton on (a, λ) (the constraint's Schur complement).
+                dlambda = c.newton_update(cx.newton, &w.res, h, gap1, gap_target);
             } else {
-                self.delta.copy_from_slice(&w.res);
-                self.solve_matrix();
+                cx.newton.delta.copy_from_slice(&w.res);
+                cx.newton.solve();
             }
-            let big = max_abs(&self.delta);
+            let big = max_abs(&cx.newton.delta);
             let dq = big * c.c_q;
             if !dq.is_finite() {
                 break;
@@ -550,15 +462,15 @@ impl Integrator {
             iterations = it + 1;
             // Absolute tolerance, floored at the round-off level of the update itself. The
             // state where the residual was evaluated is kept (the update is below tolerance).
-            let amax = max_abs(&self.qdd1);
-            let vmax = max_abs(&self.qd1);
-            let tol = self.newton_tol + 1e-13 * (c.c_q * amax + h * vmax);
+            let amax = max_abs(&st.qdd1);
+            let vmax = max_abs(&st.qd1);
+            let tol = cx.newton.tol + 1e-13 * (c.c_q * amax + h * vmax);
             // The energy balance of the step is off by exactly h v̄ᵀ(residual): demand it
             // small too, unless it has reached its round-off floor (no longer falls) or the
             // update is far below tolerance.
             let defect = (h * dot(&w.vbar, &w.res)).abs();
             let e_scale = scale0 + scale1 + dot(&w.minus_q, &w.dq).abs();
-            let on_surface = (gap1 - gap_target).abs() <= self.newton_tol;
+            let on_surface = (gap1 - gap_target).abs() <= cx.newton.tol;
             if dq <= tol
                 && on_surface
                 && (defect <= ENERGY_TOL * e_scale
@@ -593,7 +505,7 @@ impl Integrator {
                 continue;
             }
             if (it > 2 && dq > 10.0 * last && !(forced_now && formed_it == Some(it)))
-                || (robust && dq > self.length_scale)
+                || (robust && dq > cx.length_scale)
             {
                 // Diverging: give up early, the caller retries with a shorter step. (Not on
                 // the iteration of a refresh forced by a stalled stale matrix: its updates
@@ -607,22 +519,22 @@ impl Integrator {
             }
             last = dq;
             for i in 0..n {
-                self.qdd1[i] -= self.delta[i];
+                st.qdd1[i] -= cx.newton.delta[i];
             }
             lambda -= dlambda;
         }
-        if let Some(c) = contact.filter(|_| converged) {
-            c.step_lambda = lambda;
+        if let Some(c) = constraint.filter(|_| converged) {
+            c.set_multiplier(lambda);
         }
-        self.counters.rhs += passes;
+        cx.counters.rhs += passes;
         // See the module docs: the linear contraction makes > 3 iterations normal here.
-        self.slow_convergence = !converged || iterations > 8;
+        cx.newton.slow_convergence = !converged || iterations > 8;
         if !converged {
-            if self.adaptive.is_some() || h > 1e-6 * self.h_nominal {
+            if cx.adaptive.is_some() || h > 1e-6 * cx.h_nominal {
                 return Ok(Some(f64::INFINITY));
             }
             return Err(FemError::Runaway {
-                t: self.t,
+                t: st.t,
                 what: format!("Newton iteration did not converge (last update {last:.3e})"),
                 location: None,
                 why: "the step is too large for the nonlinearity or the solution diverged".into(),
@@ -631,10 +543,10 @@ impl Integrator {
         }
         // Works with the scheme's own quadrature: their sum is Δqᵀ Q(t_mid, q̄, v̄).
         let mut pending = Works::default();
-        let (_, p_kv) = self.chain.dissipation_power(t_mid, &w.vbar);
+        let (_, p_kv) = cx.chain.dissipation_power(t_mid, &w.vbar);
         pending.kelvin_voigt = p_kv * h;
-        for li in 0..self.chain.links.len() {
-            let j = &self.chain.links[li].joint;
+        for li in 0..cx.chain.links.len() {
+            let j = &cx.chain.links[li].joint;
             if j.dof == NONE {
                 continue;
             }
@@ -643,24 +555,33 @@ impl Integrator {
             pending.applied_torque += law * dth;
             pending.joint_damper += j.damping * w.vbar[j.dof] * dth;
             // The torque channel reports the law at the sample time.
-            self.chain.joint_torque[li] = j.applied(t_law);
+            cx.chain.joint_torque[li] = j.applied(t_law);
         }
-        if self.chain.tip_load != 0.0 || self.chain.distributed_load != 0.0 {
+        if cx.chain.tip_load != 0.0 || cx.chain.distributed_load != 0.0 {
             let total = -dot(&w.minus_q, &w.dq);
             pending.applied_load =
                 total - pending.applied_torque + pending.joint_damper + pending.kelvin_voigt;
         }
         w.pending = pending;
         // q̈ slot holds the mean acceleration ā (predictor and error estimate of the next step).
-        self.a1.copy_from_slice(&self.qdd1);
-        Ok(self.adaptive.map(|ad| {
+        st.a1.copy_from_slice(&st.qdd1);
+        Ok(cx.adaptive.map(|ad| {
             let ratio = 2.0 * h / (h + if w.have_prev { w.h_prev } else { 0.0 });
             let mut err = 0.0f64;
             for i in 0..n {
-                let e = h * h / 12.0 * (self.qdd1[i] - self.qdd[i]) * ratio;
-                err = err.max(e.abs() / (ad.atol + ad.rtol * self.q1[i].abs()));
+                let e = h * h / 12.0 * (st.qdd1[i] - st.qdd[i]) * ratio;
+                err = err.max(e.abs() / (ad.atol + ad.rtol * st.q1[i].abs()));
             }
             err
         }))
+    }
+
+    fn commit(&mut self, h: f64, works: &mut Works) -> bool {
+        self.work.commit(h, works);
+        true
+    }
+
+    fn restart(&mut self) {
+        self.work.restart();
     }
 }

@@ -9,7 +9,7 @@
 //!
 //! **Constrained phase** (multipliers, index 3 at the position level). The midpoint step gains
 //! the constraint force ∇̄g λ and the equation g(q₁) = 0 (bordered Newton on (a, λ) by the
-//! Schur complement, see [`crate::midpoint`]); ∇̄g is the Gonzalez discrete gradient of g in
+//! Schur complement, see [`crate::method::energy_midpoint`]); ∇̄g is the Gonzalez discrete gradient of g in
 //! the same metric M(q̄) as the potential, so Δqᵀ∇̄g = g(q₁) − g(q₀) = 0 and the constraint
 //! does no work: the ledger closes to the Newton tolerance in every phase. |g| at the step
 //! ends is at the Newton tolerance (1e-11·L; measured ≤ 1.4e-14 ft). G q̇ at the step ends is
@@ -66,7 +66,7 @@
 //! first-order equation), which does not damp a deviation from the balance (it flips sign every
 //! step) and leaves the end rate v₁ = 2v̄ − v₀ undetermined: in contact runs every step ends
 //! with ψ projected onto its balance (strain energy removed booked `numerical_massless`) and
-//! the rates made consistent ([`crate::massless`], measurements there).
+//! the rates made consistent ([`crate::events::massless`], measurements there).
 //! Without Kelvin–Voigt the rotations are algebraic (∂V/∂ψ = 0) and ψ̇ jumps with the massive
 //! velocities (condensation q̇ = C q̇_m): refused with `unsupported`.
 //! Operators M⁻¹ become (M + μNNᵀ)⁻¹ (μ the largest diagonal mass), exactly M⁻¹ on the
@@ -99,7 +99,7 @@
 //! keep λ(h) continuous in h so that the secant converges: the velocity is projected onto
 //! G q̇ = 0 after every constrained step (drift control; kinetic energy removed booked as
 //! `contact_projection`), and a shortened step removes only the share (h/h_nominal)² of the
-//! start gap (see [`crate::midpoint`]) instead of carrying g(q₀)/h² into the multiplier.
+//! start gap (see [`crate::method::energy_midpoint`]) instead of carrying g(q₀)/h² into the multiplier.
 //! Measured (`flexverify run … --backend fem`, 3 s, default step): `barhorst-case1`
 //! (8 elements) 31 releases, largest |λ| 9.2e-5 lbf = 3.2e-7·W (before the projected
 //! velocity: 81 releases, 4.3e-3 lbf = 1.5e-5·W at brackets of 1e-13·t);
@@ -148,8 +148,8 @@
 //! these switching times are not converged quantities; the contact episodes are.
 //!
 //! Bilateral contacts (circle or line wall, Coulomb friction, stick–slip) reuse the gap,
-//! gradient and bordered Newton of this module with the geometry of [`crate::wall`] and are
-//! driven by [`crate::friction`] (`Contact::bilateral`).
+//! gradient and bordered Newton of this module with the geometry of [`crate::events::wall`] and are
+//! driven by [`crate::events::friction`] (`Contact::bilateral`).
 //!
 //! Refused with `unsupported`: unilateral circle surfaces, friction on a unilateral contact,
 //! more than one contact, contact with prescribed joint motion, contact on Timoshenko links
@@ -164,8 +164,9 @@ use data::scene::{ContactMode, Surface};
 use crate::band::DenseLu;
 use crate::chain::{Chain, MAX_LINKS, Parts};
 use crate::error::FemError;
-use crate::integrator::Integrator;
-use crate::massless::Massless;
+use crate::events::massless::Massless;
+use crate::linalg::dot;
+use crate::method::{ConstraintView, NewtonSystem, StepConstraint};
 
 /// Gap tolerance of a located contact start, relative to the longest link.
 pub const GAP_TOL: f64 = 1e-10;
@@ -175,8 +176,6 @@ pub const FORCE_TOL: f64 = 1e-8;
 pub const TIME_TOL: f64 = 1e-13;
 /// Most contact events in a run.
 pub const MAX_EVENTS: usize = 20_000;
-/// Secant iterations at most per located event.
-const MAX_SECANT: usize = 80;
 /// Shortest step (relative to the nominal one) the stretch of an undetermined grazing contact
 /// is refined to (module docs).
 pub const REFINE_MIN: f64 = 1e-5;
@@ -198,9 +197,9 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
     let Some(c) = scene.contacts.first() else {
         return Ok(());
     };
-    // Bilateral contacts (line or circle, with or without friction): `crate::friction`.
+    // Bilateral contacts (line or circle, with or without friction): `crate::events::friction`.
     let bilateral = c.mode == ContactMode::Bilateral;
-    crate::friction::check(scene)?;
+    crate::events::friction::check(scene)?;
     if let (false, Surface::Circle { .. }) = (bilateral, &c.surface) {
         return Err(FemError::unsupported(format!(
             "fem: unilateral contact with a circular surface (scene `{}`) is not implemented; \
@@ -286,10 +285,10 @@ pub struct Contact {
     /// A located release not yet reported: it is reported once the free motion after it has
     /// been stepped, and withdrawn when the tip turns out not to leave the surface (module
     /// docs, "Grazing").
-    pending_release: Option<Event>,
+    pub(crate) pending_release: Option<Event>,
     /// Bilateral contact (circle or line wall, Coulomb friction, stick–slip): None for the
     /// unilateral line contact of this module.
-    pub bilateral: Option<Box<crate::friction::Bilateral>>,
+    pub bilateral: Option<Box<crate::events::friction::Bilateral>>,
     pub(crate) jac: Vec<f64>,
     /// ∇g(q̄), ∇̄g, ∇g(q₁) and S⁻¹∇̄g of the constrained Newton iteration.
     pub(crate) g_mid: Vec<f64>,
@@ -298,7 +297,7 @@ pub struct Contact {
     pub(crate) s_inv_g: Vec<f64>,
     mass: DenseLu,
     /// Exactly massless directions N (Timoshenko sections without rotary inertia, see
-    /// [`crate::massless`]; None otherwise).
+    /// [`crate::events::massless`]; None otherwise).
     pub(crate) massless: Option<Massless>,
     /// All massless directions of [`Chain::massless_directions`] (the exact ones and the
     /// frame directions of mass O(s²)): the regularization M + μ N Nᵀ, by DOF.
@@ -327,7 +326,7 @@ impl Contact {
             .iter()
             .position(|l| l.name == c.link)
             .unwrap_or(0);
-        let bilateral = crate::friction::Bilateral::from_scene(c, chain.ndof)?;
+        let bilateral = crate::events::friction::Bilateral::from_scene(c, chain.ndof)?;
         let (point, normal) = match c.surface {
             Surface::Line { point, normal } => (point, normal),
             // The circle's normal depends on the tip position: `bilateral.wall` has it.
@@ -418,7 +417,7 @@ impl Contact {
     pub fn gradient(&mut self, chain: &Chain, t: f64, q: &[f64], out: &mut [f64]) -> f64 {
         let n = chain.ndof;
         let r = chain.tip_jacobian(t, self.link, q, &mut self.jac);
-        // A circle's normal is that at the tip (crate::wall); a line's is fixed.
+        // A circle's normal is that at the tip (crate::events::wall); a line's is fixed.
         let normal = match self.bilateral.as_deref() {
             Some(b) => b.wall.frame(r).normal,
             None => self.normal,
@@ -621,7 +620,7 @@ impl Contact {
     /// Plastic projection of the velocity onto G q̇ = 0 (q̇ ← q̇ − M⁻¹Gᵀ(G q̇)/(G M⁻¹Gᵀ)),
     /// only when `inward_only` is false or G q̇ < 0; returns the kinetic energy it removes,
     /// ½(G q̇)²/(G M⁻¹Gᵀ) ≥ 0. Records the gap and the drift G q̇ before the projection.
-    fn project(
+    pub(crate) fn project(
         &mut self,
         chain: &mut Chain,
         t: f64,
@@ -658,413 +657,87 @@ impl Contact {
         }
     }
 
-    fn push(&mut self, e: Event) {
+    pub(crate) fn push(&mut self, e: Event) {
         self.n_events += 1;
         self.events.push(e);
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// What happens after the (possibly shortened) step is accepted.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Post {
-    None,
-    /// The gap reached zero at the step end: contact start and impact.
-    Impact {
-        time_tolerance: f64,
-    },
-    /// The normal force reached zero at the step end.
-    Release {
-        time_tolerance: f64,
-    },
-    /// The contact phase over the step is not determined at this step length (module docs,
-    /// "Grazing"): retry the stretch with a quarter step.
-    Refine,
-}
-
-/// Which event function a trial step is measured by.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Watch {
-    Gap,
-    Force,
-}
-
-/// Outcome of [`Integrator::illinois_on_step`]: the step length h reached (the bracket end
-/// b ≥ root, or an accepted trial), the width of the bracket that holds the root, whether the
-/// event function met its tolerance at h (`exact`, trial solved) and whether the last solved
-/// trial is h.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Located {
-    pub h: f64,
-    pub width: f64,
-    pub exact: bool,
-    pub solved: bool,
-}
-
-impl Integrator {
-    fn contact_mut(&mut self) -> &mut Contact {
-        self.contact
-            .as_deref_mut()
-            .expect("contact integrator without a contact")
+/// The contact held in a constrained phase, as the method sees it: the force ∇̄g λ with ∇̄g
+/// the Gonzalez discrete gradient of the gap (metric W = M(q̄), as for the potential, so
+/// Δqᵀ∇̄g = g(q₁) − g(q₀) and the constraint does no work), friction and the stick constraint
+/// of a bilateral wall ([`crate::events::friction`]), and the bordered Newton update.
+impl StepConstraint for Contact {
+    fn value(&self, chain: &Chain, t: f64, q: &[f64]) -> f64 {
+        self.gap_at(chain, t, q)
     }
 
-    /// Event function at the end of the trial step just solved (q₁, q̇₁ at t₁).
-    fn event_value(&mut self, watch: Watch, t1: f64) -> Result<f64, FemError> {
-        let Some(mut c) = self.contact.take() else {
-            return Ok(0.0);
-        };
-        let out = match watch {
-            Watch::Gap => Ok(c.gap_at(&self.chain, t1, &self.q1)),
-            Watch::Force => {
-                c.state_force(&mut self.chain, t1, &self.q1, &self.qd1)
-                    .map(|(l, _, passes)| {
-                        self.counters.rhs += passes;
-                        c.lambda = l;
-                        l
-                    })
-            }
-        };
-        self.contact = Some(c);
-        out
+    fn multiplier(&self) -> f64 {
+        self.step_lambda
     }
 
-    /// Solves the step of length h from the current state (phase as set) and returns the event
-    /// function at its end; a Newton failure is an error here (the full step converged).
-    fn trial(&mut self, watch: Watch, h: f64) -> Result<f64, FemError> {
-        let t1 = self.t + h;
-        match self.midpoint_step(h, t1, t1)? {
-            Some(e) if e.is_infinite() => Err(FemError::Runaway {
-                t: self.t,
-                what: format!("Newton failed on a shortened step (h = {h:.3e}) locating an event"),
-                location: Some("contact1".into()),
-                why: "the event-location step did not converge".into(),
-                remedy: "reduce --dt".into(),
-            }),
-            _ => self.event_value(watch, t1),
-        }
+    fn set_multiplier(&mut self, lambda: f64) {
+        self.step_lambda = lambda;
     }
 
-    /// Illinois secant on the step length for the root of an event function F(h), each value a
-    /// re-solved shortened step (`trial`): F(a) = fa > 0, F(b) = fb ≤ 0, F decreasing through
-    /// the root. Stops at a trial with −tol ≤ F ≤ 0 (or 0 < F ≤ tol when `accept_positive`),
-    /// which is left solved (`Located::exact`), or when the bracket is narrower than
-    /// [`TIME_TOL`]·max(t, 1); `b_solved` says whether the last trial solved is b (true on
-    /// entry if F(b) was the last evaluation). A trial whose Newton iteration fails is replaced
-    /// by other points of the bracket (its midpoint, then its quarter points).
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn illinois_on_step(
-        &mut self,
-        (mut a, mut fa): (f64, f64),
-        (mut b, mut fb): (f64, f64),
-        tol: f64,
-        accept_positive: bool,
-        mut b_solved: bool,
-        mut trial: impl FnMut(&mut Self, f64) -> Result<f64, FemError>,
-    ) -> Result<Located, FemError> {
-        let mut side = 0i32;
-        for _ in 0..MAX_SECANT {
-            if b - a <= TIME_TOL * self.t.abs().max(1.0) {
-                break;
-            }
-            let margin = 1e-6 * (b - a);
-            let mut c = b - fb * (b - a) / (fb - fa);
-            if !c.is_finite() {
-                c = 0.5 * (a + b);
-            }
-            c = c.clamp(a + margin, b - margin);
-            let mut fc = trial(self, c);
-            for frac in [0.5, 0.75, 0.25, 0.9] {
-                if fc.is_ok() {
-                    break;
-                }
-                c = a + frac * (b - a);
-                fc = trial(self, c);
-            }
-            let fc = fc?;
-            if fc <= 0.0 {
-                b = c;
-                fb = fc;
-                b_solved = true;
-                if fc >= -tol {
-                    return Ok(Located {
-                        h: b,
-                        width: b - a,
-                        exact: true,
-                        solved: true,
-                    });
-                }
-                if side == -1 {
-                    fa *= 0.5;
-                }
-                side = -1;
-            } else {
-                if accept_positive && fc <= tol {
-                    // The root lies in [c, b].
-                    return Ok(Located {
-                        h: c,
-                        width: b - c,
-                        exact: true,
-                        solved: true,
-                    });
-                }
-                a = c;
-                fa = fc;
-                b_solved = false;
-                if side == 1 {
-                    fb *= 0.5;
-                }
-                side = 1;
-            }
-        }
-        Ok(Located {
-            h: b,
-            width: b - a,
-            exact: false,
-            solved: b_solved,
-        })
-    }
-
-    /// Locates the root of a unilateral event function (gap or normal force) inside the step
-    /// [a0, h] (F(a0) = f0 > 0, F(h) = f1 ≤ 0): to |F| ≤ tol (either side for the gap, the
-    /// non-positive side for the force) or a bracket narrower than [`TIME_TOL`]. Leaves the
-    /// accepted trial solved in q₁, q̇₁ and returns (h*, bracket width).
-    fn locate(
-        &mut self,
-        watch: Watch,
-        a0: f64,
-        h: f64,
-        f0: f64,
-        f1: f64,
-        tol: f64,
-    ) -> Result<(f64, f64), FemError> {
-        let loc =
-            self.illinois_on_step((a0, f0), (h, f1), tol, watch == Watch::Gap, true, |s, c| {
-                s.trial(watch, c)
-            })?;
-        let (width, mut b) = (loc.width, loc.h);
-        if loc.exact {
-            return Ok((b, width));
-        }
-        if !loc.solved {
-            let mut fb = self.trial(watch, b)?;
-            // The re-solved bracket end can land on the other side by the Newton noise of the
-            // event function: widen towards the full step, where F(h) ≤ 0 was measured, until
-            // it does not.
-            let mut k = 0;
-            while fb > 0.0 && b < h && k < 20 {
-                b = (b + width * 4f64.powi(k)).min(h);
-                fb = self.trial(watch, b)?;
-                k += 1;
-            }
-            return Ok((b, b - (loc.h - width)));
-        }
-        Ok((b, width))
-    }
-
-    /// Event handling after a converged trial step of length h (state in q₁, q̇₁): returns the
-    /// step length to accept (the trial for it solved) and what to do after accepting it.
-    pub(crate) fn contact_after_trial(&mut self, h: f64) -> Result<(f64, Post), FemError> {
-        if self.contact_mut().bilateral.is_some() {
-            return self.bilateral_after_trial(h);
-        }
-        let (t0, t1) = (self.t, self.t + h);
-        let c = self.contact_mut();
-        if c.n_events >= MAX_EVENTS {
-            return Err(FemError::Runaway {
-                t: t0,
-                what: format!("{} contact events", c.n_events),
-                location: Some("contact1".into()),
-                why: "impacts and releases accumulate (Zeno-like)".into(),
-                remedy: "shorten t_end or add damping".into(),
-            });
-        }
-        let tol_g = c.gap_tol;
-        let constrained = c.constrained;
-        let refine_min = REFINE_MIN * self.h_nominal;
-        if !constrained {
-            let g0 = self.contact_mut().gap;
-            let g1 = self.event_value(Watch::Gap, t1)?;
-            if g1 >= -tol_g {
-                self.contact_mut().flush_pending();
-                return Ok((h, Post::None));
-            }
-            if g0 > tol_g {
-                self.contact_mut().flush_pending();
-                let (hs, width) = self.locate(Watch::Gap, 0.0, h, g0, g1, tol_g)?;
-                return Ok((
-                    hs,
-                    Post::Impact {
-                        time_tolerance: width,
-                    },
-                ));
-            }
-            // Grazing: the step starts on the surface and ends below it, with no flight above
-            // the gap tolerance at its end. Shorter steps first (the flight after a release,
-            // or the return to the surface, is then resolved); at the shortest step the tip
-            // does not leave the surface: a release just located there is withdrawn, else the
-            // contact starts at the step start (module docs).
-            if h > refine_min {
-                return Ok((h, Post::Refine));
-            }
-            let mut c = self.contact.take().expect("contact");
-            if c.pending_release.take().is_none() {
-                c.push(Event::ContactStart {
-                    t: t0,
-                    contact: 1,
-                    time_tolerance: 0.0,
-                });
-            }
-            let res = c.impact(&mut self.chain, t0, &self.q, &mut self.qd);
-            let res = res.and_then(|e| {
-                if let Some(e) = e {
-                    c.push(e);
-                }
-                c.state_force(&mut self.chain, t0, &self.q, &self.qd)
-            });
-            c.constrained = true;
-            if let Ok((l, _, _)) = res {
-                c.lambda = l;
-                c.step_lambda = l.max(0.0);
-            }
-            self.contact = Some(c);
-            res?;
-            if let Some(w) = self.midpoint.as_mut() {
-                w.restart();
-            }
-            match self.midpoint_step(h, t1, t1)? {
-                Some(e) if e.is_infinite() => {
-                    return Err(FemError::Runaway {
-                        t: t0,
-                        what: "Newton failed on the constrained step of a grazing contact".into(),
-                        location: Some("contact1".into()),
-                        why: "the constrained step did not converge".into(),
-                        remedy: "reduce --dt".into(),
-                    });
-                }
-                _ => {}
-            }
-        }
-        // Constrained: the normal force at the step end decides.
-        let lam0 = self.contact_mut().lambda;
-        let lam1 = self.event_value(Watch::Force, t1)?;
-        if lam1 > 0.0 {
-            return Ok((h, Post::None));
-        }
-        let tol_f = self.contact_mut().force_tol;
-        if lam0 > 0.0 {
-            let (hs, width) = self.locate(Watch::Force, 0.0, h, lam0, lam1, tol_f)?;
-            return Ok((
-                hs,
-                Post::Release {
-                    time_tolerance: width,
-                },
-            ));
-        }
-        // A constrained phase whose start force is not positive (grazing): the force does not
-        // cross zero inside the step. Shorter steps first; at the shortest step the tip is
-        // released at its end, the force there reported (module docs).
-        if h > refine_min {
-            return Ok((h, Post::Refine));
-        }
-        let c = self.contact_mut();
-        if -lam1 > GRAZING_FORCE_LIMIT * c.force_tol / FORCE_TOL {
-            // Far from zero: the free motion and the normal force contradict each other at the
-            // shortest step (module docs, "Grazing"): stop rather than release there.
-            return Err(FemError::Runaway {
-                t: t0,
-                what: format!(
-                    "grazing contact undetermined down to the shortest step ({h:.1e} s): the \
-                     free motion enters the surface while the normal force is {lam1:.3e}"
-                ),
-                location: Some(GRAZING_LOCATION.into()),
-                why: "the normal force of the constrained dynamics (without the almost \
-                      massless frame modes of Timoshenko links without rotary inertia on free \
-                      joints without hub inertia) contradicts the stepped free motion, which \
-                      carries them"
-                    .into(),
-                remedy: "refine the mesh (≥ 8 elements per link) or switch on rotary inertia"
-                    .into(),
-            });
-        }
-        Ok((h, Post::Release { time_tolerance: h }))
-    }
-
-    /// Records the drift of an accepted constrained step and applies the located event at the
-    /// new state.
-    pub(crate) fn contact_after_accept(&mut self, post: Post) -> Result<(), FemError> {
-        if self.contact_mut().bilateral.is_some() {
-            return self.bilateral_after_accept();
-        }
-        let t = self.t;
-        let Some(mut c) = self.contact.take() else {
-            return Ok(());
-        };
-        let out = self.apply_post(&mut c, t, post);
-        self.contact = Some(c);
-        out
-    }
-
-    fn apply_post(&mut self, c: &mut Contact, t: f64, post: Post) -> Result<(), FemError> {
-        if c.constrained {
-            // Drift of the step end (gap and G q̇ of the state-force evaluation there); at a
-            // release the velocity is projected onto G q̇ = 0 if the tip moves inward (module
-            // docs).
-            c.drift_velocity = c.normal_velocity;
-            c.max_gap = c.max_gap.max(c.gap.abs());
-            c.max_normal_velocity = c.max_normal_velocity.max(c.drift_velocity.abs());
-            if matches!(post, Post::Release { .. } | Post::None) {
-                // Drift control: G q̇ = 0 at the start of every constrained step, so that the
-                // state force of a shortened step (the release event function) is continuous
-                // in h and the step multiplier stays finite as h → 0.
-                let inward_only = post != Post::None;
-                let loss = c.project(&mut self.chain, t, &self.q, &mut self.qd, inward_only)?;
-                self.counters.rhs += self.chain.ndof + 1;
-                c.projection_loss += loss;
-            }
+    fn add_force(&mut self, chain: &Chain, v: &ConstraintView<'_>, res: &mut [f64]) -> f64 {
+        let c = self;
+        let n = res.len();
+        let [_, t_mid, t1] = v.t;
+        let (lambda, denom, g0) = (v.lambda, v.denom, v.g0);
+        // Constraint force ∇̄g λ with ∇̄g the discrete gradient of the gap in the same
+        // metric: Δqᵀ∇̄g = g(q₁) − g(q₀), so the constraint does no work.
+        let mut g_mid = std::mem::take(&mut c.g_mid);
+        let mut g_end = std::mem::take(&mut c.g_end);
+        c.gradient(chain, t_mid, v.qbar, &mut g_mid);
+        let gap1 = c.gradient(chain, t1, v.q1, &mut g_end);
+        let gd = dot(&g_mid, v.dq);
+        let corr_g = if denom > 0.0 {
+            (gap1 - g0 - gd) / denom
         } else {
-            c.gap = c.gap_at(&self.chain, t, &self.q);
+            0.0
+        };
+        for i in 0..n {
+            c.g_bar[i] = g_mid[i] + corr_g * v.w_dq[i];
+            res[i] -= lambda * c.g_bar[i];
         }
-        match post {
-            Post::None => return Ok(()),
-            Post::Refine => return Ok(()),
-            Post::Release { time_tolerance } => {
-                c.flush_pending();
-                c.pending_release = Some(Event::Release {
-                    t,
-                    contact: 1,
-                    normal_force: c.lambda,
-                    time_tolerance,
-                });
-                c.constrained = false;
-                c.lambda = 0.0;
-                c.step_lambda = 0.0;
-            }
-            Post::Impact { time_tolerance } => {
-                c.push(Event::ContactStart {
-                    t,
-                    contact: 1,
-                    time_tolerance,
-                });
-                if let Some(e) = c.impact(&mut self.chain, t, &self.q, &mut self.qd)? {
-                    c.push(e);
-                }
-                let (l, _, passes) = c.state_force(&mut self.chain, t, &self.q, &self.qd)?;
-                self.counters.rhs += passes;
-                if l > 0.0 {
-                    c.constrained = true;
-                    c.lambda = l;
-                    c.step_lambda = l;
-                } else {
-                    c.lambda = 0.0;
-                }
-            }
+        c.g_mid = g_mid;
+        c.g_end = g_end;
+        if c.bilateral.is_some() {
+            // Friction (sliding) or the tangential stick constraint: crate::events::friction.
+            return crate::events::friction::midpoint_terms(c, chain, v, gap1, res);
         }
-        if let Some(w) = self.midpoint.as_mut() {
-            w.restart();
+        gap1
+    }
+
+    fn newton_update(
+        &mut self,
+        newton: &mut NewtonSystem,
+        res: &[f64],
+        h: f64,
+        gap1: f64,
+        gap_target: f64,
+    ) -> f64 {
+        let c = self;
+        if crate::events::friction::sticking(c) {
+            // Sticking friction contact: two multipliers (crate::events::friction).
+            return crate::events::friction::stick_newton_update(newton, c, res, h);
         }
-        Ok(())
+        let n = res.len();
+        // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (h²/2) ∇g(q₁)·δa = g(q₁)
+        // (∂q₁/∂a = h²/2), by the Schur complement with two solves of S.
+        newton.delta.copy_from_slice(&c.g_bar);
+        newton.solve();
+        c.s_inv_g.copy_from_slice(&newton.delta);
+        newton.delta.copy_from_slice(res);
+        newton.solve();
+        let half_h2 = 0.5 * h * h;
+        let cx = half_h2 * dot(&c.g_end, &newton.delta);
+        let cy = half_h2 * dot(&c.g_end, &c.s_inv_g);
+        let dlambda = (gap1 - gap_target - cx) / cy;
+        for i in 0..n {
+            newton.delta[i] += c.s_inv_g[i] * dlambda;
+        }
+        dlambda
     }
 }

@@ -1,0 +1,206 @@
+//! Time-integration methods: one type per method behind the [`Stepper`] trait.
+//!
+//! A method advances R(q, q̇, q̈, t) = 0 ([`crate::chain::Chain::residual`]) over one step of
+//! length h from the state at the step start to a trial end ([`StepState`]); the driver
+//! ([`crate::driver`]) chooses h, accepts or rejects the trial, books the works and handles
+//! events. A method never names a scene family or a contact: a bilateral constraint (a tip
+//! held on a surface) reaches it only through [`StepConstraint`], which adds the constraint
+//! force and the bordered Newton update to the method's own iteration.
+//!
+//! * [`generalized_alpha`]: implicit generalized-α (Chung–Hulbert, Arnold–Brüls form),
+//!   fixed or adaptive steps;
+//! * [`central_difference`]: explicit central difference (velocity-Verlet form) under its
+//!   stability bound 2/ω_max;
+//! * [`energy_midpoint`]: the energy-consistent midpoint (discrete-gradient) scheme, the only
+//!   one that accepts a [`StepConstraint`];
+//! * [`implicit_midpoint`]: the implicit midpoint rule (one-stage Gauss), fixed or adaptive
+//!   steps.
+//!
+//! Shared machinery: the Newton matrix S = c_a M + c_v C + c_q K and its solver
+//! ([`newton`]) and the consistent acceleration of a (re)start ([`start`]).
+//!
+//! Adding a method: one new file here implementing [`Stepper`], one `match` line in
+//! [`stepper`] (and the name in [`crate::settings`]).
+
+pub mod central_difference;
+pub mod energy_midpoint;
+pub mod generalized_alpha;
+pub mod implicit_midpoint;
+pub mod newton;
+pub mod start;
+
+pub use newton::{JacobianKind, NewtonSystem};
+
+use crate::chain::Chain;
+use crate::error::FemError;
+use crate::settings::Method;
+
+/// Work counters.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Counters {
+    pub steps: usize,
+    pub rejected: usize,
+    pub rhs: usize,
+    pub jacobians: usize,
+    pub factorizations: usize,
+    pub newton: usize,
+}
+
+/// Running energy-ledger integrals (cumulative works).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Works {
+    pub applied_torque: f64,
+    pub applied_load: f64,
+    pub prescribed_motion: f64,
+    pub joint_damper: f64,
+    pub kelvin_voigt: f64,
+    /// Strain energy removed by projecting the massless section rotations onto their balance
+    /// (`crate::events::massless`, ledger `numerical_massless`).
+    pub numerical_massless: f64,
+}
+
+/// Adaptive step control.
+#[derive(Debug, Clone, Copy)]
+pub struct Adaptive {
+    pub rtol: f64,
+    pub atol: f64,
+}
+
+/// The state at the step start (t, q, q̇, q̈ and the generalized-α pseudo-acceleration a)
+/// and the trial end of the step being solved (q₁, q̇₁, q̈₁, a₁).
+#[derive(Debug, Clone)]
+pub struct StepState {
+    pub t: f64,
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+    pub a: Vec<f64>,
+    pub q1: Vec<f64>,
+    pub qd1: Vec<f64>,
+    pub qdd1: Vec<f64>,
+    pub a1: Vec<f64>,
+}
+
+impl StepState {
+    /// All zero at t = 0 for `n` DOFs.
+    pub fn new(n: usize) -> Self {
+        StepState {
+            t: 0.0,
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+            a: vec![0.0; n],
+            q1: vec![0.0; n],
+            qd1: vec![0.0; n],
+            qdd1: vec![0.0; n],
+            a1: vec![0.0; n],
+        }
+    }
+
+    /// Makes the trial end the current state at t₁.
+    pub fn swap_in(&mut self, t1: f64) {
+        std::mem::swap(&mut self.q, &mut self.q1);
+        std::mem::swap(&mut self.qd, &mut self.qd1);
+        std::mem::swap(&mut self.qdd, &mut self.qdd1);
+        std::mem::swap(&mut self.a, &mut self.a1);
+        self.t = t1;
+    }
+}
+
+/// What a method works on during one step: the model, the state, the Newton system and the
+/// counters, plus the driver's step settings.
+pub struct StepContext<'a> {
+    pub chain: &'a mut Chain,
+    pub state: &'a mut StepState,
+    pub newton: &'a mut NewtonSystem,
+    pub counters: &'a mut Counters,
+    pub adaptive: Option<Adaptive>,
+    /// The fixed step (shortened steps are measured against it).
+    pub h_nominal: f64,
+    /// Largest link length (scales tolerances).
+    pub length_scale: f64,
+}
+
+/// One Newton iterate of a step, as a constraint sees it.
+pub struct ConstraintView<'a> {
+    /// Newton iteration index within the step.
+    pub it: usize,
+    /// t₀, t_mid, t₁.
+    pub t: [f64; 3],
+    pub q0: &'a [f64],
+    pub q1: &'a [f64],
+    pub qbar: &'a [f64],
+    pub dq: &'a [f64],
+    /// W Δq = M(q̄)Δq and ΔqᵀWΔq (the metric of the discrete gradients).
+    pub w_dq: &'a [f64],
+    pub denom: f64,
+    /// Constraint value at the step start, g(q₀).
+    pub g0: f64,
+    /// Normal multiplier of this iterate.
+    pub lambda: f64,
+}
+
+/// A bilateral constraint held during a step (a tip on a surface, optionally with friction),
+/// seen by a method through its force and its Newton border only.
+pub trait StepConstraint {
+    /// Constraint value g(q) at (t, q).
+    fn value(&self, chain: &Chain, t: f64, q: &[f64]) -> f64;
+    /// The multiplier the step starts from (the last accepted step's).
+    fn multiplier(&self) -> f64;
+    /// Stores the multiplier of a converged step.
+    fn set_multiplier(&mut self, lambda: f64);
+    /// Subtracts the constraint force (and friction) of the iterate from the momentum
+    /// residual `res`; returns the constraint value Newton must drive to its target.
+    fn add_force(&mut self, chain: &Chain, view: &ConstraintView<'_>, res: &mut [f64]) -> f64;
+    /// Bordered Newton update: leaves δa in `newton.delta` (from the residual `res`, the
+    /// Newton matrix factorized in `newton`) and returns δλ; `gap1` is the value returned by
+    /// [`StepConstraint::add_force`], `gap_target` what it must reach; ∂q₁/∂a = h²/2.
+    fn newton_update(
+        &mut self,
+        newton: &mut NewtonSystem,
+        res: &[f64],
+        h: f64,
+        gap1: f64,
+        gap_target: f64,
+    ) -> f64;
+}
+
+/// One integration method.
+pub trait Stepper: std::fmt::Debug {
+    /// Solves the step t₀ → t₁ = t₀ + h from `cx.state` into its trial end (laws evaluated at
+    /// `t_law`, = t₁ except as a left limit at a discontinuity). Returns the scaled local error
+    /// estimate when adaptive, `Some(∞)` when Newton failed (the driver retries shorter).
+    /// `constraint`: a held bilateral constraint (methods without that support refuse it).
+    fn step(
+        &mut self,
+        cx: &mut StepContext<'_>,
+        constraint: Option<&mut dyn StepConstraint>,
+        h: f64,
+        t1: f64,
+        t_law: f64,
+    ) -> Result<Option<f64>, FemError>;
+
+    /// Whether every stretch between stop times must be split into equal steps.
+    fn equal_steps(&self) -> bool {
+        false
+    }
+
+    /// Books the accepted step's works with the method's own quadrature; false when the
+    /// driver books them (trapezoidal rule on the joint quantities).
+    fn commit(&mut self, _h: f64, _works: &mut Works) -> bool {
+        false
+    }
+
+    /// Forgets the previous step (restart after a discontinuity or an event).
+    fn restart(&mut self) {}
+}
+
+/// The stepper of a method, for `n` DOFs (`rho_inf`: generalized-α spectral radius).
+pub fn stepper(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper> {
+    match method {
+        Method::GeneralizedAlpha => Box::new(generalized_alpha::GeneralizedAlpha::new(rho_inf)),
+        Method::CentralDifference => Box::new(central_difference::CentralDifference),
+        Method::EnergyMidpoint => Box::new(energy_midpoint::EnergyMidpoint::new(n)),
+        Method::ImplicitMidpoint => Box::new(implicit_midpoint::ImplicitMidpoint),
+    }
+}
