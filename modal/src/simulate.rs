@@ -10,7 +10,10 @@ use data::{
 
 use crate::contact::{ContactState, locate_crossing};
 use crate::error::ModalError;
-use crate::integrate::{Dopri5, IntegrateError, OdeRhs, Sdirk, StepStats, Tolerances};
+use crate::integrate::{
+    Build, DOPRI5, METHODS, MethodInfo, OdeRhs, TRBDF2_FIXED, Tolerances, method_named,
+    method_names,
+};
 use crate::model::Chain;
 use crate::model::integrals::dot;
 use crate::newton::ChainNewton;
@@ -27,45 +30,31 @@ pub const DEFAULT_ATOL: f64 = 1e-10;
 /// 11 000 steps at 1e-8 / 1e-10).
 pub const FIXED_STEP_NEWTON_TOL: (f64, f64) = (1e-6, 1e-8);
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// Adaptive Dormand–Prince 5(4).
-    Dopri5,
-    /// Adaptive TR-BDF2.
-    Trbdf2,
-    /// TR-BDF2 with a fixed step (`dt`, or [`default_step`]).
-    Trbdf2Fixed,
-    /// The trapezoidal rule with a fixed step (`dt`, or [`default_step`]).
-    Trapezoid,
-}
+/// An integration method of the registry ([`crate::integrate::METHODS`]).
+pub type Method = &'static MethodInfo;
 
-impl Method {
-    pub fn parse(name: Option<&str>) -> Result<Self, ModalError> {
-        match name {
-            None | Some("dopri5") => Ok(Method::Dopri5),
-            Some("trbdf2") | Some("sdirk") | Some("tr-bdf2") => Ok(Method::Trbdf2),
-            Some("trbdf2-fixed") => Ok(Method::Trbdf2Fixed),
-            Some("trapezoid") => Ok(Method::Trapezoid),
-            Some(other) => Err(ModalError::invalid(
-                "time.method",
-                format!(
-                    "`{other}`: the modal backend offers `dopri5`, `trbdf2` (alias `sdirk`) \
-                     `trbdf2-fixed` and `trapezoid`"
-                ),
-            )),
-        }
-    }
+/// The registered method called `name` (None: the default, Dormand–Prince).
+pub fn parse_method(name: Option<&str>) -> Result<Method, ModalError> {
+    let Some(name) = name else {
+        return Ok(METHODS[0]);
+    };
+    method_named(name).ok_or_else(|| {
+        ModalError::invalid(
+            "time.method",
+            format!("`{name}`: the modal backend offers {}", method_names()),
+        )
+    })
 }
 
 /// The method of a run: the one named in the settings, else the default ([`default_method`]).
 pub fn method_choice(scene: &Scene, settings: &Settings) -> Result<Method, ModalError> {
     match settings.time.method.as_deref() {
-        Some(name) => Method::parse(Some(name)),
+        Some(name) => parse_method(Some(name)),
         None => Ok(default_method(scene, settings)),
     }
 }
 
-/// The default method: fixed-step TR-BDF2 ([`Method::Trbdf2Fixed`], step [`default_step`]) for
+/// The default method: fixed-step TR-BDF2 ([`TRBDF2_FIXED`](crate::integrate::TRBDF2_FIXED), step [`default_step`]) for
 /// a chain without contact whose every link carries Kelvin–Voigt damping, when no tolerance is
 /// given; otherwise Dormand–Prince.
 ///
@@ -89,9 +78,9 @@ pub fn default_method(scene: &Scene, settings: &Settings) -> Method {
         .iter()
         .all(|l| l.kelvin_voigt.is_some_and(|g| g > 0.0));
     if tolerance_given || !scene.contacts.is_empty() || !all_damped {
-        Method::Dopri5
+        &DOPRI5
     } else {
-        Method::Trbdf2Fixed
+        &TRBDF2_FIXED
     }
 }
 
@@ -592,54 +581,6 @@ impl OdeRhs for ChainRhs {
     }
 }
 
-enum Stepper {
-    Explicit(Dopri5),
-    Implicit(Sdirk),
-}
-
-impl Stepper {
-    fn step(
-        &mut self,
-        f: &mut ChainRhs,
-        t: &mut f64,
-        y: &mut [f64],
-        stop: f64,
-    ) -> Result<(), IntegrateError> {
-        match self {
-            Stepper::Explicit(s) => s.step(f, t, y, stop),
-            Stepper::Implicit(s) => s.step(f, t, y, stop),
-        }
-    }
-    fn dense(&self, t: f64, out: &mut [f64]) {
-        match self {
-            Stepper::Explicit(s) => s.dense(t, out),
-            Stepper::Implicit(s) => s.dense(t, out),
-        }
-    }
-    fn stats(&self) -> StepStats {
-        match self {
-            Stepper::Explicit(s) => *s.stats(),
-            Stepper::Implicit(s) => *s.stats(),
-        }
-    }
-    fn reset(&mut self) {
-        match self {
-            Stepper::Explicit(s) => s.reset(),
-            Stepper::Implicit(s) => s.reset(),
-        }
-    }
-    /// After the drift projection of a constrained step: the right-hand side is unchanged, the
-    /// state moved by the (small) projection. Dopri5 restarts as after a discontinuity; TR-BDF2
-    /// keeps its Jacobian and factorization (they were thrown away after every constrained
-    /// step before, one Jacobian per step).
-    fn projected(&mut self) {
-        match self {
-            Stepper::Explicit(s) => s.reset(),
-            Stepper::Implicit(s) => s.state_changed(),
-        }
-    }
-}
-
 /// Output layout: channel names and the energy ledger names the scene needs.
 struct Output {
     obs: Observables,
@@ -909,7 +850,7 @@ pub fn simulate_detailed(
     let wall = Instant::now();
     let chain = build_chain(scene, &settings.discretization)?;
     let method = method_choice(scene, settings)?;
-    let fixed_step = matches!(method, Method::Trbdf2Fixed | Method::Trapezoid);
+    let fixed_step = method.is_fixed_step();
     let (rtol_default, atol_default) = if fixed_step {
         FIXED_STEP_NEWTON_TOL
     } else {
@@ -947,17 +888,13 @@ pub fn simulate_detailed(
     let mut y = rhs.initial_state();
     let dim = y.len();
     let tol = Tolerances { rtol, atol };
-    let mut stepper = match method {
-        Method::Dopri5 => Stepper::Explicit(Dopri5::new(dim, tol, settings.time.dt, None)),
-        Method::Trbdf2 => Stepper::Implicit(Sdirk::new(dim, tol, settings.time.dt, None)),
-        Method::Trbdf2Fixed => {
-            let h = settings.time.dt.unwrap_or_else(|| default_step(scene));
-            Stepper::Implicit(Sdirk::fixed_step(dim, tol, h))
-        }
-        Method::Trapezoid => {
-            let h = settings.time.dt.unwrap_or_else(|| default_step(scene));
-            Stepper::Implicit(Sdirk::trapezoidal(dim, tol, h))
-        }
+    let mut stepper = match method.build {
+        Build::Adaptive(build) => build(dim, tol, settings.time.dt),
+        Build::Fixed(build) => build(
+            dim,
+            tol,
+            settings.time.dt.unwrap_or_else(|| default_step(scene)),
+        ),
     };
     let mut out = Output::new(&rhs, scene, n_out);
 
@@ -1093,7 +1030,7 @@ pub fn simulate_detailed(
                     verdict = stopped(&rhs, t, "mass matrix lost positive definiteness", None);
                     break 'outer;
                 }
-                stepper.projected();
+                stepper.state_changed();
             }
             if rhs.contact.is_some() {
                 if !rhs.solve_counted(t, &y) {
