@@ -42,7 +42,7 @@
 //!
 //! Contact (Barhorst's work surface, [`contact`]): the gap g = n̂·(r_tip − p₀) is an event
 //! function located by Illinois root finding on the integrator's dense output (bracket
-//! ≤ [`simulate::EVENT_TIME_TOLERANCE`]); impact is the plastic generalized impulse–momentum
+//! ≤ [`events::EVENT_TIME_TOLERANCE`]); impact is the plastic generalized impulse–momentum
 //! jump M(q̇⁺ − q̇⁻) = GᵀΛ, G q̇⁺ = 0 (G = n̂ᵀJ_tip); while the normal force pushes, the tip
 //! slides on the surface with a Lagrange multiplier (M q̈ = f + Gᵀλ, G q̈ = −Ġq̇, index 1) and
 //! projection of q, q̇ back onto g = 0, G q̇ = 0 after every step; release is the located zero
@@ -65,10 +65,13 @@ pub mod backend;
 pub mod basis;
 pub mod contact;
 pub mod error;
+pub mod events;
 pub mod integrate;
 pub mod model;
 pub mod modes;
 pub mod newton;
+pub mod output;
+pub mod rhs;
 pub mod rocket;
 pub mod setup;
 pub mod simulate;
