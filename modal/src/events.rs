@@ -10,7 +10,7 @@
 use crate::contact::{ContactState, locate_crossing};
 use crate::error::ModalError;
 use crate::integrate::Stepper;
-use crate::model::integrals::dot;
+use crate::linalg::dot;
 use crate::rhs::ChainRhs;
 
 /// Time tolerance of the contact-start and release events (width of the final bracket).

@@ -67,6 +67,7 @@ pub mod contact;
 pub mod error;
 pub mod events;
 pub mod integrate;
+mod linalg;
 pub mod model;
 pub mod modes;
 pub mod newton;

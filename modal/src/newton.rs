@@ -23,8 +23,7 @@
 //! period-2 cycles at 24 modes), while S is assembled from the same well-scaled M, D, K that
 //! the model itself factors.
 
-use crate::model::chain::{cholesky_factor, cholesky_substitute};
-use crate::model::integrals::dot;
+use crate::linalg::{cholesky_factor, cholesky_substitute, dot};
 
 /// The linearization of one point and the factorization of one c (see the module docs).
 #[derive(Debug, Clone)]

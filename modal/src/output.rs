@@ -5,7 +5,7 @@ use data::{Diagnostic, EnergyLedger, Observables, Scene, StabilityVerdict, chann
 
 use crate::events::ContactReport;
 use crate::integrate::Stepper;
-use crate::model::integrals::dot;
+use crate::linalg::dot;
 use crate::rhs::ChainRhs;
 
 /// Tangential tip velocity v_t = t̂·ṙ_tip of a friction contact (no `data::channel` convention

@@ -7,8 +7,8 @@
 
 use crate::contact::ContactState;
 use crate::integrate::OdeRhs;
+use crate::linalg::dot;
 use crate::model::Chain;
-use crate::model::integrals::dot;
 use crate::newton::ChainNewton;
 
 /// Which cumulative power integrals the state carries (only those the scene needs).

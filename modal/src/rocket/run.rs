@@ -230,11 +230,11 @@ impl<'a> Recorder<'a> {
             i += 1;
         }
         for st in &self.stations {
-            self.row[i] = super::dense::dot(&st.u, a);
+            self.row[i] = crate::linalg::dot(&st.u, a);
             i += 1;
         }
         for st in &self.stations {
-            self.row[i] = super::dense::dot(&st.w, b);
+            self.row[i] = crate::linalg::dot(&st.w, b);
             i += 1;
         }
         for j in 0..l.nm {
