@@ -58,6 +58,15 @@
 //! links are accepted there: the tip position and Jacobian carry u(L). The inextensible link on
 //! the circle of radius L about its own hub is refused: it must stay straight (the rigid model).
 
+//!
+//! Layout of a chain run, each module knowing only those before it: [`basis`] →
+//! [`model`] (integrals, bodies, the chain's M, f, energies and tangents) → [`rhs`] (the chain
+//! as y' = f(t, y) with its structured Newton linear algebra, [`newton`]) ; [`integrate`] (one
+//! type per method behind [`integrate::Stepper`], registered in [`integrate::METHODS`]) ;
+//! [`contact`] (constraint geometry and state) → [`events`] (event functions, location on the
+//! dense output, resets, projection) ; [`output`] (samples, ledger, stop diagnostics) →
+//! [`simulate`] (the driver). Dense kernels: [`linalg`].
+
 // Dense numerical kernels index several arrays with one loop variable on purpose.
 #![allow(clippy::needless_range_loop)]
 
@@ -67,7 +76,7 @@ pub mod contact;
 pub mod error;
 pub mod events;
 pub mod integrate;
-mod linalg;
+pub mod linalg;
 pub mod model;
 pub mod modes;
 pub mod newton;

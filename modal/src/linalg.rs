@@ -5,12 +5,12 @@
 //! Timoshenko section rotation.
 
 /// Σ aᵢ bᵢ over the shorter of the two slices.
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// out = M x for the row-major n × n matrix M.
-pub(crate) fn mat_vec(m: &[f64], n: usize, x: &[f64], out: &mut [f64]) {
+pub fn mat_vec(m: &[f64], n: usize, x: &[f64], out: &mut [f64]) {
     for i in 0..n {
         let row = &m[i * n..(i + 1) * n];
         out[i] = row.iter().zip(x).map(|(a, b)| a * b).sum();
@@ -20,14 +20,14 @@ pub(crate) fn mat_vec(m: &[f64], n: usize, x: &[f64], out: &mut [f64]) {
 /// A pivot of a Cholesky factorization that is not positive and finite: the matrix is not
 /// (numerically) positive definite.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct NotPositiveDefinite {
+pub struct NotPositiveDefinite {
     /// Index of the failing pivot.
-    pub(crate) pivot: usize,
+    pub pivot: usize,
 }
 
 /// In-place Cholesky factorization A = L Lᵀ of the SPD matrix A (row-major n × n; L is left in
 /// the lower triangle).
-pub(crate) fn cholesky_factor(a: &mut [f64], n: usize) -> Result<(), NotPositiveDefinite> {
+pub fn cholesky_factor(a: &mut [f64], n: usize) -> Result<(), NotPositiveDefinite> {
     for j in 0..n {
         let mut d = a[j * n + j];
         for k in 0..j {
@@ -51,7 +51,7 @@ pub(crate) fn cholesky_factor(a: &mut [f64], n: usize) -> Result<(), NotPositive
 
 /// Forward/back substitution b ← (L Lᵀ)⁻¹ b with the lower Cholesky factor stored in `l`
 /// (row-major n × n, from [`cholesky_factor`]).
-pub(crate) fn cholesky_substitute(l: &[f64], n: usize, b: &mut [f64]) {
+pub fn cholesky_substitute(l: &[f64], n: usize, b: &mut [f64]) {
     for i in 0..n {
         let mut s = b[i];
         for k in 0..i {
@@ -69,11 +69,7 @@ pub(crate) fn cholesky_substitute(l: &[f64], n: usize, b: &mut [f64]) {
 }
 
 /// In-place Cholesky solve of the SPD system A x = b (A overwritten by its factor, b by x).
-pub(crate) fn cholesky_solve(
-    a: &mut [f64],
-    n: usize,
-    b: &mut [f64],
-) -> Result<(), NotPositiveDefinite> {
+pub fn cholesky_solve(a: &mut [f64], n: usize, b: &mut [f64]) -> Result<(), NotPositiveDefinite> {
     cholesky_factor(a, n)?;
     cholesky_substitute(a, n, b);
     Ok(())

@@ -2,7 +2,7 @@
 //! ([`crate::integrate::Sdirk`] through [`crate::integrate::OdeRhs::newton_linearize`]).
 //!
 //! The state is y = (q, v, w) (free coordinates, their rates, cumulative works) and the
-//! linearization kept is that of [`crate::simulate::ChainRhs`]'s structured Jacobian:
+//! linearization kept is that of [`crate::rhs::ChainRhs`]'s structured Jacobian:
 //! q' = v, M(q) v' = F(q, v) + Wλ with the stiff tangents K = −∂F/∂q, D = −∂F/∂v
 //! ([`crate::model::Chain::elastic_tangent`]), the contact rows A (A v' = −convective terms;
 //! W = Aᵀ, or Gᵀ − μsσTᵀ with sliding friction), and the power rows w' = P(v) with
