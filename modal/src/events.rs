@@ -4,7 +4,7 @@
 //! sticking), located by Illinois root finding on the stepper's dense output to
 //! [`EVENT_TIME_TOLERANCE`]; the resets at a located root (plastic impact, release, stick–slip
 //! switch with the Coulomb test); the drift projection of the constrained phase; the start of a
-//! bilateral run. The driver consumes them through [`ContactEvents`]; any [`Stepper`] with dense
+//! bilateral run. The driver consumes them through `ContactEvents`; any [`Stepper`] with dense
 //! output supports contact.
 
 use crate::contact::{ContactState, locate_crossing};

@@ -58,7 +58,7 @@ pub fn method_choice(scene: &Scene, settings: &Settings) -> Result<Method, Modal
     }
 }
 
-/// The default method: fixed-step TR-BDF2 ([`TRBDF2_FIXED`](crate::integrate::TRBDF2_FIXED), step [`default_step`]) for
+/// The default method: fixed-step TR-BDF2 ([`TRBDF2_FIXED`], step [`default_step`]) for
 /// a chain without contact whose every link carries Kelvin–Voigt damping, when no tolerance is
 /// given; otherwise Dormand–Prince.
 ///
