@@ -42,7 +42,7 @@
 //!
 //! Contact (Barhorst's work surface, [`contact`]): the gap g = n̂·(r_tip − p₀) is an event
 //! function located by Illinois root finding on the integrator's dense output (bracket
-//! ≤ [`simulate::EVENT_TIME_TOLERANCE`]); impact is the plastic generalized impulse–momentum
+//! ≤ [`events::EVENT_TIME_TOLERANCE`]); impact is the plastic generalized impulse–momentum
 //! jump M(q̇⁺ − q̇⁻) = GᵀΛ, G q̇⁺ = 0 (G = n̂ᵀJ_tip); while the normal force pushes, the tip
 //! slides on the surface with a Lagrange multiplier (M q̈ = f + Gᵀλ, G q̈ = −Ġq̇, index 1) and
 //! projection of q, q̇ back onto g = 0, G q̇ = 0 after every step; release is the located zero
@@ -58,6 +58,15 @@
 //! links are accepted there: the tip position and Jacobian carry u(L). The inextensible link on
 //! the circle of radius L about its own hub is refused: it must stay straight (the rigid model).
 
+//!
+//! Layout of a chain run, each module knowing only those before it: [`basis`] →
+//! [`model`] (integrals, bodies, the chain's M, f, energies and tangents) → [`rhs`] (the chain
+//! as y' = f(t, y) with its structured Newton linear algebra, [`newton`]) ; [`integrate`] (one
+//! type per method behind [`integrate::Stepper`], registered in [`integrate::METHODS`]) ;
+//! [`contact`] (constraint geometry and state) → [`events`] (event functions, location on the
+//! dense output, resets, projection) ; [`output`] (samples, ledger, stop diagnostics) →
+//! [`simulate`] (the driver). Dense kernels: [`linalg`].
+
 // Dense numerical kernels index several arrays with one loop variable on purpose.
 #![allow(clippy::needless_range_loop)]
 
@@ -65,10 +74,14 @@ pub mod backend;
 pub mod basis;
 pub mod contact;
 pub mod error;
+pub mod events;
 pub mod integrate;
+pub mod linalg;
 pub mod model;
 pub mod modes;
 pub mod newton;
+pub mod output;
+pub mod rhs;
 pub mod rocket;
 pub mod setup;
 pub mod simulate;

@@ -2,7 +2,7 @@
 //! ([`crate::integrate::Sdirk`] through [`crate::integrate::OdeRhs::newton_linearize`]).
 //!
 //! The state is y = (q, v, w) (free coordinates, their rates, cumulative works) and the
-//! linearization kept is that of [`crate::simulate::ChainRhs`]'s structured Jacobian:
+//! linearization kept is that of [`crate::rhs::ChainRhs`]'s structured Jacobian:
 //! q' = v, M(q) v' = F(q, v) + Wλ with the stiff tangents K = −∂F/∂q, D = −∂F/∂v
 //! ([`crate::model::Chain::elastic_tangent`]), the contact rows A (A v' = −convective terms;
 //! W = Aᵀ, or Gᵀ − μsσTᵀ with sliding friction), and the power rows w' = P(v) with
@@ -23,8 +23,7 @@
 //! period-2 cycles at 24 modes), while S is assembled from the same well-scaled M, D, K that
 //! the model itself factors.
 
-use crate::model::chain::{cholesky_factor, cholesky_substitute};
-use crate::model::integrals::dot;
+use crate::linalg::{cholesky_factor, cholesky_substitute, dot};
 
 /// The linearization of one point and the factorization of one c (see the module docs).
 #[derive(Debug, Clone)]

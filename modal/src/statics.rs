@@ -5,8 +5,7 @@
 use data::{Cost, Scene, Settings, StaticResult};
 
 use crate::error::ModalError;
-use crate::model::chain::cholesky_solve;
-use crate::model::integrals::dot;
+use crate::linalg::{cholesky_solve, dot};
 use crate::setup::build_chain;
 
 pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, ModalError> {

@@ -28,6 +28,16 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     (x, w)
 }
 
+/// Nodes and weights of the n-point Gauss–Legendre rule on [0, 1] (ascending nodes).
+pub fn gauss_legendre_unit(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let (mut x, mut w) = gauss_legendre(n);
+    for (xi, wi) in x.iter_mut().zip(&mut w) {
+        *xi = 0.5 * (1.0 + *xi);
+        *wi *= 0.5;
+    }
+    (x, w)
+}
+
 fn legendre_and_derivative(n: usize, z: f64) -> (f64, f64) {
     let (mut p0, mut p1) = (1.0, z);
     if n == 0 {

@@ -1,8 +1,8 @@
 //! Dormand–Prince 5(4) with FSAL, PI step control and Hairer's 4th-order dense output.
 
 use super::{
-    IntegrateError, OdeRhs, StepStats, Tolerances, clip_step, error_norm, initial_step, min_step,
-    next_step, shrink_after_blowup,
+    Build, IntegrateError, MethodInfo, OdeRhs, StepStats, Stepper, StopReason, Tolerances,
+    clip_step, error_norm, initial_step, min_step, next_step, shrink_after_blowup, stop_reason,
 };
 
 // Butcher tableau (Dormand & Prince 1980).
@@ -52,6 +52,13 @@ const EXPO1: f64 = 0.2 - BETA * 0.75;
 const SAFETY: f64 = 0.9;
 const FAC_MIN: f64 = 0.2; // largest decrease per step
 const FAC_MAX: f64 = 10.0; // largest increase per step
+
+/// Registry entry ([`super::METHODS`]).
+pub const DOPRI5: MethodInfo = MethodInfo {
+    name: "dopri5",
+    aliases: &[],
+    build: Build::Adaptive(|dim, tol, h_init| Box::new(Dopri5::new(dim, tol, h_init, None))),
+};
 
 /// Adaptive Dormand–Prince 5(4) integrator (see the module docs).
 #[derive(Debug, Clone)]
@@ -129,7 +136,7 @@ impl Dopri5 {
     }
 
     /// Advances one accepted step, never past `t_stop`. Updates `t` and `y`.
-    pub fn step<F: OdeRhs>(
+    pub fn step<F: OdeRhs + ?Sized>(
         &mut self,
         f: &mut F,
         t: &mut f64,
@@ -212,7 +219,7 @@ impl Dopri5 {
         }
     }
 
-    fn stages<F: OdeRhs>(&mut self, f: &mut F, t: f64, y: &[f64], h: f64) {
+    fn stages<F: OdeRhs + ?Sized>(&mut self, f: &mut F, t: f64, y: &[f64], h: f64) {
         let n = y.len();
         let ys = &mut self.y_stage;
         for i in 0..n {
@@ -294,5 +301,30 @@ impl Dopri5 {
     /// The initial step this integrator was created with.
     pub fn h_init(&self) -> Option<f64> {
         self.h_init
+    }
+}
+
+impl Stepper for Dopri5 {
+    fn step(
+        &mut self,
+        f: &mut dyn OdeRhs,
+        t: &mut f64,
+        y: &mut [f64],
+        t_stop: f64,
+    ) -> Result<StopReason, IntegrateError> {
+        Dopri5::step(self, f, t, y, t_stop)?;
+        Ok(stop_reason(*t, t_stop))
+    }
+    fn dense(&self, t_out: f64, out: &mut [f64]) {
+        Dopri5::dense(self, t_out, out)
+    }
+    fn stats(&self) -> StepStats {
+        self.stats
+    }
+    fn last_step(&self) -> f64 {
+        self.h_last
+    }
+    fn reset(&mut self) {
+        Dopri5::reset(self)
     }
 }

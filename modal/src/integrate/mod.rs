@@ -12,12 +12,129 @@
 //!   trapezoidal rule ([`Sdirk::trapezoidal`], no damping).
 //!
 //! Both keep all work arrays in the struct: a step performs no heap allocation.
+//!
+//! Every method implements [`Stepper`] (one accepted step, dense output over it, work
+//! counters, restart after a discontinuity) and is registered in [`METHODS`] under its name:
+//! a driver holds a `Box<dyn Stepper>` built from the registry entry and never names a
+//! method. Adding a method is one new file (the method type, its `Stepper` impl and its
+//! [`MethodInfo`]) plus its line in [`METHODS`].
 
 mod dopri5;
 mod sdirk;
 
-pub use dopri5::Dopri5;
-pub use sdirk::Sdirk;
+pub use dopri5::{DOPRI5, Dopri5};
+pub use sdirk::{Sdirk, TRAPEZOID, TRBDF2, TRBDF2_FIXED};
+
+/// Why [`Stepper::step`] returned.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    /// One step was accepted and `t` lies before `t_stop`.
+    InternalStep,
+    /// `t` equals `t_stop` (also when the interval was already empty).
+    TstopReached,
+}
+
+/// One integration method for y' = f(t, y) with its state between steps.
+pub trait Stepper {
+    /// Advances one accepted step from (`t`, `y`), never past `t_stop` (landing on it exactly
+    /// when it is reached).
+    fn step(
+        &mut self,
+        f: &mut dyn OdeRhs,
+        t: &mut f64,
+        y: &mut [f64],
+        t_stop: f64,
+    ) -> Result<StopReason, IntegrateError>;
+    /// y(`t_out`) inside the last accepted step (continuous extension of the method).
+    fn dense(&self, t_out: f64, out: &mut [f64]);
+    fn stats(&self) -> StepStats;
+    /// Size of the last accepted step.
+    fn last_step(&self) -> f64;
+    /// Restart after a discontinuity of the right-hand side or the state (forget every stage
+    /// and linearization carried between steps).
+    fn reset(&mut self);
+    /// The state was moved by a small amount outside the method (a projection onto a
+    /// constraint manifold) while the right-hand side stayed the same; by default a restart.
+    fn state_changed(&mut self) {
+        self.reset();
+    }
+}
+
+/// How a registered method is constructed.
+#[derive(Clone, Copy)]
+pub enum Build {
+    /// Error-controlled step size; `h_init` is the first step (None: estimated).
+    Adaptive(fn(dim: usize, tol: Tolerances, h_init: Option<f64>) -> Box<dyn Stepper>),
+    /// Constant step `h`; `tol` scales the convergence test of the implicit stages only.
+    Fixed(fn(dim: usize, tol: Tolerances, h: f64) -> Box<dyn Stepper>),
+}
+
+/// Registry entry of one integration method.
+#[derive(Clone, Copy)]
+pub struct MethodInfo {
+    /// The name a scene's settings use (`time.method`).
+    pub name: &'static str,
+    /// Other accepted names.
+    pub aliases: &'static [&'static str],
+    pub build: Build,
+}
+
+impl MethodInfo {
+    pub fn is_fixed_step(&self) -> bool {
+        matches!(self.build, Build::Fixed(_))
+    }
+
+    fn answers_to(&self, name: &str) -> bool {
+        self.name == name || self.aliases.contains(&name)
+    }
+}
+
+impl PartialEq for MethodInfo {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
+}
+
+impl Eq for MethodInfo {}
+
+impl std::fmt::Debug for MethodInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
+
+/// Every integration method of the crate, the first one being the default.
+pub const METHODS: &[&MethodInfo] = &[&DOPRI5, &TRBDF2, &TRBDF2_FIXED, &TRAPEZOID];
+
+/// The registered method named (or aliased) `name`.
+pub fn method_named(name: &str) -> Option<&'static MethodInfo> {
+    METHODS.iter().copied().find(|m| m.answers_to(name))
+}
+
+/// The registered names for a message: "`a`, `b` (alias `c`), `d`".
+pub fn method_names() -> String {
+    METHODS
+        .iter()
+        .map(|m| {
+            let mut s = format!("`{}`", m.name);
+            if !m.aliases.is_empty() {
+                let aliases: Vec<String> = m.aliases.iter().map(|a| format!("`{a}`")).collect();
+                s.push_str(&format!(" (alias {})", aliases.join(", ")));
+            }
+            s
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// [`StopReason`] of a step that ended at `t` with target `t_stop`.
+pub(crate) fn stop_reason(t: f64, t_stop: f64) -> StopReason {
+    if t >= t_stop {
+        StopReason::TstopReached
+    } else {
+        StopReason::InternalStep
+    }
+}
 
 use thiserror::Error;
 
@@ -148,7 +265,7 @@ pub(crate) fn next_step(h_next: f64, h: f64, h_try: f64, clipped: bool, h_max: f
 /// the tolerance, limited by a second-derivative estimate. Uses `f0 = f(t, y)`;
 /// `y1`, `f1` are scratch arrays. Costs one extra RHS evaluation.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn initial_step<F: OdeRhs>(
+pub(crate) fn initial_step<F: OdeRhs + ?Sized>(
     f: &mut F,
     tol: &Tolerances,
     order: i32,

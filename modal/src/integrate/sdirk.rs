@@ -73,8 +73,8 @@ use faer::perm::PermRef;
 use faer::{Conj, Mat, MatMut, Par};
 
 use super::{
-    IntegrateError, OdeRhs, StepStats, Tolerances, clip_step, error_norm, initial_step, min_step,
-    next_step, shrink_after_blowup,
+    Build, IntegrateError, MethodInfo, OdeRhs, StepStats, Stepper, StopReason, Tolerances,
+    clip_step, error_norm, initial_step, min_step, next_step, shrink_after_blowup, stop_reason,
 };
 
 const SQRT2: f64 = std::f64::consts::SQRT_2;
@@ -122,7 +122,7 @@ struct IterationMatrix {
 
 impl IterationMatrix {
     /// x ← (I − h d J)⁻¹ x.
-    fn solve<F: OdeRhs>(&mut self, f: &mut F, x: &mut [f64]) {
+    fn solve<F: OdeRhs + ?Sized>(&mut self, f: &mut F, x: &mut [f64]) {
         if self.structured {
             f.newton_solve(x);
             return;
@@ -141,6 +141,24 @@ impl IterationMatrix {
         );
     }
 }
+
+/// Registry entries ([`super::METHODS`]): adaptive TR-BDF2, fixed-step TR-BDF2 and the
+/// fixed-step trapezoidal rule.
+pub const TRBDF2: MethodInfo = MethodInfo {
+    name: "trbdf2",
+    aliases: &["sdirk", "tr-bdf2"],
+    build: Build::Adaptive(|dim, tol, h_init| Box::new(Sdirk::new(dim, tol, h_init, None))),
+};
+pub const TRBDF2_FIXED: MethodInfo = MethodInfo {
+    name: "trbdf2-fixed",
+    aliases: &[],
+    build: Build::Fixed(|dim, tol, h| Box::new(Sdirk::fixed_step(dim, tol, h))),
+};
+pub const TRAPEZOID: MethodInfo = MethodInfo {
+    name: "trapezoid",
+    aliases: &[],
+    build: Build::Fixed(|dim, tol, h| Box::new(Sdirk::trapezoidal(dim, tol, h))),
+};
 
 /// Implicit adaptive TR-BDF2 integrator (see the module docs).
 pub struct Sdirk {
@@ -278,7 +296,7 @@ impl Sdirk {
         self.eta = 1.0;
     }
 
-    fn update_jacobian<F: OdeRhs>(&mut self, f: &mut F, t: f64, y: &[f64]) {
+    fn update_jacobian<F: OdeRhs + ?Sized>(&mut self, f: &mut F, t: f64, y: &[f64]) {
         self.stats.jacobian_evals += 1;
         self.iter.structured = f.newton_linearize(t, y);
         self.jac_analytic = self.iter.structured || f.jacobian(t, y, &mut self.jac);
@@ -292,7 +310,7 @@ impl Sdirk {
     }
 
     /// Forward differences around (t, y) with f(t, y) = f1.
-    fn difference_jacobian<F: OdeRhs>(&mut self, f: &mut F, t: f64, y: &[f64]) {
+    fn difference_jacobian<F: OdeRhs + ?Sized>(&mut self, f: &mut F, t: f64, y: &[f64]) {
         let n = y.len();
         self.work.copy_from_slice(y);
         for j in 0..n {
@@ -313,7 +331,7 @@ impl Sdirk {
 
     /// Factors I − h d J. A structured factorization that fails (the right-hand side's
     /// matrix is not definite) falls back to the dense Jacobian at the step start (t, y).
-    fn factorize<F: OdeRhs>(&mut self, f: &mut F, t: f64, y: &[f64], h: f64) {
+    fn factorize<F: OdeRhs + ?Sized>(&mut self, f: &mut F, t: f64, y: &[f64], h: f64) {
         self.stats.factorizations += 1;
         self.lu_h = h;
         if self.iter.structured {
@@ -353,7 +371,7 @@ impl Sdirk {
     /// η‖Δz‖θ^left ≥ [`NEWTON_TOL`] (the remaining iterations cannot reach it). An iteration
     /// that stalls from the second update on with its last two updates ≤ [`NOISE_ACCEPT`]
     /// is taken as converged to the evaluation's noise floor (see the module docs).
-    fn newton<F: OdeRhs>(
+    fn newton<F: OdeRhs + ?Sized>(
         &mut self,
         f: &mut F,
         tz: f64,
@@ -423,7 +441,7 @@ impl Sdirk {
     }
 
     /// Advances one accepted step, never past `t_stop`.
-    pub fn step<F: OdeRhs>(
+    pub fn step<F: OdeRhs + ?Sized>(
         &mut self,
         f: &mut F,
         t: &mut f64,
@@ -550,7 +568,7 @@ impl Sdirk {
     /// Handles a failed stage iteration; returns the step to try next. An old Jacobian is
     /// refreshed and the same step retried; with a fresh one the step is cut.
     #[allow(clippy::too_many_arguments)]
-    fn after_newton_failure<F: OdeRhs>(
+    fn after_newton_failure<F: OdeRhs + ?Sized>(
         &mut self,
         f: &mut F,
         t: f64,
@@ -582,7 +600,7 @@ impl Sdirk {
     }
 
     /// Commits the step to `y_new`: dense-output data, t, y and f(t₁, y₁).
-    fn accept<F: OdeRhs>(
+    fn accept<F: OdeRhs + ?Sized>(
         &mut self,
         f: &mut F,
         t: &mut f64,
@@ -626,5 +644,34 @@ impl Sdirk {
                 + h01 * self.y_new[i]
                 + h11 * h * self.f1[i];
         }
+    }
+}
+
+impl Stepper for Sdirk {
+    fn step(
+        &mut self,
+        f: &mut dyn OdeRhs,
+        t: &mut f64,
+        y: &mut [f64],
+        t_stop: f64,
+    ) -> Result<StopReason, IntegrateError> {
+        Sdirk::step(self, f, t, y, t_stop)?;
+        Ok(stop_reason(*t, t_stop))
+    }
+    fn dense(&self, t_out: f64, out: &mut [f64]) {
+        Sdirk::dense(self, t_out, out)
+    }
+    fn stats(&self) -> StepStats {
+        self.stats
+    }
+    fn last_step(&self) -> f64 {
+        self.h_last
+    }
+    fn reset(&mut self) {
+        Sdirk::reset(self)
+    }
+    /// Keeps the Jacobian and its factorization: the right-hand side is unchanged.
+    fn state_changed(&mut self) {
+        Sdirk::state_changed(self)
     }
 }

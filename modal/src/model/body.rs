@@ -25,7 +25,7 @@
 //! E = 𝕄 ν̇ + h with h = 𝕄̇ν + (ω J P, −(J P)·V, −∂T/∂e), P = ∂T/∂V.
 
 use super::chain::LinkModel;
-use super::integrals::{dot, mat_vec};
+use crate::linalg::{dot, mat_vec};
 
 /// Work vectors and tip quantities of one body evaluation.
 #[derive(Debug, Clone)]

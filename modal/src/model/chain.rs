@@ -16,9 +16,10 @@
 use data::scene::{PrescribedMotion, TorqueLaw};
 
 use super::body::{BodyScratch, body_terms};
-use super::integrals::{LinkIntegrals, dot};
+use super::integrals::LinkIntegrals;
 use super::section::Section;
 use crate::basis::ShapeSet;
+use crate::linalg::{cholesky_solve, cholesky_substitute, dot};
 
 /// One joint: its law and initial state.
 #[derive(Debug, Clone)]
@@ -416,7 +417,7 @@ impl Chain {
                 self.mff[r * nf + c] = self.mass[gr * n + gc];
             }
         }
-        cholesky_solve(&mut self.mff, nf, &mut self.rhs_f)?;
+        cholesky_solve(&mut self.mff, nf, &mut self.rhs_f).map_err(|_| SingularMass)?;
         for (r, &gr) in self.free.iter().enumerate() {
             qdd[gr] = self.rhs_f[r];
         }
@@ -626,55 +627,6 @@ impl Chain {
     /// Force side f(q, q̇, t) of the last evaluation.
     pub fn force(&self) -> &[f64] {
         &self.force
-    }
-}
-
-/// In-place Cholesky solve of the SPD system A x = b (A row-major n × n, overwritten).
-pub(crate) fn cholesky_solve(a: &mut [f64], n: usize, b: &mut [f64]) -> Result<(), SingularMass> {
-    cholesky_factor(a, n)?;
-    cholesky_substitute(a, n, b);
-    Ok(())
-}
-
-/// In-place Cholesky factorization A = L Lᵀ of the SPD matrix A (row-major n × n; L is left in
-/// the lower triangle).
-pub(crate) fn cholesky_factor(a: &mut [f64], n: usize) -> Result<(), SingularMass> {
-    for j in 0..n {
-        let mut d = a[j * n + j];
-        for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k];
-        }
-        if d <= 0.0 || !d.is_finite() {
-            return Err(SingularMass);
-        }
-        let d = d.sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / d;
-        }
-    }
-    Ok(())
-}
-
-/// Forward/back substitution with the lower Cholesky factor stored in `a` (row-major n × n).
-pub(crate) fn cholesky_substitute(a: &[f64], n: usize, b: &mut [f64]) {
-    for i in 0..n {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= a[i * n + k] * b[k];
-        }
-        b[i] = s / a[i * n + i];
-    }
-    for i in (0..n).rev() {
-        let mut s = b[i];
-        for k in i + 1..n {
-            s -= a[k * n + i] * b[k];
-        }
-        b[i] = s / a[i * n + i];
     }
 }
 

@@ -19,18 +19,6 @@
 use crate::basis::ShapeSet;
 use crate::basis::quadrature::Quadrature;
 
-/// Row-major square matrix helpers.
-pub(crate) fn mat_vec(m: &[f64], n: usize, x: &[f64], out: &mut [f64]) {
-    for i in 0..n {
-        let row = &m[i * n..(i + 1) * n];
-        out[i] = row.iter().zip(x).map(|(a, b)| a * b).sum();
-    }
-}
-
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
 #[derive(Debug, Clone)]
 pub struct LinkIntegrals {
     pub length: f64,

@@ -56,7 +56,7 @@
 
 use crate::basis::ShapeSet;
 use crate::basis::quadrature::Quadrature;
-use crate::model::chain::cholesky_solve;
+use crate::linalg::cholesky_solve;
 
 /// Which section model a link uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

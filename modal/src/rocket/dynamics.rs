@@ -19,8 +19,8 @@
 
 use super::basis::Basis;
 use super::body::Body;
-use super::dense::{cholesky_in_place, cholesky_solve, dot};
 use super::integrals::{Moments, QuadTable};
+use crate::linalg::{cholesky_factor, cholesky_substitute, dot, mat_vec};
 
 /// Indices of the state vector y = [q | v | quadratures].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -246,8 +246,8 @@ fn project_initial_shape(
     }
     let mut gram = m0.ww.clone();
     let mut b = rhs.clone();
-    if cholesky_in_place(&mut gram, n).is_ok() {
-        cholesky_solve(&gram, n, &mut b);
+    if cholesky_factor(&mut gram, n).is_ok() {
+        cholesky_substitute(&gram, n, &mut b);
     } else {
         // The eigenfunctions are m₀-orthogonal, so the Gram matrix is diagonal and positive;
         // a failed factorization can only be round-off: use its diagonal.
@@ -689,7 +689,7 @@ pub fn rhs(model: &Model, ws: &mut Workspace, t: f64, y: &[f64], dydt: &mut [f64
         qd[quad::MOM_OUTFLOW] = mo.0;
         qd[quad::MOM_OUTFLOW + 1] = mo.1;
         fill_mass_matrix(l, body, chi, q, false, &mut ws.mass_chi);
-        super::dense::mat_vec(&ws.mass_chi, nd, v, &mut ws.tmp);
+        mat_vec(&ws.mass_chi, nd, v, &mut ws.tmp);
         let kin = 0.5 * dot(v, &ws.tmp);
         let (s, c) = theta.sin_cos();
         let height = chi.total * q[1] + s * csh.sx + c * csh.sy;
@@ -706,12 +706,12 @@ pub fn rhs(model: &Model, ws: &mut Workspace, t: f64, y: &[f64], dydt: &mut [f64
     dydt[1] = s * vx + c * vy;
     dydt[2..nd].copy_from_slice(&v[2..nd]);
     // accelerations
-    if let Err(p) = cholesky_in_place(&mut ws.mass, nd) {
+    if let Err(p) = cholesky_factor(&mut ws.mass, nd).map_err(|e| e.pivot) {
         ws.failed_pivot = Some((t, p));
         dydt[nd..2 * nd].iter_mut().for_each(|x| *x = f64::NAN);
         return false;
     }
-    cholesky_solve(&ws.mass, nd, &mut ws.rhs);
+    cholesky_substitute(&ws.mass, nd, &mut ws.rhs);
     dydt[nd..2 * nd].copy_from_slice(&ws.rhs);
     true
 }
@@ -739,7 +739,7 @@ pub fn snapshot(model: &Model, ws: &mut Workspace, t: f64, y: &[f64]) -> Snapsho
     ws.mom
         .set_affine(&model.m0, model.burnt_per_length(t), &model.chi);
     fill_mass_matrix(l, body, &ws.mom, q, true, &mut ws.mass);
-    super::dense::mat_vec(&ws.mass, nd, v, &mut ws.tmp);
+    mat_vec(&ws.mass, nd, v, &mut ws.tmp);
     let kinetic = 0.5 * dot(v, &ws.tmp);
     let pb = (ws.tmp[0], ws.tmp[1]);
     let mt = ws.mass[0];

@@ -11,45 +11,7 @@
 //! are integrated by 4-point Gauss–Legendre quadrature (exact for the degree-6 integrands).
 
 use super::body::Body;
-
-/// Gauss–Legendre nodes and weights on [0, 1].
-pub fn gauss_unit(points: usize) -> (Vec<f64>, Vec<f64>) {
-    // Nodes on [-1, 1] by Newton iteration on P_n, started from the Chebyshev guess.
-    let n = points;
-    let mut xs = vec![0.0; n];
-    let mut ws = vec![0.0; n];
-    for i in 0..n {
-        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        for _ in 0..100 {
-            let (p, dp) = legendre(n, z);
-            let dz = p / dp;
-            z -= dz;
-            if dz.abs() < 1e-16 {
-                break;
-            }
-        }
-        let (_, dp) = legendre(n, z);
-        xs[i] = 0.5 * (1.0 - z);
-        ws[i] = 1.0 / ((1.0 - z * z) * dp * dp);
-    }
-    (xs, ws)
-}
-
-/// Legendre polynomial P_n(z) and its derivative.
-fn legendre(n: usize, z: f64) -> (f64, f64) {
-    let (mut p0, mut p1) = (1.0, z);
-    if n == 0 {
-        return (1.0, 0.0);
-    }
-    for k in 2..=n {
-        let kf = k as f64;
-        let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-        p0 = p1;
-        p1 = p2;
-    }
-    let dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-    (p1, dp)
-}
+use crate::basis::quadrature::gauss_legendre_unit;
 
 /// One element of the fine mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -173,7 +135,7 @@ pub fn bending_matrices(mesh: &FineMesh) -> (Vec<f64>, Vec<f64>, usize) {
     let n = mesh.bending_dofs();
     let mut k = vec![0.0; n * n];
     let mut m = vec![0.0; n * n];
-    let (gs, gw) = gauss_unit(4);
+    let (gs, gw) = gauss_legendre_unit(4);
     for (e, el) in mesh.elements.iter().enumerate() {
         let map = FineMesh::bending_map(e);
         for (s, w) in gs.iter().zip(&gw) {
@@ -196,7 +158,7 @@ pub fn axial_matrices(mesh: &FineMesh) -> (Vec<f64>, Vec<f64>, usize) {
     let n = mesh.axial_dofs();
     let mut k = vec![0.0; n * n];
     let mut m = vec![0.0; n * n];
-    let (gs, gw) = gauss_unit(4);
+    let (gs, gw) = gauss_legendre_unit(4);
     for (e, el) in mesh.elements.iter().enumerate() {
         let map = FineMesh::axial_map(e);
         for (s, w) in gs.iter().zip(&gw) {
@@ -220,7 +182,7 @@ mod tests {
 
     #[test]
     fn elem_gauss_rule_integrates_degree_7_exactly() {
-        let (x, w) = gauss_unit(4);
+        let (x, w) = gauss_legendre_unit(4);
         for p in 0..8 {
             let q: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(p)).sum();
             // exact ∫₀¹ s^p ds = 1/(p+1); round-off of a 4-term sum

@@ -7,7 +7,7 @@
 //! mass integral is therefore affine in s: I(t) = I[m₀] − s·Δm·I[χ]. No quadrature runs per step.
 
 use super::basis::Basis;
-use super::fine_mesh::gauss_unit;
+use crate::basis::quadrature::gauss_legendre_unit;
 
 /// Moments of a weight ρ(x) against the basis (U_k axial, W_k bending), n modes per field.
 #[derive(Debug, Clone, PartialEq)]
@@ -88,7 +88,7 @@ impl QuadTable {
     pub fn new(basis: &Basis, points_per_element: usize) -> QuadTable {
         let n = basis.modes();
         let mesh = &basis.mesh;
-        let (gs, gw) = gauss_unit(points_per_element);
+        let (gs, gw) = gauss_legendre_unit(points_per_element);
         let np = mesh.elements.len() * gs.len();
         let mut t = QuadTable {
             n,

@@ -88,7 +88,6 @@
 mod basis;
 mod body;
 mod config;
-mod dense;
 mod dynamics;
 mod eig;
 mod error;

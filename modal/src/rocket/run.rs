@@ -12,7 +12,7 @@ use super::body::Body;
 use super::config::{self, Method, TimeConfig};
 use super::dynamics::{Model, Phase, StationModes, Workspace, quad, rhs, snapshot};
 use super::error::RocketError;
-use crate::integrate::{Dopri5, IntegrateError, OdeRhs, Sdirk, StepStats, Tolerances};
+use crate::integrate::{Dopri5, IntegrateError, OdeRhs, Sdirk, Stepper, Tolerances};
 
 /// The ODE right-hand side handed to the integrators.
 struct RocketRhs<'a> {
@@ -75,53 +75,10 @@ fn initial_state(model: &Model) -> Vec<f64> {
     y
 }
 
-enum Stepper {
-    Explicit(Box<Dopri5>),
-    Implicit(Box<Sdirk>),
-}
-
-impl Stepper {
-    fn new(method: Method, dim: usize, tol: Tolerances, h0: Option<f64>) -> Stepper {
-        match method {
-            Method::Dopri5 => Stepper::Explicit(Box::new(Dopri5::new(dim, tol, h0, None))),
-            Method::TrBdf2 => Stepper::Implicit(Box::new(Sdirk::new(dim, tol, h0, None))),
-        }
-    }
-    fn step(
-        &mut self,
-        f: &mut RocketRhs,
-        t: &mut f64,
-        y: &mut [f64],
-        t_stop: f64,
-    ) -> Result<(), IntegrateError> {
-        match self {
-            Stepper::Explicit(s) => s.step(f, t, y, t_stop),
-            Stepper::Implicit(s) => s.step(f, t, y, t_stop),
-        }
-    }
-    fn dense(&self, t: f64, out: &mut [f64]) {
-        match self {
-            Stepper::Explicit(s) => s.dense(t, out),
-            Stepper::Implicit(s) => s.dense(t, out),
-        }
-    }
-    fn reset(&mut self) {
-        match self {
-            Stepper::Explicit(s) => s.reset(),
-            Stepper::Implicit(s) => s.reset(),
-        }
-    }
-    fn stats(&self) -> StepStats {
-        match self {
-            Stepper::Explicit(s) => *s.stats(),
-            Stepper::Implicit(s) => *s.stats(),
-        }
-    }
-    fn last_step(&self) -> f64 {
-        match self {
-            Stepper::Explicit(s) => s.last_step(),
-            Stepper::Implicit(s) => s.last_step(),
-        }
+fn stepper(method: Method, dim: usize, tol: Tolerances, h0: Option<f64>) -> Box<dyn Stepper> {
+    match method {
+        Method::Dopri5 => Box::new(Dopri5::new(dim, tol, h0, None)),
+        Method::TrBdf2 => Box::new(Sdirk::new(dim, tol, h0, None)),
     }
 }
 
@@ -273,11 +230,11 @@ impl<'a> Recorder<'a> {
             i += 1;
         }
         for st in &self.stations {
-            self.row[i] = super::dense::dot(&st.u, a);
+            self.row[i] = crate::linalg::dot(&st.u, a);
             i += 1;
         }
         for st in &self.stations {
-            self.row[i] = super::dense::dot(&st.w, b);
+            self.row[i] = crate::linalg::dot(&st.w, b);
             i += 1;
         }
         for j in 0..l.nm {
@@ -377,7 +334,7 @@ pub fn simulate_detailed(
         rtol: tc.rtol,
         atol: tc.atol,
     };
-    let mut stepper = Stepper::new(tc.method, dim, tol, tc.dt);
+    let mut stepper = stepper(tc.method, dim, tol, tc.dt);
 
     // Output grid and the one discontinuity of the loads (burn-out).
     // the last sample is t_end itself, also when it is not a multiple of the interval
