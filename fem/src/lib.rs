@@ -61,9 +61,10 @@
 //! use an exact finite-difference Jacobian (dense LU, reused across steps). Newton failures in
 //! fixed-step mode retry the stretch with quarter steps (reported as rejected steps). Default
 //! step: min(output interval, T₁/40) with T₁ the first flexible period of the stiffest link
-//! (clamped-free on a prescribed joint, pinned-free on a free one), fitted to divide the output
-//! interval. Central difference: 2/ω_max by power iteration on the
-//! linearized K, M at t = 0; a user step above it is refused, the automatic step is 0.9× it.
+//! (clamped-free on a prescribed joint, pinned-free on a free one) — and at most T₁/320 of the
+//! most flexible link in a free chain where nothing dissipates
+//! ([`run::UNDAMPED_STEPS_PER_PERIOD`]) — fitted to divide the output interval. Central
+//! difference: 2/ω_max by power iteration on the linearized K, M at t = 0; a user step above it is refused, the automatic step is 0.9× it.
 //! On request also the implicit midpoint rule `implicit-midpoint` (one-stage Gauss, second
 //! order, no numerical damping, works booked by the trapezoidal rule:
 //! [`method::implicit_midpoint`]).

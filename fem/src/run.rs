@@ -26,6 +26,25 @@ pub const DEFAULT_SAFETY: f64 = 0.9;
 /// `two-link-free` the joint angle at 2 s was 19 % off and the ledger closed to 0.15 only.
 pub const STEPS_PER_PERIOD: f64 = 40.0;
 
+/// Default step of a free chain of linear beams (no foreshortening, no axial field) in which
+/// nothing dissipates the flexible motion (no joint damper, no Kelvin–Voigt, no contact): this
+/// many steps per first pinned-free period of its most flexible link. Without dissipation every
+/// excited mode rings for the whole run and the second-order schemes' phase error, (ωh)²/12 of
+/// each period, accumulates instead of decaying. With foreshortening the modes the step does
+/// not resolve feed the joint angles through the nonlinear coupling, and a moderately finer step
+/// does not converge: on `two-link-free-undamped` (16 elements, joint-1 angle low-passed at
+/// 20 Hz, against h = 1.47e-4 s) h = 7.1e-4 s differs by 3.7e-3 rad and h = 2.1e-4 s (3.4 times
+/// the cost) still by 3.1e-3; such chains keep the 40-step rule.
+/// Measured against `flexverify run single-link --backend modal --modes 12 --rtol 1e-10 --atol
+/// 1e-12` (16 elements, hub angle, max over 3 s): 2.6e-2 rad at 40 steps per stiffest-link
+/// period, 7.4e-4 at 320 (h = 3.85e-4 s; modal's own default: 5.8e-4); on
+/// the damped `two-link-free` the joint-1 angle moves by only 1.3e-4 rad between 40 steps and a
+/// 4 times smaller step. The rule ignores how small a
+/// stiff link's flexible amplitudes are: a link 1000 times stiffer than `single-link` gets
+/// 236 000 steps for its 3 s, where a step 8 times longer changes its hub angle by far less
+/// than its flexible correction; pass `--dt` there.
+pub const UNDAMPED_STEPS_PER_PERIOD: f64 = 320.0;
+
 /// Steps per period of the first axial mode of an extensible link whose tip is held by a
 /// bilateral wall (see [`axial_wall_step`]).
 pub const STEPS_PER_AXIAL_PERIOD: f64 = 16.0;
@@ -113,6 +132,31 @@ pub fn default_method(scene: &Scene) -> Method {
     } else {
         Method::GeneralizedAlpha
     }
+}
+
+/// For a chain of linear beams whose joints are all free and in which nothing dissipates (no
+/// joint damper, no Kelvin–Voigt, no contact), the first pinned-free frequency of its most flexible link: the
+/// slowest flexible mode, whose phase error [`UNDAMPED_STEPS_PER_PERIOD`] bounds.
+fn undissipated_free_chain_frequency(scene: &Scene) -> Option<f64> {
+    let dissipates = |l: &data::scene::Link| {
+        l.kelvin_voigt.unwrap_or(0.0) > 0.0 || l.joint.damping.unwrap_or(0.0) > 0.0
+    };
+    if !scene.contacts.is_empty()
+        || scene
+            .links
+            .iter()
+            .any(|l| l.joint.prescribed.is_some() || dissipates(l) || l.foreshortening || l.axial)
+    {
+        return None;
+    }
+    let beta1 = pinned_free_beta1();
+    scene
+        .links
+        .iter()
+        .map(|l| {
+            beta1 * beta1 * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt()
+        })
+        .reduce(f64::min)
 }
 
 /// A Timoshenko link without rotary inertia on a free joint without hub inertia, with neither
@@ -217,8 +261,12 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
             beta1 * beta1 * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt()
         })
         .fold(0.0f64, f64::max);
-    let h_rule = (2.0 * std::f64::consts::PI / (STEPS_PER_PERIOD * omega1))
+    let mut h_rule = (2.0 * std::f64::consts::PI / (STEPS_PER_PERIOD * omega1))
         .min(axial_wall_step(scene).unwrap_or(f64::INFINITY));
+    if let Some(omega_flexible) = undissipated_free_chain_frequency(scene) {
+        h_rule =
+            h_rule.min(2.0 * std::f64::consts::PI / (UNDAMPED_STEPS_PER_PERIOD * omega_flexible));
+    }
     let contact = Contact::from_scene(scene, &chain)?;
     if contact.is_some() {
         if method != Method::EnergyMidpoint {
