@@ -32,21 +32,14 @@
 
 use data::scene::{Gravity, Link, PrescribedMotion, TorqueLaw};
 
+use data::FemElement;
+
 use crate::band::BorderedBand;
-use crate::element::euler_bernoulli as eb;
-use crate::element::hermite::{dot4, hermite};
-use crate::element::quadrature::gauss01;
-use crate::element::timoshenko as timo;
+use crate::element::tables::dotn;
+use crate::element::{self, ElementDofs, InteriorField, MeshElement};
 use crate::error::FemError;
 
-/// Index value meaning "no DOF" (clamped node or prescribed joint).
-pub const NONE: usize = usize::MAX;
-/// Gauss points per element for inertia and loads (exact consistent mass).
-const NG: usize = 4;
-/// Sub-intervals per element for the foreshortening integrals (between Gauss points).
-const NSUB: usize = NG + 1;
-/// Gauss points per sub-interval (v′² and v′N′ are quartic: 3 points are exact).
-const NSG: usize = 3;
+pub use crate::element::{MAXE, NONE};
 /// Longest chain the backend builds (fixed-size per-point column buffers, no allocation).
 pub const MAX_LINKS: usize = 6;
 /// Ancestor columns of J at most: joint, tip slope, tip v, tip u per link.
@@ -114,19 +107,6 @@ impl JointModel {
     }
 }
 
-/// Local DOFs per element at most (Timoshenko: v₁, ψ₁, v₂, ψ₂, v(⅓), v(⅔), ψ(½)).
-pub const MAXE: usize = timo::NDOF;
-
-/// Σ aₖ dₖ over the first `ne` entries (same summation order as [`dot4`] for ne = 4).
-#[inline]
-fn dotn(a: &[f64; MAXE], d: &[f64; MAXE], ne: usize) -> f64 {
-    let mut s = 0.0;
-    for k in 0..ne {
-        s += a[k] * d[k];
-    }
-    s
-}
-
 /// One link with its element mesh and DOF map.
 #[derive(Debug, Clone)]
 pub struct LinkModel {
@@ -139,9 +119,9 @@ pub struct LinkModel {
     pub ea: f64,
     pub axial: bool,
     pub foreshortening: bool,
-    /// Timoshenko link (`shear`): cubic v, quadratic ψ, three interior DOFs per element.
+    /// Timoshenko link (`shear`): the section angle is a field of its own.
     pub shear: bool,
-    /// Local DOFs per element: 4 (Hermite cubic) or 7 (Timoshenko).
+    /// Local DOFs per element (4 nodal + interior).
     pub ne: usize,
     /// Section rotary inertia ρI when `rotary_inertia` is on (else 0).
     pub rho_i: f64,
@@ -156,106 +136,34 @@ pub struct LinkModel {
     pub v_dof: Vec<usize>,
     pub r_dof: Vec<usize>,
     pub u_dof: Vec<usize>,
-    /// Timoshenko interior DOFs (v(⅓), v(⅔), ψ(½)) of element e at 3e..3e+3 (empty otherwise).
+    /// Element-interior DOFs of element e at ni·e..ni·(e + 1), ni = the element's interior
+    /// count (e.g. Timoshenko v(⅓), v(⅔), ψ(½); quintic a₁, a₂; empty for the cubic).
     pub int_dof: Vec<usize>,
-    /// Element stiffness (same for all elements of the link), first `ne` rows/columns used:
-    /// ∫EI v″² (Euler–Bernoulli) or ∫EI ψ′² + κGA(v′ − ψ)² (Timoshenko).
-    pub k_el: [[f64; MAXE]; MAXE],
-    /// Bending part ∫EI (section angle)′² of `k_el` (Kelvin–Voigt acts on it only).
-    pub kb_el: [[f64; MAXE]; MAXE],
+    /// The element of this link: kind, operators and tabulated shapes.
+    pub element: MeshElement,
 }
 
 impl LinkModel {
+    /// Element-interior DOFs per element.
+    fn n_interior(&self) -> usize {
+        self.ne - 4
+    }
+
     fn elem_dofs(&self, e: usize) -> [usize; MAXE] {
         let mut d = [NONE; MAXE];
         d[0] = self.v_dof[e];
         d[1] = self.r_dof[e];
         d[2] = self.v_dof[e + 1];
         d[3] = self.r_dof[e + 1];
-        if self.shear {
-            d[4..7].copy_from_slice(&self.int_dof[3 * e..3 * e + 3]);
-        }
+        let ni = self.n_interior();
+        d[4..4 + ni].copy_from_slice(&self.int_dof[ni * e..ni * (e + 1)]);
         d
     }
 
     /// Shape functions at local coordinate ξ of an element: (v, section angle).
     fn shapes_at(&self, xi: f64) -> ([f64; MAXE], [f64; MAXE]) {
-        let (mut n, mut b) = ([0.0; MAXE], [0.0; MAXE]);
-        if self.shear {
-            let s = timo::shapes(xi, self.h);
-            n = s.v;
-            b = s.th;
-        } else {
-            let s = hermite(xi, self.h);
-            n[..4].copy_from_slice(&s.n);
-            b[..4].copy_from_slice(&s.dn);
-        }
-        (n, b)
-    }
-}
-
-/// Quadrature tables shared by all elements of one link (they all have length h).
-#[derive(Debug, Clone)]
-struct LinkTables {
-    /// Main Gauss points: ξ, weight·h, v shapes N, their x-derivatives N′ and the section
-    /// angle shapes B (B = N′ for Euler–Bernoulli, the ψ shapes for Timoshenko).
-    xi: [f64; NG],
-    wh: [f64; NG],
-    n: [[f64; MAXE]; NG],
-    dn: [[f64; MAXE]; NG],
-    b: [[f64; MAXE]; NG],
-    /// Sub-interval points: weight·h and N′ (NSUB × NSG).
-    sub_wh: [[f64; NSG]; NSUB],
-    sub_dn: [[[f64; MAXE]; NSG]; NSUB],
-}
-
-impl LinkTables {
-    fn new(h: f64, shear: bool) -> Self {
-        let (p, w) = gauss01(NG);
-        let (ps, ws) = gauss01(NSG);
-        let mut t = LinkTables {
-            xi: [0.0; NG],
-            wh: [0.0; NG],
-            n: [[0.0; MAXE]; NG],
-            dn: [[0.0; MAXE]; NG],
-            b: [[0.0; MAXE]; NG],
-            sub_wh: [[0.0; NSG]; NSUB],
-            sub_dn: [[[0.0; MAXE]; NSG]; NSUB],
-        };
-        // (N, N′, B) at ξ.
-        let at = |xi: f64| {
-            let (mut n, mut dn, mut b) = ([0.0; MAXE], [0.0; MAXE], [0.0; MAXE]);
-            if shear {
-                let s = timo::shapes(xi, h);
-                n = s.v;
-                dn = s.dv;
-                b = s.th;
-            } else {
-                let s = hermite(xi, h);
-                n[..4].copy_from_slice(&s.n);
-                dn[..4].copy_from_slice(&s.dn);
-                b[..4].copy_from_slice(&s.dn);
-            }
-            (n, dn, b)
-        };
-        for g in 0..NG {
-            let (n, dn, b) = at(p[g]);
-            t.xi[g] = p[g];
-            t.wh[g] = w[g] * h;
-            t.n[g] = n;
-            t.dn[g] = dn;
-            t.b[g] = b;
-        }
-        for j in 0..NSUB {
-            let a = if j == 0 { 0.0 } else { p[j - 1] };
-            let b = if j == NG { 1.0 } else { p[j] };
-            for k in 0..NSG {
-                let xi = a + (b - a) * ps[k];
-                t.sub_wh[j][k] = ws[k] * (b - a) * h;
-                t.sub_dn[j][k] = at(xi).1;
-            }
-        }
-        t
+        let s = self.element.kind.shapes(xi, self.h);
+        (s.n, s.b)
     }
 }
 
@@ -286,37 +194,10 @@ pub struct FrameState {
     pub subtree_force: [f64; 2],
 }
 
-/// Element-averaged membrane strain of an extensible Timoshenko element,
-/// ε̄ = (u₂ − u₁)/h + (1/2h)∫v′² (the same locking-free averaged strain as the Euler–Bernoulli
-/// von Kármán element, with the Timoshenko v′; Gauss-4 integrates the quartic v′² exactly), and
-/// its gradient with respect to (u₁, u₂, element DOFs).
-fn membrane(
-    tb: &LinkTables,
-    h: f64,
-    u: [f64; 2],
-    d: &[f64; MAXE],
-    ne: usize,
-) -> (f64, [f64; MAXE + 2]) {
-    let mut half_int = 0.0;
-    let mut g = [0.0; MAXE + 2];
-    g[0] = -1.0 / h;
-    g[1] = 1.0 / h;
-    for k in 0..NG {
-        let dn = &tb.dn[k];
-        let vp = dotn(dn, d, ne);
-        half_int += tb.wh[k] * 0.5 * vp * vp;
-        for a in 0..ne {
-            g[2 + a] += tb.wh[k] / h * vp * dn[a];
-        }
-    }
-    ((u[1] - u[0]) / h + half_int / h, g)
-}
-
 /// The assembled chain model with preallocated work buffers.
 #[derive(Debug, Clone)]
 pub struct Chain {
     pub links: Vec<LinkModel>,
-    tables: Vec<LinkTables>,
     pub gravity: [f64; 2],
     pub ndof: usize,
     /// Interior/border split for the Newton matrix.
@@ -414,8 +295,20 @@ pub struct NewtonCoefficients {
 }
 
 impl Chain {
-    /// Builds the chain for `links` with `n_el` elements per link.
+    /// Builds the chain for `links` with `n_el` Hermite-cubic (Timoshenko for `shear` links)
+    /// elements per link.
     pub fn new(links: &[Link], gravity: Option<&Gravity>, n_el: usize) -> Result<Self, FemError> {
+        Self::with_element(links, gravity, n_el, None)
+    }
+
+    /// Builds the chain for `links` with `n_el` elements per link of the element `choice`
+    /// (`discretization.element`; see [`element::for_link`]).
+    pub fn with_element(
+        links: &[Link],
+        gravity: Option<&Gravity>,
+        n_el: usize,
+        choice: Option<FemElement>,
+    ) -> Result<Self, FemError> {
         let nl = links.len();
         if nl > MAX_LINKS {
             return Err(FemError::unsupported(format!(
@@ -433,26 +326,21 @@ impl Chain {
                 ));
             }
             let h = l.length / n_el as f64;
+            let kind = element::for_link(l, choice)?;
+            let ni = kind.interior().len();
             let has_child = i + 1 < nl;
             let mut v_dof = vec![NONE; n_el + 1];
             let mut r_dof = vec![NONE; n_el + 1];
             let mut u_dof = vec![NONE; n_el + 1];
-            // Timoshenko interior DOFs only exist (are allocated) for shear links.
-            let mut int_dof = if l.shear {
-                vec![NONE; 3 * n_el]
-            } else {
-                Vec::new()
-            };
+            let mut int_dof = vec![NONE; ni * n_el];
             let interior_nodes = if has_child { n_el - 1 } else { n_el };
             // Element e's interior DOFs precede node e + 1: every element's DOFs stay within
             // one contiguous window (the band).
             for e in 0..n_el {
-                if l.shear {
-                    for k in 0..3 {
-                        int_dof[3 * e + k] = next + k;
-                    }
-                    next += 3;
+                for k in 0..ni {
+                    int_dof[ni * e + k] = next + k;
                 }
+                next += ni;
                 let k = e + 1;
                 if k > interior_nodes {
                     continue;
@@ -465,21 +353,6 @@ impl Chain {
                     next += 1;
                 }
             }
-            let (k_el, kb_el) = if l.shear {
-                // support::check_planar guarantees κGA for shear links.
-                let kga = l.shear_stiffness.unwrap_or(0.0);
-                (
-                    timo::stiffness(l.bending_stiffness, kga, h),
-                    timo::stiffness(l.bending_stiffness, 0.0, h),
-                )
-            } else {
-                let k4 = eb::bending_stiffness(l.bending_stiffness, h);
-                let mut k = [[0.0; MAXE]; MAXE];
-                for a in 0..4 {
-                    k[a][..4].copy_from_slice(&k4[a]);
-                }
-                (k, k)
-            };
             let j = &l.joint;
             models.push(LinkModel {
                 length: l.length,
@@ -495,7 +368,7 @@ impl Chain {
                 axial: l.axial,
                 foreshortening: l.foreshortening,
                 shear: l.shear,
-                ne: if l.shear { timo::NDOF } else { 4 },
+                ne: kind.local_dofs(),
                 rho_i: if l.rotary_inertia {
                     l.rotary_inertia_per_length.unwrap_or(0.0)
                 } else {
@@ -519,8 +392,7 @@ impl Chain {
                 r_dof,
                 u_dof,
                 int_dof,
-                k_el,
-                kb_el,
+                element: MeshElement::new(kind, l, h),
             });
         }
         let n_interior = next;
@@ -547,21 +419,25 @@ impl Chain {
             .iter()
             .map(|m| {
                 let dpn = if m.axial { 3 } else { 2 };
-                if m.shear { 2 * dpn + 2 } else { 2 * dpn - 1 }
+                2 * dpn - 1 + m.n_interior()
             })
             .max()
             .unwrap_or(3);
-        let tables = models
+        let force = models
             .iter()
-            .map(|m| LinkTables::new(m.h, m.shear))
+            .map(|m| vec![[0.0; 2]; m.n_el * m.element.quad.ng])
             .collect();
-        let force = models.iter().map(|m| vec![[0.0; 2]; m.n_el * NG]).collect();
-        let pos: Vec<Vec<[f64; 2]>> = models.iter().map(|m| vec![[0.0; 2]; m.n_el * NG]).collect();
+        let pos: Vec<Vec<[f64; 2]>> = models
+            .iter()
+            .map(|m| vec![[0.0; 2]; m.n_el * m.element.quad.ng])
+            .collect();
         let vel = pos.clone();
-        let tail = models.iter().map(|m| vec![0.0; m.n_el * NSUB]).collect();
+        let tail = models
+            .iter()
+            .map(|m| vec![0.0; m.n_el * (m.element.quad.ng + 1)])
+            .collect();
         Ok(Chain {
             links: models,
-            tables,
             gravity: gravity.map_or([0.0, 0.0], |g| g.vector),
             ndof: next,
             n_interior,
@@ -580,7 +456,9 @@ impl Chain {
     /// Whether some DOFs carry no mass: the section rotations ψ of a Timoshenko link without
     /// rotary inertia (M is singular there; the stiffness determines them).
     pub fn has_massless_dofs(&self) -> bool {
-        self.links.iter().any(|l| l.shear && l.rho_i == 0.0)
+        self.links
+            .iter()
+            .any(|l| l.element.kind.independent_rotation() && l.rho_i == 0.0)
     }
 
     /// Basis of the massless directions (null space of M at a rest state) of the Timoshenko
@@ -611,11 +489,18 @@ impl Chain {
     fn massless_directions_with(&self, frames: bool) -> Vec<Vec<(usize, f64)>> {
         let mut dirs = Vec::new();
         for (li, l) in self.links.iter().enumerate() {
-            if !l.shear || l.rho_i > 0.0 {
+            let kind = l.element.kind;
+            if !kind.independent_rotation() || l.rho_i > 0.0 {
                 continue;
             }
+            let interior = kind.interior();
+            let ni = interior.len();
             for e in 0..l.n_el {
-                dirs.push(vec![(l.int_dof[3 * e + 2], 1.0)]);
+                for (k, idof) in interior.iter().enumerate() {
+                    if idof.field == InteriorField::Rotation {
+                        dirs.push(vec![(l.int_dof[ni * e + k], 1.0)]);
+                    }
+                }
             }
             for k in 1..l.n_el {
                 dirs.push(vec![(l.r_dof[k], 1.0)]);
@@ -639,8 +524,10 @@ impl Chain {
                     }
                 }
                 for e in 0..l.n_el {
-                    for (j, at) in [(0, 1.0 / 3.0), (1, 2.0 / 3.0)] {
-                        d.push((l.int_dof[3 * e + j], -(e as f64 + at) * l.h));
+                    for (k, idof) in interior.iter().enumerate() {
+                        if idof.field == InteriorField::Deflection {
+                            d.push((l.int_dof[ni * e + k], -(e as f64 + idof.at) * l.h));
+                        }
                     }
                 }
                 if tip != NONE {
@@ -769,7 +656,7 @@ impl Chain {
         let mut parent: Option<FrameState> = None;
         for li in 0..self.links.len() {
             let l = &self.links[li];
-            let tb = &self.tables[li];
+            let tb = &l.element.quad;
             let (th, dth, ddth) = match l.joint.prescribed_at(t) {
                 Some(k) => k,
                 None => (q[l.joint.dof], qd[l.joint.dof], qdd[l.joint.dof]),
@@ -817,9 +704,9 @@ impl Chain {
                 let ud = [Self::val(qd, ua), Self::val(qd, ub)];
                 let udd = [Self::val(qdd, ua), Self::val(qdd, ub)];
                 let xa = e as f64 * l.h;
-                for j in 0..NSUB {
+                for j in 0..tb.ng + 1 {
                     if fs {
-                        for k in 0..NSG {
+                        for k in 0..tb.nsg {
                             let dn = &tb.sub_dn[j][k];
                             let wgt = tb.sub_wh[j][k];
                             let vp = dotn(dn, &d, ne);
@@ -830,7 +717,7 @@ impl Chain {
                             sdd -= wgt * (vpd * vpd + vp * vpdd);
                         }
                     }
-                    if j == NG {
+                    if j == tb.ng {
                         continue;
                     }
                     let g = j;
@@ -862,12 +749,12 @@ impl Chain {
                     } else {
                         0.0
                     };
-                    self.force[li][e * NG + g] = sub(
+                    self.force[li][e * tb.ng + g] = sub(
                         scale(m, sub(scale(inertia, a), g_loc)),
                         [0.0, q_load * tb.wh[g]],
                     );
-                    self.pos[li][e * NG + g] = p;
-                    self.vel[li][e * NG + g] = pd;
+                    self.pos[li][e * tb.ng + g] = p;
+                    self.vel[li][e * tb.ng + g] = pd;
                 }
             }
             // Tip.
@@ -933,7 +820,7 @@ impl Chain {
         let mut child_m = 0.0;
         for li in (0..nl).rev() {
             let l = &self.links[li];
-            let tb = &self.tables[li];
+            let tb = &l.element.quad;
             let fr = self.frames[li];
             let g_loc = rot_t(fr.phi, g_in);
             let k = l.n_el;
@@ -966,9 +853,9 @@ impl Chain {
                 let d = Self::elem_v(q, &dofs);
                 let mut fe = [0.0; MAXE];
                 let (mut fu0, mut fu1) = (0.0, 0.0);
-                for g in 0..NG {
-                    let f = self.force[li][e * NG + g];
-                    let p = self.pos[li][e * NG + g];
+                for g in 0..tb.ng {
+                    let f = self.force[li][e * tb.ng + g];
+                    let p = self.pos[li][e * tb.ng + g];
                     f_sum = add(f_sum, f);
                     m_sum += cross(p, f);
                     for a in 0..ne {
@@ -984,7 +871,7 @@ impl Chain {
                 // φ + β(x) (β = v′ or ψ), which every upstream rotation turns by one.
                 if l.rho_i > 0.0 && parts.inertia {
                     let ddd = Self::elem_v(qdd, &dofs);
-                    for g in 0..NG {
+                    for g in 0..tb.ng {
                         let b = &tb.b[g];
                         let mr = l.rho_i * tb.wh[g] * (fr.ddphi + dotn(b, &ddd, ne));
                         m_sum += mr;
@@ -994,9 +881,9 @@ impl Chain {
                     }
                 }
                 if l.foreshortening {
-                    for j in (0..NSUB).rev() {
-                        self.tail[li][e * NSUB + j] = tail;
-                        for kk in 0..NSG {
+                    for j in (0..tb.ng + 1).rev() {
+                        self.tail[li][e * (tb.ng + 1) + j] = tail;
+                        for kk in 0..tb.nsg {
                             let dn = &tb.sub_dn[j][kk];
                             let vp = dotn(dn, &d, ne);
                             let c = -tail * tb.sub_wh[j][kk] * vp;
@@ -1005,45 +892,24 @@ impl Chain {
                             }
                         }
                         if j > 0 {
-                            tail += self.force[li][e * NG + j - 1][0];
+                            tail += self.force[li][e * tb.ng + j - 1][0];
                         }
                     }
                 }
                 // Elastic forces.
-                if cons && l.axial && !l.shear {
+                if cons {
                     let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                    let fv = eb::von_karman_force(
-                        l.ea,
-                        l.ei,
-                        l.h,
-                        &[u[0], u[1], d[0], d[1], d[2], d[3]],
-                    );
-                    fu0 += fv[0];
-                    fu1 += fv[1];
-                    for a in 0..4 {
-                        fe[a] += fv[2 + a];
-                    }
-                } else if cons {
-                    for a in 0..ne {
-                        fe[a] += dotn(&l.k_el[a], &d, ne);
-                    }
-                    if l.axial {
-                        // Timoshenko: membrane part ½EA h ε̄² (see `membrane`).
-                        let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                        let (eps, gr) = membrane(tb, l.h, u, &d, ne);
-                        let nf = l.ea * l.h * eps;
-                        fu0 += nf * gr[0];
-                        fu1 += nf * gr[1];
-                        for a in 0..ne {
-                            fe[a] += nf * gr[2 + a];
-                        }
-                    }
+                    let mut fu = [fu0, fu1];
+                    l.element
+                        .kind
+                        .internal_force(&l.element, u, &d, &mut fu, &mut fe);
+                    [fu0, fu1] = fu;
                 }
                 if l.kelvin_voigt > 0.0 && noncons {
                     let dd = Self::elem_v(qd, &dofs);
                     let c = l.kelvin_voigt / l.ei;
                     for a in 0..ne {
-                        fe[a] += c * dotn(&l.kb_el[a], &dd, ne);
+                        fe[a] += c * dotn(&l.element.kb[a], &dd, ne);
                     }
                 }
                 for a in 0..ne {
@@ -1107,7 +973,7 @@ impl Chain {
         let mut jc = [ColumnAt::default(); MAXE + 2 + MAX_COLUMNS];
         for li in 0..nl {
             let l = &self.links[li];
-            let tb = &self.tables[li];
+            let tb = &l.element.quad;
             let fr = self.frames[li];
             let g_loc = rot_t(fr.phi, g_in);
             let mut ncols = 0usize;
@@ -1272,9 +1138,9 @@ impl Chain {
             let ne = l.ne;
             for e in 0..l.n_el {
                 let dofs = l.elem_dofs(e);
-                for g in 0..NG {
+                for g in 0..tb.ng {
                     let m = l.rho_a * tb.wh[g];
-                    let p = self.pos[li][e * NG + g];
+                    let p = self.pos[li][e * tb.ng + g];
                     let xi = tb.xi[g];
                     let n = tb.n[g];
                     // Translation columns of the point: the v shapes (the ψ DOFs of a
@@ -1282,7 +1148,7 @@ impl Chain {
                     let mut local = [(NONE, [0.0; 2]); MAXE + 2];
                     let mut nloc = 0;
                     for a in 0..ne {
-                        if l.shear && (a == 1 || a == 3 || a == 6) {
+                        if !l.element.kind.translates(a) {
                             continue;
                         }
                         local[nloc] = (dofs[a], [0.0, n[a]]);
@@ -1291,14 +1157,14 @@ impl Chain {
                     local[nloc] = (l.u_dof[e], [1.0 - xi, 0.0]);
                     local[nloc + 1] = (l.u_dof[e + 1], [xi, 0.0]);
                     nloc += 2;
-                    let pd = self.vel[li][e * NG + g];
-                    let f = self.force[li][e * NG + g];
+                    let pd = self.vel[li][e * tb.ng + g];
+                    let f = self.force[li][e * tb.ng + g];
                     point(s, &mut jc, m, p, pd, f, &local[..nloc]);
                 }
                 // Section rotary inertia: the section angle is linear in q (J constant), so
                 // only the mass term c_a ρI w JᵀJ.
                 if l.rho_i > 0.0 && c.c_a != 0.0 {
-                    for g in 0..NG {
+                    for g in 0..tb.ng {
                         let mw = c.c_a * l.rho_i * tb.wh[g];
                         let b = &tb.b[g];
                         let mut jr = [(NONE, 0.0); MAX_COLUMNS + 1 + MAXE];
@@ -1321,83 +1187,34 @@ impl Chain {
                     }
                 }
                 // Elastic tangent, Kelvin–Voigt, foreshortening geometric stiffness.
-                if l.axial && !l.shear {
+                {
                     let d = Self::elem_v(q, &dofs);
                     let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                    let kt = eb::von_karman_tangent(
-                        l.ea,
-                        l.ei,
-                        l.h,
-                        &[u[0], u[1], d[0], d[1], d[2], d[3]],
-                    );
-                    let all = [
-                        l.u_dof[e],
-                        l.u_dof[e + 1],
-                        dofs[0],
-                        dofs[1],
-                        dofs[2],
-                        dofs[3],
-                    ];
-                    for a in 0..6 {
-                        for b in 0..6 {
-                            if all[a] != NONE && all[b] != NONE {
-                                s.add(all[a], all[b], c.c_q * kt[a][b]);
-                            }
-                        }
-                    }
-                } else {
-                    for a in 0..ne {
-                        for b in 0..ne {
-                            if dofs[a] != NONE && dofs[b] != NONE {
-                                s.add(dofs[a], dofs[b], c.c_q * l.k_el[a][b]);
-                            }
-                        }
-                    }
-                    if l.axial {
-                        // Timoshenko membrane tangent EA h ggᵀ + EA ε̄ ∫N′N′ (v block).
-                        let d = Self::elem_v(q, &dofs);
-                        let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                        let (eps, gr) = membrane(tb, l.h, u, &d, ne);
-                        let mut all = [NONE; MAXE + 2];
-                        all[0] = l.u_dof[e];
-                        all[1] = l.u_dof[e + 1];
-                        all[2..2 + ne].copy_from_slice(&dofs[..ne]);
-                        for a in 0..ne + 2 {
-                            for b in 0..ne + 2 {
-                                if all[a] != NONE && all[b] != NONE {
-                                    s.add(all[a], all[b], c.c_q * l.ea * l.h * gr[a] * gr[b]);
-                                }
-                            }
-                        }
-                        let nf = l.ea * eps;
-                        for g in 0..NG {
-                            let dn = &tb.dn[g];
-                            let wgt = c.c_q * nf * tb.wh[g];
-                            for a in 0..ne {
-                                for b in 0..ne {
-                                    if dofs[a] != NONE && dofs[b] != NONE {
-                                        s.add(dofs[a], dofs[b], wgt * dn[a] * dn[b]);
-                                    }
-                                }
-                            }
-                        }
-                    }
+                    let edofs = ElementDofs {
+                        u: [l.u_dof[e], l.u_dof[e + 1]],
+                        d: dofs,
+                    };
+                    l.element
+                        .kind
+                        .tangent(&l.element, &edofs, u, &d, c.c_q, &mut |i, j, v| {
+                            s.add(i, j, v)
+                        });
                 }
                 if l.kelvin_voigt > 0.0 {
                     let cf = l.kelvin_voigt / l.ei;
                     for a in 0..ne {
                         for b in 0..ne {
                             if dofs[a] != NONE && dofs[b] != NONE {
-                                s.add(dofs[a], dofs[b], c.c_v * cf * l.kb_el[a][b]);
+                                s.add(dofs[a], dofs[b], c.c_v * cf * l.element.kb[a][b]);
                             }
                         }
                     }
                 }
                 if l.foreshortening {
                     let mut kg = [[0.0; MAXE]; MAXE];
-                    for j in 0..NSUB {
-                        let tl = self.tail[li][e * NSUB + j];
-                        for kk in 0..NSG {
+                    for j in 0..tb.ng + 1 {
+                        let tl = self.tail[li][e * (tb.ng + 1) + j];
+                        for kk in 0..tb.nsg {
                             let dn = &tb.sub_dn[j][kk];
                             let wgt = -tl * tb.sub_wh[j][kk];
                             for a in 0..ne {
@@ -1458,7 +1275,7 @@ impl Chain {
         let (mut kin, mut strain, mut spring, mut grav) = (0.0, 0.0, 0.0, 0.0);
         for li in 0..self.links.len() {
             let l = &self.links[li];
-            let tb = &self.tables[li];
+            let tb = &l.element.quad;
             let (th, dth) = match l.joint.prescribed_at(t) {
                 Some((a, b, _)) => (a, b),
                 None => (q[l.joint.dof], qd[l.joint.dof]),
@@ -1478,9 +1295,9 @@ impl Chain {
                 let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
                 let ud = [Self::val(qd, l.u_dof[e]), Self::val(qd, l.u_dof[e + 1])];
                 let xa = e as f64 * l.h;
-                for j in 0..NSUB {
+                for j in 0..tb.ng + 1 {
                     if l.foreshortening {
-                        for k in 0..NSG {
+                        for k in 0..tb.nsg {
                             let dn = &tb.sub_dn[j][k];
                             let wgt = tb.sub_wh[j][k];
                             let vp = dotn(dn, &d, ne);
@@ -1488,7 +1305,7 @@ impl Chain {
                             sd -= wgt * vp * dotn(dn, &dd, ne);
                         }
                     }
-                    if j == NG {
+                    if j == tb.ng {
                         continue;
                     }
                     let xi = tb.xi[j];
@@ -1514,22 +1331,9 @@ impl Chain {
                         kin += 0.5 * l.rho_i * tb.wh[j] * om * om;
                     }
                 }
-                if l.axial && !l.shear {
-                    strain += eb::von_karman_energy(
-                        l.ea,
-                        l.ei,
-                        l.h,
-                        &[u[0], u[1], d[0], d[1], d[2], d[3]],
-                    );
-                } else {
-                    for a in 0..ne {
-                        strain += 0.5 * d[a] * dotn(&l.k_el[a], &d, ne);
-                    }
-                    if l.axial {
-                        let (eps, _) = membrane(tb, l.h, u, &d, ne);
-                        strain += 0.5 * l.ea * l.h * eps * eps;
-                    }
-                }
+                l.element
+                    .kind
+                    .add_strain_energy(&l.element, u, &d, &mut strain);
             }
             let k = l.n_el;
             let (ut, utd) = if l.axial {
@@ -1560,7 +1364,6 @@ impl Chain {
         [kin, strain, spring, grav]
     }
 
-    /// Dissipated powers at a state: (joint dampers, Kelvin–Voigt).
     /// Power of the applied transverse loads, Qᵀq̇ (constant loads: exact work over a
     /// trapezoidal step when q̇ is the step's mean velocity).
     pub fn load_power(&self, qd: &[f64]) -> f64 {
@@ -1570,36 +1373,16 @@ impl Chain {
         let mut p = self.tip_load * Self::val(qd, l.v_dof[l.n_el]);
         if self.distributed_load != 0.0 {
             let q0 = self.distributed_load;
-            if l.shear {
-                // Consistent loads ∫q₀N of the Timoshenko v shapes (Gauss-4: exact).
-                let tb = &self.tables[self.links.len() - 1];
-                let mut fq = [0.0; MAXE];
-                for g in 0..NG {
-                    for a in 0..MAXE {
-                        fq[a] += q0 * tb.wh[g] * tb.n[g][a];
-                    }
-                }
-                for e in 0..l.n_el {
-                    let dd = Self::elem_v(qd, &l.elem_dofs(e));
-                    p += dotn(&fq, &dd, MAXE);
-                }
-            } else {
-                let h = l.h;
-                let fq = [
-                    0.5 * q0 * h,
-                    q0 * h * h / 12.0,
-                    0.5 * q0 * h,
-                    -q0 * h * h / 12.0,
-                ];
-                for e in 0..l.n_el {
-                    let dd = Self::elem_v(qd, &l.elem_dofs(e));
-                    p += dot4(&fq, &[dd[0], dd[1], dd[2], dd[3]]);
-                }
+            let fq = l.element.kind.consistent_load(&l.element, q0);
+            for e in 0..l.n_el {
+                let dd = Self::elem_v(qd, &l.elem_dofs(e));
+                p += dotn(&fq, &dd, l.ne);
             }
         }
         p
     }
 
+    /// Dissipated powers at a state: (joint dampers, Kelvin–Voigt).
     pub fn dissipation_power(&self, t: f64, qd: &[f64]) -> (f64, f64) {
         let (mut pj, mut pkv) = (0.0, 0.0);
         for l in &self.links {
@@ -1613,7 +1396,7 @@ impl Chain {
                 for e in 0..l.n_el {
                     let dd = Self::elem_v(qd, &l.elem_dofs(e));
                     for a in 0..l.ne {
-                        pkv += c * dd[a] * dotn(&l.kb_el[a], &dd, l.ne);
+                        pkv += c * dd[a] * dotn(&l.element.kb[a], &dd, l.ne);
                     }
                 }
             }
@@ -1660,12 +1443,12 @@ impl Chain {
     /// s(L) = −½∫v′² of link `li`.
     pub fn foreshortening_at_tip(&self, li: usize, q: &[f64]) -> f64 {
         let l = &self.links[li];
-        let tb = &self.tables[li];
+        let tb = &l.element.quad;
         let mut s = 0.0;
         for e in 0..l.n_el {
             let d = Self::elem_v(q, &l.elem_dofs(e));
-            for j in 0..NSUB {
-                for k in 0..NSG {
+            for j in 0..tb.ng + 1 {
+                for k in 0..tb.nsg {
                     let vp = dotn(&tb.sub_dn[j][k], &d, l.ne);
                     s -= 0.5 * tb.sub_wh[j][k] * vp * vp;
                 }
@@ -1702,7 +1485,7 @@ impl Chain {
                 return format!("joint {} angle", li + 1);
             }
             for k in 0..=l.n_el {
-                let slope = if l.shear { "ψ" } else { "v′" };
+                let slope = l.element.kind.slope_label();
                 for (what, map) in [("v", &l.v_dof), (slope, &l.r_dof), ("u", &l.u_dof)] {
                     if map[k] == dof {
                         return format!(
@@ -1716,8 +1499,9 @@ impl Chain {
         }
         for (li, l) in self.links.iter().enumerate() {
             if let Some(p) = l.int_dof.iter().position(|&d| d == dof) {
-                let (e, k) = (p / 3, p % 3);
-                let (what, at) = [("v", 1.0 / 3.0), ("v", 2.0 / 3.0), ("ψ", 0.5)][k];
+                let interior = l.element.kind.interior();
+                let (e, k) = (p / interior.len(), p % interior.len());
+                let (what, at) = (interior[k].label, interior[k].at);
                 return format!(
                     "link {} element {} interior {what} (x = {:.4})",
                     li + 1,
@@ -1786,14 +1570,14 @@ impl Chain {
             if l.axial {
                 put(jac, l.u_dof[m], ex);
             } else if l.foreshortening {
-                let tb = &self.tables[k];
+                let tb = &l.element.quad;
                 for e in 0..l.n_el {
                     let dofs = l.elem_dofs(e);
                     let d = Self::elem_v(q, &dofs);
                     let ne = l.ne;
                     let mut ds = [0.0; MAXE];
-                    for j in 0..NSUB {
-                        for kk in 0..NSG {
+                    for j in 0..tb.ng + 1 {
+                        for kk in 0..tb.nsg {
                             let dn = &tb.sub_dn[j][kk];
                             let c = -tb.sub_wh[j][kk] * dotn(dn, &d, ne);
                             for a in 0..ne {

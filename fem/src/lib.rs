@@ -195,7 +195,7 @@ impl FemBackend {
         let n_el = settings::elements(&settings.discretization)?;
         let link = &scene.links[0];
         let omega = linear::hub_rate(link)?;
-        let element = linear::ElementKind::for_link(link, settings.discretization.element)?;
+        let element = element::for_link(link, settings.discretization.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
         let modes = modes::link_modes(&sys, count)?;
         let stations = scene.simulation.field_stations;
@@ -233,7 +233,7 @@ impl FemBackend {
         let n_el = settings::elements(&settings.discretization)?;
         let link = &scene.links[0];
         let omega = linear::hub_rate(link)?;
-        let element = linear::ElementKind::for_link(link, settings.discretization.element)?;
+        let element = element::for_link(link, settings.discretization.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
         let (tip_deflection, tip_rotation) = statics::solve(scene, &sys)?;
         Ok(StaticResult {
@@ -276,13 +276,6 @@ impl Backend for FemBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
-        if settings.discretization.element == Some(data::FemElement::HermiteQuintic) {
-            return Err(FemError::unsupported(
-                "fem run: the `hermite-quintic` element is implemented for modes and statics \
-                 only; dynamics uses `hermite-cubic` (omit `discretization.element`)",
-            )
-            .into());
-        }
         Ok(run::simulate(scene, settings)?)
     }
 }

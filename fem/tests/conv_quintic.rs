@@ -185,7 +185,7 @@ fn sys_quintic_rotating_beam_agrees_with_extrapolated_cubic() {
 }
 
 #[test]
-fn sys_quintic_dof_count_and_refusals() {
+fn sys_quintic_dof_count_in_modes_and_dynamics_and_shear_refusal() {
     let sc = data::load_scene("cantilever").unwrap();
     let n = 8;
     let plan = FemBackend
@@ -195,11 +195,9 @@ fn sys_quintic_dof_count_and_refusals() {
     assert_eq!(plan.total(), 4 * n);
     let m = FemBackend.modes(&sc, &settings(n, QUINTIC), 2).unwrap();
     assert_eq!(m.cost.dofs, plan.total());
-    // Dynamics: refused by name, not run with the cubic.
-    match FemBackend.simulate(&sc, &settings(n, QUINTIC)) {
-        Err(BackendError::Unsupported(msg)) => assert!(msg.contains("hermite-quintic"), "{msg}"),
-        other => panic!("{other:?}"),
-    }
+    // Dynamics builds the same element: the run's DOFs are the plan's.
+    let run = FemBackend.simulate(&sc, &settings(n, QUINTIC)).unwrap();
+    assert_eq!(run.cost.dofs, plan.total());
     // A shear link uses the Timoshenko element: asking for the quintic is a settings error.
     let tim = data::load_scene("cantilever-timoshenko").unwrap();
     match FemBackend.modes(&tim, &settings(n, QUINTIC), 2) {
