@@ -22,12 +22,13 @@
 //!
 //! Lagrange's equations are R(q, q̇, q̈, t) = Σ m Jᵀ(r̈ − g) + ∂U/∂q + C q̇ − Q = 0 with
 //! J = ∂r/∂q ([`chain`]), evaluated in O(n) per link by a forward kinematic and a backward force
-//! pass. Discretization: Hermite-cubic v (+ linear u) per element ([`element`]), consistent mass
-//! by 4-point Gauss quadrature (frequency error O(h⁴)). Modes and statics ([`linear`]) also offer
-//! the hierarchical Hermite-quintic element (`discretization.element = "hermite-quintic"`: cubic
-//! plus two C¹ interior bubbles, frequency error O(h⁸); dynamics refuses it). `shear` links use
-//! the Timoshenko element with cubic v and quadratic ψ (locking-free, O(h⁴)) in modes, statics
-//! and dynamics; its interior DOFs v(⅓), v(⅔), ψ(½) are global DOFs, never condensed.
+//! pass. Discretization: one [`element::Element`] per link, the same in modes, statics
+//! ([`linear`]) and dynamics ([`chain`]): Hermite-cubic v (+ linear u), consistent mass by
+//! 4-point Gauss quadrature (frequency error O(h⁴)); the hierarchical Hermite-quintic element
+//! (`discretization.element = "hermite-quintic"`: cubic plus two C¹ interior bubbles, 6-point
+//! Gauss, frequency error O(h⁸)); for `shear` links the Timoshenko element with cubic v and
+//! quadratic ψ (locking-free, O(h⁴)). Interior DOFs (the quintic's bubble amplitudes, the
+//! Timoshenko v(⅓), v(⅔), ψ(½)) are global DOFs, never condensed.
 //!
 //! Timoshenko links without rotary inertia have massless directions (every ψ, and turning the
 //! frame against v = −αx when the hub has no inertia): their equations are static balances
@@ -125,9 +126,9 @@
 //! in `simulate`; their work is the ledger input `applied_load`.
 //!
 //! ## Layers
-//! [`element`] (element operators, tested alone) → [`linear`] (assembled linear link: modes,
-//! statics) and [`chain`] (nonlinear floating-frame system) → [`band`] (bordered-band solver,
-//! linear cost per step) → [`integrator`] (generalized-α / central difference, `step()`) and
+//! [`element`] (element trait and registry, element operators tested alone) → [`linear`]
+//! (assembled linear link: modes, statics) and [`chain`] (nonlinear floating-frame system) →
+//! [`band`] (faer sparse LU of the bordered-band Newton matrix, symbolic part reused) → [`integrator`] (generalized-α / central difference, `step()`) and
 //! [`midpoint`] (energy-midpoint step, bordered by [`contact`] when the tip is on the surface, and
 //! by [`friction`] for the bilateral wall) →
 //! [`run`] (observables, energy ledger, cost).
