@@ -1,8 +1,8 @@
 //! Linear model of one clamped link (modes and statics): dense K and M about the reference state.
 //!
-//! Elements ([`crate::element::for_link`]): Hermite cubic (default) or hierarchical Hermite quintic for
-//! Euler–Bernoulli links (`discretization.element`), the cubic-v/quadratic-θ element for `shear`
-//! links. DOF order per element e = 0..n−1: its interior DOFs (quintic bubbles a₁, a₂; Timoshenko
+//! Elements ([`crate::element::for_link`]): Hermite cubic (default) or hierarchical Hermite
+//! quintic for Euler–Bernoulli links (`discretization.element`), the cubic-v/quadratic-θ element
+//! for `shear` links. DOF order per element e = 0..n−1: its interior DOFs (quintic bubbles a₁, a₂; Timoshenko
 //! v(⅓), v(⅔), θ(½)), then the DOFs of its end node e+1: v, rotation (v′ for Euler–Bernoulli, θ
 //! for Timoshenko), then u when `axial` is on. Node 0 is clamped and has no DOFs. Interleaving the
 //! interior DOFs keeps the matrices banded. For a hub spinning at constant Ω (prescribed
