@@ -1,45 +1,114 @@
-//! Bordered band solver for the Newton matrix of a floating-frame chain.
+//! Linear solvers for the Newton matrix of a floating-frame chain, through faer.
 //!
-//! Ordering: the n_I *interior* elastic DOFs first (banded, half-bandwidth b, because elements only
-//! couple neighbouring nodes), then the n_B *border* DOFs (free joint angles and the tip-node DOFs of
-//! links that carry a child), which couple densely to whole links. Factorization: band LU of the
-//! interior block (no pivoting: the block is dominated by the positive definite c·M + K), then
-//! the small dense Schur complement with partial pivoting. Cost O(n_I b² + n_I b n_B + n_B³):
-//! linear in the number of elements. All storage is allocated once; factorize/solve allocate nothing.
+//! [`BorderedBand`]: the pattern of the chain's Newton matrix is fixed by its DOF layout. The
+//! n_I *interior* elastic DOFs come first and form a band of half-bandwidth b (elements only couple
+//! neighbouring nodes); the n_B *border* DOFs (free joint angles and the tip-node DOFs of links
+//! that carry a child) couple densely to whole links. That pattern is built once as a compressed
+//! sparse column structure, with faer's symbolic LU (COLAMD ordering) of it; every Newton matrix
+//! reuses both and only refactorizes numerically (sparse LU with partial pivoting), into storage
+//! and a workspace allocated once: factorize/solve allocate nothing.
+//!
+//! [`DenseLu`]: dense LU with partial pivoting (faer `lu_in_place`) for the small dense systems:
+//! the exact finite-difference Jacobian of chains whose foreshortening couples whole links to
+//! the joint angles, mass matrices of the contact and friction maps, the massless-direction
+//! balance.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::factor::lu_in_place;
+use faer::linalg::triangular_solve::{
+    solve_unit_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, Mat, MatMut, Par};
 
 use crate::error::FemError;
 
-#[derive(Debug, Clone)]
+/// The chain's Newton matrix in its fixed bordered-band pattern, with its sparse LU.
 pub struct BorderedBand {
     ni: usize,
     nb: usize,
     b: usize,
-    /// Interior band, row-major: band[i*(2b+1) + (j − i + b)].
-    band: Vec<f64>,
-    /// S_IB (n_I × n_B), row-major.
-    ib: Vec<f64>,
-    /// S_BI (n_B × n_I), row-major.
-    bi: Vec<f64>,
-    /// S_BB (n_B × n_B); after factorization the LU of the Schur complement.
-    schur: DenseLu,
-    /// Y = A⁻¹ S_IB after factorization (n_I × n_B, row-major).
-    y: Vec<f64>,
-    tmp_b: Vec<f64>,
+    /// Column pointers of the pattern (column j < n_I: rows of the band, then the border rows;
+    /// border column: every row).
+    col_ptr: Vec<usize>,
+    pattern: SymbolicSparseColMat<usize>,
+    /// Entries in pattern order.
+    values: Vec<f64>,
+    symbolic: SymbolicLu<usize>,
+    numeric: NumericLu<usize, f64>,
+    scratch: StackReq,
+    mem: MemBuffer,
     factored: bool,
+}
+
+impl Clone for BorderedBand {
+    fn clone(&self) -> Self {
+        BorderedBand {
+            ni: self.ni,
+            nb: self.nb,
+            b: self.b,
+            col_ptr: self.col_ptr.clone(),
+            pattern: self.pattern.clone(),
+            values: self.values.clone(),
+            symbolic: self.symbolic.clone(),
+            numeric: self.numeric.clone(),
+            scratch: self.scratch,
+            mem: MemBuffer::new(self.scratch),
+            factored: self.factored,
+        }
+    }
+}
+
+impl std::fmt::Debug for BorderedBand {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("BorderedBand")
+            .field("interior", &self.ni)
+            .field("border", &self.nb)
+            .field("half_bandwidth", &self.b)
+            .field("nnz", &self.values.len())
+            .field("factored", &self.factored)
+            .finish()
+    }
 }
 
 impl BorderedBand {
     pub fn new(ni: usize, nb: usize, b: usize) -> Self {
+        let n = ni + nb;
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut rows = Vec::new();
+        col_ptr.push(0);
+        for j in 0..n {
+            if j < ni {
+                let (lo, hi) = (j.saturating_sub(b), (j + b).min(ni - 1));
+                rows.extend(lo..=hi);
+                rows.extend(ni..n);
+            } else {
+                rows.extend(0..n);
+            }
+            col_ptr.push(rows.len());
+        }
+        let nnz = rows.len();
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr.clone(), None, rows);
+        // The pattern is structurally nonsingular (full diagonal): the symbolic factorization
+        // cannot fail.
+        let symbolic = factorize_symbolic_lu(pattern.rb(), Default::default())
+            .expect("symbolic LU of the bordered-band pattern");
+        let scratch = symbolic
+            .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
         BorderedBand {
             ni,
             nb,
             b,
-            band: vec![0.0; ni * (2 * b + 1)],
-            ib: vec![0.0; ni * nb],
-            bi: vec![0.0; nb * ni],
-            schur: DenseLu::new(nb),
-            y: vec![0.0; ni * nb],
-            tmp_b: vec![0.0; nb],
+            col_ptr,
+            pattern,
+            values: vec![0.0; nnz],
+            symbolic,
+            numeric: NumericLu::new(),
+            scratch,
+            mem: MemBuffer::new(scratch),
             factored: false,
         }
     }
@@ -53,146 +122,83 @@ impl BorderedBand {
     }
 
     pub fn clear(&mut self) {
-        self.band.iter_mut().for_each(|x| *x = 0.0);
-        self.ib.iter_mut().for_each(|x| *x = 0.0);
-        self.bi.iter_mut().for_each(|x| *x = 0.0);
-        self.schur.a.iter_mut().for_each(|x| *x = 0.0);
+        self.values.iter_mut().for_each(|x| *x = 0.0);
         self.factored = false;
+    }
+
+    /// Position of entry (i, j) in `values` (None outside the pattern).
+    #[inline]
+    fn position(&self, i: usize, j: usize) -> Option<usize> {
+        let (ni, b) = (self.ni, self.b);
+        let start = self.col_ptr[j];
+        if j >= ni {
+            return Some(start + i);
+        }
+        let lo = j.saturating_sub(b);
+        let hi = (j + b).min(ni - 1);
+        if i < ni {
+            (lo..=hi).contains(&i).then(|| start + (i - lo))
+        } else {
+            Some(start + (hi - lo + 1) + (i - ni))
+        }
     }
 
     /// Adds `v` to entry (i, j) of the global matrix. Interior pairs must lie within the band.
     #[inline]
     pub fn add(&mut self, i: usize, j: usize, v: f64) {
-        let (ni, nb, b) = (self.ni, self.nb, self.b);
-        match (i < ni, j < ni) {
-            (true, true) => {
-                debug_assert!(i.abs_diff(j) <= b, "entry ({i},{j}) outside band {b}");
-                self.band[i * (2 * b + 1) + (j + b - i)] += v;
-            }
-            (true, false) => self.ib[i * nb + (j - ni)] += v,
-            (false, true) => self.bi[(i - ni) * ni + j] += v,
-            (false, false) => self.schur.a[(i - ni) * nb + (j - ni)] += v,
+        let p = self.position(i, j);
+        debug_assert!(p.is_some(), "entry ({i},{j}) outside band {}", self.b);
+        if let Some(p) = p {
+            self.values[p] += v;
         }
     }
 
     /// Entry (i, j) before factorization.
     pub fn get(&self, i: usize, j: usize) -> f64 {
-        let (ni, nb, b) = (self.ni, self.nb, self.b);
-        match (i < ni, j < ni) {
-            (true, true) => {
-                if i.abs_diff(j) <= b {
-                    self.band[i * (2 * b + 1) + (j + b - i)]
-                } else {
-                    0.0
-                }
-            }
-            (true, false) => self.ib[i * nb + (j - ni)],
-            (false, true) => self.bi[(i - ni) * ni + j],
-            (false, false) => self.schur.a[(i - ni) * nb + (j - ni)],
-        }
+        self.position(i, j).map_or(0.0, |p| self.values[p])
     }
 
-    /// y = A x (before factorization).
+    /// y = A x (before factorization). Each row sums its entries in increasing column order.
     pub fn matvec(&self, x: &[f64], y: &mut [f64]) {
-        let (ni, nb, b) = (self.ni, self.nb, self.b);
-        let w = 2 * b + 1;
-        for i in 0..ni {
-            let lo = i.saturating_sub(b);
-            let hi = (i + b).min(ni - 1);
-            let mut s = 0.0;
-            for j in lo..=hi {
-                s += self.band[i * w + (j + b - i)] * x[j];
+        let n = self.n();
+        let rows = self.pattern.row_idx();
+        y[..n].iter_mut().for_each(|v| *v = 0.0);
+        for j in 0..n {
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                y[rows[p]] += self.values[p] * x[j];
             }
-            for k in 0..nb {
-                s += self.ib[i * nb + k] * x[ni + k];
-            }
-            y[i] = s;
-        }
-        for r in 0..nb {
-            let mut s = 0.0;
-            for j in 0..ni {
-                s += self.bi[r * ni + j] * x[j];
-            }
-            for k in 0..nb {
-                s += self.schur.a[r * nb + k] * x[ni + k];
-            }
-            y[ni + r] = s;
         }
     }
 
-    /// In-place LU of the band (Doolittle, no pivoting).
-    fn band_factor(&mut self) -> Result<(), usize> {
-        let (n, b) = (self.ni, self.b);
-        let w = 2 * b + 1;
-        for k in 0..n {
-            let piv = self.band[k * w + b];
-            if piv == 0.0 || !piv.is_finite() {
-                return Err(k);
-            }
-            let hi = (k + b).min(n.saturating_sub(1));
-            for i in (k + 1)..=hi {
-                let l = self.band[i * w + (k + b - i)] / piv;
-                self.band[i * w + (k + b - i)] = l;
-                for j in (k + 1)..=hi {
-                    self.band[i * w + (j + b - i)] -= l * self.band[k * w + (j + b - k)];
-                }
-            }
-        }
-        Ok(())
-    }
-
-    fn band_solve(band: &[f64], n: usize, b: usize, x: &mut [f64], stride: usize, col: usize) {
-        let w = 2 * b + 1;
-        for i in 0..n {
-            let lo = i.saturating_sub(b);
-            let mut s = x[i * stride + col];
-            for j in lo..i {
-                s -= band[i * w + (j + b - i)] * x[j * stride + col];
-            }
-            x[i * stride + col] = s;
-        }
-        for i in (0..n).rev() {
-            let hi = (i + b).min(n - 1);
-            let mut s = x[i * stride + col];
-            for j in (i + 1)..=hi {
-                s -= band[i * w + (j + b - i)] * x[j * stride + col];
-            }
-            x[i * stride + col] = s / band[i * w + b];
-        }
-    }
-
-    /// Factorizes the assembled matrix (numeric only: the pattern is fixed at construction).
+    /// Factorizes the assembled matrix (numeric only: the pattern and its symbolic LU are fixed
+    /// at construction).
     pub fn factorize(&mut self) -> Result<(), FemError> {
-        let (ni, nb) = (self.ni, self.nb);
-        self.band_factor().map_err(|p| FemError::Singular {
-            what: "Newton (interior band)".into(),
-            pivot: p,
-            t: f64::NAN,
-        })?;
-        // Y = A⁻¹ S_IB, column by column.
-        self.y.copy_from_slice(&self.ib);
-        for c in 0..nb {
-            Self::band_solve(&self.band, ni, self.b, &mut self.y, nb, c);
-        }
-        // Schur complement S = S_BB − S_BI Y.
-        for r in 0..nb {
-            for c in 0..nb {
-                let mut s = 0.0;
-                for j in 0..ni {
-                    s += self.bi[r * ni + j] * self.y[j * nb + c];
-                }
-                self.schur.a[r * nb + c] -= s;
-            }
-        }
-        // Dense LU with partial pivoting.
-        self.schur.factorize().map_err(|e| match e {
-            FemError::Singular { pivot, .. } => FemError::Singular {
-                what: "Newton (border Schur complement)".into(),
-                pivot: ni + pivot,
+        self.factored = false;
+        if let Some(p) = self.values.iter().position(|v| !v.is_finite()) {
+            let col = self.col_ptr.partition_point(|&c| c <= p) - 1;
+            return Err(FemError::Singular {
+                what: "Newton (non-finite entry)".into(),
+                pivot: col,
                 t: f64::NAN,
-            },
-            other => other,
-        })?;
+            });
+        }
+        let a = SparseColMatRef::new(self.pattern.rb(), &self.values);
+        self.symbolic
+            .factorize_numeric_lu(
+                &mut self.numeric,
+                a,
+                Par::Seq,
+                MemStack::new(&mut self.mem),
+                Default::default(),
+            )
+            .map_err(|e| FemError::Singular {
+                what: "Newton (sparse LU)".into(),
+                pivot: match e {
+                    faer::sparse::linalg::LuError::SymbolicSingular { index } => index,
+                    faer::sparse::linalg::LuError::Generic(_) => 0,
+                },
+                t: f64::NAN,
+            })?;
         self.factored = true;
         Ok(())
     }
@@ -200,68 +206,82 @@ impl BorderedBand {
     /// Solves A x = r in place (after [`BorderedBand::factorize`]).
     pub fn solve_in_place(&mut self, x: &mut [f64]) {
         debug_assert!(self.factored);
-        let (ni, nb) = (self.ni, self.nb);
-        Self::band_solve(&self.band, ni, self.b, x, 1, 0);
-        // r_B − S_BI x_I'
-        for r in 0..nb {
-            let mut s = x[ni + r];
-            for j in 0..ni {
-                s -= self.bi[r * ni + j] * x[j];
-            }
-            self.tmp_b[r] = s;
-        }
-        self.schur.solve_in_place(&mut self.tmp_b);
-        for i in 0..ni {
-            let mut s = 0.0;
-            for c in 0..nb {
-                s += self.y[i * nb + c] * self.tmp_b[c];
-            }
-            x[i] -= s;
-        }
-        x[ni..].copy_from_slice(&self.tmp_b);
+        let n = self.n();
+        let lu = LuRef::new_unchecked(&self.symbolic, &self.numeric);
+        lu.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut x[..n], n, 1),
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+        );
     }
 }
 
-/// Dense LU with partial pivoting: the border Schur complement above, and the exact
-/// finite-difference Jacobian of chains whose foreshortening couples whole links to the joint
-/// angles.
+/// Dense LU with partial pivoting (faer), factorized in place.
 #[derive(Debug, Clone)]
 pub struct DenseLu {
     n: usize,
-    a: Vec<f64>,
-    piv: Vec<usize>,
+    a: Mat<f64>,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    /// Row interchanges equivalent to the pivoting permutation: applying
+    /// swap(k, swaps[k]) for k = 0, 1, … moves row perm[k] of the right-hand side to k.
+    swaps: Vec<usize>,
+    row_at: Vec<usize>,
+    /// Workspace of `lu_in_place` (allocated once).
+    scratch: Vec<std::mem::MaybeUninit<u8>>,
 }
 
 impl DenseLu {
     pub fn new(n: usize) -> Self {
         DenseLu {
             n,
-            a: vec![0.0; n * n],
-            piv: vec![0; n],
+            a: Mat::zeros(n, n),
+            perm: vec![0; n],
+            perm_inv: vec![0; n],
+            swaps: vec![0; n],
+            row_at: vec![0; n],
+            scratch: {
+                let req = faer::linalg::lu::partial_pivoting::factor::lu_in_place_scratch::<
+                    usize,
+                    f64,
+                >(n, n, Par::Seq, Default::default());
+                vec![std::mem::MaybeUninit::new(0); req.size_bytes() + req.align_bytes()]
+            },
         }
     }
+
     /// Column j of the matrix (before factorization).
     pub fn set_column(&mut self, j: usize, col: &[f64]) {
         for i in 0..self.n {
-            self.a[i * self.n + j] = col[i];
+            self.a[(i, j)] = col[i];
         }
     }
+
     pub fn factorize(&mut self) -> Result<(), FemError> {
         let n = self.n;
+        for j in 0..n {
+            for i in 0..n {
+                if !self.a[(i, j)].is_finite() {
+                    return Err(FemError::Singular {
+                        what: "Newton (dense, non-finite entry)".into(),
+                        pivot: j,
+                        t: f64::NAN,
+                    });
+                }
+            }
+        }
+        let stack = MemStack::new(&mut self.scratch);
+        lu_in_place(
+            self.a.as_mut(),
+            &mut self.perm,
+            &mut self.perm_inv,
+            Par::Seq,
+            stack,
+            Default::default(),
+        );
         for k in 0..n {
-            let mut p = k;
-            for i in (k + 1)..n {
-                if self.a[i * n + k].abs() > self.a[p * n + k].abs() {
-                    p = i;
-                }
-            }
-            self.piv[k] = p;
-            if p != k {
-                for j in 0..n {
-                    self.a.swap(k * n + j, p * n + j);
-                }
-            }
-            let d = self.a[k * n + k];
+            let d = self.a[(k, k)];
             if d == 0.0 || !d.is_finite() {
                 return Err(FemError::Singular {
                     what: "Newton (dense)".into(),
@@ -269,42 +289,73 @@ impl DenseLu {
                     t: f64::NAN,
                 });
             }
-            for i in (k + 1)..n {
-                let l = self.a[i * n + k] / d;
-                self.a[i * n + k] = l;
-                if l != 0.0 {
-                    for j in (k + 1)..n {
-                        self.a[i * n + j] -= l * self.a[k * n + j];
-                    }
-                }
-            }
+        }
+        // Permutation → interchanges: `where_row[r]` is the current position of original row r,
+        // `row_at[i]` the original row at position i (perm_inv is reused for the former).
+        let (where_row, row_at) = (&mut self.perm_inv, &mut self.row_at);
+        for r in 0..n {
+            where_row[r] = r;
+            row_at[r] = r;
+        }
+        for k in 0..n {
+            let r = self.perm[k];
+            let p = where_row[r];
+            self.swaps[k] = p;
+            let displaced = row_at[k];
+            row_at[k] = r;
+            row_at[p] = displaced;
+            where_row[r] = k;
+            where_row[displaced] = p;
         }
         Ok(())
     }
+
     pub fn solve_in_place(&self, x: &mut [f64]) {
         let n = self.n;
-        // Rows were swapped whole during factorization: permute b completely first.
         for k in 0..n {
-            x.swap(k, self.piv[k]);
+            x.swap(k, self.swaps[k]);
         }
-        for k in 0..n {
-            for i in (k + 1)..n {
-                x[i] -= self.a[i * n + k] * x[k];
-            }
-        }
-        for k in (0..n).rev() {
-            let mut s = x[k];
-            for j in (k + 1)..n {
-                s -= self.a[k * n + j] * x[j];
-            }
-            x[k] = s / self.a[k * n + k];
-        }
+        let mut rhs = MatMut::from_column_major_slice_mut(&mut x[..n], n, 1);
+        solve_unit_lower_triangular_in_place(self.a.as_ref(), rhs.rb_mut(), Par::Seq);
+        solve_upper_triangular_in_place(self.a.as_ref(), rhs, Par::Seq);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sys_dense_lu_solves_a_system_that_needs_pivoting() {
+        // Zero leading diagonal entries: only a pivoted LU gets through.
+        let n = 7;
+        let a = |i: usize, j: usize| {
+            if i == j {
+                if i.is_multiple_of(3) { 0.0 } else { 4.0 }
+            } else {
+                ((i * 7 + j * 3) as f64 * 0.61).sin()
+            }
+        };
+        let mut lu = DenseLu::new(n);
+        for j in 0..n {
+            let col: Vec<f64> = (0..n).map(|i| a(i, j)).collect();
+            lu.set_column(j, &col);
+        }
+        lu.factorize().unwrap();
+        let x_true: Vec<f64> = (0..n).map(|i| 1.0 + 0.3 * i as f64).collect();
+        let mut r: Vec<f64> = (0..n)
+            .map(|i| (0..n).map(|j| a(i, j) * x_true[j]).sum())
+            .collect();
+        lu.solve_in_place(&mut r);
+        for i in 0..n {
+            assert!(
+                (r[i] - x_true[i]).abs() < 1e-12,
+                "{i}: {} vs {}",
+                r[i],
+                x_true[i]
+            );
+        }
+    }
 
     #[test]
     fn sys_bordered_band_solves_like_dense() {

@@ -6,16 +6,22 @@
 //! Rᵢ₊₁ = rᵢ(Lᵢ) (scenes.md joint convention), with β the section angle relative to the frame:
 //! v′ for Euler–Bernoulli links, the section rotation ψ for Timoshenko (`shear`) links.
 //!
-//! Elements: Hermite cubic v (DOFs v, v′ per node), or for `shear` links the Timoshenko element
-//! of [`crate::element::timoshenko`]: cubic Lagrange v, quadratic ψ, DOFs (v, ψ) per node plus
-//! v(⅓), v(⅔), ψ(½) per element (global, numbered just before the element's end node so the band
-//! stays 2·dpn + 2 wide). Its strain energy ½∫EI ψ′² + ½∫κGA(v′ − ψ)² is locking-free (the
-//! Kirchhoff subspace is the C¹ cubics) and reduces to the Hermite cubic as κGA → ∞; the
-//! foreshortening and membrane strain use the centre-line slope v′ (quartic v′²: integrated
-//! exactly). Kelvin–Voigt acts on the curvature (β′) only. Section rotary inertia adds
-//! ½∫ρI(φ̇ + β̇)² (angle linear in q: mass only). The "tip slope" column of J that an ancestor
-//! link contributes is β(L), so the per-point Jacobian columns (joint, tip slope, tip v, tip u
-//! per ancestor) are the same for both element kinds.
+//! Elements: every link is meshed with one [`crate::element::Element`] (Hermite cubic or
+//! quintic for Euler–Bernoulli links, the Timoshenko element for `shear` links), whose local
+//! DOFs are (v, β) at both end nodes plus its interior DOFs (global, numbered just before the
+//! element's end node so the band stays 2·dpn − 1 + n_interior wide). The chain integrates
+//! inertia, loads and foreshortening from the element's shapes tabulated at its own Gauss orders
+//! ([`crate::element::Quadrature`]); the elastic force, tangent and strain energy come from the
+//! element. For a Timoshenko link the foreshortening and membrane strain use the centre-line
+//! slope v′, and its ψ DOFs move no material point. Kelvin–Voigt acts on the curvature (β′)
+//! only. Section rotary inertia adds ½∫ρI(φ̇ + β̇)² (angle linear in q: mass only). The "tip
+//! slope" column of J that an ancestor link contributes is β(L), so the per-point Jacobian
+//! columns (joint, tip slope, tip v, tip u per ancestor) are the same for every element.
+//!
+//! Modules, one job each: [`Chain::with_element`] here builds the DOF layout and the element
+//! operators; `kinematics` is the forward pass (frame and point kinematics, tip kinematics for
+//! observables and contact), `forces` the backward pass (the residual), `newton` the Newton
+//! matrix, `energies` the stored energies and powers; `geometry` holds the planar vector helpers.
 //!
 //! With T = ½Σ m|ṙ|² (Gauss quadrature of ρA, tip masses, tip and hub inertias) and
 //! V = U_elastic + U_joint − Σ m g·r, Lagrange's equations are exactly
@@ -28,63 +34,29 @@
 //! finite differences of the residual). With foreshortening it omits the ∂s/∂q couplings, which
 //! are dense over a link: O(v′²) between elastic DOFs but O(v′) in the joint rows — harmless for
 //! a prescribed hub (spin-up: 2–3 Newton iterations per step), while free chains with
-//! foreshortening use an exact finite-difference Jacobian instead (see `integrator`).
+//! foreshortening use an exact finite-difference Jacobian instead (see `method::newton`).
 
+use data::FemElement;
 use data::scene::{Gravity, Link, PrescribedMotion, TorqueLaw};
 
 use crate::band::BorderedBand;
-use crate::element::euler_bernoulli as eb;
-use crate::element::hermite::{dot4, hermite};
-use crate::element::quadrature::gauss01;
-use crate::element::timoshenko as timo;
+use crate::element::tables::dotn;
+use crate::element::{self, ElementDofs, InteriorField, MeshElement};
 use crate::error::FemError;
 
-/// Index value meaning "no DOF" (clamped node or prescribed joint).
-pub const NONE: usize = usize::MAX;
-/// Gauss points per element for inertia and loads (exact consistent mass).
-const NG: usize = 4;
-/// Sub-intervals per element for the foreshortening integrals (between Gauss points).
-const NSUB: usize = NG + 1;
-/// Gauss points per sub-interval (v′² and v′N′ are quartic: 3 points are exact).
-const NSG: usize = 3;
+pub use crate::element::{MAXE, NONE};
+pub use forces::Parts;
+pub use newton::NewtonCoefficients;
+
+mod energies;
+mod forces;
+mod geometry;
+mod kinematics;
+mod newton;
 /// Longest chain the backend builds (fixed-size per-point column buffers, no allocation).
 pub const MAX_LINKS: usize = 6;
 /// Ancestor columns of J at most: joint, tip slope, tip v, tip u per link.
 const MAX_COLUMNS: usize = 4 * MAX_LINKS;
-
-#[inline]
-fn perp(a: [f64; 2]) -> [f64; 2] {
-    [-a[1], a[0]]
-}
-#[inline]
-fn rot(phi: f64, a: [f64; 2]) -> [f64; 2] {
-    let (s, c) = phi.sin_cos();
-    [c * a[0] - s * a[1], s * a[0] + c * a[1]]
-}
-#[inline]
-fn rot_t(phi: f64, a: [f64; 2]) -> [f64; 2] {
-    rot(-phi, a)
-}
-#[inline]
-fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
-    a[0] * b[1] - a[1] * b[0]
-}
-#[inline]
-fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
-    a[0] * b[0] + a[1] * b[1]
-}
-#[inline]
-fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    [a[0] + b[0], a[1] + b[1]]
-}
-#[inline]
-fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    [a[0] - b[0], a[1] - b[1]]
-}
-#[inline]
-fn scale(s: f64, a: [f64; 2]) -> [f64; 2] {
-    [s * a[0], s * a[1]]
-}
 
 /// The joint at a link's root.
 #[derive(Debug, Clone)]
@@ -114,19 +86,6 @@ impl JointModel {
     }
 }
 
-/// Local DOFs per element at most (Timoshenko: v₁, ψ₁, v₂, ψ₂, v(⅓), v(⅔), ψ(½)).
-pub const MAXE: usize = timo::NDOF;
-
-/// Σ aₖ dₖ over the first `ne` entries (same summation order as [`dot4`] for ne = 4).
-#[inline]
-fn dotn(a: &[f64; MAXE], d: &[f64; MAXE], ne: usize) -> f64 {
-    let mut s = 0.0;
-    for k in 0..ne {
-        s += a[k] * d[k];
-    }
-    s
-}
-
 /// One link with its element mesh and DOF map.
 #[derive(Debug, Clone)]
 pub struct LinkModel {
@@ -139,9 +98,9 @@ pub struct LinkModel {
     pub ea: f64,
     pub axial: bool,
     pub foreshortening: bool,
-    /// Timoshenko link (`shear`): cubic v, quadratic ψ, three interior DOFs per element.
+    /// Timoshenko link (`shear`): the section angle is a field of its own.
     pub shear: bool,
-    /// Local DOFs per element: 4 (Hermite cubic) or 7 (Timoshenko).
+    /// Local DOFs per element (4 nodal + interior).
     pub ne: usize,
     /// Section rotary inertia ρI when `rotary_inertia` is on (else 0).
     pub rho_i: f64,
@@ -156,106 +115,34 @@ pub struct LinkModel {
     pub v_dof: Vec<usize>,
     pub r_dof: Vec<usize>,
     pub u_dof: Vec<usize>,
-    /// Timoshenko interior DOFs (v(⅓), v(⅔), ψ(½)) of element e at 3e..3e+3 (empty otherwise).
+    /// Element-interior DOFs of element e at ni·e..ni·(e + 1), ni = the element's interior
+    /// count (e.g. Timoshenko v(⅓), v(⅔), ψ(½); quintic a₁, a₂; empty for the cubic).
     pub int_dof: Vec<usize>,
-    /// Element stiffness (same for all elements of the link), first `ne` rows/columns used:
-    /// ∫EI v″² (Euler–Bernoulli) or ∫EI ψ′² + κGA(v′ − ψ)² (Timoshenko).
-    pub k_el: [[f64; MAXE]; MAXE],
-    /// Bending part ∫EI (section angle)′² of `k_el` (Kelvin–Voigt acts on it only).
-    pub kb_el: [[f64; MAXE]; MAXE],
+    /// The element of this link: kind, operators and tabulated shapes.
+    pub element: MeshElement,
 }
 
 impl LinkModel {
+    /// Element-interior DOFs per element.
+    fn n_interior(&self) -> usize {
+        self.ne - 4
+    }
+
     fn elem_dofs(&self, e: usize) -> [usize; MAXE] {
         let mut d = [NONE; MAXE];
         d[0] = self.v_dof[e];
         d[1] = self.r_dof[e];
         d[2] = self.v_dof[e + 1];
         d[3] = self.r_dof[e + 1];
-        if self.shear {
-            d[4..7].copy_from_slice(&self.int_dof[3 * e..3 * e + 3]);
-        }
+        let ni = self.n_interior();
+        d[4..4 + ni].copy_from_slice(&self.int_dof[ni * e..ni * (e + 1)]);
         d
     }
 
     /// Shape functions at local coordinate ξ of an element: (v, section angle).
     fn shapes_at(&self, xi: f64) -> ([f64; MAXE], [f64; MAXE]) {
-        let (mut n, mut b) = ([0.0; MAXE], [0.0; MAXE]);
-        if self.shear {
-            let s = timo::shapes(xi, self.h);
-            n = s.v;
-            b = s.th;
-        } else {
-            let s = hermite(xi, self.h);
-            n[..4].copy_from_slice(&s.n);
-            b[..4].copy_from_slice(&s.dn);
-        }
-        (n, b)
-    }
-}
-
-/// Quadrature tables shared by all elements of one link (they all have length h).
-#[derive(Debug, Clone)]
-struct LinkTables {
-    /// Main Gauss points: ξ, weight·h, v shapes N, their x-derivatives N′ and the section
-    /// angle shapes B (B = N′ for Euler–Bernoulli, the ψ shapes for Timoshenko).
-    xi: [f64; NG],
-    wh: [f64; NG],
-    n: [[f64; MAXE]; NG],
-    dn: [[f64; MAXE]; NG],
-    b: [[f64; MAXE]; NG],
-    /// Sub-interval points: weight·h and N′ (NSUB × NSG).
-    sub_wh: [[f64; NSG]; NSUB],
-    sub_dn: [[[f64; MAXE]; NSG]; NSUB],
-}
-
-impl LinkTables {
-    fn new(h: f64, shear: bool) -> Self {
-        let (p, w) = gauss01(NG);
-        let (ps, ws) = gauss01(NSG);
-        let mut t = LinkTables {
-            xi: [0.0; NG],
-            wh: [0.0; NG],
-            n: [[0.0; MAXE]; NG],
-            dn: [[0.0; MAXE]; NG],
-            b: [[0.0; MAXE]; NG],
-            sub_wh: [[0.0; NSG]; NSUB],
-            sub_dn: [[[0.0; MAXE]; NSG]; NSUB],
-        };
-        // (N, N′, B) at ξ.
-        let at = |xi: f64| {
-            let (mut n, mut dn, mut b) = ([0.0; MAXE], [0.0; MAXE], [0.0; MAXE]);
-            if shear {
-                let s = timo::shapes(xi, h);
-                n = s.v;
-                dn = s.dv;
-                b = s.th;
-            } else {
-                let s = hermite(xi, h);
-                n[..4].copy_from_slice(&s.n);
-                dn[..4].copy_from_slice(&s.dn);
-                b[..4].copy_from_slice(&s.dn);
-            }
-            (n, dn, b)
-        };
-        for g in 0..NG {
-            let (n, dn, b) = at(p[g]);
-            t.xi[g] = p[g];
-            t.wh[g] = w[g] * h;
-            t.n[g] = n;
-            t.dn[g] = dn;
-            t.b[g] = b;
-        }
-        for j in 0..NSUB {
-            let a = if j == 0 { 0.0 } else { p[j - 1] };
-            let b = if j == NG { 1.0 } else { p[j] };
-            for k in 0..NSG {
-                let xi = a + (b - a) * ps[k];
-                t.sub_wh[j][k] = ws[k] * (b - a) * h;
-                t.sub_dn[j][k] = at(xi).1;
-            }
-        }
-        t
+        let s = self.element.kind.shapes(xi, self.h);
+        (s.n, s.b)
     }
 }
 
@@ -286,37 +173,10 @@ pub struct FrameState {
     pub subtree_force: [f64; 2],
 }
 
-/// Element-averaged membrane strain of an extensible Timoshenko element,
-/// ε̄ = (u₂ − u₁)/h + (1/2h)∫v′² (the same locking-free averaged strain as the Euler–Bernoulli
-/// von Kármán element, with the Timoshenko v′; Gauss-4 integrates the quartic v′² exactly), and
-/// its gradient with respect to (u₁, u₂, element DOFs).
-fn membrane(
-    tb: &LinkTables,
-    h: f64,
-    u: [f64; 2],
-    d: &[f64; MAXE],
-    ne: usize,
-) -> (f64, [f64; MAXE + 2]) {
-    let mut half_int = 0.0;
-    let mut g = [0.0; MAXE + 2];
-    g[0] = -1.0 / h;
-    g[1] = 1.0 / h;
-    for k in 0..NG {
-        let dn = &tb.dn[k];
-        let vp = dotn(dn, d, ne);
-        half_int += tb.wh[k] * 0.5 * vp * vp;
-        for a in 0..ne {
-            g[2 + a] += tb.wh[k] / h * vp * dn[a];
-        }
-    }
-    ((u[1] - u[0]) / h + half_int / h, g)
-}
-
 /// The assembled chain model with preallocated work buffers.
 #[derive(Debug, Clone)]
 pub struct Chain {
     pub links: Vec<LinkModel>,
-    tables: Vec<LinkTables>,
     pub gravity: [f64; 2],
     pub ndof: usize,
     /// Interior/border split for the Newton matrix.
@@ -339,83 +199,21 @@ pub struct Chain {
     pub distributed_load: f64,
 }
 
-/// A column of J contributed by an ancestor (or own joint) DOF, in frame-i coordinates.
-#[derive(Debug, Clone, Copy, Default)]
-struct AncestorColumn {
-    dof: usize,
-    /// Rotation about a centre (`vec` = centre, `dvec` = its velocity) or translation along
-    /// `vec` (whose frame turns at `rate`).
-    rotation: bool,
-    vec: [f64; 2],
-    dvec: [f64; 2],
-    centre_acc: [f64; 2],
-    rate: f64,
-    rate_dot: f64,
-    /// Position along the chain (smaller = closer to the ground).
-    pos: f64,
-}
-
-/// A column of J evaluated at one mass point.
-#[derive(Debug, Clone, Copy, Default)]
-struct ColumnAt {
-    dof: usize,
-    j: [f64; 2],
-    jdot: [f64; 2],
-    rotation: bool,
-    pos: f64,
-    centre_acc: [f64; 2],
-    /// Angular velocity and acceleration of the frame a translation column is attached to.
-    rate: f64,
-    rate_dot: f64,
-}
-
-/// Which force groups [`Chain::residual_parts`] includes. The energy-consistent integrator
-/// needs them apart: the inertial operator alone gives mass products M(q)x = R_in(q, 0, x) and
-/// the velocity terms R_in(q, v, 0) = Ṁv − ∂T/∂q; the conservative group is ∇V; the rest is −Q.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Parts {
-    /// Σ m Jᵀ r̈ (with hub and tip rotary inertias).
-    pub inertia: bool,
-    /// ∂V/∂q: strain, joint springs, gravity.
-    pub conservative: bool,
-    /// −Q: applied joint torques and loads, joint dampers, Kelvin–Voigt.
-    pub nonconservative: bool,
-}
-
-impl Parts {
-    pub const ALL: Parts = Parts {
-        inertia: true,
-        conservative: true,
-        nonconservative: true,
-    };
-    pub const INERTIA: Parts = Parts {
-        inertia: true,
-        conservative: false,
-        nonconservative: false,
-    };
-    pub const CONSERVATIVE: Parts = Parts {
-        inertia: false,
-        conservative: true,
-        nonconservative: false,
-    };
-    pub const NONCONSERVATIVE: Parts = Parts {
-        inertia: false,
-        conservative: false,
-        nonconservative: true,
-    };
-}
-
-/// What the Newton matrix is a derivative of: S = ∂R/∂q̈ + c_v ∂R/∂q̇ + c_q ∂R/∂q.
-#[derive(Debug, Clone, Copy)]
-pub struct NewtonCoefficients {
-    pub c_a: f64,
-    pub c_v: f64,
-    pub c_q: f64,
-}
-
 impl Chain {
-    /// Builds the chain for `links` with `n_el` elements per link.
+    /// Builds the chain for `links` with `n_el` Hermite-cubic (Timoshenko for `shear` links)
+    /// elements per link.
     pub fn new(links: &[Link], gravity: Option<&Gravity>, n_el: usize) -> Result<Self, FemError> {
+        Self::with_element(links, gravity, n_el, None)
+    }
+
+    /// Builds the chain for `links` with `n_el` elements per link of the element `choice`
+    /// (`discretization.element`; see [`element::for_link`]).
+    pub fn with_element(
+        links: &[Link],
+        gravity: Option<&Gravity>,
+        n_el: usize,
+        choice: Option<FemElement>,
+    ) -> Result<Self, FemError> {
         let nl = links.len();
         if nl > MAX_LINKS {
             return Err(FemError::unsupported(format!(
@@ -433,26 +231,21 @@ impl Chain {
                 ));
             }
             let h = l.length / n_el as f64;
+            let kind = element::for_link(l, choice)?;
+            let ni = kind.interior().len();
             let has_child = i + 1 < nl;
             let mut v_dof = vec![NONE; n_el + 1];
             let mut r_dof = vec![NONE; n_el + 1];
             let mut u_dof = vec![NONE; n_el + 1];
-            // Timoshenko interior DOFs only exist (are allocated) for shear links.
-            let mut int_dof = if l.shear {
-                vec![NONE; 3 * n_el]
-            } else {
-                Vec::new()
-            };
+            let mut int_dof = vec![NONE; ni * n_el];
             let interior_nodes = if has_child { n_el - 1 } else { n_el };
             // Element e's interior DOFs precede node e + 1: every element's DOFs stay within
             // one contiguous window (the band).
             for e in 0..n_el {
-                if l.shear {
-                    for k in 0..3 {
-                        int_dof[3 * e + k] = next + k;
-                    }
-                    next += 3;
+                for k in 0..ni {
+                    int_dof[ni * e + k] = next + k;
                 }
+                next += ni;
                 let k = e + 1;
                 if k > interior_nodes {
                     continue;
@@ -465,21 +258,6 @@ impl Chain {
                     next += 1;
                 }
             }
-            let (k_el, kb_el) = if l.shear {
-                // support::check_planar guarantees κGA for shear links.
-                let kga = l.shear_stiffness.unwrap_or(0.0);
-                (
-                    timo::stiffness(l.bending_stiffness, kga, h),
-                    timo::stiffness(l.bending_stiffness, 0.0, h),
-                )
-            } else {
-                let k4 = eb::bending_stiffness(l.bending_stiffness, h);
-                let mut k = [[0.0; MAXE]; MAXE];
-                for a in 0..4 {
-                    k[a][..4].copy_from_slice(&k4[a]);
-                }
-                (k, k)
-            };
             let j = &l.joint;
             models.push(LinkModel {
                 length: l.length,
@@ -495,7 +273,7 @@ impl Chain {
                 axial: l.axial,
                 foreshortening: l.foreshortening,
                 shear: l.shear,
-                ne: if l.shear { timo::NDOF } else { 4 },
+                ne: kind.local_dofs(),
                 rho_i: if l.rotary_inertia {
                     l.rotary_inertia_per_length.unwrap_or(0.0)
                 } else {
@@ -519,8 +297,7 @@ impl Chain {
                 r_dof,
                 u_dof,
                 int_dof,
-                k_el,
-                kb_el,
+                element: MeshElement::new(kind, l, h),
             });
         }
         let n_interior = next;
@@ -547,21 +324,25 @@ impl Chain {
             .iter()
             .map(|m| {
                 let dpn = if m.axial { 3 } else { 2 };
-                if m.shear { 2 * dpn + 2 } else { 2 * dpn - 1 }
+                2 * dpn - 1 + m.n_interior()
             })
             .max()
             .unwrap_or(3);
-        let tables = models
+        let force = models
             .iter()
-            .map(|m| LinkTables::new(m.h, m.shear))
+            .map(|m| vec![[0.0; 2]; m.n_el * m.element.quad.ng])
             .collect();
-        let force = models.iter().map(|m| vec![[0.0; 2]; m.n_el * NG]).collect();
-        let pos: Vec<Vec<[f64; 2]>> = models.iter().map(|m| vec![[0.0; 2]; m.n_el * NG]).collect();
+        let pos: Vec<Vec<[f64; 2]>> = models
+            .iter()
+            .map(|m| vec![[0.0; 2]; m.n_el * m.element.quad.ng])
+            .collect();
         let vel = pos.clone();
-        let tail = models.iter().map(|m| vec![0.0; m.n_el * NSUB]).collect();
+        let tail = models
+            .iter()
+            .map(|m| vec![0.0; m.n_el * (m.element.quad.ng + 1)])
+            .collect();
         Ok(Chain {
             links: models,
-            tables,
             gravity: gravity.map_or([0.0, 0.0], |g| g.vector),
             ndof: next,
             n_interior,
@@ -580,7 +361,9 @@ impl Chain {
     /// Whether some DOFs carry no mass: the section rotations ψ of a Timoshenko link without
     /// rotary inertia (M is singular there; the stiffness determines them).
     pub fn has_massless_dofs(&self) -> bool {
-        self.links.iter().any(|l| l.shear && l.rho_i == 0.0)
+        self.links
+            .iter()
+            .any(|l| l.element.kind.independent_rotation() && l.rho_i == 0.0)
     }
 
     /// Basis of the massless directions (null space of M at a rest state) of the Timoshenko
@@ -611,11 +394,18 @@ impl Chain {
     fn massless_directions_with(&self, frames: bool) -> Vec<Vec<(usize, f64)>> {
         let mut dirs = Vec::new();
         for (li, l) in self.links.iter().enumerate() {
-            if !l.shear || l.rho_i > 0.0 {
+            let kind = l.element.kind;
+            if !kind.independent_rotation() || l.rho_i > 0.0 {
                 continue;
             }
+            let interior = kind.interior();
+            let ni = interior.len();
             for e in 0..l.n_el {
-                dirs.push(vec![(l.int_dof[3 * e + 2], 1.0)]);
+                for (k, idof) in interior.iter().enumerate() {
+                    if idof.field == InteriorField::Rotation {
+                        dirs.push(vec![(l.int_dof[ni * e + k], 1.0)]);
+                    }
+                }
             }
             for k in 1..l.n_el {
                 dirs.push(vec![(l.r_dof[k], 1.0)]);
@@ -639,8 +429,10 @@ impl Chain {
                     }
                 }
                 for e in 0..l.n_el {
-                    for (j, at) in [(0, 1.0 / 3.0), (1, 2.0 / 3.0)] {
-                        d.push((l.int_dof[3 * e + j], -(e as f64 + at) * l.h));
+                    for (k, idof) in interior.iter().enumerate() {
+                        if idof.field == InteriorField::Deflection {
+                            d.push((l.int_dof[ni * e + k], -(e as f64 + idof.at) * l.h));
+                        }
                     }
                 }
                 if tip != NONE {
@@ -758,943 +550,6 @@ impl Chain {
         d
     }
 
-    /// Forward pass: frame and tip kinematics of every link (no forces).
-    fn forward(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], parts: Parts) {
-        let g_in = if parts.conservative {
-            self.gravity
-        } else {
-            [0.0; 2]
-        };
-        let inertia = if parts.inertia { 1.0 } else { 0.0 };
-        let mut parent: Option<FrameState> = None;
-        for li in 0..self.links.len() {
-            let l = &self.links[li];
-            let tb = &self.tables[li];
-            let (th, dth, ddth) = match l.joint.prescribed_at(t) {
-                Some(k) => k,
-                None => (q[l.joint.dof], qd[l.joint.dof], qdd[l.joint.dof]),
-            };
-            let mut fr = FrameState {
-                theta: th,
-                dtheta: dth,
-                ddtheta: ddth,
-                ..Default::default()
-            };
-            match parent {
-                None => {
-                    fr.phi = th;
-                    fr.dphi = dth;
-                    fr.ddphi = ddth;
-                }
-                Some(p) => {
-                    fr.phi = p.phi + p.slope_tip + th;
-                    fr.dphi = p.dphi + p.dslope_tip + dth;
-                    fr.ddphi = p.ddphi + p.ddslope_tip + ddth;
-                    let pr = add(p.r, rot(p.phi, p.p_tip));
-                    let pdr = add(
-                        p.dr,
-                        rot(p.phi, add(scale(p.dphi, perp(p.p_tip)), p.dp_tip)),
-                    );
-                    fr.r = pr;
-                    fr.dr = pdr;
-                    fr.ddr = rot(p.phi, p.a_tip);
-                }
-            }
-            let (phi, w, dw) = (fr.phi, fr.dphi, fr.ddphi);
-            let frame_acc = rot_t(phi, fr.ddr);
-            let g_loc = rot_t(phi, g_in);
-            // Cumulative foreshortening s, ṡ, s̈ along the link.
-            let (mut s, mut sd, mut sdd) = (0.0, 0.0, 0.0);
-            let fs = l.foreshortening;
-            let ne = l.ne;
-            for e in 0..l.n_el {
-                let dofs = l.elem_dofs(e);
-                let d = Self::elem_v(q, &dofs);
-                let dd = Self::elem_v(qd, &dofs);
-                let ddd = Self::elem_v(qdd, &dofs);
-                let (ua, ub) = (l.u_dof[e], l.u_dof[e + 1]);
-                let u = [Self::val(q, ua), Self::val(q, ub)];
-                let ud = [Self::val(qd, ua), Self::val(qd, ub)];
-                let udd = [Self::val(qdd, ua), Self::val(qdd, ub)];
-                let xa = e as f64 * l.h;
-                for j in 0..NSUB {
-                    if fs {
-                        for k in 0..NSG {
-                            let dn = &tb.sub_dn[j][k];
-                            let wgt = tb.sub_wh[j][k];
-                            let vp = dotn(dn, &d, ne);
-                            let vpd = dotn(dn, &dd, ne);
-                            let vpdd = dotn(dn, &ddd, ne);
-                            s -= 0.5 * wgt * vp * vp;
-                            sd -= wgt * vp * vpd;
-                            sdd -= wgt * (vpd * vpd + vp * vpdd);
-                        }
-                    }
-                    if j == NG {
-                        continue;
-                    }
-                    let g = j;
-                    let n = &tb.n[g];
-                    let xi = tb.xi[g];
-                    let (ax, axd, axdd) = if l.axial {
-                        (
-                            (1.0 - xi) * u[0] + xi * u[1],
-                            (1.0 - xi) * ud[0] + xi * ud[1],
-                            (1.0 - xi) * udd[0] + xi * udd[1],
-                        )
-                    } else if fs {
-                        (s, sd, sdd)
-                    } else {
-                        (0.0, 0.0, 0.0)
-                    };
-                    let p = [xa + xi * l.h + ax, dotn(n, &d, ne)];
-                    let pd = [axd, dotn(n, &dd, ne)];
-                    let pdd = [axdd, dotn(n, &ddd, ne)];
-                    let a = add(
-                        add(frame_acc, scale(dw, perp(p))),
-                        add(scale(-w * w, p), add(scale(2.0 * w, perp(pd)), pdd)),
-                    );
-                    let m = l.rho_a * tb.wh[g];
-                    // Applied uniform transverse load on the last link (frame y), as a density
-                    // with the d'Alembert sign: Gauss-4 gives its consistent nodal loads exactly.
-                    let q_load = if li + 1 == self.links.len() && parts.nonconservative {
-                        self.distributed_load
-                    } else {
-                        0.0
-                    };
-                    self.force[li][e * NG + g] = sub(
-                        scale(m, sub(scale(inertia, a), g_loc)),
-                        [0.0, q_load * tb.wh[g]],
-                    );
-                    self.pos[li][e * NG + g] = p;
-                    self.vel[li][e * NG + g] = pd;
-                }
-            }
-            // Tip.
-            let k = l.n_el;
-            let (ut, utd, utdd) = if l.axial {
-                (
-                    Self::val(q, l.u_dof[k]),
-                    Self::val(qd, l.u_dof[k]),
-                    Self::val(qdd, l.u_dof[k]),
-                )
-            } else if fs {
-                (s, sd, sdd)
-            } else {
-                (0.0, 0.0, 0.0)
-            };
-            let p = [l.length + ut, Self::val(q, l.v_dof[k])];
-            let pd = [utd, Self::val(qd, l.v_dof[k])];
-            let pdd = [utdd, Self::val(qdd, l.v_dof[k])];
-            fr.p_tip = p;
-            fr.dp_tip = pd;
-            fr.a_tip = add(
-                add(frame_acc, scale(dw, perp(p))),
-                add(scale(-w * w, p), add(scale(2.0 * w, perp(pd)), pdd)),
-            );
-            fr.slope_tip = Self::val(q, l.r_dof[k]);
-            fr.dslope_tip = Self::val(qd, l.r_dof[k]);
-            fr.ddslope_tip = Self::val(qdd, l.r_dof[k]);
-            self.frames[li] = fr;
-            parent = Some(fr);
-        }
-    }
-
-    /// Residual R(q, q̇, q̈) of the equations of motion at time t (see module docs), written
-    /// into `res`; also fills the joint torques.
-    pub fn residual(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], res: &mut [f64]) {
-        self.residual_parts(t, q, qd, qdd, Parts::ALL, res);
-    }
-
-    /// The force groups `parts` of the residual (see [`Parts`]); the sum over all groups is
-    /// [`Chain::residual`]. Only the full residual updates [`Chain::joint_torque`]; the Newton
-    /// matrix reads the point data of the last call, which must therefore be a full residual.
-    pub fn residual_parts(
-        &mut self,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-        parts: Parts,
-        res: &mut [f64],
-    ) {
-        res.iter_mut().for_each(|x| *x = 0.0);
-        self.forward(t, q, qd, qdd, parts);
-        let g_in = if parts.conservative {
-            self.gravity
-        } else {
-            [0.0; 2]
-        };
-        let inertia = if parts.inertia { 1.0 } else { 0.0 };
-        let (cons, noncons) = (parts.conservative, parts.nonconservative);
-        let nl = self.links.len();
-        // Child loads passed to the parent: resultant (inertial) and moment about the child root.
-        let mut child_f = [0.0; 2];
-        let mut child_m = 0.0;
-        for li in (0..nl).rev() {
-            let l = &self.links[li];
-            let tb = &self.tables[li];
-            let fr = self.frames[li];
-            let g_loc = rot_t(fr.phi, g_in);
-            let k = l.n_el;
-            // Tip body and child loads (frame coordinates).
-            let f_tipmass = scale(l.tip_mass, sub(scale(inertia, fr.a_tip), g_loc));
-            // An applied tip force enters with the d'Alembert sign (R collects −Q).
-            let p_tip = if li + 1 == nl && noncons {
-                self.tip_load
-            } else {
-                0.0
-            };
-            let f_tip = sub(add(f_tipmass, rot_t(fr.phi, child_f)), [0.0, p_tip]);
-            let m_tip = inertia * l.tip_inertia * (fr.ddphi + fr.ddslope_tip) + child_m;
-            let mut add_res = |i: usize, v: f64| {
-                if i != NONE {
-                    res[i] += v;
-                }
-            };
-            add_res(l.v_dof[k], f_tip[1]);
-            add_res(l.u_dof[k], f_tip[0]);
-            add_res(l.r_dof[k], m_tip);
-            // Distributed inertia/gravity, elastic and damping forces, element by element
-            // (tip to root so the tail load T accumulates).
-            let mut f_sum = [0.0; 2];
-            let mut m_sum = 0.0;
-            let mut tail = f_tip[0];
-            let ne = l.ne;
-            for e in (0..l.n_el).rev() {
-                let dofs = l.elem_dofs(e);
-                let d = Self::elem_v(q, &dofs);
-                let mut fe = [0.0; MAXE];
-                let (mut fu0, mut fu1) = (0.0, 0.0);
-                for g in 0..NG {
-                    let f = self.force[li][e * NG + g];
-                    let p = self.pos[li][e * NG + g];
-                    f_sum = add(f_sum, f);
-                    m_sum += cross(p, f);
-                    for a in 0..ne {
-                        fe[a] += f[1] * tb.n[g][a];
-                    }
-                    if l.axial {
-                        let xi = tb.xi[g];
-                        fu0 += f[0] * (1.0 - xi);
-                        fu1 += f[0] * xi;
-                    }
-                }
-                // Section rotary inertia: moment density ρI(φ̈ + β̈) on the section angle
-                // φ + β(x) (β = v′ or ψ), which every upstream rotation turns by one.
-                if l.rho_i > 0.0 && parts.inertia {
-                    let ddd = Self::elem_v(qdd, &dofs);
-                    for g in 0..NG {
-                        let b = &tb.b[g];
-                        let mr = l.rho_i * tb.wh[g] * (fr.ddphi + dotn(b, &ddd, ne));
-                        m_sum += mr;
-                        for a in 0..ne {
-                            fe[a] += mr * b[a];
-                        }
-                    }
-                }
-                if l.foreshortening {
-                    for j in (0..NSUB).rev() {
-                        self.tail[li][e * NSUB + j] = tail;
-                        for kk in 0..NSG {
-                            let dn = &tb.sub_dn[j][kk];
-                            let vp = dotn(dn, &d, ne);
-                            let c = -tail * tb.sub_wh[j][kk] * vp;
-                            for a in 0..ne {
-                                fe[a] += c * dn[a];
-                            }
-                        }
-                        if j > 0 {
-                            tail += self.force[li][e * NG + j - 1][0];
-                        }
-                    }
-                }
-                // Elastic forces.
-                if cons && l.axial && !l.shear {
-                    let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                    let fv = eb::von_karman_force(
-                        l.ea,
-                        l.ei,
-                        l.h,
-                        &[u[0], u[1], d[0], d[1], d[2], d[3]],
-                    );
-                    fu0 += fv[0];
-                    fu1 += fv[1];
-                    for a in 0..4 {
-                        fe[a] += fv[2 + a];
-                    }
-                } else if cons {
-                    for a in 0..ne {
-                        fe[a] += dotn(&l.k_el[a], &d, ne);
-                    }
-                    if l.axial {
-                        // Timoshenko: membrane part ½EA h ε̄² (see `membrane`).
-                        let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                        let (eps, gr) = membrane(tb, l.h, u, &d, ne);
-                        let nf = l.ea * l.h * eps;
-                        fu0 += nf * gr[0];
-                        fu1 += nf * gr[1];
-                        for a in 0..ne {
-                            fe[a] += nf * gr[2 + a];
-                        }
-                    }
-                }
-                if l.kelvin_voigt > 0.0 && noncons {
-                    let dd = Self::elem_v(qd, &dofs);
-                    let c = l.kelvin_voigt / l.ei;
-                    for a in 0..ne {
-                        fe[a] += c * dotn(&l.kb_el[a], &dd, ne);
-                    }
-                }
-                for a in 0..ne {
-                    if dofs[a] != NONE {
-                        res[dofs[a]] += fe[a];
-                    }
-                }
-                if l.axial {
-                    if l.u_dof[e] != NONE {
-                        res[l.u_dof[e]] += fu0;
-                    }
-                    if l.u_dof[e + 1] != NONE {
-                        res[l.u_dof[e + 1]] += fu1;
-                    }
-                }
-            }
-            // Subtree resultant and moment about this link's root Rᵢ.
-            let f_total_loc = add(f_sum, f_tip);
-            let moment =
-                m_sum + cross(fr.p_tip, f_tip) + m_tip + inertia * l.hub_inertia * fr.ddphi;
-            let fr_mut = &mut self.frames[li];
-            fr_mut.subtree_moment = moment;
-            fr_mut.subtree_force = rot(fr.phi, f_total_loc);
-            child_f = fr_mut.subtree_force;
-            child_m = moment;
-            // Joint equation: moment + spring + damper − applied = actuator torque.
-            let j = &l.joint;
-            let spring = if cons {
-                j.stiffness * (fr.theta - j.set_point)
-            } else {
-                0.0
-            };
-            let (damper, law) = if noncons {
-                (j.damping * fr.dtheta, j.applied(t))
-            } else {
-                (0.0, 0.0)
-            };
-            if j.dof != NONE {
-                res[j.dof] += moment + spring + damper - law;
-            }
-            if parts == Parts::ALL {
-                self.joint_torque[li] = if j.dof != NONE {
-                    law
-                } else {
-                    moment + spring + damper - law
-                };
-            }
-        }
-    }
-
-    /// Assembles the Newton matrix c_a·M + c_v·C + c_q·K at the state of the last
-    /// [`Chain::residual`] call (which must precede it).
-    pub fn newton_matrix(&self, q: &[f64], c: NewtonCoefficients, s: &mut BorderedBand) {
-        s.clear();
-        let nl = self.links.len();
-        let g_in = self.gravity;
-        // Columns of J for the DOFs of ancestors (and the own joint), in frame-i coordinates.
-        // Fixed-size buffer: no heap allocation per Newton matrix.
-        let mut cols = [AncestorColumn::default(); MAX_COLUMNS];
-        // Per-point column buffer, reused (filled up to the point's column count).
-        let mut jc = [ColumnAt::default(); MAXE + 2 + MAX_COLUMNS];
-        for li in 0..nl {
-            let l = &self.links[li];
-            let tb = &self.tables[li];
-            let fr = self.frames[li];
-            let g_loc = rot_t(fr.phi, g_in);
-            let mut ncols = 0usize;
-            // Frame-coordinate position, velocity and acceleration of a point Rc relative to Rᵢ.
-            let rel = |o: &FrameState| {
-                let c = rot_t(fr.phi, sub(o.r, fr.r));
-                let cdot = add(scale(-fr.dphi, perp(c)), rot_t(fr.phi, sub(o.dr, fr.dr)));
-                let acc = rot_t(fr.phi, o.ddr);
-                (c, cdot, acc)
-            };
-            for (aj, al) in self.links.iter().enumerate().take(li + 1) {
-                let fa = &self.frames[aj];
-                if al.joint.dof != NONE {
-                    let (c, cdot, acc) = rel(fa);
-                    cols[ncols] = AncestorColumn {
-                        dof: al.joint.dof,
-                        rotation: true,
-                        vec: c,
-                        dvec: cdot,
-                        centre_acc: acc,
-                        rate: 0.0,
-                        rate_dot: 0.0,
-                        pos: 2.0 * aj as f64,
-                    };
-                    ncols += 1;
-                }
-                if aj < li {
-                    let child = &self.frames[aj + 1];
-                    let (c, cdot, acc) = rel(child);
-                    if al.r_dof[al.n_el] != NONE {
-                        cols[ncols] = AncestorColumn {
-                            dof: al.r_dof[al.n_el],
-                            rotation: true,
-                            vec: c,
-                            dvec: cdot,
-                            centre_acc: acc,
-                            rate: 0.0,
-                            rate_dot: 0.0,
-                            pos: 2.0 * aj as f64 + 1.0,
-                        };
-                        ncols += 1;
-                    }
-                    for (dof, e) in [
-                        (al.v_dof[al.n_el], [0.0, 1.0]),
-                        (al.u_dof[al.n_el], [1.0, 0.0]),
-                    ] {
-                        if dof != NONE {
-                            cols[ncols] = AncestorColumn {
-                                dof,
-                                rotation: false,
-                                vec: rot_t(fr.phi, rot(fa.phi, e)),
-                                dvec: [0.0; 2],
-                                centre_acc: [0.0; 2],
-                                rate: fa.dphi,
-                                rate_dot: fa.ddphi,
-                                pos: 2.0 * aj as f64 + 0.5,
-                            };
-                            ncols += 1;
-                        }
-                    }
-                }
-            }
-            let w = fr.dphi;
-            let wd = fr.ddphi;
-            let local_pos = 2.0 * li as f64 + 0.5;
-            // One mass point: m at local position p with velocity ṗ and d'Alembert density
-            // f = m(a − g). Adds c_a·M + c_v·C + c_q·K_inertial for all its columns, with
-            // C = Σ m Jᵀ 2J̇ and K_inertial = Σ m[(∂J/∂q)ᵀ(a − g) + Jᵀ ∂a/∂q].
-            let point = |s: &mut BorderedBand,
-                         jc: &mut [ColumnAt; MAXE + 2 + MAX_COLUMNS],
-                         m: f64,
-                         p: [f64; 2],
-                         pd: [f64; 2],
-                         f: [f64; 2],
-                         local: &[(usize, [f64; 2])]| {
-                let mut nj = 0;
-                for &(dof, v) in local {
-                    if dof != NONE {
-                        jc[nj] = ColumnAt {
-                            dof,
-                            j: v,
-                            jdot: scale(w, perp(v)),
-                            rotation: false,
-                            pos: local_pos,
-                            centre_acc: [0.0; 2],
-                            rate: w,
-                            rate_dot: wd,
-                        };
-                        nj += 1;
-                    }
-                }
-                for col in &cols[..ncols] {
-                    jc[nj] = if col.rotation {
-                        let j = perp(sub(p, col.vec));
-                        ColumnAt {
-                            dof: col.dof,
-                            j,
-                            jdot: add(scale(w, perp(j)), perp(sub(pd, col.dvec))),
-                            rotation: true,
-                            pos: col.pos,
-                            centre_acc: col.centre_acc,
-                            rate: 0.0,
-                            rate_dot: 0.0,
-                        }
-                    } else {
-                        ColumnAt {
-                            dof: col.dof,
-                            j: col.vec,
-                            jdot: scale(col.rate, perp(col.vec)),
-                            rotation: false,
-                            pos: col.pos,
-                            centre_acc: [0.0; 2],
-                            rate: col.rate,
-                            rate_dot: col.rate_dot,
-                        }
-                    };
-                    nj += 1;
-                }
-                let acc = add(scale(1.0 / m, f), g_loc);
-                for a in 0..nj {
-                    let ca = &jc[a];
-                    for b in 0..nj {
-                        let cb = &jc[b];
-                        let mut v = c.c_a * m * dot(ca.j, cb.j);
-                        v += c.c_v * 2.0 * m * dot(ca.j, cb.jdot);
-                        // ∂J_a/∂q_b: a rotation b upstream of a's attachment rotates J_a; for a
-                        // rotation a, anything downstream moves the point about a's centre.
-                        let dja = if cb.rotation && cb.pos <= ca.pos {
-                            perp(ca.j)
-                        } else if ca.rotation {
-                            perp(cb.j)
-                        } else {
-                            [0.0; 2]
-                        };
-                        // ∂a/∂q_b: rigid rotation of the downstream acceleration field about the
-                        // centre, or the frame's rigid acceleration field at a displaced point.
-                        let dacc = if cb.rotation {
-                            perp(sub(acc, cb.centre_acc))
-                        } else {
-                            add(
-                                scale(-cb.rate * cb.rate, cb.j),
-                                scale(cb.rate_dot, perp(cb.j)),
-                            )
-                        };
-                        v += c.c_q * m * (dot(dja, sub(acc, g_loc)) + dot(ca.j, dacc));
-                        if v != 0.0 {
-                            s.add(ca.dof, cb.dof, v);
-                        }
-                    }
-                }
-            };
-            // Rotation columns (upstream joints and tip slopes): they turn every section of
-            // this link by one.
-            let mut rot_dofs = [NONE; MAX_COLUMNS + 1];
-            let mut nr = 0;
-            for col in &cols[..ncols] {
-                if col.rotation {
-                    rot_dofs[nr] = col.dof;
-                    nr += 1;
-                }
-            }
-            let ne = l.ne;
-            for e in 0..l.n_el {
-                let dofs = l.elem_dofs(e);
-                for g in 0..NG {
-                    let m = l.rho_a * tb.wh[g];
-                    let p = self.pos[li][e * NG + g];
-                    let xi = tb.xi[g];
-                    let n = tb.n[g];
-                    // Translation columns of the point: the v shapes (the ψ DOFs of a
-                    // Timoshenko element do not move it), then u.
-                    let mut local = [(NONE, [0.0; 2]); MAXE + 2];
-                    let mut nloc = 0;
-                    for a in 0..ne {
-                        if l.shear && (a == 1 || a == 3 || a == 6) {
-                            continue;
-                        }
-                        local[nloc] = (dofs[a], [0.0, n[a]]);
-                        nloc += 1;
-                    }
-                    local[nloc] = (l.u_dof[e], [1.0 - xi, 0.0]);
-                    local[nloc + 1] = (l.u_dof[e + 1], [xi, 0.0]);
-                    nloc += 2;
-                    let pd = self.vel[li][e * NG + g];
-                    let f = self.force[li][e * NG + g];
-                    point(s, &mut jc, m, p, pd, f, &local[..nloc]);
-                }
-                // Section rotary inertia: the section angle is linear in q (J constant), so
-                // only the mass term c_a ρI w JᵀJ.
-                if l.rho_i > 0.0 && c.c_a != 0.0 {
-                    for g in 0..NG {
-                        let mw = c.c_a * l.rho_i * tb.wh[g];
-                        let b = &tb.b[g];
-                        let mut jr = [(NONE, 0.0); MAX_COLUMNS + 1 + MAXE];
-                        let mut nj = 0;
-                        for &dof in &rot_dofs[..nr] {
-                            jr[nj] = (dof, 1.0);
-                            nj += 1;
-                        }
-                        for a in 0..ne {
-                            if dofs[a] != NONE && b[a] != 0.0 {
-                                jr[nj] = (dofs[a], b[a]);
-                                nj += 1;
-                            }
-                        }
-                        for &(da, va) in &jr[..nj] {
-                            for &(db, vb) in &jr[..nj] {
-                                s.add(da, db, mw * va * vb);
-                            }
-                        }
-                    }
-                }
-                // Elastic tangent, Kelvin–Voigt, foreshortening geometric stiffness.
-                if l.axial && !l.shear {
-                    let d = Self::elem_v(q, &dofs);
-                    let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                    let kt = eb::von_karman_tangent(
-                        l.ea,
-                        l.ei,
-                        l.h,
-                        &[u[0], u[1], d[0], d[1], d[2], d[3]],
-                    );
-                    let all = [
-                        l.u_dof[e],
-                        l.u_dof[e + 1],
-                        dofs[0],
-                        dofs[1],
-                        dofs[2],
-                        dofs[3],
-                    ];
-                    for a in 0..6 {
-                        for b in 0..6 {
-                            if all[a] != NONE && all[b] != NONE {
-                                s.add(all[a], all[b], c.c_q * kt[a][b]);
-                            }
-                        }
-                    }
-                } else {
-                    for a in 0..ne {
-                        for b in 0..ne {
-                            if dofs[a] != NONE && dofs[b] != NONE {
-                                s.add(dofs[a], dofs[b], c.c_q * l.k_el[a][b]);
-                            }
-                        }
-                    }
-                    if l.axial {
-                        // Timoshenko membrane tangent EA h ggᵀ + EA ε̄ ∫N′N′ (v block).
-                        let d = Self::elem_v(q, &dofs);
-                        let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                        let (eps, gr) = membrane(tb, l.h, u, &d, ne);
-                        let mut all = [NONE; MAXE + 2];
-                        all[0] = l.u_dof[e];
-                        all[1] = l.u_dof[e + 1];
-                        all[2..2 + ne].copy_from_slice(&dofs[..ne]);
-                        for a in 0..ne + 2 {
-                            for b in 0..ne + 2 {
-                                if all[a] != NONE && all[b] != NONE {
-                                    s.add(all[a], all[b], c.c_q * l.ea * l.h * gr[a] * gr[b]);
-                                }
-                            }
-                        }
-                        let nf = l.ea * eps;
-                        for g in 0..NG {
-                            let dn = &tb.dn[g];
-                            let wgt = c.c_q * nf * tb.wh[g];
-                            for a in 0..ne {
-                                for b in 0..ne {
-                                    if dofs[a] != NONE && dofs[b] != NONE {
-                                        s.add(dofs[a], dofs[b], wgt * dn[a] * dn[b]);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
-                if l.kelvin_voigt > 0.0 {
-                    let cf = l.kelvin_voigt / l.ei;
-                    for a in 0..ne {
-                        for b in 0..ne {
-                            if dofs[a] != NONE && dofs[b] != NONE {
-                                s.add(dofs[a], dofs[b], c.c_v * cf * l.kb_el[a][b]);
-                            }
-                        }
-                    }
-                }
-                if l.foreshortening {
-                    let mut kg = [[0.0; MAXE]; MAXE];
-                    for j in 0..NSUB {
-                        let tl = self.tail[li][e * NSUB + j];
-                        for kk in 0..NSG {
-                            let dn = &tb.sub_dn[j][kk];
-                            let wgt = -tl * tb.sub_wh[j][kk];
-                            for a in 0..ne {
-                                for b in 0..ne {
-                                    kg[a][b] += wgt * dn[a] * dn[b];
-                                }
-                            }
-                        }
-                    }
-                    for a in 0..ne {
-                        for b in 0..ne {
-                            if dofs[a] != NONE && dofs[b] != NONE {
-                                s.add(dofs[a], dofs[b], c.c_q * kg[a][b]);
-                            }
-                        }
-                    }
-                }
-            }
-            // Tip mass.
-            let k = l.n_el;
-            if l.tip_mass > 0.0 {
-                let local = [(l.v_dof[k], [0.0, 1.0]), (l.u_dof[k], [1.0, 0.0])];
-                let f = scale(l.tip_mass, sub(fr.a_tip, g_loc));
-                point(s, &mut jc, l.tip_mass, fr.p_tip, fr.dp_tip, f, &local);
-            }
-            // Rotational inertias: tip (rotates with φᵢ + slope(L)) and hub (with φᵢ).
-            if l.hub_inertia > 0.0 {
-                for a in 0..nr {
-                    for b in 0..nr {
-                        s.add(rot_dofs[a], rot_dofs[b], c.c_a * l.hub_inertia);
-                    }
-                }
-            }
-            if l.tip_inertia > 0.0 {
-                if l.r_dof[k] != NONE {
-                    rot_dofs[nr] = l.r_dof[k];
-                    nr += 1;
-                }
-                for a in 0..nr {
-                    for b in 0..nr {
-                        s.add(rot_dofs[a], rot_dofs[b], c.c_a * l.tip_inertia);
-                    }
-                }
-            }
-            // Joint spring and damper.
-            if l.joint.dof != NONE {
-                let jd = l.joint.dof;
-                s.add(jd, jd, c.c_q * l.joint.stiffness + c.c_v * l.joint.damping);
-            }
-        }
-    }
-
-    /// Stored energies at a state: (kinetic, strain, joint_spring, gravity).
-    pub fn energies(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; 4] {
-        debug_assert_eq!(qd.len(), q.len());
-        let g_in = self.gravity;
-        let mut parent: Option<(FrameState, [f64; 2], [f64; 2])> = None;
-        let (mut kin, mut strain, mut spring, mut grav) = (0.0, 0.0, 0.0, 0.0);
-        for li in 0..self.links.len() {
-            let l = &self.links[li];
-            let tb = &self.tables[li];
-            let (th, dth) = match l.joint.prescribed_at(t) {
-                Some((a, b, _)) => (a, b),
-                None => (q[l.joint.dof], qd[l.joint.dof]),
-            };
-            let (phi, w, r0, dr0) = match parent {
-                None => (th, dth, [0.0, 0.0], [0.0, 0.0]),
-                Some((p, r, dr)) => (p.phi + p.slope_tip + th, p.dphi + p.dslope_tip + dth, r, dr),
-            };
-            spring += 0.5 * l.joint.stiffness * (th - l.joint.set_point).powi(2);
-            kin += 0.5 * l.hub_inertia * w * w;
-            let (mut s, mut sd) = (0.0, 0.0);
-            let ne = l.ne;
-            for e in 0..l.n_el {
-                let dofs = l.elem_dofs(e);
-                let d = Self::elem_v(q, &dofs);
-                let dd = Self::elem_v(qd, &dofs);
-                let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                let ud = [Self::val(qd, l.u_dof[e]), Self::val(qd, l.u_dof[e + 1])];
-                let xa = e as f64 * l.h;
-                for j in 0..NSUB {
-                    if l.foreshortening {
-                        for k in 0..NSG {
-                            let dn = &tb.sub_dn[j][k];
-                            let wgt = tb.sub_wh[j][k];
-                            let vp = dotn(dn, &d, ne);
-                            s -= 0.5 * wgt * vp * vp;
-                            sd -= wgt * vp * dotn(dn, &dd, ne);
-                        }
-                    }
-                    if j == NG {
-                        continue;
-                    }
-                    let xi = tb.xi[j];
-                    let (ax, axd) = if l.axial {
-                        (
-                            (1.0 - xi) * u[0] + xi * u[1],
-                            (1.0 - xi) * ud[0] + xi * ud[1],
-                        )
-                    } else if l.foreshortening {
-                        (s, sd)
-                    } else {
-                        (0.0, 0.0)
-                    };
-                    let p = [xa + xi * l.h + ax, dotn(&tb.n[j], &d, ne)];
-                    let pd = [axd, dotn(&tb.n[j], &dd, ne)];
-                    let v = add(dr0, rot(phi, add(scale(w, perp(p)), pd)));
-                    let m = l.rho_a * tb.wh[j];
-                    kin += 0.5 * m * dot(v, v);
-                    grav -= m * dot(g_in, add(r0, rot(phi, p)));
-                    if l.rho_i > 0.0 {
-                        // ½ρI(φ̇ + β̇)², β the section angle relative to the frame.
-                        let om = w + dotn(&tb.b[j], &dd, ne);
-                        kin += 0.5 * l.rho_i * tb.wh[j] * om * om;
-                    }
-                }
-                if l.axial && !l.shear {
-                    strain += eb::von_karman_energy(
-                        l.ea,
-                        l.ei,
-                        l.h,
-                        &[u[0], u[1], d[0], d[1], d[2], d[3]],
-                    );
-                } else {
-                    for a in 0..ne {
-                        strain += 0.5 * d[a] * dotn(&l.k_el[a], &d, ne);
-                    }
-                    if l.axial {
-                        let (eps, _) = membrane(tb, l.h, u, &d, ne);
-                        strain += 0.5 * l.ea * l.h * eps * eps;
-                    }
-                }
-            }
-            let k = l.n_el;
-            let (ut, utd) = if l.axial {
-                (Self::val(q, l.u_dof[k]), Self::val(qd, l.u_dof[k]))
-            } else if l.foreshortening {
-                (s, sd)
-            } else {
-                (0.0, 0.0)
-            };
-            let p = [l.length + ut, Self::val(q, l.v_dof[k])];
-            let pd = [utd, Self::val(qd, l.v_dof[k])];
-            let v_tip = add(dr0, rot(phi, add(scale(w, perp(p)), pd)));
-            let r_tip = add(r0, rot(phi, p));
-            kin += 0.5 * l.tip_mass * dot(v_tip, v_tip);
-            grav -= l.tip_mass * dot(g_in, r_tip);
-            let slope = Self::val(q, l.r_dof[k]);
-            let dslope = Self::val(qd, l.r_dof[k]);
-            kin += 0.5 * l.tip_inertia * (w + dslope).powi(2);
-            let fs = FrameState {
-                phi,
-                dphi: w,
-                slope_tip: slope,
-                dslope_tip: dslope,
-                ..Default::default()
-            };
-            parent = Some((fs, r_tip, v_tip));
-        }
-        [kin, strain, spring, grav]
-    }
-
-    /// Dissipated powers at a state: (joint dampers, Kelvin–Voigt).
-    /// Power of the applied transverse loads, Qᵀq̇ (constant loads: exact work over a
-    /// trapezoidal step when q̇ is the step's mean velocity).
-    pub fn load_power(&self, qd: &[f64]) -> f64 {
-        let Some(l) = self.links.last() else {
-            return 0.0;
-        };
-        let mut p = self.tip_load * Self::val(qd, l.v_dof[l.n_el]);
-        if self.distributed_load != 0.0 {
-            let q0 = self.distributed_load;
-            if l.shear {
-                // Consistent loads ∫q₀N of the Timoshenko v shapes (Gauss-4: exact).
-                let tb = &self.tables[self.links.len() - 1];
-                let mut fq = [0.0; MAXE];
-                for g in 0..NG {
-                    for a in 0..MAXE {
-                        fq[a] += q0 * tb.wh[g] * tb.n[g][a];
-                    }
-                }
-                for e in 0..l.n_el {
-                    let dd = Self::elem_v(qd, &l.elem_dofs(e));
-                    p += dotn(&fq, &dd, MAXE);
-                }
-            } else {
-                let h = l.h;
-                let fq = [
-                    0.5 * q0 * h,
-                    q0 * h * h / 12.0,
-                    0.5 * q0 * h,
-                    -q0 * h * h / 12.0,
-                ];
-                for e in 0..l.n_el {
-                    let dd = Self::elem_v(qd, &l.elem_dofs(e));
-                    p += dot4(&fq, &[dd[0], dd[1], dd[2], dd[3]]);
-                }
-            }
-        }
-        p
-    }
-
-    pub fn dissipation_power(&self, t: f64, qd: &[f64]) -> (f64, f64) {
-        let (mut pj, mut pkv) = (0.0, 0.0);
-        for l in &self.links {
-            let dth = match l.joint.prescribed_at(t) {
-                Some((_, r, _)) => r,
-                None => qd[l.joint.dof],
-            };
-            pj += l.joint.damping * dth * dth;
-            if l.kelvin_voigt > 0.0 {
-                let c = l.kelvin_voigt / l.ei;
-                for e in 0..l.n_el {
-                    let dd = Self::elem_v(qd, &l.elem_dofs(e));
-                    for a in 0..l.ne {
-                        pkv += c * dd[a] * dotn(&l.kb_el[a], &dd, l.ne);
-                    }
-                }
-            }
-        }
-        (pj, pkv)
-    }
-
-    /// Joint angle and rate of link `li` at a state.
-    pub fn joint_state(&self, li: usize, t: f64, q: &[f64], qd: &[f64]) -> (f64, f64) {
-        let j = &self.links[li].joint;
-        match j.prescribed_at(t) {
-            Some((a, r, _)) => (a, r),
-            None => (q[j.dof], qd[j.dof]),
-        }
-    }
-
-    /// Inertial tip position of every link at a state (forward pass with zero rates).
-    pub fn tip_positions(&self, t: f64, q: &[f64], out: &mut [[f64; 2]]) {
-        let mut parent: Option<(f64, [f64; 2])> = None;
-        for (li, l) in self.links.iter().enumerate() {
-            let th = match l.joint.prescribed_at(t) {
-                Some((a, _, _)) => a,
-                None => q[l.joint.dof],
-            };
-            let (phi, r0) = match parent {
-                None => (th, [0.0, 0.0]),
-                Some((pp, r)) => (pp + th, r),
-            };
-            let k = l.n_el;
-            let ax = if l.axial {
-                Self::val(q, l.u_dof[k])
-            } else if l.foreshortening {
-                self.foreshortening_at_tip(li, q)
-            } else {
-                0.0
-            };
-            let p = [l.length + ax, Self::val(q, l.v_dof[k])];
-            let r = add(r0, rot(phi, p));
-            out[li] = r;
-            parent = Some((phi + Self::val(q, l.r_dof[k]), r));
-        }
-    }
-
-    /// s(L) = −½∫v′² of link `li`.
-    pub fn foreshortening_at_tip(&self, li: usize, q: &[f64]) -> f64 {
-        let l = &self.links[li];
-        let tb = &self.tables[li];
-        let mut s = 0.0;
-        for e in 0..l.n_el {
-            let d = Self::elem_v(q, &l.elem_dofs(e));
-            for j in 0..NSUB {
-                for k in 0..NSG {
-                    let vp = dotn(&tb.sub_dn[j][k], &d, l.ne);
-                    s -= 0.5 * tb.sub_wh[j][k] * vp * vp;
-                }
-            }
-        }
-        s
-    }
-
-    /// Transverse deflection v(x) of link `li` (Hermite interpolation).
-    pub fn deflection(&self, li: usize, q: &[f64], x: f64) -> f64 {
-        let l = &self.links[li];
-        let e = ((x / l.h).floor() as usize).min(l.n_el - 1);
-        let xi = ((x - e as f64 * l.h) / l.h).clamp(0.0, 1.0);
-        let d = Self::elem_v(q, &l.elem_dofs(e));
-        dotn(&l.shapes_at(xi).0, &d, l.ne)
-    }
-
-    /// Axial tip displacement u(L) of link `li` (extensible links).
-    pub fn tip_axial(&self, li: usize, q: &[f64]) -> f64 {
-        let l = &self.links[li];
-        Self::val(q, l.u_dof[l.n_el])
-    }
-
-    /// Transverse tip deflection v(L) of link `li`.
-    pub fn tip_deflection(&self, li: usize, q: &[f64]) -> f64 {
-        let l = &self.links[li];
-        Self::val(q, l.v_dof[l.n_el])
-    }
-
     /// Human-readable location of a DOF (for diagnostics).
     pub fn describe_dof(&self, dof: usize) -> String {
         for (li, l) in self.links.iter().enumerate() {
@@ -1702,7 +557,7 @@ impl Chain {
                 return format!("joint {} angle", li + 1);
             }
             for k in 0..=l.n_el {
-                let slope = if l.shear { "ψ" } else { "v′" };
+                let slope = l.element.kind.slope_label();
                 for (what, map) in [("v", &l.v_dof), (slope, &l.r_dof), ("u", &l.u_dof)] {
                     if map[k] == dof {
                         return format!(
@@ -1716,8 +571,9 @@ impl Chain {
         }
         for (li, l) in self.links.iter().enumerate() {
             if let Some(p) = l.int_dof.iter().position(|&d| d == dof) {
-                let (e, k) = (p / 3, p % 3);
-                let (what, at) = [("v", 1.0 / 3.0), ("v", 2.0 / 3.0), ("ψ", 0.5)][k];
+                let interior = l.element.kind.interior();
+                let (e, k) = (p / interior.len(), p % interior.len());
+                let (what, at) = (interior[k].label, interior[k].at);
                 return format!(
                     "link {} element {} interior {what} (x = {:.4})",
                     li + 1,
@@ -1729,106 +585,5 @@ impl Chain {
         format!("dof {dof}")
     }
 
-    // ---- Tip kinematics for contact ([`crate::contact`]) ----
-
-    /// Inertial position of the tip of link `li` and its Jacobian J = ∂r_tip/∂q, written as two
-    /// rows (x: `jac[..n]`, y: `jac[n..2n]`, n = [`Chain::ndof`]). Exact, from the chain's own
-    /// frame recursion (the same one [`Chain::tip_positions`] evaluates): every DOF either turns
-    /// the frames downstream of it about a frame origin Rₖ — the joint angle θₖ about Rₖ and the
-    /// tip rotation of link k about Rₖ₊₁, column ẑ × (r − R) — or moves the tip of link k in
-    /// its own frame: v(L) along A(φₖ)ŷ, u(L) along A(φₖ)x̂ and, with foreshortening, every
-    /// transverse DOF d along A(φₖ)x̂ with ∂s(L)/∂d = −∫ v′ N′ (the quadrature of s). O(n).
-    pub fn tip_jacobian(&self, t: f64, li: usize, q: &[f64], jac: &mut [f64]) -> [f64; 2] {
-        let n = self.ndof;
-        jac[..2 * n].iter_mut().for_each(|x| *x = 0.0);
-        let mut origin = [[0.0; 2]; MAX_LINKS];
-        let mut angle = [0.0; MAX_LINKS];
-        let mut parent: Option<(f64, [f64; 2])> = None;
-        let mut r = [0.0; 2];
-        for k in 0..=li {
-            let l = &self.links[k];
-            let th = match l.joint.prescribed_at(t) {
-                Some((a, _, _)) => a,
-                None => q[l.joint.dof],
-            };
-            let (phi, r0) = match parent {
-                None => (th, [0.0, 0.0]),
-                Some((pp, rr)) => (pp + th, rr),
-            };
-            let m = l.n_el;
-            let ax = if l.axial {
-                Self::val(q, l.u_dof[m])
-            } else if l.foreshortening {
-                self.foreshortening_at_tip(k, q)
-            } else {
-                0.0
-            };
-            r = add(r0, rot(phi, [l.length + ax, Self::val(q, l.v_dof[m])]));
-            origin[k] = r0;
-            angle[k] = phi;
-            parent = Some((phi + Self::val(q, l.r_dof[m]), r));
-        }
-        let put = |jac: &mut [f64], dof: usize, c: [f64; 2]| {
-            if dof != NONE {
-                jac[dof] += c[0];
-                jac[n + dof] += c[1];
-            }
-        };
-        for k in 0..=li {
-            let l = &self.links[k];
-            let m = l.n_el;
-            put(jac, l.joint.dof, perp(sub(r, origin[k])));
-            if k < li {
-                put(jac, l.r_dof[m], perp(sub(r, origin[k + 1])));
-            }
-            put(jac, l.v_dof[m], rot(angle[k], [0.0, 1.0]));
-            let ex = rot(angle[k], [1.0, 0.0]);
-            if l.axial {
-                put(jac, l.u_dof[m], ex);
-            } else if l.foreshortening {
-                let tb = &self.tables[k];
-                for e in 0..l.n_el {
-                    let dofs = l.elem_dofs(e);
-                    let d = Self::elem_v(q, &dofs);
-                    let ne = l.ne;
-                    let mut ds = [0.0; MAXE];
-                    for j in 0..NSUB {
-                        for kk in 0..NSG {
-                            let dn = &tb.sub_dn[j][kk];
-                            let c = -tb.sub_wh[j][kk] * dotn(dn, &d, ne);
-                            for a in 0..ne {
-                                ds[a] += c * dn[a];
-                            }
-                        }
-                    }
-                    for a in 0..ne {
-                        put(jac, dofs[a], scale(ds[a], ex));
-                    }
-                }
-            }
-        }
-        r
-    }
-
-    /// Tip of link `li`: inertial position, velocity and acceleration at (q, q̇, q̈) from the
-    /// forward kinematic pass of the residual (exact for every element the pass handles). With
-    /// q̈ = 0 the acceleration is the convective term J̇q̇. Overwrites the point data of the
-    /// last residual call (call [`Chain::residual`] again before [`Chain::newton_matrix`]).
-    pub fn tip_motion(
-        &mut self,
-        t: f64,
-        li: usize,
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-    ) -> [[f64; 2]; 3] {
-        self.forward(t, q, qd, qdd, Parts::INERTIA);
-        let fr = self.frames[li];
-        let r = add(fr.r, rot(fr.phi, fr.p_tip));
-        let v = add(
-            fr.dr,
-            rot(fr.phi, add(scale(fr.dphi, perp(fr.p_tip)), fr.dp_tip)),
-        );
-        [r, v, rot(fr.phi, fr.a_tip)]
-    }
+    // ---- Tip kinematics for contact (`crate::events::contact`) ----
 }

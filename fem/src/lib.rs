@@ -22,12 +22,13 @@
 //!
 //! Lagrange's equations are R(q, q̇, q̈, t) = Σ m Jᵀ(r̈ − g) + ∂U/∂q + C q̇ − Q = 0 with
 //! J = ∂r/∂q ([`chain`]), evaluated in O(n) per link by a forward kinematic and a backward force
-//! pass. Discretization: Hermite-cubic v (+ linear u) per element ([`element`]), consistent mass
-//! by 4-point Gauss quadrature (frequency error O(h⁴)). Modes and statics ([`linear`]) also offer
-//! the hierarchical Hermite-quintic element (`discretization.element = "hermite-quintic"`: cubic
-//! plus two C¹ interior bubbles, frequency error O(h⁸); dynamics refuses it). `shear` links use
-//! the Timoshenko element with cubic v and quadratic ψ (locking-free, O(h⁴)) in modes, statics
-//! and dynamics; its interior DOFs v(⅓), v(⅔), ψ(½) are global DOFs, never condensed.
+//! pass. Discretization: one [`element::Element`] per link, the same in modes, statics
+//! ([`linear`]) and dynamics ([`chain`]): Hermite-cubic v (+ linear u), consistent mass by
+//! 4-point Gauss quadrature (frequency error O(h⁴)); the hierarchical Hermite-quintic element
+//! (`discretization.element = "hermite-quintic"`: cubic plus two C¹ interior bubbles, 6-point
+//! Gauss, frequency error O(h⁸)); for `shear` links the Timoshenko element with cubic v and
+//! quadratic ψ (locking-free, O(h⁴)). Interior DOFs (the quintic's bubble amplitudes, the
+//! Timoshenko v(⅓), v(⅔), ψ(½)) are global DOFs, never condensed.
 //!
 //! Timoshenko links without rotary inertia have massless directions (every ψ, and turning the
 //! frame against v = −αx when the hub has no inertia): their equations are static balances
@@ -130,9 +131,10 @@
 //!
 //! ## Layers
 //! Each layer imports only the ones above it:
-//! 1. model: [`element`] (element operators, tested alone) → [`linear`] (assembled linear
-//!    link: modes, statics) and [`chain`] (nonlinear floating-frame system), [`band`]
-//!    (bordered-band solver, linear cost per step);
+//! 1. model: [`element`] (the element trait and its registry; element operators tested alone)
+//!    → [`linear`] (assembled linear link: modes, statics) and [`chain`] (nonlinear
+//!    floating-frame system), [`band`] (faer sparse LU of the bordered-band Newton matrix,
+//!    symbolic part reused; linear cost per step);
 //! 2. methods: [`method`] — one type per integration method behind
 //!    [`method::Stepper`] ([`method::generalized_alpha`], [`method::central_difference`],
 //!    [`method::energy_midpoint`]), the Newton system and the consistent start; a held
@@ -203,7 +205,7 @@ impl FemBackend {
         let n_el = settings::elements(&settings.discretization)?;
         let link = &scene.links[0];
         let omega = linear::hub_rate(link)?;
-        let element = linear::ElementKind::for_link(link, settings.discretization.element)?;
+        let element = element::for_link(link, settings.discretization.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
         let modes = modes::link_modes(&sys, count)?;
         let stations = scene.simulation.field_stations;
@@ -241,7 +243,7 @@ impl FemBackend {
         let n_el = settings::elements(&settings.discretization)?;
         let link = &scene.links[0];
         let omega = linear::hub_rate(link)?;
-        let element = linear::ElementKind::for_link(link, settings.discretization.element)?;
+        let element = element::for_link(link, settings.discretization.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
         let (tip_deflection, tip_rotation) = statics::solve(scene, &sys)?;
         Ok(StaticResult {
@@ -284,13 +286,6 @@ impl Backend for FemBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
-        if settings.discretization.element == Some(data::FemElement::HermiteQuintic) {
-            return Err(FemError::unsupported(
-                "fem run: the `hermite-quintic` element is implemented for modes and statics \
-                 only; dynamics uses `hermite-cubic` (omit `discretization.element`)",
-            )
-            .into());
-        }
         Ok(run::simulate(scene, settings)?)
     }
 }

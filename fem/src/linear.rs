@@ -1,8 +1,8 @@
 //! Linear model of one clamped link (modes and statics): dense K and M about the reference state.
 //!
-//! Elements ([`ElementKind`]): Hermite cubic (default) or hierarchical Hermite quintic for
-//! Euler–Bernoulli links (`discretization.element`), the cubic-v/quadratic-θ element for `shear`
-//! links. DOF order per element e = 0..n−1: its interior DOFs (quintic bubbles a₁, a₂; Timoshenko
+//! Elements ([`crate::element::for_link`]): Hermite cubic (default) or hierarchical Hermite
+//! quintic for Euler–Bernoulli links (`discretization.element`), the cubic-v/quadratic-θ element
+//! for `shear` links. DOF order per element e = 0..n−1: its interior DOFs (quintic bubbles a₁, a₂; Timoshenko
 //! v(⅓), v(⅔), θ(½)), then the DOFs of its end node e+1: v, rotation (v′ for Euler–Bernoulli, θ
 //! for Timoshenko), then u when `axial` is on. Node 0 is clamped and has no DOFs. Interleaving the
 //! interior DOFs keeps the matrices banded. For a hub spinning at constant Ω (prescribed
@@ -13,109 +13,16 @@
 //!
 //! so that in-plane bending obeys ω_in² = ω_out² − Ω² for the inextensible model.
 
-use data::FemElement;
 use data::scene::{Link, PrescribedMotion};
 use faer::Mat;
 
 use crate::element::euler_bernoulli as eb;
 use crate::element::quadrature::gauss01;
-use crate::element::{hermite, quintic, timoshenko};
+use crate::element::{Element, Local, MAXE};
 use crate::error::FemError;
 
-/// Largest local DOF count of any element (Timoshenko: 7).
-const MAX_LOCAL: usize = timoshenko::NDOF;
-
-/// Local element matrix padded to the largest element; only the leading `n` × `n` block is used.
-type Local = [[f64; MAX_LOCAL]; MAX_LOCAL];
-
-/// The transverse element a link uses in the linear model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ElementKind {
-    /// Euler–Bernoulli, Hermite cubic: DOFs (v₁, v₁′, v₂, v₂′).
-    HermiteCubic,
-    /// Euler–Bernoulli, Hermite cubic + two bubbles: (v₁, v₁′, v₂, v₂′, a₁, a₂).
-    HermiteQuintic,
-    /// Timoshenko, cubic v / quadratic θ: (v₁, θ₁, v₂, θ₂, v(⅓), v(⅔), θ(½)).
-    Timoshenko,
-}
-
-impl ElementKind {
-    /// The element for `link` under the `discretization.element` choice. The choice names an
-    /// Euler–Bernoulli element; a `shear` link always uses the Timoshenko element, and asking
-    /// for the quintic there is refused rather than silently ignored.
-    pub fn for_link(link: &Link, choice: Option<FemElement>) -> Result<Self, FemError> {
-        match (link.shear, choice.unwrap_or_default()) {
-            (false, FemElement::HermiteCubic) => Ok(ElementKind::HermiteCubic),
-            (false, FemElement::HermiteQuintic) => Ok(ElementKind::HermiteQuintic),
-            (true, FemElement::HermiteCubic) => Ok(ElementKind::Timoshenko),
-            (true, FemElement::HermiteQuintic) => Err(FemError::InvalidSettings {
-                field: "discretization.element".into(),
-                message: "`hermite-quintic` is an Euler–Bernoulli element; a `shear` link uses                           the Timoshenko (cubic v, quadratic θ) element: omit the field or use                           `hermite-cubic`"
-                    .into(),
-            }),
-        }
-    }
-
-    /// Element-interior DOFs per element.
-    pub fn interior(self) -> usize {
-        match self {
-            ElementKind::HermiteCubic => 0,
-            ElementKind::HermiteQuintic => quintic::INTERIOR,
-            ElementKind::Timoshenko => timoshenko::INTERIOR,
-        }
-    }
-
-    /// Local transverse DOFs per element (4 nodal + interior).
-    pub fn local_dofs(self) -> usize {
-        4 + self.interior()
-    }
-
-    /// Transverse-deflection shape functions of the local DOFs at ξ (zero for rotation DOFs θ).
-    pub fn v_shapes(self, xi: f64, h: f64) -> [f64; MAX_LOCAL] {
-        let mut n = [0.0; MAX_LOCAL];
-        match self {
-            ElementKind::HermiteCubic => n[..4].copy_from_slice(&hermite::hermite(xi, h).n),
-            ElementKind::HermiteQuintic => {
-                n[..quintic::NDOF].copy_from_slice(&quintic::shapes(xi, h).n)
-            }
-            ElementKind::Timoshenko => n.copy_from_slice(&timoshenko::shapes(xi, h).v),
-        }
-        n
-    }
-
-    /// Element mass and stiffness (ρI enters through the slope for Euler–Bernoulli and through θ
-    /// for Timoshenko).
-    fn matrices(self, link: &Link, rho_a: f64, rho_i: f64, h: f64) -> (Local, Local) {
-        let ei = link.bending_stiffness;
-        match self {
-            ElementKind::HermiteCubic => (
-                pad(&eb::mass(rho_a, rho_i, h)),
-                pad(&eb::bending_stiffness(ei, h)),
-            ),
-            ElementKind::HermiteQuintic => (
-                pad(&quintic::mass(rho_a, rho_i, h)),
-                pad(&quintic::bending_stiffness(ei, h)),
-            ),
-            ElementKind::Timoshenko => {
-                // support::check_planar guarantees κGA for shear links.
-                let kga = link.shear_stiffness.unwrap_or(f64::INFINITY);
-                (
-                    timoshenko::mass(rho_a, rho_i, h),
-                    timoshenko::stiffness(ei, kga, h),
-                )
-            }
-        }
-    }
-}
-
-/// Copies an N×N element matrix into the padded local block.
-fn pad<const N: usize>(a: &[[f64; N]; N]) -> Local {
-    let mut out = [[0.0; MAX_LOCAL]; MAX_LOCAL];
-    for i in 0..N {
-        out[i][..N].copy_from_slice(&a[i]);
-    }
-    out
-}
+/// The element kind of a link (from [`crate::element::for_link`]).
+pub type ElementKind = &'static dyn Element;
 
 /// Where the DOFs sit: per element, `interior` DOFs, then `dofs_per_node` DOFs of its end node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -149,8 +56,8 @@ impl NodeLayout {
         self.axial && i % self.block() == self.interior + 2
     }
     /// Global index of each local transverse DOF of element `e` (None: clamped).
-    pub fn element_dofs(&self, e: usize) -> [Option<usize>; MAX_LOCAL] {
-        let mut d = [None; MAX_LOCAL];
+    pub fn element_dofs(&self, e: usize) -> [Option<usize>; MAXE] {
+        let mut d = [None; MAXE];
         d[0] = self.v(e);
         d[1] = self.rot(e);
         d[2] = self.v(e + 1);
@@ -199,7 +106,7 @@ impl LinearLink {
     ) -> Result<Self, FemError> {
         let layout = NodeLayout {
             dofs_per_node: if link.axial { 3 } else { 2 },
-            interior: element.interior(),
+            interior: element.interior().len(),
             axial: link.axial,
             shear: link.shear,
         };
@@ -207,11 +114,6 @@ impl LinearLink {
             return Err(FemError::unsupported(
                 "fem modes: extensible link on a spinning hub: the axial–bending Coriolis \
                  coupling makes this a gyroscopic (state-space) eigenproblem, not implemented",
-            ));
-        }
-        if element == ElementKind::Timoshenko && link.foreshortening && omega != 0.0 {
-            return Err(FemError::unsupported(
-                "fem modes: centrifugal stiffening of a Timoshenko link is not implemented",
             ));
         }
         let n = n_el * layout.block();
@@ -228,10 +130,14 @@ impl LinearLink {
         let l = link.length;
         let w2 = omega * omega;
         let nl = element.local_dofs();
-        // Same for every element: h is uniform.
-        let (me, ke) = element.matrices(link, rho_a, rho_i, h);
+        // Same for every element: h is uniform. ρI enters through the slope for Euler–Bernoulli
+        // and through θ for Timoshenko.
+        let ei = link.bending_stiffness;
+        // support::check_planar guarantees κGA for shear links.
+        let kga = link.shear_stiffness.unwrap_or(f64::INFINITY);
+        let (me, ke) = (element.mass(rho_a, rho_i, h), element.stiffness(ei, kga, h));
         // Rotating-frame softening −Ω²∫ρA v² (translational mass only).
-        let (mv, _) = element.matrices(link, rho_a, 0.0, h);
+        let mv = element.mass(rho_a, 0.0, h);
         for e in 0..n_el {
             let dofs = layout.element_dofs(e);
             let mut kt = ke;
@@ -247,12 +153,12 @@ impl LinearLink {
                         let x = xa + xi * h;
                         0.5 * rho_a * w2 * (l * l - x * x) + tip_mass * w2 * l
                     };
-                    let kg = match element {
-                        ElementKind::HermiteCubic => pad(&eb::geometric_stiffness(h, force)),
-                        ElementKind::HermiteQuintic => pad(&quintic::geometric_stiffness(h, force)),
-                        // Refused above.
-                        ElementKind::Timoshenko => [[0.0; MAX_LOCAL]; MAX_LOCAL],
-                    };
+                    let kg: Local = element.geometric_stiffness(h, &force).ok_or_else(|| {
+                        FemError::unsupported(format!(
+                            "fem modes: centrifugal stiffening of a {} link is not implemented",
+                            element.name()
+                        ))
+                    })?;
                     for i in 0..nl {
                         for j in 0..nl {
                             kt[i][j] += kg[i][j];
@@ -312,7 +218,7 @@ impl LinearLink {
         let h = self.length / self.n_el as f64;
         let e = ((x / h).floor() as usize).min(self.n_el - 1);
         let xi = ((x - e as f64 * h) / h).clamp(0.0, 1.0);
-        let n = self.element.v_shapes(xi, h);
+        let n = self.element.shapes(xi, h).n;
         let dofs = self.layout.element_dofs(e);
         (0..self.element.local_dofs())
             .map(|k| dofs[k].map_or(0.0, |i| n[k] * d[i]))
@@ -324,9 +230,9 @@ impl LinearLink {
         let h = self.length / self.n_el as f64;
         let (pts, wts) = gauss01(6);
         let nl = self.element.local_dofs();
-        let mut fe = [0.0; MAX_LOCAL];
+        let mut fe = [0.0; MAXE];
         for (xi, w) in pts.iter().zip(wts) {
-            let nv = self.element.v_shapes(*xi, h);
+            let nv = self.element.shapes(*xi, h).n;
             for k in 0..nl {
                 fe[k] += w * h * q * nv[k];
             }

@@ -2,8 +2,8 @@
 
 use data::{DofPlan, FemElement, Scene};
 
+use crate::element;
 use crate::error::FemError;
-use crate::linear::ElementKind;
 use crate::support::check_planar;
 
 /// DOFs per field and the physics built, for `n_el` elements per link of the chosen element
@@ -20,35 +20,14 @@ pub fn dof_plan(
         if l.joint.prescribed.is_none() {
             plan.add(format!("joint{li} angle"), 1);
         }
-        let kind = ElementKind::for_link(l, element)?;
-        match kind {
-            ElementKind::HermiteCubic => {
-                plan.add(format!("link{li} transverse v"), n_el);
-                plan.add(format!("link{li} slope v′"), n_el);
-            }
-            ElementKind::HermiteQuintic => {
-                plan.add(format!("link{li} transverse v"), n_el);
-                plan.add(format!("link{li} slope v′"), n_el);
-                plan.add(format!("link{li} bubble amplitudes a₁, a₂"), 2 * n_el);
-            }
-            ElementKind::Timoshenko => {
-                // Nodal v plus v(⅓), v(⅔) per element; nodal θ plus θ(½).
-                plan.add(format!("link{li} transverse v"), 3 * n_el);
-                plan.add(format!("link{li} section rotation θ"), 2 * n_el);
-            }
+        let kind = element::for_link(l, element)?;
+        for (field, per_element) in kind.plan_fields() {
+            plan.add(format!("link{li} {field}"), per_element * n_el);
         }
         if l.axial {
             plan.add(format!("link{li} axial u"), n_el);
         }
-        let beam = match kind {
-            ElementKind::HermiteCubic => "Euler–Bernoulli beam (Hermite cubic v",
-            ElementKind::HermiteQuintic => {
-                "Euler–Bernoulli beam (Hermite quintic v: cubic + 2 C¹ bubbles; modes/statics only"
-            }
-            ElementKind::Timoshenko => {
-                "Timoshenko beam (cubic v, quadratic θ, interior DOFs global"
-            }
-        };
+        let beam = kind.description();
         let mut b = vec![format!(
             "link{li}: {beam}{}), {n_el} elements",
             if l.axial { ", linear u" } else { "" }

@@ -240,7 +240,12 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
                 .into(),
         });
     }
-    let mut chain = Chain::new(&scene.links, scene.gravity.as_ref(), n_el)?;
+    let mut chain = Chain::with_element(
+        &scene.links,
+        scene.gravity.as_ref(),
+        n_el,
+        settings.discretization.element,
+    )?;
     if let Some(st) = &scene.statics {
         // The scene's static loads act as a step load in dynamics (scene `cantilever`: the
         // response oscillates about the static deflection).

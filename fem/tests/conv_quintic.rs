@@ -185,7 +185,7 @@ fn sys_quintic_rotating_beam_agrees_with_extrapolated_cubic() {
 }
 
 #[test]
-fn sys_quintic_dof_count_and_refusals() {
+fn sys_quintic_dof_count_in_modes_and_dynamics_and_shear_refusal() {
     let sc = data::load_scene("cantilever").unwrap();
     let n = 8;
     let plan = FemBackend
@@ -195,11 +195,9 @@ fn sys_quintic_dof_count_and_refusals() {
     assert_eq!(plan.total(), 4 * n);
     let m = FemBackend.modes(&sc, &settings(n, QUINTIC), 2).unwrap();
     assert_eq!(m.cost.dofs, plan.total());
-    // Dynamics: refused by name, not run with the cubic.
-    match FemBackend.simulate(&sc, &settings(n, QUINTIC)) {
-        Err(BackendError::Unsupported(msg)) => assert!(msg.contains("hermite-quintic"), "{msg}"),
-        other => panic!("{other:?}"),
-    }
+    // Dynamics builds the same element: the run's DOFs are the plan's.
+    let run = FemBackend.simulate(&sc, &settings(n, QUINTIC)).unwrap();
+    assert_eq!(run.cost.dofs, plan.total());
     // A shear link uses the Timoshenko element: asking for the quintic is a settings error.
     let tim = data::load_scene("cantilever-timoshenko").unwrap();
     match FemBackend.modes(&tim, &settings(n, QUINTIC), 2) {
@@ -209,4 +207,67 @@ fn sys_quintic_dof_count_and_refusals() {
         }
         other => panic!("{other:?}"),
     }
+}
+
+/// Hub angle history θ(tᵢ) of `single-link` with `n` elements of `element`, all runs at the same
+/// fixed step so that they share one time discretization and differ only in space.
+fn hub_angle_history(n: usize, element: Option<FemElement>, dt: f64) -> Vec<f64> {
+    let sc = data::load_scene("single-link").unwrap();
+    let mut s = settings(n, element);
+    s.time.dt = Some(dt);
+    let run = FemBackend.simulate(&sc, &s).unwrap();
+    run.observables.get("joint1.angle").unwrap().values.clone()
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+#[test]
+fn conv_quintic_dynamics_converges_to_the_refined_cubic_hub_angle_history() {
+    // One step for every run, T₁/400 of the scene's first flexible period
+    // (clamped–free β₁L = 1.8751: ω₁ = β₁² √(EI/ρA)); the comparison is spatial only.
+    let sc = data::load_scene("single-link").unwrap();
+    let l = &sc.links[0];
+    let beta1 = 1.875_104_068_711_961 / l.length;
+    let omega1 = beta1 * beta1 * (l.bending_stiffness / l.mass_per_length).sqrt();
+    let dt = 2.0 * std::f64::consts::PI / omega1 / 400.0;
+    eprintln!("dt = {dt:.3e}");
+    let (c4, c8, c16) = (
+        hub_angle_history(4, None, dt),
+        hub_angle_history(8, None, dt),
+        hub_angle_history(16, None, dt),
+    );
+    let (q4, q8) = (
+        hub_angle_history(4, QUINTIC, dt),
+        hub_angle_history(8, QUINTIC, dt),
+    );
+    // The cubic converges at O(h⁴) in the history too, so Richardson's estimate of the error
+    // of the 16-element cubic is |c8 − c16|/(2⁴ − 1).
+    let (d48, d816) = (max_diff(&c4, &c8), max_diff(&c8, &c16));
+    let order = (d48 / d816).log2();
+    let e16 = d816 / 15.0;
+    let (dq4, dq8, dq48) = (max_diff(&q4, &c16), max_diff(&q8, &c16), max_diff(&q4, &q8));
+    eprintln!(
+        "cubic order {order:.2}, cubic-16 error ≈ {e16:.2e}; |q4 − c16| {dq4:.2e}, \
+         |q8 − c16| {dq8:.2e}, |q4 − q8| {dq48:.2e}"
+    );
+    assert!(order > 3.5, "cubic history order {order}");
+    // The quintic (O(h⁸)) at 4 and 8 elements is at least as accurate as the cubic at 16: it
+    // differs from it by no more than the two errors, ≤ 2·e16, and its own refinement changes
+    // the history by less than the cubic-16 error.
+    assert!(
+        dq4 <= 2.0 * e16,
+        "|q4 − c16| = {dq4} vs 2·e16 = {}",
+        2.0 * e16
+    );
+    assert!(
+        dq8 <= 2.0 * e16,
+        "|q8 − c16| = {dq8} vs 2·e16 = {}",
+        2.0 * e16
+    );
+    assert!(dq48 <= e16, "|q4 − q8| = {dq48} vs e16 = {e16}");
 }

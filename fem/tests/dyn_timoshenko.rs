@@ -11,7 +11,8 @@ mod common;
 use data::{Backend, RunResult, Scene, Settings, StabilityVerdict};
 use fem::FemBackend;
 use fem::chain::{Chain, NewtonCoefficients, Parts};
-use fem::linear::{ElementKind, LinearLink};
+use fem::element::timoshenko::Timoshenko;
+use fem::linear::LinearLink;
 
 /// Switches Timoshenko shear on for every link: κGA = `ratio`·EI/L², ρI = `rho_i_ratio`·ρA L²
 /// (rotary inertia on when > 0).
@@ -248,7 +249,7 @@ fn cross_timoshenko_chain_linearized_at_rest_is_the_linear_model() {
         sc.links[0].axial = axial;
         let n_el = 6;
         let mut ch = Chain::new(&sc.links, None, n_el).unwrap();
-        let lin = LinearLink::assemble(&sc.links[0], n_el, 0.0, ElementKind::Timoshenko).unwrap();
+        let lin = LinearLink::assemble(&sc.links[0], n_el, 0.0, &Timoshenko).unwrap();
         let n = ch.ndof;
         assert_eq!(n, lin.ndof());
         assert_eq!(n, n_el * (if axial { 6 } else { 5 }));

@@ -6,11 +6,21 @@
 
 mod common;
 
+use data::FemElement;
 use fem::chain::{Chain, NewtonCoefficients};
+
+/// The default element (Hermite cubic; Timoshenko on `shear` links).
+const CUBIC: Option<FemElement> = None;
+const QUINTIC: Option<FemElement> = Some(FemElement::HermiteQuintic);
 
 /// A chain with every effect switched on (tip masses and inertias, hub inertia, gravity,
 /// foreshortening as requested) at a generic state.
-fn setup(name: &str, n_el: usize, foreshortening: bool) -> (Chain, Vec<f64>, Vec<f64>, Vec<f64>) {
+fn setup(
+    name: &str,
+    n_el: usize,
+    foreshortening: bool,
+    element: Option<FemElement>,
+) -> (Chain, Vec<f64>, Vec<f64>, Vec<f64>) {
     let mut sc = data::load_scene(name).unwrap();
     for l in sc.links.iter_mut() {
         l.foreshortening = foreshortening && !l.axial;
@@ -21,7 +31,7 @@ fn setup(name: &str, n_el: usize, foreshortening: bool) -> (Chain, Vec<f64>, Vec
     sc.gravity = Some(data::scene::Gravity {
         vector: [0.3, -9.0],
     });
-    let ch = Chain::new(&sc.links, sc.gravity.as_ref(), n_el).unwrap();
+    let ch = Chain::with_element(&sc.links, sc.gravity.as_ref(), n_el, element).unwrap();
     let n = ch.ndof;
     let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
     ch.initial_state(&mut q, &mut qd);
@@ -36,13 +46,16 @@ fn setup(name: &str, n_el: usize, foreshortening: bool) -> (Chain, Vec<f64>, Vec
 
 #[test]
 fn sys_residual_is_lagrange_of_the_reported_energies() {
-    for (name, fs) in [
-        ("single-link", false),
-        ("single-link", true),
-        ("two-link-free-undamped", true),
-        ("spin-up-axial", false),
+    for (name, fs, element) in [
+        ("single-link", false, CUBIC),
+        ("single-link", true, CUBIC),
+        ("two-link-free-undamped", true, CUBIC),
+        ("spin-up-axial", false, CUBIC),
+        ("single-link", true, QUINTIC),
+        ("two-link-free-undamped", true, QUINTIC),
+        ("spin-up-axial", false, QUINTIC),
     ] {
-        let (mut ch, q, qd, qdd) = setup(name, 3, fs);
+        let (mut ch, q, qd, qdd) = setup(name, 3, fs, element);
         let n = ch.ndof;
         let t = 0.3;
         let mut r = vec![0.0; n];
@@ -107,13 +120,16 @@ fn sys_newton_matrix_is_the_residual_derivative() {
     // foreshortening the omitted terms — ∂s/∂q couplings, dense over a link — are O(v′) in the
     // joint rows and O(v′²) elsewhere: at this state (v′ ≈ 0.1) they are ≈ 6 % of the scale,
     // which is why free chains with foreshortening use the dense finite-difference Jacobian.
-    for (name, fs, tol) in [
-        ("single-link", false, 1e-7),
-        ("two-link-free-undamped", false, 1e-4),
-        ("spin-up-axial", false, 1e-7),
-        ("single-link", true, 0.1),
+    for (name, fs, tol, element) in [
+        ("single-link", false, 1e-7, CUBIC),
+        ("two-link-free-undamped", false, 1e-4, CUBIC),
+        ("spin-up-axial", false, 1e-7, CUBIC),
+        ("single-link", true, 0.1, CUBIC),
+        ("single-link", false, 1e-7, QUINTIC),
+        ("two-link-free-undamped", false, 1e-4, QUINTIC),
+        ("spin-up-axial", false, 1e-7, QUINTIC),
     ] {
-        let (mut ch, q, qd, qdd) = setup(name, 3, fs);
+        let (mut ch, q, qd, qdd) = setup(name, 3, fs, element);
         let (worst, scale) = common::newton_matrix_fd_error(&mut ch, &q, &qd, &qdd, c);
         assert!(
             worst < tol * scale,
@@ -127,12 +143,13 @@ fn sys_mass_product_and_kinetic_gradient_match_the_reported_kinetic_energy() {
     // The energy-midpoint ingredients against finite differences of `energies()`' kinetic term
     // T(q, x) = ½xᵀM(q)x: M(q)x = ∂T/∂x (T is quadratic in x: central differences are exact up
     // to round-off), ½xᵀM(q)x = T, and ∂T/∂q from Ṁ(x)x − R_in(q, x, 0).
-    for (name, fs) in [
-        ("single-link", false),
-        ("single-link", true),
-        ("two-link-free-undamped", true),
+    for (name, fs, element) in [
+        ("single-link", false, CUBIC),
+        ("single-link", true, CUBIC),
+        ("two-link-free-undamped", true, CUBIC),
+        ("two-link-free-undamped", true, QUINTIC),
     ] {
-        let (mut ch, q, x, _) = setup(name, 3, fs);
+        let (mut ch, q, x, _) = setup(name, 3, fs, element);
         let n = ch.ndof;
         let t = 0.3;
         let mx = fem::method::energy_midpoint::mass_product(&mut ch, t, &q, &x);
@@ -182,8 +199,12 @@ fn sys_mass_product_and_kinetic_gradient_match_the_reported_kinetic_energy() {
 #[test]
 fn sys_residual_parts_sum_to_the_residual_and_conservative_part_is_grad_v() {
     use fem::chain::Parts;
-    for (name, fs) in [("single-link", true), ("two-link-free", true)] {
-        let (mut ch, q, qd, qdd) = setup(name, 3, fs);
+    for (name, fs, element) in [
+        ("single-link", true, CUBIC),
+        ("two-link-free", true, CUBIC),
+        ("two-link-free", true, QUINTIC),
+    ] {
+        let (mut ch, q, qd, qdd) = setup(name, 3, fs, element);
         let n = ch.ndof;
         let t = 0.7;
         let mut full = vec![0.0; n];
@@ -225,5 +246,58 @@ fn sys_residual_parts_sum_to_the_residual_and_conservative_part_is_grad_v() {
                 grad[i]
             );
         }
+    }
+}
+
+#[test]
+fn sys_newton_solve_of_real_chain_matrices_is_backward_stable() {
+    // The Newton matrices of the arms at their default meshes, with the coefficients of a
+    // generalized-α step (ρ∞ = 0.9, h = 1e-3): the sparse LU solve leaves a residual at
+    // round-off, ‖S x − r‖ ≤ n ε ‖S‖∞ ‖x‖∞ (a backward error of a few ulps per row).
+    let n_el = fem::settings::elements(&data::Discretization::default()).unwrap();
+    for name in [
+        "two-link-free",
+        "barhorst-case1-timoshenko",
+        "spin-up-axial",
+    ] {
+        let sc = data::load_scene(name).unwrap();
+        let mut ch = Chain::new(&sc.links, sc.gravity.as_ref(), n_el).unwrap();
+        let n = ch.ndof;
+        let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+        ch.initial_state(&mut q, &mut qd);
+        for i in 0..n {
+            q[i] += 1e-3 * (i as f64 * 1.3).sin();
+            qd[i] += 0.1 * (i as f64 * 0.7).cos();
+        }
+        let mut r = vec![0.0; n];
+        ch.residual(0.2, &q, &qd, &vec![0.0; n], &mut r);
+        let (rho, h) = (0.9, 1e-3);
+        let (am, af) = ((2.0 * rho - 1.0) / (rho + 1.0), rho / (rho + 1.0));
+        let beta = 0.25 * (1.0 - am + af) * (1.0 - am + af);
+        let gamma = 0.5 - am + af;
+        let c = NewtonCoefficients {
+            c_a: (1.0 - am) / (beta * h * h),
+            c_v: (1.0 - af) * gamma / (beta * h),
+            c_q: 1.0 - af,
+        };
+        let mut s = ch.new_matrix();
+        ch.newton_matrix(&q, c, &mut s);
+        let norm_s = (0..n)
+            .map(|i| (0..n).map(|j| s.get(i, j).abs()).sum::<f64>())
+            .fold(0.0f64, f64::max);
+        let unfactored = s.clone();
+        s.factorize().unwrap();
+        let mut x = r.clone();
+        s.solve_in_place(&mut x);
+        let mut sx = vec![0.0; n];
+        unfactored.matvec(&x, &mut sx);
+        let res = sx
+            .iter()
+            .zip(&r)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let norm_x = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let bound = n as f64 * f64::EPSILON * norm_s * norm_x;
+        eprintln!("{name}: n = {n}, ‖Sx − r‖ = {res:.2e}, bound {bound:.2e}");
+        assert!(res <= bound, "{name}: ‖Sx − r‖ = {res:e} > {bound:e}");
     }
 }

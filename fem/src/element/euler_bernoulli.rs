@@ -15,6 +15,7 @@
 use super::Mat4;
 use super::hermite::{dot4, hermite};
 use super::quadrature::gauss01;
+use super::{Element, ElementDofs, InteriorDof, Local, MAXE, MeshElement, NONE, Row, Shapes, pad};
 
 /// Consistent transverse mass ∫ρA NᵢNⱼ (+ ∫ρI Nᵢ′Nⱼ′ when `rho_i` > 0).
 pub fn mass(rho_a: f64, rho_i: f64, h: f64) -> Mat4 {
@@ -153,6 +154,120 @@ pub fn von_karman_tangent(ea: f64, ei: f64, h: f64, d: &VkDofs) -> [[f64; 6]; 6]
         }
     }
     k
+}
+
+/// The Euler–Bernoulli Hermite-cubic element: DOFs (v₁, v₁′, v₂, v₂′). An extensible link uses
+/// the von Kármán operators above (element-averaged membrane strain, linear u).
+#[derive(Debug, Clone, Copy)]
+pub struct HermiteCubic;
+
+impl Element for HermiteCubic {
+    fn name(&self) -> &'static str {
+        "Hermite-cubic"
+    }
+    fn description(&self) -> &'static str {
+        "Euler–Bernoulli beam (Hermite cubic v"
+    }
+    fn plan_fields(&self) -> &'static [(&'static str, usize)] {
+        &[("transverse v", 1), ("slope v′", 1)]
+    }
+    fn slope_label(&self) -> &'static str {
+        "v′"
+    }
+    fn interior(&self) -> &'static [InteriorDof] {
+        &[]
+    }
+    fn independent_rotation(&self) -> bool {
+        false
+    }
+    fn gauss_points(&self) -> usize {
+        4
+    }
+    fn sub_gauss_points(&self) -> usize {
+        3
+    }
+    fn shapes(&self, xi: f64, h: f64) -> Shapes {
+        let s = hermite(xi, h);
+        let mut out = Shapes::default();
+        out.n[..4].copy_from_slice(&s.n);
+        out.dn[..4].copy_from_slice(&s.dn);
+        out.b[..4].copy_from_slice(&s.dn);
+        out
+    }
+    fn translates(&self, _a: usize) -> bool {
+        true
+    }
+    fn mass(&self, rho_a: f64, rho_i: f64, h: f64) -> Local {
+        pad(&mass(rho_a, rho_i, h))
+    }
+    fn stiffness(&self, ei: f64, _kga: f64, h: f64) -> Local {
+        pad(&bending_stiffness(ei, h))
+    }
+    fn geometric_stiffness(&self, h: f64, axial_force: &dyn Fn(f64) -> f64) -> Option<Local> {
+        Some(pad(&geometric_stiffness(h, axial_force)))
+    }
+    fn internal_force(
+        &self,
+        el: &MeshElement,
+        u: [f64; 2],
+        d: &Row,
+        fu: &mut [f64; 2],
+        fe: &mut Row,
+    ) {
+        if el.axial {
+            let fv = von_karman_force(el.ea, el.ei, el.h, &[u[0], u[1], d[0], d[1], d[2], d[3]]);
+            fu[0] += fv[0];
+            fu[1] += fv[1];
+            for a in 0..4 {
+                fe[a] += fv[2 + a];
+            }
+        } else {
+            super::linear_internal_force(el, u, d, fu, fe);
+        }
+    }
+    fn tangent(
+        &self,
+        el: &MeshElement,
+        dofs: &ElementDofs,
+        u: [f64; 2],
+        d: &Row,
+        c_q: f64,
+        add: &mut dyn FnMut(usize, usize, f64),
+    ) {
+        if el.axial {
+            let kt = von_karman_tangent(el.ea, el.ei, el.h, &[u[0], u[1], d[0], d[1], d[2], d[3]]);
+            let dd = &dofs.d;
+            let all = [dofs.u[0], dofs.u[1], dd[0], dd[1], dd[2], dd[3]];
+            for a in 0..6 {
+                for b in 0..6 {
+                    if all[a] != NONE && all[b] != NONE {
+                        add(all[a], all[b], c_q * kt[a][b]);
+                    }
+                }
+            }
+        } else {
+            super::linear_tangent(el, dofs, u, d, c_q, add);
+        }
+    }
+    fn add_strain_energy(&self, el: &MeshElement, u: [f64; 2], d: &Row, strain: &mut f64) {
+        if el.axial {
+            *strain += von_karman_energy(el.ea, el.ei, el.h, &[u[0], u[1], d[0], d[1], d[2], d[3]]);
+        } else {
+            super::linear_strain_energy(el, u, d, strain);
+        }
+    }
+    fn consistent_load(&self, el: &MeshElement, q0: f64) -> Row {
+        // ∫q₀N of the Hermite cubics in closed form.
+        let h = el.h;
+        let mut fq = [0.0; MAXE];
+        fq[..4].copy_from_slice(&[
+            0.5 * q0 * h,
+            q0 * h * h / 12.0,
+            0.5 * q0 * h,
+            -q0 * h * h / 12.0,
+        ]);
+        fq
+    }
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@
 
 use super::hermite::hermite;
 use super::quadrature::gauss01;
+use super::{Element, InteriorDof, InteriorField, Local, Shapes, pad};
 
 /// Number of local DOFs of one element.
 pub const NDOF: usize = 6;
@@ -93,6 +94,74 @@ pub fn geometric_stiffness(h: f64, axial_force: impl Fn(f64) -> f64) -> Mat6 {
         }
     }
     k
+}
+
+/// The hierarchical Hermite-quintic Euler–Bernoulli element, DOFs (v₁, v₁′, v₂, v₂′, a₁, a₂).
+/// An extensible link uses the element-averaged membrane strain (the element's 6-point rule
+/// integrates its degree-8 v′² exactly).
+#[derive(Debug, Clone, Copy)]
+pub struct HermiteQuintic;
+
+impl Element for HermiteQuintic {
+    fn name(&self) -> &'static str {
+        "Hermite-quintic"
+    }
+    fn description(&self) -> &'static str {
+        "Euler–Bernoulli beam (Hermite quintic v: cubic + 2 C¹ bubbles"
+    }
+    fn plan_fields(&self) -> &'static [(&'static str, usize)] {
+        &[
+            ("transverse v", 1),
+            ("slope v′", 1),
+            ("bubble amplitudes a₁, a₂", INTERIOR),
+        ]
+    }
+    fn slope_label(&self) -> &'static str {
+        "v′"
+    }
+    fn interior(&self) -> &'static [InteriorDof] {
+        &[
+            InteriorDof {
+                field: InteriorField::Bubble,
+                label: "a₁",
+                at: 0.5,
+            },
+            InteriorDof {
+                field: InteriorField::Bubble,
+                label: "a₂",
+                at: 0.5,
+            },
+        ]
+    }
+    fn independent_rotation(&self) -> bool {
+        false
+    }
+    fn gauss_points(&self) -> usize {
+        6
+    }
+    fn sub_gauss_points(&self) -> usize {
+        5
+    }
+    fn shapes(&self, xi: f64, h: f64) -> Shapes {
+        let s = shapes(xi, h);
+        let mut out = Shapes::default();
+        out.n[..NDOF].copy_from_slice(&s.n);
+        out.dn[..NDOF].copy_from_slice(&s.dn);
+        out.b[..NDOF].copy_from_slice(&s.dn);
+        out
+    }
+    fn translates(&self, _a: usize) -> bool {
+        true
+    }
+    fn mass(&self, rho_a: f64, rho_i: f64, h: f64) -> Local {
+        pad(&mass(rho_a, rho_i, h))
+    }
+    fn stiffness(&self, ei: f64, _kga: f64, h: f64) -> Local {
+        pad(&bending_stiffness(ei, h))
+    }
+    fn geometric_stiffness(&self, h: f64, axial_force: &dyn Fn(f64) -> f64) -> Option<Local> {
+        Some(pad(&geometric_stiffness(h, axial_force)))
+    }
 }
 
 #[cfg(test)]

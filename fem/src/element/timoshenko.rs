@@ -19,6 +19,7 @@
 //! cannot follow the linearly varying shear force of a vibrating element and converges at O(h²).
 
 use super::quadrature::gauss01;
+use super::{Element, InteriorDof, InteriorField, Local, Shapes};
 
 /// Number of local DOFs of one element.
 pub const NDOF: usize = 7;
@@ -125,6 +126,75 @@ pub fn mass(rho_a: f64, rho_i: f64, h: f64) -> Mat7 {
         }
     }
     m
+}
+
+/// The Timoshenko element (cubic v, quadratic θ), DOFs (v₁, θ₁, v₂, θ₂, v(⅓), v(⅔), θ(½)).
+#[derive(Debug, Clone, Copy)]
+pub struct Timoshenko;
+
+impl Element for Timoshenko {
+    fn name(&self) -> &'static str {
+        "Timoshenko"
+    }
+    fn description(&self) -> &'static str {
+        "Timoshenko beam (cubic v, quadratic θ, interior DOFs global"
+    }
+    fn plan_fields(&self) -> &'static [(&'static str, usize)] {
+        // Nodal v plus v(⅓), v(⅔) per element; nodal θ plus θ(½).
+        &[("transverse v", 3), ("section rotation θ", 2)]
+    }
+    fn slope_label(&self) -> &'static str {
+        "ψ"
+    }
+    fn interior(&self) -> &'static [InteriorDof] {
+        &[
+            InteriorDof {
+                field: InteriorField::Deflection,
+                label: "v",
+                at: 1.0 / 3.0,
+            },
+            InteriorDof {
+                field: InteriorField::Deflection,
+                label: "v",
+                at: 2.0 / 3.0,
+            },
+            InteriorDof {
+                field: InteriorField::Rotation,
+                label: "ψ",
+                at: 0.5,
+            },
+        ]
+    }
+    fn independent_rotation(&self) -> bool {
+        true
+    }
+    fn gauss_points(&self) -> usize {
+        4
+    }
+    fn sub_gauss_points(&self) -> usize {
+        3
+    }
+    fn shapes(&self, xi: f64, h: f64) -> Shapes {
+        let s = shapes(xi, h);
+        Shapes {
+            n: s.v,
+            dn: s.dv,
+            b: s.th,
+        }
+    }
+    fn translates(&self, a: usize) -> bool {
+        // θ₁, θ₂, θ(½) turn sections only.
+        !(a == 1 || a == 3 || a == 6)
+    }
+    fn mass(&self, rho_a: f64, rho_i: f64, h: f64) -> Local {
+        mass(rho_a, rho_i, h)
+    }
+    fn stiffness(&self, ei: f64, kga: f64, h: f64) -> Local {
+        stiffness(ei, kga, h)
+    }
+    fn geometric_stiffness(&self, _h: f64, _axial_force: &dyn Fn(f64) -> f64) -> Option<Local> {
+        None
+    }
 }
 
 #[cfg(test)]

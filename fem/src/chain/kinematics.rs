@@ -1,0 +1,325 @@
+//! Kinematic pass: frame and point kinematics of every link (positions, velocities,
+//! accelerations at the quadrature points, cumulative foreshortening), and the tip kinematics
+//! that observables and contact read (positions, Jacobian, motion).
+
+use super::geometry::{add, perp, rot, rot_t, scale, sub};
+use super::{Chain, FrameState, MAX_LINKS, MAXE, NONE, Parts, dotn};
+
+impl Chain {
+    /// Forward pass: frame and tip kinematics of every link (no forces).
+    pub(super) fn forward(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], parts: Parts) {
+        let g_in = if parts.conservative {
+            self.gravity
+        } else {
+            [0.0; 2]
+        };
+        let inertia = if parts.inertia { 1.0 } else { 0.0 };
+        let mut parent: Option<FrameState> = None;
+        for li in 0..self.links.len() {
+            let l = &self.links[li];
+            let tb = &l.element.quad;
+            let (th, dth, ddth) = match l.joint.prescribed_at(t) {
+                Some(k) => k,
+                None => (q[l.joint.dof], qd[l.joint.dof], qdd[l.joint.dof]),
+            };
+            let mut fr = FrameState {
+                theta: th,
+                dtheta: dth,
+                ddtheta: ddth,
+                ..Default::default()
+            };
+            match parent {
+                None => {
+                    fr.phi = th;
+                    fr.dphi = dth;
+                    fr.ddphi = ddth;
+                }
+                Some(p) => {
+                    fr.phi = p.phi + p.slope_tip + th;
+                    fr.dphi = p.dphi + p.dslope_tip + dth;
+                    fr.ddphi = p.ddphi + p.ddslope_tip + ddth;
+                    let pr = add(p.r, rot(p.phi, p.p_tip));
+                    let pdr = add(
+                        p.dr,
+                        rot(p.phi, add(scale(p.dphi, perp(p.p_tip)), p.dp_tip)),
+                    );
+                    fr.r = pr;
+                    fr.dr = pdr;
+                    fr.ddr = rot(p.phi, p.a_tip);
+                }
+            }
+            let (phi, w, dw) = (fr.phi, fr.dphi, fr.ddphi);
+            let frame_acc = rot_t(phi, fr.ddr);
+            let g_loc = rot_t(phi, g_in);
+            // Cumulative foreshortening s, ṡ, s̈ along the link.
+            let (mut s, mut sd, mut sdd) = (0.0, 0.0, 0.0);
+            let fs = l.foreshortening;
+            let ne = l.ne;
+            for e in 0..l.n_el {
+                let dofs = l.elem_dofs(e);
+                let d = Self::elem_v(q, &dofs);
+                let dd = Self::elem_v(qd, &dofs);
+                let ddd = Self::elem_v(qdd, &dofs);
+                let (ua, ub) = (l.u_dof[e], l.u_dof[e + 1]);
+                let u = [Self::val(q, ua), Self::val(q, ub)];
+                let ud = [Self::val(qd, ua), Self::val(qd, ub)];
+                let udd = [Self::val(qdd, ua), Self::val(qdd, ub)];
+                let xa = e as f64 * l.h;
+                for j in 0..tb.ng + 1 {
+                    if fs {
+                        for k in 0..tb.nsg {
+                            let dn = &tb.sub_dn[j][k];
+                            let wgt = tb.sub_wh[j][k];
+                            let vp = dotn(dn, &d, ne);
+                            let vpd = dotn(dn, &dd, ne);
+                            let vpdd = dotn(dn, &ddd, ne);
+                            s -= 0.5 * wgt * vp * vp;
+                            sd -= wgt * vp * vpd;
+                            sdd -= wgt * (vpd * vpd + vp * vpdd);
+                        }
+                    }
+                    if j == tb.ng {
+                        continue;
+                    }
+                    let g = j;
+                    let n = &tb.n[g];
+                    let xi = tb.xi[g];
+                    let (ax, axd, axdd) = if l.axial {
+                        (
+                            (1.0 - xi) * u[0] + xi * u[1],
+                            (1.0 - xi) * ud[0] + xi * ud[1],
+                            (1.0 - xi) * udd[0] + xi * udd[1],
+                        )
+                    } else if fs {
+                        (s, sd, sdd)
+                    } else {
+                        (0.0, 0.0, 0.0)
+                    };
+                    let p = [xa + xi * l.h + ax, dotn(n, &d, ne)];
+                    let pd = [axd, dotn(n, &dd, ne)];
+                    let pdd = [axdd, dotn(n, &ddd, ne)];
+                    let a = add(
+                        add(frame_acc, scale(dw, perp(p))),
+                        add(scale(-w * w, p), add(scale(2.0 * w, perp(pd)), pdd)),
+                    );
+                    let m = l.rho_a * tb.wh[g];
+                    // Applied uniform transverse load on the last link (frame y), as a density
+                    // with the d'Alembert sign: Gauss-4 gives its consistent nodal loads exactly.
+                    let q_load = if li + 1 == self.links.len() && parts.nonconservative {
+                        self.distributed_load
+                    } else {
+                        0.0
+                    };
+                    self.force[li][e * tb.ng + g] = sub(
+                        scale(m, sub(scale(inertia, a), g_loc)),
+                        [0.0, q_load * tb.wh[g]],
+                    );
+                    self.pos[li][e * tb.ng + g] = p;
+                    self.vel[li][e * tb.ng + g] = pd;
+                }
+            }
+            // Tip.
+            let k = l.n_el;
+            let (ut, utd, utdd) = if l.axial {
+                (
+                    Self::val(q, l.u_dof[k]),
+                    Self::val(qd, l.u_dof[k]),
+                    Self::val(qdd, l.u_dof[k]),
+                )
+            } else if fs {
+                (s, sd, sdd)
+            } else {
+                (0.0, 0.0, 0.0)
+            };
+            let p = [l.length + ut, Self::val(q, l.v_dof[k])];
+            let pd = [utd, Self::val(qd, l.v_dof[k])];
+            let pdd = [utdd, Self::val(qdd, l.v_dof[k])];
+            fr.p_tip = p;
+            fr.dp_tip = pd;
+            fr.a_tip = add(
+                add(frame_acc, scale(dw, perp(p))),
+                add(scale(-w * w, p), add(scale(2.0 * w, perp(pd)), pdd)),
+            );
+            fr.slope_tip = Self::val(q, l.r_dof[k]);
+            fr.dslope_tip = Self::val(qd, l.r_dof[k]);
+            fr.ddslope_tip = Self::val(qdd, l.r_dof[k]);
+            self.frames[li] = fr;
+            parent = Some(fr);
+        }
+    }
+
+    /// Joint angle and rate of link `li` at a state.
+    pub fn joint_state(&self, li: usize, t: f64, q: &[f64], qd: &[f64]) -> (f64, f64) {
+        let j = &self.links[li].joint;
+        match j.prescribed_at(t) {
+            Some((a, r, _)) => (a, r),
+            None => (q[j.dof], qd[j.dof]),
+        }
+    }
+
+    /// Inertial tip position of every link at a state (forward pass with zero rates).
+    pub fn tip_positions(&self, t: f64, q: &[f64], out: &mut [[f64; 2]]) {
+        let mut parent: Option<(f64, [f64; 2])> = None;
+        for (li, l) in self.links.iter().enumerate() {
+            let th = match l.joint.prescribed_at(t) {
+                Some((a, _, _)) => a,
+                None => q[l.joint.dof],
+            };
+            let (phi, r0) = match parent {
+                None => (th, [0.0, 0.0]),
+                Some((pp, r)) => (pp + th, r),
+            };
+            let k = l.n_el;
+            let ax = if l.axial {
+                Self::val(q, l.u_dof[k])
+            } else if l.foreshortening {
+                self.foreshortening_at_tip(li, q)
+            } else {
+                0.0
+            };
+            let p = [l.length + ax, Self::val(q, l.v_dof[k])];
+            let r = add(r0, rot(phi, p));
+            out[li] = r;
+            parent = Some((phi + Self::val(q, l.r_dof[k]), r));
+        }
+    }
+
+    /// s(L) = −½∫v′² of link `li`.
+    pub fn foreshortening_at_tip(&self, li: usize, q: &[f64]) -> f64 {
+        let l = &self.links[li];
+        let tb = &l.element.quad;
+        let mut s = 0.0;
+        for e in 0..l.n_el {
+            let d = Self::elem_v(q, &l.elem_dofs(e));
+            for j in 0..tb.ng + 1 {
+                for k in 0..tb.nsg {
+                    let vp = dotn(&tb.sub_dn[j][k], &d, l.ne);
+                    s -= 0.5 * tb.sub_wh[j][k] * vp * vp;
+                }
+            }
+        }
+        s
+    }
+
+    /// Transverse deflection v(x) of link `li` (Hermite interpolation).
+    pub fn deflection(&self, li: usize, q: &[f64], x: f64) -> f64 {
+        let l = &self.links[li];
+        let e = ((x / l.h).floor() as usize).min(l.n_el - 1);
+        let xi = ((x - e as f64 * l.h) / l.h).clamp(0.0, 1.0);
+        let d = Self::elem_v(q, &l.elem_dofs(e));
+        dotn(&l.shapes_at(xi).0, &d, l.ne)
+    }
+
+    /// Axial tip displacement u(L) of link `li` (extensible links).
+    pub fn tip_axial(&self, li: usize, q: &[f64]) -> f64 {
+        let l = &self.links[li];
+        Self::val(q, l.u_dof[l.n_el])
+    }
+
+    /// Transverse tip deflection v(L) of link `li`.
+    pub fn tip_deflection(&self, li: usize, q: &[f64]) -> f64 {
+        let l = &self.links[li];
+        Self::val(q, l.v_dof[l.n_el])
+    }
+
+    /// Inertial position of the tip of link `li` and its Jacobian J = ∂r_tip/∂q, written as two
+    /// rows (x: `jac[..n]`, y: `jac[n..2n]`, n = [`Chain::ndof`]). Exact, from the chain's own
+    /// frame recursion (the same one [`Chain::tip_positions`] evaluates): every DOF either turns
+    /// the frames downstream of it about a frame origin Rₖ — the joint angle θₖ about Rₖ and the
+    /// tip rotation of link k about Rₖ₊₁, column ẑ × (r − R) — or moves the tip of link k in
+    /// its own frame: v(L) along A(φₖ)ŷ, u(L) along A(φₖ)x̂ and, with foreshortening, every
+    /// transverse DOF d along A(φₖ)x̂ with ∂s(L)/∂d = −∫ v′ N′ (the quadrature of s). O(n).
+    pub fn tip_jacobian(&self, t: f64, li: usize, q: &[f64], jac: &mut [f64]) -> [f64; 2] {
+        let n = self.ndof;
+        jac[..2 * n].iter_mut().for_each(|x| *x = 0.0);
+        let mut origin = [[0.0; 2]; MAX_LINKS];
+        let mut angle = [0.0; MAX_LINKS];
+        let mut parent: Option<(f64, [f64; 2])> = None;
+        let mut r = [0.0; 2];
+        for k in 0..=li {
+            let l = &self.links[k];
+            let th = match l.joint.prescribed_at(t) {
+                Some((a, _, _)) => a,
+                None => q[l.joint.dof],
+            };
+            let (phi, r0) = match parent {
+                None => (th, [0.0, 0.0]),
+                Some((pp, rr)) => (pp + th, rr),
+            };
+            let m = l.n_el;
+            let ax = if l.axial {
+                Self::val(q, l.u_dof[m])
+            } else if l.foreshortening {
+                self.foreshortening_at_tip(k, q)
+            } else {
+                0.0
+            };
+            r = add(r0, rot(phi, [l.length + ax, Self::val(q, l.v_dof[m])]));
+            origin[k] = r0;
+            angle[k] = phi;
+            parent = Some((phi + Self::val(q, l.r_dof[m]), r));
+        }
+        let put = |jac: &mut [f64], dof: usize, c: [f64; 2]| {
+            if dof != NONE {
+                jac[dof] += c[0];
+                jac[n + dof] += c[1];
+            }
+        };
+        for k in 0..=li {
+            let l = &self.links[k];
+            let m = l.n_el;
+            put(jac, l.joint.dof, perp(sub(r, origin[k])));
+            if k < li {
+                put(jac, l.r_dof[m], perp(sub(r, origin[k + 1])));
+            }
+            put(jac, l.v_dof[m], rot(angle[k], [0.0, 1.0]));
+            let ex = rot(angle[k], [1.0, 0.0]);
+            if l.axial {
+                put(jac, l.u_dof[m], ex);
+            } else if l.foreshortening {
+                let tb = &l.element.quad;
+                for e in 0..l.n_el {
+                    let dofs = l.elem_dofs(e);
+                    let d = Self::elem_v(q, &dofs);
+                    let ne = l.ne;
+                    let mut ds = [0.0; MAXE];
+                    for j in 0..tb.ng + 1 {
+                        for kk in 0..tb.nsg {
+                            let dn = &tb.sub_dn[j][kk];
+                            let c = -tb.sub_wh[j][kk] * dotn(dn, &d, ne);
+                            for a in 0..ne {
+                                ds[a] += c * dn[a];
+                            }
+                        }
+                    }
+                    for a in 0..ne {
+                        put(jac, dofs[a], scale(ds[a], ex));
+                    }
+                }
+            }
+        }
+        r
+    }
+
+    /// Tip of link `li`: inertial position, velocity and acceleration at (q, q̇, q̈) from the
+    /// forward kinematic pass of the residual (exact for every element the pass handles). With
+    /// q̈ = 0 the acceleration is the convective term J̇q̇. Overwrites the point data of the
+    /// last residual call (call [`Chain::residual`] again before [`Chain::newton_matrix`]).
+    pub fn tip_motion(
+        &mut self,
+        t: f64,
+        li: usize,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+    ) -> [[f64; 2]; 3] {
+        self.forward(t, q, qd, qdd, Parts::INERTIA);
+        let fr = self.frames[li];
+        let r = add(fr.r, rot(fr.phi, fr.p_tip));
+        let v = add(
+            fr.dr,
+            rot(fr.phi, add(scale(fr.dphi, perp(fr.p_tip)), fr.dp_tip)),
+        );
+        [r, v, rot(fr.phi, fr.a_tip)]
+    }
+}
