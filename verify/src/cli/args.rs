@@ -68,6 +68,22 @@ pub enum Command {
         format: Format,
         #[arg(long)]
         out: Option<std::path::PathBuf>,
+        /// Run only shard I of N (I/N, 1 <= I <= N) of the selected cases and write its
+        /// partial result (shard-I-of-N.json, plots) into --out; `flexverify merge` combines
+        /// the N parts into the report of one unsharded run.
+        #[arg(long, allow_hyphen_values = true, value_parser = parse_shard)]
+        shard: Option<crate::shard::Shard>,
+    },
+    /// Combine the outputs of `verify --shard I/N` (every shard exactly once) into the report
+    /// one unsharded run writes; exit 1 if any check failed.
+    Merge {
+        /// Folders holding shard-I-of-N.json files (one folder may hold several).
+        #[arg(required = true)]
+        dirs: Vec<std::path::PathBuf>,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        #[arg(long)]
+        out: std::path::PathBuf,
     },
     /// Refinement study of one quantity: observed order, Richardson reference, work-precision.
     Converge {
@@ -232,6 +248,12 @@ pub struct CommonOpts {
     /// Write result files (atomically) into this folder.
     #[arg(long)]
     pub out: Option<std::path::PathBuf>,
+}
+
+/// `--shard I/N`.
+fn parse_shard(s: &str) -> Result<crate::shard::Shard, String> {
+    s.parse()
+        .map_err(|e: crate::shard::ShardParseError| e.to_string())
 }
 
 /// A finite number > 0.
