@@ -8,6 +8,12 @@
 //! rows of one unsharded run bit for bit, apart from wall times. The modulo split spreads the
 //! expensive families (catalog order groups them) over all shards, with no cost model to keep.
 //!
+//! `converge --shard I/N` splits the same way over the study's rungs (every backend's ladder,
+//! in order, flattened): a [`ConvergeShardFile`] holds the rungs' measurements, and
+//! [`merge_converge`] hands them to the study in place of fresh runs, so the merged study is
+//! the unsharded one. A sharded ladder measures every rung; a rung after the ladder's end
+//! (first failure after a success) is measured but not used, as in one run.
+//!
 //! [`merge`] refuses parts that do not belong together: different versions, suites, filters or
 //! shard counts, a shard index given twice or missing, rows that are not exactly the shard's
 //! share of the selection.
@@ -20,11 +26,16 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use data::{BackendKind, Settings};
+
+use crate::study::{Refine, RungMeasurement};
 use crate::suite::Suite;
 use crate::suite::evaluate::Outcome;
 
-/// Format tag written into every shard file; bumped when the layout changes.
+/// Format tag written into every `verify` shard file; bumped when the layout changes.
 pub const SHARD_FORMAT: &str = "flexverify-verify-shard/1";
+/// Format tag of `converge` shard files.
+pub const CONVERGE_SHARD_FORMAT: &str = "flexverify-converge-shard/1";
 
 /// Shard `index` of `count` (1-based: `--shard 1/3`, `2/3`, `3/3`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -168,9 +179,16 @@ pub enum MergeError {
     WrongRows { path: PathBuf, shard: Shard },
 }
 
-/// Reads every `shard-*-of-*.json` in each folder (a folder may hold one shard or all of them).
-pub fn read_dirs(dirs: &[PathBuf]) -> Result<Vec<(PathBuf, ShardFile)>, MergeError> {
-    let mut files = Vec::new();
+/// The shard files found by [`read_dirs`]: all of `verify` or all of `converge`.
+pub enum Parts {
+    Verify(Vec<(PathBuf, ShardFile)>),
+    Converge(Vec<(PathBuf, ConvergeShardFile)>),
+}
+
+/// Reads every `shard-*.json` in each folder (a folder may hold one shard or all of them).
+pub fn read_dirs(dirs: &[PathBuf]) -> Result<Parts, MergeError> {
+    let mut verify = Vec::new();
+    let mut converge = Vec::new();
     for dir in dirs {
         let entries = std::fs::read_dir(dir).map_err(|source| MergeError::Read {
             path: dir.clone(),
@@ -193,21 +211,40 @@ pub fn read_dirs(dirs: &[PathBuf]) -> Result<Vec<(PathBuf, ShardFile)>, MergeErr
                 path: path.clone(),
                 source,
             })?;
-            let file: ShardFile =
-                serde_json::from_str(&text).map_err(|e| MergeError::NotAShard {
-                    path: path.clone(),
-                    reason: e.to_string(),
-                })?;
-            if file.format != SHARD_FORMAT {
-                return Err(MergeError::NotAShard {
-                    path,
-                    reason: format!("format `{}`, expected `{SHARD_FORMAT}`", file.format),
-                });
+            let not_a_shard = |reason: String| MergeError::NotAShard {
+                path: path.clone(),
+                reason,
+            };
+            let value: serde_json::Value =
+                serde_json::from_str(&text).map_err(|e| not_a_shard(e.to_string()))?;
+            match value.get("format").and_then(|f| f.as_str()) {
+                Some(SHARD_FORMAT) => verify.push((
+                    path.clone(),
+                    serde_json::from_str(&text).map_err(|e| not_a_shard(e.to_string()))?,
+                )),
+                Some(CONVERGE_SHARD_FORMAT) => converge.push((
+                    path.clone(),
+                    serde_json::from_str(&text).map_err(|e| not_a_shard(e.to_string()))?,
+                )),
+                other => {
+                    return Err(not_a_shard(format!(
+                        "format {other:?}, expected `{SHARD_FORMAT}` or `{CONVERGE_SHARD_FORMAT}`"
+                    )));
+                }
             }
-            files.push((path, file));
         }
     }
-    Ok(files)
+    match (verify.is_empty(), converge.is_empty()) {
+        (false, true) => Ok(Parts::Verify(verify)),
+        (true, false) => Ok(Parts::Converge(converge)),
+        _ => Err(MergeError::Mismatch {
+            first: verify[0].0.clone(),
+            second: converge[0].0.clone(),
+            what: "commands",
+            a: "verify".into(),
+            b: "converge".into(),
+        }),
+    }
 }
 
 /// The rows of the whole selection, in selection order, from one file per shard.
@@ -304,6 +341,151 @@ pub fn merge(
         .map(|k| by_index[&(k % count + 1)].1.outcomes[k / count].clone())
         .collect();
     Ok((first.suite, first.filter.clone(), outcomes))
+}
+
+/// One rung of a sharded study: its place in the flattened ladders and its measurement.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct MeasuredRung {
+    /// Index in the flattened ladders (backend order, then rung order).
+    pub position: usize,
+    pub backend: BackendKind,
+    /// Index of the rung in its backend's ladder.
+    pub rung: usize,
+    pub measurement: RungMeasurement,
+}
+
+/// One shard's rungs of `flexverify converge`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ConvergeShardFile {
+    pub format: String,
+    pub version: String,
+    /// The scene argument (catalog name or path; `merge` loads it again).
+    pub scene: String,
+    pub quantity: String,
+    pub refine: Refine,
+    pub backends: Vec<BackendKind>,
+    pub base: Settings,
+    pub shard: Shard,
+    /// Rungs of all ladders together.
+    pub rungs_total: usize,
+    pub measurements: Vec<MeasuredRung>,
+}
+
+impl ConvergeShardFile {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        scene: &str,
+        quantity: &str,
+        refine: Refine,
+        backends: &[BackendKind],
+        base: &Settings,
+        shard: Shard,
+        rungs_total: usize,
+        measurements: Vec<MeasuredRung>,
+    ) -> Self {
+        ConvergeShardFile {
+            format: CONVERGE_SHARD_FORMAT.to_string(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: scene.to_string(),
+            quantity: quantity.to_string(),
+            refine,
+            backends: backends.to_vec(),
+            base: base.clone(),
+            shard,
+            rungs_total,
+            measurements,
+        }
+    }
+
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("serializable shard file")
+    }
+}
+
+/// The measurements of every rung, keyed by (backend, rung index), from one file per shard;
+/// also the first file (its scene, quantity, refine, backends and base settings).
+#[allow(clippy::type_complexity)]
+pub fn merge_converge(
+    files: &[(PathBuf, ConvergeShardFile)],
+) -> Result<
+    (
+        ConvergeShardFile,
+        BTreeMap<(BackendKind, usize), RungMeasurement>,
+    ),
+    MergeError,
+> {
+    let Some((first_path, first)) = files.first() else {
+        return Err(MergeError::NoShards("the given folders".into()));
+    };
+    let this_version = env!("CARGO_PKG_VERSION");
+    if first.version != this_version {
+        return Err(MergeError::Mismatch {
+            first: first_path.clone(),
+            second: PathBuf::from("this flexverify"),
+            what: "versions",
+            a: first.version.clone(),
+            b: this_version.to_string(),
+        });
+    }
+    let mut by_index: BTreeMap<usize, &PathBuf> = BTreeMap::new();
+    let mut rungs = BTreeMap::new();
+    for (path, file) in files {
+        let fields = |f: &ConvergeShardFile| {
+            [
+                ("versions", f.version.clone()),
+                ("scenes", f.scene.clone()),
+                ("quantities", f.quantity.clone()),
+                ("refinements", format!("{:?}", f.refine)),
+                ("backends", format!("{:?}", f.backends)),
+                ("settings", format!("{:?}", f.base)),
+                ("shard counts", f.shard.count.to_string()),
+                ("rung counts", f.rungs_total.to_string()),
+            ]
+        };
+        for ((what, a), (_, b)) in fields(first).into_iter().zip(fields(file)) {
+            if a != b {
+                return Err(MergeError::Mismatch {
+                    first: first_path.clone(),
+                    second: path.clone(),
+                    what,
+                    a,
+                    b,
+                });
+            }
+        }
+        let positions: Vec<usize> = file.measurements.iter().map(|m| m.position).collect();
+        let share: Vec<usize> = (0..file.rungs_total)
+            .filter(|&p| file.shard.owns(p))
+            .collect();
+        if positions != share {
+            return Err(MergeError::WrongRows {
+                path: path.clone(),
+                shard: file.shard,
+            });
+        }
+        if let Some(other) = by_index.insert(file.shard.index, path) {
+            return Err(MergeError::Duplicate {
+                shard: file.shard,
+                first: other.clone(),
+                second: path.clone(),
+            });
+        }
+        for m in &file.measurements {
+            rungs.insert((m.backend, m.rung), m.measurement.clone());
+        }
+    }
+    let count = first.shard.count;
+    let missing: Vec<String> = (1..=count)
+        .filter(|i| !by_index.contains_key(i))
+        .map(|i| i.to_string())
+        .collect();
+    if !missing.is_empty() {
+        return Err(MergeError::Missing {
+            missing: missing.join(", "),
+            count,
+        });
+    }
+    Ok((first.clone(), rungs))
 }
 
 /// Copies the plots (`*.svg`, `*.png`) the shards drew into `out`.

@@ -220,3 +220,69 @@ fn sys_shard_bad_shard_argument_exits_2_with_one_message() {
     assert!(err.contains("ladders"), "{err}");
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn sys_shard_converge_rungs_merge_into_the_single_study() {
+    let root = scratch("converge");
+    let study = [
+        "converge",
+        "cantilever",
+        "--quantity",
+        "freq1",
+        "--backend",
+        "fem,modal",
+    ];
+    let single = root.join("single");
+    let mut args = study.to_vec();
+    args.extend(["--format", "csv", "--out", s(&single)]);
+    let (code, stdout_single, err) = flexverify(&args);
+    assert_eq!(code, 0, "{err}");
+    let parts = root.join("parts");
+    for i in 1..=3 {
+        let shard = format!("{i}/3");
+        let mut args = study.to_vec();
+        args.extend(["--shard", &shard, "--out", s(&parts)]);
+        let (code, _, err) = flexverify(&args);
+        assert_eq!(code, 0, "{err}");
+    }
+    let merged = root.join("merged");
+    let (code, stdout_merged, err) =
+        flexverify(&["merge", s(&parts), "--format", "csv", "--out", s(&merged)]);
+    assert_eq!(code, 0, "{err}");
+    let name = "converge-cantilever-freq1";
+    let json_single = std::fs::read_to_string(single.join(format!("{name}.json"))).unwrap();
+    let json_merged = std::fs::read_to_string(merged.join(format!("{name}.json"))).unwrap();
+    assert!(json_single.contains("\"rungs\""));
+    assert_eq!(
+        json_without_wall(&json_single),
+        json_without_wall(&json_merged)
+    );
+    let without_wall_column = |t: &str| -> Vec<String> {
+        t.lines()
+            .map(|l| l.rsplit_once(',').map_or(l, |(head, _)| head).to_string())
+            .collect()
+    };
+    assert_eq!(
+        without_wall_column(&stdout_single),
+        without_wall_column(&stdout_merged)
+    );
+    assert!(stdout_single.lines().next().unwrap().ends_with("wall_s"));
+
+    // A part of another study is refused.
+    let other = root.join("other");
+    let mut args = vec![
+        "converge",
+        "cantilever",
+        "--quantity",
+        "freq2",
+        "--backend",
+        "fem,modal",
+    ];
+    args.extend(["--shard", "2/3", "--out", s(&other)]);
+    assert_eq!(flexverify(&args).0, 0);
+    std::fs::remove_file(parts.join("shard-2-of-3.json")).unwrap();
+    let (code, _, err) = flexverify(&["merge", s(&parts), s(&other), "--out", s(&merged)]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("quantities differ"), "{err}");
+    let _ = std::fs::remove_dir_all(&root);
+}

@@ -74,8 +74,8 @@ pub enum Command {
         #[arg(long, allow_hyphen_values = true, value_parser = parse_shard)]
         shard: Option<crate::shard::Shard>,
     },
-    /// Combine the outputs of `verify --shard I/N` (every shard exactly once) into the report
-    /// one unsharded run writes; exit 1 if any check failed.
+    /// Combine the outputs of `verify --shard I/N` or `converge --shard I/N` (every shard
+    /// exactly once) into what one unsharded run writes; exit 1 if any check failed.
     Merge {
         /// Folders holding shard-I-of-N.json files (one folder may hold several).
         #[arg(required = true)]
@@ -94,6 +94,10 @@ pub enum Command {
         /// Refine space (elements/stations/modes) or time (dt).
         #[arg(long, value_enum, default_value_t = Refine::Space)]
         refine: Refine,
+        /// Measure only shard I of N of the rungs (all ladders, flattened) and write them
+        /// (shard-I-of-N.json) into --out; `flexverify merge` builds the study from the N parts.
+        #[arg(long, allow_hyphen_values = true, value_parser = parse_shard)]
+        shard: Option<crate::shard::Shard>,
         #[command(flatten)]
         opts: CommonOpts,
     },

@@ -124,9 +124,15 @@ pub fn verify_shard(
     summarize(&file.outcomes, &format!("{wall:.1} s wall, shard {shard}"))
 }
 
-/// `flexverify merge`: the shards' rows combined into the report of one unsharded run.
+/// `flexverify merge`: the shards' rows combined into the report of one unsharded run (or,
+/// for `converge` parts, the study of one unsharded run).
 pub fn merge(dirs: &[PathBuf], format: Format, out: &Path) -> Result<(), CliError> {
-    let files = shard::read_dirs(dirs).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    let files = match shard::read_dirs(dirs).map_err(|e| CliError::Input(format!("error: {e}")))? {
+        shard::Parts::Verify(files) => files,
+        shard::Parts::Converge(files) => {
+            return super::studies::merge_converge(&files, dirs, format, out);
+        }
+    };
     let (_suite, _filter, outcomes) =
         shard::merge(&files).map_err(|e| CliError::Input(format!("error: {e}")))?;
     print_outcomes(&outcomes, format);

@@ -34,8 +34,12 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             scene,
             quantity,
             refine,
+            shard,
             opts,
-        } => super::studies::converge(&scene, &quantity, refine, &opts),
+        } => match shard {
+            None => super::studies::converge(&scene, &quantity, refine, &opts),
+            Some(shard) => super::studies::converge_shard(&scene, &quantity, refine, &opts, shard),
+        },
         Command::Recommend {
             scene,
             quantity,
