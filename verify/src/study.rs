@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use data::{BackendKind, Scene, Settings};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
 use crate::output::{Column, csv_table, fitted_table, text_table, wrap, write_atomic};
@@ -19,7 +19,7 @@ use crate::suite::reference::{analytic_value, default_analytic_id};
 use crate::suite::run_cache::{RunCache, compute};
 
 /// What a study refines.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Refine {
     /// Elements, stations or modes (the backend's space discretization).
@@ -193,6 +193,52 @@ fn min_wall_time(
     best
 }
 
+/// One rung's measurement: (value, peak |channel| for time histories, smallest wall time over
+/// a few repeats), or why the backend could not give the quantity at that rung.
+pub type RungMeasurement = Result<(f64, Option<f64>, f64), String>;
+
+/// A rung to measure: its settings, refinement parameter h and label.
+pub type RungSpec = (Settings, f64, String);
+
+/// The ladders of a study: per backend, each rung's settings, h and label, in refinement order.
+pub fn rung_specs(
+    scene: &Scene,
+    refine: Refine,
+    kinds: &[BackendKind],
+    base: &Settings,
+) -> Vec<(BackendKind, Vec<RungSpec>)> {
+    kinds
+        .iter()
+        .map(|&kind| {
+            let spec = match refine {
+                Refine::Space => space_ladder(kind, base),
+                Refine::Time => time_ladder(base, scene),
+            };
+            (kind, spec)
+        })
+        .collect()
+}
+
+/// Measures one rung (the quantity must parse: see [`parse_quantity`]).
+pub fn measure_rung(
+    cache: &RunCache,
+    scene: &Scene,
+    kind: BackendKind,
+    settings: &Settings,
+    q: &Quantity,
+) -> RungMeasurement {
+    measure(cache, scene, kind, settings, q)
+        .map(|(value, peak, wall)| (value, peak, min_wall_time(scene, kind, settings, q, wall)))
+}
+
+/// The quantity of a study, parsed against its scene.
+pub fn parse_quantity(scene: &Scene, quantity: &str) -> Result<Quantity, Error> {
+    Quantity::parse(quantity, scene).map_err(|reason| Error::InvalidQuantity {
+        quantity: quantity.to_string(),
+        reason: reason.to_string(),
+    })
+}
+
 /// Runs the ladders and fills errors against the best available reference, reporting each
 /// rung to `progress`.
 pub fn run_study(
@@ -204,28 +250,46 @@ pub fn run_study(
     rung_budget_s: Option<f64>,
     progress: &dyn Progress,
 ) -> Result<Study, Error> {
-    let q = Quantity::parse(quantity, scene).map_err(|reason| Error::InvalidQuantity {
-        quantity: quantity.to_string(),
-        reason: reason.to_string(),
-    })?;
+    let q = parse_quantity(scene, quantity)?;
     let cache = RunCache::default();
+    let measured = |kind: BackendKind, _rung: usize, settings: &Settings| {
+        measure_rung(&cache, scene, kind, settings, &q)
+    };
+    study_from_rungs(
+        scene,
+        quantity,
+        refine,
+        kinds,
+        base,
+        rung_budget_s,
+        progress,
+        &measured,
+    )
+}
+
+/// The study built from rung measurements given by `measured(backend, rung index, settings)`
+/// — fresh runs ([`run_study`]) or the rows of `converge --shard` parts (`merge`). A ladder
+/// ends at the first failure after a success, or when a rung costs more than the budget.
+#[allow(clippy::too_many_arguments)]
+pub fn study_from_rungs(
+    scene: &Scene,
+    quantity: &str,
+    refine: Refine,
+    kinds: &[BackendKind],
+    base: &Settings,
+    rung_budget_s: Option<f64>,
+    progress: &dyn Progress,
+    measured: &dyn Fn(BackendKind, usize, &Settings) -> RungMeasurement,
+) -> Result<Study, Error> {
+    let q = parse_quantity(scene, quantity)?;
     let mut ladders = Vec::new();
-    let specs: Vec<_> = kinds
-        .iter()
-        .map(|&kind| {
-            let spec = match refine {
-                Refine::Space => space_ladder(kind, base),
-                Refine::Time => time_ladder(base, scene),
-            };
-            (kind, spec)
-        })
-        .collect();
+    let specs = rung_specs(scene, refine, kinds, base);
     progress.begin(specs.iter().map(|(_, s)| s.len()).sum(), "rungs");
     for (kind, rungs_spec) in specs {
         let mut rungs: Vec<Rung> = Vec::new();
         let mut note = None;
         let rungs_total = rungs_spec.len();
-        for (settings, h, label) in rungs_spec {
+        for (rung_index, (settings, h, label)) in rungs_spec.into_iter().enumerate() {
             progress.start(&format!("{} {quantity}: {kind} {label}", scene.name));
             // A full-suite ladder stops once a rung costs more than the budget: the next
             // rung would cost several times more.
@@ -234,10 +298,10 @@ pub fn run_study(
             {
                 break;
             }
-            match measure(&cache, scene, kind, &settings, &q) {
-                Ok((value, peak, wall)) => {
+            match measured(kind, rung_index, &settings) {
+                Ok((value, peak, wall_time_s)) => {
                     rungs.push(Rung {
-                        wall_time_s: min_wall_time(scene, kind, &settings, &q, wall),
+                        wall_time_s,
                         backend: kind,
                         discretization: label,
                         h,
@@ -521,7 +585,27 @@ pub fn converge(
     base: &Settings,
     progress: &dyn Progress,
 ) -> Result<Study, Error> {
-    let study = run_study(scene, quantity, refine, kinds, base, None, progress)?;
+    let q = parse_quantity(scene, quantity)?;
+    let cache = RunCache::default();
+    let measured = |kind: BackendKind, _rung: usize, settings: &Settings| {
+        measure_rung(&cache, scene, kind, settings, &q)
+    };
+    converge_from_rungs(scene, quantity, refine, kinds, base, progress, &measured)
+}
+
+/// [`converge`] from given rung measurements (see [`study_from_rungs`]).
+pub fn converge_from_rungs(
+    scene: &Scene,
+    quantity: &str,
+    refine: Refine,
+    kinds: &[BackendKind],
+    base: &Settings,
+    progress: &dyn Progress,
+    measured: &dyn Fn(BackendKind, usize, &Settings) -> RungMeasurement,
+) -> Result<Study, Error> {
+    let study = study_from_rungs(
+        scene, quantity, refine, kinds, base, None, progress, measured,
+    )?;
     if study.ladders.iter().all(|l| l.rungs.is_empty()) {
         return Err(Error::QuantityNotProduced {
             quantity: quantity.to_string(),

@@ -68,6 +68,22 @@ pub enum Command {
         format: Format,
         #[arg(long)]
         out: Option<std::path::PathBuf>,
+        /// Run only shard I of N (I/N, 1 <= I <= N) of the selected cases and write its
+        /// partial result (shard-I-of-N.json, plots) into --out; `flexverify merge` combines
+        /// the N parts into the report of one unsharded run.
+        #[arg(long, allow_hyphen_values = true, value_parser = parse_shard)]
+        shard: Option<crate::shard::Shard>,
+    },
+    /// Combine the outputs of `verify --shard I/N` or `converge --shard I/N` (every shard
+    /// exactly once) into what one unsharded run writes; exit 1 if any check failed.
+    Merge {
+        /// Folders holding shard-I-of-N.json files (one folder may hold several).
+        #[arg(required = true)]
+        dirs: Vec<std::path::PathBuf>,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        #[arg(long)]
+        out: std::path::PathBuf,
     },
     /// Refinement study of one quantity: observed order, Richardson reference, work-precision.
     Converge {
@@ -78,6 +94,10 @@ pub enum Command {
         /// Refine space (elements/stations/modes) or time (dt).
         #[arg(long, value_enum, default_value_t = Refine::Space)]
         refine: Refine,
+        /// Measure only shard I of N of the rungs (all ladders, flattened) and write them
+        /// (shard-I-of-N.json) into --out; `flexverify merge` builds the study from the N parts.
+        #[arg(long, allow_hyphen_values = true, value_parser = parse_shard)]
+        shard: Option<crate::shard::Shard>,
         #[command(flatten)]
         opts: CommonOpts,
     },
@@ -232,6 +252,12 @@ pub struct CommonOpts {
     /// Write result files (atomically) into this folder.
     #[arg(long)]
     pub out: Option<std::path::PathBuf>,
+}
+
+/// `--shard I/N`.
+fn parse_shard(s: &str) -> Result<crate::shard::Shard, String> {
+    s.parse()
+        .map_err(|e: crate::shard::ShardParseError| e.to_string())
 }
 
 /// A finite number > 0.

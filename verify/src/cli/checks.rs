@@ -1,14 +1,15 @@
 //! `verify` and `stability`: run a suite through the library, print it, map failures to exit 1.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::CliError;
 use super::progress::Bar;
-use crate::output::{Format, TERMINAL_WIDTH};
+use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
+use crate::shard::{self, Shard, ShardFile};
 use crate::stability::{self, Verdict};
 use crate::study;
 use crate::suite::evaluate::{Outcome, Status};
-use crate::suite::{Suite, plots, report, run_cases_with_progress};
+use crate::suite::{Suite, plots, report, run_cases_with_progress, run_selected, select_cases};
 
 pub fn verify(
     suite: Suite,
@@ -60,6 +61,113 @@ pub fn verify(
         outcomes.len() - failed.len(),
         failed.len(),
         wall
+    );
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(CliError::Failed(
+            failed
+                .iter()
+                .map(|o| format!("FAILED {}: {}", o.id, o.message))
+                .collect::<Vec<_>>()
+                .join("\n"),
+        ))
+    }
+}
+
+/// `verify --shard I/N`: this shard's share of the selected cases, printed, and written as
+/// `shard-I-of-N.json` (with the cases' plots) for `flexverify merge`.
+pub fn verify_shard(
+    suite: Suite,
+    filter: Option<&str>,
+    format: Format,
+    out: Option<&Path>,
+    shard: Shard,
+) -> Result<(), CliError> {
+    let Some(dir) = out else {
+        return Err(CliError::Input(
+            "error: --shard needs --out DIR (where the shard writes its partial result)".into(),
+        ));
+    };
+    if suite == Suite::Full && filter.is_none() {
+        return Err(CliError::Input(
+            "error: --shard splits cases; the unfiltered full suite also runs the refinement \
+             ladders, which are not sharded. Shard the cases with --filter '' (every case, no \
+             ladders)"
+                .into(),
+        ));
+    }
+    let started = std::time::Instant::now();
+    let selection = select_cases(suite, filter)?;
+    let cases = shard.share(&selection);
+    let bar = Bar::new();
+    let (outcomes, cache) = run_selected(&cases, &bar);
+    bar.clear();
+    let wall = started.elapsed().as_secs_f64();
+    print_outcomes(&outcomes, format);
+    std::fs::create_dir_all(dir)?;
+    plots::draw_all(dir, &cases, &outcomes, &cache);
+    let file = ShardFile::new(
+        suite,
+        filter,
+        shard,
+        selection.iter().map(|c| c.id.clone()).collect(),
+        outcomes,
+    );
+    write_atomic(dir, &shard.file_name(), file.to_json().as_bytes())?;
+    eprintln!(
+        "wrote shard {shard} ({} of {} cases) to {}",
+        file.outcomes.len(),
+        selection.len(),
+        dir.join(shard.file_name()).display()
+    );
+    summarize(&file.outcomes, &format!("{wall:.1} s wall, shard {shard}"))
+}
+
+/// `flexverify merge`: the shards' rows combined into the report of one unsharded run (or,
+/// for `converge` parts, the study of one unsharded run).
+pub fn merge(dirs: &[PathBuf], format: Format, out: &Path) -> Result<(), CliError> {
+    let files = match shard::read_dirs(dirs).map_err(|e| CliError::Input(format!("error: {e}")))? {
+        shard::Parts::Verify(files) => files,
+        shard::Parts::Converge(files) => {
+            return super::studies::merge_converge(&files, dirs, format, out);
+        }
+    };
+    let (_suite, _filter, outcomes) =
+        shard::merge(&files).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    print_outcomes(&outcomes, format);
+    std::fs::create_dir_all(out)?;
+    shard::copy_plots(dirs, out)?;
+    report::write_all(out, &outcomes)?;
+    eprintln!(
+        "wrote the verification report to {}/index.html",
+        out.display()
+    );
+    summarize(
+        &outcomes,
+        &format!("merged from {} shards", files[0].1.shard.count),
+    )
+}
+
+fn print_outcomes(outcomes: &[Outcome], format: Format) {
+    match format {
+        Format::Table => print!("{}", report::terminal_table(outcomes, TERMINAL_WIDTH)),
+        Format::Wide => print!("{}", report::wide_table(outcomes)),
+        Format::Csv => print!("{}", report::csv(outcomes)),
+        Format::Json => println!("{}", report::json(outcomes)),
+    }
+}
+
+/// Prints the pass/fail count; a failed check is exit 1.
+fn summarize(outcomes: &[Outcome], note: &str) -> Result<(), CliError> {
+    let failed: Vec<&Outcome> = outcomes
+        .iter()
+        .filter(|o| o.status != Status::Pass)
+        .collect();
+    eprintln!(
+        "{} passed, {} failed ({note})",
+        outcomes.len() - failed.len(),
+        failed.len(),
     );
     if failed.is_empty() {
         Ok(())

@@ -22,13 +22,24 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             filter,
             format,
             out,
-        } => super::checks::verify(suite, filter.as_deref(), format, out.as_deref()),
+            shard,
+        } => match shard {
+            None => super::checks::verify(suite, filter.as_deref(), format, out.as_deref()),
+            Some(shard) => {
+                super::checks::verify_shard(suite, filter.as_deref(), format, out.as_deref(), shard)
+            }
+        },
+        Command::Merge { dirs, format, out } => super::checks::merge(&dirs, format, &out),
         Command::Converge {
             scene,
             quantity,
             refine,
+            shard,
             opts,
-        } => super::studies::converge(&scene, &quantity, refine, &opts),
+        } => match shard {
+            None => super::studies::converge(&scene, &quantity, refine, &opts),
+            Some(shard) => super::studies::converge_shard(&scene, &quantity, refine, &opts, shard),
+        },
         Command::Recommend {
             scene,
             quantity,

@@ -1,12 +1,17 @@
 //! `converge` and `recommend`: a refinement study through the library, printed.
 
-use data::load_scene;
+use std::path::{Path, PathBuf};
+
+use data::{BackendKind, Settings, load_scene};
 
 use super::CliError;
 use super::args::CommonOpts;
 use super::progress::Bar;
-use crate::output::{Format, TERMINAL_WIDTH};
-use crate::study::{self, Refine};
+use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
+use crate::progress::Progress;
+use crate::shard::{ConvergeShardFile, MeasuredRung, Shard};
+use crate::study::{self, Refine, RungMeasurement, Study};
+use crate::suite::run_cache::RunCache;
 
 pub fn converge(
     scene: &str,
@@ -25,18 +30,124 @@ pub fn converge(
         &bar,
     )?;
     bar.clear();
-    if let Some(dir) = &opts.out {
-        for n in study::write_study(dir, &study)? {
+    write_and_print(&study, opts.out.as_deref(), opts.format)
+}
+
+fn write_and_print(study: &Study, out: Option<&Path>, format: Format) -> Result<(), CliError> {
+    if let Some(dir) = out {
+        for n in study::write_study(dir, study)? {
             eprintln!("note: {n}");
         }
         eprintln!("wrote the study and its plots to {}", dir.display());
     }
-    match opts.format {
-        Format::Json => println!("{}", study::json(&study)),
-        Format::Csv => print!("{}", study::csv(&study)),
-        Format::Wide => print!("{}", study::wide_table(&study)),
-        Format::Table => print!("{}", study::terminal_table(&study, TERMINAL_WIDTH)),
+    match format {
+        Format::Json => println!("{}", study::json(study)),
+        Format::Csv => print!("{}", study::csv(study)),
+        Format::Wide => print!("{}", study::wide_table(study)),
+        Format::Table => print!("{}", study::terminal_table(study, TERMINAL_WIDTH)),
     }
+    Ok(())
+}
+
+/// `converge --shard I/N`: measures this shard's rungs and writes them for `flexverify merge`.
+pub fn converge_shard(
+    scene_arg: &str,
+    quantity: &str,
+    refine: Refine,
+    opts: &CommonOpts,
+    shard: Shard,
+) -> Result<(), CliError> {
+    let Some(dir) = &opts.out else {
+        return Err(CliError::Input(
+            "error: --shard needs --out DIR (where the shard writes its partial result)".into(),
+        ));
+    };
+    let scene = load_scene(scene_arg)?;
+    let q = study::parse_quantity(&scene, quantity)?;
+    let kinds = opts.kinds();
+    let base = opts.settings();
+    let flat: Vec<(BackendKind, usize, Settings)> =
+        study::rung_specs(&scene, refine, &kinds, &base)
+            .into_iter()
+            .flat_map(|(kind, spec)| {
+                spec.into_iter()
+                    .enumerate()
+                    .map(move |(rung, (settings, _, _))| (kind, rung, settings))
+            })
+            .collect();
+    let cache = RunCache::default();
+    let bar = Bar::new();
+    let mine: Vec<usize> = (0..flat.len()).filter(|&p| shard.owns(p)).collect();
+    bar.begin(mine.len(), "rungs");
+    let measurements: Vec<MeasuredRung> = mine
+        .into_iter()
+        .map(|position| {
+            let (kind, rung, settings) = &flat[position];
+            bar.start(&format!("{} {quantity}: {kind} rung {rung}", scene.name));
+            let measurement = study::measure_rung(&cache, &scene, *kind, settings, &q);
+            bar.advance();
+            MeasuredRung {
+                position,
+                backend: *kind,
+                rung: *rung,
+                measurement,
+            }
+        })
+        .collect();
+    bar.finish();
+    bar.clear();
+    let file = ConvergeShardFile::new(
+        scene_arg,
+        quantity,
+        refine,
+        &kinds,
+        &base,
+        shard,
+        flat.len(),
+        measurements,
+    );
+    write_atomic(dir, &shard.file_name(), file.to_json().as_bytes())?;
+    eprintln!(
+        "wrote shard {shard} ({} of {} rungs) to {}",
+        file.measurements.len(),
+        flat.len(),
+        dir.join(shard.file_name()).display()
+    );
+    Ok(())
+}
+
+/// `flexverify merge` of `converge` parts: the study of one unsharded run.
+pub fn merge_converge(
+    files: &[(PathBuf, ConvergeShardFile)],
+    dirs: &[PathBuf],
+    format: Format,
+    out: &Path,
+) -> Result<(), CliError> {
+    let (head, rungs) =
+        crate::shard::merge_converge(files).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    let scene = load_scene(&head.scene)?;
+    let measured = |kind: BackendKind, rung: usize, _: &Settings| -> RungMeasurement {
+        rungs
+            .get(&(kind, rung))
+            .cloned()
+            .unwrap_or_else(|| Err(format!("{kind}: rung {rung} missing from the shards")))
+    };
+    let study = study::converge_from_rungs(
+        &scene,
+        &head.quantity,
+        head.refine,
+        &head.backends,
+        &head.base,
+        &crate::progress::Silent,
+        &measured,
+    )?;
+    std::fs::create_dir_all(out)?;
+    write_and_print(&study, Some(out), format)?;
+    eprintln!(
+        "merged {} converge shards from {} folder(s)",
+        head.shard.count,
+        dirs.len()
+    );
     Ok(())
 }
 

@@ -2,13 +2,13 @@
 
 use data::cases::{Case, CaseSettings, Norm, Reference, scene_with_overrides};
 use data::{BackendError, Scene, Settings, StabilityVerdict, load_scene};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::quantity::Quantity;
 use super::reference::analytic_value;
 use super::run_cache::{Answer, RunCache};
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Status {
     Pass,
@@ -18,7 +18,7 @@ pub enum Status {
 }
 
 /// A row of the verification table.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Outcome {
     pub id: String,
     pub check: String,

@@ -51,6 +51,14 @@ pub fn run_cases_with_progress(
     filter: Option<&str>,
     progress: &dyn Progress,
 ) -> Result<(Vec<data::cases::Case>, Vec<Outcome>, RunCache), Error> {
+    let selected = select_cases(suite, filter)?;
+    let (outcomes, cache) = run_selected(&selected, progress);
+    Ok((selected, outcomes, cache))
+}
+
+/// The cases of `suite` whose id contains `filter`, in catalog order; an empty selection is
+/// an error (a typo in `--filter` must not pass as an empty success).
+pub fn select_cases(suite: Suite, filter: Option<&str>) -> Result<Vec<data::cases::Case>, Error> {
     let cases = all_cases()?;
     let selected: Vec<_> = cases
         .into_iter()
@@ -63,9 +71,19 @@ pub fn run_cases_with_progress(
             filter: filter.map(str::to_string),
         });
     }
+    Ok(selected)
+}
+
+/// Evaluates `cases` in parallel; outcomes come back in the order of `cases`. Each outcome
+/// depends only on its own case (the cache memoizes deterministic backend runs), so a case
+/// gives the same row whichever other cases run beside it — what makes sharding exact.
+pub fn run_selected(
+    cases: &[data::cases::Case],
+    progress: &dyn Progress,
+) -> (Vec<Outcome>, RunCache) {
     let cache = RunCache::default();
-    progress.begin(selected.len(), "cases");
-    let outcomes: Vec<Outcome> = selected
+    progress.begin(cases.len(), "cases");
+    let outcomes: Vec<Outcome> = cases
         .par_iter()
         .map(|c| {
             progress.start(&c.id);
@@ -75,5 +93,5 @@ pub fn run_cases_with_progress(
         })
         .collect();
     progress.finish();
-    Ok((selected, outcomes, cache))
+    (outcomes, cache)
 }
