@@ -68,6 +68,11 @@
 //! * [`link`]: one link in a rotating frame (`spin-up`, `spin-up-linear`, `single-link`,
 //!   `rotating-beam` runs) on the same grid and stepping: foreshortening stiffening, prescribed
 //!   hub motion (reported torque) or hub torque with inertia, spring, damper, Kelvin–Voigt.
+//!   Ledger: kinetic, strain, and only the enabled terms of joint_spring | applied_torque or
+//!   prescribed_motion | joint_damper, kelvin_voigt. **Default method** ([`runs::default_method`]):
+//!   velocity-form when a force depends on the velocities (a free hub's İθ̇ and θ̇² terms,
+//!   Kelvin–Voigt), on which the two-step scheme's computational mode grows; the report's
+//!   two-step scheme for a prescribed undamped hub.
 //!   **Step bound with the centrifugal tension.** The report's σ² ≤ h⁴m/(4EI) is 2/ω_max of the
 //!   bending stencil alone. With foreshortening the spinning link carries the tension
 //!   N(x) = θ̇² W(x) ≈ ρAθ̇²(L² − x²)/2 (W = Σ_{i>x} m_i x_i), whose string stiffness N/h² raises
