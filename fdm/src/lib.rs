@@ -255,6 +255,7 @@ impl Backend for FdmBackend {
                 "fdm modes of the rocket: the variable-mass body has no fixed modes; use `run`"
                     .into(),
             )),
+            ModelChoice::TwoLinkChain => Ok(chain::modes::modes(scene, settings, &s, count)?),
             _ => Ok(beam::modes(scene, settings, &s, count)?),
         }
     }
