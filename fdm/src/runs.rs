@@ -12,6 +12,7 @@ use crate::method::VelocityForm;
 use crate::output::{Outcome, Outputs};
 use crate::rocket::system::RocketSystem;
 use crate::settings::{FdmSettings, Method};
+use crate::system::System;
 
 /// Default safety factor of a Timoshenko chain with contact (an accuracy choice, not a
 /// stability one). Impacts excite the condensed operator's shear waves near the step bound,
@@ -40,7 +41,20 @@ pub fn rocket(scene: &Scene, settings: &Settings, s: &FdmSettings) -> Result<Run
     Ok(out.into_run_result(scene, settings))
 }
 
-/// Runs one link on its hub (default method: the report's two-step scheme).
+/// The method of a run: the scene's `time.method` when set; otherwise the one that converges
+/// for the model — the one-step velocity form when any force depends on the velocities
+/// ([`System::damped`]: damping, or the gyroscopic İθ̇ and θ̇² terms of a free hub), on which
+/// the two-step scheme's computational mode grows; else the report's two-step scheme.
+pub fn default_method(settings: &Settings, s: &FdmSettings, sys: &dyn System) -> Method {
+    if settings.time.method.is_none() && sys.damped() {
+        Method::VelocityForm
+    } else {
+        s.method
+    }
+}
+
+/// Runs one link on its hub (method: [`default_method`] — the velocity form for a torque-driven
+/// hub or Kelvin–Voigt damping, the report's two-step scheme for a prescribed undamped hub).
 pub fn single_link(
     scene: &Scene,
     settings: &Settings,
@@ -48,7 +62,8 @@ pub fn single_link(
 ) -> Result<RunResult, FdmError> {
     let mut sys = FloatingLink::from_scene(scene, s.stations)?;
     let (q0, v0) = sys.initial_state();
-    let ctl = StepControl::for_scene(scene, s, s.method, false, true);
+    let method = default_method(settings, s, &sys);
+    let ctl = StepControl::for_scene(scene, s, method, false, true);
     Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, settings))
 }
 

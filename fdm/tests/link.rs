@@ -50,6 +50,74 @@ fn sys_link_dof_plans() {
     );
 }
 
+/// (stored, inputs, dissipation) term names of a run's ledger.
+fn ledger_terms(r: &RunResult) -> [Vec<&str>; 3] {
+    fn names(t: &[data::EnergyTerm]) -> Vec<&str> {
+        t.iter().map(|x| x.name.as_str()).collect()
+    }
+    [
+        names(&r.ledger.stored),
+        names(&r.ledger.inputs),
+        names(&r.ledger.dissipation),
+    ]
+}
+
+#[test]
+fn sys_link_ledger_books_only_the_scene_terms() {
+    // Only what the scene enables is booked: `single-link` has no joint spring, damper or
+    // Kelvin–Voigt (as fem/modal: kinetic, strain, applied_torque).
+    let mut s = Settings::default();
+    s.time.t_end = Some(0.05);
+    let r = run("single-link", |_| {}, &s);
+    assert_eq!(
+        ledger_terms(&r),
+        [vec!["kinetic", "strain"], vec!["applied_torque"], vec![]]
+    );
+    assert_eq!(r.cost.dofs, 41, "hub angle + 40 stations");
+    // prescribed hub: the motion is the input, no hub DOF
+    let r = run("spin-up", |_| {}, &s);
+    assert_eq!(
+        ledger_terms(&r),
+        [vec!["kinetic", "strain"], vec!["prescribed_motion"], vec![]]
+    );
+    assert_eq!(r.cost.dofs, 40);
+    // every term switched on, and the ledger still closes with them
+    let all = |sc: &mut data::Scene| {
+        let j = &mut sc.links[0].joint;
+        j.stiffness = Some(2.0);
+        j.damping = Some(0.05);
+        j.set_point = Some(0.3);
+        sc.links[0].kelvin_voigt = Some(1e-4);
+    };
+    let r = run("single-link", all, &s);
+    assert_eq!(
+        ledger_terms(&r),
+        [
+            vec!["kinetic", "strain", "joint_spring"],
+            vec!["applied_torque"],
+            vec!["joint_damper", "kelvin_voigt"]
+        ]
+    );
+    for t in r.ledger.stored.iter().chain(&r.ledger.dissipation) {
+        assert!(
+            t.values.iter().any(|v| *v != 0.0),
+            "{} is booked and non-zero",
+            t.name
+        );
+    }
+    assert!(r.ledger.relative_closure() < 1e-4);
+    // a torque-driven hub without a torque law has no input term
+    let r = run(
+        "single-link",
+        |sc| {
+            all(sc);
+            sc.links[0].joint.torque = None;
+        },
+        &s,
+    );
+    assert_eq!(ledger_terms(&r)[1], Vec::<&str>::new());
+}
+
 #[test]
 fn dyn_spin_up_stays_bounded_with_foreshortening_and_diverges_without() {
     let s = Settings::default();
@@ -85,7 +153,9 @@ fn dyn_spin_up_stays_bounded_with_foreshortening_and_diverges_without() {
 fn dyn_single_link_report_scheme_parasitic_velocity_form_closes_energy() {
     // The free hub couples θ̇ and v̇ (İθ̇ and θ̇² terms): velocity-dependent forces on which the
     // two-step scheme's computational mode grows even without damping. It is detected…
-    let out = run("single-link", |_| {}, &Settings::default());
+    let mut report = Settings::default();
+    report.time.method = Some("report".into());
+    let out = run("single-link", |_| {}, &report);
     match &out.verdict {
         StabilityVerdict::Stopped { diagnostic } => {
             eprintln!("single-link, report: {diagnostic}");
@@ -106,6 +176,12 @@ fn dyn_single_link_report_scheme_parasitic_velocity_form_closes_energy() {
     eprintln!(
         "single-link, velocity-form: steps {}, ledger closure {c:.3e}",
         out.cost.steps
+    );
+    // …which is the default for this scene (velocity-dependent forces): the same bits.
+    let default = run("single-link", |_| {}, &Settings::default());
+    assert_eq!(
+        default.observables.get("joint1.angle").unwrap().values,
+        out.observables.get("joint1.angle").unwrap().values
     );
     // second-order scheme, torque switches inside steps (one O(τ²) energy error per switch)
     assert!(c < 1e-4);

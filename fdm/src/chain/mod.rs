@@ -50,6 +50,7 @@ pub mod contact;
 pub mod dual;
 pub mod kinetic;
 mod mass;
+pub mod modes;
 mod outputs;
 pub mod timoshenko;
 

@@ -345,6 +345,28 @@ impl FloatingLink {
         }
     }
 
+    /// The ledger terms the scene enables (the others are neither computed into the ledger nor
+    /// stored): an input when the hub is prescribed or has a torque law, a joint spring and
+    /// damper when their constants are non-zero, Kelvin–Voigt when γ > 0.
+    fn input_enabled(&self) -> bool {
+        match &self.drive {
+            Drive::Prescribed(_) => true,
+            Drive::Torque { law, .. } => law.is_some(),
+        }
+    }
+
+    fn spring_enabled(&self) -> bool {
+        matches!(self.drive, Drive::Torque { stiffness, .. } if stiffness != 0.0)
+    }
+
+    fn damper_enabled(&self) -> bool {
+        matches!(self.drive, Drive::Torque { damping, .. } if damping != 0.0)
+    }
+
+    fn kelvin_voigt_enabled(&self) -> bool {
+        self.gamma > 0.0
+    }
+
     pub fn dof_plan(&self) -> DofPlan {
         let mut plan = DofPlan::default();
         if !self.prescribed() {
@@ -434,7 +456,18 @@ impl System for FloatingLink {
     }
 
     fn powers(&self, out: &mut [f64]) {
-        out.copy_from_slice(&self.power);
+        let enabled = [
+            self.input_enabled(),
+            self.damper_enabled(),
+            self.kelvin_voigt_enabled(),
+        ];
+        let mut k = 0;
+        for (p, on) in self.power.iter().zip(enabled) {
+            if on {
+                out[k] = *p;
+                k += 1;
+            }
+        }
     }
 
     fn bound(&self, t: f64) -> Bound {
@@ -476,15 +509,17 @@ impl System for FloatingLink {
             ke -= rate * rate * self.phi(vs);
         }
         let strain = Self::bending_energy(self.h, self.ei, vs);
-        let spring = match &self.drive {
-            Drive::Torque {
-                stiffness,
-                set_point,
-                ..
-            } => 0.5 * stiffness * (th - set_point).powi(2),
-            Drive::Prescribed(_) => 0.0,
-        };
-        out.copy_from_slice(&[ke, strain, spring]);
+        out[0] = ke;
+        out[1] = strain;
+        if let Drive::Torque {
+            stiffness,
+            set_point,
+            ..
+        } = &self.drive
+            && self.spring_enabled()
+        {
+            out[2] = 0.5 * stiffness * (th - set_point).powi(2);
+        }
     }
 
     fn monitored(&self) -> Range<usize> {

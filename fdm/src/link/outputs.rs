@@ -77,16 +77,26 @@ impl Outputs for FloatingLink {
     }
 
     fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
-        let input = if self.prescribed() {
-            "prescribed_motion"
-        } else {
-            "applied_torque"
-        };
-        (
-            vec!["kinetic", "strain", "joint_spring"],
-            vec![input],
-            vec!["joint_damper", "kelvin_voigt"],
-        )
+        let mut stored = vec!["kinetic", "strain"];
+        if self.spring_enabled() {
+            stored.push("joint_spring");
+        }
+        let mut inputs = Vec::new();
+        if self.input_enabled() {
+            inputs.push(if self.prescribed() {
+                "prescribed_motion"
+            } else {
+                "applied_torque"
+            });
+        }
+        let mut diss = Vec::new();
+        if self.damper_enabled() {
+            diss.push("joint_damper");
+        }
+        if self.kelvin_voigt_enabled() {
+            diss.push("kelvin_voigt");
+        }
+        (stored, inputs, diss)
     }
 
     fn dof_name(&self, i: usize) -> String {
