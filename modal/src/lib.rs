@@ -31,9 +31,9 @@
 //! for the exact inextensible kinetic terms) plus a dense N³/3 Cholesky of the small reduced
 //! mass matrix. Prescribed hub motion is
 //! imposed exactly and the torque it needs is reported. Time integration: [`integrate`]
-//! (by default fixed-step TR-BDF2 at a fraction of the fastest first bending period for damped
-//! chains without contact, Dormand–Prince 5(4) otherwise, see
-//! [`simulate::default_method`]; adaptive TR-BDF2 for stiff cases: many `poly` modes, whose
+//! (by default adaptive TR-BDF2 for Kelvin–Voigt-damped chains without contact,
+//! Dormand–Prince 5(4) otherwise, see [`simulate::default_method`]; adaptive TR-BDF2 is also
+//! the method for other stiff cases: many `poly` modes, whose
 //! overdamped Kelvin–Voigt eigenvalues reach −1.4e7 / −4.8e7 / −1.4e8 s⁻¹ at 16 / 20 / 24 modes
 //! per link on `barhorst-case1-tipmass`). TR-BDF2 solves its Newton systems through the
 //! chain's own factored linearization ([`newton`]: Cholesky of M + cD + c²K with the contact
