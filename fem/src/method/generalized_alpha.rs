@@ -14,7 +14,7 @@
 use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
 use crate::linalg::max_abs;
-use crate::method::{JacobianKind, StepConstraint, StepContext, Stepper};
+use crate::method::{StepConstraint, StepContext, Stepper};
 
 #[derive(Debug, Clone, Copy)]
 struct AlphaParams {
@@ -106,19 +106,8 @@ impl Stepper for GeneralizedAlpha {
                 .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
             cx.counters.rhs += 1;
             cx.counters.newton += 1;
-            // The band matrix is cheap and fresh every step (near-quadratic convergence keeps the
-            // iteration error far below the tolerance, which the tight ledger checks need); the
-            // dense finite-difference matrix is reused across steps (modified Newton) while
-            // Newton converges in ≤ 3 iterations and the step is unchanged.
-            let fresh = cx.newton.jacobian == JacobianKind::Banded
-                || cx.newton.matrix_h != h
-                || cx.newton.slow_convergence;
-            if (it == 0 && fresh) || it == 6 || it == 12 || it == 18 {
-                cx.newton
-                    .form(cx.chain, st, cx.counters, cx.h_nominal, c, t_law, t1)?;
-                cx.newton.matrix_h = h;
-                cx.newton.slow_convergence = false;
-            }
+            cx.newton
+                .form_if_due(it, h, cx.chain, st, cx.counters, cx.h_nominal, c, t_law, t1)?;
             cx.newton.delta.copy_from_slice(&cx.newton.res);
             cx.newton.solve();
             let mut big = 0.0f64;

@@ -18,7 +18,7 @@
 use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
 use crate::linalg::max_abs;
-use crate::method::{JacobianKind, StepConstraint, StepContext, Stepper};
+use crate::method::{StepConstraint, StepContext, Stepper};
 
 /// Newton iterations at most before the step is retried shorter.
 const MAX_ITERATIONS: usize = 30;
@@ -65,17 +65,8 @@ impl Stepper for ImplicitMidpoint {
                 .residual(t_mid, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
             cx.counters.rhs += 1;
             cx.counters.newton += 1;
-            // Band matrix fresh every step; the dense finite-difference one reused across
-            // steps while Newton converges in ≤ 3 iterations at an unchanged step.
-            let fresh = cx.newton.jacobian == JacobianKind::Banded
-                || cx.newton.matrix_h != h
-                || cx.newton.slow_convergence;
-            if (it == 0 && fresh) || it == 6 || it == 12 || it == 18 {
-                cx.newton
-                    .form(cx.chain, st, cx.counters, cx.h_nominal, c, t_mid, t1)?;
-                cx.newton.matrix_h = h;
-                cx.newton.slow_convergence = false;
-            }
+            cx.newton
+                .form_if_due(it, h, cx.chain, st, cx.counters, cx.h_nominal, c, t_mid, t1)?;
             cx.newton.delta.copy_from_slice(&cx.newton.res);
             cx.newton.solve();
             for i in 0..n {

@@ -70,6 +70,35 @@ impl NewtonSystem {
         }
     }
 
+    /// Re-forms and factors the matrix when it is due in Newton iteration `it` of a step of
+    /// size `h`: at the first iteration when it is stale — the band matrix is cheap and formed
+    /// fresh every step (near-quadratic convergence keeps the iteration error far below the
+    /// tolerance, which the tight ledger checks need), the dense finite-difference matrix is
+    /// reused across steps (modified Newton) while Newton converges in ≤ 3 iterations at an
+    /// unchanged step — and every 6th iteration.
+    #[allow(clippy::too_many_arguments)]
+    pub fn form_if_due(
+        &mut self,
+        it: usize,
+        h: f64,
+        chain: &mut Chain,
+        st: &StepState,
+        counters: &mut Counters,
+        h_nominal: f64,
+        c: NewtonCoefficients,
+        t_law: f64,
+        t: f64,
+    ) -> Result<(), FemError> {
+        let fresh =
+            self.jacobian == JacobianKind::Banded || self.matrix_h != h || self.slow_convergence;
+        if (it == 0 && fresh) || it == 6 || it == 12 || it == 18 {
+            self.form(chain, st, counters, h_nominal, c, t_law, t)?;
+            self.matrix_h = h;
+            self.slow_convergence = false;
+        }
+        Ok(())
+    }
+
     /// Forms and factorizes the Newton matrix at (q1, q̇1, q̈1) after a residual evaluation there.
     #[allow(clippy::too_many_arguments)]
     pub fn form(
