@@ -247,6 +247,21 @@ pub fn read_dirs(dirs: &[PathBuf]) -> Result<Parts, MergeError> {
     }
 }
 
+/// Refuses a part written by another version of flexverify.
+fn same_version(path: &Path, version: &str) -> Result<(), MergeError> {
+    let this_version = env!("CARGO_PKG_VERSION");
+    if version == this_version {
+        return Ok(());
+    }
+    Err(MergeError::Mismatch {
+        first: path.to_path_buf(),
+        second: PathBuf::from("this flexverify"),
+        what: "versions",
+        a: version.to_string(),
+        b: this_version.to_string(),
+    })
+}
+
 /// The rows of the whole selection, in selection order, from one file per shard.
 pub fn merge(
     files: &[(PathBuf, ShardFile)],
@@ -254,16 +269,7 @@ pub fn merge(
     let Some((first_path, first)) = files.first() else {
         return Err(MergeError::NoShards("the given folders".into()));
     };
-    let this_version = env!("CARGO_PKG_VERSION");
-    if first.version != this_version {
-        return Err(MergeError::Mismatch {
-            first: first_path.clone(),
-            second: PathBuf::from("this flexverify"),
-            what: "versions",
-            a: first.version.clone(),
-            b: this_version.to_string(),
-        });
-    }
+    same_version(first_path, &first.version)?;
     let mut by_index: BTreeMap<usize, (&PathBuf, &ShardFile)> = BTreeMap::new();
     for (path, file) in files {
         let differ = |what, a: String, b: String| MergeError::Mismatch {
@@ -417,16 +423,7 @@ pub fn merge_converge(
     let Some((first_path, first)) = files.first() else {
         return Err(MergeError::NoShards("the given folders".into()));
     };
-    let this_version = env!("CARGO_PKG_VERSION");
-    if first.version != this_version {
-        return Err(MergeError::Mismatch {
-            first: first_path.clone(),
-            second: PathBuf::from("this flexverify"),
-            what: "versions",
-            a: first.version.clone(),
-            b: this_version.to_string(),
-        });
-    }
+    same_version(first_path, &first.version)?;
     let mut by_index: BTreeMap<usize, &PathBuf> = BTreeMap::new();
     let mut rungs = BTreeMap::new();
     for (path, file) in files {

@@ -188,11 +188,7 @@ impl Element for HermiteCubic {
     }
     fn shapes(&self, xi: f64, h: f64) -> Shapes {
         let s = hermite(xi, h);
-        let mut out = Shapes::default();
-        out.n[..4].copy_from_slice(&s.n);
-        out.dn[..4].copy_from_slice(&s.dn);
-        out.b[..4].copy_from_slice(&s.dn);
-        out
+        Shapes::euler_bernoulli(&s.n, &s.dn)
     }
     fn translates(&self, _a: usize) -> bool {
         true

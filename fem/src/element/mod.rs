@@ -91,6 +91,18 @@ pub struct Shapes {
     pub b: Row,
 }
 
+impl Shapes {
+    /// Shapes of an Euler–Bernoulli element (every local DOF is a deflection DOF; the section
+    /// angle is the slope, B = N′), zero-padded to [`MAXE`].
+    pub fn euler_bernoulli(n: &[f64], dn: &[f64]) -> Self {
+        let mut out = Shapes::default();
+        out.n[..n.len()].copy_from_slice(n);
+        out.dn[..dn.len()].copy_from_slice(dn);
+        out.b[..dn.len()].copy_from_slice(dn);
+        out
+    }
+}
+
 /// Global DOFs of one element: axial u at both ends and the local transverse DOFs
 /// ([`NONE`] where clamped or absent).
 #[derive(Debug, Clone, Copy)]

@@ -144,11 +144,7 @@ impl Element for HermiteQuintic {
     }
     fn shapes(&self, xi: f64, h: f64) -> Shapes {
         let s = shapes(xi, h);
-        let mut out = Shapes::default();
-        out.n[..NDOF].copy_from_slice(&s.n);
-        out.dn[..NDOF].copy_from_slice(&s.dn);
-        out.b[..NDOF].copy_from_slice(&s.dn);
-        out
+        Shapes::euler_bernoulli(&s.n, &s.dn)
     }
     fn translates(&self, _a: usize) -> bool {
         true

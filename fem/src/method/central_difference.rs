@@ -8,7 +8,7 @@
 use crate::chain::{Chain, NewtonCoefficients};
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
-use crate::method::{StepConstraint, StepContext, StepState, Stepper};
+use crate::method::{StepConstraint, StepContext, StepState, Stepper, refuse_constraint};
 
 /// Central difference (no state of its own).
 #[derive(Debug, Clone, Copy)]
@@ -23,11 +23,7 @@ impl Stepper for CentralDifference {
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        if constraint.is_some() {
-            return Err(FemError::unsupported(
-                "fem central-difference: contact constraints are stepped by energy-midpoint only",
-            ));
-        }
+        refuse_constraint("central-difference", constraint.is_some())?;
         let st = &mut *cx.state;
         let n = st.q.len();
         for i in 0..n {

@@ -14,7 +14,7 @@
 use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
 use crate::linalg::max_abs;
-use crate::method::{StepConstraint, StepContext, Stepper};
+use crate::method::{StepConstraint, StepContext, Stepper, refuse_constraint};
 
 #[derive(Debug, Clone, Copy)]
 struct AlphaParams {
@@ -62,11 +62,7 @@ impl Stepper for GeneralizedAlpha {
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        if constraint.is_some() {
-            return Err(FemError::unsupported(
-                "fem generalized-alpha: contact constraints are stepped by energy-midpoint only",
-            ));
-        }
+        refuse_constraint("generalized-alpha", constraint.is_some())?;
         let st = &mut *cx.state;
         let AlphaParams {
             alpha_m,

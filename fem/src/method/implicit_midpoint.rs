@@ -18,7 +18,7 @@
 use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
 use crate::linalg::max_abs;
-use crate::method::{StepConstraint, StepContext, Stepper};
+use crate::method::{StepConstraint, StepContext, Stepper, refuse_constraint};
 
 /// Newton iterations at most before the step is retried shorter.
 const MAX_ITERATIONS: usize = 30;
@@ -37,11 +37,7 @@ impl Stepper for ImplicitMidpoint {
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        if constraint.is_some() {
-            return Err(FemError::unsupported(
-                "fem implicit-midpoint: contact constraints are stepped by energy-midpoint only",
-            ));
-        }
+        refuse_constraint("implicit-midpoint", constraint.is_some())?;
         let st = &mut *cx.state;
         let n = st.q.len();
         let t_mid = st.t + 0.5 * h;

@@ -204,3 +204,13 @@ pub fn stepper(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper> {
         Method::ImplicitMidpoint => Box::new(implicit_midpoint::ImplicitMidpoint),
     }
 }
+
+/// A method without a bordered (constrained) update refuses a held contact.
+pub(crate) fn refuse_constraint(method: &str, held: bool) -> Result<(), FemError> {
+    if held {
+        return Err(FemError::unsupported(format!(
+            "fem {method}: contact constraints are stepped by energy-midpoint only"
+        )));
+    }
+    Ok(())
+}

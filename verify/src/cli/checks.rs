@@ -52,27 +52,7 @@ pub fn verify(
             dir.display()
         );
     }
-    let failed: Vec<&Outcome> = outcomes
-        .iter()
-        .filter(|o| o.status != Status::Pass)
-        .collect();
-    eprintln!(
-        "{} passed, {} failed ({:.1} s wall)",
-        outcomes.len() - failed.len(),
-        failed.len(),
-        wall
-    );
-    if failed.is_empty() {
-        Ok(())
-    } else {
-        Err(CliError::Failed(
-            failed
-                .iter()
-                .map(|o| format!("FAILED {}: {}", o.id, o.message))
-                .collect::<Vec<_>>()
-                .join("\n"),
-        ))
-    }
+    summarize(&outcomes, &format!("{wall:.1} s wall"))
 }
 
 /// `verify --shard I/N`: this shard's share of the selected cases, printed, and written as
