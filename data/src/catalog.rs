@@ -37,6 +37,9 @@ catalog!(
     "rocket-launch-60",
     "rocket-launch-75",
     "single-link-3d",
+    "single-link-3d-constant-rate",
+    "single-link-3d-soft-sag",
+    "single-link-3d-stiff",
     "mobile-manipulator",
 );
 

@@ -30,6 +30,6 @@ pub use error::{LoadError, SceneError};
 pub use reader::parse_scene;
 pub use results::{
     Channel, Cost, Diagnostic, EnergyLedger, EnergyTerm, Event, ModalResult, ModeShape,
-    Observables, RunResult, StabilityVerdict, StaticResult, channel,
+    Observables, RunResult, StabilityVerdict, StaticResult, channel, ledger_term,
 };
 pub use scene::{Family, Scene};

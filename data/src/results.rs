@@ -40,6 +40,33 @@ pub mod channel {
     pub fn field_deflection(i: usize, k: usize) -> String {
         format!("link{i}.v@{k}")
     }
+    /// 3-D link (seed 002): vertical tip deflection w(L), twist φ(L) and the tip slopes v′(L),
+    /// w′(L) of link i in its turning frame. With `tip_axial` (u(L)), `tip_deflection` (v(L)) and
+    /// the base angle they fix the payload's orientation to second order (seed eq. 2).
+    pub fn tip_vertical(i: usize) -> String {
+        format!("link{i}.tip_w")
+    }
+    pub fn tip_twist(i: usize) -> String {
+        format!("link{i}.tip_twist")
+    }
+    pub fn tip_slope_horizontal(i: usize) -> String {
+        format!("link{i}.tip_slope_v")
+    }
+    pub fn tip_slope_vertical(i: usize) -> String {
+        format!("link{i}.tip_slope_w")
+    }
+    /// 3-D link: vertical deflection and twist at field station k.
+    pub fn field_vertical(i: usize, k: usize) -> String {
+        format!("link{i}.w@{k}")
+    }
+    pub fn field_twist(i: usize, k: usize) -> String {
+        format!("link{i}.phi@{k}")
+    }
+    /// 3-D link: inertial position of the payload's centre of mass (origin on the base axis at
+    /// the rod's root, Z up).
+    pub const PAYLOAD_X: &str = "payload.X";
+    pub const PAYLOAD_Y: &str = "payload.Y";
+    pub const PAYLOAD_Z: &str = "payload.Z";
     /// Contact phase of contact c: 0 free, 1 constrained and sliding (or frictionless), 2 sticking.
     pub fn contact_phase(c: usize) -> String {
         format!("contact{c}.phase")
@@ -78,6 +105,32 @@ pub mod channel {
     pub const STEP_SIZE: &str = "step_size";
     /// Stability bound on the step in force at that time (explicit schemes).
     pub const STABILITY_BOUND: &str = "stability_bound";
+}
+
+/// Standard energy-ledger term names (see [`EnergyLedger`]).
+pub mod ledger_term {
+    use crate::scene::LinkField;
+
+    pub const KINETIC: &str = "kinetic";
+    pub const STRAIN: &str = "strain";
+    pub const GRAVITY: &str = "gravity";
+    pub const JOINT_SPRING: &str = "joint_spring";
+    pub const APPLIED_TORQUE: &str = "applied_torque";
+    pub const PRESCRIBED_MOTION: &str = "prescribed_motion";
+    pub const JOINT_DAMPER: &str = "joint_damper";
+    pub const KELVIN_VOIGT: &str = "kelvin_voigt";
+    pub const FRICTION: &str = "friction";
+    pub const IMPACT: &str = "impact";
+
+    /// Kelvin–Voigt dissipation of one field of the 3-D link, booked separately per field.
+    pub fn kelvin_voigt_of(field: LinkField) -> &'static str {
+        match field {
+            LinkField::Axial => "kelvin_voigt_axial",
+            LinkField::Horizontal => "kelvin_voigt_horizontal",
+            LinkField::Vertical => "kelvin_voigt_vertical",
+            LinkField::Torsion => "kelvin_voigt_torsion",
+        }
+    }
 }
 
 /// Sampled time series of named channels on a common time grid.

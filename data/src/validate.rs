@@ -6,7 +6,8 @@
 
 use crate::locate::FieldPath;
 use crate::scene::{
-    Contact, InitialShape, Joint, Link, PrescribedMotion, Rocket, Scene, Surface, TorqueLaw,
+    Contact, InitialShape, Joint, Link, LinkField, LinkInitialShape, PayloadLink, PrescribedMotion,
+    Rocket, Scene, Surface, TorqueLaw,
 };
 
 /// Largest accepted scene file.
@@ -239,29 +240,7 @@ pub fn validate(scene: &Scene) -> Vec<Issue> {
         check_rocket(&mut c, &FieldPath::root().key("rocket"), r);
     }
     if let Some(p) = &scene.payload_link {
-        let b = FieldPath::root().key("payload_link");
-        for (k, v) in [
-            ("length", p.length),
-            ("radius", p.radius),
-            ("youngs_modulus", p.youngs_modulus),
-            ("shear_modulus", p.shear_modulus),
-            ("density", p.density),
-            ("payload_mass", p.payload_mass),
-            ("base_inertia", p.base_inertia),
-        ] {
-            c.positive(b.key(k), v);
-        }
-        c.non_negative(b.key("payload_offset"), p.payload_offset);
-        c.non_negative(b.key("motor_friction"), p.motor_friction);
-        for (k, v) in p.payload_inertia.iter().enumerate() {
-            c.positive(b.key("payload_inertia").index(k), *v);
-        }
-        for (k, v) in p.kelvin_voigt.iter().enumerate() {
-            c.non_negative(b.key("kelvin_voigt").index(k), *v);
-        }
-        for (k, v) in p.gravity.iter().enumerate() {
-            c.finite(b.key("gravity").index(k), *v);
-        }
+        check_payload_link(&mut c, &FieldPath::root().key("payload_link"), p);
     }
     if let Some(m) = &scene.mobile_manipulator {
         let b = FieldPath::root().key("mobile_manipulator");
@@ -345,6 +324,150 @@ fn check_link(c: &mut Checker, p: &FieldPath, l: &Link) {
         );
     }
     check_joint(c, &p.key("joint"), &l.joint);
+}
+
+fn check_payload_link(c: &mut Checker, b: &FieldPath, p: &PayloadLink) {
+    for (k, v) in [
+        ("length", p.length),
+        ("radius", p.radius),
+        ("youngs_modulus", p.youngs_modulus),
+        ("shear_modulus", p.shear_modulus),
+        ("density", p.density),
+    ] {
+        c.positive(b.key(k), v);
+    }
+    if p.radius.is_finite() && p.length.is_finite() && p.radius >= 0.1 * p.length {
+        c.fail(
+            b.key("radius"),
+            format!(
+                "radius {} is not small against length {}: the rod model neglects shear and \
+                 warping",
+                p.radius, p.length
+            ),
+            "a slender rod, radius < length / 10",
+        );
+    }
+    if p.fields.is_empty() {
+        c.fail(
+            b.key("fields"),
+            "no elastic field: the rod would be rigid",
+            "a subset of [\"axial\", \"horizontal\", \"vertical\", \"torsion\"], or omit `fields` for all four",
+        );
+    }
+    for (k, f) in p.fields.iter().enumerate() {
+        if p.fields[..k].contains(f) {
+            c.fail(
+                b.key("fields").index(k),
+                format!("field `{}` listed twice", f.name()),
+                "each field at most once",
+            );
+        }
+    }
+    let pl = b.key("payload");
+    c.positive(pl.key("mass"), p.payload.mass);
+    c.non_negative(pl.key("offset"), p.payload.offset);
+    let i = &p.payload.inertia;
+    for r in 0..3 {
+        for col in 0..3 {
+            c.finite(pl.key("inertia").index(r).index(col), i[r][col]);
+        }
+    }
+    for (r, col) in [(0, 1), (0, 2), (1, 2)] {
+        if i[r][col] != i[col][r] {
+            c.fail(
+                pl.key("inertia").index(r).index(col),
+                format!(
+                    "inertia matrix is not symmetric: [{r}][{col}] = {} but [{col}][{r}] = {}",
+                    i[r][col], i[col][r]
+                ),
+                "a symmetric matrix [[I1, I4, I5], [I4, I2, I6], [I5, I6, I3]]",
+            );
+        }
+    }
+    if i.iter().flatten().all(|v| v.is_finite()) && is_symmetric(i) {
+        // Positive definite, and each principal moment at most the sum of the other two, i.e.
+        // (tr I / 2)·1 − I positive semidefinite (Sylvester's criteria on both).
+        let tr = i[0][0] + i[1][1] + i[2][2];
+        let slack = std::array::from_fn(|r| {
+            std::array::from_fn(|col| if r == col { 0.5 * tr } else { 0.0 } - i[r][col])
+        });
+        if !(leading_minors_positive(i) && principal_minors_nonnegative(&slack, tr.abs())) {
+            c.fail(
+                pl.key("inertia"),
+                "not the inertia matrix of a rigid body: its principal moments must be positive \
+                 and each at most the sum of the other two",
+                "a symmetric positive definite matrix satisfying the triangle inequality",
+            );
+        }
+    }
+    check_joint(c, &b.key("base"), &p.base);
+    if let Some(k) = &p.kelvin_voigt {
+        let kp = b.key("kelvin_voigt");
+        for f in LinkField::ALL {
+            let key = f.name();
+            if let Some(v) = match f {
+                LinkField::Axial => k.axial,
+                LinkField::Horizontal => k.horizontal,
+                LinkField::Vertical => k.vertical,
+                LinkField::Torsion => k.torsion,
+            } {
+                c.non_negative(kp.key(key), v);
+                if v > 0.0 && !p.has(f) {
+                    c.fail(
+                        kp.key(key),
+                        format!("damping on the `{key}` field, which the rod does not carry"),
+                        format!("add \"{key}\" to `fields`, or remove `kelvin_voigt.{key}`"),
+                    );
+                }
+            }
+        }
+    }
+    if let Some(g) = p.gravity {
+        c.non_negative(b.key("gravity"), g);
+        if g > 0.0 && !p.has(LinkField::Vertical) {
+            c.fail(
+                b.key("gravity"),
+                "gravity bends the rod vertically, but the `vertical` field is off",
+                "add \"vertical\" to `fields`, or remove `gravity`",
+            );
+        }
+    }
+    if p.initial_shape == LinkInitialShape::StaticSag && p.gravity.is_none_or(|g| g == 0.0) {
+        c.fail(
+            b.key("initial_shape"),
+            "a static-sag start without gravity",
+            "`gravity = 9.81` (or another g), or `initial_shape = \"undeformed\"`",
+        );
+    }
+}
+
+fn is_symmetric(m: &[[f64; 3]; 3]) -> bool {
+    m[0][1] == m[1][0] && m[0][2] == m[2][0] && m[1][2] == m[2][1]
+}
+
+fn det2(m: &[[f64; 3]; 3], a: usize, b: usize) -> f64 {
+    m[a][a] * m[b][b] - m[a][b] * m[b][a]
+}
+
+fn det3(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+fn leading_minors_positive(m: &[[f64; 3]; 3]) -> bool {
+    m[0][0] > 0.0 && det2(m, 0, 1) > 0.0 && det3(m) > 0.0
+}
+
+/// All principal minors non-negative up to round-off relative to `scale` (an entry's size):
+/// positive semidefinite.
+fn principal_minors_nonnegative(m: &[[f64; 3]; 3], scale: f64) -> bool {
+    let eps = 1e-12;
+    (0..3).all(|k| m[k][k] >= -eps * scale)
+        && [(0, 1), (0, 2), (1, 2)]
+            .iter()
+            .all(|&(a, b)| det2(m, a, b) >= -eps * scale * scale)
+        && det3(m) >= -eps * scale.powi(3)
 }
 
 fn check_joint(c: &mut Checker, p: &FieldPath, j: &Joint) {

@@ -106,7 +106,10 @@ impl CheckKind {
 /// * `contactC.normal_force` — a force on the tip;
 /// * `rocket.X`, `rocket.Y`, `rocket.vX`, `rocket.vY` — inertial mass-centre position and
 ///   momentum / mass;
-/// * `energy.NAME` — energy-ledger terms.
+/// * `energy.NAME` — energy-ledger terms;
+/// * `payload.X`, `payload.Y`, `payload.Z` — the 3-D link's payload position;
+/// * `linkN.tip_w`, `linkN.tip_twist` — the 3-D link's vertical tip deflection and tip twist, in
+///   the base's turning frame, which the clamped root fixes the same way in every backend.
 ///
 /// Not invariant: tip deflections and axial displacements in a link's floating frame, field
 /// deflections `linkN.v@K`, rocket body-axis displacements and attitude (their axes depend on
@@ -121,6 +124,9 @@ pub fn frame_invariant(channel: &str) -> bool {
             | data::channel::ROCKET_Y
             | data::channel::ROCKET_VX
             | data::channel::ROCKET_VY
+            | data::channel::PAYLOAD_X
+            | data::channel::PAYLOAD_Y
+            | data::channel::PAYLOAD_Z
     ) {
         return true;
     }
@@ -131,7 +137,7 @@ pub fn frame_invariant(channel: &str) -> bool {
             })
         })
     };
-    indexed("link", &["tip_x", "tip_y"])
+    indexed("link", &["tip_x", "tip_y", "tip_w", "tip_twist"])
         || indexed("joint", &["angle", "rate", "torque"])
         || indexed("contact", &["normal_force"])
 }

@@ -15,7 +15,9 @@ mod planar;
 mod rocket;
 
 pub use mobile::MobileManipulator;
-pub use payload::PayloadLink;
+pub use payload::{
+    InitialShape as LinkInitialShape, KelvinVoigt3d, LinkField, Payload, PayloadLink,
+};
 pub use planar::{
     Contact, ContactMode, Gravity, Joint, Link, PrescribedMotion, Statics, Studies, Surface,
     TorqueLaw,
@@ -138,6 +140,9 @@ impl Scene {
             ("contact", !self.contacts.is_empty()),
             ("friction", self.contacts.iter().any(|c| c.friction > 0.0)),
         ];
+        if let Some(p) = &self.payload_link {
+            return p.physics_flags();
+        }
         if self.family() != Family::PlanarChain {
             flags.retain(|(_, on)| *on);
         }
