@@ -367,9 +367,9 @@ fn check_payload_link(c: &mut Checker, b: &FieldPath, p: &PayloadLink) {
     c.positive(pl.key("mass"), p.payload.mass);
     c.non_negative(pl.key("offset"), p.payload.offset);
     let i = &p.payload.inertia;
-    for r in 0..3 {
-        for col in 0..3 {
-            c.finite(pl.key("inertia").index(r).index(col), i[r][col]);
+    for (r, row) in i.iter().enumerate() {
+        for (col, v) in row.iter().enumerate() {
+            c.finite(pl.key("inertia").index(r).index(col), *v);
         }
     }
     for (r, col) in [(0, 1), (0, 2), (1, 2)] {
