@@ -20,7 +20,8 @@
 //! `axial_freqN` / `bending_freqN` (N-th of that kind), `tip_static` (static tip deflection),
 //! `CHANNEL@T` (observable at time T; `tip_deflection`, `tip_x`, `tip_y` alias the last link's
 //! channel), `peak:CHANNEL` (max |value| over the run), `ledger_closure` (relative energy-ledger
-//! residual), `max_momentum_residual` (impacts), `impulseN`, `impact_timeN`, `release_timeN`,
+//! residual), `max_momentum_residual` (impacts), `impulseN`, `impulse_excessN` (Λ/(m_tip|v_n⁻|) − 1, with a tip
+//! mass), `impact_timeN`, `release_timeN`,
 //! `episode_startN:F` / `episode_endN:F` (contact events), and whole histories compared with a
 //! reference backend's over the run, error max_t |a(t) − b(t)| / max_t |b(t)|:
 //! * `history:CHANNEL` — the raw history; CHANNEL is an observable or `energy.NAME`, a term of

@@ -323,6 +323,10 @@ pub enum Event {
         impulse: f64,
         /// ‖M(q̇⁺ − q̇⁻) − GᵀΛ‖ / ‖M(q̇⁺ − q̇⁻)‖.
         momentum_residual: f64,
+        /// Normal tip velocity G q̇⁻ just before the jump (negative: approaching the surface).
+        /// With a tip mass the impulse tends to m_tip·|v_n⁻| as the beam is refined (the rest of
+        /// the beam takes no part in an instantaneous point impact).
+        normal_velocity_before: f64,
         /// Normal tip velocity after the jump.
         normal_velocity_after: f64,
         kinetic_energy_lost: f64,

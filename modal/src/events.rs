@@ -295,6 +295,7 @@ fn switch_phase(
         velocity_after: y[nf..2 * nf].to_vec(),
         impulse,
         momentum_residual,
+        normal_velocity_before: v_before,
         normal_velocity_after: c.normal_velocity,
         kinetic_energy_lost: loss,
     });

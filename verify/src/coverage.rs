@@ -160,6 +160,7 @@ pub fn row_kinds(case: &Case, scene: &Scene) -> Vec<(CheckKind, Vec<BackendKind>
         Some(
             Quantity::MaxMomentumResidual
                 | Quantity::Impulse { .. }
+                | Quantity::ImpulseExcess { .. }
                 | Quantity::ImpactTime { .. }
                 | Quantity::ReleaseTime { .. }
                 | Quantity::Episode { .. }

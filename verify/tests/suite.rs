@@ -155,6 +155,7 @@ fn prop_contact_quantities_read_the_events_and_refuse_missing_ones() {
         velocity_after: vec![],
         impulse,
         momentum_residual: 1e-16,
+        normal_velocity_before: -1.0,
         normal_velocity_after: 0.0,
         kinetic_energy_lost: 1.0,
     };

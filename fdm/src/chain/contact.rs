@@ -345,6 +345,7 @@ impl TwoLinkChain {
             velocity_after: v.to_vec(),
             impulse,
             momentum_residual,
+            normal_velocity_before: gv,
             normal_velocity_after,
             kinetic_energy_lost,
         })

@@ -612,6 +612,7 @@ impl Contact {
             velocity_after: qd.to_vec(),
             impulse,
             momentum_residual,
+            normal_velocity_before: v_before,
             normal_velocity_after: self.normal_velocity,
             kinetic_energy_lost: loss,
         }))

@@ -200,8 +200,26 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 scene.simulation.output_interval
             );
             say!("physics");
+            let width = flags.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
             for (k, v) in &flags {
-                say!("  {:<18} {}", k, if *v { "on" } else { "off" });
+                say!("  {:<width$} {}", k, if *v { "on" } else { "off" });
+            }
+            if let Some(p) = &scene.payload_link {
+                say!(
+                    "rod: L = {}, R = {}, E = {:e}, G = {:e}, ρ = {}; fields {}; payload m = {}, c = {}",
+                    p.length,
+                    p.radius,
+                    p.youngs_modulus,
+                    p.shear_modulus,
+                    p.density,
+                    p.fields
+                        .iter()
+                        .map(|f| f.symbol())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    p.payload.mass,
+                    p.payload.offset
+                );
             }
             for (i, l) in scene.links.iter().enumerate() {
                 say!(

@@ -26,6 +26,11 @@ pub enum Quantity {
     MaxMomentumResidual,
     /// Normal impulse Λ of the n-th impact (1-based).
     Impulse { n: usize },
+    /// Relative excess Λ / (m_tip·|v_n⁻|) − 1 of the n-th impulse over the tip-mass momentum
+    /// limit, v_n⁻ the tip's normal velocity just before that impact (both read off the run).
+    /// It vanishes as the beam is refined: an instantaneous point impact stops the tip mass
+    /// alone.
+    ImpulseExcess { n: usize, tip_mass: f64 },
     /// Time of the n-th impact.
     ImpactTime { n: usize },
     /// Time of the n-th release (normal force through zero).
@@ -118,6 +123,24 @@ impl Quantity {
                 n: nth(rest, "release")?,
             });
         }
+        if let Some(rest) = t.strip_prefix("impulse_excess") {
+            let contact_link = scene
+                .contacts
+                .first()
+                .and_then(|c| scene.link_index(&c.link))
+                .ok_or_else(|| format!("`{text}` needs a scene with a contact"))?;
+            let link = &scene.links[contact_link];
+            let tip_mass = link.tip_mass.filter(|m| *m > 0.0).ok_or_else(|| {
+                format!(
+                    "`{text}` needs a tip mass on the contact link `{}`",
+                    link.name
+                )
+            })?;
+            return Ok(Quantity::ImpulseExcess {
+                n: nth(rest, "impact")?,
+                tip_mass,
+            });
+        }
         if let Some(rest) = t.strip_prefix("impulse") {
             return Ok(Quantity::Impulse {
                 n: nth(rest, "impact")?,
@@ -179,7 +202,7 @@ impl Quantity {
         Err(format!(
             "unknown quantity `{text}`; expected freqN, axial_freqN, bending_freqN, tip_static, \
              CHANNEL@T, peak:CHANNEL, history:CHANNEL, lowpassF:history:CHANNEL, ledger_closure, max_momentum_residual, \
-             impulseN, impact_timeN, release_timeN, episode_startN:F or episode_endN:F"
+             impulseN, impulse_excessN, impact_timeN, release_timeN, episode_startN:F or episode_endN:F"
         ))
     }
 
@@ -286,6 +309,28 @@ impl Quantity {
                     return Err("the run had no impact: no momentum balance to check".into());
                 }
                 Ok(residuals.into_iter().fold(0.0, f64::max))
+            }
+            Quantity::ImpulseExcess { n, tip_mass } => {
+                let (impulse, v_before) = r
+                    .events
+                    .iter()
+                    .filter_map(|e| match e {
+                        data::Event::Impact {
+                            impulse,
+                            normal_velocity_before,
+                            ..
+                        } => Some((*impulse, *normal_velocity_before)),
+                        _ => None,
+                    })
+                    .nth(*n - 1)
+                    .ok_or_else(|| format!("impact {n} was asked for; the run had fewer"))?;
+                let limit = tip_mass * v_before.abs();
+                if !(limit > 0.0) {
+                    return Err(format!(
+                        "impact {n} has no approach velocity (v_n⁻ = {v_before:e})"
+                    ));
+                }
+                Ok(impulse / limit - 1.0)
             }
             Quantity::Impulse { n } | Quantity::ImpactTime { n } => {
                 let impacts: Vec<(f64, f64)> = r
