@@ -19,6 +19,7 @@ fn impact(t: f64) -> Event {
         velocity_after: vec![],
         impulse: 1.0,
         momentum_residual: 0.0,
+        normal_velocity_before: -1.0,
         normal_velocity_after: 0.0,
         kinetic_energy_lost: 0.0,
     }

@@ -325,7 +325,7 @@ impl Quantity {
                     .nth(*n - 1)
                     .ok_or_else(|| format!("impact {n} was asked for; the run had fewer"))?;
                 let limit = tip_mass * v_before.abs();
-                if !(limit > 0.0) {
+                if limit.is_nan() || limit <= 0.0 {
                     return Err(format!(
                         "impact {n} has no approach velocity (v_n⁻ = {v_before:e})"
                     ));
