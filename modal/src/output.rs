@@ -43,6 +43,8 @@ pub(crate) struct Output {
     stations: Vec<Vec<f64>>,
     has_spring: bool,
     has_gravity: bool,
+    /// fᵀq₀ of the step load (its work is fᵀq − fᵀq₀), set at the first sample.
+    load_origin: Option<f64>,
 }
 
 impl Output {
@@ -102,6 +104,9 @@ impl Output {
         if rhs.slots.prescribed.is_some() {
             inputs.push("prescribed_motion");
         }
+        if chain.step_load.is_some() {
+            inputs.push("applied_load");
+        }
         let mut diss = Vec::new();
         if rhs.slots.joint_damper.is_some() {
             diss.push("joint_damper");
@@ -151,6 +156,7 @@ impl Output {
             stations,
             has_spring,
             has_gravity,
+            load_origin: None,
         }
     }
 
@@ -250,9 +256,14 @@ impl Output {
             k += 1;
         }
         let s = rhs.slots;
-        let (mut inputs, mut ni) = ([0.0; 2], 0);
+        let (mut inputs, mut ni) = ([0.0; 3], 0);
         for i in [s.applied, s.prescribed].into_iter().flatten() {
             inputs[ni] = y[i];
+            ni += 1;
+        }
+        if let Some(f) = &rhs.chain.step_load {
+            let fq = dot(f, &rhs.q);
+            inputs[ni] = fq - *self.load_origin.get_or_insert(fq);
             ni += 1;
         }
         let (mut diss, mut nd) = ([0.0; 4], 0);

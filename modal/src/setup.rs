@@ -307,7 +307,46 @@ pub fn build_chain_for(
         });
     }
     let gravity = scene.gravity.as_ref().map(|g| g.vector);
-    Ok(Chain::new(links, joints, gravity))
+    let mut chain = Chain::new(links, joints, gravity);
+    if purpose == Purpose::Dynamics {
+        chain.step_load = step_load(scene, &chain)?;
+    }
+    Ok(chain)
+}
+
+/// The scene's `[statics]` loads as the constant generalized force of a step load (as fem
+/// applies them in dynamics): tip force P along the link frame's y and uniform load q per unit
+/// length, on the transverse coordinates b of a single clamped link,
+/// f_b = P φ(L) + q ∫₀ᴸ φ dx.
+fn step_load(scene: &Scene, chain: &Chain) -> Result<Option<Vec<f64>>, ModalError> {
+    let Some(st) = &scene.statics else {
+        return Ok(None);
+    };
+    let (p, q) = (
+        st.tip_force.unwrap_or(0.0),
+        st.distributed_load.unwrap_or(0.0),
+    );
+    if p == 0.0 && q == 0.0 {
+        return Ok(None);
+    }
+    let clamped_single = scene.links.len() == 1
+        && matches!(
+            scene.links[0].joint.prescribed,
+            Some(data::scene::PrescribedMotion::Fixed)
+        );
+    if !clamped_single {
+        return Err(ModalError::Unsupported(
+            "modal: the [statics] loads act in dynamics only on a single clamped link".into(),
+        ));
+    }
+    let l = &chain.links[0];
+    let mut f = vec![0.0; chain.n];
+    // `phi1` is the mass-weighted ∫ρA φ.
+    let q_per_mass = q / scene.links[0].mass_per_length;
+    for i in 0..l.nb() {
+        f[l.b0 + i] = p * l.ints.phi_l[i] + q_per_mass * l.ints.phi1[i];
+    }
+    Ok(Some(f))
 }
 
 /// The DOFs of the model (the axial field is listed when on; simulate then reports Unsupported).

@@ -138,6 +138,9 @@ pub struct Chain {
     rhs_f: Vec<f64>,
     /// Torques the prescribed joints needed at the last `accelerations` call (per joint; 0 for free).
     pub(crate) tau_prescribed: Vec<f64>,
+    /// Constant generalized force of the scene's `[statics]` loads, applied as a step at t = 0
+    /// (N entries; None without loads). Its work is fᵀ(q − q₀).
+    pub step_load: Option<Vec<f64>>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -196,6 +199,7 @@ impl Chain {
             mff: vec![0.0; nf * nf],
             rhs_f: vec![0.0; nf],
             tau_prescribed: vec![0.0; nj],
+            step_load: None,
         }
     }
 
@@ -204,7 +208,10 @@ impl Chain {
     pub fn evaluate(&mut self, t: f64, q: &[f64], qd: &[f64]) {
         let n = self.n;
         self.mass.iter_mut().for_each(|v| *v = 0.0);
-        self.force.iter_mut().for_each(|v| *v = 0.0);
+        match &self.step_load {
+            Some(f) => self.force.copy_from_slice(f),
+            None => self.force.iter_mut().for_each(|v| *v = 0.0),
+        }
         let g = self.gravity;
         for i in 0..self.links.len() {
             // Frame kinematics of link i.
