@@ -99,17 +99,18 @@
 //!   second-order kinetic energy indefinite (see [`chain`]). Kinetic energy to second order in
 //!   the deflections, exact in the angles (the single link's order); Lagrange's equations with
 //!   p = ∂T/∂q̇ and the exact (∂p/∂q)q̇ by dual numbers; mass matrix = lumped diagonal + four
-//!   full columns (4×4 Schur complement, O(n) per step). Joint springs/dampers (set-points) on
-//!   θ₁ and θ₂ = β-clamp angle − θ − ψ (ψ one-sided second-order tip slope). Ledger: kinetic,
+//!   full columns and link 1's tip ghost y = v_{r+1} (5×5 Schur complement, O(n) per step).
+//!   Joint springs/dampers (set-points) on θ₁ and θ₂ = β-clamp angle − θ − ψ (ψ = central tip
+//!   slope on the tip ghost; link 1's bending energy carries its trapezoid end term, so the
+//!   elbow moment EIκ(L₁) = K₂θ₂ is a second-order boundary condition). Ledger: kinetic,
 //!   strain, joint_spring | applied_torque | joint_damper, kelvin_voigt. **Default method:
 //!   velocity-form** (free joints make the inertia forces velocity dependent and damping is on;
 //!   the two-step scheme's parasitic root grows). **Modes** ([`chain::modes`]): K x = ω² M x of
 //!   the integrated station equations linearized about the set points (straight links, at rest;
 //!   M from the momenta, K = −∂F/∂q), undamped; Euler–Bernoulli chains only. Against the
-//!   spring-jointed beams (tests/chain_modes.rs): O(h²) with hinged joints (K → 0) and the
-//!   flexible modes of the scene's springs, but only O(h) where the elbow carries a moment
-//!   (K → ∞: 2.4/1.1/0.5 % on mode 2 at 21/41/81 stations) — the elbow coupling (link 1's tip
-//!   bending energy as at a free end, the one-sided tip slope) is first order. The inertia terms quadratic in q̇ are taken
+//!   spring-jointed beams (tests/chain_modes.rs): O(h²) with hinged joints (K → 0), the scene's
+//!   springs and the moment-carrying stiff elbow (K → ∞: observed orders 1.89–2.02; mode 2
+//!   0.26/0.066/0.016 % at 21/41/81 stations). The inertia terms quadratic in q̇ are taken
 //!   from the drift velocities v_{j±½} ([`method::velocity_form`]): at the predicted velocity the
 //!   foreshortening couplings turned the unresolved bending waves into a bias growing with
 //!   the number of stations (1 s mean of joint 2 on `two-link-free-undamped`: 0.681, 0.665,

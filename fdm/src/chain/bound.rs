@@ -5,7 +5,7 @@
 // Index loops over the power-iteration vectors read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::{SHEAR_SITE, TwoLinkChain};
+use super::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
 use crate::system::{Bound, BoundKind, System, damped_step_factor};
 
 impl TwoLinkChain {
@@ -141,6 +141,24 @@ impl TwoLinkChain {
                     sigma: sig,
                     kind: BoundKind::Transverse,
                     site: 3 + k,
+                };
+            }
+        }
+        // Link 1's tip ghost y against the tip half cell's J_t/(4h²): the elbow spring and
+        // damper act on it as on link 2's clamp ghost.
+        if self.tip_ghost.is_some() {
+            let (h, lp, joint) = (self.hs[0], &self.links[0], &self.joints[1]);
+            let m = self.jt / (4.0 * h * h);
+            let stiff = lp.ei / (2.0 * h * h * h) + joint.stiffness / (4.0 * h * h);
+            let damp = lp.gamma / (2.0 * h * h * h) + joint.damping / (4.0 * h * h);
+            let w = (stiff / m).sqrt();
+            let zeta = damp / (2.0 * (stiff * m).sqrt());
+            let sig = 0.9 * 2.0 / w * damped_step_factor(zeta);
+            if sig < best.sigma {
+                best = Bound {
+                    sigma: sig,
+                    kind: BoundKind::Transverse,
+                    site: TIP_SITE,
                 };
             }
         }

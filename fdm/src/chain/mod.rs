@@ -17,30 +17,38 @@
 //! * T: [`kinetic`] (second order in the deflections, exact in the angles: the single link's
 //!   order) + Σ ½J_c,ℓ (clamp angle rate)²;
 //! * V = Σ_ℓ ½ Σᵢ cᵢ h EI κᵢ² (the single link's ghost-node bending energy, [`crate::link`],
-//!   with κ₀ from the ghost) plus ½K₁(θ₁ − θ₁⁰)² + ½K₂(θ₂ − θ₂⁰)², θ₁ the clamp angle of
-//!   link 1, θ₂ = (clamp angle of link 2) − θ − ψ(v), ψ = (−4v_{r−1} + v_{r−2})/(2h₁) (the
-//!   second-order one-sided slope with v_r = 0): the elbow spring loads link 1's free end with
-//!   the moment K₂(θ₂ − θ₂⁰) — the free end of a pinned elbow when K₂ = 0;
-//! * D = Σ_ℓ ½ Σᵢ cᵢ h γ κ̇ᵢ² + ½D₁θ̇₁² + ½D₂θ̇₂²; applied torque laws τⱼ(t) do the work ∫τⱼ θ̇ⱼ.
+//!   with κ₀ from the clamp ghost) plus ½K₁(θ₁ − θ₁⁰)² + ½K₂(θ₂ − θ₂⁰)², θ₁ the clamp angle of
+//!   link 1, θ₂ = (clamp angle of link 2) − θ − ψ, ψ = (y − v_{r−1})/(2h₁) the central tip
+//!   slope of link 1 with its **tip ghost** y = v_{r+1} (v_r = 0). Link 1's sum runs to the
+//!   elbow station with the trapezoid end weight c_r = ½ and κ_r = (y + v_{r−1})/h², so ∂V/∂y
+//!   = 0 reads EI κ_r = K₂(θ₂ − θ₂⁰) + O(h²): the elbow moment is a second-order boundary
+//!   condition (as the clamp ghost's κ₀ at each root), and the shear is the reaction of v_r = 0
+//!   in the frame equations. (Treating link 1's tip as a free end, κ_r = 0 in the energy with
+//!   a one-sided slope, is O(h) wherever the elbow carries a moment.) The tip section turns
+//!   with θ + ψ and carries its half cell's rotary inertia J_t = ρA₁h₁³/24 (O(h³), as J_c);
+//! * D = Σ_ℓ ½ Σᵢ cᵢ h γ κ̇ᵢ² + ½D₁θ̇₁² + ½D₂θ̇₂² (link 1's sum with the same tip term);
+//!   applied torque laws τⱼ(t) do the work ∫τⱼ θ̇ⱼ.
 //!
 //! M(q) q̈ = Q − ∂V/∂q − ∂D/∂q̇ + ∂T/∂q − (∂p/∂q) q̇, with p = ∂T/∂q̇ = M q̇. The last term is one
-//! forward-mode dual-number pass over p ([`dual`]); the columns of M for θ, β, x₁, x₂ are p at
-//! unit velocities plus J_c e eᵀ; the rest of M is the diagonal of lumped masses, so the solve
-//! is a 4×4 Schur complement: O(n) per force evaluation, no allocation in the step loop.
+//! forward-mode dual-number pass over p ([`dual`]); the columns of M for θ, β, x₁, x₂ (and y)
+//! are p at unit velocities plus J_c e eᵀ (J_t e eᵀ); the rest of M is the diagonal of lumped
+//! masses, so the solve is a 5×5 Schur complement: O(n) per force evaluation, no allocation in
+//! the step loop.
 //!
 //! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
 //! on). Bound: 0.9 · 2/ω_max with ω_max from a power iteration on the linearized chain at t = 0
 //! (once per run, O(n²)), with ζ = max(Kelvin–Voigt ζ of that frequency, κ_max/(2ω_max)) —
 //! κ_max the fastest damping rate, a power iteration on −∂a/∂q̇ (the joint dampers act on the
 //! clamp half-cell inertia: overdamped modes, velocity-form limit τ → 1/κ) — and the
-//! clamp-rotation modes with their joint-damper ratio. Gravity: V_g of the lumped masses
+//! clamp-rotation modes and link 1's tip-rotation mode with their joint-damper ratios. Gravity: V_g of the lumped masses
 //! ([`TwoLinkChain`]'s `gravity_potential`). Tip contact: [`contact`]. Observables: joint angles/rates (clamp angles),
 //! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame.
 //!
 //! **Timoshenko links** (`shear` on both links): [`timoshenko`] — ψ at the stations replaces the
 //! clamp ghost (the clamp section's turn from the chord is ψ₀), ψ is massless in the chord
-//! frames and condensed; the ghost slots of q stay in place, unused (zero force, a decoupled
-//! unit mass), so the mass solve and the contact code are shared unchanged.
+//! frames and condensed; the clamp ghost slots of q stay in place, unused (zero force, a
+//! decoupled unit mass), so the mass solve and the contact code are shared unchanged; there is
+//! no tip ghost (link 1's tip section is the condensed ψ).
 
 // Index loops over parallel buffers (q, v, a, columns of M) read like the formulas.
 #![allow(clippy::needless_range_loop)]
@@ -68,6 +76,8 @@ use timoshenko::TimoFields;
 
 /// Bound sites ≥ this are the Timoshenko links' shear bounds.
 const SHEAR_SITE: usize = 10;
+/// Bound site of link 1's tip-ghost rotation mode (Euler links).
+const TIP_SITE: usize = 5;
 
 /// Default stations per link.
 pub const DEFAULT_STATIONS: usize = 21;
@@ -108,6 +118,11 @@ pub struct TwoLinkChain {
     pub kappa_max: f64,
     /// clamp half-cell rotary inertias ρA h³/24 of links 1 and 2
     jc: [f64; 2],
+    /// Euler links: q-slot of link 1's tip ghost y = v_{r+1} (the elbow section's turn from
+    /// the chord, ψ = (y − v_{r−1})/(2h₁)) and the tip half cell's rotary inertia ρA₁h₁³/24;
+    /// Timoshenko links: none (link 1's tip section is the condensed ψ)
+    tip_ghost: Option<usize>,
+    jt: f64,
     /// q-slots of the clamp ghost deflections x₁, x₂ (station 1 of each link is the chord
     /// frame's zero) and the link steps
     slots: [usize; 2],
@@ -118,7 +133,8 @@ pub struct TwoLinkChain {
     obs_scratch_v: std::cell::RefCell<Vec<f64>>,
     // scratch (allocated once)
     p: Vec<Dual>,
-    cols: [Vec<f64>; 4],
+    /// the full columns of M: θ, β, x₁, x₂ and (Euler) the tip ghost y
+    cols: [Vec<f64>; 5],
     unit: Vec<f64>,
     zeros: Vec<f64>,
     rhs: Vec<f64>,
@@ -294,7 +310,14 @@ impl TwoLinkChain {
             set_point: l.joint.set_point.unwrap_or(0.0),
             law: l.joint.torque.clone(),
         };
-        let nd = inertia.dofs();
+        // Euler links: link 1's tip ghost y after the inertia's coordinates
+        let tip_ghost = (!shear).then(|| inertia.dofs());
+        let jt = if shear {
+            0.0
+        } else {
+            clamp(&scene.links[0], h1)
+        };
+        let nd = inertia.dofs() + usize::from(tip_ghost.is_some());
         let contact = TipContact::from_scene(scene)?;
         let mu1g = {
             let mut acc = inertia.mass2;
@@ -315,7 +338,7 @@ impl TwoLinkChain {
             ],
             field_stations: scene.simulation.field_stations.max(2),
             p: vec![Dual::default(); nd],
-            cols: [vec![0.0; nd], vec![0.0; nd], vec![0.0; nd], vec![0.0; nd]],
+            cols: std::array::from_fn(|_| vec![0.0; nd]),
             unit: vec![0.0; nd],
             zeros: vec![0.0; nd],
             rhs: vec![0.0; nd],
@@ -326,6 +349,8 @@ impl TwoLinkChain {
             omega_max: 0.0,
             kappa_max: 0.0,
             jc,
+            tip_ghost,
+            jt,
             slots: [1 + r1, 1 + r1 + r2],
             hs: [h1, h2],
             qk: vec![0.0; nd],
@@ -355,6 +380,12 @@ impl TwoLinkChain {
             }
             chain.cols[2 + k] = col;
         }
+        if let Some(y) = chain.tip_ghost {
+            let mut col = std::mem::take(&mut chain.cols[4]);
+            chain.add_tip(chain.jt / (2.0 * chain.hs[0]), &mut col);
+            debug_assert_eq!(col[y], chain.jt / (4.0 * chain.hs[0] * chain.hs[0]));
+            chain.cols[4] = col;
+        }
         chain.omega_max = chain.top_frequency();
         chain.kappa_max = chain.top_damping_rate();
         Ok(chain)
@@ -383,6 +414,12 @@ impl TwoLinkChain {
             plan.add(
                 "clamp ghost deflections x₁, x₂ (clamp turn against the chord)",
                 2,
+            );
+        }
+        if self.tip_ghost.is_some() {
+            plan.add(
+                "link 1 tip ghost y = v_{r+1} (elbow section turn and moment against the chord)",
+                1,
             );
         }
         plan.add(
@@ -417,7 +454,7 @@ impl TwoLinkChain {
     }
 
     pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
-        let n = self.inertia.dofs();
+        let n = self.dofs();
         let mut q = vec![0.0; n];
         let mut v = vec![0.0; n];
         // elastic fields at rest and straight: ψ = 0, β = θ₁ + θ₂
@@ -473,10 +510,39 @@ impl TwoLinkChain {
 
     /// Tip slope ψ of link 1 and the stencil (indices into q, weights).
     fn slope_stencil(&self) -> [(usize, f64); 2] {
-        // (3v_r − 4v_{r−1} + v_{r−2})/(2h) with v_r = 0 in the chord frame
         let i = self.inertia.i_tip1();
         let h = self.inertia.h1;
-        [(i - 1, -4.0 / (2.0 * h)), (i - 2, 1.0 / (2.0 * h))]
+        match self.tip_ghost {
+            // central (y − v_{r−1})/(2h) with the tip ghost y = v_{r+1}
+            Some(y) => [(y, 1.0 / (2.0 * h)), (i - 1, -1.0 / (2.0 * h))],
+            // Timoshenko (joint angles from the condensed ψ; unused): one-sided
+            // (3v_r − 4v_{r−1} + v_{r−2})/(2h) with v_r = 0 in the chord frame
+            None => [(i - 1, -4.0 / (2.0 * h)), (i - 2, 1.0 / (2.0 * h))],
+        }
+    }
+
+    /// Link 1's tip-section angle θ + ψ (applied to q or q̇; Euler links).
+    fn tip_angle(&self, q: &[f64]) -> f64 {
+        let psi: f64 = self.slope_stencil().iter().map(|(i, c)| c * q[*i]).sum();
+        q[TH] + psi
+    }
+
+    /// Adds J_t e eᵀ·(scale) of link 1's tip-section rotation to a column/momentum vector:
+    /// e = ∂(θ + ψ)/∂q (1 at θ, 1/(2h) at y, −1/(2h) at v_{r−1}); nothing without a tip ghost.
+    fn add_tip(&self, weight: f64, out: &mut [f64]) {
+        if self.tip_ghost.is_some() {
+            out[TH] += weight;
+            for (i, c) in self.slope_stencil() {
+                out[i] += weight * c;
+            }
+        }
+    }
+
+    /// Link 1's tip term of the trapezoid bending energy, ¼h c κ_r² with κ_r = (y + u)/h²
+    /// (u = v_{r−1}, v_r = 0, y = v_{r+1}): (energy, ∂/∂y = ∂/∂u).
+    fn tip_bending(h: f64, c: f64, u: f64, y: f64) -> (f64, f64) {
+        let h3 = h * h * h;
+        (c * (y + u).powi(2) / (4.0 * h3), c * (y + u) / (2.0 * h3))
     }
 
     /// q-index of station 1 of link ℓ.
@@ -518,10 +584,15 @@ impl TwoLinkChain {
     fn chord(&mut self, q: &[f64], v: &[f64]) {
         self.qk.copy_from_slice(q);
         self.vk.copy_from_slice(v);
-        for s in self.slots {
+        for s in self.ghosts() {
             self.qk[s] = 0.0;
             self.vk[s] = 0.0;
         }
+    }
+
+    /// The q-slots that move no lumped mass: the clamp ghosts and (Euler) link 1's tip ghost.
+    fn ghosts(&self) -> impl Iterator<Item = usize> + use<> {
+        self.slots.into_iter().chain(self.tip_ghost)
     }
 
     /// Diagonal mass of coordinate i outside the full columns θ, β, x₁, x₂.
@@ -531,6 +602,9 @@ impl TwoLinkChain {
             if i == self.first(k) {
                 d += self.jc[k] / (4.0 * self.hs[k] * self.hs[k]);
             }
+        }
+        if self.tip_ghost.is_some() && i == self.inertia.i_tip1() - 1 {
+            d += self.jt / (4.0 * self.hs[0] * self.hs[0]);
         }
         d
     }
@@ -555,12 +629,15 @@ impl TwoLinkChain {
         for i in 0..q.len() {
             out[i] = p[i].re;
         }
-        for k in 0..2 {
-            out[self.slots[k]] = 0.0;
+        for s in self.ghosts() {
+            out[s] = 0.0;
         }
         for k in 0..2 {
             let w = self.jc[k] * self.clamp_angle(qd, k);
             self.add_clamp(k, w, out);
+        }
+        if self.tip_ghost.is_some() {
+            self.add_tip(self.jt * self.tip_angle(qd), out);
         }
     }
 
@@ -638,11 +715,15 @@ impl TwoLinkChain {
             return;
         }
         self.vk.copy_from_slice(v);
-        for s in self.slots {
+        for s in self.ghosts() {
             self.vk[s] = 0.0;
         }
         let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
         let mut p_kv = 0.0;
+        if let Some(y) = self.tip_ghost {
+            let u = v[self.inertia.i_tip1() - 1];
+            p_kv += 2.0 * Self::tip_bending(self.hs[0], self.links[0].gamma, u, v[y]).0;
+        }
         for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
             .into_iter()
             .enumerate()
@@ -678,7 +759,7 @@ impl TwoLinkChain {
         self.inertia.grad_q(&self.qk, &self.vk, scratch);
         self.inertia
             .momenta(&self.qk, &self.vk, &self.vk, &mut self.p);
-        for s in self.slots {
+        for s in self.ghosts() {
             scratch[s] = 0.0;
             self.p[s] = Dual::default();
         }
@@ -728,6 +809,21 @@ impl TwoLinkChain {
             f[r - 1] = fx; // the tip entry carries the ghost's force
             out[range].copy_from_slice(f);
         }
+        if let Some(y) = self.tip_ghost {
+            // link 1's tip term of the bending energy (elbow moment EIκ_r) and its Kelvin–Voigt
+            // dissipation
+            let (h, lp, u) = (self.hs[0], &self.links[0], self.inertia.i_tip1() - 1);
+            let (_, g) = Self::tip_bending(h, lp.ei, q[u], q[y]);
+            let (mut fy, mut fu) = (-g, -g);
+            if lp.gamma != 0.0 {
+                let (d2, gv) = Self::tip_bending(h, lp.gamma, v[u], v[y]);
+                p_kv += 2.0 * d2;
+                fy -= gv;
+                fu -= gv;
+            }
+            out[y] = fy;
+            out[u] += fu;
+        }
         let th2 = self.elbow(q);
         let th2d = self.elbow(v);
         let j = &self.joints;
@@ -757,7 +853,7 @@ impl TwoLinkChain {
 
 impl System for TwoLinkChain {
     fn dofs(&self) -> usize {
-        self.inertia.dofs()
+        self.inertia.dofs() + usize::from(self.tip_ghost.is_some())
     }
 
     fn accel(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) {
@@ -864,7 +960,7 @@ impl System for TwoLinkChain {
         let mut vk = self.obs_scratch_v.borrow_mut();
         qk.copy_from_slice(q);
         vk.copy_from_slice(v);
-        for s in self.slots {
+        for s in self.ghosts() {
             qk[s] = 0.0;
             vk[s] = 0.0;
         }
@@ -877,6 +973,11 @@ impl System for TwoLinkChain {
             ke += 0.5 * self.jc[k] * self.clamp_angle(v, k).powi(2);
             // κ₀ = (u₁ + x)/h² instead of the single link's 2u₁/h²
             strain += c * ((u1 + x).powi(2) / 4.0 - u1 * u1) / (h * h * h);
+        }
+        if let Some(y) = self.tip_ghost {
+            ke += 0.5 * self.jt * self.tip_angle(v).powi(2);
+            let u = q[ine.i_tip1() - 1];
+            strain += Self::tip_bending(self.hs[0], self.links[0].ei, u, q[y]).0;
         }
         let j = &self.joints;
         let mut spring = 0.5 * j[0].stiffness * (self.clamp_angle(q, 0) - j[0].set_point).powi(2)
