@@ -10,7 +10,7 @@ use super::kinetic::{BE, TH};
 use crate::system::System;
 
 /// Largest number of full columns (θ, β, x₁, x₂, y).
-const MAX_FULL: usize = 5;
+pub(super) const MAX_FULL: usize = 5;
 
 impl TwoLinkChain {
     /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`; the ghost
@@ -42,7 +42,7 @@ impl TwoLinkChain {
     }
 
     /// The number of full columns of M: 5 with link 1's tip ghost, else 4.
-    fn nfull(&self) -> usize {
+    pub(super) fn nfull(&self) -> usize {
         4 + usize::from(self.tip_ghost.is_some())
     }
 
@@ -124,7 +124,7 @@ impl TwoLinkChain {
 }
 
 /// Gaussian elimination with partial pivoting on the leading `n`×`n` block (n ≤ 5).
-fn solve_small(
+pub(super) fn solve_small(
     mut a: [[f64; MAX_FULL]; MAX_FULL],
     mut b: [f64; MAX_FULL],
     n: usize,

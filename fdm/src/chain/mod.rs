@@ -56,6 +56,7 @@
 mod bound;
 pub mod contact;
 pub mod dual;
+pub mod implicit;
 pub mod kinetic;
 mod mass;
 pub mod modes;
@@ -158,6 +159,13 @@ pub struct TwoLinkChain {
     minv_g: Vec<f64>,
     /// (|g|, |Gq̇|, energy removed) of the last constrained step's projections
     last_projection: [f64; 3],
+    /// the damping matrix C and the banded factorization of the implicit kick ([`implicit`]);
+    /// none: damping explicit in the forces
+    implicit: Option<Box<implicit::ImplicitDamping>>,
+    /// `forces` leaves the damping out (the implicit kick adds it at the drift velocity)
+    skip_damping: bool,
+    /// scratch of [`Self::add_damping_forces`] and the implicit kick (length n)
+    vd: Vec<f64>,
     /// Timoshenko links (`shear` on both): the condensed section rotations ([`timoshenko`]);
     /// the ghost slots are then unused (held at zero with a unit dummy mass)
     timo: Option<TimoFields>,
@@ -366,6 +374,9 @@ impl TwoLinkChain {
             grow: vec![0.0; nd],
             minv_g: vec![0.0; nd],
             last_projection: [0.0; 3],
+            implicit: None,
+            skip_damping: false,
+            vd: vec![0.0; nd],
             timo,
         };
         // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
@@ -783,6 +794,8 @@ impl TwoLinkChain {
             self.qk = qk;
             return;
         }
+        // the implicit kick (`implicit`) takes the damping forces separately
+        let damp = !self.skip_damping;
         let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
         let mut p_kv = 0.0;
         for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
@@ -799,7 +812,7 @@ impl TwoLinkChain {
             let slot = self.slots[link];
             let (_, gx) = Self::ghost_bending(h, lp.ei, &self.qk[range.clone()], q[slot], f);
             let mut fx = gx;
-            if lp.gamma != 0.0 {
+            if lp.gamma != 0.0 && damp {
                 let (d2, gv) =
                     Self::ghost_bending(h, lp.gamma, &self.vk[range.clone()], v[slot], f);
                 p_kv += 2.0 * d2;
@@ -815,7 +828,7 @@ impl TwoLinkChain {
             let (h, lp, u) = (self.hs[0], &self.links[0], self.inertia.i_tip1() - 1);
             let (_, g) = Self::tip_bending(h, lp.ei, q[u], q[y]);
             let (mut fy, mut fu) = (-g, -g);
-            if lp.gamma != 0.0 {
+            if lp.gamma != 0.0 && damp {
                 let (d2, gv) = Self::tip_bending(h, lp.gamma, v[u], v[y]);
                 p_kv += 2.0 * d2;
                 fy -= gv;
@@ -830,8 +843,13 @@ impl TwoLinkChain {
         let ext = [j[0].torque(t), j[1].torque(t)];
         let th1 = self.clamp_angle(q, 0);
         let th1d = self.clamp_angle(v, 0);
-        let tau1 = ext[0] - j[0].stiffness * (th1 - j[0].set_point) - j[0].damping * th1d;
-        let tau2 = ext[1] - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * th2d;
+        let dj = if damp {
+            [j[0].damping, j[1].damping]
+        } else {
+            [0.0; 2]
+        };
+        let tau1 = ext[0] - j[0].stiffness * (th1 - j[0].set_point) - dj[0] * th1d;
+        let tau2 = ext[1] - j[1].stiffness * (th2 - j[1].set_point) - dj[1] * th2d;
         // τ₁ on θ₁ (clamp angle of link 1); τ₂ on θ₂ = clamp angle of link 2 − θ − ψ(v)
         self.add_clamp(0, tau1, out);
         self.add_clamp(1, tau2, out);
@@ -848,6 +866,55 @@ impl TwoLinkChain {
             j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
             p_kv,
         ];
+    }
+}
+
+impl TwoLinkChain {
+    /// Adds the damping forces −∂D/∂q̇ = −C q̇ at `v` into `out`: Kelvin–Voigt (the ghost-node
+    /// bending stencil on the rates, link 1's tip term) and the joint dampers (Euler links;
+    /// the same terms as [`Self::forces`]). Linear in `v` with constant C.
+    pub(crate) fn add_damping_forces(&mut self, v: &[f64], out: &mut [f64]) {
+        let mut vd = std::mem::take(&mut self.vd);
+        vd.copy_from_slice(v);
+        for s in self.ghosts() {
+            vd[s] = 0.0;
+        }
+        let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
+        for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
+            .into_iter()
+            .enumerate()
+        {
+            let lp = &self.links[link];
+            if lp.gamma == 0.0 {
+                continue;
+            }
+            f.iter_mut().for_each(|x| *x = 0.0);
+            let slot = self.slots[link];
+            let (_, gv) =
+                Self::ghost_bending(self.hs[link], lp.gamma, &vd[range.clone()], v[slot], f);
+            let r = f.len();
+            f[r - 1] = gv;
+            for (o, x) in out[range].iter_mut().zip(f.iter()) {
+                *o += x;
+            }
+        }
+        if let Some(y) = self.tip_ghost {
+            let (h, lp, u) = (self.hs[0], &self.links[0], self.inertia.i_tip1() - 1);
+            if lp.gamma != 0.0 {
+                let (_, g) = Self::tip_bending(h, lp.gamma, v[u], v[y]);
+                out[y] -= g;
+                out[u] -= g;
+            }
+        }
+        let tau1 = -self.joints[0].damping * self.clamp_angle(v, 0);
+        let tau2 = -self.joints[1].damping * self.elbow(v);
+        self.add_clamp(0, tau1, out);
+        self.add_clamp(1, tau2, out);
+        out[TH] -= tau2;
+        for (i, c) in self.slope_stencil() {
+            out[i] -= tau2 * c;
+        }
+        self.vd = vd;
     }
 }
 
@@ -882,6 +949,21 @@ impl System for TwoLinkChain {
             }
             self.lambda = lam;
         }
+    }
+
+    fn implicit_kick(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        inertia: DriftVelocities,
+        tau: f64,
+        a: &mut [f64],
+    ) -> bool {
+        if self.implicit.is_none() || self.constrained {
+            return false;
+        }
+        self.implicit_kick_solve(t, q, inertia, tau, a);
+        true
     }
 
     fn accel_split(
