@@ -36,7 +36,10 @@
 //! the step loop.
 //!
 //! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
-//! on). Bound: 0.9 · 2/ω_max with ω_max from a power iteration on the linearized chain at t = 0
+//! on). Without contact the damping (constant C) is implicit in the closing kick ([`implicit`]:
+//! Crank–Nicolson in the damping, banded solve) and the bound is the undamped one below (ζ = 0);
+//! with contact (restartable steps) it is explicit and the bound carries the damping.
+//! Bound: 0.9 · 2/ω_max with ω_max from a power iteration on the linearized chain at t = 0
 //! (once per run, O(n²)), with ζ = max(Kelvin–Voigt ζ of that frequency, κ_max/(2ω_max)) —
 //! κ_max the fastest damping rate, a power iteration on −∂a/∂q̇ (the joint dampers act on the
 //! clamp half-cell inertia: overdamped modes, velocity-form limit τ → 1/κ) — and the
