@@ -99,23 +99,29 @@
 //!   second-order kinetic energy indefinite (see [`chain`]). Kinetic energy to second order in
 //!   the deflections, exact in the angles (the single link's order); Lagrange's equations with
 //!   p = ∂T/∂q̇ and the exact (∂p/∂q)q̇ by dual numbers; mass matrix = lumped diagonal + four
-//!   full columns (4×4 Schur complement, O(n) per step). Joint springs/dampers (set-points) on
-//!   θ₁ and θ₂ = β-clamp angle − θ − ψ (ψ one-sided second-order tip slope). Ledger: kinetic,
+//!   full columns and link 1's tip ghost y = v_{r+1} (5×5 Schur complement, O(n) per step).
+//!   Joint springs/dampers (set-points) on θ₁ and θ₂ = β-clamp angle − θ − ψ (ψ = central tip
+//!   slope on the tip ghost; link 1's bending energy carries its trapezoid end term, so the
+//!   elbow moment EIκ(L₁) = K₂θ₂ is a second-order boundary condition). Ledger: kinetic,
 //!   strain, joint_spring | applied_torque | joint_damper, kelvin_voigt. **Default method:
 //!   velocity-form** (free joints make the inertia forces velocity dependent and damping is on;
 //!   the two-step scheme's parasitic root grows). **Modes** ([`chain::modes`]): K x = ω² M x of
 //!   the integrated station equations linearized about the set points (straight links, at rest;
 //!   M from the momenta, K = −∂F/∂q), undamped; Euler–Bernoulli chains only. Against the
-//!   spring-jointed beams (tests/chain_modes.rs): O(h²) with hinged joints (K → 0) and the
-//!   flexible modes of the scene's springs, but only O(h) where the elbow carries a moment
-//!   (K → ∞: 2.4/1.1/0.5 % on mode 2 at 21/41/81 stations) — the elbow coupling (link 1's tip
-//!   bending energy as at a free end, the one-sided tip slope) is first order. The inertia terms quadratic in q̇ are taken
+//!   spring-jointed beams (tests/chain_modes.rs): O(h²) with hinged joints (K → 0), the scene's
+//!   springs and the moment-carrying stiff elbow (K → ∞: observed orders 1.89–2.02; mode 2
+//!   0.26/0.066/0.016 % at 21/41/81 stations). The inertia terms quadratic in q̇ are taken
 //!   from the drift velocities v_{j±½} ([`method::velocity_form`]): at the predicted velocity the
 //!   foreshortening couplings turned the unresolved bending waves into a bias growing with
 //!   the number of stations (1 s mean of joint 2 on `two-link-free-undamped`: 0.681, 0.665,
 //!   0.636 at 21/41/81 stations against fem's 0.6968; now 0.6972, 0.6969, 0.6969, and the 20 Hz
 //!   low-passed joint-1 history over 10 s differs 2.0e-2, 6.1e-3 between 21/41 and 41/81 stations).
-//!   Measured (tests/chain.rs): undamped 10 s energy error bounded (no drift), O(τ²); damped ledger closure 6.3e-6 (with the κ_max bound below); joint angles O(h²)
+//!   **Damping implicit** without contact ([`chain::implicit`]): Kelvin–Voigt and the joint
+//!   dampers (−Cq̇, C constant) Crank–Nicolson across the velocity form's two kicks,
+//!   (M + ½τC)a = F solved by a banded LDLᵀ (pentadiagonal, factored once per step length) and
+//!   a 5×5 Schur complement, O(n) per step: `two-link-free` steps at the undamped bound
+//!   (21 stations, 10 s: 2.15e5 steps instead of 2.55e6).
+//!   Measured (tests/chain.rs): undamped 10 s energy error bounded (no drift), O(τ²); damped ledger closure O(τ²) (1.24e-4, 3.10e-5 at 11 stations, safety 0.5, 0.25); joint angles O(h²)
 //!   (orders 1.99, 1.91); rigid limit within 0.5 % of the swing. Step bound: 0.9 × 2/ω_max of
 //!   the chain linearized at rest (no rates, so no centrifugal tension) and the per-link 5.44;
 //!   the 0.9 leaves room for a 23 % rise of ω_max², while the tension share N h²/(4EI) at the
@@ -129,7 +135,7 @@
 //!   (loss booked as `impact`), constrained sliding M q̈ = f + Gᵀλ, Gq̈ + Ġq̇ = 0 with
 //!   position/velocity projection, release located on λ(step length); channels
 //!   `contact1.normal_force`, `contact1.phase`, `contact1.gap`; events `contact-start`,
-//!   `impact`, `release`. The step bound also takes the fastest damping rate κ_max (power
+//!   `impact`, `release`. With contact the damping stays explicit and the step bound also takes the fastest damping rate κ_max (power
 //!   iteration on −∂a/∂q̇: the joint dampers on the clamp half-cell inertia are strongly
 //!   overdamped, limit τ ≤ 1/κ), and ¼ of the bound for 2000 steps after each velocity jump.
 //!   Measured (tests/contact.rs): momentum residual ≤ 1e-14, |Gq̇⁺| ≤ 1e-14, ledger closure

@@ -70,6 +70,22 @@ pub trait System {
         let _ = inertia;
         self.accel(t, q, v, a);
     }
+    /// The velocity form's closing kick with the damping implicit (Crank–Nicolson in the
+    /// damping across the step): writes a with (M + ½τC) a = F(q, v_{j+½}) (damping C at the
+    /// drift velocity `inertia.current`, inertia terms as [`System::accel_split`]), so that
+    /// v_{j+1} = v_{j+½} + ½τa carries −½τM⁻¹C v_{j+1}; stores the powers at v_{j+1}. Returns
+    /// false (a untouched) for systems whose damping is explicit (the default).
+    fn implicit_kick(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        inertia: DriftVelocities,
+        tau: f64,
+        a: &mut [f64],
+    ) -> bool {
+        let _ = (t, q, inertia, tau, a);
+        false
+    }
     /// Powers stored by the last [`System::accel`] call: inputs then dissipations (the order
     /// of [`crate::output::Outputs::ledger_names`]).
     fn powers(&self, out: &mut [f64]);

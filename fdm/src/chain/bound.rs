@@ -5,7 +5,7 @@
 // Index loops over the power-iteration vectors read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::{SHEAR_SITE, TwoLinkChain};
+use super::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
 use crate::system::{Bound, BoundKind, System, damped_step_factor};
 
 impl TwoLinkChain {
@@ -116,11 +116,13 @@ impl TwoLinkChain {
             }
             return best;
         }
+        // implicit damping ([`super::implicit`]): the undamped bound (ζ = 0 throughout)
+        let explicit = if self.implicit_damping() { 0.0 } else { 1.0 };
         let zeta = self
             .links
             .iter()
-            .map(|lp| lp.gamma * self.omega_max / (2.0 * lp.ei))
-            .fold(self.kappa_max / (2.0 * self.omega_max), f64::max);
+            .map(|lp| explicit * lp.gamma * self.omega_max / (2.0 * lp.ei))
+            .fold(explicit * self.kappa_max / (2.0 * self.omega_max), f64::max);
         let mut best = Bound {
             sigma: 0.9 * 2.0 / self.omega_max * damped_step_factor(zeta),
             kind: BoundKind::Transverse,
@@ -132,7 +134,8 @@ impl TwoLinkChain {
             let h = self.hs[k];
             let m = self.jc[k] / (4.0 * h * h);
             let stiff = lp.ei / (2.0 * h * h * h) + self.joints[k].stiffness / (4.0 * h * h);
-            let damp = lp.gamma / (2.0 * h * h * h) + self.joints[k].damping / (4.0 * h * h);
+            let damp =
+                explicit * (lp.gamma / (2.0 * h * h * h) + self.joints[k].damping / (4.0 * h * h));
             let w = (stiff / m).sqrt();
             let zeta = damp / (2.0 * (stiff * m).sqrt());
             let sig = 0.9 * 2.0 / w * damped_step_factor(zeta);
@@ -144,6 +147,24 @@ impl TwoLinkChain {
                 };
             }
         }
+        // Link 1's tip ghost y against the tip half cell's J_t/(4h²): the elbow spring and
+        // damper act on it as on link 2's clamp ghost.
+        if self.tip_ghost.is_some() {
+            let (h, lp, joint) = (self.hs[0], &self.links[0], &self.joints[1]);
+            let m = self.jt / (4.0 * h * h);
+            let stiff = lp.ei / (2.0 * h * h * h) + joint.stiffness / (4.0 * h * h);
+            let damp = explicit * (lp.gamma / (2.0 * h * h * h) + joint.damping / (4.0 * h * h));
+            let w = (stiff / m).sqrt();
+            let zeta = damp / (2.0 * (stiff * m).sqrt());
+            let sig = 0.9 * 2.0 / w * damped_step_factor(zeta);
+            if sig < best.sigma {
+                best = Bound {
+                    sigma: sig,
+                    kind: BoundKind::Transverse,
+                    site: TIP_SITE,
+                };
+            }
+        }
         for (k, lp) in self.links.iter().enumerate() {
             let h = if k == 0 {
                 self.inertia.h1
@@ -151,7 +172,7 @@ impl TwoLinkChain {
                 self.inertia.h2
             };
             let sigma = (h.powi(4) * lp.rho_a / (4.0 * lp.ei)).sqrt();
-            let zeta = lp.gamma * (2.0 / sigma) / (2.0 * lp.ei);
+            let zeta = explicit * lp.gamma * (2.0 / sigma) / (2.0 * lp.ei);
             let s = sigma * damped_step_factor(zeta);
             if s < best.sigma {
                 best = Bound {

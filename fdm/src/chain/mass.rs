@@ -1,6 +1,6 @@
-//! The chain's mass matrix: the lumped diagonal plus four full columns (θ, β and the clamp
-//! ghosts x₁, x₂), solved by a 4×4 Schur complement — O(n) per force evaluation, no
-//! allocation.
+//! The chain's mass matrix: the lumped diagonal plus the full columns θ, β, the clamp ghosts
+//! x₁, x₂ and (Euler links) link 1's tip ghost y, solved by a Schur complement on those
+//! (at most 5×5) — O(n) per force evaluation, no allocation.
 
 // Index loops over the columns of M read like the formulas.
 #![allow(clippy::needless_range_loop)]
@@ -8,6 +8,9 @@
 use super::TwoLinkChain;
 use super::kinetic::{BE, TH};
 use crate::system::System;
+
+/// Largest number of full columns (θ, β, x₁, x₂, y).
+pub(super) const MAX_FULL: usize = 5;
 
 impl TwoLinkChain {
     /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`; the ghost
@@ -24,31 +27,49 @@ impl TwoLinkChain {
             for i in 0..n {
                 self.cols[c][i] = self.p[i].re;
             }
-            for s in self.slots {
+            for s in self.ghosts() {
                 self.cols[c][s] = 0.0;
             }
-            // J_c e eᵀ: column of the frame angle gets J_c e (the ghost's −J_c e/(2h) is fixed)
+            // J_c e eᵀ: column of the frame angle gets J_c e (the ghost's −J_c e/(2h) is fixed);
+            // θ's column also gets J_t e of link 1's tip section (y's column is fixed)
             let mut col = std::mem::take(&mut self.cols[c]);
             self.add_clamp(c, self.jc[c], &mut col);
+            if idx == TH {
+                self.add_tip(self.jt, &mut col);
+            }
             self.cols[c] = col;
         }
     }
 
-    /// The indices of the four full columns of M: θ, β and the ghosts x₁, x₂.
-    pub(super) fn full(&self) -> [usize; 4] {
-        [TH, BE, self.slots[0], self.slots[1]]
+    /// The number of full columns of M: 5 with link 1's tip ghost, else 4.
+    pub(super) fn nfull(&self) -> usize {
+        4 + usize::from(self.tip_ghost.is_some())
+    }
+
+    /// The indices of the full columns of M: θ, β, the ghosts x₁, x₂ and (Euler) y; unused
+    /// entries are `usize::MAX`.
+    pub(super) fn full(&self) -> [usize; MAX_FULL] {
+        [
+            TH,
+            BE,
+            self.slots[0],
+            self.slots[1],
+            self.tip_ghost.unwrap_or(usize::MAX),
+        ]
     }
 
     /// out = M⁻¹ rhs with the columns of the last [`Self::build_columns`]: Schur complement
-    /// on {θ, β, x₁, x₂}; the rest of M is diagonal. O(n), no allocation.
+    /// on the full columns; the rest of M is diagonal. O(n), no allocation.
     pub(super) fn solve_mass(&self, rhs: &[f64], out: &mut [f64]) {
         let n = self.dofs();
+        let nf = self.nfull();
         let full = self.full();
-        let mut s = [[0.0; 4]; 4];
-        let mut b = [0.0; 4];
-        for r in 0..4 {
+        let full = &full[..nf];
+        let mut s = [[0.0; MAX_FULL]; MAX_FULL];
+        let mut b = [0.0; MAX_FULL];
+        for r in 0..nf {
             b[r] = rhs[full[r]];
-            for c in 0..4 {
+            for c in 0..nf {
                 s[r][c] = self.cols[c][full[r]];
             }
         }
@@ -57,20 +78,20 @@ impl TwoLinkChain {
                 continue;
             }
             let d = self.diag_mass(i);
-            for r in 0..4 {
+            for r in 0..nf {
                 let mri = self.cols[r][i];
                 b[r] -= mri * rhs[i] / d;
-                for c in 0..4 {
+                for c in 0..nf {
                     s[r][c] -= mri * self.cols[c][i] / d;
                 }
             }
         }
-        let x = solve4(s, b);
+        let x = solve_small(s, b, nf);
         for i in 0..n {
             if let Some(k) = full.iter().position(|&f| f == i) {
                 out[i] = x[k];
             } else {
-                let coupled: f64 = (0..4).map(|c| self.cols[c][i] * x[c]).sum();
+                let coupled: f64 = (0..nf).map(|c| self.cols[c][i] * x[c]).sum();
                 out[i] = (rhs[i] - coupled) / self.diag_mass(i);
             }
         }
@@ -80,7 +101,9 @@ impl TwoLinkChain {
     /// column c also gives row c).
     pub(super) fn mass_mul(&self, x: &[f64], out: &mut [f64]) {
         let n = self.dofs();
+        let nf = self.nfull();
         let full = self.full();
+        let full = &full[..nf];
         for i in 0..n {
             if let Some(r) = full.iter().position(|&f| f == i) {
                 let mut acc = 0.0;
@@ -94,31 +117,35 @@ impl TwoLinkChain {
                 out[i] = acc;
             } else {
                 out[i] = self.diag_mass(i) * x[i]
-                    + (0..4).map(|c| self.cols[c][i] * x[full[c]]).sum::<f64>();
+                    + (0..nf).map(|c| self.cols[c][i] * x[full[c]]).sum::<f64>();
             }
         }
     }
 }
 
-/// Gaussian elimination with partial pivoting on a 4×4 system.
-fn solve4(mut a: [[f64; 4]; 4], mut b: [f64; 4]) -> [f64; 4] {
-    for col in 0..4 {
-        let piv = (col..4)
+/// Gaussian elimination with partial pivoting on the leading `n`×`n` block (n ≤ 5).
+pub(super) fn solve_small(
+    mut a: [[f64; MAX_FULL]; MAX_FULL],
+    mut b: [f64; MAX_FULL],
+    n: usize,
+) -> [f64; MAX_FULL] {
+    for col in 0..n {
+        let piv = (col..n)
             .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
             .unwrap_or(col);
         a.swap(col, piv);
         b.swap(col, piv);
-        for row in col + 1..4 {
+        for row in col + 1..n {
             let f = a[row][col] / a[col][col];
-            for k in col..4 {
+            for k in col..n {
                 a[row][k] -= f * a[col][k];
             }
             b[row] -= f * b[col];
         }
     }
-    let mut x = [0.0; 4];
-    for row in (0..4).rev() {
-        let s: f64 = (row + 1..4).map(|k| a[row][k] * x[k]).sum();
+    let mut x = [0.0; MAX_FULL];
+    for row in (0..n).rev() {
+        let s: f64 = (row + 1..n).map(|k| a[row][k] * x[k]).sum();
         x[row] = (b[row] - s) / a[row][row];
     }
     x

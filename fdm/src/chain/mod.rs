@@ -17,30 +17,41 @@
 //! * T: [`kinetic`] (second order in the deflections, exact in the angles: the single link's
 //!   order) + Σ ½J_c,ℓ (clamp angle rate)²;
 //! * V = Σ_ℓ ½ Σᵢ cᵢ h EI κᵢ² (the single link's ghost-node bending energy, [`crate::link`],
-//!   with κ₀ from the ghost) plus ½K₁(θ₁ − θ₁⁰)² + ½K₂(θ₂ − θ₂⁰)², θ₁ the clamp angle of
-//!   link 1, θ₂ = (clamp angle of link 2) − θ − ψ(v), ψ = (−4v_{r−1} + v_{r−2})/(2h₁) (the
-//!   second-order one-sided slope with v_r = 0): the elbow spring loads link 1's free end with
-//!   the moment K₂(θ₂ − θ₂⁰) — the free end of a pinned elbow when K₂ = 0;
-//! * D = Σ_ℓ ½ Σᵢ cᵢ h γ κ̇ᵢ² + ½D₁θ̇₁² + ½D₂θ̇₂²; applied torque laws τⱼ(t) do the work ∫τⱼ θ̇ⱼ.
+//!   with κ₀ from the clamp ghost) plus ½K₁(θ₁ − θ₁⁰)² + ½K₂(θ₂ − θ₂⁰)², θ₁ the clamp angle of
+//!   link 1, θ₂ = (clamp angle of link 2) − θ − ψ, ψ = (y − v_{r−1})/(2h₁) the central tip
+//!   slope of link 1 with its **tip ghost** y = v_{r+1} (v_r = 0). Link 1's sum runs to the
+//!   elbow station with the trapezoid end weight c_r = ½ and κ_r = (y + v_{r−1})/h², so ∂V/∂y
+//!   = 0 reads EI κ_r = K₂(θ₂ − θ₂⁰) + O(h²): the elbow moment is a second-order boundary
+//!   condition (as the clamp ghost's κ₀ at each root), and the shear is the reaction of v_r = 0
+//!   in the frame equations. (Treating link 1's tip as a free end, κ_r = 0 in the energy with
+//!   a one-sided slope, is O(h) wherever the elbow carries a moment.) The tip section turns
+//!   with θ + ψ and carries its half cell's rotary inertia J_t = ρA₁h₁³/24 (O(h³), as J_c);
+//! * D = Σ_ℓ ½ Σᵢ cᵢ h γ κ̇ᵢ² + ½D₁θ̇₁² + ½D₂θ̇₂² (link 1's sum with the same tip term);
+//!   applied torque laws τⱼ(t) do the work ∫τⱼ θ̇ⱼ.
 //!
 //! M(q) q̈ = Q − ∂V/∂q − ∂D/∂q̇ + ∂T/∂q − (∂p/∂q) q̇, with p = ∂T/∂q̇ = M q̇. The last term is one
-//! forward-mode dual-number pass over p ([`dual`]); the columns of M for θ, β, x₁, x₂ are p at
-//! unit velocities plus J_c e eᵀ; the rest of M is the diagonal of lumped masses, so the solve
-//! is a 4×4 Schur complement: O(n) per force evaluation, no allocation in the step loop.
+//! forward-mode dual-number pass over p ([`dual`]); the columns of M for θ, β, x₁, x₂ (and y)
+//! are p at unit velocities plus J_c e eᵀ (J_t e eᵀ); the rest of M is the diagonal of lumped
+//! masses, so the solve is a 5×5 Schur complement: O(n) per force evaluation, no allocation in
+//! the step loop.
 //!
 //! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
-//! on). Bound: 0.9 · 2/ω_max with ω_max from a power iteration on the linearized chain at t = 0
+//! on). Without contact the damping (constant C) is implicit in the closing kick ([`implicit`]:
+//! Crank–Nicolson in the damping, banded solve) and the bound is the undamped one below (ζ = 0);
+//! with contact (restartable steps) it is explicit and the bound carries the damping.
+//! Bound: 0.9 · 2/ω_max with ω_max from a power iteration on the linearized chain at t = 0
 //! (once per run, O(n²)), with ζ = max(Kelvin–Voigt ζ of that frequency, κ_max/(2ω_max)) —
 //! κ_max the fastest damping rate, a power iteration on −∂a/∂q̇ (the joint dampers act on the
 //! clamp half-cell inertia: overdamped modes, velocity-form limit τ → 1/κ) — and the
-//! clamp-rotation modes with their joint-damper ratio. Gravity: V_g of the lumped masses
+//! clamp-rotation modes and link 1's tip-rotation mode with their joint-damper ratios. Gravity: V_g of the lumped masses
 //! ([`TwoLinkChain`]'s `gravity_potential`). Tip contact: [`contact`]. Observables: joint angles/rates (clamp angles),
 //! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame.
 //!
 //! **Timoshenko links** (`shear` on both links): [`timoshenko`] — ψ at the stations replaces the
 //! clamp ghost (the clamp section's turn from the chord is ψ₀), ψ is massless in the chord
-//! frames and condensed; the ghost slots of q stay in place, unused (zero force, a decoupled
-//! unit mass), so the mass solve and the contact code are shared unchanged.
+//! frames and condensed; the clamp ghost slots of q stay in place, unused (zero force, a
+//! decoupled unit mass), so the mass solve and the contact code are shared unchanged; there is
+//! no tip ghost (link 1's tip section is the condensed ψ).
 
 // Index loops over parallel buffers (q, v, a, columns of M) read like the formulas.
 #![allow(clippy::needless_range_loop)]
@@ -48,6 +59,7 @@
 mod bound;
 pub mod contact;
 pub mod dual;
+pub mod implicit;
 pub mod kinetic;
 mod mass;
 pub mod modes;
@@ -68,6 +80,8 @@ use timoshenko::TimoFields;
 
 /// Bound sites ≥ this are the Timoshenko links' shear bounds.
 const SHEAR_SITE: usize = 10;
+/// Bound site of link 1's tip-ghost rotation mode (Euler links).
+const TIP_SITE: usize = 5;
 
 /// Default stations per link.
 pub const DEFAULT_STATIONS: usize = 21;
@@ -108,6 +122,11 @@ pub struct TwoLinkChain {
     pub kappa_max: f64,
     /// clamp half-cell rotary inertias ρA h³/24 of links 1 and 2
     jc: [f64; 2],
+    /// Euler links: q-slot of link 1's tip ghost y = v_{r+1} (the elbow section's turn from
+    /// the chord, ψ = (y − v_{r−1})/(2h₁)) and the tip half cell's rotary inertia ρA₁h₁³/24;
+    /// Timoshenko links: none (link 1's tip section is the condensed ψ)
+    tip_ghost: Option<usize>,
+    jt: f64,
     /// q-slots of the clamp ghost deflections x₁, x₂ (station 1 of each link is the chord
     /// frame's zero) and the link steps
     slots: [usize; 2],
@@ -118,7 +137,8 @@ pub struct TwoLinkChain {
     obs_scratch_v: std::cell::RefCell<Vec<f64>>,
     // scratch (allocated once)
     p: Vec<Dual>,
-    cols: [Vec<f64>; 4],
+    /// the full columns of M: θ, β, x₁, x₂ and (Euler) the tip ghost y
+    cols: [Vec<f64>; 5],
     unit: Vec<f64>,
     zeros: Vec<f64>,
     rhs: Vec<f64>,
@@ -142,6 +162,13 @@ pub struct TwoLinkChain {
     minv_g: Vec<f64>,
     /// (|g|, |Gq̇|, energy removed) of the last constrained step's projections
     last_projection: [f64; 3],
+    /// the damping matrix C and the banded factorization of the implicit kick ([`implicit`]);
+    /// none: damping explicit in the forces
+    implicit: Option<Box<implicit::ImplicitDamping>>,
+    /// `forces` leaves the damping out (the implicit kick adds it at the drift velocity)
+    skip_damping: bool,
+    /// scratch of [`Self::add_damping_forces`] and the implicit kick (length n)
+    vd: Vec<f64>,
     /// Timoshenko links (`shear` on both): the condensed section rotations ([`timoshenko`]);
     /// the ghost slots are then unused (held at zero with a unit dummy mass)
     timo: Option<TimoFields>,
@@ -294,7 +321,14 @@ impl TwoLinkChain {
             set_point: l.joint.set_point.unwrap_or(0.0),
             law: l.joint.torque.clone(),
         };
-        let nd = inertia.dofs();
+        // Euler links: link 1's tip ghost y after the inertia's coordinates
+        let tip_ghost = (!shear).then(|| inertia.dofs());
+        let jt = if shear {
+            0.0
+        } else {
+            clamp(&scene.links[0], h1)
+        };
+        let nd = inertia.dofs() + usize::from(tip_ghost.is_some());
         let contact = TipContact::from_scene(scene)?;
         let mu1g = {
             let mut acc = inertia.mass2;
@@ -315,7 +349,7 @@ impl TwoLinkChain {
             ],
             field_stations: scene.simulation.field_stations.max(2),
             p: vec![Dual::default(); nd],
-            cols: [vec![0.0; nd], vec![0.0; nd], vec![0.0; nd], vec![0.0; nd]],
+            cols: std::array::from_fn(|_| vec![0.0; nd]),
             unit: vec![0.0; nd],
             zeros: vec![0.0; nd],
             rhs: vec![0.0; nd],
@@ -326,6 +360,8 @@ impl TwoLinkChain {
             omega_max: 0.0,
             kappa_max: 0.0,
             jc,
+            tip_ghost,
+            jt,
             slots: [1 + r1, 1 + r1 + r2],
             hs: [h1, h2],
             qk: vec![0.0; nd],
@@ -341,6 +377,9 @@ impl TwoLinkChain {
             grow: vec![0.0; nd],
             minv_g: vec![0.0; nd],
             last_projection: [0.0; 3],
+            implicit: None,
+            skip_damping: false,
+            vd: vec![0.0; nd],
             timo,
         };
         // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
@@ -354,6 +393,12 @@ impl TwoLinkChain {
                 chain.add_clamp(k, -chain.jc[k] / (2.0 * chain.hs[k]), &mut col);
             }
             chain.cols[2 + k] = col;
+        }
+        if let Some(y) = chain.tip_ghost {
+            let mut col = std::mem::take(&mut chain.cols[4]);
+            chain.add_tip(chain.jt / (2.0 * chain.hs[0]), &mut col);
+            debug_assert_eq!(col[y], chain.jt / (4.0 * chain.hs[0] * chain.hs[0]));
+            chain.cols[4] = col;
         }
         chain.omega_max = chain.top_frequency();
         chain.kappa_max = chain.top_damping_rate();
@@ -383,6 +428,12 @@ impl TwoLinkChain {
             plan.add(
                 "clamp ghost deflections x₁, x₂ (clamp turn against the chord)",
                 2,
+            );
+        }
+        if self.tip_ghost.is_some() {
+            plan.add(
+                "link 1 tip ghost y = v_{r+1} (elbow section turn and moment against the chord)",
+                1,
             );
         }
         plan.add(
@@ -417,7 +468,7 @@ impl TwoLinkChain {
     }
 
     pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
-        let n = self.inertia.dofs();
+        let n = self.dofs();
         let mut q = vec![0.0; n];
         let mut v = vec![0.0; n];
         // elastic fields at rest and straight: ψ = 0, β = θ₁ + θ₂
@@ -473,10 +524,39 @@ impl TwoLinkChain {
 
     /// Tip slope ψ of link 1 and the stencil (indices into q, weights).
     fn slope_stencil(&self) -> [(usize, f64); 2] {
-        // (3v_r − 4v_{r−1} + v_{r−2})/(2h) with v_r = 0 in the chord frame
         let i = self.inertia.i_tip1();
         let h = self.inertia.h1;
-        [(i - 1, -4.0 / (2.0 * h)), (i - 2, 1.0 / (2.0 * h))]
+        match self.tip_ghost {
+            // central (y − v_{r−1})/(2h) with the tip ghost y = v_{r+1}
+            Some(y) => [(y, 1.0 / (2.0 * h)), (i - 1, -1.0 / (2.0 * h))],
+            // Timoshenko (joint angles from the condensed ψ; unused): one-sided
+            // (3v_r − 4v_{r−1} + v_{r−2})/(2h) with v_r = 0 in the chord frame
+            None => [(i - 1, -4.0 / (2.0 * h)), (i - 2, 1.0 / (2.0 * h))],
+        }
+    }
+
+    /// Link 1's tip-section angle θ + ψ (applied to q or q̇; Euler links).
+    fn tip_angle(&self, q: &[f64]) -> f64 {
+        let psi: f64 = self.slope_stencil().iter().map(|(i, c)| c * q[*i]).sum();
+        q[TH] + psi
+    }
+
+    /// Adds J_t e eᵀ·(scale) of link 1's tip-section rotation to a column/momentum vector:
+    /// e = ∂(θ + ψ)/∂q (1 at θ, 1/(2h) at y, −1/(2h) at v_{r−1}); nothing without a tip ghost.
+    fn add_tip(&self, weight: f64, out: &mut [f64]) {
+        if self.tip_ghost.is_some() {
+            out[TH] += weight;
+            for (i, c) in self.slope_stencil() {
+                out[i] += weight * c;
+            }
+        }
+    }
+
+    /// Link 1's tip term of the trapezoid bending energy, ¼h c κ_r² with κ_r = (y + u)/h²
+    /// (u = v_{r−1}, v_r = 0, y = v_{r+1}): (energy, ∂/∂y = ∂/∂u).
+    fn tip_bending(h: f64, c: f64, u: f64, y: f64) -> (f64, f64) {
+        let h3 = h * h * h;
+        (c * (y + u).powi(2) / (4.0 * h3), c * (y + u) / (2.0 * h3))
     }
 
     /// q-index of station 1 of link ℓ.
@@ -518,10 +598,15 @@ impl TwoLinkChain {
     fn chord(&mut self, q: &[f64], v: &[f64]) {
         self.qk.copy_from_slice(q);
         self.vk.copy_from_slice(v);
-        for s in self.slots {
+        for s in self.ghosts() {
             self.qk[s] = 0.0;
             self.vk[s] = 0.0;
         }
+    }
+
+    /// The q-slots that move no lumped mass: the clamp ghosts and (Euler) link 1's tip ghost.
+    fn ghosts(&self) -> impl Iterator<Item = usize> + use<> {
+        self.slots.into_iter().chain(self.tip_ghost)
     }
 
     /// Diagonal mass of coordinate i outside the full columns θ, β, x₁, x₂.
@@ -531,6 +616,9 @@ impl TwoLinkChain {
             if i == self.first(k) {
                 d += self.jc[k] / (4.0 * self.hs[k] * self.hs[k]);
             }
+        }
+        if self.tip_ghost.is_some() && i == self.inertia.i_tip1() - 1 {
+            d += self.jt / (4.0 * self.hs[0] * self.hs[0]);
         }
         d
     }
@@ -555,12 +643,15 @@ impl TwoLinkChain {
         for i in 0..q.len() {
             out[i] = p[i].re;
         }
-        for k in 0..2 {
-            out[self.slots[k]] = 0.0;
+        for s in self.ghosts() {
+            out[s] = 0.0;
         }
         for k in 0..2 {
             let w = self.jc[k] * self.clamp_angle(qd, k);
             self.add_clamp(k, w, out);
+        }
+        if self.tip_ghost.is_some() {
+            self.add_tip(self.jt * self.tip_angle(qd), out);
         }
     }
 
@@ -638,11 +729,15 @@ impl TwoLinkChain {
             return;
         }
         self.vk.copy_from_slice(v);
-        for s in self.slots {
+        for s in self.ghosts() {
             self.vk[s] = 0.0;
         }
         let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
         let mut p_kv = 0.0;
+        if let Some(y) = self.tip_ghost {
+            let u = v[self.inertia.i_tip1() - 1];
+            p_kv += 2.0 * Self::tip_bending(self.hs[0], self.links[0].gamma, u, v[y]).0;
+        }
         for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
             .into_iter()
             .enumerate()
@@ -678,7 +773,7 @@ impl TwoLinkChain {
         self.inertia.grad_q(&self.qk, &self.vk, scratch);
         self.inertia
             .momenta(&self.qk, &self.vk, &self.vk, &mut self.p);
-        for s in self.slots {
+        for s in self.ghosts() {
             scratch[s] = 0.0;
             self.p[s] = Dual::default();
         }
@@ -702,6 +797,8 @@ impl TwoLinkChain {
             self.qk = qk;
             return;
         }
+        // the implicit kick (`implicit`) takes the damping forces separately
+        let damp = !self.skip_damping;
         let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
         let mut p_kv = 0.0;
         for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
@@ -718,7 +815,7 @@ impl TwoLinkChain {
             let slot = self.slots[link];
             let (_, gx) = Self::ghost_bending(h, lp.ei, &self.qk[range.clone()], q[slot], f);
             let mut fx = gx;
-            if lp.gamma != 0.0 {
+            if lp.gamma != 0.0 && damp {
                 let (d2, gv) =
                     Self::ghost_bending(h, lp.gamma, &self.vk[range.clone()], v[slot], f);
                 p_kv += 2.0 * d2;
@@ -728,14 +825,34 @@ impl TwoLinkChain {
             f[r - 1] = fx; // the tip entry carries the ghost's force
             out[range].copy_from_slice(f);
         }
+        if let Some(y) = self.tip_ghost {
+            // link 1's tip term of the bending energy (elbow moment EIκ_r) and its Kelvin–Voigt
+            // dissipation
+            let (h, lp, u) = (self.hs[0], &self.links[0], self.inertia.i_tip1() - 1);
+            let (_, g) = Self::tip_bending(h, lp.ei, q[u], q[y]);
+            let (mut fy, mut fu) = (-g, -g);
+            if lp.gamma != 0.0 && damp {
+                let (d2, gv) = Self::tip_bending(h, lp.gamma, v[u], v[y]);
+                p_kv += 2.0 * d2;
+                fy -= gv;
+                fu -= gv;
+            }
+            out[y] = fy;
+            out[u] += fu;
+        }
         let th2 = self.elbow(q);
         let th2d = self.elbow(v);
         let j = &self.joints;
         let ext = [j[0].torque(t), j[1].torque(t)];
         let th1 = self.clamp_angle(q, 0);
         let th1d = self.clamp_angle(v, 0);
-        let tau1 = ext[0] - j[0].stiffness * (th1 - j[0].set_point) - j[0].damping * th1d;
-        let tau2 = ext[1] - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * th2d;
+        let dj = if damp {
+            [j[0].damping, j[1].damping]
+        } else {
+            [0.0; 2]
+        };
+        let tau1 = ext[0] - j[0].stiffness * (th1 - j[0].set_point) - dj[0] * th1d;
+        let tau2 = ext[1] - j[1].stiffness * (th2 - j[1].set_point) - dj[1] * th2d;
         // τ₁ on θ₁ (clamp angle of link 1); τ₂ on θ₂ = clamp angle of link 2 − θ − ψ(v)
         self.add_clamp(0, tau1, out);
         self.add_clamp(1, tau2, out);
@@ -755,9 +872,58 @@ impl TwoLinkChain {
     }
 }
 
+impl TwoLinkChain {
+    /// Adds the damping forces −∂D/∂q̇ = −C q̇ at `v` into `out`: Kelvin–Voigt (the ghost-node
+    /// bending stencil on the rates, link 1's tip term) and the joint dampers (Euler links;
+    /// the same terms as [`Self::forces`]). Linear in `v` with constant C.
+    pub(crate) fn add_damping_forces(&mut self, v: &[f64], out: &mut [f64]) {
+        let mut vd = std::mem::take(&mut self.vd);
+        vd.copy_from_slice(v);
+        for s in self.ghosts() {
+            vd[s] = 0.0;
+        }
+        let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
+        for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
+            .into_iter()
+            .enumerate()
+        {
+            let lp = &self.links[link];
+            if lp.gamma == 0.0 {
+                continue;
+            }
+            f.iter_mut().for_each(|x| *x = 0.0);
+            let slot = self.slots[link];
+            let (_, gv) =
+                Self::ghost_bending(self.hs[link], lp.gamma, &vd[range.clone()], v[slot], f);
+            let r = f.len();
+            f[r - 1] = gv;
+            for (o, x) in out[range].iter_mut().zip(f.iter()) {
+                *o += x;
+            }
+        }
+        if let Some(y) = self.tip_ghost {
+            let (h, lp, u) = (self.hs[0], &self.links[0], self.inertia.i_tip1() - 1);
+            if lp.gamma != 0.0 {
+                let (_, g) = Self::tip_bending(h, lp.gamma, v[u], v[y]);
+                out[y] -= g;
+                out[u] -= g;
+            }
+        }
+        let tau1 = -self.joints[0].damping * self.clamp_angle(v, 0);
+        let tau2 = -self.joints[1].damping * self.elbow(v);
+        self.add_clamp(0, tau1, out);
+        self.add_clamp(1, tau2, out);
+        out[TH] -= tau2;
+        for (i, c) in self.slope_stencil() {
+            out[i] -= tau2 * c;
+        }
+        self.vd = vd;
+    }
+}
+
 impl System for TwoLinkChain {
     fn dofs(&self) -> usize {
-        self.inertia.dofs()
+        self.inertia.dofs() + usize::from(self.tip_ghost.is_some())
     }
 
     fn accel(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) {
@@ -786,6 +952,21 @@ impl System for TwoLinkChain {
             }
             self.lambda = lam;
         }
+    }
+
+    fn implicit_kick(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        inertia: DriftVelocities,
+        tau: f64,
+        a: &mut [f64],
+    ) -> bool {
+        if self.implicit.is_none() || self.constrained {
+            return false;
+        }
+        self.implicit_kick_solve(t, q, inertia, tau, a);
+        true
     }
 
     fn accel_split(
@@ -864,7 +1045,7 @@ impl System for TwoLinkChain {
         let mut vk = self.obs_scratch_v.borrow_mut();
         qk.copy_from_slice(q);
         vk.copy_from_slice(v);
-        for s in self.slots {
+        for s in self.ghosts() {
             qk[s] = 0.0;
             vk[s] = 0.0;
         }
@@ -877,6 +1058,11 @@ impl System for TwoLinkChain {
             ke += 0.5 * self.jc[k] * self.clamp_angle(v, k).powi(2);
             // κ₀ = (u₁ + x)/h² instead of the single link's 2u₁/h²
             strain += c * ((u1 + x).powi(2) / 4.0 - u1 * u1) / (h * h * h);
+        }
+        if let Some(y) = self.tip_ghost {
+            ke += 0.5 * self.jt * self.tip_angle(v).powi(2);
+            let u = q[ine.i_tip1() - 1];
+            strain += Self::tip_bending(self.hs[0], self.links[0].ei, u, q[y]).0;
         }
         let j = &self.joints;
         let mut spring = 0.5 * j[0].stiffness * (self.clamp_angle(q, 0) - j[0].set_point).powi(2)

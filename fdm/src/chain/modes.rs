@@ -47,7 +47,7 @@ impl TwoLinkChain {
     }
 
     fn dofs_total(&self) -> usize {
-        self.inertia.dofs()
+        crate::system::System::dofs(self)
     }
 
     /// The linearized modes about [`TwoLinkChain::reference_state`].

@@ -5,7 +5,7 @@
 use data::channel;
 
 use super::kinetic::{BE, TH, seg_energy};
-use super::{SHEAR_SITE, TwoLinkChain};
+use super::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
 use crate::output::{Outputs, sample_field};
 use crate::system::Bound;
 
@@ -16,6 +16,8 @@ impl Outputs for TwoLinkChain {
                 "link {} shear sawtooth of the condensed Timoshenko operator (σ = h√(ρA/κGA))",
                 b.site - SHEAR_SITE + 1
             )
+        } else if b.site == TIP_SITE {
+            "tip-rotation mode of link 1 (tip ghost node against J_t)".into()
         } else if b.site >= 3 {
             format!(
                 "clamp-rotation mode of link {} (ghost node against J_c)",
@@ -158,6 +160,7 @@ impl Outputs for TwoLinkChain {
             }
             _ if i == self.slots[0] => "link 1 clamp ghost deflection x₁ = v₋₁".into(),
             _ if i == self.slots[1] => "link 2 clamp ghost deflection x₂ = w₋₁".into(),
+            _ if Some(i) == self.tip_ghost => "link 1 tip ghost deflection y = v_{r+1}".into(),
             _ if ine.iv().contains(&i) => {
                 let k = i - 1;
                 format!("link 1 v at station {k} (x = {:.4})", k as f64 * ine.h1)

@@ -18,6 +18,11 @@
 //! grows like the number of stations (measured on `two-link-free-undamped`: the joint angles
 //! then move away from the converged answer as the grid is refined).
 //!
+//! **Implicit damping** ([`System::implicit_kick`]). A system may take the closing kick with
+//! its (linear, constant) damping C implicit: (M + ½τC)a_{j+1} = F(q_{j+1}, v_{j+½}), so the
+//! step applies −½τM⁻¹C at v_j (opening kick, explicit) and at v_{j+1} (closing kick): Crank–
+//! Nicolson in the damping, stable for every κτ, and the step stays at the undamped bound.
+//!
 //! **Restartable steps** ([`VelocityForm::predicted`]). With every force at the predicted
 //! velocity a step depends on level j alone, so a step can be re-taken from the same level with
 //! another length (event location: [`crate::chain::contact`]) and the drift positions
@@ -116,7 +121,9 @@ impl Stepper for VelocityForm {
                     0.0
                 },
             };
-            sys.accel_split(t_new, &st.next.q, &st.pred, drift, &mut st.acc_next);
+            if !sys.implicit_kick(t_new, &st.next.q, drift, tau, &mut st.acc_next) {
+                sys.accel_split(t_new, &st.next.q, &st.pred, drift, &mut st.acc_next);
+            }
             self.drift_prev.copy_from_slice(&st.next.v);
             self.have_drift_prev = true;
         } else {

@@ -1,0 +1,57 @@
+//! `two-link-free` (joint dampers + Kelvin–Voigt), 1 s, single-threaded: the default (damping
+//! implicit in the velocity form's closing kick, the undamped step bound) at 21 and 41
+//! stations per link, and the explicit damping (the damped step bound) at 21 stations over
+//! 0.1 s for comparison (×10 for the same simulated time).
+//! Run: cargo bench -p fdm --bench chain -- --quick
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use data::{Settings, load_scene};
+use fdm::FdmSettings;
+use fdm::chain::TwoLinkChain;
+use fdm::driver::{StepControl, integrate};
+
+fn settings(stations: usize, t_end: f64) -> (Settings, FdmSettings) {
+    let mut settings = Settings::default();
+    settings.discretization.stations = Some(stations);
+    settings.time.t_end = Some(t_end);
+    let s = FdmSettings::from_settings(&settings).expect("valid settings");
+    (settings, s)
+}
+
+fn bench(c: &mut Criterion) {
+    let scene = load_scene("two-link-free").expect("catalog scene");
+    let mut group = c.benchmark_group("two_link_free");
+    group.sample_size(10);
+    for n in [21usize, 41] {
+        let (settings, s) = settings(n, 1.0);
+        group.bench_function(format!("1s_{n}_stations_implicit_damping"), |b| {
+            b.iter(|| {
+                let out = fdm::runs::two_link_chain(&scene, &settings, &s).expect("run");
+                std::hint::black_box(out.cost.steps)
+            })
+        });
+    }
+    let (_, s) = settings(21, 0.1);
+    group.bench_function("0.1s_21_stations_explicit_damping", |b| {
+        b.iter(|| {
+            let mut sys = TwoLinkChain::from_scene(&scene, s.stations).expect("chain");
+            let (q0, v0) = sys.initial_state();
+            let ctl = StepControl {
+                method: fdm::Method::VelocityForm,
+                safety: s.safety,
+                forced_dt: None,
+                t_end: 0.1,
+                output_interval: scene.simulation.output_interval,
+                log_change: s.step_log_change,
+                lookahead: false,
+                enforce_bound: true,
+            };
+            let out = integrate(&mut sys, &q0, &v0, &ctl).expect("run");
+            std::hint::black_box(out.cost.steps)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
