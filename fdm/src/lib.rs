@@ -171,6 +171,7 @@ pub mod events;
 pub mod link;
 pub mod method;
 pub mod output;
+pub mod payload_link;
 pub mod rocket;
 pub mod runs;
 pub mod settings;
@@ -199,6 +200,8 @@ pub enum ModelChoice {
     SingleLink,
     /// Two links in series, with its tip contact if any ([`chain`]).
     TwoLinkChain,
+    /// The 3-D link with an offset payload ([`payload_link`]).
+    PayloadLink,
 }
 
 impl ModelChoice {
@@ -206,6 +209,7 @@ impl ModelChoice {
     pub fn of(scene: &Scene) -> Result<Self, FdmError> {
         match scene.family() {
             Family::Rocket => Ok(ModelChoice::Rocket),
+            Family::PayloadLink => Ok(ModelChoice::PayloadLink),
             Family::PlanarChain => Ok(match scene.links.len() {
                 1 if matches!(
                     scene.links[0].joint.prescribed,
@@ -246,6 +250,9 @@ impl Backend for FdmBackend {
             ModelChoice::SingleLink => {
                 link::FloatingLink::from_scene(scene, s.stations)?.dof_plan()
             }
+            ModelChoice::PayloadLink => {
+                payload_link::PayloadLinkModel::from_scene(scene, s.stations)?.dof_plan()
+            }
         })
     }
 
@@ -262,6 +269,9 @@ impl Backend for FdmBackend {
                     .into(),
             )),
             ModelChoice::TwoLinkChain => Ok(chain::modes::modes(scene, settings, &s, count)?),
+            ModelChoice::PayloadLink => {
+                Ok(payload_link::analysis::modes(scene, settings, &s, count)?)
+            }
             _ => Ok(beam::modes(scene, settings, &s, count)?),
         }
     }
@@ -270,6 +280,9 @@ impl Backend for FdmBackend {
         let s = FdmSettings::from_settings(settings)?;
         if scene.family() == Family::PlanarChain {
             return Ok(beam::statics(scene, settings, &s)?);
+        }
+        if scene.family() == Family::PayloadLink {
+            return Ok(payload_link::analysis::statics(scene, settings, &s)?);
         }
         Err(BackendError::Unsupported(format!(
             "fdm statics for {} scenes",
@@ -284,6 +297,7 @@ impl Backend for FdmBackend {
             ModelChoice::Cantilever => return Err(beam::simulate_unsupported(scene).into()),
             ModelChoice::TwoLinkChain => runs::two_link_chain(scene, settings, &s)?,
             ModelChoice::SingleLink => runs::single_link(scene, settings, &s)?,
+            ModelChoice::PayloadLink => payload_link::run::simulate(scene, settings, &s)?,
         })
     }
 }
