@@ -5,8 +5,9 @@
 //! joint spring on θ), linearized about the straight rod at the base's reference rate Ω (the
 //! rate of a constant-rate base, else 0). −Ω²H is the centrifugal softening and the
 //! foreshortening's tension stiffening of the θ̇²M_θθ(q)/2 term. The gyroscopic coupling
-//! Ω(B − Bᵀ) is left out (undamped, symmetric problem). Solved densely by Cholesky reduction.
-//! Each mode is named by the field (or θ) carrying most of its kinetic energy.
+//! Ω(B − Bᵀ) is left out (undamped, symmetric problem), densely.
+//! Each mode is named by the field (or θ) carrying most of its kinetic energy. Solved in the
+//! flexibility form (K + σM)⁻¹M (see [`PayloadLinkModel::spectrum`]).
 //!
 //! **Statics**: K q = f_g, the discrete static equations under gravity at rest (the static-sag
 //! start of the dynamics).
@@ -19,7 +20,7 @@ use super::{BaseDrive, PayloadLinkModel, apply};
 use crate::error::FdmError;
 use crate::settings::FdmSettings;
 
-/// Frequencies (rad/s, ascending), M-orthonormal vectors (columns, over ż) and kinds.
+/// Frequencies (rad/s, ascending), mode vectors (columns, over ż) and kinds.
 pub struct Spectrum {
     pub omega: Vec<f64>,
     pub vectors: Mat<f64>,
@@ -67,33 +68,49 @@ impl PayloadLinkModel {
     /// The linearized spectrum (module docs).
     pub fn spectrum(&self) -> Result<Spectrum, FdmError> {
         let (m, k) = self.linearized();
+        let n = m.nrows();
         let numerical = |message: String| FdmError::Numerical { t: 0.0, message };
-        let llt = m
-            .llt(Side::Lower)
-            .map_err(|e| numerical(format!("mass matrix not positive definite: {e:?}")))?;
+        // Flexibility form: the lowest ω² are the largest μ = 1/(ω² + σ) of
+        // (K + σM)⁻¹M, which a backward-stable solver resolves to ε relative to μ_max; in the
+        // stiffness form they would sit ~10 decades below ‖M⁻¹K‖ (axial and torsional
+        // sawtooth) and lose digits at fine grids. σ > 0 makes a free base's θ definite.
+        let sigma = 1e-9
+            * (0..n)
+                .map(|i| k[(i, i)] / m[(i, i)])
+                .fold(0.0f64, f64::max)
+                .max(f64::MIN_POSITIVE);
+        let shifted = Mat::<f64>::from_fn(n, n, |i, j| k[(i, j)] + sigma * m[(i, j)]);
+        let llt = shifted.llt(Side::Lower).map_err(|e| {
+            numerical(format!(
+                "stiffness not positive definite at the reference rate (the rod buckles): {e:?}"
+            ))
+        })?;
         let l = llt.L();
-        let mut t = k.clone();
+        let mut t = m.clone();
         l.solve_lower_triangular_in_place(&mut t);
         let mut c = t.transpose().to_owned();
         l.solve_lower_triangular_in_place(&mut c);
-        let n = c.nrows();
         let c = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
         let ev = c
             .self_adjoint_eigen(Side::Lower)
             .map_err(|e| numerical(format!("eigen decomposition failed: {e:?}")))?;
         let s = ev.S().column_vector();
-        let lmax = (0..n).map(|i| s[i].abs()).fold(0.0f64, f64::max);
+        // descending μ ↔ ascending ω
         let mut omega = Vec::with_capacity(n);
-        for i in 0..n {
-            let lam = s[i];
-            if lam < -1e-9 * lmax {
+        let mut x = Mat::<f64>::zeros(n, n);
+        let u = ev.U();
+        for (jj, j) in (0..n).rev().enumerate() {
+            let mu = s[j];
+            if !(mu > 0.0) {
                 return Err(numerical(format!(
-                    "negative eigenvalue {lam:e}: the rod buckles at the reference rate"
+                    "non-positive flexibility eigenvalue {mu:e}"
                 )));
             }
-            omega.push(lam.max(0.0).sqrt());
+            omega.push((1.0 / mu - sigma).max(0.0).sqrt());
+            for i in 0..n {
+                x[(i, jj)] = u[(i, j)];
+            }
         }
-        let mut x = ev.U().to_owned();
         l.transpose().solve_upper_triangular_in_place(&mut x);
         let off = usize::from(self.free_base());
         let kinds = (0..n)
