@@ -101,7 +101,7 @@ impl PayloadLinkModel {
         let u = ev.U();
         for (jj, j) in (0..n).rev().enumerate() {
             let mu = s[j];
-            if !(mu > 0.0) {
+            if mu.is_nan() || mu <= 0.0 {
                 return Err(numerical(format!(
                     "non-positive flexibility eigenvalue {mu:e}"
                 )));
