@@ -602,3 +602,6 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 pub mod analysis;
+
+#[cfg(test)]
+mod tests;
