@@ -204,7 +204,6 @@ fn sys_unsupported_scenes_say_what_is_missing() {
         "cantilever-axial",
         "cantilever-timoshenko",
         "constrained-arm",
-        "single-link-3d",
         "mobile-manipulator",
     ] {
         let scene = load_scene(name).unwrap();

@@ -1,0 +1,607 @@
+//! The 3-D flexible link with an offset payload (seed 002, `[payload_link]`) on the report's
+//! station grid: the fields u (axial), v (horizontal), w (vertical) and φ (twist) at stations
+//! 1…r (station 0 clamped), the base angle θ free or prescribed.
+//!
+//! ## Discrete Lagrangian (docs/single-link-3d.md, truncated at second order in the fields)
+//! Stations x_i = ih, h = L/r; trapezoid-lumped masses m_i = ρAh (m_r = ρAh/2), torsional
+//! inertias ρJh (ρJh/2 at the tip); segment slopes g_s = (f_{s+1} − f_s)/h; curvatures
+//! κ_0 = 2f_1/h² (clamped fictitious station f_{−1} = f_1, weight ½), κ_i = Δ²f_i/h² inside, and
+//! κ_r = 0 (the report's free-end fictitious station f_{r+1} = 2f_r − f_{r−1}); tip slope
+//! f′_L = (3f_r − 4f_{r−1} + f_{r−2})/(2h); foreshortening s_i = ½Σ_{s<i} h(g_v² + g_w²).
+//!
+//! * V = ½Σ_s h(EA g_u² + GJ g_φ²) + ½Σ_i c_i h EI(κ_v,i² + κ_w,i²) (c_0 = ½),
+//!   V_g = g(Σ m_i w_i + m_p(w_L + c w′_L)), Rayleigh D = the same sums with E → C_X, C_Y, C_Z,
+//!   G → C_Φ on the rates.
+//! * T = ½ ż ᵀ M(q) ż with ż = (θ̇, q̇): the field block M_ff is constant (lumped masses, the
+//!   sections' rotary inertia ρI Σ_s h(ġ_v² + ġ_w²), the payload's m_p(u̇_L² + ẏ² + ż²) with
+//!   y = v_L + c v′_L, z = w_L + c w′_L, and its b₁ᵀ I_p b₁, b₁ = (φ̇_L, −ẇ′_L, v̇′_L)); the
+//!   coupling M_θf = c + Bq is affine (transport x_i v̇_i, Coriolis m(u v̇ − v u̇), the sections'
+//!   ρ(I v̇′ + J w′φ̇), the payload's m_p((L + c + u_L)ẏ − y u̇_L) and its aᵀI_p b to second
+//!   order, a = Rᵀe_z, b = Rᵀω); M_θθ = M₀ + 2gᵀq + qᵀHq (rigid inertias, the axial shift
+//!   2x u, the foreshortening −2x s, u² + v², the sections' (J − I)w′², the payload's
+//!   2(L+c)(u_L − s_L − ½c(v′_L² + w′_L²)) + u_L² + y² and aᵀI_p a).
+//!
+//! Lagrange's equations (M_θf = m, F the field forces):
+//!   M_ff q̈ + m θ̈ = −θ̇(B − Bᵀ)q̇ + θ̇²(g + Hq) − Kq − Cq̇ + f_g,
+//!   M_θθ θ̈ + m·q̈ = T_mot − b_m θ̇ − K_θ(θ − θ₀) − Ṁ_θθ θ̇ − (Bq̇)·q̇,  Ṁ_θθ = 2gᵀq̇ + 2q̇ᵀHq,
+//! θ̈ eliminated by a Schur complement on the banded M_ff (stations interleaved: u, v, w, φ per
+//! station, half-bandwidth ≤ 3 × fields). With a prescribed base the second line gives the
+//! torque the base needs.
+//!
+//! ## Time stepping ([`run`])
+//! The report's central difference in its one-step velocity form (kick–drift–kick, stable to
+//! 2/ω_max), step τ = safety × min over the carried fields of the Gershgorin bound of the
+//! lumped operator — axial h√(ρA/EA), bending h²√(ρA/4EI), torsion h√(ρJ/GJ) inside the rod
+//! (rotary and payload inertia only lower ω_max, so the lumped bound is safe). A forced `--dt`
+//! above it is refused naming the field. **Kelvin–Voigt implicitly**: explicit, the strain-rate
+//! damping bounds the step by ≈ ρh²/(4C) (axial, 2.5e-7 s for the catalog rod at 21 stations,
+//! 40× below the elastic bound), so the damping force is taken at the step-end velocity,
+//! (M_ff + ½τC) q̈_{j+1} = F(q_{j+1}, v_pred) − C v_{j+½}, one banded factorization per run; the
+//! remaining velocity terms (Coriolis, motor friction) at the predicted velocity.
+//!
+//! Not built: the centrifugal tension's share of the step bound (the base rates of the catalog
+//! add < 1e-4 of ω_max²), the gyroscopic term in `modes` (K − Ω²H against M_ff, undamped).
+
+pub mod band;
+pub mod run;
+
+use data::ledger_term;
+use data::scene::{LinkField, PayloadLink, PrescribedMotion, TorqueLaw};
+use data::{DofPlan, Scene};
+
+use crate::error::FdmError;
+use band::Triplets;
+
+/// Default stations (including the clamped root).
+pub const DEFAULT_STATIONS: usize = 21;
+
+/// A linear functional of the field coordinates: (index, coefficient).
+pub type Lin = Vec<(usize, f64)>;
+
+fn combine(parts: &[(&Lin, f64)]) -> Lin {
+    let mut out = Lin::new();
+    for (l, s) in parts {
+        for &(i, c) in l.iter() {
+            out.push((i, s * c));
+        }
+    }
+    out
+}
+
+fn apply(l: &Lin, q: &[f64]) -> f64 {
+    l.iter().map(|&(i, c)| c * q[i]).sum()
+}
+
+/// How the base angle moves.
+#[derive(Debug, Clone)]
+pub enum BaseDrive {
+    Prescribed(PrescribedMotion),
+    Free {
+        law: Option<TorqueLaw>,
+        stiffness: f64,
+        damping: f64,
+        set_point: f64,
+    },
+}
+
+/// The discrete model of one `[payload_link]` scene.
+#[derive(Debug, Clone)]
+pub struct PayloadLinkModel {
+    pub(crate) r: usize,
+    pub(crate) h: f64,
+    pub(crate) length: f64,
+    pub(crate) offset: f64,
+    pub(crate) fields: Vec<LinkField>,
+    /// field coordinates (stations 1…r × carried fields)
+    pub(crate) n: usize,
+    pub(crate) drive: BaseDrive,
+    pub(crate) theta0: f64,
+    pub(crate) rate0: f64,
+    pub(crate) mff: Triplets,
+    pub(crate) c_theta: Vec<f64>,
+    /// M_θf += B q: entries (f, g) with f the velocity index, g the position index
+    pub(crate) b_theta: Triplets,
+    pub(crate) m0: f64,
+    pub(crate) g_theta: Vec<f64>,
+    pub(crate) h_theta: Triplets,
+    /// stiffness per carried field
+    pub(crate) stiffness: Vec<(LinkField, Triplets)>,
+    /// Kelvin–Voigt: (field, index into `stiffness`, C/modulus): C_f = ratio K_f
+    pub(crate) damping: Vec<(LinkField, usize, f64)>,
+    pub(crate) f_gravity: Option<Vec<f64>>,
+    /// lumped diagonal (rod only) per coordinate, for the step bound
+    pub(crate) lumped: Vec<f64>,
+    pub(crate) field_stations: usize,
+    // output functionals
+    pub(crate) tip: [Lin; 4],
+    pub(crate) slope_v: Lin,
+    pub(crate) slope_w: Lin,
+    pub(crate) seg_v: Vec<Lin>,
+    pub(crate) seg_w: Vec<Lin>,
+}
+
+impl PayloadLinkModel {
+    pub fn from_scene(scene: &Scene, stations: Option<usize>) -> Result<Self, FdmError> {
+        let p = scene.payload_link.as_ref().ok_or_else(|| {
+            FdmError::Unsupported(format!("fdm: `{}` has no [payload_link]", scene.name))
+        })?;
+        Self::build(
+            p,
+            stations,
+            scene.simulation.field_stations.max(2),
+            &scene.name,
+        )
+    }
+
+    fn build(
+        p: &PayloadLink,
+        stations: Option<usize>,
+        field_stations: usize,
+        name: &str,
+    ) -> Result<Self, FdmError> {
+        let base = &p.base;
+        let drive = match &base.prescribed {
+            Some(m) => {
+                if base.torque.is_some()
+                    || base.stiffness.is_some_and(|k| k != 0.0)
+                    || base.damping.is_some_and(|d| d != 0.0)
+                {
+                    return Err(FdmError::Unsupported(format!(
+                        "fdm: `{name}`: a prescribed base with a torque law, spring or motor \
+                         friction (the prescribed motion already fixes θ)"
+                    )));
+                }
+                BaseDrive::Prescribed(m.clone())
+            }
+            None => BaseDrive::Free {
+                law: base.torque.clone(),
+                stiffness: base.stiffness.unwrap_or(0.0),
+                damping: p.motor_friction(),
+                set_point: base.set_point.unwrap_or(0.0),
+            },
+        };
+        let n_st = stations.unwrap_or(DEFAULT_STATIONS);
+        let r = n_st - 1;
+        let h = p.length / r as f64;
+        let mut fields: Vec<LinkField> = LinkField::ALL
+            .iter()
+            .copied()
+            .filter(|f| p.has(*f))
+            .collect();
+        fields.dedup();
+        let nf = fields.len();
+        let n = r * nf;
+        let slot = |f: LinkField| fields.iter().position(|x| *x == f);
+        let st = |f: LinkField, i: usize| -> Lin {
+            match slot(f) {
+                Some(k) if i >= 1 => vec![((i - 1) * nf + k, 1.0)],
+                _ => Lin::new(),
+            }
+        };
+        let seg = |f: LinkField, s: usize| -> Lin {
+            combine(&[(&st(f, s + 1), 1.0 / h), (&st(f, s), -1.0 / h)])
+        };
+        let tip_slope = |f: LinkField| -> Lin {
+            combine(&[
+                (&st(f, r), 1.5 / h),
+                (&st(f, r - 1), -2.0 / h),
+                (&st(f, r - 2), 0.5 / h),
+            ])
+        };
+        // curvature at station i (0 ≤ i < r) and its quadrature weight
+        let curv = |f: LinkField, i: usize| -> (Lin, f64) {
+            let h2 = h * h;
+            if i == 0 {
+                (combine(&[(&st(f, 1), 2.0 / h2)]), 0.5)
+            } else {
+                (
+                    combine(&[
+                        (&st(f, i + 1), 1.0 / h2),
+                        (&st(f, i), -2.0 / h2),
+                        (&st(f, i - 1), 1.0 / h2),
+                    ]),
+                    1.0,
+                )
+            }
+        };
+        use LinkField::{Axial as U, Horizontal as V, Torsion as P, Vertical as W};
+
+        let rho = p.density;
+        let (area, i2, jp) = (p.area(), p.second_moment(), p.polar_moment());
+        let mass_at = |i: usize| {
+            if i == r {
+                0.5 * rho * area * h
+            } else {
+                rho * area * h
+            }
+        };
+        let x = |i: usize| i as f64 * h;
+        let mp = p.payload.mass;
+        let c = p.payload.offset;
+        let lc = p.length + c;
+        let d = p.payload.inertia;
+
+        // functionals at the tip
+        let (eu, ev, ew, ephi) = (st(U, r), st(V, r), st(W, r), st(P, r));
+        let (sv, sw) = (tip_slope(V), tip_slope(W));
+        let ly = combine(&[(&ev, 1.0), (&sv, c)]);
+        let lz = combine(&[(&ew, 1.0), (&sw, c)]);
+
+        // ---- field mass M_ff
+        let mut mff = Triplets::default();
+        let mut lumped = vec![0.0; n];
+        for i in 1..=r {
+            for f in [U, V, W] {
+                let l = st(f, i);
+                mff.outer(mass_at(i), &l, &l);
+                for &(k, _) in &l {
+                    lumped[k] = mass_at(i);
+                }
+            }
+            let l = st(P, i);
+            let jm = rho * jp * if i == r { 0.5 * h } else { h };
+            mff.outer(jm, &l, &l);
+            for &(k, _) in &l {
+                lumped[k] = jm;
+            }
+        }
+        for s in 0..r {
+            for f in [V, W] {
+                let g = seg(f, s);
+                mff.outer(rho * i2 * h, &g, &g);
+            }
+        }
+        mff.outer(mp, &eu, &eu);
+        mff.outer(mp, &ly, &ly);
+        mff.outer(mp, &lz, &lz);
+        let b1 = [ephi.clone(), combine(&[(&sw, -1.0)]), sv.clone()];
+        for a in 0..3 {
+            for b in 0..3 {
+                mff.outer(d[a][b], &b1[a], &b1[b]);
+            }
+        }
+
+        // ---- coupling M_θf = c + B q
+        let mut c_theta = vec![0.0; n];
+        let mut b_theta = Triplets::default();
+        let add_c = |c_theta: &mut Vec<f64>, l: &Lin, s: f64| {
+            for &(k, v) in l {
+                c_theta[k] += s * v;
+            }
+        };
+        for i in 1..=r {
+            let m = mass_at(i);
+            add_c(&mut c_theta, &st(V, i), m * x(i));
+            b_theta.outer(-m, &st(U, i), &st(V, i));
+            b_theta.outer(m, &st(V, i), &st(U, i));
+        }
+        // sections: ρ∫(I v̇′ + J w′ φ̇) = ρI v̇_L + Σ_s h ρJ g_w,s (φ̇_s + φ̇_{s+1})/2
+        add_c(&mut c_theta, &ev, rho * i2);
+        for s in 0..r {
+            let phibar = combine(&[(&st(P, s), 0.5), (&st(P, s + 1), 0.5)]);
+            b_theta.outer(rho * jp * h, &phibar, &seg(W, s));
+        }
+        // payload translation: m_p[(L_c + u_L) ẏ − y u̇_L]
+        add_c(&mut c_theta, &ly, mp * lc);
+        b_theta.outer(mp, &ly, &eu);
+        b_theta.outer(-mp, &eu, &ly);
+        // payload rotation: aᵀ I_p b to second order
+        let msw = combine(&[(&sw, -1.0)]);
+        add_c(&mut c_theta, &ephi, d[2][0]);
+        add_c(&mut c_theta, &msw, d[2][1]);
+        add_c(&mut c_theta, &sv, d[2][2]);
+        b_theta.outer(-0.5 * d[2][0], &sw, &sv);
+        b_theta.outer(0.5 * d[2][0], &sv, &sw);
+        b_theta.outer(d[2][1], &sv, &ephi);
+        b_theta.outer(d[2][2], &sw, &ephi);
+        b_theta.outer(d[0][0], &ephi, &sw);
+        b_theta.outer(-d[0][1], &sw, &sw);
+        b_theta.outer(d[0][2], &sv, &sw);
+        b_theta.outer(d[1][0], &ephi, &ephi);
+        b_theta.outer(-d[1][1], &sw, &ephi);
+        b_theta.outer(d[1][2], &sv, &ephi);
+
+        // ---- M_θθ = m0 + 2 gᵀq + qᵀHq
+        let mut m0 = p.base_inertia() + mp * lc * lc + rho * i2 * p.length + d[2][2];
+        let mut g_theta = vec![0.0; n];
+        let mut h_theta = Triplets::default();
+        for i in 1..=r {
+            let m = mass_at(i);
+            m0 += m * x(i) * x(i);
+            add_c(&mut g_theta, &st(U, i), m * x(i));
+            h_theta.outer(m, &st(U, i), &st(U, i));
+            h_theta.outer(m, &st(V, i), &st(V, i));
+        }
+        // −2 Σ m_i x_i s_i = −Σ_s h W_s (g_v² + g_w²), W_s = Σ_{i>s} m_i x_i;
+        // payload −2 L_c s_L = −L_c Σ_s h (g_v² + g_w²); sections ρ(J − I)Σ_s h g_w²
+        let mut wseg = 0.0;
+        let mut wsegs = vec![0.0; r];
+        for s in (0..r).rev() {
+            wseg += mass_at(s + 1) * x(s + 1);
+            wsegs[s] = wseg;
+        }
+        let mut seg_v = Vec::with_capacity(r);
+        let mut seg_w = Vec::with_capacity(r);
+        for (s, wseg_s) in wsegs.iter().enumerate() {
+            let (gv, gw) = (seg(V, s), seg(W, s));
+            let k = -h * (wseg_s + mp * lc);
+            h_theta.outer(k, &gv, &gv);
+            h_theta.outer(k, &gw, &gw);
+            h_theta.outer(rho * (jp - i2) * h, &gw, &gw);
+            seg_v.push(gv);
+            seg_w.push(gw);
+        }
+        add_c(&mut g_theta, &eu, mp * lc);
+        h_theta.outer(-mp * lc * c, &sv, &sv);
+        h_theta.outer(-mp * lc * c, &sw, &sw);
+        h_theta.outer(mp, &eu, &eu);
+        h_theta.outer(mp, &ly, &ly);
+        // aᵀ I_p a
+        add_c(&mut g_theta, &sw, d[2][0]);
+        add_c(&mut g_theta, &ephi, d[2][1]);
+        h_theta.sym_outer(-0.5 * d[2][1], &sv, &sw);
+        h_theta.outer(-d[2][2], &sw, &sw);
+        h_theta.outer(-d[2][2], &ephi, &ephi);
+        h_theta.outer(d[0][0], &sw, &sw);
+        h_theta.sym_outer(d[0][1], &sw, &ephi);
+        h_theta.outer(d[1][1], &ephi, &ephi);
+
+        // ---- stiffness and Kelvin–Voigt
+        let mut stiffness = Vec::new();
+        let mut damping = Vec::new();
+        for &f in &fields {
+            let mut k = Triplets::default();
+            let modulus = match f {
+                U => {
+                    for s in 0..r {
+                        let g = seg(U, s);
+                        k.outer(h * p.axial_stiffness(), &g, &g);
+                    }
+                    p.youngs_modulus
+                }
+                P => {
+                    for s in 0..r {
+                        let g = seg(P, s);
+                        k.outer(h * p.torsional_stiffness(), &g, &g);
+                    }
+                    p.shear_modulus
+                }
+                V | W => {
+                    for i in 0..r {
+                        let (kap, wt) = curv(f, i);
+                        k.outer(wt * h * p.bending_stiffness(), &kap, &kap);
+                    }
+                    p.youngs_modulus
+                }
+            };
+            if let Some(cf) = p.kelvin_voigt_on(f) {
+                damping.push((f, stiffness.len(), cf / modulus));
+            }
+            stiffness.push((f, k));
+        }
+
+        let f_gravity = p.gravity.filter(|g| *g != 0.0).and_then(|g| {
+            slot(W)?;
+            let mut fg = vec![0.0; n];
+            for i in 1..=r {
+                for &(k, v) in &st(W, i) {
+                    fg[k] -= g * mass_at(i) * v;
+                }
+            }
+            for &(k, v) in &lz {
+                fg[k] -= g * mp * v;
+            }
+            Some(fg)
+        });
+
+        Ok(PayloadLinkModel {
+            r,
+            h,
+            length: p.length,
+            offset: c,
+            n,
+            drive,
+            theta0: base.initial_angle,
+            rate0: base.initial_rate,
+            mff,
+            c_theta,
+            b_theta,
+            m0,
+            g_theta,
+            h_theta,
+            stiffness,
+            damping,
+            f_gravity,
+            lumped,
+            field_stations,
+            tip: [eu, ev, ew, ephi],
+            slope_v: sv,
+            slope_w: sw,
+            seg_v,
+            seg_w,
+            fields,
+        })
+    }
+
+    pub fn field_dofs(&self) -> usize {
+        self.n
+    }
+
+    pub fn free_base(&self) -> bool {
+        matches!(self.drive, BaseDrive::Free { .. })
+    }
+
+    /// The base's (θ, θ̇, θ̈) when prescribed.
+    pub(crate) fn prescribed_at(&self, t: f64) -> Option<(f64, f64, f64)> {
+        match &self.drive {
+            BaseDrive::Prescribed(m) => {
+                let (a, b, c) = m.kinematics(t);
+                Some((self.theta0 + a, self.rate0 + b, c))
+            }
+            BaseDrive::Free { .. } => None,
+        }
+    }
+
+    /// Coordinate index of field f at station i (1…r).
+    pub fn index(&self, f: LinkField, i: usize) -> Option<usize> {
+        let k = self.fields.iter().position(|x| *x == f)?;
+        (1..=self.r)
+            .contains(&i)
+            .then(|| (i - 1) * self.fields.len() + k)
+    }
+
+    pub fn dof_plan(&self) -> DofPlan {
+        let mut plan = DofPlan::default();
+        if self.free_base() {
+            plan.add("base angle θ", 1);
+        }
+        for &f in &self.fields {
+            plan.add(
+                format!(
+                    "{} {} at stations 1…{} (root clamped)",
+                    f.name(),
+                    f.symbol(),
+                    self.r
+                ),
+                self.r,
+            );
+        }
+        plan.builds
+            .push("payload (mass, offset, full inertia) at the tip".into());
+        if self.fields.contains(&LinkField::Horizontal)
+            || self.fields.contains(&LinkField::Vertical)
+        {
+            plan.builds.push("foreshortening".into());
+        }
+        if self.f_gravity.is_some() {
+            plan.builds.push("gravity".into());
+        }
+        for (f, _, _) in &self.damping {
+            plan.builds.push(format!("Kelvin–Voigt {}", f.name()));
+        }
+        plan
+    }
+
+    /// Mass coupling m = c + Bq into `out`.
+    pub(crate) fn m_theta(&self, q: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(&self.c_theta);
+        self.b_theta.mul_add(q, out);
+    }
+
+    /// M_θθ(q).
+    pub(crate) fn m_thth(&self, q: &[f64]) -> f64 {
+        self.m0 + 2.0 * dot(&self.g_theta, q) + self.h_theta.form(q, q)
+    }
+
+    /// Kinetic energy ½M_θθθ̇² + θ̇ m·q̇ + ½q̇ᵀM_ff q̇ (`m`: scratch).
+    pub(crate) fn kinetic(&self, q: &[f64], v: &[f64], rate: f64, m: &mut [f64]) -> f64 {
+        self.m_theta(q, m);
+        0.5 * self.m_thth(q) * rate * rate + rate * dot(m, v) + 0.5 * self.mff.form(v, v)
+    }
+
+    pub(crate) fn strain(&self, q: &[f64]) -> f64 {
+        self.stiffness.iter().map(|(_, k)| 0.5 * k.form(q, q)).sum()
+    }
+
+    pub(crate) fn gravity_energy(&self, q: &[f64]) -> f64 {
+        self.f_gravity.as_ref().map_or(0.0, |f| -dot(f, q))
+    }
+
+    /// Field forces without the Kelvin–Voigt and the θ̈ terms:
+    /// F0 = −θ̇(B − Bᵀ)q̇ + θ̇²(g + Hq) − Kq + f_g, written into `out`.
+    pub(crate) fn field_forces(&self, q: &[f64], v: &[f64], rate: f64, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for (_, k) in &self.stiffness {
+            k.mul_add(q, out);
+        }
+        out.iter_mut().for_each(|x| *x = -*x);
+        if let Some(fg) = &self.f_gravity {
+            for (o, f) in out.iter_mut().zip(fg) {
+                *o += f;
+            }
+        }
+        if rate != 0.0 {
+            let w2 = rate * rate;
+            for (o, g) in out.iter_mut().zip(&self.g_theta) {
+                *o += w2 * g;
+            }
+            for &(i, j, c) in &self.h_theta.entries {
+                out[i] += w2 * c * q[j];
+            }
+            // −θ̇ (B − Bᵀ) q̇
+            for &(i, j, c) in &self.b_theta.entries {
+                out[i] -= rate * c * v[j];
+                out[j] += rate * c * v[i];
+            }
+        }
+    }
+
+    /// The θ equation's velocity terms Ṁ_θθ θ̇ + (Bq̇)·q̇.
+    pub(crate) fn theta_velocity_terms(&self, q: &[f64], v: &[f64], rate: f64) -> f64 {
+        let mdot = 2.0 * dot(&self.g_theta, v) + 2.0 * self.h_theta.form(v, q);
+        mdot * rate + self.b_theta.form(v, v)
+    }
+
+    /// The linear static deflection under gravity, K q = f_g (zero without gravity).
+    pub fn static_sag(&self) -> Result<Vec<f64>, FdmError> {
+        let Some(fg) = &self.f_gravity else {
+            return Ok(vec![0.0; self.n]);
+        };
+        let parts: Vec<(&Triplets, f64)> = self.stiffness.iter().map(|(_, k)| (k, 1.0)).collect();
+        let chol = band::BandCholesky::factor(self.n, &parts, "the stiffness matrix")?;
+        let mut q = fg.clone();
+        chol.solve_in_place(&mut q);
+        Ok(q)
+    }
+
+    /// The step bound per carried field: (field, σ = min_k 2/√(Σ_j |K_kj| / m_k), station).
+    pub fn field_bounds(&self) -> Vec<(LinkField, f64, usize)> {
+        let mut out = Vec::new();
+        for (f, k) in &self.stiffness {
+            // entries of one coordinate pair can come from several cells: sum them first
+            let dense_rows = {
+                let mut acc = std::collections::BTreeMap::new();
+                for &(i, j, c) in &k.entries {
+                    *acc.entry((i, j)).or_insert(0.0) += c;
+                }
+                let mut rows = vec![0.0; self.n];
+                for ((i, _), c) in acc {
+                    rows[i] += f64::abs(c);
+                }
+                rows
+            };
+            let mut best = (f64::INFINITY, 0);
+            for i in 1..=self.r {
+                let Some(ix) = self.index(*f, i) else {
+                    continue;
+                };
+                let w2 = dense_rows[ix] / self.lumped[ix];
+                if w2 > 0.0 {
+                    let s = 2.0 / w2.sqrt();
+                    if s < best.0 {
+                        best = (s, i);
+                    }
+                }
+            }
+            out.push((*f, best.0, best.1));
+        }
+        out
+    }
+
+    /// The ledger's Kelvin–Voigt term names, in the order of `damping`.
+    pub(crate) fn kv_names(&self) -> Vec<&'static str> {
+        self.damping
+            .iter()
+            .map(|(f, _, _)| ledger_term::kelvin_voigt_of(*f))
+            .collect()
+    }
+}
+
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+pub mod analysis;
+
+#[cfg(test)]
+mod tests;
