@@ -173,6 +173,33 @@ impl Stepper {
 
     /// Assembles and factorizes the Newton matrix ∂R/∂a at the iterate of the last residual.
     fn newton_matrix(&mut self, h: f64, mid: &Mid) -> Result<(), FemError> {
+        self.assemble_newton(h, mid);
+        self.newton.factorize()?;
+        self.counters.factorizations += 1;
+        Ok(())
+    }
+
+    /// Residual R(a) and the dense Newton matrix ∂R/∂a of a step of length h from the current
+    /// state at the midpoint acceleration (a_d, a_θ); a prescribed base takes a_θ from its law.
+    /// For tests of the analytic matrix against finite differences of the residual.
+    pub fn residual_and_newton(
+        &mut self,
+        h: f64,
+        a: &[f64],
+        a_theta: f64,
+    ) -> (Vec<f64>, faer::Mat<f64>) {
+        let n = self.model.n;
+        self.a.copy_from_slice(a);
+        self.a_theta = a_theta;
+        let mid = self.midpoint(h);
+        self.residual(&mid);
+        self.assemble_newton(h, &mid);
+        let nn = n + usize::from(self.model.free_base());
+        let jac = faer::Mat::from_fn(nn, nn, |i, j| self.newton.get(i, j));
+        (self.rhs[..nn].to_vec(), jac)
+    }
+
+    fn assemble_newton(&mut self, h: f64, mid: &Mid) {
         let md = &self.model;
         let n = md.n;
         let (ch, cq) = (0.5 * h, 0.25 * h * h);
@@ -208,9 +235,6 @@ impl Stepper {
                 + cq * k;
             nb.add(n, n, tt);
         }
-        nb.factorize()?;
-        self.counters.factorizations += 1;
-        Ok(())
     }
 
     /// One implicit-midpoint step of length h; books the works with the midpoint quadrature.
