@@ -25,6 +25,12 @@ impl Band {
         }
     }
 
+    /// Position of entry (i, j) in `data` (inside the band).
+    #[inline]
+    pub fn index(&self, i: usize, j: usize) -> usize {
+        self.at(i, j)
+    }
+
     #[inline]
     fn at(&self, i: usize, j: usize) -> usize {
         debug_assert!(

@@ -14,7 +14,7 @@
 use crate::band::BorderedBand;
 use crate::error::FemError;
 
-use super::model::{Model, dot};
+use super::model::{Band, Model, dot};
 
 /// Newton iterations before a step is declared failed.
 const MAX_NEWTON: usize = 25;
@@ -73,6 +73,10 @@ pub struct Stepper {
     kcv: Vec<f64>,
     ga: Vec<f64>,
     tmp: Vec<f64>,
+    /// Newton-matrix d-block as A₀ + θ̇B_g + θ̇²B_k + a_θB_t for the step length `combo_h`:
+    /// A₀ = M + ½hC + ¼h²K_s, B_g = ½h(Gᵀ − G), B_k = −¼h²K_c, B_t = ¼h²Gᵀ.
+    combo_h: f64,
+    combo: [Band; 4],
 }
 
 /// Midpoint quantities of one Newton iterate.
@@ -112,6 +116,8 @@ impl Stepper {
             kcv: z.clone(),
             ga: z.clone(),
             tmp: z,
+            combo_h: f64::NAN,
+            combo: std::array::from_fn(|_| Band::zeros(0, 0)),
         }
     }
 
@@ -204,14 +210,32 @@ impl Stepper {
         let n = md.n;
         let (ch, cq) = (0.5 * h, 0.25 * h * h);
         let w = mid.rate;
+        if self.combo_h != h {
+            // Once per step length (fixed steps: once per run).
+            let (n, b) = (md.n, md.m.b);
+            let mut c = std::array::from_fn(|_| Band::zeros(n, b));
+            c[0].add_scaled(1.0, &md.m);
+            c[0].add_scaled(ch, &md.c);
+            c[0].add_scaled(cq, &md.ks);
+            c[2].add_scaled(-cq, &md.kc);
+            for i in 0..n {
+                for j in md.m.cols(i) {
+                    let (gij, gji) = (md.g.get(i, j), md.g.get(j, i));
+                    c[1].add(i, j, ch * (gji - gij));
+                    c[3].add(i, j, cq * gji);
+                }
+            }
+            self.combo = c;
+            self.combo_h = h;
+        }
         let nb = &mut self.newton;
         nb.clear();
+        let [a0, bg, bk, bt] = &self.combo;
+        let (s1, s2, s3) = (w, w * w, self.a_theta);
         for i in 0..n {
             for j in md.m.cols(i) {
-                let (gij, gji) = (md.g.get(i, j), md.g.get(j, i));
-                let v = md.m.get(i, j)
-                    + ch * (w * (gji - gij) + md.c.get(i, j))
-                    + cq * (md.ks.get(i, j) - w * w * md.kc.get(i, j) + self.a_theta * gji);
+                let k = a0.index(i, j);
+                let v = a0.data[k] + s1 * bg.data[k] + s2 * bk.data[k] + s3 * bt.data[k];
                 if v != 0.0 {
                     nb.add(i, j, v);
                 }
@@ -253,9 +277,13 @@ impl Stepper {
             + self.state.d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let mut converged = false;
         let mut mid = self.midpoint(h);
-        for _ in 0..MAX_NEWTON {
+        for it in 0..MAX_NEWTON {
             self.residual(&mid);
-            self.newton_matrix(h, &mid)?;
+            // Modified Newton: the matrix of the step's first iterate (its change over one
+            // correction is tiny); refreshed every iteration should that converge slowly.
+            if it == 0 || it >= 3 {
+                self.newton_matrix(h, &mid)?;
+            }
             self.counters.newton += 1;
             let nn = n + usize::from(free);
             for v in self.rhs[..nn].iter_mut() {
