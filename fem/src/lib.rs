@@ -129,6 +129,14 @@
 //! The scene's `[statics]` loads (tip force, uniform load on the last link) act as step loads
 //! in `simulate`; their work is the ledger input `applied_load`.
 //!
+//! ## 3-D payload link (seed 002)
+//! Scenes of the `[payload_link]` family are solved by [`payload_link`]: 3-D beam elements
+//! ([`element::beam3d`]: axial, two bending planes, torsion) in the turning frame with the
+//! second-order kinematics of docs/single-link-3d.md, the payload as a rigid body at the tip,
+//! modes, gravity statics and implicit-midpoint dynamics. It shares the element tables
+//! (Hermite cubics, Gauss rules), the bordered-band LU ([`band`]) and the dense eigensolver
+//! ([`modes`]) with the planar chains, nothing else.
+//!
 //! ## Layers
 //! Each layer imports only the ones above it:
 //! 1. model: [`element`] (the element trait and its registry; element operators tested alone)
