@@ -129,6 +129,14 @@
 //! The scene's `[statics]` loads (tip force, uniform load on the last link) act as step loads
 //! in `simulate`; their work is the ledger input `applied_load`.
 //!
+//! ## 3-D payload link (seed 002)
+//! Scenes of the `[payload_link]` family are solved by [`payload_link`]: 3-D beam elements
+//! ([`element::beam3d`]: axial, two bending planes, torsion) in the turning frame with the
+//! second-order kinematics of docs/single-link-3d.md, the payload as a rigid body at the tip,
+//! modes, gravity statics and implicit-midpoint dynamics. It shares the element tables
+//! (Hermite cubics, Gauss rules), the bordered-band LU ([`band`]) and the dense eigensolver
+//! ([`modes`]) with the planar chains, nothing else.
+//!
 //! ## Layers
 //! Each layer imports only the ones above it:
 //! 1. model: [`element`] (the element trait and its registry; element operators tested alone)
@@ -161,6 +169,7 @@ pub mod linalg;
 pub mod linear;
 pub mod method;
 pub mod modes;
+pub mod payload_link;
 pub mod plan;
 pub mod run;
 pub mod settings;
@@ -269,6 +278,9 @@ impl Backend for FemBackend {
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
         let n_el = settings::elements(disc)?;
+        if payload_link::link(scene).is_some() {
+            return Ok(payload_link::dof_plan(scene, n_el)?);
+        }
         Ok(plan::dof_plan(scene, n_el, disc.element)?)
     }
 
@@ -278,14 +290,23 @@ impl Backend for FemBackend {
         settings: &Settings,
         count: usize,
     ) -> Result<ModalResult, BackendError> {
+        if payload_link::link(scene).is_some() {
+            return Ok(payload_link::modes(scene, settings, count)?);
+        }
         Ok(self.modes_impl(scene, settings, count)?)
     }
 
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
+        if payload_link::link(scene).is_some() {
+            return Ok(payload_link::statics(scene, settings)?);
+        }
         Ok(self.statics_impl(scene, settings)?)
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+        if payload_link::link(scene).is_some() {
+            return Ok(payload_link::simulate(scene, settings)?);
+        }
         Ok(run::simulate(scene, settings)?)
     }
 }

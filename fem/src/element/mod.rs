@@ -29,6 +29,7 @@
 //!
 //! A new element is one new file implementing [`Element`] plus one line in [`for_link`].
 
+pub mod beam3d;
 pub mod euler_bernoulli;
 pub mod hermite;
 pub mod quadrature;
