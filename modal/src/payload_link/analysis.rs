@@ -1,0 +1,161 @@
+//! Rayleigh–Ritz frequencies and the gravity sag of the payload link (see the module doc of
+//! [`super`] for what the linearization keeps).
+
+use std::time::Instant;
+
+use data::scene::LinkField;
+use data::{Cost, ModalResult, ModeShape, Scene, Settings, StaticResult};
+use faer::Mat;
+
+use super::model::LinkModel;
+use super::{set_up, static_sag};
+use crate::error::ModalError;
+use crate::modes::generalized_eigen;
+
+/// Name of a mode whose kinetic energy sits mostly in a field.
+pub fn kind_name(field: LinkField) -> &'static str {
+    match field {
+        LinkField::Axial => "axial",
+        LinkField::Horizontal => "bending-horizontal",
+        LinkField::Vertical => "bending-vertical",
+        LinkField::Torsion => "torsion",
+    }
+}
+
+/// The linearized pencil (K_eff, M) over (θ if free, q) at the base's reference rate.
+pub fn linear_pencil(model: &LinkModel) -> (Mat<f64>, Mat<f64>, f64) {
+    let n = model.n;
+    let base = &model.base;
+    let o = usize::from(base.free);
+    let rate = if base.free {
+        base.initial_rate
+    } else {
+        base.prescribed_state(0.0).1
+    };
+    let nd = n + o;
+    let mut k = Mat::<f64>::zeros(nd, nd);
+    let mut m = Mat::<f64>::zeros(nd, nd);
+    for i in 0..n {
+        for j in 0..n {
+            m[(o + i, o + j)] = model.mass[i * n + j];
+            k[(o + i, o + j)] =
+                model.stiffness[i * n + j] - rate * rate * model.centrifugal[i * n + j];
+        }
+    }
+    if base.free {
+        m[(0, 0)] = model.j0;
+        for i in 0..n {
+            m[(0, 1 + i)] = model.b[i];
+            m[(1 + i, 0)] = model.b[i];
+        }
+        k[(0, 0)] = base.spring.map_or(0.0, |(ks, _)| ks);
+    }
+    (k, m, rate)
+}
+
+pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, ModalError> {
+    let wall = Instant::now();
+    let s = set_up(scene, &settings.discretization)?;
+    let model = &s.model;
+    let (k, m, _) = linear_pencil(model);
+    let (lambda, vecs) = generalized_eigen(&k, &m)?;
+    let nd = k.nrows();
+    let o = usize::from(model.base.free);
+    let count = count.min(nd);
+    let scale = lambda
+        .iter()
+        .fold(0.0f64, |a, v| a.max(v.abs()))
+        .max(1e-300);
+    let ns = scene.simulation.field_stations.max(2);
+    let mut frequencies = Vec::with_capacity(count);
+    let mut kinds = Vec::with_capacity(count);
+    let mut shapes = Vec::with_capacity(count);
+    for c in 0..count {
+        let lam = lambda[c];
+        let f = if lam.abs() < 1e-12 * scale {
+            0.0
+        } else {
+            lam.signum() * lam.abs().sqrt() / std::f64::consts::TAU
+        };
+        frequencies.push(f);
+        // Kinetic share of each block (x is M-orthonormal).
+        let share = |r0: usize, len: usize| {
+            let mut s = 0.0;
+            for r in r0..r0 + len {
+                for cc in r0..r0 + len {
+                    s += vecs[(r, c)] * m[(r, cc)] * vecs[(cc, c)];
+                }
+            }
+            s
+        };
+        let dominant = model
+            .blocks
+            .iter()
+            .map(|b| (b, share(o + b.offset, b.count())))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        let theta_share = if o == 1 { share(0, 1) } else { 0.0 };
+        kinds.push(match dominant {
+            _ if f == 0.0 => "rigid".to_string(),
+            Some((b, s)) if s >= theta_share => kind_name(b.field).to_string(),
+            _ => "rigid".to_string(),
+        });
+        if let Some((b, _)) = dominant {
+            let mut phi = vec![0.0; b.count()];
+            let mut x = Vec::with_capacity(ns);
+            let mut v = Vec::with_capacity(ns);
+            for st in 0..ns {
+                let xs = model.length * st as f64 / (ns - 1) as f64;
+                b.basis.eval(xs, 0, &mut phi);
+                let val: f64 = phi
+                    .iter()
+                    .enumerate()
+                    .map(|(j, p)| p * vecs[(o + b.offset + j, c)])
+                    .sum();
+                x.push(xs);
+                v.push(val);
+            }
+            let vmax = v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            if vmax > 0.0 {
+                v.iter_mut().for_each(|e| *e /= vmax);
+            }
+            shapes.push(ModeShape {
+                link: 1,
+                x,
+                transverse: v,
+            });
+        }
+    }
+    Ok(ModalResult {
+        backend: data::BackendKind::Modal,
+        scene: scene.name.clone(),
+        settings: settings.clone(),
+        frequencies_hz: frequencies,
+        kinds,
+        shapes,
+        cost: Cost {
+            wall_time_s: wall.elapsed().as_secs_f64(),
+            dofs: nd,
+            ..Cost::default()
+        },
+    })
+}
+
+/// The linear gravity sag: `tip_deflection` = w(L), `tip_rotation` = w′(L).
+pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, ModalError> {
+    let wall = Instant::now();
+    let s = set_up(scene, &settings.discretization)?;
+    let q = static_sag(&s.model)?;
+    let dot = |r: &[f64]| r.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>();
+    Ok(StaticResult {
+        backend: data::BackendKind::Modal,
+        scene: scene.name.clone(),
+        settings: settings.clone(),
+        tip_deflection: dot(&s.model.tip.w),
+        tip_rotation: dot(&s.model.tip.slope_w),
+        cost: Cost {
+            wall_time_s: wall.elapsed().as_secs_f64(),
+            dofs: s.model.n,
+            ..Cost::default()
+        },
+    })
+}
