@@ -190,6 +190,7 @@ struct Output {
     obs: Observables,
     ledger: EnergyLedger,
     values: Vec<f64>,
+    stored: Vec<f64>,
     has_gravity: bool,
     has_spring: bool,
 }
@@ -254,6 +255,7 @@ impl Output {
             obs: Observables::with_channels(&specs),
             ledger: EnergyLedger::new(&stored, &[input], &diss),
             values: Vec::with_capacity(n_channels),
+            stored: Vec::with_capacity(4),
             has_gravity,
             has_spring,
         }
@@ -307,15 +309,17 @@ impl Output {
             }
         }
         self.obs.push(t, &self.values);
-        let mut stored = vec![m.kinetic(base.rate, q, qd), m.strain(q)];
+        self.stored.clear();
+        self.stored.push(m.kinetic(base.rate, q, qd));
+        self.stored.push(m.strain(q));
         if self.has_gravity {
-            stored.push(m.gravity_energy(q));
+            self.stored.push(m.gravity_energy(q));
         }
         if self.has_spring {
-            stored.push(m.base.spring(base.theta).1);
+            self.stored.push(m.base.spring(base.theta).1);
         }
         let w0 = 2 * rhs.nd;
         let works = &y[w0..w0 + rhs.nw];
-        self.ledger.push(t, &stored, &works[..1], &works[1..]);
+        self.ledger.push(t, &self.stored, &works[..1], &works[1..]);
     }
 }
