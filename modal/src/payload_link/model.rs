@@ -548,6 +548,26 @@ impl RotationForm {
                 };
             }
         }
+        // The differences leave round-off (~ε·max|I_p|) where a coefficient is exactly zero
+        // (e.g. every coupling of v′ with w′, φ for a diagonal I_p): clear it, so that a
+        // decoupled pair stays decoupled to the bit.
+        let floor =
+            64.0 * f64::EPSILON * inertia.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        let chop = |v: &mut f64| {
+            if v.abs() <= floor {
+                *v = 0.0;
+            }
+        };
+        chop(&mut r.j0);
+        for a in 0..3 {
+            chop(&mut r.b[a]);
+            chop(&mut r.h[a]);
+            for c in 0..3 {
+                chop(&mut r.m[a][c]);
+                chop(&mut r.g[a][c]);
+                chop(&mut r.n[a][c]);
+            }
+        }
         r
     }
 }
