@@ -159,3 +159,64 @@ pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, Modal
         },
     })
 }
+
+/// Frequencies \[Hz\] with the gyroscopic coupling at the reference rate Ω:
+/// M q̈ + Ω(Gᵀ − G) q̇ + K_eff q = 0 (prescribed base; K_eff = K − Ω²N must be positive
+/// definite). With z = (q̇, q), A = diag(M, K_eff) and the skew B = [[Ω(Gᵀ − G), K_eff],
+/// [−K_eff, 0]], A ż + B z = 0; for A = LLᵀ, S = L⁻¹BL⁻ᵀ is skew, its eigenvalues ±iω, and the
+/// ω² are the (doubled) eigenvalues of the symmetric SᵀS. Ascending, `count` of them.
+pub fn gyroscopic_frequencies(
+    scene: &Scene,
+    settings: &Settings,
+    count: usize,
+) -> Result<Vec<f64>, ModalError> {
+    let s = set_up(scene, &settings.discretization)?;
+    let model = &s.model;
+    if model.base.free {
+        return Err(ModalError::Unsupported(
+            "gyroscopic frequencies of a free base (the base angle is not a coordinate of \
+             this analysis)"
+                .into(),
+        ));
+    }
+    let (k, m, rate) = linear_pencil(model);
+    let n = model.n;
+    let mut a = Mat::<f64>::zeros(2 * n, 2 * n);
+    let mut b = Mat::<f64>::zeros(2 * n, 2 * n);
+    for i in 0..n {
+        for j in 0..n {
+            a[(i, j)] = m[(i, j)];
+            a[(n + i, n + j)] = k[(i, j)];
+            b[(i, j)] = rate * (model.gyro[j * n + i] - model.gyro[i * n + j]);
+            b[(i, n + j)] = k[(i, j)];
+            b[(n + i, j)] = -k[(i, j)];
+        }
+    }
+    let llt = a
+        .llt(faer::Side::Lower)
+        .map_err(|_| ModalError::Numerical {
+            t: 0.0,
+            message: "K − Ω²N is not positive definite: no gyroscopic frequencies".into(),
+        })?;
+    let l = llt.L();
+    let mut t = b.clone();
+    l.solve_lower_triangular_in_place(&mut t);
+    let mut sk = t.transpose().to_owned();
+    l.solve_lower_triangular_in_place(&mut sk);
+    // sk = (L⁻¹ B L⁻ᵀ)ᵀ = −S; SᵀS is the same from either sign.
+    let c = sk.transpose() * &sk;
+    let c = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
+    let mut w2 =
+        c.self_adjoint_eigenvalues(faer::Side::Lower)
+            .map_err(|_| ModalError::Numerical {
+                t: 0.0,
+                message: "eigen-decomposition did not converge".into(),
+            })?;
+    w2.sort_by(|x, y| x.total_cmp(y));
+    Ok(w2
+        .iter()
+        .step_by(2)
+        .take(count)
+        .map(|v| v.max(0.0).sqrt() / std::f64::consts::TAU)
+        .collect())
+}
