@@ -1,11 +1,12 @@
-//! The `data::Backend` implementation: planar chains here, the rocket in [`crate::rocket`].
+//! The `data::Backend` implementation: planar chains here, the rocket in [`crate::rocket`], the
+//! 3-D payload link in [`crate::payload_link`].
 
 use data::{
     Backend, BackendError, BackendKind, Discretization, DofPlan, Family, ModalResult, RunResult,
     Scene, Settings, StaticResult,
 };
 
-use crate::{modes, rocket, setup, simulate, statics};
+use crate::{modes, payload_link, rocket, setup, simulate, statics};
 
 /// The assumed-mode backend (unit struct; all state lives in a run).
 #[derive(Debug, Clone, Copy, Default)]
@@ -19,6 +20,7 @@ impl Backend for ModalBackend {
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
         match scene.family() {
             Family::Rocket => rocket::dof_plan(scene, disc),
+            Family::PayloadLink => Ok(payload_link::dof_plan(scene, disc)?),
             _ => Ok(setup::dof_plan(scene, disc)?),
         }
     }
@@ -31,6 +33,7 @@ impl Backend for ModalBackend {
     ) -> Result<ModalResult, BackendError> {
         match scene.family() {
             Family::Rocket => rocket::modes(scene, settings, count),
+            Family::PayloadLink => Ok(payload_link::modes(scene, settings, count)?),
             _ => Ok(modes::modes(scene, settings, count)?),
         }
     }
@@ -38,6 +41,7 @@ impl Backend for ModalBackend {
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
         match scene.family() {
             Family::Rocket => Err(BackendError::unsupported("modal: statics of the rocket")),
+            Family::PayloadLink => Ok(payload_link::statics(scene, settings)?),
             _ => Ok(statics::statics(scene, settings)?),
         }
     }
@@ -45,6 +49,7 @@ impl Backend for ModalBackend {
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
         match scene.family() {
             Family::Rocket => rocket::simulate(scene, settings),
+            Family::PayloadLink => Ok(payload_link::simulate(scene, settings)?),
             _ => Ok(simulate::simulate(scene, settings)?),
         }
     }

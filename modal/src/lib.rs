@@ -38,7 +38,8 @@
 //! per link on `barhorst-case1-tipmass`). TR-BDF2 solves its Newton systems through the
 //! chain's own factored linearization ([`newton`]: Cholesky of M + cD + c²K with the contact
 //! rows, never M⁻¹K) and keeps it across the drift projections of the contact phase. The
-//! rocket (seed 003) is in [`rocket`].
+//! rocket (seed 003) is in [`rocket`], the 3-D
+//! link with an offset payload (seed 002) in [`payload_link`].
 //!
 //! Contact (Barhorst's work surface, [`contact`]): the gap g = n̂·(r_tip − p₀) is an event
 //! function located by Illinois root finding on the integrator's dense output (bracket
@@ -81,6 +82,7 @@ pub mod model;
 pub mod modes;
 pub mod newton;
 pub mod output;
+pub mod payload_link;
 pub mod rhs;
 pub mod rocket;
 pub mod setup;

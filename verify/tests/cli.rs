@@ -114,8 +114,15 @@ fn cli_missing_scene_and_bad_numbers_exit_2() {
 
 #[test]
 fn cli_unsupported_requests_exit_3_without_results() {
-    // No backend integrates the mobile manipulator yet.
-    let (code, out, err) = flexverify(&["run", "mobile-manipulator", "--format", "json"]);
+    // The modal backend has no statics of the free-free rocket.
+    let (code, out, err) = flexverify(&[
+        "statics",
+        "rocket",
+        "--backend",
+        "modal",
+        "--format",
+        "json",
+    ]);
     assert_eq!(code, 3, "{out}{err}");
     assert!(err.contains("unsupported"), "{err}");
     assert!(out.trim().is_empty(), "a fake result was printed: {out}");
