@@ -132,6 +132,14 @@ impl Quantity {
         if let Some(rest) = t.strip_prefix("freq") {
             return freq(rest, None);
         }
+        // KIND_freqN for the other mode kinds a backend reports (the 3-D link's `horizontal`,
+        // `vertical`, `torsion`).
+        if let Some((kind, rest)) = t.split_once("_freq")
+            && !kind.is_empty()
+            && kind.chars().all(|c| c.is_ascii_lowercase() || c == '-')
+        {
+            return freq(rest, Some(kind));
+        }
         match t {
             "tip_static" => return Ok(Quantity::StaticTip),
             "ledger_closure" => return Ok(Quantity::LedgerClosure),
@@ -177,7 +185,8 @@ impl Quantity {
             });
         }
         Err(format!(
-            "unknown quantity `{text}`; expected freqN, axial_freqN, bending_freqN, tip_static, \
+            "unknown quantity `{text}`; expected freqN, KIND_freqN (axial, bending, horizontal, \
+             vertical, torsion), tip_static, \
              CHANNEL@T, peak:CHANNEL, history:CHANNEL, lowpassF:history:CHANNEL, ledger_closure, max_momentum_residual, \
              impulseN, impact_timeN, release_timeN, episode_startN:F or episode_endN:F"
         ))
