@@ -699,9 +699,15 @@ mod tests {
         }
     }
 
-    /// Rayleigh–Ritz with φ_m = ξ² P_m(2ξ − 1) for a clamped plane at rest.
+    /// Rayleigh–Ritz with φ_m = ξ² P_m(2ξ − 1) for a clamped plane at rest; for a hub root the
+    /// rigid rotation φ = ξ (hub inertia I_B on its slope) replaces the last function, and the
+    /// rigid mode ω = 0 is dropped.
     fn ritz(p: &BendingPlane, nb: usize) -> Vec<f64> {
         let l = p.length;
+        let hub = match p.root {
+            PlaneRoot::Clamped => None,
+            PlaneRoot::Hub { inertia, .. } => Some(inertia),
+        };
         let nq = 3 * nb + 10;
         let mut k = Mat::<f64>::zeros(nb, nb);
         let mut m = Mat::<f64>::zeros(nb, nb);
@@ -720,6 +726,9 @@ mod tests {
             }
             (0..nb)
                 .map(|j| {
+                    if hub.is_some() && j == nb - 1 {
+                        return (xi, 1.0 / l, 0.0);
+                    }
                     let (a, b, c) = (pv[j], 2.0 * dp[j], 4.0 * ddp[j]);
                     (
                         xi * xi * a,
@@ -753,6 +762,9 @@ mod tests {
                 m[(i, j)] += p.tip_mass * ci * cj + p.tip_inertia * tip[i].1 * tip[j].1;
             }
         }
+        if let Some(ib) = hub {
+            m[(nb - 1, nb - 1)] += ib / (l * l);
+        }
         let llt = m.llt(Side::Lower).expect("mass matrix SPD");
         let lm = llt.L();
         let mut t = k.clone();
@@ -760,7 +772,32 @@ mod tests {
         let mut c = t.transpose().to_owned();
         lm.solve_lower_triangular_in_place(&mut c);
         let ev = c.self_adjoint_eigenvalues(Side::Lower).unwrap();
-        ev.into_iter().map(f64::sqrt).collect()
+        let skip = usize::from(hub.is_some());
+        ev.into_iter().skip(skip).map(f64::sqrt).collect()
+    }
+
+    #[test]
+    fn elem_hub_coupled_plane_matches_rayleigh_ritz() {
+        // Between the limits: the sign of the hub's inertia in EI W″(0) = −ω² I_B W′(0) is
+        // what this checks (both limits hold for either sign).
+        for ib in [0.05, 0.5] {
+            let mut p = plane(0.5, 0.02, 1.5e-4, 1.96e-5);
+            p.root = PlaneRoot::Hub {
+                inertia: ib,
+                stiffness: 0.0,
+            };
+            let f = p.frequencies(3).unwrap();
+            let r = ritz(&p, 16);
+            for k in 0..3 {
+                assert!(r[k] >= f[k] * (1.0 - 1e-9), "Ritz is an upper bound");
+                assert!(
+                    rel(r[k], f[k]) < 1e-6,
+                    "I_B {ib} mode {k}: {} {}",
+                    r[k],
+                    f[k]
+                );
+            }
+        }
     }
 
     #[test]
