@@ -55,12 +55,12 @@ fn sys_products_of_inertia_need_the_override() {
     // single-link-3d's own payload couples the planes: its frequency references refuse it and
     // the rows use the diagonal override.
     let scene = data::load_scene("single-link-3d").unwrap();
-    let q = Quantity::parse("vertical_freq1", &scene).unwrap();
+    let q = Quantity::parse("bending-vertical_freq1", &scene).unwrap();
     let e = analytic_value("payload-vertical", &scene, &q).unwrap_err();
     assert!(e.contains("products of inertia"), "{e}");
-    let q = Quantity::parse("horizontal_freq1", &scene).unwrap();
+    let q = Quantity::parse("bending-horizontal_freq1", &scene).unwrap();
     assert!(
-        matches!(q, Quantity::Frequency { n: 1, ref kind } if kind.as_deref() == Some("horizontal"))
+        matches!(q, Quantity::Frequency { n: 1, ref kind } if kind.as_deref() == Some("bending-horizontal"))
     );
 }
 

@@ -132,8 +132,8 @@ impl Quantity {
         if let Some(rest) = t.strip_prefix("freq") {
             return freq(rest, None);
         }
-        // KIND_freqN for the other mode kinds a backend reports (the 3-D link's `horizontal`,
-        // `vertical`, `torsion`).
+        // KIND_freqN for the other mode kinds a backend reports (the 3-D link's
+        // `bending-horizontal`, `bending-vertical`, `torsion`).
         if let Some((kind, rest)) = t.split_once("_freq")
             && !kind.is_empty()
             && kind.chars().all(|c| c.is_ascii_lowercase() || c == '-')
@@ -185,8 +185,8 @@ impl Quantity {
             });
         }
         Err(format!(
-            "unknown quantity `{text}`; expected freqN, KIND_freqN (axial, bending, horizontal, \
-             vertical, torsion), tip_static, \
+            "unknown quantity `{text}`; expected freqN, KIND_freqN (axial, bending, \
+             bending-horizontal, bending-vertical, torsion), tip_static, \
              CHANNEL@T, peak:CHANNEL, history:CHANNEL, lowpassF:history:CHANNEL, ledger_closure, max_momentum_residual, \
              impulseN, impact_timeN, release_timeN, episode_startN:F or episode_endN:F"
         ))
@@ -218,7 +218,13 @@ impl Quantity {
                 .frequencies_hz
                 .iter()
                 .zip(&r.kinds)
-                .filter(|(_, kk)| *kk == k)
+                // A parenthetical qualifier ("bending-horizontal (no gyroscopic)") keeps the kind.
+                .filter(|(_, kk)| {
+                    *kk == k
+                        || kk
+                            .strip_prefix(k.as_str())
+                            .is_some_and(|r| r.starts_with(" ("))
+                })
                 .map(|(f, _)| *f)
                 .collect(),
         };

@@ -11,8 +11,8 @@
 //! | `static-linear` | `tip_static` | PL³/3EI + qL⁴/8EI for the scene's `[statics]` loads |
 //! | `rigid-single-link` | `joint1.angle@T`, `joint1.rate@T` | rigid link + hub + tip mass under the torque law (closed form) |
 //! | `rigid-two-link` | `jointI.angle@T`, `jointI.rate@T` | rigid two-link arm with the scene's springs/dampers (tight RK) |
-//! | `payload-horizontal` | `horizontal_freqN` | 3-D link: bending in the turning plane with the payload's mass, offset and I₃ (hub-coupled for a free base, rotating at a constant rate) |
-//! | `payload-vertical` | `vertical_freqN` | 3-D link: vertical bending with the payload's mass, offset and I₂ (rotating at a constant rate) |
+//! | `payload-horizontal` | `bending-horizontal_freqN` | 3-D link: bending in the turning plane with the payload's mass, offset and I₃ (hub-coupled for a free base, rotating at a constant rate) |
+//! | `payload-vertical` | `bending-vertical_freqN` | 3-D link: vertical bending with the payload's mass, offset and I₂ (rotating at a constant rate) |
 //! | `payload-torsion` | `torsion_freqN` | 3-D link: ζ tan ζ = ρJL/I₁ |
 //! | `payload-axial` | `axial_freqN` | 3-D link: ζ tan ζ = ρAL/m, softened by the base rate |
 //! | `payload-static-sag` | `tip_static` | 3-D link: linear sag w_L under self-weight, payload weight and its offset moment |
@@ -249,9 +249,9 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
         }
         "payload-horizontal" | "payload-vertical" => {
             let p = payload_link(scene)?;
-            let kind = id.trim_start_matches("payload-");
-            let n = mode_number(q, Some(kind))?;
-            let plane = if kind == "horizontal" {
+            let plane_name = id.trim_start_matches("payload-");
+            let n = mode_number(q, Some(&format!("bending-{plane_name}")))?;
+            let plane = if plane_name == "horizontal" {
                 ana::payload_link::BendingPlane::horizontal(p)
             } else {
                 ana::payload_link::BendingPlane::vertical(p)
@@ -311,8 +311,10 @@ pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
         let id = match q {
             Quantity::Frequency {
                 kind: Some(kind), ..
-            } if ["horizontal", "vertical", "torsion", "axial"].contains(&kind.as_str()) => {
-                format!("payload-{kind}")
+            } if ["bending-horizontal", "bending-vertical", "torsion", "axial"]
+                .contains(&kind.as_str()) =>
+            {
+                format!("payload-{}", kind.trim_start_matches("bending-"))
             }
             Quantity::StaticTip => "payload-static-sag".to_string(),
             _ => return None,
