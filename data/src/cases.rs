@@ -103,11 +103,15 @@ impl CaseSettings {
 pub enum Reference {
     /// A closed form / root-finding / shooting reference computed by code (id, see verify).
     Analytic { analytic: String },
-    /// The same quantity from another backend (cross-check).
+    /// The same quantity from another backend (cross-check), or — with `overrides` — from a
+    /// backend on a variant of the case's scene (e.g. the same backend without gravity: a
+    /// decoupling claim checked run against run). The overrides apply on top of the case's own.
     Backend {
         backend: BackendKind,
         #[serde(default)]
         settings: CaseSettings,
+        #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+        overrides: std::collections::BTreeMap<String, toml::Value>,
     },
     /// Observed order of convergence over a refinement ladder; `order` is the theoretical
     /// value the least-squares fit of log error against log h must match. Errors are taken
@@ -192,7 +196,8 @@ case_files!(
     "convergence",
     "friction",
     "contact",
-    "histories"
+    "histories",
+    "payload_link"
 );
 
 /// Parses a case file with located errors.

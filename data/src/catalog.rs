@@ -40,6 +40,8 @@ catalog!(
     "single-link-3d-constant-rate",
     "single-link-3d-soft-sag",
     "single-link-3d-stiff",
+    "single-link-3d-thin",
+    "single-link-3d-heavy-payload",
     "mobile-manipulator",
 );
 

@@ -70,6 +70,7 @@ fn against(backend: BackendKind) -> Reference {
     Reference::Backend {
         backend,
         settings: CaseSettings::default(),
+        overrides: Default::default(),
     }
 }
 

@@ -12,6 +12,9 @@
 //! * [`rotating`] — flapwise (Frobenius series) and in-plane rotating-cantilever frequencies.
 //! * [`rigid`] — rigid-link limits: torque-driven link, seed 001's friction-constrained link
 //!   (eq. 71), the rigid two-link Barhorst arm, the static normal force of an arm on its tip.
+//! * [`payload_link`] — the 3-D link with an offset payload (seed 002): bending in both planes
+//!   with the payload's mass, offset and inertia (rotating, hub-coupled), torsion, axial, linear
+//!   and large-deflection sag (the seed's formula against the elastica), the rigid-base limit.
 //! * [`rocket`] — rigid translation of the variable-mass rocket (rocket equation with gravity).
 //! * [`numerics`] — the root finder, the adaptive Runge–Kutta and double-double arithmetic,
 //!   written here so that no code is shared with a backend.
@@ -19,6 +22,7 @@
 pub mod beam;
 mod error;
 pub mod numerics;
+pub mod payload_link;
 pub mod rigid;
 pub mod rocket;
 pub mod rotating;

@@ -233,12 +233,31 @@ pub fn evaluate(case: &Case, cache: &RunCache) -> Outcome {
     out
 }
 
+/// The case's scene with its overrides and, on top, `extra` ones (a reference run on a variant
+/// of the scene).
+pub fn case_scene(
+    case: &Case,
+    extra: &std::collections::BTreeMap<String, toml::Value>,
+) -> Result<Scene, String> {
+    if case.overrides.is_empty() && extra.is_empty() {
+        return load_scene(&case.scene).map_err(|e| e.to_string());
+    }
+    let mut all = case.overrides.clone();
+    all.extend(extra.iter().map(|(k, v)| (k.clone(), v.clone())));
+    scene_with_overrides(&case.scene, &all)
+}
+
+/// " on overrides {k = v, …}" for a reference run on a scene variant ("" otherwise).
+fn variant_label(extra: &std::collections::BTreeMap<String, toml::Value>) -> String {
+    if extra.is_empty() {
+        return String::new();
+    }
+    let parts: Vec<String> = extra.iter().map(|(k, v)| format!("{k} = {v}")).collect();
+    format!(" on the scene with {}", parts.join(", "))
+}
+
 fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<(), String> {
-    let scene = if case.overrides.is_empty() {
-        load_scene(&case.scene).map_err(|e| e.to_string())?
-    } else {
-        scene_with_overrides(&case.scene, &case.overrides)?
-    };
+    let scene = case_scene(case, &Default::default())?;
     let q = Quantity::parse(&case.quantity, &scene)?;
     let settings = case.settings.to_settings();
 
@@ -314,24 +333,27 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
         Reference::Backend {
             backend,
             settings: ref_settings,
+            overrides: ref_overrides,
         },
     ) = (&q, &case.reference)
     {
-        let run = |kind, s: &Settings| match cache.get(&scene, kind, s, q.analysis(), 0) {
+        let ref_scene = case_scene(case, ref_overrides)?;
+        let run = |sc: &Scene, kind, s: &Settings| match cache.get(sc, kind, s, q.analysis(), 0) {
             Answer::Run(Ok(r)) => Ok(r),
             Answer::Run(Err(e)) => Err(format!("{kind}: {e}")),
             _ => Err("not a run".to_string()),
         };
-        let a = run(case.backend, &settings)?;
-        let b = run(*backend, &ref_settings.to_settings())?;
+        let a = run(&scene, case.backend, &settings)?;
+        let b = run(&ref_scene, *backend, &ref_settings.to_settings())?;
         let d = super::history::compare(&a, &b, channel, *lowpass_hz)
             .map_err(|e| format!("{} vs {backend}: {e}", case.backend))?;
         out.wall_time_s += a.cost.wall_time_s + b.cost.wall_time_s;
         out.value = Some(d.max_abs_diff);
         out.reference = Some(d.reference_peak);
         out.reference_label = format!(
-            "history of {backend}({}){}, error = max|Δ| / its peak",
+            "history of {backend}({}){}{}, error = max|Δ| / its peak",
             settings_label(ref_settings),
+            variant_label(ref_overrides),
             lowpass_hz.map_or(String::new(), |f| format!(", both low-passed at {f} Hz"))
         );
         if d.reference_peak <= 0.0 {
@@ -349,9 +371,18 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
             out.reference_label = format!("analytic:{analytic}");
             (analytic_value(analytic, &scene, &q)?, None)
         }
-        Reference::Backend { backend, settings } => {
-            out.reference_label = format!("{backend}({})", settings_label(settings));
-            let (r, p, w) = measure(cache, &scene, *backend, &settings.to_settings(), &q)?;
+        Reference::Backend {
+            backend,
+            settings,
+            overrides,
+        } => {
+            out.reference_label = format!(
+                "{backend}({}){}",
+                settings_label(settings),
+                variant_label(overrides)
+            );
+            let ref_scene = case_scene(case, overrides)?;
+            let (r, p, w) = measure(cache, &ref_scene, *backend, &settings.to_settings(), &q)?;
             out.wall_time_s += w;
             (r, p)
         }

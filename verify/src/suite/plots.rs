@@ -62,10 +62,13 @@ pub fn draw_all(dir: &Path, cases: &[Case], outcomes: &[Outcome], cache: &RunCac
                 Reference::Backend {
                     backend,
                     settings: rs,
+                    overrides,
                 },
             ) => {
                 let a = run(cache, &scene, case.backend, &settings);
-                let b = run(cache, &scene, *backend, &rs.to_settings());
+                let b = super::evaluate::case_scene(case, overrides)
+                    .ok()
+                    .and_then(|variant| run(cache, &variant, *backend, &rs.to_settings()));
                 match (
                     a.and_then(|r| series_of(&r, channel)),
                     b.and_then(|r| series_of(&r, channel)),

@@ -155,6 +155,14 @@ impl Quantity {
         if let Some(rest) = t.strip_prefix("freq") {
             return freq(rest, None);
         }
+        // KIND_freqN for the other mode kinds a backend reports (the 3-D link's
+        // `bending-horizontal`, `bending-vertical`, `torsion`).
+        if let Some((kind, rest)) = t.split_once("_freq")
+            && !kind.is_empty()
+            && kind.chars().all(|c| c.is_ascii_lowercase() || c == '-')
+        {
+            return freq(rest, Some(kind));
+        }
         match t {
             "tip_static" => return Ok(Quantity::StaticTip),
             "ledger_closure" => return Ok(Quantity::LedgerClosure),
@@ -200,7 +208,8 @@ impl Quantity {
             });
         }
         Err(format!(
-            "unknown quantity `{text}`; expected freqN, axial_freqN, bending_freqN, tip_static, \
+            "unknown quantity `{text}`; expected freqN, KIND_freqN (axial, bending, \
+             bending-horizontal, bending-vertical, torsion), tip_static, \
              CHANNEL@T, peak:CHANNEL, history:CHANNEL, lowpassF:history:CHANNEL, ledger_closure, max_momentum_residual, \
              impulseN, impulse_excessN, impact_timeN, release_timeN, episode_startN:F or episode_endN:F"
         ))
@@ -232,7 +241,13 @@ impl Quantity {
                 .frequencies_hz
                 .iter()
                 .zip(&r.kinds)
-                .filter(|(_, kk)| *kk == k)
+                // A parenthetical qualifier ("bending-horizontal (no gyroscopic)") keeps the kind.
+                .filter(|(_, kk)| {
+                    *kk == k
+                        || kk
+                            .strip_prefix(k.as_str())
+                            .is_some_and(|r| r.starts_with(" ("))
+                })
                 .map(|(f, _)| *f)
                 .collect(),
         };

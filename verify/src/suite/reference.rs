@@ -11,10 +11,17 @@
 //! | `static-linear` | `tip_static` | PL³/3EI + qL⁴/8EI for the scene's `[statics]` loads |
 //! | `rigid-single-link` | `joint1.angle@T`, `joint1.rate@T` | rigid link + hub + tip mass under the torque law (closed form) |
 //! | `rigid-two-link` | `jointI.angle@T`, `jointI.rate@T` | rigid two-link arm with the scene's springs/dampers (tight RK) |
+//! | `payload-horizontal` | `bending-horizontal_freqN` | 3-D link: bending in the turning plane with the payload's mass, offset and I₃ (hub-coupled for a free base, rotating at a constant rate) |
+//! | `payload-vertical` | `bending-vertical_freqN` | 3-D link: vertical bending with the payload's mass, offset and I₂ (rotating at a constant rate) |
+//! | `payload-torsion` | `torsion_freqN` | 3-D link: ζ tan ζ = ρJL/I₁ |
+//! | `payload-axial` | `axial_freqN` | 3-D link: ζ tan ζ = ρAL/m, softened by the base rate |
+//! | `payload-static-sag` | `tip_static` | 3-D link: linear sag w_L under self-weight, payload weight and its offset moment |
+//! | `payload-rigid-base` | `joint1.angle@T`, `joint1.rate@T` | 3-D link, E, G → ∞: (I_B + ρAL³/3 + ρIL + m(L + c)² + I₃) θ̈ = T_mot − b_m θ̇ |
 //! | `rocket-translation` | `rocket.vX@T`, `rocket.vY@T`, `rocket.mass@T` | rocket equation with gravity: material (momentum / mass) velocity |
 
 use data::Scene;
 use data::scene::Link;
+use data::scene::PayloadLink;
 use data::scene::PrescribedMotion;
 
 use super::quantity::Quantity;
@@ -29,6 +36,15 @@ fn single_link(scene: &Scene) -> Result<&Link, String> {
             scene.links.len()
         )),
     }
+}
+
+fn payload_link(scene: &Scene) -> Result<&PayloadLink, String> {
+    scene.payload_link.as_ref().ok_or_else(|| {
+        format!(
+            "this analytic reference needs a [payload_link] scene; `{}` is not one",
+            scene.name
+        )
+    })
 }
 
 fn mode_number(q: &Quantity, want_kind: Option<&str>) -> Result<usize, String> {
@@ -237,16 +253,80 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
                 )),
             }
         }
+        "payload-horizontal" | "payload-vertical" => {
+            let p = payload_link(scene)?;
+            let plane_name = id.trim_start_matches("payload-");
+            let n = mode_number(q, Some(&format!("bending-{plane_name}")))?;
+            let plane = if plane_name == "horizontal" {
+                ana::payload_link::BendingPlane::horizontal(p)
+            } else {
+                ana::payload_link::BendingPlane::vertical(p)
+            };
+            nth(plane.and_then(|pl| pl.frequencies_hz(n)), n)
+        }
+        "payload-torsion" => {
+            let p = payload_link(scene)?;
+            let n = mode_number(q, Some("torsion"))?;
+            nth(ana::payload_link::torsion_frequencies_hz(p, n), n)
+        }
+        "payload-axial" => {
+            let p = payload_link(scene)?;
+            let n = mode_number(q, Some("axial"))?;
+            nth(ana::payload_link::axial_frequencies_hz(p, n), n)
+        }
+        "payload-static-sag" => {
+            if !matches!(q, Quantity::StaticTip) {
+                return Err("`payload-static-sag` applies to `tip_static` (w_L)".into());
+            }
+            let p = payload_link(scene)?;
+            if p.gravity.is_none_or(|g| g == 0.0) {
+                return Err("the scene has no gravity: no sag".into());
+            }
+            Ok(ana::payload_link::linear_sag(p)
+                .map_err(|e| e.to_string())?
+                .0)
+        }
+        "payload-rigid-base" => {
+            let Quantity::At { channel, t } = q else {
+                return Err("`payload-rigid-base` applies to CHANNEL@T".into());
+            };
+            let (angle, rate) =
+                ana::payload_link::RigidPayloadBase::from_link(payload_link(scene)?)
+                    .and_then(|r| r.state(*t))
+                    .map_err(|e| e.to_string())?;
+            match channel.as_str() {
+                "joint1.angle" => Ok(angle),
+                "joint1.rate" => Ok(rate),
+                c => Err(format!(
+                    "`payload-rigid-base` has no channel `{c}` (joint1.angle, joint1.rate)"
+                )),
+            }
+        }
         other => Err(format!(
             "unknown analytic reference `{other}`; known: clamped-free, tip-mass, timoshenko, \
              axial-clamped-free, rotating-in-plane, static-linear, rigid-single-link, rigid-two-link, \
-             constrained-rigid-link, rocket-translation, tip-mass-momentum-limit"
+             constrained-rigid-link, rocket-translation, tip-mass-momentum-limit, payload-horizontal, \
+             payload-vertical, payload-torsion, payload-axial, payload-static-sag, payload-rigid-base"
         )),
     }
 }
 
 /// The analytic reference that naturally applies to a quantity on a scene, if any.
 pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
+    if scene.payload_link.is_some() {
+        let id = match q {
+            Quantity::Frequency {
+                kind: Some(kind), ..
+            } if ["bending-horizontal", "bending-vertical", "torsion", "axial"]
+                .contains(&kind.as_str()) =>
+            {
+                format!("payload-{}", kind.trim_start_matches("bending-"))
+            }
+            Quantity::StaticTip => "payload-static-sag".to_string(),
+            _ => return None,
+        };
+        return Some(id);
+    }
     let [l] = scene.links.as_slice() else {
         return None;
     };
