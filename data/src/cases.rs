@@ -191,7 +191,8 @@ case_files!(
     "convergence",
     "friction",
     "contact",
-    "histories"
+    "histories",
+    "mobile"
 );
 
 /// Parses a case file with located errors.

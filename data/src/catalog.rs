@@ -38,6 +38,9 @@ catalog!(
     "rocket-launch-75",
     "single-link-3d",
     "mobile-manipulator",
+    "mobile-platform",
+    "mobile-arm-fixed-base",
+    "mobile-manipulator-flexible",
 );
 
 /// Names of the catalog scenes.
