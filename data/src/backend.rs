@@ -15,9 +15,13 @@ pub enum BackendKind {
     Fem,
     Fdm,
     Modal,
+    /// verify's rigid reference, for families that have one (the mobile manipulator); not a
+    /// discretization, so not in [`BackendKind::ALL`].
+    Reference,
 }
 
 impl BackendKind {
+    /// The three discretizations.
     pub const ALL: [BackendKind; 3] = [BackendKind::Fem, BackendKind::Fdm, BackendKind::Modal];
 
     pub fn name(self) -> &'static str {
@@ -25,6 +29,7 @@ impl BackendKind {
             BackendKind::Fem => "fem",
             BackendKind::Fdm => "fdm",
             BackendKind::Modal => "modal",
+            BackendKind::Reference => "reference",
         }
     }
 }

@@ -197,7 +197,8 @@ case_files!(
     "friction",
     "contact",
     "histories",
-    "payload_link"
+    "payload_link",
+    "mobile"
 );
 
 /// Parses a case file with located errors.

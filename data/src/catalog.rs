@@ -43,6 +43,9 @@ catalog!(
     "single-link-3d-thin",
     "single-link-3d-heavy-payload",
     "mobile-manipulator",
+    "mobile-platform",
+    "mobile-arm-fixed-base",
+    "mobile-manipulator-flexible",
 );
 
 /// Names of the catalog scenes.

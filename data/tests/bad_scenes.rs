@@ -166,3 +166,51 @@ fn empty_file_says_what_is_missing() {
     let e = err("");
     assert!(e.message.contains("missing field"), "{e}");
 }
+
+const MOBILE: &str = include_str!("../scenes/mobile-manipulator.toml");
+
+#[test]
+fn mobile_asymmetric_inertia_names_the_tensor() {
+    let text = MOBILE.replace(
+        "inertia = [[0.0002, 0.00003, 0.0], [0.00003, 0.00025, 0.0], [0.0, 0.0, 0.00025]]",
+        "inertia = [[0.0002, 0.00003, 0.0], [0.0, 0.00025, 0.0], [0.0, 0.0, 0.00025]]",
+    );
+    let e = err(&text);
+    assert_eq!(e.path, "mobile_manipulator.arm.gripper.inertia", "{e}");
+    assert!(e.message.contains("not symmetric"), "{e}");
+}
+
+#[test]
+fn mobile_unphysical_inertia_is_rejected() {
+    // Izz larger than Ixx + Iyy: no real body has it.
+    let text = MOBILE.replace(
+        "inertia = [[0.0002, 0.0, 0.0], [0.0, 0.0076, 0.0], [0.0, 0.0, 0.0076]]",
+        "inertia = [[0.0002, 0.0, 0.0], [0.0, 0.0076, 0.0], [0.0, 0.0, 0.0176]]",
+    );
+    let e = err(&text);
+    assert_eq!(e.path, "mobile_manipulator.arm.links[0].inertia", "{e}");
+    assert!(
+        e.expected.contains("triangle") || e.message.contains("triangle"),
+        "{e}"
+    );
+}
+
+#[test]
+fn mobile_odd_wheels_and_missing_axle_are_named() {
+    let e = err(&MOBILE.replace("wheel_count = 6", "wheel_count = 5"));
+    assert_eq!(e.path, "mobile_manipulator.platform.wheel_count", "{e}");
+    let e = err(&MOBILE.replace("driven_axles = [1, 2, 3]", "driven_axles = [1, 4]"));
+    assert_eq!(e.path, "mobile_manipulator.platform.driven_axles[1]", "{e}");
+    assert!(e.expected.contains("1 to 3"), "{e}");
+}
+
+#[test]
+fn mobile_torque_schedule_width_is_checked() {
+    let text = MOBILE.replace(
+        "amplitude = [0.05, 0.3, 0.2, 0.05]",
+        "amplitude = [0.05, 0.3, 0.2]",
+    );
+    let e = err(&text);
+    assert_eq!(e.path, "mobile_manipulator.arm.torques.amplitude", "{e}");
+    assert!(e.expected.contains("4 entries"), "{e}");
+}

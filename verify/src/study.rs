@@ -126,6 +126,8 @@ fn space_ladder(kind: BackendKind, base: &Settings) -> Vec<(Settings, f64, Strin
         s
     };
     match kind {
+        // The rigid reference has no spatial discretization.
+        BackendKind::Reference => {}
         BackendKind::Fem => {
             for n in [2usize, 4, 8, 16, 32, 64] {
                 out.push((

@@ -76,7 +76,7 @@ fn against(backend: BackendKind) -> Reference {
 
 #[test]
 fn sys_coverage_row_kinds_are_derived_from_reference_and_quantity() {
-    use BackendKind::*;
+    use BackendKind::{Fdm, Fem, Modal};
     let scene = data::load_scene("two-link-free").unwrap();
     let kinds =
         |c: &Case| -> Vec<CheckKind> { row_kinds(c, &scene).into_iter().map(|k| k.0).collect() };

@@ -14,7 +14,10 @@ mod payload;
 mod planar;
 mod rocket;
 
-pub use mobile::MobileManipulator;
+pub use mobile::{
+    Arm, ArmLink, FlexibleLink, InitialState, MobileManipulator, Platform, RigidBody,
+    TorqueSchedule,
+};
 pub use payload::{
     InitialShape as LinkInitialShape, KelvinVoigt3d, LinkField, Payload, PayloadLink,
 };
@@ -116,6 +119,11 @@ impl Scene {
     /// Physics switched on anywhere in the scene, as human-readable flags
     /// (used by `describe`; every entry is an effect a backend must build).
     pub fn physics_flags(&self) -> Vec<(&'static str, bool)> {
+        if let Some(m) = &self.mobile_manipulator {
+            let mut flags = m.physics_flags();
+            flags.retain(|(_, on)| *on);
+            return flags;
+        }
         let any = |f: fn(&Link) -> bool| self.links.iter().any(f);
         let mut flags = vec![
             ("gravity", self.gravity.is_some()),

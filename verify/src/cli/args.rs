@@ -172,25 +172,43 @@ pub enum BackendChoice {
     Fem,
     Fdm,
     Modal,
+    /// verify's rigid reference (mobile manipulator scenes).
+    Reference,
     All,
 }
 
 impl CommonOpts {
-    /// The chosen backends, each once, in catalog order.
+    /// The chosen backends, each once, in catalog order (`all` means the three
+    /// discretizations; the reference only when named).
     pub fn kinds(&self) -> Vec<data::BackendKind> {
+        self.chosen_kinds(false)
+    }
+
+    /// The chosen backends for a scene: `all` also takes verify's rigid reference when the
+    /// scene's family has one (the mobile manipulator).
+    pub fn kinds_for(&self, scene: &data::Scene) -> Vec<data::BackendKind> {
+        self.chosen_kinds(scene.family() == data::Family::MobileManipulator)
+    }
+
+    fn chosen_kinds(&self, all_takes_reference: bool) -> Vec<data::BackendKind> {
         use data::BackendKind as K;
         let chosen = |k: K| {
             self.backend.iter().any(|&c| {
-                c == BackendChoice::All
+                (c == BackendChoice::All && (k != K::Reference || all_takes_reference))
                     || matches!(
                         (c, k),
                         (BackendChoice::Fem, K::Fem)
                             | (BackendChoice::Fdm, K::Fdm)
                             | (BackendChoice::Modal, K::Modal)
+                            | (BackendChoice::Reference, K::Reference)
                     )
             })
         };
-        K::ALL.into_iter().filter(|&k| chosen(k)).collect()
+        K::ALL
+            .into_iter()
+            .chain([K::Reference])
+            .filter(|&k| chosen(k))
+            .collect()
     }
 }
 

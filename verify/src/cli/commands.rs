@@ -119,7 +119,7 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(name)?;
     let settings = opts.settings();
     let mut plans = Vec::new();
-    for kind in opts.kinds() {
+    for kind in opts.kinds_for(&scene) {
         match backend(kind).dof_plan(&scene, &settings.discretization) {
             Ok(plan) => plans.push(BackendPlan {
                 backend: kind,
@@ -286,7 +286,7 @@ fn for_backends<T>(
 ) -> Result<Vec<(BackendKind, T)>, CliError> {
     let mut done = Vec::new();
     let mut unsupported = Vec::new();
-    for kind in opts.kinds() {
+    for kind in opts.kinds_for(scene) {
         match f(backend(kind).as_ref()) {
             Ok(v) => done.push((kind, v)),
             Err(BackendError::Unsupported(why)) => {

@@ -9,8 +9,11 @@
 //!   integrated by Dormand–Prince at tight tolerance (scene `two-link-free` and variants).
 //! * [`resting`] — the static normal force of the rigid arm resting on its tip
 //!   (scene `barhorst-case1-stiff-elbow`).
+//! * [`mobile`] — the rigid mobile manipulator of seed 004 (platform with nonholonomic
+//!   constraints, four-joint arm), two formulations and inverse dynamics (backend `reference`).
 
 pub mod constrained;
+pub mod mobile;
 pub mod resting;
 pub mod single;
 pub mod two_link;
