@@ -32,9 +32,8 @@
 //! Newton on the mean acceleration a = (v₁ − v₀)/h with the generalized-α matrix machinery at
 //! (q̄, v̄, a): S = M + (h/2)C + (h²/4)K (∂q̄/∂a = h²/4, ∂v̄/∂a = h/2), analytic bordered-band or
 //! the exact finite-difference dense matrix for free chains with foreshortening (reused across
-//! steps while Newton converges in ≤ 8 iterations and its extra iterations have not yet cost
-//! as much as a new matrix, `NewtonSystem::reuse_cost`: S is the derivative of R(q̄, v̄, a), not
-//! of the discrete equations, so convergence is linear — about 1e-2..1e-3 per iteration — and
+//! steps while Newton converges in ≤ 8 iterations: S is the derivative of R(q̄, v̄, a), not of
+//! the discrete equations, so convergence is linear — about 1e-2..1e-3 per iteration — and
 //! re-forming the dense matrix after every slow step cost 1.5× more, measured on
 //! `two-link-free-undamped`). The correction term is not differentiated (quasi-Newton). The
 //! matrix is re-formed every 6th iteration only while the update is above tolerance: the
