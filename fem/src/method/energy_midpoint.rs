@@ -534,16 +534,7 @@ impl Stepper for EnergyMidpoint {
         }
         cx.counters.rhs += passes;
         // See the module docs: the linear contraction makes > 3 iterations normal here.
-        // A matrix reused across steps is re-formed when Newton fails or needs > 8 iterations,
-        // or when its extra iterations have cost as much as a new finite-difference matrix
-        // (`NewtonSystem::reuse_cost`; on `two-link-free` a matrix kept while Newton stayed
-        // under 9 iterations took 6 per step instead of 3.5: 38 % more residual passes).
-        let per_iteration = passes as f64 / iterations.max(1) as f64;
-        let costly = cx.newton.jacobian == JacobianKind::DenseFiniteDifference
-            && cx
-                .newton
-                .reuse_cost(formed_it == Some(0), iterations, per_iteration);
-        cx.newton.slow_convergence = !converged || iterations > 8 || costly;
+        cx.newton.slow_convergence = !converged || iterations > 8;
         if !converged {
             if cx.adaptive.is_some() || h > 1e-6 * cx.h_nominal {
                 return Ok(Some(f64::INFINITY));

@@ -27,11 +27,6 @@ pub struct NewtonSystem {
     /// Step size the current matrix was formed with, and whether it must be refreshed.
     pub matrix_h: f64,
     pub slow_convergence: bool,
-    /// Newton iterations of the step whose matrix was formed at its first iteration, and the
-    /// residual passes spent since then on iterations beyond that count (the cost of reusing
-    /// the matrix: [`NewtonSystem::reuse_cost`]).
-    pub fresh_iterations: usize,
-    pub excess_passes: f64,
     /// Residual at the trial point (input of [`NewtonSystem::form`]).
     pub res: Vec<f64>,
     /// Right-hand side and solution of [`NewtonSystem::solve`].
@@ -64,8 +59,6 @@ impl NewtonSystem {
             dense: (jacobian == JacobianKind::DenseFiniteDifference).then(|| DenseLu::new(n)),
             matrix_h: f64::NAN,
             slow_convergence: true,
-            fresh_iterations: 0,
-            excess_passes: 0.0,
             res: vec![0.0; n],
             delta: vec![0.0; n],
             tol: 1e-11 * length_scale.max(1e-3),
@@ -104,27 +97,6 @@ impl NewtonSystem {
             self.slow_convergence = false;
         }
         Ok(())
-    }
-
-    /// Books a converged step's Newton iterations for the refresh rule and tells whether the
-    /// reused matrix has cost more than forming a new one: the passes spent on iterations beyond
-    /// those of the step the matrix was fresh for (`passes_per_iteration` each) add up to the
-    /// passes of a finite-difference matrix (one per DOF). Amortized refresh: a stale matrix
-    /// that costs one extra iteration per step is re-formed every ~n/passes_per_iteration steps.
-    pub fn reuse_cost(
-        &mut self,
-        fresh: bool,
-        iterations: usize,
-        passes_per_iteration: f64,
-    ) -> bool {
-        if fresh {
-            self.fresh_iterations = iterations;
-            self.excess_passes = 0.0;
-            return false;
-        }
-        self.excess_passes +=
-            iterations.saturating_sub(self.fresh_iterations) as f64 * passes_per_iteration;
-        self.excess_passes >= self.res.len() as f64
     }
 
     /// Whether the current matrix was formed for steps of length `h`, up to round-off: a step
