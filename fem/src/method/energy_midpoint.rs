@@ -412,7 +412,7 @@ impl Stepper for EnergyMidpoint {
             cx.counters.newton += 1;
             // Newton matrix at (q̄, v̄, a): a full residual there fills the chain's point data.
             let fresh = cx.newton.jacobian == JacobianKind::Banded
-                || !cx.newton.formed_for(h)
+                || cx.newton.matrix_h != h
                 || cx.newton.slow_convergence;
             // The periodic refresh only while the update is above tolerance: once it is within
             // tolerance and only the energy defect is being polished, the stale matrix still

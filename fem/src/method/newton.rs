@@ -90,22 +90,13 @@ impl NewtonSystem {
         t: f64,
     ) -> Result<(), FemError> {
         let fresh =
-            self.jacobian == JacobianKind::Banded || !self.formed_for(h) || self.slow_convergence;
+            self.jacobian == JacobianKind::Banded || self.matrix_h != h || self.slow_convergence;
         if (it == 0 && fresh) || it == 6 || it == 12 || it == 18 {
             self.form(chain, st, counters, h_nominal, c, t_law, t)?;
             self.matrix_h = h;
             self.slow_convergence = false;
         }
         Ok(())
-    }
-
-    /// Whether the current matrix was formed for steps of length `h`, up to round-off: a step
-    /// that ends on an output time is `target − t`, which differs from the nominal step in its
-    /// last bits (on `barhorst-case1` every other step), and an exact comparison re-formed the
-    /// dense finite-difference matrix at every step. A relative difference of 1e-9 changes
-    /// the coefficients c_v, c_q by as much: far below what slows Newton.
-    pub fn formed_for(&self, h: f64) -> bool {
-        (self.matrix_h - h).abs() <= 1e-9 * h
     }
 
     /// Forms and factorizes the Newton matrix at (q1, q̇1, q̈1) after a residual evaluation there.
