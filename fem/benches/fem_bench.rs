@@ -1,7 +1,8 @@
 //! Criterion benches: assembly (residual + Newton matrix), one generalized-α step, the full
 //! 20 s spin-up for 4–64 elements, and the full 3 s `single-link` run at default settings with
 //! energy-midpoint (the default there) and generalized-α; whole default runs of the arms
-//! (`two-link-free-undamped` 10 s, `barhorst-case1` 3 s).
+//! (`two-link-free-undamped` 10 s, `barhorst-case1` 3 s) and the first second of
+//! `two-link-free-undamped` (`arms-1s`).
 //! Run: `cargo bench -p fem --bench fem_bench -- --quick` (one group: append its name, e.g. `arms`).
 
 use std::hint::black_box;
@@ -104,5 +105,28 @@ fn arms(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, assembly, one_step, spin_up, single_link, arms);
+/// The free two-link arm over its first second at default settings (energy-midpoint, 16
+/// elements per link, dense finite-difference Newton matrix refreshed when Newton slows): the
+/// per-step cost of the foreshortening chain without the 10 s of the whole run.
+fn arms_short(c: &mut Criterion) {
+    let mut g = c.benchmark_group("arms-1s");
+    g.sample_size(10);
+    let sc = data::load_scene("two-link-free-undamped").unwrap();
+    let mut st = Settings::default();
+    st.time.t_end = Some(1.0);
+    g.bench_function("two-link-free-undamped", |b| {
+        b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
+    });
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    assembly,
+    one_step,
+    spin_up,
+    single_link,
+    arms,
+    arms_short
+);
 criterion_main!(benches);

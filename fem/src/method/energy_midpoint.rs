@@ -35,7 +35,10 @@
 //! steps while Newton converges in ≤ 8 iterations: S is the derivative of R(q̄, v̄, a), not of
 //! the discrete equations, so convergence is linear — about 1e-2..1e-3 per iteration — and
 //! re-forming the dense matrix after every slow step cost 1.5× more, measured on
-//! `two-link-free-undamped`). The correction term is not differentiated (quasi-Newton). The iterate is accepted at the point where the residual was evaluated, so the
+//! `two-link-free-undamped`). The correction term is not differentiated (quasi-Newton). The
+//! matrix is re-formed every 6th iteration only while the update is above tolerance: the
+//! iterations that only reduce the energy defect keep the stale matrix, which still contracts.
+//! The iterate is accepted at the point where the residual was evaluated, so the
 //! booked energies and works are those of the equations actually solved.
 //!
 //! Tip contact ([`crate::events::contact`], through [`StepConstraint`]): in a constrained phase the momentum equation gains
@@ -55,8 +58,8 @@
 //!   applied); the first update of such a fresh matrix may be larger than the stalled ones
 //!   (no divergence test on it), an update larger than a link length is a failure, and a
 //!   singular matrix at an iterate is a Newton failure (the stretch is retried shorter);
-//! * the periodic refresh is skipped, and the iterate accepted, once the update is within
-//!   tolerance and only the energy defect is being reduced (a new matrix there only added
+//! * the iterate is accepted once the update is within tolerance and the next one is larger
+//!   (round-off noise while the energy defect is being reduced; a new matrix there only added
 //!   noise, and its larger update was taken for divergence);
 //! * the predictor is the previous mean acceleration only if that step was not 10× shorter
 //!   (a located event just before: its mean acceleration is close to the point value, 5e6 at
@@ -411,13 +414,16 @@ impl Stepper for EnergyMidpoint {
             let fresh = cx.newton.jacobian == JacobianKind::Banded
                 || cx.newton.matrix_h != h
                 || cx.newton.slow_convergence;
-            // (With a unilateral contact: not where the last update was already within
-            // tolerance and only the energy defect is being polished: a new finite-difference
-            // matrix there only adds noise. Without: constrained steps shortened to locate an
-            // event refresh every iteration, their impulsive multipliers making the
-            // quasi-Newton contraction poor; the unilateral contact refreshes stale matrices
-            // instead, below.)
-            let periodic = (it == 6 || it == 12 || it == 18) && (!robust || last > polish_tol);
+            // The periodic refresh only while the update is above tolerance: once it is within
+            // tolerance and only the energy defect is being polished, the stale matrix still
+            // contracts (1e-2..1e-3 per iteration) and a new one only costs (on
+            // `two-link-free-undamped` the polish reached iteration 6 in almost every step: one
+            // dense finite-difference matrix per step, 20 % of the residual passes); with a
+            // unilateral contact a new matrix there also added noise. (Constrained steps
+            // shortened to locate an event refresh every iteration without a unilateral
+            // contact, their impulsive multipliers making the quasi-Newton contraction poor;
+            // the unilateral contact refreshes stale matrices instead, below.)
+            let periodic = (it == 6 || it == 12 || it == 18) && last > polish_tol;
             let refresh = !robust && constraint.is_some() && h < 0.999 * cx.h_nominal;
             if (it == 0 && fresh) || periodic || refresh || force_refresh {
                 formed_it = Some(it);
