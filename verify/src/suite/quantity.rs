@@ -218,7 +218,10 @@ impl Quantity {
     /// Modes to request from a backend (0 for non-modal quantities).
     pub fn modes_needed(&self) -> usize {
         match self {
-            Quantity::Frequency { n, .. } => super::run_cache::mode_count(*n),
+            Quantity::Frequency { n, kind: None } => super::run_cache::mode_count(*n),
+            // The n-th mode of one kind can sit far up the spectrum (the 3-D link's first axial
+            // mode is its ~15th): ask for enough modes that every field has n of its own.
+            Quantity::Frequency { n, kind: Some(_) } => 4 * super::run_cache::mode_count(*n),
             _ => 0,
         }
     }
