@@ -130,8 +130,8 @@ pub enum TorqueSchedule {
         #[serde(default)]
         bias: Vec<f64>,
     },
-    /// values[k] holds on [times[k], times[k+1]) (the last one to the end); zero before
-    /// times[0]. Accelerate–cruise–decelerate paths are written this way.
+    /// `values[k]` holds on `[times[k], times[k+1])` (the last one to the end); zero before
+    /// `times[0]`. Accelerate–cruise–decelerate paths are written this way.
     Steps {
         times: Vec<f64>,
         values: Vec<Vec<f64>>,

@@ -11,13 +11,13 @@
 //! the clamp half cells ρAh³/24 shrink it like h³–h⁴.
 //!
 //! **Solve.** M + ½τC is the lumped diagonal plus the full columns F = {θ, β, x₁, x₂, y} of M
-//! ([`super::mass`]) plus C. Outside F ("band": v₁…v_{r−1}, w₁…w_{r−1} in q order) C is
+//! (`chain::mass`) plus C. Outside F ("band": v₁…v_{r−1}, w₁…w_{r−1} in q order) C is
 //! pentadiagonal — the bending stencil per link, and the elbow damper couples v_{r−1} with the
 //! adjacent w₁ — so A_BB = D_B + ½τC_BB is SPD pentadiagonal and constant while τ is: its
 //! LDLᵀ is computed once per step length. Per kick: Z = A_BB⁻¹A_BF (|F| columns, A_BF from the
 //! current columns of M), the |F|×|F| Schur complement A_FF − A_BFᵀZ, back substitution: six
 //! banded solves, O(n), no allocation. C itself is read once from
-//! [`TwoLinkChain::add_damping_forces`] by probing: each full column alone, the band columns
+//! `TwoLinkChain::add_damping_forces` by probing: each full column alone, the band columns
 //! in five interleaved colours (bandwidth 2).
 //!
 //! **Ledger.** The powers are those of the level velocities (v_{j+1}ᵀCv_{j+1} and the joint
@@ -203,7 +203,7 @@ impl TwoLinkChain {
         self.implicit = Some(imp);
     }
 
-    /// out = (M + ½τC)⁻¹ rhs with the columns of the last [`Self::build_columns`] (module
+    /// out = (M + ½τC)⁻¹ rhs with the columns of the last `build_columns` (module
     /// docs). O(n), no allocation (the factorization is redone only when τ changes).
     pub fn solve_damped_mass(&mut self, tau: f64, rhs: &[f64], out: &mut [f64]) {
         let mut imp = self.implicit.take().expect("implicit damping");

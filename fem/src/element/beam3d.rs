@@ -63,7 +63,7 @@ impl NodeLayout {
     }
 }
 
-/// A linear functional of the DOFs, Σ val·d[idx], with at most four terms.
+/// A linear functional of the DOFs, `Σ val·d[idx]`, with at most four terms.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Row {
     pub len: usize,
