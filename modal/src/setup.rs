@@ -444,3 +444,23 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
     }
     Ok(plan)
 }
+
+/// The run's end time (settings override the scene), after checking it and any user step.
+pub(crate) fn checked_span(scene: &Scene, settings: &data::Settings) -> Result<f64, ModalError> {
+    let t_end = settings.time.t_end.unwrap_or(scene.simulation.t_end);
+    if !(t_end > 0.0 && t_end.is_finite()) {
+        return Err(ModalError::invalid(
+            "time.t_end",
+            format!("{t_end} is not a positive time"),
+        ));
+    }
+    if let Some(dt) = settings.time.dt
+        && !(dt > 0.0 && dt.is_finite())
+    {
+        return Err(ModalError::invalid(
+            "time.dt",
+            format!("{dt} is not a positive step"),
+        ));
+    }
+    Ok(t_end)
+}

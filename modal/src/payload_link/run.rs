@@ -76,21 +76,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
             "tolerances must be positive",
         ));
     }
-    let t_end = settings.time.t_end.unwrap_or(scene.simulation.t_end);
-    if !(t_end > 0.0 && t_end.is_finite()) {
-        return Err(ModalError::invalid(
-            "time.t_end",
-            format!("{t_end} is not a positive time"),
-        ));
-    }
-    if let Some(dt) = settings.time.dt
-        && !(dt > 0.0 && dt.is_finite())
-    {
-        return Err(ModalError::invalid(
-            "time.dt",
-            format!("{dt} is not a positive step"),
-        ));
-    }
+    let t_end = crate::setup::checked_span(scene, settings)?;
     let q0 = match link.initial_shape {
         LinkInitialShape::StaticSag => static_sag(&model)?,
         LinkInitialShape::Undeformed => vec![0.0; model.n],

@@ -73,6 +73,7 @@ use serde::{Deserialize, Serialize};
 use crate::analytic::beam::axial_tip_mass_frequencies_hz;
 use crate::analytic::error::{AnalyticError, Result, finite, non_negative, positive};
 use crate::analytic::numerics::ode::Dopri5;
+use crate::analytic::numerics::quadrature::gauss_legendre;
 use crate::analytic::numerics::roots::{RootOptions, brent, first_roots};
 use crate::analytic::rigid::law_breakpoints;
 
@@ -424,32 +425,6 @@ pub fn seed_sag(alpha: f64) -> Result<(f64, f64)> {
     };
     let ah = brent(closure, 0.0, hi, RootOptions::default())?;
     Ok((ah, integrate(ah, &|xi| slope(ah, xi))))
-}
-
-/// Gauss–Legendre quadrature of order `n` on \[a, b\] (nodes by Newton on P_n).
-fn gauss_legendre(a: f64, b: f64, n: usize, g: &dyn Fn(f64) -> f64) -> f64 {
-    let mut sum = 0.0;
-    for i in 1..=n {
-        let mut z = (PI * (i as f64 - 0.25) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let dz = p1 / dp;
-            z -= dz;
-            if dz.abs() < 1e-16 {
-                break;
-            }
-        }
-        let w = 2.0 / ((1.0 - z * z) * dp * dp);
-        sum += w * g(0.5 * (b - a) * z + 0.5 * (a + b));
-    }
-    0.5 * (b - a) * sum
 }
 
 /// Large-deflection sag of a cantilever (inextensible, unshearable) under a dead tip load F at

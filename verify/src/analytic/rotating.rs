@@ -245,26 +245,9 @@ mod tests {
 
     /// Gauss–Legendre nodes/weights on \[0, 1\].
     fn gauss01(n: usize) -> Vec<(f64, f64)> {
-        (1..=n)
-            .map(|i| {
-                let mut z = (PI * (i as f64 - 0.25) / (n as f64 + 0.5)).cos();
-                let mut dp = 1.0;
-                for _ in 0..100 {
-                    let (mut p0, mut p1) = (1.0, z);
-                    for k in 2..=n {
-                        let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                        p0 = p1;
-                        p1 = p2;
-                    }
-                    dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-                    let dz = p1 / dp;
-                    z -= dz;
-                    if dz.abs() < 1e-16 {
-                        break;
-                    }
-                }
-                (0.5 * (z + 1.0), 1.0 / ((1.0 - z * z) * dp * dp))
-            })
+        crate::analytic::numerics::quadrature::gauss_legendre_nodes(n)
+            .into_iter()
+            .map(|(z, w)| (0.5 * (z + 1.0), 0.5 * w))
             .collect()
     }
 

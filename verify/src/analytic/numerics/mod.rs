@@ -4,8 +4,10 @@
 //! an analytic reference cannot come from shared code:
 //! * [`roots`] — Brent's safeguarded bracketing root finder and a sign-change scanner;
 //! * [`ode`] — the Dormand–Prince 5(4) adaptive Runge–Kutta integrator;
-//! * [`ddouble`] — double-double arithmetic for power series whose sums cancel heavily.
+//! * [`ddouble`] — double-double arithmetic for power series whose sums cancel heavily;
+//! * [`quadrature`] — Gauss–Legendre rules.
 
 pub mod ddouble;
 pub mod ode;
+pub mod quadrature;
 pub mod roots;
