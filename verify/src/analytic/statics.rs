@@ -177,27 +177,7 @@ mod tests {
         // Independent route: from the first integral, ds = dθ / sqrt(2α(sin θ₀ − sin θ)); with
         // θ = θ₀ − w² the integrand is smooth. θ₀ solves ∫ ds = 1; then y = ∫ sin θ ds.
         // Gauss–Legendre (n = 40, nodes by Newton) on w ∈ [0, sqrt(θ₀)].
-        let n = 40;
-        let mut nodes = Vec::new();
-        for i in 1..=n {
-            let mut z = (std::f64::consts::PI * (i as f64 - 0.25) / (n as f64 + 0.5)).cos();
-            let mut dp = 0.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, z);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
-                let dz = p1 / dp;
-                z -= dz;
-                if dz.abs() < 1e-16 {
-                    break;
-                }
-            }
-            nodes.push((z, 2.0 / ((1.0 - z * z) * dp * dp)));
-        }
+        let nodes = crate::analytic::numerics::quadrature::gauss_legendre_nodes(40);
         let quad = |alpha: f64, th0: f64, g: &dyn Fn(f64) -> f64| {
             let b = th0.sqrt();
             nodes
