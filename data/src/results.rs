@@ -17,6 +17,8 @@ pub mod channel {
     pub fn joint_rate(i: usize) -> String {
         format!("joint{i}.rate")
     }
+    /// Unit of every joint-torque channel (one spelling across backends).
+    pub const TORQUE_UNIT: &str = "force·length";
     /// Total torque the joint actuator applies (applied law, or what prescribed motion needed).
     pub fn joint_torque(i: usize) -> String {
         format!("joint{i}.torque")

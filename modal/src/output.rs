@@ -58,7 +58,7 @@ impl Output {
             let k = i + 1;
             specs.push((channel::joint_angle(k), "rad"));
             specs.push((channel::joint_rate(k), "rad/time"));
-            specs.push((channel::joint_torque(k), "force*length"));
+            specs.push((channel::joint_torque(k), channel::TORQUE_UNIT));
             specs.push((channel::tip_x(k), "length"));
             specs.push((channel::tip_y(k), "length"));
             specs.push((channel::tip_deflection(k), "length"));

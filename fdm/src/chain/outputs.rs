@@ -35,7 +35,7 @@ impl Outputs for TwoLinkChain {
         for j in 1..=2 {
             c.push((channel::joint_angle(j), "rad"));
             c.push((channel::joint_rate(j), "rad/time"));
-            c.push((channel::joint_torque(j), "torque"));
+            c.push((channel::joint_torque(j), channel::TORQUE_UNIT));
         }
         for l in 1..=2 {
             c.push((channel::tip_x(l), "length"));

@@ -33,7 +33,7 @@ impl Outputs for FloatingLink {
         let mut c = vec![
             (channel::joint_angle(1), "rad"),
             (channel::joint_rate(1), "rad/time"),
-            (channel::joint_torque(1), "torque"),
+            (channel::joint_torque(1), channel::TORQUE_UNIT),
             (channel::tip_x(1), "length"),
             (channel::tip_y(1), "length"),
             (channel::tip_deflection(1), "length"),

@@ -227,7 +227,7 @@ impl PayloadLinkModel {
         let mut c = vec![
             (channel::joint_angle(1), "rad"),
             (channel::joint_rate(1), "rad/time"),
-            (channel::joint_torque(1), "torque"),
+            (channel::joint_torque(1), channel::TORQUE_UNIT),
             (channel::PAYLOAD_X.to_string(), "length"),
             (channel::PAYLOAD_Y.to_string(), "length"),
             (channel::PAYLOAD_Z.to_string(), "length"),

@@ -187,7 +187,7 @@ impl Output {
         let mut specs: Vec<(String, &str)> = vec![
             (channel::joint_angle(1), "rad"),
             (channel::joint_rate(1), "rad/time"),
-            (channel::joint_torque(1), "force*length"),
+            (channel::joint_torque(1), channel::TORQUE_UNIT),
             (channel::PAYLOAD_X.to_string(), "length"),
             (channel::PAYLOAD_Y.to_string(), "length"),
             (channel::PAYLOAD_Z.to_string(), "length"),
