@@ -341,12 +341,18 @@ fn step_load(scene: &Scene, chain: &Chain) -> Result<Option<Vec<f64>>, ModalErro
     }
     let l = &chain.links[0];
     let mut f = vec![0.0; chain.n];
+    f[l.b0..l.b0 + l.nb()].copy_from_slice(&transverse_load(scene, l, p, q));
+    Ok(Some(f))
+}
+
+/// Generalized force of a tip force P and a uniform load q (per unit length) on the transverse
+/// coordinates of link `l` of a single-link scene: P φ(L) + q ∫₀ᴸ φ dx.
+pub(crate) fn transverse_load(scene: &Scene, l: &LinkModel, p: f64, q: f64) -> Vec<f64> {
     // `phi1` is the mass-weighted ∫ρA φ.
     let q_per_mass = q / scene.links[0].mass_per_length;
-    for i in 0..l.nb() {
-        f[l.b0 + i] = p * l.ints.phi_l[i] + q_per_mass * l.ints.phi1[i];
-    }
-    Ok(Some(f))
+    (0..l.nb())
+        .map(|i| p * l.ints.phi_l[i] + q_per_mass * l.ints.phi1[i])
+        .collect()
 }
 
 /// The DOFs of the model (the axial field is listed when on; simulate then reports Unsupported).

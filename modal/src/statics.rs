@@ -6,7 +6,7 @@ use data::{Cost, Scene, Settings, StaticResult};
 
 use crate::error::ModalError;
 use crate::linalg::{cholesky_solve, dot};
-use crate::setup::build_chain;
+use crate::setup::{build_chain, transverse_load};
 
 pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, ModalError> {
     let wall = std::time::Instant::now();
@@ -32,16 +32,9 @@ pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, Modal
     // Bending block [b, c] (c: Timoshenko section rotations); loads act on v only.
     let mut k = l.section.kbc.clone();
     let p = loads.tip_force.unwrap_or(0.0);
-    let q = loads.distributed_load.unwrap_or(0.0) / l_mass_per_length(scene);
-    let mut b: Vec<f64> = (0..nbc)
-        .map(|i| {
-            if i < nb {
-                p * l.ints.phi_l[i] + q * l.ints.phi1[i]
-            } else {
-                0.0
-            }
-        })
-        .collect();
+    let q = loads.distributed_load.unwrap_or(0.0);
+    let mut b = transverse_load(scene, l, p, q);
+    b.resize(nbc, 0.0);
     cholesky_solve(&mut k, nbc, &mut b).map_err(|_| ModalError::Numerical {
         t: 0.0,
         message: "bending stiffness matrix not positive definite".into(),
@@ -59,9 +52,4 @@ pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, Modal
             ..Cost::default()
         },
     })
-}
-
-/// Φ₁ holds ∫ρA φ; the load integral needs ∫φ = Φ₁/ρA.
-fn l_mass_per_length(scene: &Scene) -> f64 {
-    scene.links[0].mass_per_length
 }
