@@ -137,6 +137,13 @@
 //! (Hermite cubics, Gauss rules), the bordered-band LU ([`band`]) and the dense eigensolver
 //! ([`modes`]) with the planar chains, nothing else.
 //!
+//! ## Mobile manipulator with a flexible pitch link (seed 004, issue 19)
+//! Scenes of the `[mobile_manipulator]` family with a `flexible_link` are solved by [`mobile`]:
+//! the platform, turret, rigid links and gripper as rigid bodies on the null space of the
+//! nonholonomic constraints, the flexible link as Hermite-cubic beam elements in two bending
+//! planes (linear floating frame), implicit midpoint in time. It shares the Hermite tables and
+//! Gauss rules with the planar chains, nothing else. Rigid mobile scenes are the reference's.
+
 //! ## Layers
 //! Each layer imports only the ones above it:
 //! 1. model: [`element`] (the element trait and its registry; element operators tested alone)
@@ -168,6 +175,7 @@ pub mod events;
 pub mod linalg;
 pub mod linear;
 pub mod method;
+pub mod mobile;
 pub mod modes;
 pub mod payload_link;
 pub mod plan;
@@ -277,6 +285,9 @@ impl Backend for FemBackend {
     }
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
+        if mobile::scene_model(scene).is_some() {
+            return Ok(mobile::dof_plan(scene, disc)?);
+        }
         let n_el = settings::elements(disc)?;
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::dof_plan(scene, n_el)?);
@@ -304,6 +315,9 @@ impl Backend for FemBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+        if mobile::scene_model(scene).is_some() {
+            return Ok(mobile::simulate(scene, settings)?);
+        }
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::simulate(scene, settings)?);
         }

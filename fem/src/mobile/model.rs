@@ -1,0 +1,936 @@
+//! Kinematics, mass matrix and generalized forces of the mobile manipulator with one flexible
+//! pitch link, in the speeds ν of the constraint null space (Kane's form of Lagrange's
+//! equations: the partial velocities of every mass element project its inertial force).
+//!
+//! Coordinates q = (x, y, ψ, φ_R, φ_L | θ₁…θ₄ | e), speeds ν = (φ̇_R, φ̇_L | θ̇₁…θ̇₄ | ė) with
+//! q̇ = S(q) ν: ẋ = u cos ψ, ẏ = u sin ψ, ψ̇ = r(φ̇_R − φ̇_L)/(2b), u = r(φ̇_R + φ̇_L)/2, the
+//! identity elsewhere (the platform block is absent when the scene has no platform). e holds,
+//! per node 1…N of the flexible link (node 0 is clamped), (v, v′, w, w′).
+//!
+//! Frames F0…F5 as in the scene's convention (F0 platform, F1 turret, F2…F4 pitch links, F5
+//! gripper). The tip of the flexible link (frame F) sits at o_F + R_F(L, v_N, w_N) with
+//! orientation R_F R_z(v′_N) R_y(−w′_N); the next pitch joint rotates that frame about its −y.
+//! So the tip DOFs act on everything distal as two prismatic joints (along R_F e_y, R_F e_z)
+//! and two revolute ones (about R_F e_z, then the rotated −e_y, through the tip point), while
+//! the link's own material points p(x) = o_F + R_F(x, v(x), w(x)) move with the Hermite-cubic
+//! shape functions of their element.
+//!
+//! For a mass element with partial velocities (J_v, J_ω)ᵢ = ∂(v, ω)/∂νᵢ:
+//!
+//! ```text
+//! M̄ = Σ m J_vᵀ J_v + J_ωᵀ R J Rᵀ J_ω + diag(J_side on φ_R, φ_L)
+//! M̄ ν̇ + b = Σ J_vᵀ m (a + g e_z) + J_ωᵀ (I α + ω × I ω) + K e
+//! ```
+//!
+//! with the accelerations a, α of the element computed by the recursive kinematics at
+//! q̈ = S ν̇ + Ṡ ν; b is the same sum at ν̇ = 0. The beam contributes ∫ μ(…) dx by 4-point Gauss
+//! quadrature per element, exact here (the integrands are polynomials of degree ≤ 6 in x).
+//! K = ∫ (EI_out N″ᵀN″ on v, EI_in N″ᵀN″ on w) dx, the Euler–Bernoulli strain energy.
+
+use data::scene::{MobileManipulator, RigidBody};
+
+use crate::element::hermite::{HermiteAt, hermite};
+use crate::element::quadrature::gauss01;
+use crate::error::FemError;
+
+pub type Vec3 = [f64; 3];
+pub type Mat3 = [[f64; 3]; 3];
+
+pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+pub(crate) fn dot3(a: Vec3, b: Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+pub(crate) fn add(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+pub(crate) fn scale(s: f64, a: Vec3) -> Vec3 {
+    [s * a[0], s * a[1], s * a[2]]
+}
+pub(crate) fn mat_vec(m: &Mat3, v: Vec3) -> Vec3 {
+    [dot3(m[0], v), dot3(m[1], v), dot3(m[2], v)]
+}
+pub(crate) fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
+    let mut c = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
+        }
+    }
+    c
+}
+/// R J Rᵀ.
+pub(crate) fn rotate_inertia(r: &Mat3, j: &Mat3) -> Mat3 {
+    let rj = mat_mul(r, j);
+    let mut c = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for k in 0..3 {
+            c[i][k] = rj[i][0] * r[k][0] + rj[i][1] * r[k][1] + rj[i][2] * r[k][2];
+        }
+    }
+    c
+}
+pub(crate) fn rot_z(t: f64) -> Mat3 {
+    let (s, c) = t.sin_cos();
+    [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+}
+/// Rotation by t about −y (= R_y(−t)): x ↦ (cos t, 0, sin t).
+pub(crate) fn rot_pitch(t: f64) -> Mat3 {
+    let (s, c) = t.sin_cos();
+    [[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]]
+}
+
+const EY: Vec3 = [0.0, 1.0, 0.0];
+const EZ: Vec3 = [0.0, 0.0, 1.0];
+const MINUS_EY: Vec3 = [0.0, -1.0, 0.0];
+
+/// Gauss points per element (exact for the mass integrands of degree ≤ 7).
+pub const GAUSS: usize = 4;
+/// Most partial-velocity columns one mass element can have: 2 platform + 4 joints + 8 beam
+/// DOFs of its element (or the 4 tip DOFs).
+const MAX_COLS: usize = 14;
+
+/// Platform parameters (chassis and wheels composed about the composite mass centre).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlatformModel {
+    pub mass: f64,
+    pub com_offset: f64,
+    pub yaw_inertia: f64,
+    pub wheel_radius: f64,
+    pub half_track: f64,
+    /// Spin inertia of one side's wheels.
+    pub side_spin_inertia: f64,
+    /// Viscous friction of one side's wheel bearings.
+    pub side_friction: f64,
+}
+
+/// A rigid body moving with frame `frame`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Body {
+    pub frame: usize,
+    pub mass: f64,
+    pub com: Vec3,
+    pub inertia: Mat3,
+}
+
+/// The flexible pitch link.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlexLink {
+    /// Pitch link index 0…2 (scene `link` − 1); its frame is F(2 + link).
+    pub link: usize,
+    pub frame: usize,
+    pub length: f64,
+    pub elements: usize,
+    /// Element length.
+    pub le: f64,
+    /// Line density m/L.
+    pub mu: f64,
+    pub ei_in: f64,
+    pub ei_out: f64,
+    /// Elastic DOFs 4N.
+    pub ne: usize,
+    /// Stiffness K (ne × ne, row-major).
+    pub stiffness: Vec<f64>,
+    /// Shape functions at the Gauss points of an element (the same on every element).
+    pub shapes: [HermiteAt; GAUSS],
+    /// Gauss abscissae (fraction of the element) and weights (times le).
+    pub gauss_xi: [f64; GAUSS],
+    pub gauss_w: [f64; GAUSS],
+}
+
+impl FlexLink {
+    /// Global elastic index of local element DOF `l` (0..4: node a value/slope, node b
+    /// value/slope) of element `el` for field `field` (0 = v, 1 = w); None at the clamp.
+    #[inline]
+    pub fn dof(el: usize, l: usize, field: usize) -> Option<usize> {
+        let node = el + l / 2;
+        (node > 0).then(|| 4 * (node - 1) + 2 * field + (l % 2))
+    }
+
+    /// v(x) and w(x) (field 0, 1) of element `el` with shape values `n` from the elastic DOFs.
+    fn field_at(&self, e: &[f64], el: usize, n: &[f64; 4]) -> [f64; 2] {
+        let mut out = [0.0; 2];
+        for (f, o) in out.iter_mut().enumerate() {
+            for l in 0..4 {
+                if let Some(g) = Self::dof(el, l, f) {
+                    *o += n[l] * e[g];
+                }
+            }
+        }
+        out
+    }
+
+    /// (v, v′, w, w′) at the tip.
+    pub fn tip(&self, e: &[f64]) -> [f64; 4] {
+        let b = self.ne - 4;
+        [e[b], e[b + 1], e[b + 2], e[b + 3]]
+    }
+
+    fn assemble_stiffness(&mut self) {
+        let ne = self.ne;
+        self.stiffness = vec![0.0; ne * ne];
+        let (xs, ws) = gauss01(GAUSS);
+        for el in 0..self.elements {
+            for (f, ei) in [(0, self.ei_out), (1, self.ei_in)] {
+                for (xi, w) in xs.iter().zip(ws) {
+                    let s = hermite(*xi, self.le);
+                    for a in 0..4 {
+                        let Some(ga) = Self::dof(el, a, f) else {
+                            continue;
+                        };
+                        for b in 0..4 {
+                            let Some(gb) = Self::dof(el, b, f) else {
+                                continue;
+                            };
+                            self.stiffness[ga * ne + gb] += ei * w * self.le * s.ddn[a] * s.ddn[b];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Where each coordinate and speed sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Layout {
+    pub platform: bool,
+    /// Index of θ₁ in q and in ν.
+    pub q_arm: usize,
+    pub nu_arm: usize,
+    /// First elastic index in q and in ν.
+    pub q_el: usize,
+    pub nu_el: usize,
+    /// Elastic DOFs.
+    pub ne: usize,
+    /// Coordinates n and speeds m.
+    pub n: usize,
+    pub m: usize,
+}
+
+/// The model of a `[mobile_manipulator]` scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    pub layout: Layout,
+    pub gravity: f64,
+    pub platform: Option<PlatformModel>,
+    /// Fixed pose (x, y, ψ) of F0 without a platform.
+    pub ground_pose: [f64; 3],
+    pub mount: Vec3,
+    pub base_height: f64,
+    pub lengths: [f64; 3],
+    /// Rigid bodies: platform (frame 0) if present, turret, the rigid links, the flexible
+    /// link's residual inertia (massless), the gripper.
+    pub bodies: Vec<Body>,
+    pub flex: Option<FlexLink>,
+    pub joint_friction: [f64; 4],
+}
+
+/// Frames F0…F5 at (q, q̇, q̈) and the axes the coordinates move them about.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Frames {
+    pub o: [Vec3; 6],
+    pub r: [Mat3; 6],
+    pub w: [Vec3; 6],
+    pub al: [Vec3; 6],
+    pub v: [Vec3; 6],
+    pub a: [Vec3; 6],
+    /// Inertial axis of joint k (k = 1…4) through o[k].
+    pub axis: [Vec3; 5],
+    /// Tip of the flexible link: point, prismatic axes R_F e_y, R_F e_z, revolute axes
+    /// R_F e_z (v′_N) and R_F R_z(v′_N)(−e_y) (w′_N).
+    pub tip_o: Vec3,
+    pub tip_axes: [Vec3; 4],
+}
+
+/// Partial velocities of one mass element: speed index, J_v, J_ω.
+#[derive(Debug, Clone, Copy)]
+pub struct Partials {
+    pub len: usize,
+    pub idx: [usize; MAX_COLS],
+    pub jv: [Vec3; MAX_COLS],
+    pub jw: [Vec3; MAX_COLS],
+}
+
+impl Default for Partials {
+    fn default() -> Self {
+        Partials {
+            len: 0,
+            idx: [0; MAX_COLS],
+            jv: [[0.0; 3]; MAX_COLS],
+            jw: [[0.0; 3]; MAX_COLS],
+        }
+    }
+}
+
+impl Partials {
+    #[inline]
+    fn push(&mut self, i: usize, jv: Vec3, jw: Vec3) {
+        self.idx[self.len] = i;
+        self.jv[self.len] = jv;
+        self.jw[self.len] = jw;
+        self.len += 1;
+    }
+}
+
+/// Rotates frame (r, w, al) about its local axis `u` by (t, ṫ, ẗ); returns the inertial axis.
+fn revolute(r: &mut Mat3, w: &mut Vec3, al: &mut Vec3, u: Vec3, t: [f64; 3]) -> Vec3 {
+    let axis = mat_vec(r, u);
+    *al = add(add(*al, cross(*w, scale(t[1], axis))), scale(t[2], axis));
+    *w = add(*w, scale(t[1], axis));
+    let rot = if u == EZ {
+        rot_z(t[0])
+    } else {
+        rot_pitch(t[0])
+    };
+    *r = mat_mul(r, &rot);
+    axis
+}
+
+/// The link body's inertia about its centre minus the slender rod's diag(0, mL²/12, mL²/12).
+pub fn residual_inertia(mass: f64, length: f64, inertia: &Mat3) -> Mat3 {
+    let rod = mass * length * length / 12.0;
+    let mut j = *inertia;
+    j[1][1] -= rod;
+    j[2][2] -= rod;
+    j
+}
+
+/// Smallest eigenvalue of a symmetric 3 × 3 matrix is ≥ −tol (Sylvester on J + tol I would
+/// not do for semi-definite; the principal minors of J are checked instead).
+fn positive_semidefinite(j: &Mat3, tol: f64) -> bool {
+    let d = [j[0][0], j[1][1], j[2][2]];
+    let m2 = [
+        j[0][0] * j[1][1] - j[0][1] * j[1][0],
+        j[0][0] * j[2][2] - j[0][2] * j[2][0],
+        j[1][1] * j[2][2] - j[1][2] * j[2][1],
+    ];
+    let det = j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1])
+        - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
+        + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
+    let s = tol * d.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    d.iter().all(|&x| x >= -s) && m2.iter().all(|&x| x >= -s * s) && det >= -s * s * s
+}
+
+impl Model {
+    /// Builds the model with `elements` Hermite-cubic elements on the flexible link (ignored
+    /// without one: then the model is the rigid system, used by the tests).
+    pub fn from_scene(m: &MobileManipulator, elements: usize) -> Result<Self, FemError> {
+        let arm = m.arm.as_ref().ok_or_else(|| {
+            FemError::unsupported(
+                "fem mobile manipulator: a scene without an arm (the platform alone has no \
+                 flexible part; use the reference)",
+            )
+        })?;
+        if arm.links.len() != 3 {
+            return Err(FemError::unsupported(format!(
+                "fem mobile manipulator: {} pitch links (the model has three)",
+                arm.links.len()
+            )));
+        }
+        let platform = m.platform.as_ref().map(|p| {
+            let axles = p.wheel_count / 2;
+            let mw = p.wheel_mass;
+            let mass = p.chassis_mass + p.wheel_count as f64 * mw;
+            let xs: Vec<f64> = (0..axles)
+                .map(|k| {
+                    if axles == 1 {
+                        0.0
+                    } else {
+                        p.wheelbase * (0.5 - k as f64 / (axles - 1) as f64)
+                    }
+                })
+                .collect();
+            let com_offset =
+                (p.chassis_mass * p.chassis_com_offset + 2.0 * mw * xs.iter().sum::<f64>()) / mass;
+            let mut yaw = p.chassis_yaw_inertia
+                + p.chassis_mass * (p.chassis_com_offset - com_offset).powi(2);
+            for &x in &xs {
+                yaw += 2.0
+                    * (mw * ((x - com_offset).powi(2) + p.half_track.powi(2))
+                        + p.wheel_diametral_inertia);
+            }
+            PlatformModel {
+                mass,
+                com_offset,
+                yaw_inertia: yaw,
+                wheel_radius: p.wheel_radius,
+                half_track: p.half_track,
+                side_spin_inertia: axles as f64 * p.wheel_spin_inertia,
+                side_friction: axles as f64 * p.wheel_friction,
+            }
+        });
+        let body = |frame: usize, b: &RigidBody| Body {
+            frame,
+            mass: b.mass,
+            com: b.com,
+            inertia: b.inertia,
+        };
+        let mut bodies = Vec::new();
+        if let Some(p) = &platform {
+            bodies.push(Body {
+                frame: 0,
+                mass: p.mass,
+                com: [p.com_offset, 0.0, 0.0],
+                inertia: [[0.0; 3], [0.0; 3], [0.0, 0.0, p.yaw_inertia]],
+            });
+        }
+        bodies.push(body(1, &arm.turret));
+        let mut flex = None;
+        let mut lengths = [0.0; 3];
+        for (k, l) in arm.links.iter().enumerate() {
+            lengths[k] = l.length;
+            let frame = 2 + k;
+            match &m.flexible_link {
+                Some(f) if f.link == k + 1 => {
+                    let half = 0.5 * l.length;
+                    let off = (l.com[0] - half).abs() + l.com[1].abs() + l.com[2].abs();
+                    if off > 1e-12 * l.length {
+                        return Err(FemError::unsupported(format!(
+                            "fem mobile manipulator: flexible link {} has its mass centre at \
+                             {:?}; the uniform beam needs ({half}, 0, 0)",
+                            k + 1,
+                            l.com
+                        )));
+                    }
+                    let j_res = residual_inertia(l.mass, l.length, &l.inertia);
+                    if !positive_semidefinite(&j_res, 1e-12) {
+                        return Err(FemError::unsupported(format!(
+                            "fem mobile manipulator: flexible link {}: its inertia minus the \
+                             slender rod's m L²/12 is not positive semi-definite",
+                            k + 1
+                        )));
+                    }
+                    for (what, v) in [
+                        ("bending_stiffness_in_plane", f.bending_stiffness_in_plane),
+                        (
+                            "bending_stiffness_out_of_plane",
+                            f.bending_stiffness_out_of_plane,
+                        ),
+                    ] {
+                        if !(v.is_finite() && v > 0.0) {
+                            return Err(FemError::unsupported(format!(
+                                "fem mobile manipulator: flexible_link.{what} = {v} (must be \
+                                 positive)"
+                            )));
+                        }
+                    }
+                    bodies.push(Body {
+                        frame,
+                        mass: 0.0,
+                        com: [half, 0.0, 0.0],
+                        inertia: j_res,
+                    });
+                    let (xs, ws) = gauss01(GAUSS);
+                    let le = l.length / elements as f64;
+                    let mut fl = FlexLink {
+                        link: k,
+                        frame,
+                        length: l.length,
+                        elements,
+                        le,
+                        mu: l.mass / l.length,
+                        ei_in: f.bending_stiffness_in_plane,
+                        ei_out: f.bending_stiffness_out_of_plane,
+                        ne: 4 * elements,
+                        stiffness: Vec::new(),
+                        shapes: std::array::from_fn(|g| hermite(xs[g], le)),
+                        gauss_xi: std::array::from_fn(|g| xs[g]),
+                        gauss_w: std::array::from_fn(|g| ws[g] * le),
+                    };
+                    fl.assemble_stiffness();
+                    flex = Some(fl);
+                }
+                _ => bodies.push(body(frame, &l.body())),
+            }
+        }
+        if let Some(f) = &m.flexible_link
+            && !(1..=3).contains(&f.link)
+        {
+            return Err(FemError::unsupported(format!(
+                "fem mobile manipulator: flexible_link.link = {} (pitch links are 1..=3)",
+                f.link
+            )));
+        }
+        bodies.push(body(5, &arm.gripper));
+        let np = if platform.is_some() { 5 } else { 0 };
+        let mp = if platform.is_some() { 2 } else { 0 };
+        let ne = flex.as_ref().map_or(0, |f| f.ne);
+        let layout = Layout {
+            platform: platform.is_some(),
+            q_arm: np,
+            nu_arm: mp,
+            q_el: np + 4,
+            nu_el: mp + 4,
+            ne,
+            n: np + 4 + ne,
+            m: mp + 4 + ne,
+        };
+        Ok(Model {
+            layout,
+            gravity: m.gravity,
+            platform,
+            ground_pose: [m.initial.x, m.initial.y, m.initial.heading],
+            mount: arm.mount,
+            base_height: arm.base_height,
+            lengths,
+            bodies,
+            flex,
+            joint_friction: arm.joint_friction,
+        })
+    }
+
+    /// Recursive kinematics of F0…F5 at (q, q̇, q̈) (full coordinate rates, any q̇).
+    pub fn frames(&self, q: &[f64], qd: &[f64], qdd: &[f64]) -> Frames {
+        let mut f = Frames::default();
+        let l = self.layout;
+        if l.platform {
+            f.o[0] = [q[0], q[1], 0.0];
+            f.r[0] = rot_z(q[2]);
+            f.w[0] = [0.0, 0.0, qd[2]];
+            f.al[0] = [0.0, 0.0, qdd[2]];
+            f.v[0] = [qd[0], qd[1], 0.0];
+            f.a[0] = [qdd[0], qdd[1], 0.0];
+        } else {
+            let [x, y, psi] = self.ground_pose;
+            f.o[0] = [x, y, 0.0];
+            f.r[0] = rot_z(psi);
+        }
+        let a0 = l.q_arm;
+        for k in 1..6 {
+            // Offset of frame k's origin in frame k − 1 (with its rates when it is a flexible tip).
+            let mut d = [[0.0; 3]; 3];
+            let mut tip = None;
+            match k {
+                1 => d[0] = self.mount,
+                2 => d[0] = [0.0, 0.0, self.base_height],
+                _ => {
+                    d[0] = [self.lengths[k - 3], 0.0, 0.0];
+                    if let Some(fl) = &self.flex
+                        && fl.frame == k - 1
+                    {
+                        let b = l.q_el + fl.ne - 4;
+                        d[0][1] = q[b];
+                        d[0][2] = q[b + 2];
+                        d[1] = [0.0, qd[b], qd[b + 2]];
+                        d[2] = [0.0, qdd[b], qdd[b + 2]];
+                        tip = Some(b);
+                    }
+                }
+            }
+            let (r, w, al) = (f.r[k - 1], f.w[k - 1], f.al[k - 1]);
+            let dp = mat_vec(&r, d[0]);
+            let dv = mat_vec(&r, d[1]);
+            let da = mat_vec(&r, d[2]);
+            f.o[k] = add(f.o[k - 1], dp);
+            f.v[k] = add(add(f.v[k - 1], cross(w, dp)), dv);
+            f.a[k] = add(
+                add(
+                    add(f.a[k - 1], cross(al, dp)),
+                    cross(w, add(cross(w, dp), scale(2.0, dv))),
+                ),
+                da,
+            );
+            let (mut r, mut w, mut al) = (r, w, al);
+            if let Some(b) = tip {
+                f.tip_o = f.o[k];
+                f.tip_axes[0] = mat_vec(&r, EY);
+                f.tip_axes[1] = mat_vec(&r, EZ);
+                f.tip_axes[2] = revolute(
+                    &mut r,
+                    &mut w,
+                    &mut al,
+                    EZ,
+                    [q[b + 1], qd[b + 1], qdd[b + 1]],
+                );
+                f.tip_axes[3] = revolute(
+                    &mut r,
+                    &mut w,
+                    &mut al,
+                    MINUS_EY,
+                    [q[b + 3], qd[b + 3], qdd[b + 3]],
+                );
+            }
+            if k < 5 {
+                let u = if k == 1 { EZ } else { MINUS_EY };
+                let j = a0 + k - 1;
+                f.axis[k] = revolute(&mut r, &mut w, &mut al, u, [q[j], qd[j], qdd[j]]);
+            }
+            f.r[k] = r;
+            f.w[k] = w;
+            f.al[k] = al;
+        }
+        f
+    }
+
+    /// q̇ = S(q) ν into `qd` and Ṡ ν into `sdot_nu`.
+    pub fn velocities(&self, q: &[f64], nu: &[f64], qd: &mut [f64], sdot_nu: &mut [f64]) {
+        let l = self.layout;
+        sdot_nu[..l.n].fill(0.0);
+        if let Some(p) = &self.platform {
+            let (s, c) = q[2].sin_cos();
+            let u = 0.5 * p.wheel_radius * (nu[0] + nu[1]);
+            let psid = 0.5 * p.wheel_radius / p.half_track * (nu[0] - nu[1]);
+            qd[0] = u * c;
+            qd[1] = u * s;
+            qd[2] = psid;
+            qd[3] = nu[0];
+            qd[4] = nu[1];
+            sdot_nu[0] = -u * s * psid;
+            sdot_nu[1] = u * c * psid;
+        }
+        qd[l.q_arm..l.n].copy_from_slice(&nu[l.nu_arm..l.m]);
+    }
+
+    /// Partial velocities ∂(v, ω)/∂ν of a point `p` fixed to frame `k` (k ≤ 5).
+    fn frame_partials(&self, f: &Frames, q: &[f64], k: usize, p: Vec3, out: &mut Partials) {
+        out.len = 0;
+        let l = self.layout;
+        if let Some(pl) = &self.platform {
+            let (s, c) = q[2].sin_cos();
+            let half = 0.5 * pl.wheel_radius;
+            let v = [half * c, half * s, 0.0];
+            let yaw = half / pl.half_track;
+            let turn = cross(EZ, sub(p, f.o[0]));
+            out.push(0, add(v, scale(yaw, turn)), [0.0, 0.0, yaw]);
+            out.push(1, sub(v, scale(yaw, turn)), [0.0, 0.0, -yaw]);
+        }
+        for j in 1..5.min(k + 1) {
+            let axis = f.axis[j];
+            out.push(l.nu_arm + j - 1, cross(axis, sub(p, f.o[j])), axis);
+        }
+        if let Some(fl) = &self.flex
+            && k > fl.frame
+        {
+            let b = l.nu_el + fl.ne - 4;
+            let zero = [0.0; 3];
+            out.push(b, f.tip_axes[0], zero);
+            out.push(b + 2, f.tip_axes[1], zero);
+            let arm = sub(p, f.tip_o);
+            out.push(b + 1, cross(f.tip_axes[2], arm), f.tip_axes[2]);
+            out.push(b + 3, cross(f.tip_axes[3], arm), f.tip_axes[3]);
+        }
+    }
+
+    /// Partial velocities of the beam point of element `el` with shapes `s` at inertial
+    /// position `p`: the frame's (rigid) columns plus R_F N e_y, R_F N e_z.
+    #[allow(clippy::too_many_arguments)]
+    fn beam_partials(
+        &self,
+        f: &Frames,
+        q: &[f64],
+        fl: &FlexLink,
+        el: usize,
+        s: &HermiteAt,
+        p: Vec3,
+        out: &mut Partials,
+    ) {
+        self.frame_partials(f, q, fl.frame, p, out);
+        let (ey, ez) = (mat_vec(&f.r[fl.frame], EY), mat_vec(&f.r[fl.frame], EZ));
+        let zero = [0.0; 3];
+        for (field, axis) in [(0, ey), (1, ez)] {
+            for a in 0..4 {
+                if let Some(g) = FlexLink::dof(el, a, field) {
+                    out.push(self.layout.nu_el + g, scale(s.n[a], axis), zero);
+                }
+            }
+        }
+    }
+
+    /// Reduced mass matrix M̄(q) (m × m, row-major into `mass`) and the reduced generalized
+    /// inertial, gravity and elastic forces at (q, ν, ν̇) into `force` (M̄ ν̇ + b).
+    pub fn evaluate(
+        &self,
+        q: &[f64],
+        nu: &[f64],
+        nudot: &[f64],
+        ws: &mut Workspace,
+        mass: Option<&mut [f64]>,
+        force: &mut [f64],
+    ) {
+        let l = self.layout;
+        let (n, m) = (l.n, l.m);
+        self.velocities(q, nu, &mut ws.qd, &mut ws.sdn);
+        // q̈ = S ν̇ + Ṡ ν.
+        self.velocities(q, nudot, &mut ws.qdd, &mut ws.scratch);
+        for i in 0..n {
+            ws.qdd[i] += ws.sdn[i];
+        }
+        let f = self.frames(q, &ws.qd, &ws.qdd);
+        force[..m].fill(0.0);
+        let mut mass = mass;
+        if let Some(mm) = mass.as_deref_mut() {
+            mm[..m * m].fill(0.0);
+        }
+        let gvec = [0.0, 0.0, self.gravity];
+        let mut jp = Partials::default();
+        for b in &self.bodies {
+            let r = &f.r[b.frame];
+            let rc = mat_vec(r, b.com);
+            let p = add(f.o[b.frame], rc);
+            let (w, al) = (f.w[b.frame], f.al[b.frame]);
+            let acc = add(add(f.a[b.frame], cross(al, rc)), cross(w, cross(w, rc)));
+            let iw = rotate_inertia(r, &b.inertia);
+            let lin = scale(b.mass, add(acc, gvec));
+            let ang = add(mat_vec(&iw, al), cross(w, mat_vec(&iw, w)));
+            self.frame_partials(&f, q, b.frame, p, &mut jp);
+            accumulate(&jp, b.mass, &iw, lin, ang, m, force, mass.as_deref_mut());
+        }
+        if let Some(fl) = &self.flex {
+            let fr = fl.frame;
+            let r = &f.r[fr];
+            let (w, al) = (f.w[fr], f.al[fr]);
+            let e = &q[l.q_el..l.q_el + fl.ne];
+            let ed = &ws.qd[l.q_el..l.q_el + fl.ne];
+            let edd = &ws.qdd[l.q_el..l.q_el + fl.ne];
+            let zero3 = [[0.0; 3]; 3];
+            for el in 0..fl.elements {
+                for g in 0..GAUSS {
+                    let s = &fl.shapes[g];
+                    let x = (el as f64 + fl.gauss_xi[g]) * fl.le;
+                    let [vv, ww] = fl.field_at(e, el, &s.n);
+                    let [vd, wd] = fl.field_at(ed, el, &s.n);
+                    let [vdd, wdd] = fl.field_at(edd, el, &s.n);
+                    let d = mat_vec(r, [x, vv, ww]);
+                    let dv = mat_vec(r, [0.0, vd, wd]);
+                    let da = mat_vec(r, [0.0, vdd, wdd]);
+                    let p = add(f.o[fr], d);
+                    let acc = add(
+                        add(
+                            add(f.a[fr], cross(al, d)),
+                            cross(w, add(cross(w, d), scale(2.0, dv))),
+                        ),
+                        da,
+                    );
+                    let dm = fl.mu * fl.gauss_w[g];
+                    let lin = scale(dm, add(acc, gvec));
+                    self.beam_partials(&f, q, fl, el, s, p, &mut jp);
+                    accumulate(
+                        &jp,
+                        dm,
+                        &zero3,
+                        lin,
+                        [0.0; 3],
+                        m,
+                        force,
+                        mass.as_deref_mut(),
+                    );
+                }
+            }
+            for i in 0..fl.ne {
+                let row = &fl.stiffness[i * fl.ne..(i + 1) * fl.ne];
+                force[l.nu_el + i] += row.iter().zip(e).map(|(k, x)| k * x).sum::<f64>();
+            }
+        }
+        if let Some(p) = &self.platform {
+            for s in 0..2 {
+                force[s] += p.side_spin_inertia * nudot[s];
+                if let Some(mm) = mass.as_deref_mut() {
+                    mm[s * m + s] += p.side_spin_inertia;
+                }
+            }
+        }
+    }
+
+    /// Applied generalized forces in ν: inputs τ (wheels then joints) minus viscous friction.
+    pub fn applied(&self, nu: &[f64], tau: &[f64], out: &mut [f64]) {
+        let l = self.layout;
+        out[..l.m].fill(0.0);
+        if let Some(p) = &self.platform {
+            for s in 0..2 {
+                out[s] = tau[s] - p.side_friction * nu[s];
+            }
+        }
+        for i in 0..4 {
+            let j = l.nu_arm + i;
+            out[j] = tau[j] - self.joint_friction[i] * nu[j];
+        }
+    }
+
+    /// Kinetic energy from the bodies' and beam points' velocities (any q̇).
+    pub fn kinetic_energy(&self, q: &[f64], qd: &[f64]) -> f64 {
+        let zeros = vec![0.0; self.layout.n];
+        let f = self.frames(q, qd, &zeros);
+        let mut t = 0.0;
+        for b in &self.bodies {
+            let r = &f.r[b.frame];
+            let rc = mat_vec(r, b.com);
+            let w = f.w[b.frame];
+            let v = add(f.v[b.frame], cross(w, rc));
+            let iw = rotate_inertia(r, &b.inertia);
+            t += 0.5 * b.mass * dot3(v, v) + 0.5 * dot3(w, mat_vec(&iw, w));
+        }
+        if let Some(fl) = &self.flex {
+            let l = self.layout;
+            let (e, ed) = (&q[l.q_el..l.n], &qd[l.q_el..l.n]);
+            let fr = fl.frame;
+            for el in 0..fl.elements {
+                for g in 0..GAUSS {
+                    let s = &fl.shapes[g];
+                    let x = (el as f64 + fl.gauss_xi[g]) * fl.le;
+                    let [vv, ww] = fl.field_at(e, el, &s.n);
+                    let [vd, wd] = fl.field_at(ed, el, &s.n);
+                    let d = mat_vec(&f.r[fr], [x, vv, ww]);
+                    let v = add(
+                        add(f.v[fr], cross(f.w[fr], d)),
+                        mat_vec(&f.r[fr], [0.0, vd, wd]),
+                    );
+                    t += 0.5 * fl.mu * fl.gauss_w[g] * dot3(v, v);
+                }
+            }
+        }
+        if let Some(p) = &self.platform {
+            t += 0.5 * p.side_spin_inertia * (qd[3] * qd[3] + qd[4] * qd[4]);
+        }
+        t
+    }
+
+    /// Gravitational potential Σ m g z + ∫ μ g z dx.
+    pub fn gravity_energy(&self, q: &[f64]) -> f64 {
+        let zeros = vec![0.0; self.layout.n];
+        let f = self.frames(q, &zeros, &zeros);
+        let mut v = 0.0;
+        for b in &self.bodies {
+            v += b.mass * self.gravity * add(f.o[b.frame], mat_vec(&f.r[b.frame], b.com))[2];
+        }
+        if let Some(fl) = &self.flex {
+            let e = &q[self.layout.q_el..self.layout.n];
+            for el in 0..fl.elements {
+                for g in 0..GAUSS {
+                    let s = &fl.shapes[g];
+                    let x = (el as f64 + fl.gauss_xi[g]) * fl.le;
+                    let [vv, ww] = fl.field_at(e, el, &s.n);
+                    let z = f.o[fl.frame][2] + mat_vec(&f.r[fl.frame], [x, vv, ww])[2];
+                    v += fl.mu * fl.gauss_w[g] * self.gravity * z;
+                }
+            }
+        }
+        v
+    }
+
+    /// Strain energy ½ eᵀ K e.
+    pub fn strain_energy(&self, q: &[f64]) -> f64 {
+        let Some(fl) = &self.flex else {
+            return 0.0;
+        };
+        let e = &q[self.layout.q_el..self.layout.n];
+        let mut u = 0.0;
+        for i in 0..fl.ne {
+            for j in 0..fl.ne {
+                u += e[i] * fl.stiffness[i * fl.ne + j] * e[j];
+            }
+        }
+        0.5 * u
+    }
+
+    /// Inertial positions of every mass element (bodies' mass centres, then the beam's Gauss
+    /// points) by direct position kinematics, for the tests' velocity differences.
+    pub fn material_points(&self, q: &[f64]) -> Vec<(f64, Vec3, Mat3, Mat3)> {
+        let zeros = vec![0.0; self.layout.n];
+        let f = self.frames(q, &zeros, &zeros);
+        let mut out = Vec::new();
+        for b in &self.bodies {
+            out.push((
+                b.mass,
+                add(f.o[b.frame], mat_vec(&f.r[b.frame], b.com)),
+                f.r[b.frame],
+                b.inertia,
+            ));
+        }
+        if let Some(fl) = &self.flex {
+            let e = &q[self.layout.q_el..self.layout.n];
+            for el in 0..fl.elements {
+                for g in 0..GAUSS {
+                    let s = &fl.shapes[g];
+                    let x = (el as f64 + fl.gauss_xi[g]) * fl.le;
+                    let [vv, ww] = fl.field_at(e, el, &s.n);
+                    let p = add(f.o[fl.frame], mat_vec(&f.r[fl.frame], [x, vv, ww]));
+                    out.push((fl.mu * fl.gauss_w[g], p, f.r[fl.frame], [[0.0; 3]; 3]));
+                }
+            }
+        }
+        out
+    }
+
+    /// Inertial position of the gripper frame origin (tip of link 3).
+    pub fn end_effector(&self, q: &[f64]) -> Vec3 {
+        let zeros = vec![0.0; self.layout.n];
+        self.frames(q, &zeros, &zeros).o[5]
+    }
+
+    /// |A(q) q̇|∞ of the no-sideways-slip and rolling constraints (0 without platform).
+    pub fn constraint_residual(&self, q: &[f64], qd: &[f64]) -> f64 {
+        let Some(p) = &self.platform else {
+            return 0.0;
+        };
+        let (s, c) = q[2].sin_cos();
+        let (b, r) = (p.half_track, p.wheel_radius);
+        let lateral = -s * qd[0] + c * qd[1];
+        let fwd = c * qd[0] + s * qd[1];
+        lateral
+            .abs()
+            .max((fwd + b * qd[2] - r * qd[3]).abs())
+            .max((fwd - b * qd[2] - r * qd[4]).abs())
+    }
+}
+
+/// Adds one mass element's contribution: force += Jᵀ(lin, ang), M̄ += m J_vᵀJ_v + J_ωᵀ I J_ω.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn accumulate(
+    jp: &Partials,
+    mass_el: f64,
+    iw: &Mat3,
+    lin: Vec3,
+    ang: Vec3,
+    m: usize,
+    force: &mut [f64],
+    mass: Option<&mut [f64]>,
+) {
+    for a in 0..jp.len {
+        force[jp.idx[a]] += dot3(jp.jv[a], lin) + dot3(jp.jw[a], ang);
+    }
+    if let Some(mm) = mass {
+        let rotating = iw.iter().any(|row| row.iter().any(|&x| x != 0.0));
+        for a in 0..jp.len {
+            let iwa = if rotating {
+                mat_vec(iw, jp.jw[a])
+            } else {
+                [0.0; 3]
+            };
+            let ia = jp.idx[a];
+            for b in 0..jp.len {
+                let ib = jp.idx[b];
+                mm[ia * m + ib] += mass_el * dot3(jp.jv[a], jp.jv[b]) + dot3(jp.jw[b], iwa);
+            }
+        }
+    }
+}
+
+/// Scratch vectors of one evaluation (allocated once per run).
+#[derive(Debug, Clone)]
+pub struct Workspace {
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+    pub sdn: Vec<f64>,
+    pub scratch: Vec<f64>,
+}
+
+impl Workspace {
+    pub fn new(n: usize) -> Self {
+        Workspace {
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+            sdn: vec![0.0; n],
+            scratch: vec![0.0; n],
+        }
+    }
+}
