@@ -3,7 +3,9 @@
 //! A history is an observable channel (`data::channel`) or an energy-ledger term addressed as
 //! `energy.NAME` (a stored, input or dissipation term of `data::EnergyLedger`, e.g.
 //! `energy.kinetic`, `energy.strain`, `energy.joint_damper`; `energy.total` is the sum of the
-//! stored terms). The error of run `a` against run `b` is
+//! stored terms, and `energy.A+B` the sum of the named terms — e.g. `energy.impact+kelvin_voigt`,
+//! the dissipation split between a plastic impact and the beam's damping, whose parts depend on
+//! the resolution of the impact while their sum converges). The error of run `a` against run `b` is
 //!
 //! ```text
 //! max_t |a(t) − b(t)| / max_t |b(t)|
@@ -31,13 +33,23 @@ pub fn series<'a>(r: &'a RunResult, channel: &str) -> Option<(&'a [f64], Cow<'a,
             let total: Vec<f64> = (0..l.time.len()).map(|k| l.total(k)).collect();
             return Some((&l.time, Cow::Owned(total)));
         }
-        return l
-            .stored
-            .iter()
-            .chain(&l.inputs)
-            .chain(&l.dissipation)
-            .find(|t| t.name == term)
-            .map(|t| (l.time.as_slice(), Cow::Borrowed(t.values.as_slice())));
+        let find = |name: &str| {
+            l.stored
+                .iter()
+                .chain(&l.inputs)
+                .chain(&l.dissipation)
+                .find(|t| t.name == name)
+        };
+        if term.contains('+') {
+            let mut sum = vec![0.0; l.time.len()];
+            for name in term.split('+') {
+                for (s, v) in sum.iter_mut().zip(&find(name)?.values) {
+                    *s += v;
+                }
+            }
+            return Some((&l.time, Cow::Owned(sum)));
+        }
+        return find(term).map(|t| (l.time.as_slice(), Cow::Borrowed(t.values.as_slice())));
     }
     r.observables.get(channel).map(|c| {
         (

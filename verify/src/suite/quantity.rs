@@ -279,7 +279,7 @@ impl Quantity {
                     .map(|t| format!("energy.{}", t.name))
                     .collect();
                 return format!(
-                    "no ledger term `{c}` in the run; available: energy.total, {}",
+                    "no ledger term `{c}` in the run; available: energy.total, {} (sums as energy.A+B)",
                     terms.join(", ")
                 );
             }
