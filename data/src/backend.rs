@@ -105,6 +105,118 @@ impl FemElement {
     }
 }
 
+/// A time-integration method, as `time.method` (case files) and `--method` (CLI) spell it.
+///
+/// One list for all backends: each backend declares the subset it implements and answers the
+/// others with an error naming that subset. Spellings are parsed here, once ([`Method::NAMES`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum Method {
+    /// fem: energy-consistent implicit midpoint (discrete gradient) for free-joint chains.
+    EnergyMidpoint,
+    /// fem: implicit generalized-α (Chung–Hulbert).
+    GeneralizedAlpha,
+    /// Explicit central difference: fem's velocity-Verlet form; fdm's report scheme.
+    CentralDifference,
+    /// fem: implicit midpoint rule (one-stage Gauss).
+    ImplicitMidpoint,
+    /// fdm: the report's two-step central difference.
+    Report,
+    /// fdm: the report's scheme with a Robert–Asselin filter of coefficient ν (None: the
+    /// backend's default ν). Spelled `robert-asselin` or `robert-asselin=ν`.
+    RobertAsselin { nu: Option<f64> },
+    /// fdm: one-step velocity (kick–drift–kick) form.
+    VelocityForm,
+    /// modal: adaptive Dormand–Prince 5(4).
+    Dopri5,
+    /// modal: adaptive TR-BDF2 (also spelled `tr-bdf2`, `sdirk`).
+    TrBdf2,
+    /// modal: TR-BDF2 at a fixed step.
+    TrBdf2Fixed,
+    /// modal: trapezoidal rule at a fixed step.
+    Trapezoid,
+}
+
+impl Method {
+    /// Every accepted spelling, for error messages and CLI help.
+    pub const NAMES: &'static str = "energy-midpoint, generalized-alpha, central-difference, \
+        implicit-midpoint (fem); report, central-difference, robert-asselin[=nu], velocity-form \
+        (fdm); dopri5, trbdf2 (also tr-bdf2, sdirk), trbdf2-fixed, trapezoid (modal)";
+
+    /// The canonical spelling (`robert-asselin=ν` with its coefficient when one is given).
+    pub fn name(self) -> String {
+        let fixed = match self {
+            Method::EnergyMidpoint => "energy-midpoint",
+            Method::GeneralizedAlpha => "generalized-alpha",
+            Method::CentralDifference => "central-difference",
+            Method::ImplicitMidpoint => "implicit-midpoint",
+            Method::Report => "report",
+            Method::RobertAsselin { nu: Some(nu) } => return format!("robert-asselin={nu}"),
+            Method::RobertAsselin { nu: None } => "robert-asselin",
+            Method::VelocityForm => "velocity-form",
+            Method::Dopri5 => "dopri5",
+            Method::TrBdf2 => "trbdf2",
+            Method::TrBdf2Fixed => "trbdf2-fixed",
+            Method::Trapezoid => "trapezoid",
+        };
+        fixed.to_string()
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let name = text.trim();
+        Ok(match name {
+            "energy-midpoint" => Method::EnergyMidpoint,
+            "generalized-alpha" => Method::GeneralizedAlpha,
+            "central-difference" => Method::CentralDifference,
+            "implicit-midpoint" => Method::ImplicitMidpoint,
+            "report" => Method::Report,
+            "robert-asselin" => Method::RobertAsselin { nu: None },
+            "velocity-form" => Method::VelocityForm,
+            "dopri5" => Method::Dopri5,
+            "trbdf2" | "tr-bdf2" | "sdirk" => Method::TrBdf2,
+            "trbdf2-fixed" => Method::TrBdf2Fixed,
+            "trapezoid" => Method::Trapezoid,
+            _ => {
+                if let Some(value) = name.strip_prefix("robert-asselin=") {
+                    let nu = value
+                        .trim()
+                        .parse::<f64>()
+                        .map_err(|_| format!("cannot read the Robert–Asselin ν in `{name}`"))?;
+                    return Ok(Method::RobertAsselin { nu: Some(nu) });
+                }
+                return Err(format!(
+                    "unknown time-integration method `{name}`; accepted: {}",
+                    Method::NAMES
+                ));
+            }
+        })
+    }
+}
+
+impl TryFrom<String> for Method {
+    type Error = String;
+
+    fn try_from(text: String) -> Result<Self, String> {
+        text.parse()
+    }
+}
+
+impl From<Method> for String {
+    fn from(m: Method) -> String {
+        m.name()
+    }
+}
+
 /// How time is integrated.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct TimeStepping {
@@ -112,8 +224,9 @@ pub struct TimeStepping {
     pub dt: Option<f64>,
     /// Overrides the scene's end time.
     pub t_end: Option<f64>,
-    /// Backend-specific method name (e.g. `generalized-alpha`, `central-difference`, `dopri5`).
-    pub method: Option<String>,
+    /// Integration method (None: the backend's default for the scene). Each backend implements
+    /// some of the [`Method`]s and rejects the others, naming the ones it offers.
+    pub method: Option<Method>,
     /// Relative / absolute error tolerances of adaptive methods.
     pub rtol: Option<f64>,
     pub atol: Option<f64>,
@@ -211,4 +324,36 @@ pub trait Backend: Sync {
 
     /// Dynamic response over [0, t_end].
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Method;
+
+    #[test]
+    fn method_spellings_round_trip_and_unknown_names_list_the_accepted_ones() {
+        for name in [
+            "energy-midpoint",
+            "generalized-alpha",
+            "central-difference",
+            "implicit-midpoint",
+            "report",
+            "robert-asselin",
+            "robert-asselin=0.05",
+            "velocity-form",
+            "dopri5",
+            "trbdf2",
+            "trbdf2-fixed",
+            "trapezoid",
+        ] {
+            let m: Method = name.parse().unwrap();
+            assert_eq!(m.name(), name);
+        }
+        for alias in ["tr-bdf2", "sdirk"] {
+            assert_eq!(alias.parse::<Method>(), Ok(Method::TrBdf2));
+        }
+        let e = "rk4".parse::<Method>().unwrap_err();
+        assert!(e.contains("`rk4`") && e.contains(Method::NAMES), "{e}");
+        assert!("robert-asselin=x".parse::<Method>().is_err());
+    }
 }

@@ -66,7 +66,7 @@ pub struct CaseSettings {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub t_end: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub method: Option<String>,
+    pub method: Option<crate::Method>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rtol: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -88,7 +88,7 @@ impl CaseSettings {
             time: crate::TimeStepping {
                 dt: self.dt,
                 t_end: self.t_end,
-                method: self.method.clone(),
+                method: self.method,
                 rtol: self.rtol,
                 atol: self.atol,
                 safety_factor: self.safety_factor,

@@ -6,6 +6,7 @@
 //! * [`reader`] / [`validate`] — TOML → validated scene, errors with file, line, column, field;
 //! * [`catalog`] — the embedded catalog of `data/scenes/*.toml`;
 //! * [`results`] — observables, energy ledger, events, cost counters, stability verdict;
+//! * [`channel`] — the registry of observable channel names and units;
 //! * [`backend`] — the [`Backend`] trait every solver implements.
 //!
 //! No physics lives here: agreement between backends must mean something.
@@ -13,6 +14,7 @@
 pub mod backend;
 pub mod cases;
 pub mod catalog;
+pub mod channel;
 pub mod coverage;
 pub mod error;
 pub mod locate;
@@ -23,13 +25,13 @@ pub mod validate;
 
 pub use backend::{
     Backend, BackendError, BackendKind, Basis, Discretization, DofGroup, DofPlan, FemElement,
-    Settings, TimeStepping,
+    Method, Settings, TimeStepping,
 };
 pub use catalog::{CATALOG, catalog_names, catalog_scene, load_scene};
 pub use error::{LoadError, SceneError};
 pub use reader::parse_scene;
 pub use results::{
     Channel, Cost, Diagnostic, EnergyLedger, EnergyTerm, Event, ModalResult, ModeShape,
-    Observables, RunResult, StabilityVerdict, StaticResult, channel, ledger_term,
+    Observables, RunResult, StabilityVerdict, StaticResult, ledger_term,
 };
 pub use scene::{Family, Scene};

@@ -1,128 +1,61 @@
 //! What a backend returns (verification.md, "What every backend run returns").
 //!
 //! Backends fill these types; `verify` compares them. Observables are addressed by name (see
-//! [`channel`]) so that backends are compared through physical quantities, never raw DOF vectors.
+//! [`crate::channel`]) so that backends are compared through physical quantities, never raw DOF vectors.
 
 use serde::{Deserialize, Serialize};
 
 use crate::backend::{BackendKind, Settings};
 
-/// Standard observable channel names. Link and joint indices are 1-based, as in the papers.
-pub mod channel {
-    /// Joint angle θᵢ (frame angle of link i relative to its parent) \[rad\].
-    pub fn joint_angle(i: usize) -> String {
-        format!("joint{i}.angle")
-    }
-    /// Joint rate θ̇ᵢ.
-    pub fn joint_rate(i: usize) -> String {
-        format!("joint{i}.rate")
-    }
-    /// Unit of every joint-torque channel (one spelling across backends).
-    pub const TORQUE_UNIT: &str = "force·length";
-    /// Total torque the joint actuator applies (applied law, or what prescribed motion needed).
-    pub fn joint_torque(i: usize) -> String {
-        format!("joint{i}.torque")
-    }
-    /// Tip position of link i in inertial coordinates.
-    pub fn tip_x(i: usize) -> String {
-        format!("link{i}.tip_x")
-    }
-    pub fn tip_y(i: usize) -> String {
-        format!("link{i}.tip_y")
-    }
-    /// Transverse tip deflection of link i in its own floating frame.
-    pub fn tip_deflection(i: usize) -> String {
-        format!("link{i}.tip_deflection")
-    }
-    /// Axial tip displacement of link i in its floating frame (extensible links).
-    pub fn tip_axial(i: usize) -> String {
-        format!("link{i}.tip_axial")
-    }
-    /// Transverse deflection of link i at field station k (of `simulation.field_stations`).
-    pub fn field_deflection(i: usize, k: usize) -> String {
-        format!("link{i}.v@{k}")
-    }
-    /// 3-D link (seed 002): vertical tip deflection w(L), twist φ(L) and the tip slopes v′(L),
-    /// w′(L) of link i in its turning frame. With `tip_axial` (u(L)), `tip_deflection` (v(L)) and
-    /// the base angle they fix the payload's orientation to second order (seed eq. 2).
-    pub fn tip_vertical(i: usize) -> String {
-        format!("link{i}.tip_w")
-    }
-    pub fn tip_twist(i: usize) -> String {
-        format!("link{i}.tip_twist")
-    }
-    pub fn tip_slope_horizontal(i: usize) -> String {
-        format!("link{i}.tip_slope_v")
-    }
-    pub fn tip_slope_vertical(i: usize) -> String {
-        format!("link{i}.tip_slope_w")
-    }
-    /// 3-D link: vertical deflection and twist at field station k.
-    pub fn field_vertical(i: usize, k: usize) -> String {
-        format!("link{i}.w@{k}")
-    }
-    pub fn field_twist(i: usize, k: usize) -> String {
-        format!("link{i}.phi@{k}")
-    }
-    /// 3-D link: inertial position of the payload's centre of mass (origin on the base axis at
-    /// the rod's root, Z up).
-    pub const PAYLOAD_X: &str = "payload.X";
-    pub const PAYLOAD_Y: &str = "payload.Y";
-    pub const PAYLOAD_Z: &str = "payload.Z";
-    /// Contact phase of contact c: 0 free, 1 constrained and sliding (or frictionless), 2 sticking.
-    pub fn contact_phase(c: usize) -> String {
-        format!("contact{c}.phase")
-    }
-    /// Normal force of contact c (positive pushes the tip to the free side).
-    pub fn contact_normal_force(c: usize) -> String {
-        format!("contact{c}.normal_force")
-    }
-    /// Rocket: inertial position of the mass centre (aft end at the origin at launch), attitude θ
-    /// of the body axis from the horizontal, current mass.
-    pub const ROCKET_X: &str = "rocket.X";
-    pub const ROCKET_Y: &str = "rocket.Y";
-    pub const ROCKET_THETA: &str = "rocket.theta";
-    pub const ROCKET_MASS: &str = "rocket.mass";
-    /// Rocket: mass-averaged velocity of the material, linear momentum / mass (what the rocket
-    /// equation describes). It differs from d(rocket.X)/dt by the drift of the mass centre
-    /// through the body as stage 1 burns.
-    pub const ROCKET_VX: &str = "rocket.vX";
-    pub const ROCKET_VY: &str = "rocket.vY";
-    /// Rocket: elastic axial / transverse displacement at field station k (aft = 0 … nose).
-    pub fn rocket_axial(k: usize) -> String {
-        format!("rocket.u@{k}")
-    }
-    pub fn rocket_transverse(k: usize) -> String {
-        format!("rocket.w@{k}")
-    }
-    /// Rocket: displacement of discrete mass j (1-based) from its attachment station, in body
-    /// axes (u along, w across).
-    pub fn rocket_mass_axial(j: usize) -> String {
-        format!("rocket.mass{j}.u")
-    }
-    pub fn rocket_mass_transverse(j: usize) -> String {
-        format!("rocket.mass{j}.w")
-    }
-    /// Time step in use (variable-step schemes).
-    pub const STEP_SIZE: &str = "step_size";
-    /// Stability bound on the step in force at that time (explicit schemes).
-    pub const STABILITY_BOUND: &str = "stability_bound";
-}
-
 /// Standard energy-ledger term names (see [`EnergyLedger`]).
 pub mod ledger_term {
     use crate::scene::LinkField;
 
+    // Stored energies.
     pub const KINETIC: &str = "kinetic";
     pub const STRAIN: &str = "strain";
     pub const GRAVITY: &str = "gravity";
     pub const JOINT_SPRING: &str = "joint_spring";
+    /// Springs of the rocket's discrete masses.
+    pub const DISCRETE_SPRING: &str = "discrete_spring";
+
+    // Cumulative input work.
     pub const APPLIED_TORQUE: &str = "applied_torque";
+    /// Work of the scene's transverse step/tip load and distributed load.
+    pub const APPLIED_LOAD: &str = "applied_load";
     pub const PRESCRIBED_MOTION: &str = "prescribed_motion";
+    /// Rocket: work of the thrust and of the nozzle-exit pressure.
+    pub const THRUST: &str = "thrust";
+    pub const PRESSURE: &str = "pressure";
+    /// Rocket: work of the internal-flow Coriolis force (modal: the Coriolis terms of the
+    /// variable-mass equations).
+    pub const CORIOLIS: &str = "coriolis";
+    /// Rocket (fdm): work of the Coriolis force of the internal flow as the report writes it.
+    pub const CORIOLIS_FLOW: &str = "coriolis_flow";
+    /// Rocket: energy carried off by burnt propellant (an input in modal's ledger, a
+    /// dissipation in fdm's, each with the matching sign).
+    pub const MASS_OUTFLOW: &str = "mass_outflow";
+
+    // Cumulative dissipation.
     pub const JOINT_DAMPER: &str = "joint_damper";
     pub const KELVIN_VOIGT: &str = "kelvin_voigt";
+    /// Dampers of the rocket's discrete masses.
+    pub const DISCRETE_DAMPER: &str = "discrete_damper";
     pub const FRICTION: &str = "friction";
     pub const IMPACT: &str = "impact";
+    /// FEM contact: energy removed by projecting the state back onto the contact constraint.
+    pub const CONTACT_PROJECTION: &str = "contact_projection";
+    /// FEM contact with a massless tip: energy removed by the massless-node projection.
+    pub const NUMERICAL_MASSLESS: &str = "numerical_massless";
+
+    // Mobile manipulator (verify's rigid reference).
+    /// Work of the wheel drive torques.
+    pub const WHEEL_TORQUE: &str = "wheel_torque";
+    /// Work of the arm's joint torques.
+    pub const JOINT_TORQUE: &str = "joint_torque";
+    /// Dissipation in the wheel and joint friction.
+    pub const WHEEL_FRICTION: &str = "wheel_friction";
+    pub const JOINT_FRICTION: &str = "joint_friction";
 
     /// Kelvin–Voigt dissipation of one field of the 3-D link, booked separately per field.
     pub fn kelvin_voigt_of(field: LinkField) -> &'static str {

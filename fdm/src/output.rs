@@ -82,8 +82,8 @@ impl Recorder {
             .collect();
         times.dedup();
         let mut specs = sys.channels();
-        specs.push((data::channel::STEP_SIZE.to_string(), "time"));
-        specs.push((data::channel::STABILITY_BOUND.to_string(), "time"));
+        specs.push(data::channel::spec::step_size());
+        specs.push(data::channel::spec::stability_bound());
         let mut obs = Observables::with_channels(&specs);
         obs.time.reserve(times.len());
         for c in &mut obs.channels {

@@ -26,37 +26,33 @@ pub enum Method {
 }
 
 impl Method {
-    pub const ACCEPTED: &'static str = "report, robert-asselin[=nu], velocity-form";
+    /// The [`data::Method`] spellings this backend implements.
+    pub const ACCEPTED: &'static str =
+        "report (also central-difference), robert-asselin[=nu], velocity-form";
 
-    pub fn parse(name: &str) -> Result<Self, FdmError> {
-        let name = name.trim();
-        if name == "report" || name == "central-difference" {
-            return Ok(Method::Report);
-        }
-        if name == "velocity-form" {
-            return Ok(Method::VelocityForm);
-        }
-        if let Some(rest) = name.strip_prefix("robert-asselin") {
-            let nu = if rest.is_empty() {
-                DEFAULT_ASSELIN_NU
-            } else {
-                let v = rest.strip_prefix('=').unwrap_or("x");
-                v.parse::<f64>().map_err(|_| {
-                    FdmError::invalid("time.method", format!("cannot read ν in `{name}`"))
-                })?
-            };
-            if !(nu > 0.0 && nu < 0.5) {
-                return Err(FdmError::invalid(
-                    "time.method",
-                    format!("Robert–Asselin ν = {nu} must lie in (0, 0.5)"),
-                ));
+    /// This backend's reading of a method named in the settings.
+    pub fn from_data(method: data::Method) -> Result<Self, FdmError> {
+        match method {
+            data::Method::Report | data::Method::CentralDifference => Ok(Method::Report),
+            data::Method::VelocityForm => Ok(Method::VelocityForm),
+            data::Method::RobertAsselin { nu } => {
+                let nu = nu.unwrap_or(DEFAULT_ASSELIN_NU);
+                if !(nu > 0.0 && nu < 0.5) {
+                    return Err(FdmError::invalid(
+                        "time.method",
+                        format!("Robert–Asselin ν = {nu} must lie in (0, 0.5)"),
+                    ));
+                }
+                Ok(Method::RobertAsselin { nu })
             }
-            return Ok(Method::RobertAsselin { nu });
+            other => Err(FdmError::invalid(
+                "time.method",
+                format!(
+                    "the fdm backend does not implement `{other}`; it offers {}",
+                    Self::ACCEPTED
+                ),
+            )),
         }
-        Err(FdmError::invalid(
-            "time.method",
-            format!("unknown method `{name}`; accepted: {}", Self::ACCEPTED),
-        ))
     }
 
     pub fn name(&self) -> String {
@@ -107,8 +103,8 @@ impl FdmSettings {
         {
             return Err(FdmError::invalid("time.t_end", format!("{t} must be > 0")));
         }
-        let method = match &s.time.method {
-            Some(m) => Method::parse(m)?,
+        let method = match s.time.method {
+            Some(m) => Method::from_data(m)?,
             None => Method::Report,
         };
         Ok(FdmSettings {

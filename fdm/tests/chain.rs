@@ -493,7 +493,7 @@ fn dyn_chain_two_step_scheme_is_caught_and_velocity_form_is_default() {
     // scheme's spurious root (|ξ| > 1 for any step): the monitor stops it with a diagnostic,
     // which is why the chain's default (no time.method) is the velocity form.
     let mut s = with(11, 0.5);
-    s.time.method = Some("report".into());
+    s.time.method = Some("report".parse().expect("a method name"));
     let out = run("two-link-free", |_| {}, &s);
     match &out.verdict {
         StabilityVerdict::Stopped { diagnostic } => {

@@ -243,7 +243,7 @@ fn prop_contact_unsupported_settings_are_typed_errors() {
     );
     let scene = load_scene("barhorst-case1").unwrap();
     let mut s2 = s.clone();
-    s2.time.method = Some("report".into());
+    s2.time.method = Some("report".parse().expect("a method name"));
     let e = FdmBackend.simulate(&scene, &s2).unwrap_err();
     assert!(matches!(&e, BackendError::Unsupported(_)), "{e}");
 }

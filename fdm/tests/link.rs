@@ -154,7 +154,7 @@ fn dyn_single_link_report_scheme_parasitic_velocity_form_closes_energy() {
     // The free hub couples θ̇ and v̇ (İθ̇ and θ̇² terms): velocity-dependent forces on which the
     // two-step scheme's computational mode grows even without damping. It is detected…
     let mut report = Settings::default();
-    report.time.method = Some("report".into());
+    report.time.method = Some("report".parse().expect("a method name"));
     let out = run("single-link", |_| {}, &report);
     match &out.verdict {
         StabilityVerdict::Stopped { diagnostic } => {
@@ -165,7 +165,7 @@ fn dyn_single_link_report_scheme_parasitic_velocity_form_closes_energy() {
     }
     // …and the one-step velocity form runs the scene with a closed ledger.
     let mut s = Settings::default();
-    s.time.method = Some("velocity-form".into());
+    s.time.method = Some("velocity-form".parse().expect("a method name"));
     let out = run("single-link", |_| {}, &s);
     assert!(
         matches!(out.verdict, StabilityVerdict::Completed),
@@ -210,7 +210,7 @@ fn dyn_single_link_kelvin_voigt_dissipation_in_ledger() {
     // γ such that the shortest wave is strongly damped (ζ_max ≈ 1): the step bound shrinks
     // and the velocity form must still close the ledger with the dissipation term.
     let mut s = Settings::default();
-    s.time.method = Some("velocity-form".into());
+    s.time.method = Some("velocity-form".parse().expect("a method name"));
     s.time.t_end = Some(1.5);
     let out = run(
         "single-link",

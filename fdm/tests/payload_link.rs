@@ -146,6 +146,24 @@ fn dyn_payload_link_refuses_a_step_above_the_bound_naming_the_field() {
         .simulate(&s2, &settings(None, Some(1e-2), Some(0.99 * torsion)))
         .unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
+    // Channels of the carried fields only, in the registry's order, then the step monitors.
+    let written: Vec<&str> = r
+        .observables
+        .channels
+        .iter()
+        .map(|c| c.name.as_str())
+        .collect();
+    let stations = written.iter().filter(|n| n.starts_with("link1.w@")).count();
+    let mut expected: Vec<String> =
+        data::channel::payload_link(&[LinkField::Vertical, LinkField::Torsion], stations)
+            .into_iter()
+            .map(|(n, _)| n)
+            .collect();
+    expected.extend(["step_size".to_string(), "stability_bound".to_string()]);
+    assert!(stations >= 2);
+    assert_eq!(written, expected);
+    assert!(r.observables.get("link1.tip_axial").is_none());
+    assert!(r.observables.get("link1.tip_slope_v").is_none());
 }
 
 #[test]

@@ -18,7 +18,7 @@ fn ignition_mass(r: &data::scene::Rocket) -> f64 {
 
 fn settings(method: &str) -> (Settings, FdmSettings) {
     let mut s = Settings::default();
-    s.time.method = Some(method.to_string());
+    s.time.method = Some(method.parse().expect("a method name"));
     let f = FdmSettings::from_settings(&s).expect("valid");
     (s, f)
 }
@@ -366,7 +366,7 @@ fn dyn_rocket_report_two_step_at_the_reports_own_sigma_blows_up() {
         }
         v => panic!("expected a stop, got {v:?}"),
     }
-    s.time.method = Some("velocity-form".into());
+    s.time.method = Some("velocity-form".parse().expect("a method name"));
     let f = FdmSettings::from_settings(&s).unwrap();
     let (_, out) = fdm::runs::rocket_with(&scene, &f, true).unwrap();
     assert!(matches!(out.verdict, StabilityVerdict::Completed));
@@ -431,7 +431,8 @@ fn sys_rocket_invalid_settings_rejected() {
         Err(BackendError::InvalidSettings { .. })
     ));
     let mut s = Settings::default();
-    s.time.method = Some("rk4".into());
+    // A method of another backend: refused, naming the ones fdm offers.
+    s.time.method = Some(data::Method::Dopri5);
     match FdmBackend.simulate(&scene, &s) {
         Err(BackendError::InvalidSettings { message, .. }) => {
             assert!(message.contains("velocity-form"))

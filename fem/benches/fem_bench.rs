@@ -82,7 +82,7 @@ fn single_link(c: &mut Criterion) {
     g.sample_size(10);
     for m in ["energy-midpoint", "generalized-alpha"] {
         let mut st = Settings::default();
-        st.time.method = Some(m.to_string());
+        st.time.method = Some(m.parse().expect("a method name"));
         g.bench_function(m, |b| {
             b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
         });

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use data::{
     Cost, Diagnostic, EnergyLedger, Event, Observables, RunResult, Scene, Settings,
-    StabilityVerdict, channel,
+    StabilityVerdict, channel, ledger_term,
 };
 
 use crate::chain::{Chain, NONE};
@@ -358,53 +358,37 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
     let mut specs = Vec::new();
     for (i, l) in chain.links.iter().enumerate() {
         let k = i + 1;
-        specs.push((channel::joint_angle(k), "rad"));
-        specs.push((channel::joint_rate(k), "rad/time"));
-        specs.push((channel::joint_torque(k), channel::TORQUE_UNIT));
-        specs.push((channel::tip_x(k), "length"));
-        specs.push((channel::tip_y(k), "length"));
-        specs.push((channel::tip_deflection(k), "length"));
+        specs.push(channel::spec::joint_angle(k));
+        specs.push(channel::spec::joint_rate(k));
+        specs.push(channel::spec::joint_torque(k));
+        specs.push(channel::spec::tip_x(k));
+        specs.push(channel::spec::tip_y(k));
+        specs.push(channel::spec::tip_deflection(k));
         if l.axial {
-            specs.push((channel::tip_axial(k), "length"));
+            specs.push(channel::spec::tip_axial(k));
         }
         for s in 0..stations {
-            specs.push((channel::field_deflection(k, s), "length"));
+            specs.push(channel::spec::field_deflection(k, s));
         }
     }
     if !scene.contacts.is_empty() {
-        specs.push((channel::contact_normal_force(1), "force"));
-        specs.push((channel::contact_phase(1), "1"));
-        // Not standard channels: gap (constraint violation when constrained), normal tip velocity
+        specs.push(channel::spec::contact_normal_force(1));
+        specs.push(channel::spec::contact_phase(1));
+        // Gap (constraint violation when constrained), normal tip velocity
         // G q̇, and the running maxima of |g| and |G q̇| over constrained step ends (drift).
-        specs.push((GAP_CHANNEL.to_string(), "length"));
-        specs.push((NORMAL_VELOCITY_CHANNEL.to_string(), "length/time"));
-        specs.push((MAX_GAP_CHANNEL.to_string(), "length"));
-        specs.push((MAX_NORMAL_VELOCITY_CHANNEL.to_string(), "length/time"));
+        specs.push(channel::spec::contact_gap(1));
+        specs.push(channel::spec::contact_normal_velocity(1));
+        specs.push(channel::spec::contact_max_gap(1));
+        specs.push(channel::spec::contact_max_normal_velocity(1));
         if scene.contacts[0].friction > 0.0 {
             // Friction contact (crate::events::friction): slip velocity, tangential force, work.
-            specs.push((SLIP_VELOCITY_CHANNEL.to_string(), "length/time"));
-            specs.push((FRICTION_FORCE_CHANNEL.to_string(), "force"));
-            specs.push((FRICTION_WORK_CHANNEL.to_string(), "energy"));
+            specs.push(channel::spec::contact_slip_velocity(1));
+            specs.push(channel::spec::contact_friction_force(1));
+            specs.push(channel::spec::contact_friction_work(1));
         }
     }
     specs
 }
-
-/// Gap of the tip contact (negative: penetration).
-pub const GAP_CHANNEL: &str = "contact1.gap";
-/// Normal tip velocity G q̇ of the contact.
-pub const NORMAL_VELOCITY_CHANNEL: &str = "contact1.normal_velocity";
-/// Running max |g| over the ends of constrained steps (position drift).
-pub const MAX_GAP_CHANNEL: &str = "contact1.max_gap";
-/// Running max |G q̇| over the ends of constrained steps (velocity drift, O(h²)).
-pub const MAX_NORMAL_VELOCITY_CHANNEL: &str = "contact1.max_normal_velocity";
-
-/// Tangential tip velocity v_t = t̂·ṙ_tip of a friction contact.
-pub const SLIP_VELOCITY_CHANNEL: &str = "contact1.slip_velocity";
-/// Tangential force on the tip along t̂ (friction force sliding, holding force sticking).
-pub const FRICTION_FORCE_CHANNEL: &str = "contact1.friction_force";
-/// Cumulative friction work (the ledger's `friction` term).
-pub const FRICTION_WORK_CHANNEL: &str = "contact1.friction_work";
 
 /// Samples the observables at the driver's current state into `buf`.
 fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<f64>) {
@@ -445,29 +429,29 @@ fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<
 /// Names of the ledger terms the scene needs.
 fn ledger_terms(integ: &Driver) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
     let chain = &integ.chain;
-    let mut stored = vec!["kinetic", "strain"];
+    let mut stored = vec![ledger_term::KINETIC, ledger_term::STRAIN];
     if chain.links.iter().any(|l| l.joint.stiffness > 0.0) {
-        stored.push("joint_spring");
+        stored.push(ledger_term::JOINT_SPRING);
     }
     if chain.gravity != [0.0, 0.0] {
-        stored.push("gravity");
+        stored.push(ledger_term::GRAVITY);
     }
     let mut inputs = Vec::new();
     if chain.tip_load != 0.0 || chain.distributed_load != 0.0 {
-        inputs.push("applied_load");
+        inputs.push(ledger_term::APPLIED_LOAD);
     }
     if chain.links.iter().any(|l| l.joint.torque.is_some()) {
-        inputs.push("applied_torque");
+        inputs.push(ledger_term::APPLIED_TORQUE);
     }
     if chain.links.iter().any(|l| l.joint.dof == NONE) {
-        inputs.push("prescribed_motion");
+        inputs.push(ledger_term::PRESCRIBED_MOTION);
     }
     let mut diss = Vec::new();
     if chain.links.iter().any(|l| l.joint.damping > 0.0) {
-        diss.push("joint_damper");
+        diss.push(ledger_term::JOINT_DAMPER);
     }
     if chain.links.iter().any(|l| l.kelvin_voigt > 0.0) {
-        diss.push("kelvin_voigt");
+        diss.push(ledger_term::KELVIN_VOIGT);
     }
     if integ
         .contact
@@ -475,15 +459,15 @@ fn ledger_terms(integ: &Driver) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'
         .and_then(|c| c.massless.as_ref())
         .is_some_and(|m| m.project)
     {
-        diss.push("numerical_massless");
+        diss.push(ledger_term::NUMERICAL_MASSLESS);
     }
     match integ.contact.as_deref().map(|c| c.bilateral.as_deref()) {
         // A bilateral wall has no impacts or releases; friction work when μ > 0.
-        Some(Some(b)) if b.has_friction() => diss.push("friction"),
+        Some(Some(b)) if b.has_friction() => diss.push(ledger_term::FRICTION),
         Some(Some(_)) => {}
         Some(None) => {
-            diss.push("impact");
-            diss.push("contact_projection");
+            diss.push(ledger_term::IMPACT);
+            diss.push(ledger_term::CONTACT_PROJECTION);
         }
         None => {}
     }
@@ -499,9 +483,9 @@ fn push_ledger(integ: &Driver, ledger: &mut EnergyLedger) {
     let mut ns = 0;
     for term in &ledger.stored {
         stored[ns] = match term.name.as_str() {
-            "kinetic" => kin,
-            "strain" => strain,
-            "joint_spring" => spring,
+            ledger_term::KINETIC => kin,
+            ledger_term::STRAIN => strain,
+            ledger_term::JOINT_SPRING => spring,
             _ => grav,
         };
         ns += 1;
@@ -510,19 +494,21 @@ fn push_ledger(integ: &Driver, ledger: &mut EnergyLedger) {
     let mut inputs = [0.0; 3];
     for (k, term) in ledger.inputs.iter().enumerate() {
         inputs[k] = match term.name.as_str() {
-            "applied_torque" => w.applied_torque,
-            "applied_load" => w.applied_load,
+            ledger_term::APPLIED_TORQUE => w.applied_torque,
+            ledger_term::APPLIED_LOAD => w.applied_load,
             _ => w.prescribed_motion,
         };
     }
     let mut diss = [0.0; 6];
     for (k, term) in ledger.dissipation.iter().enumerate() {
         diss[k] = match term.name.as_str() {
-            "joint_damper" => w.joint_damper,
-            "numerical_massless" => w.numerical_massless,
-            "impact" => integ.contact.as_ref().map_or(0.0, |c| c.impact_loss),
-            "contact_projection" => integ.contact.as_ref().map_or(0.0, |c| c.projection_loss),
-            "friction" => integ
+            ledger_term::JOINT_DAMPER => w.joint_damper,
+            ledger_term::NUMERICAL_MASSLESS => w.numerical_massless,
+            ledger_term::IMPACT => integ.contact.as_ref().map_or(0.0, |c| c.impact_loss),
+            ledger_term::CONTACT_PROJECTION => {
+                integ.contact.as_ref().map_or(0.0, |c| c.projection_loss)
+            }
+            ledger_term::FRICTION => integ
                 .contact
                 .as_deref()
                 .and_then(|c| c.bilateral.as_deref())

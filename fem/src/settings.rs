@@ -7,12 +7,12 @@ pub const DEFAULT_ELEMENTS: usize = 16;
 /// Largest accepted element count per link (keeps dense modal analysis and memory bounded).
 pub const MAX_ELEMENTS: usize = 20_000;
 
-/// Time-integration method names accepted in `time.method`.
-pub const METHODS: [&str; 4] = [
-    "energy-midpoint",
-    "generalized-alpha",
-    "central-difference",
-    "implicit-midpoint",
+/// The [`data::Method`]s this backend implements.
+pub const METHODS: [data::Method; 4] = [
+    data::Method::EnergyMidpoint,
+    data::Method::GeneralizedAlpha,
+    data::Method::CentralDifference,
+    data::Method::ImplicitMidpoint,
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,15 +41,18 @@ pub fn elements(disc: &data::Discretization) -> Result<usize, FemError> {
 
 /// The method named in `time.method`, or `default` when none is given.
 pub fn method(time: &data::TimeStepping, default: Method) -> Result<Method, FemError> {
-    match time.method.as_deref() {
+    match time.method {
         None => Ok(default),
-        Some("energy-midpoint") => Ok(Method::EnergyMidpoint),
-        Some("generalized-alpha") => Ok(Method::GeneralizedAlpha),
-        Some("central-difference") => Ok(Method::CentralDifference),
-        Some("implicit-midpoint") => Ok(Method::ImplicitMidpoint),
+        Some(data::Method::EnergyMidpoint) => Ok(Method::EnergyMidpoint),
+        Some(data::Method::GeneralizedAlpha) => Ok(Method::GeneralizedAlpha),
+        Some(data::Method::CentralDifference) => Ok(Method::CentralDifference),
+        Some(data::Method::ImplicitMidpoint) => Ok(Method::ImplicitMidpoint),
         Some(other) => Err(FemError::InvalidSettings {
             field: "time.method".into(),
-            message: format!("unknown method `{other}`; accepted: {}", METHODS.join(", ")),
+            message: format!(
+                "the fem backend does not implement `{other}`; it offers {}",
+                METHODS.map(|m| m.name()).join(", ")
+            ),
         }),
     }
 }

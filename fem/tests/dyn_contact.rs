@@ -381,7 +381,7 @@ fn sys_contact_refusals_are_precise() {
     let sc = scene("barhorst-case1");
     for (method, rtol) in [("generalized-alpha", None), ("energy-midpoint", Some(1e-4))] {
         let mut st = settings(Some(4), Some(0.01));
-        st.time.method = Some(method.into());
+        st.time.method = Some(method.parse().expect("a method name"));
         st.time.rtol = rtol;
         match FemBackend.simulate(&sc, &st) {
             Err(BackendError::Unsupported(m)) => assert!(m.contains("contact"), "{m}"),

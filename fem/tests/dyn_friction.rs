@@ -9,7 +9,10 @@ use data::{Backend, BackendError, Event, RunResult, Scene, Settings, StabilityVe
 use fem::FemBackend;
 use fem::chain::Chain;
 use fem::events::contact::Contact;
-use fem::run::{FRICTION_FORCE_CHANNEL, FRICTION_WORK_CHANNEL, SLIP_VELOCITY_CHANNEL};
+
+const SLIP_VELOCITY_CHANNEL: &str = "contact1.slip_velocity";
+const FRICTION_FORCE_CHANNEL: &str = "contact1.friction_force";
+const FRICTION_WORK_CHANNEL: &str = "contact1.friction_work";
 
 fn arm() -> Scene {
     data::catalog::load_scene("constrained-arm").unwrap()

@@ -11,7 +11,7 @@ fn settings(n: Option<usize>, dt: Option<f64>, t_end: Option<f64>, method: &str)
     st.discretization.elements = n;
     st.time.dt = dt;
     st.time.t_end = t_end;
-    st.time.method = Some(method.to_string());
+    st.time.method = Some(method.parse().expect("a method name"));
     st
 }
 

@@ -19,7 +19,7 @@ fn run(
     st.discretization.elements = Some(n);
     st.time.dt = dt;
     st.time.t_end = t_end;
-    st.time.method = method.map(str::to_string);
+    st.time.method = method.map(|m| m.parse().expect("a method name"));
     FemBackend.simulate(&sc, &st)
 }
 
@@ -233,7 +233,7 @@ fn dyn_central_difference_runs_at_99_percent_of_its_enforced_bound() {
     let sc = data::load_scene("spin-up").unwrap();
     let mut st = Settings::default();
     st.time.t_end = Some(0.5);
-    st.time.method = Some("central-difference".into());
+    st.time.method = Some("central-difference".parse().expect("a method name"));
     st.time.dt = Some(sc.simulation.t_end);
     let bound = match FemBackend.simulate(&sc, &st) {
         Err(BackendError::StabilityBound { bound, .. }) => bound,

@@ -312,7 +312,7 @@ fn settings(n: usize, dt: Option<f64>, t_end: f64, method: Option<&str>) -> Sett
     st.discretization.elements = Some(n);
     st.time.dt = dt;
     st.time.t_end = Some(t_end);
-    st.time.method = method.map(str::to_string);
+    st.time.method = method.map(|m| m.parse().expect("a method name"));
     st
 }
 

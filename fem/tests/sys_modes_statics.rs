@@ -383,7 +383,8 @@ fn sys_unsupported_scenes_and_bad_settings_are_refused() {
         );
     }
     let mut s = Settings::default();
-    s.time.method = Some("rk4".into());
+    // A method of another backend: refused, naming the ones fem offers.
+    s.time.method = Some(data::Method::Dopri5);
     match FemBackend.simulate(&data::load_scene("spin-up").unwrap(), &s) {
         Err(BackendError::InvalidSettings { field, message }) => {
             assert_eq!(field, "time.method");

@@ -428,7 +428,7 @@ fn sys_payload_gravity_sag_is_the_cantilever_solution() {
 fn sys_payload_refuses_what_it_does_not_build() {
     let sc = scene("single-link-3d");
     let mut settings = Settings::default();
-    settings.time.method = Some("central-difference".into());
+    settings.time.method = Some("central-difference".parse().expect("a method name"));
     assert!(matches!(
         FemBackend.simulate(&sc, &settings),
         Err(data::BackendError::Unsupported(_))

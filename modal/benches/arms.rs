@@ -29,7 +29,7 @@ fn arms(c: &mut Criterion) {
     let undamped = load_scene("two-link-free-undamped").unwrap();
     let fixed = Settings {
         time: TimeStepping {
-            method: Some("trbdf2-fixed".into()),
+            method: Some("trbdf2-fixed".parse().expect("a method name")),
             dt: Some(2.5e-4),
             ..Default::default()
         },

@@ -1,22 +1,12 @@
 //! Outputs of a chain run: the sampled observables and energy ledger (channel layout chosen
 //! from what the scene has), the final state, and the diagnostics of a stopped run.
 
-use data::{Diagnostic, EnergyLedger, Observables, Scene, StabilityVerdict, channel};
+use data::{Diagnostic, EnergyLedger, Observables, Scene, StabilityVerdict, channel, ledger_term};
 
 use crate::events::ContactReport;
 use crate::integrate::Stepper;
 use crate::linalg::dot;
 use crate::rhs::ChainRhs;
-
-/// Tangential tip velocity v_t = t̂·ṙ_tip of a friction contact (no `data::channel` convention
-/// exists for it).
-pub const SLIP_VELOCITY_CHANNEL: &str = "contact1.slip_velocity";
-/// Tangential (friction) force on the tip along t̂ of a friction contact.
-pub const FRICTION_FORCE_CHANNEL: &str = "contact1.friction_force";
-
-/// Cumulative friction work ∫ μ|λ||v_t| dt (the ledger's `friction` term, as a channel so that
-/// summaries show it).
-pub const FRICTION_WORK_CHANNEL: &str = "contact1.friction_work";
 
 /// Full generalized coordinates q and rates q̇ at the end of a run, plus the contact report.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -56,29 +46,29 @@ impl Output {
         let mut specs: Vec<(String, &str)> = Vec::new();
         for (i, _) in chain.links.iter().enumerate() {
             let k = i + 1;
-            specs.push((channel::joint_angle(k), "rad"));
-            specs.push((channel::joint_rate(k), "rad/time"));
-            specs.push((channel::joint_torque(k), channel::TORQUE_UNIT));
-            specs.push((channel::tip_x(k), "length"));
-            specs.push((channel::tip_y(k), "length"));
-            specs.push((channel::tip_deflection(k), "length"));
+            specs.push(channel::spec::joint_angle(k));
+            specs.push(channel::spec::joint_rate(k));
+            specs.push(channel::spec::joint_torque(k));
+            specs.push(channel::spec::tip_x(k));
+            specs.push(channel::spec::tip_y(k));
+            specs.push(channel::spec::tip_deflection(k));
             for s in 0..ns {
-                specs.push((channel::field_deflection(k, s), "length"));
+                specs.push(channel::spec::field_deflection(k, s));
             }
         }
         let has_contact = rhs.contact.is_some();
         if has_contact {
-            specs.push((channel::contact_normal_force(1), "force"));
-            specs.push((channel::contact_phase(1), "1"));
-            // Not a standard channel: the constraint violation (penetration < 0) at the samples.
-            specs.push(("contact1.gap".to_string(), "length"));
+            specs.push(channel::spec::contact_normal_force(1));
+            specs.push(channel::spec::contact_phase(1));
+            // The constraint violation (penetration < 0) at the samples.
+            specs.push(channel::spec::contact_gap(1));
         }
         let has_friction = rhs.contact.as_ref().is_some_and(|c| c.has_friction());
         if has_friction {
-            // Not standard channels: tangential tip velocity T q̇ and friction force along t̂.
-            specs.push((SLIP_VELOCITY_CHANNEL.to_string(), "length/time"));
-            specs.push((FRICTION_FORCE_CHANNEL.to_string(), "force"));
-            specs.push((FRICTION_WORK_CHANNEL.to_string(), "energy"));
+            // Tangential tip velocity T q̇, friction force along t̂ and the friction work.
+            specs.push(channel::spec::contact_slip_velocity(1));
+            specs.push(channel::spec::contact_friction_force(1));
+            specs.push(channel::spec::contact_friction_work(1));
         }
         let mut obs = Observables::with_channels(&specs);
         obs.time.reserve(n_samples);
@@ -90,35 +80,35 @@ impl Output {
             .iter()
             .any(|j| j.prescribed.is_none() && j.stiffness > 0.0);
         let has_gravity = chain.gravity.is_some();
-        let mut stored = vec!["kinetic", "strain"];
+        let mut stored = vec![ledger_term::KINETIC, ledger_term::STRAIN];
         if has_spring {
-            stored.push("joint_spring");
+            stored.push(ledger_term::JOINT_SPRING);
         }
         if has_gravity {
-            stored.push("gravity");
+            stored.push(ledger_term::GRAVITY);
         }
         let mut inputs = Vec::new();
         if rhs.slots.applied.is_some() {
-            inputs.push("applied_torque");
+            inputs.push(ledger_term::APPLIED_TORQUE);
         }
         if rhs.slots.prescribed.is_some() {
-            inputs.push("prescribed_motion");
+            inputs.push(ledger_term::PRESCRIBED_MOTION);
         }
         if chain.step_load.is_some() {
-            inputs.push("applied_load");
+            inputs.push(ledger_term::APPLIED_LOAD);
         }
         let mut diss = Vec::new();
         if rhs.slots.joint_damper.is_some() {
-            diss.push("joint_damper");
+            diss.push(ledger_term::JOINT_DAMPER);
         }
         if rhs.slots.kelvin_voigt.is_some() {
-            diss.push("kelvin_voigt");
+            diss.push(ledger_term::KELVIN_VOIGT);
         }
         if rhs.contact.as_ref().is_some_and(|c| !c.bilateral) {
-            diss.push("impact");
+            diss.push(ledger_term::IMPACT);
         }
         if rhs.slots.friction.is_some() {
-            diss.push("friction");
+            diss.push(ledger_term::FRICTION);
         }
         let mut ledger = EnergyLedger::new(&stored, &inputs, &diss);
         ledger.time.reserve(n_samples);

@@ -12,15 +12,13 @@ use crate::contact::ContactState;
 use crate::error::ModalError;
 use crate::events::{ContactEvents, Halt};
 use crate::integrate::{
-    Build, DOPRI5, METHODS, MethodInfo, TRBDF2, Tolerances, method_named, method_names,
+    Build, DOPRI5, METHODS, MethodInfo, TRBDF2, Tolerances, method_for, method_names,
 };
 use crate::output::{Output, runaway, stopped, too_many_events};
 use crate::setup::build_chain;
 
 pub use crate::events::{ContactReport, EVENT_TIME_TOLERANCE, MAX_CONTACT_EVENTS};
-pub use crate::output::{
-    FRICTION_FORCE_CHANNEL, FRICTION_WORK_CHANNEL, FinalState, SLIP_VELOCITY_CHANNEL,
-};
+pub use crate::output::FinalState;
 pub use crate::rhs::ChainRhs;
 
 /// Default tolerances of the adaptive integrators.
@@ -41,23 +39,23 @@ pub const KELVIN_VOIGT_DEFAULT_TOL: (f64, f64) = (1e-6, 1e-8);
 /// An integration method of the registry ([`crate::integrate::METHODS`]).
 pub type Method = &'static MethodInfo;
 
-/// The registered method called `name` (None: the default, Dormand–Prince).
-pub fn parse_method(name: Option<&str>) -> Result<Method, ModalError> {
-    let Some(name) = name else {
+/// The registered implementation of `method` (None: the default, Dormand–Prince).
+pub fn parse_method(method: Option<data::Method>) -> Result<Method, ModalError> {
+    let Some(method) = method else {
         return Ok(METHODS[0]);
     };
-    method_named(name).ok_or_else(|| {
+    method_for(method).ok_or_else(|| {
         ModalError::invalid(
             "time.method",
-            format!("`{name}`: the modal backend offers {}", method_names()),
+            format!("`{method}`: the modal backend offers {}", method_names()),
         )
     })
 }
 
 /// The method of a run: the one named in the settings, else the default ([`default_method`]).
 pub fn method_choice(scene: &Scene, settings: &Settings) -> Result<Method, ModalError> {
-    match settings.time.method.as_deref() {
-        Some(name) => parse_method(Some(name)),
+    match settings.time.method {
+        Some(method) => parse_method(Some(method)),
         None => Ok(default_method(scene, settings)),
     }
 }

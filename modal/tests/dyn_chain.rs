@@ -188,7 +188,7 @@ fn run_to(
         time: TimeStepping {
             rtol: Some(rtol),
             atol: Some(rtol * 1e-3),
-            method: method.map(String::from),
+            method: method.map(|m| m.parse().expect("a method name")),
             t_end,
             ..Default::default()
         },
@@ -417,7 +417,7 @@ fn dyn_kelvin_voigt_work_through_the_release_transient_matches_resolved_integrat
         let settings = Settings {
             time: TimeStepping {
                 t_end: Some(0.1),
-                method: method.map(str::to_string),
+                method: method.map(|m| m.parse().expect("a method name")),
                 rtol,
                 atol,
                 ..Default::default()
@@ -473,7 +473,7 @@ fn dyn_two_link_free_fixed_step_and_default_follow_the_resolved_method() {
     let fixed_step = Settings {
         time: TimeStepping {
             t_end,
-            method: Some("trbdf2-fixed".into()),
+            method: Some("trbdf2-fixed".parse().expect("a method name")),
             ..Default::default()
         },
         ..Default::default()
@@ -494,7 +494,7 @@ fn dyn_two_link_free_fixed_step_and_default_follow_the_resolved_method() {
             t_end,
             rtol: Some(1e-9),
             atol: Some(1e-12),
-            method: Some("dopri5".into()),
+            method: Some("dopri5".parse().expect("a method name")),
             ..Default::default()
         },
     };

@@ -7,10 +7,11 @@ use data::{
     TimeStepping, load_scene,
 };
 use modal::ModalBackend;
-use modal::simulate::{
-    FRICTION_FORCE_CHANNEL, FRICTION_WORK_CHANNEL, FinalState, SLIP_VELOCITY_CHANNEL,
-    simulate_detailed,
-};
+use modal::simulate::{FinalState, simulate_detailed};
+
+const SLIP_VELOCITY_CHANNEL: &str = "contact1.slip_velocity";
+const FRICTION_FORCE_CHANNEL: &str = "contact1.friction_force";
+const FRICTION_WORK_CHANNEL: &str = "contact1.friction_work";
 
 fn settings(modes: usize, rtol: f64, t_end: Option<f64>) -> Settings {
     Settings {

@@ -284,7 +284,8 @@ fn sys_unsupported_and_invalid_requests_are_typed_errors() {
         );
     }
     let mut bad = Settings::default();
-    bad.time.method = Some("euler".into());
+    // A method of another backend.
+    bad.time.method = Some(data::Method::Report);
     assert!(matches!(
         ModalBackend.simulate(&load_scene("single-link").unwrap(), &bad),
         Err(BackendError::InvalidSettings { .. })

@@ -154,7 +154,7 @@ fn sys_trbdf2_contact_run_cost_and_first_impulse() {
             ..Default::default()
         },
         time: TimeStepping {
-            method: Some("trbdf2".into()),
+            method: Some("trbdf2".parse().expect("a method name")),
             rtol: Some(1e-6),
             atol: Some(1e-8),
             t_end: Some(0.29),

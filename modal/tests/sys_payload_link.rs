@@ -487,6 +487,34 @@ fn sys_payload_link_builds_only_what_the_scene_switches_on() {
     let stiff = load_scene("single-link-3d-stiff").unwrap();
     let m = LinkModel::build(link(&stiff), 6, BasisChoice::Legendre, 11).unwrap();
     assert!(m.damping.is_none() && m.damped.is_empty() && m.gravity.is_none());
+
+    // The run writes the channels of the carried fields only (no zeros for u and v).
+    let mut settings = Settings {
+        discretization: d4,
+        ..Default::default()
+    };
+    settings.time.t_end = Some(0.01);
+    let run = ModalBackend.simulate(&s, &settings).unwrap();
+    let written: Vec<&str> = run
+        .observables
+        .channels
+        .iter()
+        .map(|c| c.name.as_str())
+        .collect();
+    let stations = s.simulation.field_stations.max(2);
+    let expected =
+        data::channel::payload_link(&[LinkField::Vertical, LinkField::Torsion], stations);
+    let expected: Vec<&str> = expected.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(written, expected);
+    for absent in [
+        "link1.tip_axial",
+        "link1.tip_deflection",
+        "link1.tip_slope_v",
+        "link1.v@0",
+    ] {
+        assert!(run.observables.get(absent).is_none(), "{absent}");
+    }
+    assert!(run.observables.get("link1.tip_w").is_some());
 }
 
 #[test]
@@ -505,7 +533,7 @@ fn sys_payload_link_refuses_what_it_does_not_offer() {
     }
     let mut s = settings(6, Basis::Poly);
     s.time = TimeStepping {
-        method: Some("no-such-method".into()),
+        method: Some(data::Method::GeneralizedAlpha),
         ..Default::default()
     };
     let e = ModalBackend.simulate(&scene, &s).unwrap_err();
@@ -732,7 +760,7 @@ fn dyn_payload_link_gravity_does_not_move_v_at_constant_rate_with_diagonal_inert
     let s = Settings {
         time: TimeStepping {
             t_end: Some(0.2),
-            method: Some("trapezoid".into()),
+            method: Some("trapezoid".parse().expect("a method name")),
             dt: Some(2e-4),
             ..Default::default()
         },

@@ -862,7 +862,11 @@ pub const FULL_RUNG_BUDGET_S: f64 = 10.0;
 pub fn ladder_quantity(scene: &Scene) -> Option<String> {
     use data::scene::PrescribedMotion;
     if let Some(_r) = &scene.rocket {
-        return Some(format!("rocket.vY@{}", scene.simulation.t_end));
+        return Some(format!(
+            "{}@{}",
+            data::channel::ROCKET_VY,
+            scene.simulation.t_end
+        ));
     }
     let first = scene.links.first()?;
     let t = scene.simulation.t_end;
@@ -871,7 +875,7 @@ pub fn ladder_quantity(scene: &Scene) -> Option<String> {
             "freq1".into()
         }
         Some(PrescribedMotion::SpinUp { .. }) => format!("tip_deflection@{t}"),
-        None => format!("joint1.angle@{t}"),
+        None => format!("{}@{t}", data::channel::joint_angle(1)),
     })
 }
 

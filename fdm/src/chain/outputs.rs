@@ -2,7 +2,7 @@
 //! law + spring + damper, tip positions, deflections in the clamp-tangent frame, the contact
 //! channels.
 
-use data::channel;
+use data::{channel, ledger_term};
 
 use super::kinetic::{BE, TH, seg_energy};
 use super::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
@@ -33,23 +33,23 @@ impl Outputs for TwoLinkChain {
     fn channels(&self) -> Vec<(String, &'static str)> {
         let mut c = Vec::new();
         for j in 1..=2 {
-            c.push((channel::joint_angle(j), "rad"));
-            c.push((channel::joint_rate(j), "rad/time"));
-            c.push((channel::joint_torque(j), channel::TORQUE_UNIT));
+            c.push(channel::spec::joint_angle(j));
+            c.push(channel::spec::joint_rate(j));
+            c.push(channel::spec::joint_torque(j));
         }
         for l in 1..=2 {
-            c.push((channel::tip_x(l), "length"));
-            c.push((channel::tip_y(l), "length"));
-            c.push((channel::tip_deflection(l), "length"));
+            c.push(channel::spec::tip_x(l));
+            c.push(channel::spec::tip_y(l));
+            c.push(channel::spec::tip_deflection(l));
             for k in 0..self.field_stations {
-                c.push((channel::field_deflection(l, k), "length"));
+                c.push(channel::spec::field_deflection(l, k));
             }
         }
         if self.contact.is_some() {
-            c.push((channel::contact_normal_force(1), "force"));
-            c.push((channel::contact_phase(1), "1"));
-            // not a standard channel (as modal): the gap, negative = penetration
-            c.push(("contact1.gap".to_string(), "length"));
+            c.push(channel::spec::contact_normal_force(1));
+            c.push(channel::spec::contact_phase(1));
+            // the gap, negative = penetration
+            c.push(channel::spec::contact_gap(1));
         }
         c
     }
@@ -131,21 +131,25 @@ impl Outputs for TwoLinkChain {
     fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
         let mut inputs = Vec::new();
         if self.any_law() {
-            inputs.push("applied_torque");
+            inputs.push(ledger_term::APPLIED_TORQUE);
         }
         let mut diss = Vec::new();
         if self.any_damper() {
-            diss.push("joint_damper");
+            diss.push(ledger_term::JOINT_DAMPER);
         }
         if self.any_kv() {
-            diss.push("kelvin_voigt");
+            diss.push(ledger_term::KELVIN_VOIGT);
         }
         if self.contact.is_some() {
-            diss.push("impact");
+            diss.push(ledger_term::IMPACT);
         }
-        let mut stored = vec!["kinetic", "strain", "joint_spring"];
+        let mut stored = vec![
+            ledger_term::KINETIC,
+            ledger_term::STRAIN,
+            ledger_term::JOINT_SPRING,
+        ];
         if self.gravity.is_some() {
-            stored.push("gravity");
+            stored.push(ledger_term::GRAVITY);
         }
         (stored, inputs, diss)
     }

@@ -1,7 +1,7 @@
 //! The single link's observables (joint angle/rate/torque, tip position and deflection, the
 //! sampled deflection field) and ledger terms.
 
-use data::channel;
+use data::{channel, ledger_term};
 
 use super::FloatingLink;
 use crate::output::{Outputs, sample_field};
@@ -31,15 +31,15 @@ impl Outputs for FloatingLink {
 
     fn channels(&self) -> Vec<(String, &'static str)> {
         let mut c = vec![
-            (channel::joint_angle(1), "rad"),
-            (channel::joint_rate(1), "rad/time"),
-            (channel::joint_torque(1), channel::TORQUE_UNIT),
-            (channel::tip_x(1), "length"),
-            (channel::tip_y(1), "length"),
-            (channel::tip_deflection(1), "length"),
+            channel::spec::joint_angle(1),
+            channel::spec::joint_rate(1),
+            channel::spec::joint_torque(1),
+            channel::spec::tip_x(1),
+            channel::spec::tip_y(1),
+            channel::spec::tip_deflection(1),
         ];
         for k in 0..self.field_stations {
-            c.push((channel::field_deflection(1, k), "length"));
+            c.push(channel::spec::field_deflection(1, k));
         }
         c
     }
@@ -77,24 +77,24 @@ impl Outputs for FloatingLink {
     }
 
     fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
-        let mut stored = vec!["kinetic", "strain"];
+        let mut stored = vec![ledger_term::KINETIC, ledger_term::STRAIN];
         if self.spring_enabled() {
-            stored.push("joint_spring");
+            stored.push(ledger_term::JOINT_SPRING);
         }
         let mut inputs = Vec::new();
         if self.input_enabled() {
             inputs.push(if self.prescribed() {
-                "prescribed_motion"
+                ledger_term::PRESCRIBED_MOTION
             } else {
-                "applied_torque"
+                ledger_term::APPLIED_TORQUE
             });
         }
         let mut diss = Vec::new();
         if self.damper_enabled() {
-            diss.push("joint_damper");
+            diss.push(ledger_term::JOINT_DAMPER);
         }
         if self.kelvin_voigt_enabled() {
-            diss.push("kelvin_voigt");
+            diss.push(ledger_term::KELVIN_VOIGT);
         }
         (stored, inputs, diss)
     }

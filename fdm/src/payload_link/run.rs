@@ -224,37 +224,9 @@ impl PayloadLinkModel {
 
     /// Observable channels (name, unit).
     pub fn channels(&self) -> Vec<(String, &'static str)> {
-        let mut c = vec![
-            (channel::joint_angle(1), "rad"),
-            (channel::joint_rate(1), "rad/time"),
-            (channel::joint_torque(1), channel::TORQUE_UNIT),
-            (channel::PAYLOAD_X.to_string(), "length"),
-            (channel::PAYLOAD_Y.to_string(), "length"),
-            (channel::PAYLOAD_Z.to_string(), "length"),
-            (channel::tip_axial(1), "length"),
-            (channel::tip_deflection(1), "length"),
-            (channel::tip_vertical(1), "length"),
-            (channel::tip_twist(1), "rad"),
-            (channel::tip_slope_horizontal(1), "rad"),
-            (channel::tip_slope_vertical(1), "rad"),
-        ];
-        for (f, name, unit) in [
-            (
-                LinkField::Horizontal,
-                channel::field_deflection as fn(usize, usize) -> String,
-                "length",
-            ),
-            (LinkField::Vertical, channel::field_vertical, "length"),
-            (LinkField::Torsion, channel::field_twist, "rad"),
-        ] {
-            if self.fields.contains(&f) {
-                for k in 0..self.field_stations {
-                    c.push((name(1, k), unit));
-                }
-            }
-        }
-        c.push((channel::STEP_SIZE.to_string(), "time"));
-        c.push((channel::STABILITY_BOUND.to_string(), "time"));
+        let mut c = channel::payload_link(&self.fields, self.field_stations);
+        c.push(channel::spec::step_size());
+        c.push(channel::spec::stability_bound());
         c
     }
 
@@ -273,27 +245,27 @@ impl PayloadLinkModel {
         let y1 = v + c * sv;
         let z = w + c * sw;
         let (cs, sn) = (lvl.th.cos(), lvl.th.sin());
-        out[..12].copy_from_slice(&[
+        out[..6].copy_from_slice(&[
             lvl.th,
             lvl.rate,
             lvl.torque,
             cs * x1 - sn * y1,
             sn * x1 + cs * y1,
             z,
-            u,
-            v,
-            w,
-            phi,
-            sv,
-            sw,
         ]);
-        let mut k = 12;
+        let mut k = 6;
+        // Tip quantities of the carried fields, in the registry's order (u, v, w, φ, v′, w′).
+        for (value, tq) in [u, v, w, phi, sv, sw]
+            .iter()
+            .zip(&channel::PAYLOAD_LINK_TIP)
+        {
+            if self.fields.contains(&tq.field) {
+                out[k] = *value;
+                k += 1;
+            }
+        }
         let nf = self.field_stations;
-        for f in [
-            LinkField::Horizontal,
-            LinkField::Vertical,
-            LinkField::Torsion,
-        ] {
+        for f in channel::PAYLOAD_LINK_PROFILES.iter().map(|p| p.field) {
             if self.fields.contains(&f) {
                 sample_field(
                     self.length,

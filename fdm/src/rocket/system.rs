@@ -26,7 +26,7 @@
 
 use std::ops::Range;
 
-use data::channel;
+use data::{channel, ledger_term};
 
 use crate::output::Outputs;
 use crate::rocket::model::RocketModel;
@@ -439,22 +439,22 @@ impl Outputs for RocketSystem {
 
     fn channels(&self) -> Vec<(String, &'static str)> {
         let mut c = vec![
-            (channel::ROCKET_X.to_string(), "length"),
-            (channel::ROCKET_Y.to_string(), "length"),
-            (channel::ROCKET_THETA.to_string(), "rad"),
-            (channel::ROCKET_MASS.to_string(), "mass"),
-            (channel::ROCKET_VX.to_string(), "length/time"),
-            (channel::ROCKET_VY.to_string(), "length/time"),
+            channel::spec::rocket_x(),
+            channel::spec::rocket_y(),
+            channel::spec::rocket_theta(),
+            channel::spec::rocket_mass(),
+            channel::spec::rocket_vx(),
+            channel::spec::rocket_vy(),
         ];
         for k in 0..self.field_stations {
-            c.push((channel::rocket_axial(k), "length"));
+            c.push(channel::spec::rocket_axial(k));
         }
         for k in 0..self.field_stations {
-            c.push((channel::rocket_transverse(k), "length"));
+            c.push(channel::spec::rocket_transverse(k));
         }
         for j in 1..=self.model.masses.len() {
-            c.push((channel::rocket_mass_axial(j), "length"));
-            c.push((channel::rocket_mass_transverse(j), "length"));
+            c.push(channel::spec::rocket_mass_axial(j));
+            c.push(channel::spec::rocket_mass_transverse(j));
         }
         c
     }
@@ -503,9 +503,18 @@ impl Outputs for RocketSystem {
 
     fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
         (
-            vec!["kinetic", "strain", "gravity", "discrete_spring"],
-            vec!["thrust", "pressure", "coriolis_flow"],
-            vec!["discrete_damper", "mass_outflow"],
+            vec![
+                ledger_term::KINETIC,
+                ledger_term::STRAIN,
+                ledger_term::GRAVITY,
+                ledger_term::DISCRETE_SPRING,
+            ],
+            vec![
+                ledger_term::THRUST,
+                ledger_term::PRESSURE,
+                ledger_term::CORIOLIS_FLOW,
+            ],
+            vec![ledger_term::DISCRETE_DAMPER, ledger_term::MASS_OUTFLOW],
         )
     }
 

@@ -397,8 +397,8 @@ fn fit(h: f64, out: f64) -> f64 {
 pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
     let l = the_link(scene)?;
     let n_el = settings::elements(&settings.discretization)?;
-    match settings.time.method.as_deref() {
-        None | Some("implicit-midpoint") => {}
+    match settings.time.method {
+        None | Some(data::Method::ImplicitMidpoint) => {}
         Some(other) => {
             return Err(FemError::unsupported(format!(
                 "fem payload link: method `{other}`; only `implicit-midpoint` is implemented \
@@ -463,44 +463,7 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
     })
 }
 
-fn channel_specs(md: &Model, stations: usize) -> Vec<(String, &'static str)> {
-    let mut s = vec![
-        (channel::joint_angle(1), "rad"),
-        (channel::joint_rate(1), "rad/time"),
-        (channel::joint_torque(1), channel::TORQUE_UNIT),
-        (channel::PAYLOAD_X.to_string(), "length"),
-        (channel::PAYLOAD_Y.to_string(), "length"),
-        (channel::PAYLOAD_Z.to_string(), "length"),
-    ];
-    let has = |f| md.fields.contains(&f);
-    if has(LinkField::Axial) {
-        s.push((channel::tip_axial(1), "length"));
-    }
-    if has(LinkField::Horizontal) {
-        s.push((channel::tip_deflection(1), "length"));
-        s.push((channel::tip_slope_horizontal(1), "rad"));
-    }
-    if has(LinkField::Vertical) {
-        s.push((channel::tip_vertical(1), "length"));
-        s.push((channel::tip_slope_vertical(1), "rad"));
-    }
-    if has(LinkField::Torsion) {
-        s.push((channel::tip_twist(1), "rad"));
-    }
-    for k in 0..stations {
-        if has(LinkField::Horizontal) {
-            s.push((channel::field_deflection(1, k), "length"));
-        }
-        if has(LinkField::Vertical) {
-            s.push((channel::field_vertical(1, k), "length"));
-        }
-        if has(LinkField::Torsion) {
-            s.push((channel::field_twist(1, k), "rad"));
-        }
-    }
-    s
-}
-
+/// Samples the channels of [`channel::payload_link`] (the fields the rod carries) into `buf`.
 fn sample(st: &Stepper, torque: f64, stations: usize, buf: &mut Vec<f64>) {
     buf.clear();
     let md = &st.model;
@@ -511,28 +474,27 @@ fn sample(st: &Stepper, torque: f64, stations: usize, buf: &mut Vec<f64>) {
     buf.extend([s.theta, s.rate, torque, c * x - sn * y, sn * x + c * y, z]);
     let has = |f| md.fields.contains(&f);
     let t = &md.tip;
-    if has(LinkField::Axial) {
-        buf.push(t.u.dot(d));
-    }
-    if has(LinkField::Horizontal) {
-        buf.extend([t.v.dot(d), t.v_slope.dot(d)]);
-    }
-    if has(LinkField::Vertical) {
-        buf.extend([t.w.dot(d), t.w_slope.dot(d)]);
-    }
-    if has(LinkField::Torsion) {
-        buf.push(t.phi.dot(d));
-    }
-    for k in 0..stations {
-        let xk = md.length * k as f64 / (stations - 1) as f64;
-        if has(LinkField::Horizontal) {
-            buf.push(md.field_at(d, V, xk));
+    for (j, q) in channel::PAYLOAD_LINK_TIP.iter().enumerate() {
+        if !has(q.field) {
+            continue;
         }
-        if has(LinkField::Vertical) {
-            buf.push(md.field_at(d, W, xk));
+        // Entries in the registry's order: u, v, w, φ, v′, w′ at the tip.
+        let row = [&t.u, &t.v, &t.w, &t.phi, &t.v_slope, &t.w_slope][j];
+        buf.push(row.dot(d));
+    }
+    for p in channel::PAYLOAD_LINK_PROFILES.iter() {
+        let component = match p.field {
+            LinkField::Horizontal => V,
+            LinkField::Vertical => W,
+            LinkField::Torsion => PHI,
+            LinkField::Axial => continue,
+        };
+        if !has(p.field) {
+            continue;
         }
-        if has(LinkField::Torsion) {
-            buf.push(md.field_at(d, PHI, xk));
+        for k in 0..stations {
+            let xk = md.length * k as f64 / (stations - 1) as f64;
+            buf.push(md.field_at(d, component, xk));
         }
     }
 }
@@ -606,7 +568,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         output_interval,
         stations,
     } = prepare(scene, settings)?;
-    let specs = channel_specs(&stepper.model, stations);
+    let specs = channel::payload_link(&stepper.model.fields, stations);
     let mut obs = Observables::with_channels(&specs);
     let (s, i, d) = ledger_names(&stepper.model);
     let mut ledger = EnergyLedger::new(&s, &i, &d);

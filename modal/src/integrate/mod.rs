@@ -72,20 +72,16 @@ pub enum Build {
 /// Registry entry of one integration method.
 #[derive(Clone, Copy)]
 pub struct MethodInfo {
-    /// The name a scene's settings use (`time.method`).
+    /// The method as the settings name it (`time.method`).
+    pub method: data::Method,
+    /// Its canonical spelling, for messages.
     pub name: &'static str,
-    /// Other accepted names.
-    pub aliases: &'static [&'static str],
     pub build: Build,
 }
 
 impl MethodInfo {
     pub fn is_fixed_step(&self) -> bool {
         matches!(self.build, Build::Fixed(_))
-    }
-
-    fn answers_to(&self, name: &str) -> bool {
-        self.name == name || self.aliases.contains(&name)
     }
 }
 
@@ -106,23 +102,16 @@ impl std::fmt::Debug for MethodInfo {
 /// Every integration method of the crate, the first one being the default.
 pub const METHODS: &[&MethodInfo] = &[&DOPRI5, &TRBDF2, &TRBDF2_FIXED, &TRAPEZOID];
 
-/// The registered method named (or aliased) `name`.
-pub fn method_named(name: &str) -> Option<&'static MethodInfo> {
-    METHODS.iter().copied().find(|m| m.answers_to(name))
+/// The registered implementation of `method`, if this crate has one.
+pub fn method_for(method: data::Method) -> Option<&'static MethodInfo> {
+    METHODS.iter().copied().find(|m| m.method == method)
 }
 
-/// The registered names for a message: "`a`, `b` (alias `c`), `d`".
+/// The registered names for a message: "`a`, `b`, `c`".
 pub fn method_names() -> String {
     METHODS
         .iter()
-        .map(|m| {
-            let mut s = format!("`{}`", m.name);
-            if !m.aliases.is_empty() {
-                let aliases: Vec<String> = m.aliases.iter().map(|a| format!("`{a}`")).collect();
-                s.push_str(&format!(" (alias {})", aliases.join(", ")));
-            }
-            s
-        })
+        .map(|m| format!("`{}`", m.name))
         .collect::<Vec<_>>()
         .join(", ")
 }

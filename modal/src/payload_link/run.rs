@@ -14,7 +14,7 @@ use super::dynamics::LinkRhs;
 use super::model::LinkModel;
 use super::{SetUp, set_up, static_sag};
 use crate::error::ModalError;
-use crate::integrate::{Build, OdeRhs, TRAPEZOID, TRBDF2, Tolerances, method_named, method_names};
+use crate::integrate::{Build, OdeRhs, TRAPEZOID, TRBDF2, Tolerances, method_for, method_names};
 use crate::modes::generalized_eigen;
 
 /// Default (rtol, atol) of the adaptive methods: atol is in metres and radians (coordinates are
@@ -59,12 +59,12 @@ pub fn default_step(model: &LinkModel) -> Result<f64, ModalError> {
 pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalError> {
     let wall = Instant::now();
     let SetUp { link, model } = set_up(scene, &settings.discretization)?;
-    let method = match settings.time.method.as_deref() {
+    let method = match settings.time.method {
         None => default_method(&model),
-        Some(name) => method_named(name).ok_or_else(|| {
+        Some(method) => method_for(method).ok_or_else(|| {
             ModalError::invalid(
                 "time.method",
-                format!("`{name}`: the modal backend offers {}", method_names()),
+                format!("`{method}`: the modal backend offers {}", method_names()),
             )
         })?,
     };
@@ -184,37 +184,12 @@ struct Output {
 impl Output {
     fn new(rhs: &LinkRhs, scene: &Scene) -> Self {
         let m = &rhs.model;
-        let mut specs: Vec<(String, &str)> = vec![
-            (channel::joint_angle(1), "rad"),
-            (channel::joint_rate(1), "rad/time"),
-            (channel::joint_torque(1), channel::TORQUE_UNIT),
-            (channel::PAYLOAD_X.to_string(), "length"),
-            (channel::PAYLOAD_Y.to_string(), "length"),
-            (channel::PAYLOAD_Z.to_string(), "length"),
-            (channel::tip_axial(1), "length"),
-            (channel::tip_deflection(1), "length"),
-            (channel::tip_vertical(1), "length"),
-            (channel::tip_twist(1), "rad"),
-            (channel::tip_slope_horizontal(1), "rad"),
-            (channel::tip_slope_vertical(1), "rad"),
-        ];
-        let ns = m.stations.len();
         let _ = scene;
-        for (field, name, unit) in [
-            (
-                LinkField::Horizontal,
-                channel::field_deflection as fn(usize, usize) -> String,
-                "length",
-            ),
-            (LinkField::Vertical, channel::field_vertical, "length"),
-            (LinkField::Torsion, channel::field_twist, "rad"),
-        ] {
-            if m.block(field).is_some() {
-                for s in 0..ns {
-                    specs.push((name(1, s), unit));
-                }
-            }
-        }
+        let fields: Vec<LinkField> = LinkField::ALL
+            .into_iter()
+            .filter(|f| m.block(*f).is_some())
+            .collect();
+        let specs = channel::payload_link(&fields, m.stations.len());
         let has_gravity = m.gravity.is_some();
         let has_spring = m.base.spring.is_some();
         let mut stored = vec![ledger_term::KINETIC, ledger_term::STRAIN];
@@ -273,13 +248,14 @@ impl Output {
             co * p1 - s * p2,
             s * p1 + co * p2,
             p3,
-            u,
-            v,
-            w,
-            phi,
-            sv,
-            sw,
         ]);
+        // Tip quantities of the carried fields, in the registry's order (u, v, w, φ, v′, w′).
+        let tip = [u, v, w, phi, sv, sw];
+        for (value, q) in tip.iter().zip(&channel::PAYLOAD_LINK_TIP) {
+            if m.block(q.field).is_some() {
+                self.values.push(*value);
+            }
+        }
         for (k, field) in [
             LinkField::Horizontal,
             LinkField::Vertical,

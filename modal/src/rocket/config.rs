@@ -69,9 +69,9 @@ fn positive(field: &str, v: Option<f64>) -> Result<Option<f64>, RocketError> {
 
 pub fn time(scene: &data::Scene, settings: &Settings) -> Result<TimeConfig, RocketError> {
     let ts = &settings.time;
-    let method = match ts.method.as_deref() {
-        None | Some("dopri5") => Method::Dopri5,
-        Some("tr-bdf2") | Some("trbdf2") | Some("sdirk") => Method::TrBdf2,
+    let method = match ts.method {
+        None | Some(data::Method::Dopri5) => Method::Dopri5,
+        Some(data::Method::TrBdf2) => Method::TrBdf2,
         Some(other) => {
             return Err(RocketError::invalid(
                 "time.method",

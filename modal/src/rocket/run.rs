@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use data::{
     BackendKind, Cost, Diagnostic, EnergyLedger, Event, Observables, RunResult, Settings,
-    StabilityVerdict, channel,
+    StabilityVerdict, channel, ledger_term,
 };
 
 use super::basis::Basis;
@@ -136,24 +136,24 @@ pub struct DetailedRun {
 /// Names of the channels, in recording order.
 fn channel_specs(stations: usize, masses: usize) -> Vec<(String, &'static str)> {
     let mut v: Vec<(String, &'static str)> = vec![
-        (channel::ROCKET_X.to_string(), "length"),
-        (channel::ROCKET_Y.to_string(), "length"),
-        (channel::ROCKET_THETA.to_string(), "rad"),
-        (channel::ROCKET_MASS.to_string(), "mass"),
-        (channel::ROCKET_VX.to_string(), "length/time"),
-        (channel::ROCKET_VY.to_string(), "length/time"),
+        channel::spec::rocket_x(),
+        channel::spec::rocket_y(),
+        channel::spec::rocket_theta(),
+        channel::spec::rocket_mass(),
+        channel::spec::rocket_vx(),
+        channel::spec::rocket_vy(),
     ];
     for k in 0..stations {
-        v.push((channel::rocket_axial(k), "length"));
+        v.push(channel::spec::rocket_axial(k));
     }
     for k in 0..stations {
-        v.push((channel::rocket_transverse(k), "length"));
+        v.push(channel::spec::rocket_transverse(k));
     }
     for j in 1..=masses {
-        v.push((channel::rocket_mass_axial(j), "length"));
+        v.push(channel::spec::rocket_mass_axial(j));
     }
     for j in 1..=masses {
-        v.push((channel::rocket_mass_transverse(j), "length"));
+        v.push(channel::spec::rocket_mass_transverse(j));
     }
     v
 }
@@ -181,17 +181,26 @@ impl<'a> Recorder<'a> {
         let has_burn = model.body.burn.is_some();
         let has_masses = nm > 0;
         let has_dampers = model.body.has_dampers();
-        let mut stored = vec!["kinetic", "strain", "gravity"];
+        let mut stored = vec![
+            ledger_term::KINETIC,
+            ledger_term::STRAIN,
+            ledger_term::GRAVITY,
+        ];
         if has_masses {
-            stored.push("discrete_spring");
+            stored.push(ledger_term::DISCRETE_SPRING);
         }
         let inputs: Vec<&str> = if has_burn {
-            vec!["thrust", "pressure", "coriolis", "mass_outflow"]
+            vec![
+                ledger_term::THRUST,
+                ledger_term::PRESSURE,
+                ledger_term::CORIOLIS,
+                ledger_term::MASS_OUTFLOW,
+            ]
         } else {
             vec![]
         };
         let diss: Vec<&str> = if has_dampers {
-            vec!["discrete_damper"]
+            vec![ledger_term::DISCRETE_DAMPER]
         } else {
             vec![]
         };

@@ -253,9 +253,11 @@ pub struct CommonOpts {
     /// End time (overrides the scene).
     #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
     pub t_end: Option<f64>,
-    /// Integration method (backend-specific; see `flexverify describe`).
-    #[arg(long)]
-    pub method: Option<String>,
+    /// Integration method (backend-specific; see `flexverify describe`): energy-midpoint,
+    /// generalized-alpha, central-difference, implicit-midpoint (fem); report,
+    /// robert-asselin[=nu], velocity-form (fdm); dopri5, trbdf2, trbdf2-fixed, trapezoid (modal).
+    #[arg(long, value_parser = parse_method)]
+    pub method: Option<data::Method>,
     /// Relative tolerance of adaptive integrators.
     #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
     pub rtol: Option<f64>,
@@ -313,11 +315,16 @@ impl CommonOpts {
             time: data::TimeStepping {
                 dt: self.dt,
                 t_end: self.t_end,
-                method: self.method.clone(),
+                method: self.method,
                 rtol: self.rtol,
                 atol: self.atol,
                 safety_factor: self.safety_factor,
             },
         }
     }
+}
+
+/// `--method`: one of [`data::Method::NAMES`].
+fn parse_method(text: &str) -> Result<data::Method, String> {
+    text.parse()
 }

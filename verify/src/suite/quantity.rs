@@ -290,10 +290,19 @@ impl Quantity {
                 .map(|c| c.name.as_str())
                 .filter(|n| !n.contains('@'))
                 .collect();
-            format!(
-                "no channel `{c}` in the run; available: {}",
-                names.join(", ")
-            )
+            let payload_run = r.observables.get(data::channel::PAYLOAD_X).is_some();
+            match data::channel::payload_link_field_of(c) {
+                Some(field) if payload_run => format!(
+                    "no channel `{c}` in the run: the scene's rod does not carry the {} field \
+                     (a 3-D link writes the channels of its carried fields only); available: {}",
+                    field.name(),
+                    names.join(", ")
+                ),
+                _ => format!(
+                    "no channel `{c}` in the run; available: {}",
+                    names.join(", ")
+                ),
+            }
         };
         match self {
             Quantity::At { channel, t } => {

@@ -195,13 +195,14 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             let st = ana::RigidLink::from_scene(scene)
                 .and_then(|r| r.state(*t))
                 .map_err(|e| e.to_string())?;
-            match channel.as_str() {
-                "joint1.angle" => Ok(st.angle),
-                "joint1.rate" => Ok(st.rate),
-                c => Err(format!(
-                    "`rigid-single-link` has no channel `{c}` (joint1.angle, joint1.rate)"
-                )),
-            }
+            offered_channel(
+                id,
+                channel,
+                [
+                    (data::channel::joint_angle(1), st.angle),
+                    (data::channel::joint_rate(1), st.rate),
+                ],
+            )
         }
         "rigid-two-link" => {
             let Quantity::At { channel, t } = q else {
@@ -211,13 +212,14 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
                 .and_then(|r| r.simulate(&[0.0, *t]))
                 .map_err(|e| e.to_string())?;
             let last = |v: &Vec<f64>| v.last().copied().ok_or("empty rigid history".to_string());
-            match channel.as_str() {
-                "joint1.angle" => last(&h.q1),
-                "joint2.angle" => last(&h.q5),
-                c => Err(format!(
-                    "`rigid-two-link` has no channel `{c}` (joint1.angle, joint2.angle)"
-                )),
-            }
+            offered_channel(
+                id,
+                channel,
+                [
+                    (data::channel::joint_angle(1), last(&h.q1)?),
+                    (data::channel::joint_angle(2), last(&h.q5)?),
+                ],
+            )
         }
         "constrained-rigid-link" => {
             let Quantity::At { channel, t } = q else {
@@ -226,16 +228,16 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             let st = ana::ConstrainedRigidLink::from_scene(scene)
                 .and_then(|r| r.state(*t))
                 .map_err(|e| e.to_string())?;
-            match channel.as_str() {
-                "joint1.angle" => Ok(st.angle),
-                "joint1.rate" => Ok(st.rate),
-                "contact1.normal_force" => Ok(st.normal_force),
-                "contact1.friction_work" => Ok(st.friction_work),
-                c => Err(format!(
-                    "`constrained-rigid-link` has no channel `{c}` (joint1.angle, joint1.rate, \
-                     contact1.normal_force, contact1.friction_work)"
-                )),
-            }
+            offered_channel(
+                id,
+                channel,
+                [
+                    (data::channel::joint_angle(1), st.angle),
+                    (data::channel::joint_rate(1), st.rate),
+                    (data::channel::contact_normal_force(1), st.normal_force),
+                    (data::channel::contact_friction_work(1), st.friction_work),
+                ],
+            )
         }
         "rocket-translation" => {
             let Quantity::At { channel, t } = q else {
@@ -244,14 +246,15 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             let st = ana::RocketTranslation::from_scene(scene)
                 .and_then(|r| r.state(*t))
                 .map_err(|e| e.to_string())?;
-            match channel.as_str() {
-                "rocket.vX" => Ok(st.body_vx),
-                "rocket.vY" => Ok(st.body_vy),
-                "rocket.mass" => Ok(st.mass),
-                c => Err(format!(
-                    "`rocket-translation` has no channel `{c}` (rocket.vX, rocket.vY, rocket.mass)"
-                )),
-            }
+            offered_channel(
+                id,
+                channel,
+                [
+                    (data::channel::ROCKET_VX.to_string(), st.body_vx),
+                    (data::channel::ROCKET_VY.to_string(), st.body_vy),
+                    (data::channel::ROCKET_MASS.to_string(), st.mass),
+                ],
+            )
         }
         "payload-horizontal" | "payload-vertical" => {
             let p = payload_link(scene)?;
@@ -294,13 +297,14 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
                 ana::payload_link::RigidPayloadBase::from_link(payload_link(scene)?)
                     .and_then(|r| r.state(*t))
                     .map_err(|e| e.to_string())?;
-            match channel.as_str() {
-                "joint1.angle" => Ok(angle),
-                "joint1.rate" => Ok(rate),
-                c => Err(format!(
-                    "`payload-rigid-base` has no channel `{c}` (joint1.angle, joint1.rate)"
-                )),
-            }
+            offered_channel(
+                id,
+                channel,
+                [
+                    (data::channel::joint_angle(1), angle),
+                    (data::channel::joint_rate(1), rate),
+                ],
+            )
         }
         other => Err(format!(
             "unknown analytic reference `{other}`; known: clamped-free, tip-mass, timoshenko, \
@@ -356,4 +360,20 @@ pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
         _ => return None,
     };
     Some(id.to_string())
+}
+
+/// The value of `channel` among the channels a reference offers, or an error naming them.
+fn offered_channel<const N: usize>(
+    id: &str,
+    channel: &str,
+    offered: [(String, f64); N],
+) -> Result<f64, String> {
+    if let Some((_, v)) = offered.iter().find(|(name, _)| name == channel) {
+        return Ok(*v);
+    }
+    let names: Vec<&str> = offered.iter().map(|(name, _)| name.as_str()).collect();
+    Err(format!(
+        "`{id}` has no channel `{channel}` ({})",
+        names.join(", ")
+    ))
 }

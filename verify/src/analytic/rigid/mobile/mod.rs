@@ -24,7 +24,8 @@ pub mod seed;
 
 use std::time::Instant;
 
-use data::results::channel;
+use data::channel::spec;
+use data::ledger_term;
 use data::{
     BackendError, BackendKind, Cost, EnergyLedger, Observables, RunResult, Scene, Settings,
     StabilityVerdict,
@@ -102,44 +103,42 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, Backend
 
     let mut specs: Vec<(String, &str)> = Vec::new();
     if layout.platform.is_some() {
-        for (n, u) in [
-            ("platform.x", "m"),
-            ("platform.y", "m"),
-            ("platform.heading", "rad"),
-            ("wheel_right.angle", "rad"),
-            ("wheel_left.angle", "rad"),
-            ("wheel_right.torque", "N m"),
-            ("wheel_left.torque", "N m"),
-        ] {
-            specs.push((n.into(), u));
-        }
+        specs.extend([
+            spec::platform_x(),
+            spec::platform_y(),
+            spec::platform_heading(),
+            spec::wheel_right_angle(),
+            spec::wheel_left_angle(),
+            spec::wheel_right_torque(),
+            spec::wheel_left_torque(),
+        ]);
     }
     if layout.arm.is_some() {
         for i in 1..=4 {
-            specs.push((channel::joint_angle(i), "rad"));
-            specs.push((channel::joint_rate(i), "rad/s"));
-            specs.push((channel::joint_torque(i), "N m"));
+            specs.push(spec::arm_joint_angle(i));
+            specs.push(spec::arm_joint_rate(i));
+            specs.push(spec::arm_joint_torque(i));
         }
-        for n in ["ee.x", "ee.y", "ee.z"] {
-            specs.push((n.into(), "m"));
-        }
+        specs.extend([
+            spec::end_effector_x(),
+            spec::end_effector_y(),
+            spec::end_effector_z(),
+        ]);
     }
-    for (n, u) in [
-        ("constraint.drift", "m/s"),
-        ("formulations.position_gap", "m or rad"),
-        ("formulations.rate_gap", "rad/s"),
-        ("inverse.torque_residual", "N m"),
-    ] {
-        specs.push((n.into(), u));
-    }
+    specs.extend([
+        spec::constraint_drift(),
+        spec::formulations_position_gap(),
+        spec::formulations_rate_gap(),
+        spec::inverse_torque_residual(),
+    ]);
     if closed_form.is_some() {
-        specs.push(("seed_eq37.residual".into(), "N m"));
+        specs.push(spec::seed_eq37_residual());
     }
     let mut obs = Observables::with_channels(&specs);
     let mut ledger = EnergyLedger::new(
-        &["kinetic", "gravity"],
-        &["wheel_torque", "joint_torque"],
-        &["wheel_friction", "joint_friction"],
+        &[ledger_term::KINETIC, ledger_term::GRAVITY],
+        &[ledger_term::WHEEL_TORQUE, ledger_term::JOINT_TORQUE],
+        &[ledger_term::WHEEL_FRICTION, ledger_term::JOINT_FRICTION],
     );
     let mut row = Vec::with_capacity(specs.len());
     for s in &history.samples {
