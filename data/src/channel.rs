@@ -310,6 +310,14 @@ pub const WHEEL_LEFT_TORQUE: &str = "wheel_left.torque";
 pub const END_EFFECTOR_X: &str = "ee.x";
 pub const END_EFFECTOR_Y: &str = "ee.y";
 pub const END_EFFECTOR_Z: &str = "ee.z";
+/// In-plane deflection w(L) of flexible pitch link k at its tip, in the link frame.
+pub fn flexible_tip_in_plane(k: usize) -> String {
+    format!("link{k}.tip_in_plane")
+}
+/// Out-of-plane deflection v(L) of flexible pitch link k at its tip, in the link frame.
+pub fn flexible_tip_out_of_plane(k: usize) -> String {
+    format!("link{k}.tip_out_of_plane")
+}
 /// Violation of the platform's velocity constraints.
 pub const CONSTRAINT_DRIFT: &str = "constraint.drift";
 /// Largest position / rate difference between two formulations of the same motion.
@@ -467,6 +475,12 @@ pub mod spec {
     }
     pub fn end_effector_z() -> Spec {
         (super::END_EFFECTOR_Z.to_string(), si::METRE)
+    }
+    pub fn flexible_tip_in_plane(k: usize) -> Spec {
+        (super::flexible_tip_in_plane(k), si::METRE)
+    }
+    pub fn flexible_tip_out_of_plane(k: usize) -> Spec {
+        (super::flexible_tip_out_of_plane(k), si::METRE)
     }
     pub fn constraint_drift() -> Spec {
         (super::CONSTRAINT_DRIFT.to_string(), si::METRE_PER_SECOND)

@@ -54,7 +54,8 @@ pub mod step;
 
 use std::time::Instant;
 
-use data::results::{channel, ledger_term};
+use data::results::ledger_term;
+use data::channel::spec;
 use data::scene::MobileManipulator;
 use data::{
     BackendKind, Cost, Diagnostic, DofPlan, EnergyLedger, Observables, RunResult, Scene, Settings,
@@ -237,8 +238,8 @@ pub struct Prepared {
 pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
     let mm = the_scene(scene)?;
     let n_el = elements(&settings.discretization)?;
-    match settings.time.method.as_deref() {
-        None | Some("implicit-midpoint") => {}
+    match settings.time.method {
+        None | Some(data::Method::ImplicitMidpoint) => {}
         Some(other) => {
             return Err(FemError::unsupported(format!(
                 "fem mobile manipulator: method `{other}`; only `implicit-midpoint` is \
@@ -284,33 +285,33 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
 }
 
 fn channel_specs(md: &Model) -> Vec<(String, &'static str)> {
-    let mut s: Vec<(String, &'static str)> = Vec::new();
+    let mut s = Vec::new();
     if md.platform.is_some() {
-        for (n, u) in [
-            ("platform.x", "m"),
-            ("platform.y", "m"),
-            ("platform.heading", "rad"),
-            ("wheel_right.angle", "rad"),
-            ("wheel_left.angle", "rad"),
-            ("wheel_right.torque", channel::TORQUE_UNIT),
-            ("wheel_left.torque", channel::TORQUE_UNIT),
-        ] {
-            s.push((n.into(), u));
-        }
+        s.extend([
+            spec::platform_x(),
+            spec::platform_y(),
+            spec::platform_heading(),
+            spec::wheel_right_angle(),
+            spec::wheel_left_angle(),
+            spec::wheel_right_torque(),
+            spec::wheel_left_torque(),
+        ]);
     }
     for i in 1..=4 {
-        s.push((channel::joint_angle(i), "rad"));
-        s.push((channel::joint_rate(i), "rad/s"));
-        s.push((channel::joint_torque(i), channel::TORQUE_UNIT));
+        s.push(spec::arm_joint_angle(i));
+        s.push(spec::arm_joint_rate(i));
+        s.push(spec::arm_joint_torque(i));
     }
-    for n in ["ee.x", "ee.y", "ee.z"] {
-        s.push((n.into(), "m"));
-    }
+    s.extend([
+        spec::end_effector_x(),
+        spec::end_effector_y(),
+        spec::end_effector_z(),
+    ]);
     if let Some(fl) = &md.flex {
-        s.push((format!("link{}.tip_in_plane", fl.link + 1), "m"));
-        s.push((format!("link{}.tip_out_of_plane", fl.link + 1), "m"));
+        s.push(spec::flexible_tip_in_plane(fl.link + 1));
+        s.push(spec::flexible_tip_out_of_plane(fl.link + 1));
     }
-    s.push(("constraint.drift".into(), "m/s"));
+    s.push(spec::constraint_drift());
     s
 }
 
@@ -367,11 +368,15 @@ pub fn ledger_names(md: &Model) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'
     if md.platform.is_some() {
         (
             stored,
-            vec!["wheel_torque", "joint_torque"],
-            vec!["wheel_friction", "joint_friction"],
+            vec![ledger_term::WHEEL_TORQUE, ledger_term::JOINT_TORQUE],
+            vec![ledger_term::WHEEL_FRICTION, ledger_term::JOINT_FRICTION],
         )
     } else {
-        (stored, vec!["joint_torque"], vec!["joint_friction"])
+        (
+            stored,
+            vec![ledger_term::JOINT_TORQUE],
+            vec![ledger_term::JOINT_FRICTION],
+        )
     }
 }
 
