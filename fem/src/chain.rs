@@ -45,9 +45,11 @@ use crate::element::{self, ElementDofs, InteriorField, MeshElement};
 use crate::error::FemError;
 
 pub use crate::element::{MAXE, NONE};
+pub use augmented::AugmentedLayout;
 pub use forces::Parts;
 pub use newton::NewtonCoefficients;
 
+mod augmented;
 mod energies;
 mod forces;
 mod geometry;

@@ -434,10 +434,7 @@ impl Stepper for EnergyMidpoint {
                 cx.chain
                     .residual(t_mid, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
                 passes += 1;
-                if let Err(e) =
-                    cx.newton
-                        .form(cx.chain, st, cx.counters, cx.h_nominal, c, t_mid, t1)
-                {
+                if let Err(e) = cx.newton.form(cx.chain, st, cx.counters, c, t1) {
                     // A singular matrix at an iterate far from the solution: a Newton failure
                     // (the caller retries shorter), unless the step is already tiny.
                     if robust && h > 1e-6 * cx.h_nominal && matches!(e, FemError::Singular { .. }) {

@@ -32,8 +32,7 @@ pub fn consistent_acceleration(
             st.q1.copy_from_slice(&st.q);
             st.qd1.copy_from_slice(&st.qd);
             st.qdd1.copy_from_slice(&st.qdd);
-            cx.newton
-                .form(cx.chain, st, cx.counters, cx.h_nominal, c, t_law, st.t)?;
+            cx.newton.form(cx.chain, st, cx.counters, c, st.t)?;
             cx.newton.matrix_h = f64::NAN;
         }
         cx.newton.delta.copy_from_slice(&cx.newton.res);
