@@ -76,9 +76,10 @@ impl Chain {
         self.assemble(q, qd, qdd, c, &mut sink);
     }
 
-    /// A matrix container with the pattern of `layout`.
+    /// A matrix container with the pattern of `layout`, factorized by the band solver with a
+    /// dense border Schur complement ([`BorderedBand::with_band_solver`]).
     pub fn new_augmented_matrix(&self, layout: &AugmentedLayout) -> BorderedBand {
-        BorderedBand::new(
+        BorderedBand::with_band_solver(
             layout.n_interior,
             layout.n - layout.n_interior,
             layout.half_bandwidth,
