@@ -1,4 +1,5 @@
-//! Criterion benches: assembly (residual + Newton matrix), one generalized-α step, the full
+//! Criterion benches: assembly (residual + Newton matrix; the exact augmented matrix of the
+//! foreshortening arm with its factorization and a solve), one generalized-α step, the full
 //! 20 s spin-up for 4–64 elements, and the full 3 s `single-link` run at default settings with
 //! energy-midpoint (the default there) and generalized-α; whole default runs of the arms
 //! (`two-link-free-undamped` 10 s, `barhorst-case1` 3 s) and the first second of
@@ -106,8 +107,8 @@ fn arms(c: &mut Criterion) {
 }
 
 /// The free two-link arm over its first second at default settings (energy-midpoint, 16
-/// elements per link, dense finite-difference Newton matrix refreshed when Newton slows): the
-/// per-step cost of the foreshortening chain without the 10 s of the whole run.
+/// elements per link, exact augmented Newton matrix formed every step): the per-step cost of
+/// the foreshortening chain without the 10 s of the whole run.
 fn arms_short(c: &mut Criterion) {
     let mut g = c.benchmark_group("arms-1s");
     g.sample_size(10);
@@ -120,9 +121,49 @@ fn arms_short(c: &mut Criterion) {
     g.finish();
 }
 
+/// The exact Newton matrix of the free two-link arm with foreshortening (residual pass,
+/// augmented assembly, band LU with the border's Schur complement, one solve) for 4–64
+/// elements per link: linear in the elements.
+fn assembly_foreshortening(c: &mut Criterion) {
+    let sc = data::load_scene("two-link-free-undamped").unwrap();
+    let mut g = c.benchmark_group("assembly-foreshortening");
+    for n in MESHES {
+        let mut ch = Chain::new(&sc.links, None, n).unwrap();
+        let nd = ch.ndof;
+        let q: Vec<f64> = (0..nd).map(|i| 1e-3 * (i as f64).sin()).collect();
+        let qd = vec![0.1; nd];
+        let qdd = vec![0.2; nd];
+        let mut r = vec![0.0; nd];
+        let layout = ch.augmented_layout();
+        let mut s = ch.new_augmented_matrix(&layout);
+        let mut x = vec![0.0; layout.n];
+        let coef = NewtonCoefficients {
+            c_a: 1.0,
+            c_v: 3.6e-4,
+            c_q: 1.3e-7,
+        };
+        g.bench_with_input(
+            BenchmarkId::new("residual+exact_matrix+solve", n),
+            &n,
+            |b, _| {
+                b.iter(|| {
+                    ch.residual(black_box(3.0), &q, &qd, &qdd, &mut r);
+                    ch.exact_newton_matrix(&q, &qd, &qdd, coef, &layout, &mut s);
+                    s.factorize().unwrap();
+                    x.iter_mut().for_each(|v| *v = 1.0);
+                    s.solve_in_place(&mut x);
+                    black_box(&x);
+                })
+            },
+        );
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
     assembly,
+    assembly_foreshortening,
     one_step,
     spin_up,
     single_link,

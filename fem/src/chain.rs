@@ -31,10 +31,15 @@
 //! ∂s(x)/∂q = −∫₀ˣ v′ N′, is applied through the tail axial load T(ξ) = ∫_ξ^L f_x:
 //!   Σ f_x ∂s/∂q = −∫ T v′ N′ dξ  (exact for the quadrature, by exchanging the two sums).
 //! The Newton matrix ([`Chain::newton_matrix`]) is exact without foreshortening (checked against
-//! finite differences of the residual). With foreshortening it omits the ∂s/∂q couplings, which
-//! are dense over a link: O(v′²) between elastic DOFs but O(v′) in the joint rows — harmless for
-//! a prescribed hub (spin-up: 2–3 Newton iterations per step), while free chains with
-//! foreshortening use an exact finite-difference Jacobian instead (see `method::newton`).
+//! finite differences of the residual). With foreshortening the ∂s/∂q couplings are dense over
+//! a link (O(v′²) between elastic DOFs, O(v′) in the joint rows) but semiseparable: they reach
+//! the DOFs only through the running sums of δs, δṡ, δs̈ (forward) and of the tail load δT
+//! (backward). [`Chain::exact_newton_matrix`] keeps these sums as auxiliary unknowns at the
+//! nodes, which makes the exact matrix a sparse bordered band ([`AugmentedLayout`]): at every
+//! mass point the x-column σ = ∂s(x)/∂q of J enters through the point's virtual axial direction
+//! (its variation from Z, its generalized force into Θ and the element rows), and an ancestor's
+//! s(L) moves its descendants' points like an axial tip DOF. Checked against finite
+//! differences of the residual (`sys_foreshortening_tangent`).
 
 use data::FemElement;
 use data::scene::{Gravity, Link, PrescribedMotion, TorqueLaw};
@@ -45,9 +50,11 @@ use crate::element::{self, ElementDofs, InteriorField, MeshElement};
 use crate::error::FemError;
 
 pub use crate::element::{MAXE, NONE};
+pub use augmented::AugmentedLayout;
 pub use forces::Parts;
 pub use newton::NewtonCoefficients;
 
+mod augmented;
 mod energies;
 mod forces;
 mod geometry;

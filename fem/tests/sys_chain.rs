@@ -115,18 +115,18 @@ fn sys_newton_matrix_is_the_residual_derivative() {
         c_v: 0.01,
         c_q: 1e-4,
     };
-    // Without foreshortening the bordered-band matrix is exact (FD error ~1e-9 relative; the
-    // two-link case has larger ∂/∂q terms, still exact to FD accuracy 1e-4 of its scale). With
+    // Without foreshortening the bordered-band matrix is exact (FD error ~1e-9 relative). With
     // foreshortening the omitted terms — ∂s/∂q couplings, dense over a link — are O(v′) in the
     // joint rows and O(v′²) elsewhere: at this state (v′ ≈ 0.1) they are ≈ 6 % of the scale,
-    // which is why free chains with foreshortening use the dense finite-difference Jacobian.
+    // which is why chains with foreshortening use the exact augmented matrix
+    // (`sys_foreshortening_tangent`).
     for (name, fs, tol, element) in [
         ("single-link", false, 1e-7, CUBIC),
-        ("two-link-free-undamped", false, 1e-4, CUBIC),
+        ("two-link-free-undamped", false, 1e-7, CUBIC),
         ("spin-up-axial", false, 1e-7, CUBIC),
         ("single-link", true, 0.1, CUBIC),
         ("single-link", false, 1e-7, QUINTIC),
-        ("two-link-free-undamped", false, 1e-4, QUINTIC),
+        ("two-link-free-undamped", false, 1e-7, QUINTIC),
         ("spin-up-axial", false, 1e-7, QUINTIC),
     ] {
         let (mut ch, q, qd, qdd) = setup(name, 3, fs, element);

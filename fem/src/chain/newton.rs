@@ -2,8 +2,9 @@
 //! mass point through the columns of its Jacobian, section rotary inertia, the element tangent,
 //! Kelvin–Voigt and the foreshortening geometric stiffness, tip and hub bodies, joint springs.
 
+use super::augmented::AugmentedLayout;
 use super::geometry::{add, dot, perp, rot, rot_t, scale, sub};
-use super::{Chain, ElementDofs, FrameState, MAX_COLUMNS, MAXE, NONE};
+use super::{Chain, ElementDofs, FrameState, LinkModel, MAX_COLUMNS, MAX_LINKS, MAXE, NONE, dotn};
 use crate::band::BorderedBand;
 
 /// A column of J contributed by an ancestor (or own joint) DOF, in frame-i coordinates.
@@ -46,9 +47,55 @@ pub struct NewtonCoefficients {
 
 impl Chain {
     /// Assembles the Newton matrix c_a·M + c_v·C + c_q·K at the state of the last
-    /// [`Chain::residual`] call (which must precede it).
+    /// [`Chain::residual`] call (which must precede it). Exact without foreshortening; with
+    /// foreshortening it omits the dense ∂s/∂q couplings (see [`Chain::exact_newton_matrix`]).
     pub fn newton_matrix(&self, q: &[f64], c: NewtonCoefficients, s: &mut BorderedBand) {
         s.clear();
+        let mut sink = Sink { s, layout: None };
+        self.assemble(q, q, q, c, &mut sink);
+    }
+
+    /// The exact Newton matrix c_a·M + c_v·C + c_q·K of a chain with foreshortening, as the
+    /// augmented sparse system of `layout` ([`Chain::augmented_layout`]; module docs of
+    /// `chain::augmented`), at the state (q, q̇, q̈) of the last [`Chain::residual`] call (which
+    /// must precede it). `s` has the layout's pattern ([`Chain::new_augmented_matrix`]).
+    pub fn exact_newton_matrix(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        c: NewtonCoefficients,
+        layout: &AugmentedLayout,
+        s: &mut BorderedBand,
+    ) {
+        s.clear();
+        let mut sink = Sink {
+            s,
+            layout: Some(layout),
+        };
+        self.assemble(q, qd, qdd, c, &mut sink);
+    }
+
+    /// A matrix container with the pattern of `layout`, factorized by the band solver with a
+    /// dense border Schur complement ([`BorderedBand::with_band_solver`]).
+    pub fn new_augmented_matrix(&self, layout: &AugmentedLayout) -> BorderedBand {
+        BorderedBand::with_band_solver(
+            layout.n_interior,
+            layout.n - layout.n_interior,
+            layout.half_bandwidth,
+        )
+    }
+
+    /// The Newton matrix into `s`; with a layout, also every foreshortening coupling through
+    /// the auxiliary unknowns (q̇, q̈ are read only then).
+    fn assemble(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        c: NewtonCoefficients,
+        s: &mut Sink<'_>,
+    ) {
         let nl = self.links.len();
         let g_in = self.gravity;
         // Columns of J for the DOFs of ancestors (and the own joint), in frame-i coordinates.
@@ -56,6 +103,10 @@ impl Chain {
         let mut cols = [AncestorColumn::default(); MAX_COLUMNS];
         // Per-point column buffer, reused (filled up to the point's column count).
         let mut jc = [ColumnAt::default(); MAXE + 2 + MAX_COLUMNS];
+        // Axial displacement directions of a point whose variation comes through auxiliary
+        // unknowns: its own link's foreshortening, then each ancestor's s(L).
+        let mut virt = [Virtual::default(); MAX_LINKS + 1];
+        let exact = s.layout.is_some();
         for li in 0..nl {
             let l = &self.links[li];
             let tb = &l.element.quad;
@@ -65,11 +116,34 @@ impl Chain {
             let w = fr.dphi;
             let wd = fr.ddphi;
             let local_pos = 2.0 * li as f64 + 0.5;
+            // Ancestor tip foreshortenings s(Lₖ): translations along frame k's x axis.
+            let mut nanc = 0;
+            if let Some(lay) = s.layout {
+                for k in 0..li {
+                    if !self.links[k].foreshortening {
+                        continue;
+                    }
+                    let fa = &self.frames[k];
+                    let tip = self.links[k].n_el;
+                    let mut v = Virtual {
+                        j: rot_t(fr.phi, rot(fa.phi, [1.0, 0.0])),
+                        rate: fa.dphi,
+                        rate_dot: fa.ddphi,
+                        pos: 2.0 * k as f64 + 0.5,
+                        ..Default::default()
+                    };
+                    v.set_node(lay.z[k][tip], lay.theta[k][tip]);
+                    virt[1 + nanc] = v;
+                    nanc += 1;
+                }
+            }
             // One mass point: m at local position p with velocity ṗ and d'Alembert density
             // f = m(a − g). Adds c_a·M + c_v·C + c_q·K_inertial for all its columns, with
-            // C = Σ m Jᵀ 2J̇ and K_inertial = Σ m[(∂J/∂q)ᵀ(a − g) + Jᵀ ∂a/∂q].
-            let point = |s: &mut BorderedBand,
+            // C = Σ m Jᵀ 2J̇ and K_inertial = Σ m[(∂J/∂q)ᵀ(a − g) + Jᵀ ∂a/∂q], and (with
+            // `own`/ancestor virtual directions) the couplings through the auxiliary unknowns.
+            let point = |s: &mut Sink<'_>,
                          jc: &mut [ColumnAt; MAXE + 2 + MAX_COLUMNS],
+                         virt: &[Virtual],
                          m: f64,
                          p: [f64; 2],
                          pd: [f64; 2],
@@ -125,30 +199,15 @@ impl Chain {
                         let cb = &jc[b];
                         let mut v = c.c_a * m * dot(ca.j, cb.j);
                         v += c.c_v * 2.0 * m * dot(ca.j, cb.jdot);
-                        // ∂J_a/∂q_b: a rotation b upstream of a's attachment rotates J_a; for a
-                        // rotation a, anything downstream moves the point about a's centre.
-                        let dja = if cb.rotation && cb.pos <= ca.pos {
-                            perp(ca.j)
-                        } else if ca.rotation {
-                            perp(cb.j)
-                        } else {
-                            [0.0; 2]
-                        };
-                        // ∂a/∂q_b: rigid rotation of the downstream acceleration field about the
-                        // centre, or the frame's rigid acceleration field at a displaced point.
-                        let dacc = if cb.rotation {
-                            perp(sub(acc, cb.centre_acc))
-                        } else {
-                            add(
-                                scale(-cb.rate * cb.rate, cb.j),
-                                scale(cb.rate_dot, perp(cb.j)),
-                            )
-                        };
-                        v += c.c_q * m * (dot(dja, sub(acc, g_loc)) + dot(ca.j, dacc));
+                        let dja = column_derivative(ca.rotation, ca.pos, ca.j, cb);
+                        v += c.c_q * m * (dot(dja, sub(acc, g_loc)) + dot(ca.j, dacc(cb, acc)));
                         if v != 0.0 {
                             s.add(ca.dof, cb.dof, v);
                         }
                     }
+                }
+                if !virt.is_empty() {
+                    virtual_terms(s, &jc[..nj], virt, m, acc, f, c);
                 }
             };
             // Rotation columns (upstream joints and tip slopes): they turn every section of
@@ -162,8 +221,21 @@ impl Chain {
                 }
             }
             let ne = l.ne;
+            let own_fs = exact && l.foreshortening;
             for e in 0..l.n_el {
                 let dofs = l.elem_dofs(e);
+                // Running sums over the element's foreshortening sub-intervals: Y (the
+                // c-weighted variations of s, ṡ, s̈ per local DOF) and σ = ∂s/∂q.
+                let mut run = Running::default();
+                let (d, dd, ddd) = if own_fs {
+                    (
+                        Self::elem_v(q, &dofs),
+                        Self::elem_v(qd, &dofs),
+                        Self::elem_v(qdd, &dofs),
+                    )
+                } else {
+                    ([0.0; MAXE], [0.0; MAXE], [0.0; MAXE])
+                };
                 for g in 0..tb.ng {
                     let m = l.rho_a * tb.wh[g];
                     let p = self.pos[li][e * tb.ng + g];
@@ -185,23 +257,60 @@ impl Chain {
                     nloc += 2;
                     let pd = self.vel[li][e * tb.ng + g];
                     let f = self.force[li][e * tb.ng + g];
-                    point(s, &mut jc, m, p, pd, f, &local[..nloc]);
+                    let first = if let (true, Some(lay)) = (own_fs, s.layout) {
+                        run.sub_interval(l, g, &d, &dd, &ddd, c);
+                        virt[0] = run.own_point(lay, li, e, &dofs, ne, w, wd, local_pos);
+                        0
+                    } else {
+                        1
+                    };
+                    let v = &virt[first..1 + nanc];
+                    point(s, &mut jc, v, m, p, pd, f, &local[..nloc]);
                 }
-                // Section rotary inertia: the section angle is linear in q (J constant), so
-                // only the mass term c_a ρI w JᵀJ.
                 // Section rotary inertia: the section angle is linear in q (J constant), so
                 // only the mass term c_a ρI w JᵀJ.
                 if l.rho_i > 0.0 && c.c_a != 0.0 {
                     self.section_inertia_block(li, &dofs, &rot_dofs[..nr], c.c_a, s);
                 }
                 self.element_stiffness_block(li, e, &dofs, q, c, s);
+                if let (true, Some(lay)) = (own_fs, s.layout) {
+                    run.sub_interval(l, tb.ng, &d, &dd, &ddd, c);
+                    run.element_rows(s, lay, li, e, &dofs, ne);
+                }
             }
             // Tip mass.
             let k = l.n_el;
+            if let (true, Some(lay)) = (own_fs, s.layout) {
+                // δT at the tip is the variation of the tip's axial load.
+                s.add_at(lay.theta[li][k], lay.theta[li][k], 1.0);
+            }
             if l.tip_mass > 0.0 {
                 let local = [(l.v_dof[k], [0.0, 1.0]), (l.u_dof[k], [1.0, 0.0])];
                 let f = scale(l.tip_mass, sub(fr.a_tip, g_loc));
-                point(s, &mut jc, l.tip_mass, fr.p_tip, fr.dp_tip, f, &local);
+                let first = if let (true, Some(lay)) = (own_fs, s.layout) {
+                    let mut v = Virtual {
+                        j: [1.0, 0.0],
+                        rate: w,
+                        rate_dot: wd,
+                        pos: local_pos,
+                        ..Default::default()
+                    };
+                    v.set_node(lay.z[li][k], lay.theta[li][k]);
+                    virt[0] = v;
+                    0
+                } else {
+                    1
+                };
+                point(
+                    s,
+                    &mut jc,
+                    &virt[first..1 + nanc],
+                    l.tip_mass,
+                    fr.p_tip,
+                    fr.dp_tip,
+                    f,
+                    &local,
+                );
             }
             // Rotational inertias: tip (rotates with φᵢ + slope(L)) and hub (with φᵢ).
             if l.hub_inertia > 0.0 {
@@ -305,7 +414,7 @@ impl Chain {
         dofs: &[usize; MAXE],
         rot_dofs: &[usize],
         c_a: f64,
-        s: &mut BorderedBand,
+        s: &mut Sink<'_>,
     ) {
         let l = &self.links[li];
         let tb = &l.element.quad;
@@ -342,7 +451,7 @@ impl Chain {
         dofs: &[usize; MAXE],
         q: &[f64],
         c: NewtonCoefficients,
-        s: &mut BorderedBand,
+        s: &mut Sink<'_>,
     ) {
         let l = &self.links[li];
         let tb = &l.element.quad;
@@ -390,6 +499,312 @@ impl Chain {
                         s.add(dofs[a], dofs[b], c.c_q * kg[a][b]);
                     }
                 }
+            }
+        }
+    }
+}
+
+/// Where the Newton matrix entries go: the chain's own numbering, or the augmented layout of
+/// the exact matrix (chain DOFs through `map`, auxiliary unknowns directly).
+struct Sink<'a> {
+    s: &'a mut BorderedBand,
+    layout: Option<&'a AugmentedLayout>,
+}
+
+impl Sink<'_> {
+    /// Adds `v` at chain DOFs (i, j).
+    #[inline]
+    fn add(&mut self, i: usize, j: usize, v: f64) {
+        match self.layout {
+            None => self.s.add(i, j, v),
+            Some(l) => self.s.add(l.map[i], l.map[j], v),
+        }
+    }
+
+    /// Index of a chain DOF in the matrix.
+    #[inline]
+    fn index(&self, i: usize) -> usize {
+        match self.layout {
+            Some(l) if i != NONE => l.map[i],
+            _ => i,
+        }
+    }
+
+    /// Adds `v` at matrix indices (i, j) (skipped where either is [`NONE`]).
+    #[inline]
+    fn add_at(&mut self, i: usize, j: usize, v: f64) {
+        if i != NONE && j != NONE && v != 0.0 {
+            self.s.add(i, j, v);
+        }
+    }
+}
+
+/// ∂J_a/∂q_b at a point: an upstream rotation b turns J_a; for a rotation a, a DOF b that
+/// moves the point relative to a's centre (b downstream of it) adds perp(J_b). A translation
+/// upstream of a's centre moves the centre with the point and leaves J_a unchanged.
+#[inline]
+fn column_derivative(a_rotation: bool, a_pos: f64, a_j: [f64; 2], b: &ColumnAt) -> [f64; 2] {
+    if b.rotation && b.pos <= a_pos {
+        perp(a_j)
+    } else if a_rotation && b.pos > a_pos {
+        perp(b.j)
+    } else {
+        [0.0; 2]
+    }
+}
+
+/// ∂a/∂q_b at a point with acceleration `acc`: rigid rotation of the downstream acceleration
+/// field about the centre, or the frame's rigid acceleration field at a displaced point.
+#[inline]
+fn dacc(b: &ColumnAt, acc: [f64; 2]) -> [f64; 2] {
+    if b.rotation {
+        perp(sub(acc, b.centre_acc))
+    } else {
+        add(scale(-b.rate * b.rate, b.j), scale(b.rate_dot, perp(b.j)))
+    }
+}
+
+/// Longest expansion of a virtual direction: one auxiliary unknown plus the element's DOFs.
+const VIRTUAL_TERMS: usize = MAXE + 1;
+
+/// An axial displacement of a point whose variation is not a chain DOF: the foreshortening
+/// s(x) of the point's own link (or the tip s(L) of an ancestor), a translation along `j`
+/// attached to a frame turning at `rate`. Its variation (δs, δṡ, δs̈) is the combination `col`
+/// of matrix columns (a node's Z plus the element's running sums), and its generalized force
+/// f·j enters the rows `row` (the node's tail Θ with −1, and the element's DOFs with
+/// σ = ∂s(x)/∂q).
+#[derive(Debug, Clone, Copy)]
+struct Virtual {
+    j: [f64; 2],
+    rate: f64,
+    rate_dot: f64,
+    pos: f64,
+    col: [[(usize, f64); VIRTUAL_TERMS]; 3],
+    ncol: usize,
+    row: [(usize, f64); VIRTUAL_TERMS],
+    nrow: usize,
+}
+
+impl Default for Virtual {
+    fn default() -> Self {
+        Virtual {
+            j: [0.0; 2],
+            rate: 0.0,
+            rate_dot: 0.0,
+            pos: 0.0,
+            col: [[(NONE, 0.0); VIRTUAL_TERMS]; 3],
+            ncol: 0,
+            row: [(NONE, 0.0); VIRTUAL_TERMS],
+            nrow: 0,
+        }
+    }
+}
+
+impl Virtual {
+    /// A node's own unknowns: variation Z (three columns) and tail Θ (row, −1).
+    fn set_node(&mut self, z: [usize; 3], theta: usize) {
+        for t in 0..3 {
+            self.col[t][0] = (z[t], 1.0);
+        }
+        self.ncol = 1;
+        self.row[0] = (theta, -1.0);
+        self.nrow = 1;
+    }
+
+    /// (∂a/∂u, ∂a/∂u̇) of the point for this direction (∂a/∂ü = j).
+    fn motion(&self) -> ([f64; 2], [f64; 2]) {
+        (
+            add(
+                scale(-self.rate * self.rate, self.j),
+                scale(self.rate_dot, perp(self.j)),
+            ),
+            scale(2.0 * self.rate, perp(self.j)),
+        )
+    }
+
+    /// Adds `weight`·(k₀ δs + k₁ δṡ + k₂ δs̈) of this direction to matrix row `row`.
+    fn add_columns(&self, s: &mut Sink<'_>, row: usize, weight: f64, k: [f64; 3]) {
+        if row == NONE || weight == 0.0 {
+            return;
+        }
+        for t in 0..3 {
+            if k[t] == 0.0 {
+                continue;
+            }
+            for &(col, cc) in &self.col[t][..self.ncol] {
+                s.add_at(row, col, weight * k[t] * cc);
+            }
+        }
+    }
+}
+
+/// The couplings of one mass point m (acceleration `acc`, d'Alembert force `f`, real columns
+/// `jc`) through its virtual directions `virt`: the rows of the real columns on the
+/// variations (δs, δṡ, δs̈) (mass, Coriolis and stiffness parts of ∂(J_aᵀ f)/∂u), the virtual
+/// rows on the real columns, and the virtual rows on the virtual columns.
+fn virtual_terms(
+    s: &mut Sink<'_>,
+    jc: &[ColumnAt],
+    virt: &[Virtual],
+    m: f64,
+    acc: [f64; 2],
+    f: [f64; 2],
+    c: NewtonCoefficients,
+) {
+    for u in virt {
+        let (dacc_u, two_jdot_u) = u.motion();
+        for a in jc {
+            let mut k = [
+                m * dot(a.j, dacc_u),
+                m * dot(a.j, two_jdot_u),
+                m * dot(a.j, u.j),
+            ];
+            if a.rotation && u.pos > a.pos {
+                k[0] += dot(perp(u.j), f);
+            }
+            let ra = s.index(a.dof);
+            u.add_columns(s, ra, 1.0, k);
+        }
+        for b in jc {
+            let dja = if b.rotation && b.pos <= u.pos {
+                perp(u.j)
+            } else {
+                [0.0; 2]
+            };
+            let v = c.c_a * m * dot(u.j, b.j)
+                + c.c_v * 2.0 * m * dot(u.j, b.jdot)
+                + c.c_q * (dot(dja, f) + m * dot(u.j, dacc(b, acc)));
+            if v != 0.0 {
+                let cb = s.index(b.dof);
+                for &(row, cr) in &u.row[..u.nrow] {
+                    s.add_at(row, cb, cr * v);
+                }
+            }
+        }
+        for w in virt {
+            let (dacc_w, two_jdot_w) = w.motion();
+            let k = [
+                m * dot(u.j, dacc_w),
+                m * dot(u.j, two_jdot_w),
+                m * dot(u.j, w.j),
+            ];
+            for &(row, cr) in &u.row[..u.nrow] {
+                w.add_columns(s, row, cr, k);
+            }
+        }
+    }
+}
+
+/// Running sums over one element's foreshortening sub-intervals (the quadrature of
+/// s = −½∫v′²): Y, the variations of (s, ṡ, s̈) per local DOF weighted with the Newton
+/// coefficients — δs = −∫c_q v′ δ′, δṡ = −∫(c_q v̇′ + c_v v′) δ′,
+/// δs̈ = −∫(c_q v̈′ + 2c_v v̇′ + c_a v′) δ′ — and σ = ∂s/∂q = −∫ v′ N′.
+#[derive(Debug, Clone, Copy, Default)]
+struct Running {
+    y: [[f64; MAXE]; 3],
+    sigma: [f64; MAXE],
+}
+
+impl Running {
+    /// Adds sub-interval `j` of the element with local values (d, ḋ, d̈).
+    #[allow(clippy::too_many_arguments)]
+    fn sub_interval(
+        &mut self,
+        l: &LinkModel,
+        j: usize,
+        d: &[f64; MAXE],
+        dd: &[f64; MAXE],
+        ddd: &[f64; MAXE],
+        c: NewtonCoefficients,
+    ) {
+        let tb = &l.element.quad;
+        let ne = l.ne;
+        for k in 0..tb.nsg {
+            let dn = &tb.sub_dn[j][k];
+            let w = tb.sub_wh[j][k];
+            let vp = dotn(dn, d, ne);
+            let vpd = dotn(dn, dd, ne);
+            let vpdd = dotn(dn, ddd, ne);
+            let coef = [
+                c.c_q * vp,
+                c.c_q * vpd + c.c_v * vp,
+                c.c_q * vpdd + 2.0 * c.c_v * vpd + c.c_a * vp,
+            ];
+            for a in 0..ne {
+                let wdn = -w * dn[a];
+                self.sigma[a] += wdn * vp;
+                for t in 0..3 {
+                    self.y[t][a] += wdn * coef[t];
+                }
+            }
+        }
+    }
+
+    /// The virtual direction of a Gauss point of element `e` after its sub-intervals.
+    #[allow(clippy::too_many_arguments)]
+    fn own_point(
+        &self,
+        lay: &AugmentedLayout,
+        li: usize,
+        e: usize,
+        dofs: &[usize; MAXE],
+        ne: usize,
+        rate: f64,
+        rate_dot: f64,
+        pos: f64,
+    ) -> Virtual {
+        let mut v = Virtual {
+            j: [1.0, 0.0],
+            rate,
+            rate_dot,
+            pos,
+            ..Default::default()
+        };
+        v.set_node(lay.z[li][e], lay.theta[li][e]);
+        for a in 0..ne {
+            let i = if dofs[a] == NONE {
+                NONE
+            } else {
+                lay.map[dofs[a]]
+            };
+            for t in 0..3 {
+                v.col[t][1 + a] = (i, self.y[t][a]);
+            }
+            v.row[1 + a] = (i, self.sigma[a]);
+        }
+        v.ncol = 1 + ne;
+        v.nrow = 1 + ne;
+        v
+    }
+
+    /// The element's rows of the running sums (after all its sub-intervals):
+    /// Zₑ₊₁ − Zₑ − YΔ = 0, the identity part Θₑ − Θₑ₊₁ of the tail row (its point loads come
+    /// from the virtual rows), and σ Θₑ₊₁ in the element's DOF rows.
+    fn element_rows(
+        &self,
+        s: &mut Sink<'_>,
+        lay: &AugmentedLayout,
+        li: usize,
+        e: usize,
+        dofs: &[usize; MAXE],
+        ne: usize,
+    ) {
+        let (z0, z1) = (lay.z[li][e], lay.z[li][e + 1]);
+        for t in 0..3 {
+            s.add_at(z1[t], z1[t], 1.0);
+            s.add_at(z1[t], z0[t], -1.0);
+            for a in 0..ne {
+                if dofs[a] != NONE {
+                    s.add_at(z1[t], lay.map[dofs[a]], -self.y[t][a]);
+                }
+            }
+        }
+        let (t0, t1) = (lay.theta[li][e], lay.theta[li][e + 1]);
+        s.add_at(t0, t0, 1.0);
+        s.add_at(t0, t1, -1.0);
+        for a in 0..ne {
+            if dofs[a] != NONE {
+                s.add_at(lay.map[dofs[a]], t1, self.sigma[a]);
             }
         }
     }

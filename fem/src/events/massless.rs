@@ -45,7 +45,7 @@
 //! * **Consistent rates**: the end rates along every exact direction are set from the balances
 //!   at the end state, Nᵀ(∇V(q₁) + C q̇₁ − Q) = 0, affine in q̇ (one solve with NᵀCN,
 //!   [`Massless::make_consistent`]); the kinetic energy does not change (M N = 0). The
-//!   predictor and the finite-difference Newton matrix then see no alternating garbage, and the
+//!   predictor and the Newton matrix then see no alternating garbage, and the
 //!   joint rate of a child joint (θ̇ along e_ψ(L) − e_θ) is the physical one.
 //!
 //! (A first version solved the massless rows at the step end instead, Nᵀ(∇V(q₁) + C v̄) = 0,

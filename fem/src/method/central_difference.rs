@@ -43,8 +43,7 @@ impl Stepper for CentralDifference {
                 .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
             cx.counters.rhs += 1;
             if it == 0 {
-                cx.newton
-                    .form(cx.chain, st, cx.counters, cx.h_nominal, c, t_law, t1)?;
+                cx.newton.form(cx.chain, st, cx.counters, c, t1)?;
                 cx.newton.matrix_h = f64::NAN;
             }
             cx.newton.delta.copy_from_slice(&cx.newton.res);

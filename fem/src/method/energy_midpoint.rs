@@ -30,14 +30,13 @@
 //! * ∇V(q̄) = conservative part; Q = −(non-conservative part); V(q₁) from [`Chain::energies`].
 //!
 //! Newton on the mean acceleration a = (v₁ − v₀)/h with the generalized-α matrix machinery at
-//! (q̄, v̄, a): S = M + (h/2)C + (h²/4)K (∂q̄/∂a = h²/4, ∂v̄/∂a = h/2), analytic bordered-band or
-//! the exact finite-difference dense matrix for free chains with foreshortening (reused across
-//! steps while Newton converges in ≤ 8 iterations: S is the derivative of R(q̄, v̄, a), not of
-//! the discrete equations, so convergence is linear — about 1e-2..1e-3 per iteration — and
-//! re-forming the dense matrix after every slow step cost 1.5× more, measured on
-//! `two-link-free-undamped`). The correction term is not differentiated (quasi-Newton). The
-//! matrix is re-formed every 6th iteration only while the update is above tolerance: the
-//! iterations that only reduce the energy defect keep the stale matrix, which still contracts.
+//! (q̄, v̄, a): S = M + (h/2)C + (h²/4)K (∂q̄/∂a = h²/4, ∂v̄/∂a = h/2), analytic — the
+//! bordered band, or for chains with foreshortening the exact augmented bordered band
+//! ([`crate::chain::AugmentedLayout`]) — and formed at the first iteration of every step. S is
+//! the derivative of R(q̄, v̄, a), not of the discrete equations, and the correction term is not
+//! differentiated (quasi-Newton), so convergence is linear — about 1e-2..1e-3 per iteration.
+//! The matrix is re-formed every 6th iteration only while the update is above tolerance: the
+//! iterations that only reduce the energy defect keep it, as it still contracts.
 //! The iterate is accepted at the point where the residual was evaluated, so the
 //! booked energies and works are those of the equations actually solved.
 //!
@@ -51,8 +50,6 @@
 //! Runs with a unilateral tip contact (`NewtonSystem::unilateral_contact`; other runs are
 //! unchanged) step through impacts, releases and grazing contacts, where the iteration starts
 //! far from the solution and at step lengths down to 1e-13 s. There:
-//! * the finite-difference Newton matrix perturbs q̇ by 1e-6 of its scale at every step length
-//!   ([`crate::method::NewtonSystem::form`]);
 //! * a matrix formed at an earlier iterate or step is re-formed at the current iterate as soon
 //!   as an update is not 5× smaller than the previous one (where the update grew it is not
 //!   applied); the first update of such a fresh matrix may be larger than the stalled ones
@@ -78,7 +75,7 @@
 use crate::chain::{Chain, NONE, NewtonCoefficients, Parts};
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
-use crate::method::{ConstraintView, JacobianKind, StepConstraint, StepContext, Stepper, Works};
+use crate::method::{ConstraintView, StepConstraint, StepContext, Stepper, Works};
 
 /// Relative size of the finite-difference perturbation of q for Ṁ(x)x.
 pub const FD_STEP: f64 = 1e-5;
@@ -410,22 +407,18 @@ impl Stepper for EnergyMidpoint {
                 gap1 = c.add_force(cx.chain, &view, &mut w.res);
             }
             cx.counters.newton += 1;
-            // Newton matrix at (q̄, v̄, a): a full residual there fills the chain's point data.
-            let fresh = cx.newton.jacobian == JacobianKind::Banded
-                || cx.newton.matrix_h != h
-                || cx.newton.slow_convergence;
+            // Newton matrix at (q̄, v̄, a), formed at the first iteration of every step (it is
+            // analytic and O(n)): a full residual there fills the chain's point data.
             // The periodic refresh only while the update is above tolerance: once it is within
-            // tolerance and only the energy defect is being polished, the stale matrix still
-            // contracts (1e-2..1e-3 per iteration) and a new one only costs (on
-            // `two-link-free-undamped` the polish reached iteration 6 in almost every step: one
-            // dense finite-difference matrix per step, 20 % of the residual passes); with a
-            // unilateral contact a new matrix there also added noise. (Constrained steps
+            // tolerance and only the energy defect is being polished, the matrix still
+            // contracts (1e-2..1e-3 per iteration) and a new one only costs; with a unilateral
+            // contact a new matrix there also added noise. (Constrained steps
             // shortened to locate an event refresh every iteration without a unilateral
             // contact, their impulsive multipliers making the quasi-Newton contraction poor;
             // the unilateral contact refreshes stale matrices instead, below.)
             let periodic = (it == 6 || it == 12 || it == 18) && last > polish_tol;
             let refresh = !robust && constraint.is_some() && h < 0.999 * cx.h_nominal;
-            if (it == 0 && fresh) || periodic || refresh || force_refresh {
+            if it == 0 || periodic || refresh || force_refresh {
                 formed_it = Some(it);
                 forced_now = force_refresh;
                 force_refresh = false;
@@ -434,10 +427,7 @@ impl Stepper for EnergyMidpoint {
                 cx.chain
                     .residual(t_mid, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
                 passes += 1;
-                if let Err(e) =
-                    cx.newton
-                        .form(cx.chain, st, cx.counters, cx.h_nominal, c, t_mid, t1)
-                {
+                if let Err(e) = cx.newton.form(cx.chain, st, cx.counters, c, t1) {
                     // A singular matrix at an iterate far from the solution: a Newton failure
                     // (the caller retries shorter), unless the step is already tiny.
                     if robust && h > 1e-6 * cx.h_nominal && matches!(e, FemError::Singular { .. }) {

@@ -103,7 +103,7 @@ impl Stepper for GeneralizedAlpha {
             cx.counters.rhs += 1;
             cx.counters.newton += 1;
             cx.newton
-                .form_if_due(it, h, cx.chain, st, cx.counters, cx.h_nominal, c, t_law, t1)?;
+                .form_if_due(it, h, cx.chain, st, cx.counters, c, t1)?;
             cx.newton.delta.copy_from_slice(&cx.newton.res);
             cx.newton.solve();
             let mut big = 0.0f64;

@@ -62,7 +62,7 @@ impl Stepper for ImplicitMidpoint {
             cx.counters.rhs += 1;
             cx.counters.newton += 1;
             cx.newton
-                .form_if_due(it, h, cx.chain, st, cx.counters, cx.h_nominal, c, t_mid, t1)?;
+                .form_if_due(it, h, cx.chain, st, cx.counters, c, t1)?;
             cx.newton.delta.copy_from_slice(&cx.newton.res);
             cx.newton.solve();
             for i in 0..n {

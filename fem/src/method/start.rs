@@ -32,8 +32,7 @@ pub fn consistent_acceleration(
             st.q1.copy_from_slice(&st.q);
             st.qd1.copy_from_slice(&st.qd);
             st.qdd1.copy_from_slice(&st.qdd);
-            cx.newton
-                .form(cx.chain, st, cx.counters, cx.h_nominal, c, t_law, st.t)?;
+            cx.newton.form(cx.chain, st, cx.counters, c, st.t)?;
             cx.newton.matrix_h = f64::NAN;
         }
         cx.newton.delta.copy_from_slice(&cx.newton.res);
@@ -85,8 +84,8 @@ fn regularized_acceleration(cx: &mut StepContext<'_>, h: f64, t_law: f64) -> Res
     cx.counters.rhs += 1;
     cx.counters.jacobians += 1;
     cx.counters.factorizations += 1;
-    // The analytic band matrix even where steps use the finite-difference one:
-    // differences of the small ε·K share would drown in round-off.
+    // The band matrix of the chain DOFs (also for chains with foreshortening): the
+    // iteration only needs a contracting approximation of M + ε·K.
     cx.chain
         .residual(t_law, &st.q1, &st.qd, &st.qdd, &mut cx.newton.res);
     cx.chain.newton_matrix(&st.q1, c, &mut cx.newton.matrix);
