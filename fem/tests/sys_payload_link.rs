@@ -440,3 +440,39 @@ fn sys_payload_refuses_what_it_does_not_build() {
         Err(data::BackendError::Unsupported(_))
     ));
 }
+
+#[test]
+fn sys_payload_link_gyroscopic_modes_reduce_to_the_pencil_without_coupling() {
+    // The first-order skew form with G = 0 is the symmetric pencil (K_s − Ω²K_c, M): same ω.
+    // With G the Coriolis coupling moves the frequencies, and more at a higher rate.
+    use fem::payload_link::{gyroscopic_modes, link_modes};
+    let sc = scene("single-link-3d-constant-rate");
+    let md = Model::assemble(&link(&sc), 8).unwrap();
+    let mut uncoupled = md.clone();
+    uncoupled.g.data.iter_mut().for_each(|x| *x = 0.0);
+    let pencil = link_modes(&md, 12).unwrap();
+    let first_order = gyroscopic_modes(&uncoupled, 12).unwrap();
+    for (p, g) in pencil.iter().zip(&first_order) {
+        assert!(
+            (p.omega - g.omega).abs() <= 1e-9 * p.omega,
+            "{} vs {}",
+            p.omega,
+            g.omega
+        );
+        assert_eq!(p.kind, g.kind);
+    }
+    let shift = |md: &Model| {
+        let p = link_modes(md, 12).unwrap();
+        let g = gyroscopic_modes(md, 12).unwrap();
+        p.iter()
+            .zip(&g)
+            .map(|(a, b)| ((a.omega - b.omega) / a.omega).abs())
+            .fold(0.0f64, f64::max)
+    };
+    let slow = shift(&md);
+    let mut fast_link = link(&sc);
+    fast_link.base.prescribed = Some(data::scene::PrescribedMotion::ConstantRate { rate: 20.0 });
+    let fast = shift(&Model::assemble(&fast_link, 8).unwrap());
+    assert!(slow > 1e-9, "Coriolis shift at 2π rad/s: {slow:e}");
+    assert!(fast > 5.0 * slow, "shift {fast:e} at 20 rad/s vs {slow:e}");
+}

@@ -225,12 +225,13 @@ fn judge(case: &data::cases::StabilityCase, kind: BackendKind) -> Vec<Verdict> {
 }
 
 /// Judges every case of the suite on each of its backends (in parallel; verdicts in case
-/// order).
-pub fn run_stability(suite: Suite) -> Result<Vec<Verdict>, Error> {
+/// order); with a filter, only the cases whose id or scene contains it.
+pub fn run_stability(suite: Suite, filter: Option<&str>) -> Result<Vec<Verdict>, Error> {
     let cases = stability_cases()?;
     let jobs: Vec<_> = cases
         .iter()
         .filter(|c| suite.includes(c.suite))
+        .filter(|c| filter.is_none_or(|f| c.id.contains(f) || c.scene.contains(f)))
         .flat_map(|c| c.backends.iter().map(move |k| (c, *k)))
         .collect();
     Ok(jobs.par_iter().flat_map(|(c, k)| judge(c, *k)).collect())

@@ -37,11 +37,12 @@
 //! ## Modes ([`modes`])
 //! Linearized about the undeformed rod at the base's reference rate Ω (0, or the rate of a
 //! `constant-rate` base): K = K_s − Ω²K_c, M; a free base adds θ (mass row J₀, b₀; stiffness the
-//! joint spring). The generalized symmetric problem is solved densely ([`crate::modes`]). The
-//! gyroscopic term Ω(Gᵀ − G) is dropped from the eigenproblem (it couples u with v and w′ with φ;
-//! the kinds then read e.g. `bending-horizontal (no gyroscopic)`). A free base without spring has
-//! a rigid rotation (ω = 0), not reported. Kinds: the field holding most of a mode's kinetic
-//! energy (`axial`, `bending-horizontal`, `bending-vertical`, `torsion`, `base`).
+//! joint spring). The generalized symmetric problem is solved densely ([`crate::modes`])
+//! ([`link_modes`]). At a prescribed constant rate the gyroscopic term Ω(Gᵀ − G) (it couples u
+//! with v and w′ with φ) stays in: the quadratic eigenproblem M q̈ + Ω(Gᵀ − G)q̇ + Kq = 0 in
+//! first-order skew form ([`gyroscopic_modes`]). A free base without spring has a rigid rotation,
+//! listed first at 0 Hz with kind `rigid`. Kinds: the field holding most of a mode's kinetic
+//! energy (`axial`, `bending-horizontal`, `bending-vertical`, `torsion`, `rigid` for θ).
 //!
 //! ## Statics ([`statics`])
 //! K_s d = −f_g: the linear sag of the clamped rod under self-weight, payload weight and the
@@ -51,15 +52,15 @@
 //! ## Dynamics ([`simulate`])
 //! Implicit midpoint rule with an analytic Newton matrix ([`step`]); works booked with the
 //! scheme's midpoint quadrature. Default mesh 16 elements ([`crate::settings::DEFAULT_ELEMENTS`]);
-//! default step min(output interval, T/[`STEPS_PER_PERIOD`]) with T the shorter of the periods of
-//! the first horizontal and the first vertical bending mode of [`link_modes`] (the modes the base
-//! torque and gravity drive), fitted to divide the output interval. Torsion and axial modes
-//! (hundreds of Hz to kHz on the catalog rods, amplitudes 1e-7 rad / 1e-8 m) are not resolved by
-//! that step: the midpoint rule keeps them bounded and undamped, with a phase error (tip twist
-//! on `single-link-3d`: ≈ 5 % of its peak at the default step, 1.3 % at h = 1.25e-4 s). A stiff
-//! rod gets a short default step (`single-link-3d-stiff`: 3.1e-5 s) although its flexible
-//! amplitudes are tiny; pass `--dt` there. Only `implicit-midpoint`
-//! (the default) is accepted; adaptive steps are refused.
+//! default step [`default_step`]: the largest step (fitted to divide the output interval) whose
+//! estimated phase error of the modes the scene's loads excite (gravity against the initial
+//! shape, centrifugal load, motor torque and its switches, a prescribed base's acceleration),
+//! each damped by its Kelvin–Voigt decay, stays below [`PHASE_ERROR_TOLERANCE`] of the scale of
+//! the payload's height, its turning-plane position and the base angle. Torsion and axial modes
+//! (hundreds of Hz to kHz on the catalog rods) hardly move those observables and are not
+//! resolved by that step: the midpoint rule keeps them bounded and undamped, with a phase error
+//! in `tip_twist`. Only `implicit-midpoint` (the default) is accepted; adaptive steps are
+//! refused.
 
 pub mod model;
 pub mod step;
@@ -81,12 +82,9 @@ use crate::settings;
 use model::Model;
 use step::{State, Stepper};
 
-/// Default step: steps per period of the higher of the first bending modes of the two planes.
-/// Measured on `single-link-3d` (16 elements, 2 s, against h = 3.125e-5 s; the scheme is second
-/// order): the horizontal tip deflection v_L is off by 12 % of its peak at h = 1e-3 s (26 steps per
-/// period of the 39 Hz horizontal mode), 3.1 % at 5e-4, 0.18 % at 1.25e-4; the base angle by
-/// 3.1e-4, 7.9e-5 and 4.6e-6 of its peak. 80 steps per period gives h = 2.5e-4 s there.
-pub const STEPS_PER_PERIOD: f64 = 80.0;
+/// Default step: the largest h whose estimated phase error of the modes the loads excite stays
+/// below this fraction of each observable's scale ([`default_step`]).
+pub const PHASE_ERROR_TOLERANCE: f64 = 1e-4;
 
 /// The scene's payload link (None for other families).
 pub fn link(scene: &Scene) -> Option<&PayloadLink> {
@@ -184,8 +182,9 @@ pub struct Mode3d {
     pub vector: Vec<f64>,
 }
 
-/// The lowest `count` flexible modes.
-pub fn link_modes(md: &Model, count: usize) -> Result<Vec<Mode3d>, FemError> {
+/// Dense (K, M) of the link linearized about the undeformed rod at the reference rate Ω:
+/// K = K_s − Ω²K_c, M; a free base adds θ (mass row J₀, b₀; stiffness the joint spring) last.
+fn linearized(md: &Model) -> (Mat<f64>, Mat<f64>) {
     let n = md.n;
     let free = md.free_base();
     let nn = n + usize::from(free);
@@ -206,6 +205,15 @@ pub fn link_modes(md: &Model, count: usize) -> Result<Vec<Mode3d>, FemError> {
         }
         k[(n, n)] = md.spring().0;
     }
+    (k, m)
+}
+
+/// The lowest `count` flexible modes.
+pub fn link_modes(md: &Model, count: usize) -> Result<Vec<Mode3d>, FemError> {
+    let n = md.n;
+    let free = md.free_base();
+    let nn = n + usize::from(free);
+    let (k, m) = linearized(md);
     // Shift σM (σ > 0) makes K + σM definite with a free base's rigid rotation; λ = μ − σ.
     let tr_k: f64 = (0..nn).map(|i| k[(i, i)].abs()).sum();
     let tr_m: f64 = (0..nn).map(|i| m[(i, i)]).sum();
@@ -217,11 +225,6 @@ pub fn link_modes(md: &Model, count: usize) -> Result<Vec<Mode3d>, FemError> {
         }
     }
     let (lam, x) = crate::modes::generalized_eigen(&ks, &m)?;
-    let gyro = if omega_ref != 0.0 {
-        " (no gyroscopic)"
-    } else {
-        ""
-    };
     let mut out = Vec::new();
     for (j, &l) in lam.iter().enumerate() {
         if out.len() >= count {
@@ -246,34 +249,116 @@ pub fn link_modes(md: &Model, count: usize) -> Result<Vec<Mode3d>, FemError> {
         let mut share = [0.0; 5];
         for a in 0..nn {
             let mv: f64 = (0..nn).map(|b| m[(a, b)] * v[b]).sum();
-            let group = if a == n {
-                4
-            } else {
-                match slot_of(md, a) {
-                    U => 0,
-                    PHI => 3,
-                    s if s <= 2 => 1,
-                    _ => 2,
-                }
-            };
+            let group = if a == n { 4 } else { group_of(md, a) };
             share[group] += v[a] * mv;
         }
-        let (g, _) = share
-            .iter()
-            .enumerate()
-            .fold((0, f64::MIN), |b, (i, &s)| if s > b.1 { (i, s) } else { b });
-        let (kind, field) = match g {
-            0 => ("axial", Some(U)),
-            1 => ("bending-horizontal", Some(V)),
-            2 => ("bending-vertical", Some(W)),
-            3 => ("torsion", Some(PHI)),
-            _ => ("base", None),
-        };
+        let (kind, field) = kind_of(&share);
         out.push(Mode3d {
             omega: l.sqrt(),
-            kind: format!("{kind}{gyro}"),
+            kind: kind.to_string(),
             field,
             vector: v,
+        });
+    }
+    Ok(out)
+}
+
+/// Kind of a mode from the kinetic-energy share of each group (u, v/v′, w/w′, φ, θ).
+fn kind_of(share: &[f64; 5]) -> (&'static str, Option<usize>) {
+    let (g, _) = share
+        .iter()
+        .enumerate()
+        .fold((0, f64::MIN), |b, (i, &s)| if s > b.1 { (i, s) } else { b });
+    match g {
+        0 => ("axial", Some(U)),
+        1 => ("bending-horizontal", Some(V)),
+        2 => ("bending-vertical", Some(W)),
+        3 => ("torsion", Some(PHI)),
+        _ => ("rigid", None),
+    }
+}
+
+/// Group (0 u, 1 v/v′, 2 w/w′, 3 φ) of field DOF i.
+fn group_of(md: &Model, i: usize) -> usize {
+    match slot_of(md, i) {
+        U => 0,
+        PHI => 3,
+        s if s <= 2 => 1,
+        _ => 2,
+    }
+}
+
+/// The lowest `count` modes of a rod turning at the prescribed constant rate Ω with the
+/// gyroscopic coupling: M q̈ + Ω(Gᵀ − G) q̇ + (K_s − Ω²K_c) q = 0. With z = (q̇, q),
+/// A = diag(M, K) and the skew B = [[Ω(Gᵀ − G), K], [−K, 0]], A ż + B z = 0; for A = LLᵀ the
+/// matrix S = L⁻¹BL⁻ᵀ is skew with eigenvalues ±iω, so the ω² are the eigenvalues of the
+/// symmetric SᵀS, each twice, its two eigenvectors y spanning the mode's real plane
+/// (z = L⁻ᵀy). Kinds from the kinetic energy ½q̇ᵀMq̇ of both; the shape is the displacement
+/// part q of the one with the larger one.
+pub fn gyroscopic_modes(md: &Model, count: usize) -> Result<Vec<Mode3d>, FemError> {
+    let n = md.n;
+    if md.free_base() {
+        return Err(FemError::unsupported(
+            "fem payload link: gyroscopic modes need a prescribed base",
+        ));
+    }
+    let rate = reference_rate(md);
+    let (k, m) = linearized(md);
+    let mut a = Mat::<f64>::zeros(2 * n, 2 * n);
+    let mut b = Mat::<f64>::zeros(2 * n, 2 * n);
+    for i in 0..n {
+        for j in 0..n {
+            a[(i, j)] = m[(i, j)];
+            a[(n + i, n + j)] = k[(i, j)];
+            b[(i, j)] = rate * (md.g.get(j, i) - md.g.get(i, j));
+            b[(i, n + j)] = k[(i, j)];
+            b[(n + i, j)] = -k[(i, j)];
+        }
+    }
+    let llt = a.llt(faer::Side::Lower).map_err(|_| FemError::Numerical {
+        t: 0.0,
+        message: "K_s − Ω²K_c is not positive definite: the linearized link is unstable at the \
+                  reference rate"
+            .into(),
+    })?;
+    let l = llt.L();
+    let mut t = b;
+    l.solve_lower_triangular_in_place(&mut t);
+    let mut sk = t.transpose().to_owned();
+    l.solve_lower_triangular_in_place(&mut sk);
+    // sk = (L⁻¹BL⁻ᵀ)ᵀ; SᵀS is the same from either sign.
+    let c = sk.transpose() * &sk;
+    let c = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
+    let ev = c
+        .self_adjoint_eigen(faer::Side::Lower)
+        .map_err(|_| FemError::Numerical {
+            t: 0.0,
+            message: "eigensolver did not converge".into(),
+        })?;
+    let w2 = ev.S().column_vector();
+    let mut z = ev.U().to_owned();
+    l.transpose().solve_upper_triangular_in_place(&mut z);
+    let mut out = Vec::new();
+    for p in 0..n.min(count) {
+        let (j0, j1) = (2 * p, 2 * p + 1);
+        let mut share = [0.0; 5];
+        let mut best = (f64::MIN, j0);
+        for j in [j0, j1] {
+            for r in 0..n {
+                let mv: f64 = md.m.cols(r).map(|q| m[(r, q)] * z[(q, j)]).sum();
+                share[group_of(md, r)] += z[(r, j)] * mv;
+            }
+            let disp: f64 = (0..n).map(|r| z[(n + r, j)] * z[(n + r, j)]).sum();
+            if disp > best.0 {
+                best = (disp, j);
+            }
+        }
+        let (kind, field) = kind_of(&share);
+        out.push(Mode3d {
+            omega: (0.5 * (w2[j0] + w2[j1])).max(0.0).sqrt(),
+            kind: kind.to_string(),
+            field,
+            vector: (0..n).map(|r| z[(n + r, best.1)]).collect(),
         });
     }
     Ok(out)
@@ -292,7 +377,24 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
     let l = the_link(scene)?;
     let n_el = settings::elements(&settings.discretization)?;
     let md = build(l, n_el)?;
-    let modes = link_modes(&md, count)?;
+    // A free base without spring turns rigidly (ω = 0, kind `rigid`), listed first as by the
+    // other backends; a base at a prescribed constant rate keeps the gyroscopic coupling.
+    let rigid = md.free_base() && md.spring().0 == 0.0 && count > 0;
+    let mut modes = Vec::with_capacity(count);
+    if rigid {
+        modes.push(Mode3d {
+            omega: 0.0,
+            kind: "rigid".into(),
+            field: None,
+            vector: vec![0.0; md.n + 1],
+        });
+    }
+    let flexible = count - usize::from(rigid);
+    if reference_rate(&md) != 0.0 && !md.free_base() {
+        modes.extend(gyroscopic_modes(&md, flexible)?);
+    } else {
+        modes.extend(link_modes(&md, flexible)?);
+    }
     let st = scene.simulation.field_stations.max(2);
     let xs: Vec<f64> = (0..st)
         .map(|k| md.length * k as f64 / (st - 1) as f64)
@@ -394,6 +496,182 @@ fn fit(h: f64, out: f64) -> f64 {
     }
 }
 
+/// Default step from the linearized modes and the scene's loads.
+///
+/// The implicit midpoint rule turns a mode ω into ω_h = (2/h)·atan(ωh/2) ≈ ω(1 − (ωh)²/12), so
+/// after t_end a mode of amplitude A is off by A·min(2, ω³h²t_end/12). Each mode's amplitude is
+/// estimated from the loads that start it ringing: the imbalance at t = 0 (gravity against the
+/// initial shape, centrifugal load θ̇²(j₁ + K_c d₀), the motor torque or −b₀θ̈ of a prescribed base)
+/// plus the largest jump of those loads between samples a quarter output interval apart (a
+/// bang-bang switch): A_k = |φ_k·F|/(φ_kᵀMφ_k ω_k²) times the mode's share of three observables:
+/// the payload's height z_C, its turning-plane position y_C + (L + c)θ, and θ. The error sums of
+/// the payload's position (height and turning plane together) and of θ are held below
+/// [`PHASE_ERROR_TOLERANCE`] times their scales: the payload's initial height plus, for a free
+/// base, (L + c)·min(Θ, 1), plus Σ A_k; Θ plus Σ A_k (base), with Θ the rigid base excursion
+/// over the run (prescribed law, or a rigid-body integration of
+/// J₀θ̈ = T(t) − b_mθ̇ − K(θ − θ₀) for a free base). A mode's phase error grows over
+/// min(t_end, 1/(eσ)), σ = φᵀCφ/(2φᵀMφ) its Kelvin–Voigt (and motor-friction) decay rate.
+/// Torsion and axial modes hardly move these observables and so do not bound the step.
+pub fn default_step(md: &Model, d0: &[f64], t_end: f64, out: f64) -> Result<f64, FemError> {
+    let n = md.n;
+    let free = md.free_base();
+    let nn = n + usize::from(free);
+    let (_, m) = linearized(md);
+    let modes = link_modes(md, nn)?;
+    // Load samples F(t) on (d, θ): imbalance and base-driven loads.
+    let samples = (4.0 * t_end / out).ceil().max(1.0) as usize;
+    let dt_s = t_end / samples as f64;
+    let mut ksd0 = vec![0.0; n];
+    md.ks.matvec(d0, &mut ksd0);
+    let mut kcd0 = vec![0.0; n];
+    md.kc.matvec(d0, &mut kcd0);
+    // Rigid base: (θ, θ̇, θ̈) at the samples.
+    let mut base = Vec::with_capacity(samples + 1);
+    match md.prescribed(0.0) {
+        Some(_) => {
+            for i in 0..=samples {
+                base.push(md.prescribed(i as f64 * dt_s).unwrap_or_default());
+            }
+        }
+        None => {
+            let (k_spring, set_point) = md.spring();
+            let (mut th, mut w) = (md.initial_angle, md.initial_rate);
+            let sub = 16;
+            let hs = dt_s / sub as f64;
+            let acc = |t: f64, th: f64, w: f64| {
+                (md.motor_torque(t) - md.motor_friction * w - k_spring * (th - set_point)) / md.j0
+            };
+            base.push((th, w, acc(0.0, th, w)));
+            for i in 0..samples {
+                for j in 0..sub {
+                    let t = i as f64 * dt_s + j as f64 * hs;
+                    w += hs * acc(t, th, w);
+                    th += hs * w;
+                }
+                let t = (i + 1) as f64 * dt_s;
+                base.push((th, w, acc(t, th, w)));
+            }
+        }
+    }
+    let load = |i: usize, f: &mut [f64]| {
+        let t = i as f64 * dt_s;
+        let (_, w, a) = base[i];
+        for j in 0..n {
+            f[j] = -md.fg[j] - ksd0[j] + w * w * (md.j1[j] + kcd0[j]);
+            if !free {
+                f[j] -= md.b0[j] * a;
+            }
+        }
+        if free {
+            f[n] = md.motor_torque(t);
+        }
+    };
+    let theta0 = base[0].0;
+    let excursion = base
+        .iter()
+        .fold(0.0f64, |e, &(th, _, _)| e.max((th - theta0).abs()));
+    let arm = md.length + md.offset;
+    let mut f0 = vec![0.0; nn];
+    let mut fa = vec![0.0; nn];
+    let mut fb = vec![0.0; nn];
+    load(0, &mut f0);
+    // Per mode: excitation e_k = |φ·F(0)| + max_i |φ·(F(t_i) − F(t_{i−1}))|.
+    let mut exc: Vec<f64> = modes
+        .iter()
+        .map(|md_k| model::dot(&md_k.vector, &f0).abs())
+        .collect();
+    let mut jump = vec![0.0f64; modes.len()];
+    fa.copy_from_slice(&f0);
+    for i in 1..=samples {
+        load(i, &mut fb);
+        for (k, mk) in modes.iter().enumerate() {
+            let dj: f64 = mk
+                .vector
+                .iter()
+                .zip(fb.iter().zip(&fa))
+                .map(|(p, (b, a))| p * (b - a))
+                .sum();
+            jump[k] = jump[k].max(dj.abs());
+        }
+        std::mem::swap(&mut fa, &mut fb);
+    }
+    // Amplitudes of (vertical, turning plane, base) per mode.
+    let mut amp = Vec::with_capacity(modes.len());
+    let mut horizon = Vec::with_capacity(modes.len());
+    for (k, mk) in modes.iter().enumerate() {
+        exc[k] += jump[k];
+        let v = &mk.vector;
+        let mut mv = 0.0;
+        for a in 0..nn {
+            for b in 0..nn {
+                mv += v[a] * m[(a, b)] * v[b];
+            }
+        }
+        let q = exc[k] / (mv * mk.omega * mk.omega);
+        // Decay rate σ = φᵀCφ/(2φᵀMφ) (Kelvin–Voigt and motor friction): the phase error of a
+        // damped mode, A e^(−σt)·ω³h²t/12, peaks at t = 1/σ.
+        let mut cv = md.c.form(&v[..n], &v[..n]);
+        if free {
+            cv += md.motor_friction * v[n] * v[n];
+        }
+        let sigma = cv / (2.0 * mv);
+        horizon.push(if sigma * t_end > 1.0 {
+            1.0 / (std::f64::consts::E * sigma)
+        } else {
+            t_end
+        });
+        let th = if free { v[n] } else { 0.0 };
+        amp.push([
+            q * md.tip.z_c.dot(&v[..n]).abs(),
+            q * (md.tip.y_c.dot(&v[..n]) + arm * th).abs(),
+            q * th.abs(),
+        ]);
+    }
+    // The payload's position (height and turning plane: one vector, so a barely moving
+    // component is not held to its own tiny scale) and the base angle. A prescribed rotation
+    // is exact and adds nothing to the position's scale.
+    let sum = |c: usize| amp.iter().map(|a| a[c]).sum::<f64>();
+    let rigid_arc = if free { arm * excursion.min(1.0) } else { 0.0 };
+    let scale = [
+        md.tip.z_c.dot(d0).abs() + rigid_arc + sum(0) + sum(1),
+        if free { excursion + sum(2) } else { 0.0 },
+    ];
+    let within = |h: f64| {
+        (0..2).all(|c| {
+            if scale[c] <= 0.0 {
+                return true;
+            }
+            let e: f64 = modes
+                .iter()
+                .zip(amp.iter().zip(&horizon))
+                .map(|(mk, (a, t))| {
+                    let a = if c == 0 { a[0] + a[1] } else { a[2] };
+                    a * (mk.omega.powi(3) * h * h * t / 12.0).min(2.0)
+                })
+                .sum();
+            e <= PHASE_ERROR_TOLERANCE * scale[c]
+        })
+    };
+    if within(out) {
+        return Ok(out);
+    }
+    // Bisection in log h between a step that resolves the fastest mode to 1e-9 and `out`.
+    let fastest = modes.iter().fold(0.0f64, |w, mk| w.max(mk.omega));
+    let (mut lo, mut hi) = ((1e-9f64).sqrt() / fastest.max(1.0 / out), out);
+    if !within(lo) {
+        return Ok(lo);
+    }
+    for _ in 0..60 {
+        let mid = (lo * hi).sqrt();
+        if within(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(lo)
+}
+
 pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
     let l = the_link(scene)?;
     let n_el = settings::elements(&settings.discretization)?;
@@ -416,31 +694,14 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
         settings::positive("time.t_end", settings.time.t_end)?.unwrap_or(scene.simulation.t_end);
     let out = scene.simulation.output_interval;
     let md = build(l, n_el)?;
-    let h = match dt_user {
-        Some(h) => h,
-        None => {
-            // The first bending mode of each carried plane (or the first mode without bending).
-            let modes = link_modes(&md, 4 * md.fields.len() + 4)?;
-            let first = |kind: &str| {
-                modes
-                    .iter()
-                    .find(|m| m.kind.starts_with(kind))
-                    .map(|m| m.omega)
-            };
-            let omega = match (first("bending-horizontal"), first("bending-vertical")) {
-                (None, None) => modes.first().map_or(f64::INFINITY, |m| m.omega),
-                (a, b) => a.unwrap_or(0.0).max(b.unwrap_or(0.0)),
-            };
-            fit(
-                (2.0 * std::f64::consts::PI / (STEPS_PER_PERIOD * omega)).min(out),
-                out,
-            )
-        }
-    };
     let d = if l.initial_shape == LinkInitialShape::StaticSag {
         static_sag(&md)?
     } else {
         vec![0.0; md.n]
+    };
+    let h = match dt_user {
+        Some(h) => h,
+        None => fit(default_step(&md, &d, t_end, out)?.min(out), out),
     };
     let (theta, rate) = match md.prescribed(0.0) {
         Some((th, r, _)) => (th, r),

@@ -57,8 +57,14 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
     let wall = Instant::now();
     let s = set_up(scene, &settings.discretization)?;
     let model = &s.model;
-    let (k, m, _) = linear_pencil(model);
-    let (lambda, vecs) = generalized_eigen(&k, &m)?;
+    let (k, m, rate) = linear_pencil(model);
+    // At a prescribed constant rate the gyroscopic coupling stays in (its modes' velocity
+    // shapes give kinds and shapes); otherwise the symmetric pencil.
+    let (lambda, vecs) = if !model.base.free && rate != 0.0 {
+        gyroscopic_modes(model)?
+    } else {
+        generalized_eigen(&k, &m)?
+    };
     let nd = k.nrows();
     let o = usize::from(model.base.free);
     let count = count.min(nd);
@@ -160,18 +166,29 @@ pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, Modal
     })
 }
 
-/// Frequencies \[Hz\] with the gyroscopic coupling at the reference rate Ω:
-/// M q̈ + Ω(Gᵀ − G) q̇ + K_eff q = 0 (prescribed base; K_eff = K − Ω²N must be positive
-/// definite). With z = (q̇, q), A = diag(M, K_eff) and the skew B = [[Ω(Gᵀ − G), K_eff],
-/// [−K_eff, 0]], A ż + B z = 0; for A = LLᵀ, S = L⁻¹BL⁻ᵀ is skew, its eigenvalues ±iω, and the
-/// ω² are the (doubled) eigenvalues of the symmetric SᵀS. Ascending, `count` of them.
+/// Frequencies \[Hz\] with the gyroscopic coupling at the reference rate Ω (prescribed
+/// base), ascending, `count` of them ([`gyroscopic_modes`]).
 pub fn gyroscopic_frequencies(
     scene: &Scene,
     settings: &Settings,
     count: usize,
 ) -> Result<Vec<f64>, ModalError> {
     let s = set_up(scene, &settings.discretization)?;
-    let model = &s.model;
+    let (w2, _) = gyroscopic_modes(&s.model)?;
+    Ok(w2
+        .iter()
+        .take(count)
+        .map(|v| v.max(0.0).sqrt() / std::f64::consts::TAU)
+        .collect())
+}
+
+/// ω² and velocity shapes of M q̈ + Ω(Gᵀ − G) q̇ + K_eff q = 0 (prescribed base; K_eff = K − Ω²N
+/// must be positive definite). With z = (q̇, q), A = diag(M, K_eff) and the skew
+/// B = [[Ω(Gᵀ − G), K_eff], [−K_eff, 0]], A ż + B z = 0; for A = LLᵀ, S = L⁻¹BL⁻ᵀ is skew, its
+/// eigenvalues ±iω, and the ω² are the eigenvalues of the symmetric SᵀS, each twice. Per mode
+/// (ascending): ω² and the velocity part q̇ of the first of its two eigenvectors z = L⁻ᵀy,
+/// scaled to unit kinetic energy q̇ᵀMq̇ = 1 (columns of the returned matrix).
+pub fn gyroscopic_modes(model: &LinkModel) -> Result<(Vec<f64>, Mat<f64>), ModalError> {
     if model.base.free {
         return Err(ModalError::Unsupported(
             "gyroscopic frequencies of a free base (the base angle is not a coordinate of \
@@ -206,17 +223,38 @@ pub fn gyroscopic_frequencies(
     // sk = (L⁻¹ B L⁻ᵀ)ᵀ = −S; SᵀS is the same from either sign.
     let c = sk.transpose() * &sk;
     let c = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
-    let mut w2 =
-        c.self_adjoint_eigenvalues(faer::Side::Lower)
-            .map_err(|_| ModalError::Numerical {
-                t: 0.0,
-                message: "eigen-decomposition did not converge".into(),
-            })?;
-    w2.sort_by(|x, y| x.total_cmp(y));
-    Ok(w2
-        .iter()
-        .step_by(2)
-        .take(count)
-        .map(|v| v.max(0.0).sqrt() / std::f64::consts::TAU)
-        .collect())
+    let ev = c
+        .self_adjoint_eigen(faer::Side::Lower)
+        .map_err(|_| ModalError::Numerical {
+            t: 0.0,
+            message: "eigen-decomposition did not converge".into(),
+        })?;
+    let s2 = ev.S().column_vector();
+    let mut z = ev.U().to_owned();
+    l.transpose().solve_upper_triangular_in_place(&mut z);
+    let w2: Vec<f64> = (0..n).map(|p| 0.5 * (s2[2 * p] + s2[2 * p + 1])).collect();
+    let mut vel = Mat::<f64>::zeros(n, n);
+    for p in 0..n {
+        // The pair's vector with the larger kinetic energy (the other may be nearly all q).
+        let kin = |j: usize| {
+            let mut e = 0.0;
+            for r in 0..n {
+                for q in 0..n {
+                    e += z[(r, j)] * m[(r, q)] * z[(q, j)];
+                }
+            }
+            e
+        };
+        let (e0, e1) = (kin(2 * p), kin(2 * p + 1));
+        let (j, e) = if e0 >= e1 {
+            (2 * p, e0)
+        } else {
+            (2 * p + 1, e1)
+        };
+        let scale = if e > 0.0 { 1.0 / e.sqrt() } else { 0.0 };
+        for r in 0..n {
+            vel[(r, p)] = z[(r, j)] * scale;
+        }
+    }
+    Ok((w2, vel))
 }

@@ -16,11 +16,11 @@
 //! * `modes` ([`analysis`]): K_eff x = ω² M x linearized about the undeformed rod at the base's
 //!   reference rate Ω (0, or the constant rate of a `constant-rate` base): K_eff = K − Ω² N
 //!   (centrifugal stiffening, the softening of the in-plane field and the payload terms);
-//!   a free base adds θ (rigid mode 0 Hz without a spring). The gyroscopic matrix Ω(Gᵀ − G)
-//!   (Coriolis coupling of u with v and of w with φ) is left out of `modes`: undamped,
-//!   non-gyroscopic frequencies. [`gyroscopic_frequencies`] keeps it (prescribed base): on
-//!   `single-link-3d-constant-rate` (Ω = 2π rad/s, 6 modes per field) it moves the first ten
-//!   frequencies by at most 1.7e-6 relative (the first in-plane mode).
+//!   a free base adds θ (rigid mode 0 Hz without a spring, kind `rigid`). At a prescribed
+//!   constant rate the gyroscopic matrix Ω(Gᵀ − G) (Coriolis coupling of u with v and of w with
+//!   φ) stays in: [`analysis::gyroscopic_modes`] solves M q̈ + Ω(Gᵀ − G) q̇ + K_eff q = 0 in
+//!   first-order skew form; on `single-link-3d-constant-rate` (Ω = 2π rad/s, 6 modes per field)
+//!   it moves the first ten frequencies by at most 1.7e-6 relative (the first in-plane mode).
 //! * `statics`: K q = −f_g, the linear sag under self-weight, payload weight and the payload's
 //!   offset moment (`tip_deflection` = w_L, `tip_rotation` = w′_L); also the `static-sag` start.
 

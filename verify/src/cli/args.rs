@@ -122,6 +122,9 @@ pub enum Command {
     Stability {
         #[arg(long, value_enum, default_value_t = Suite::Quick)]
         suite: Suite,
+        /// Run only cases whose id or scene contains this text.
+        #[arg(long)]
+        filter: Option<String>,
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
         #[arg(long)]

@@ -162,8 +162,24 @@ fn summarize(outcomes: &[Outcome], note: &str) -> Result<(), CliError> {
     }
 }
 
-pub fn stability(suite: Suite, format: Format, out: Option<&Path>) -> Result<(), CliError> {
-    let verdicts = stability::run_stability(suite)?;
+pub fn stability(
+    suite: Suite,
+    filter: Option<&str>,
+    format: Format,
+    out: Option<&Path>,
+) -> Result<(), CliError> {
+    let verdicts = stability::run_stability(suite, filter)?;
+    if verdicts.is_empty() {
+        return Err(CliError::Input(format!(
+            "error: no stability case of the {} suite matches --filter `{}`",
+            if suite == Suite::Full {
+                "full"
+            } else {
+                "quick"
+            },
+            filter.unwrap_or_default()
+        )));
+    }
     match format {
         Format::Table => print!("{}", stability::terminal_table(&verdicts, TERMINAL_WIDTH)),
         Format::Wide => print!("{}", stability::wide_table(&verdicts)),

@@ -47,9 +47,12 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             opts,
         } => super::studies::recommend(&scene, &quantity, tol, &opts),
         Command::Coverage { format } => super::checks::coverage(format),
-        Command::Stability { suite, format, out } => {
-            super::checks::stability(suite, format, out.as_deref())
-        }
+        Command::Stability {
+            suite,
+            filter,
+            format,
+            out,
+        } => super::checks::stability(suite, filter.as_deref(), format, out.as_deref()),
     }
 }
 
