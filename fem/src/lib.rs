@@ -171,6 +171,7 @@ pub mod method;
 pub mod modes;
 pub mod payload_link;
 pub mod plan;
+pub mod rocket;
 pub mod run;
 pub mod settings;
 pub mod statics;
@@ -281,6 +282,9 @@ impl Backend for FemBackend {
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::dof_plan(scene, n_el)?);
         }
+        if rocket::the_rocket(scene).is_some() {
+            return Ok(rocket::dof_plan(scene, disc)?);
+        }
         Ok(plan::dof_plan(scene, n_el, disc.element)?)
     }
 
@@ -292,6 +296,9 @@ impl Backend for FemBackend {
     ) -> Result<ModalResult, BackendError> {
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::modes(scene, settings, count)?);
+        }
+        if rocket::the_rocket(scene).is_some() {
+            return Ok(rocket::modes(scene, settings, count)?);
         }
         Ok(self.modes_impl(scene, settings, count)?)
     }
@@ -306,6 +313,9 @@ impl Backend for FemBackend {
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::simulate(scene, settings)?);
+        }
+        if rocket::the_rocket(scene).is_some() {
+            return Ok(rocket::simulate(scene, settings)?);
         }
         Ok(run::simulate(scene, settings)?)
     }
