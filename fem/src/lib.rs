@@ -179,6 +179,7 @@ pub mod mobile;
 pub mod modes;
 pub mod payload_link;
 pub mod plan;
+pub mod rocket;
 pub mod run;
 pub mod settings;
 pub mod statics;
@@ -292,6 +293,9 @@ impl Backend for FemBackend {
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::dof_plan(scene, n_el)?);
         }
+        if rocket::the_rocket(scene).is_some() {
+            return Ok(rocket::dof_plan(scene, disc)?);
+        }
         Ok(plan::dof_plan(scene, n_el, disc.element)?)
     }
 
@@ -303,6 +307,9 @@ impl Backend for FemBackend {
     ) -> Result<ModalResult, BackendError> {
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::modes(scene, settings, count)?);
+        }
+        if rocket::the_rocket(scene).is_some() {
+            return Ok(rocket::modes(scene, settings, count)?);
         }
         Ok(self.modes_impl(scene, settings, count)?)
     }
@@ -320,6 +327,9 @@ impl Backend for FemBackend {
         }
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::simulate(scene, settings)?);
+        }
+        if rocket::the_rocket(scene).is_some() {
+            return Ok(rocket::simulate(scene, settings)?);
         }
         Ok(run::simulate(scene, settings)?)
     }

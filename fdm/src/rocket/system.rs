@@ -23,6 +23,11 @@
 //! of that axis; this is the definition of the modal backend, whose elastic modes are
 //! m₀-orthogonal to the rigid motions, so the channels do not depend on how either backend
 //! fixes its body frame. `rocket.X/Y` are the inertial mass centre of case and discrete masses.
+//!
+//! Loads. Thrust (at angle γ), the chamber-pressure pair ∓p·A_f and the jet Coriolis force
+//! 2θ̇ m_f v are directed by that same mean axis (angle α = atan(slope) from this body axis,
+//! θ̇ = T + α̇), not by this backend's body axis: the frame-invariant definition of
+//! docs/rocket.md, shared by the fem and modal backends.
 
 use std::ops::Range;
 
@@ -192,24 +197,44 @@ impl System for RocketSystem {
             (rr - tt * (yo + ry) + p[i], ss + tt * (xo + rx) + qv[i])
         };
         if burning {
+            // Thrust, chamber pressure and jet Coriolis force are directed by the case's mean
+            // axis (docs/rocket.md): angle α from this body axis, rate α̇.
+            let axis = mean_axis(m, |i| (u[i], w[i]));
+            let axis_rate = mean_axis(m, |i| (p[i], qv[i]));
+            let alpha = axis.slope.atan();
+            let alpha_rate = axis_rate.slope / (1.0 + axis.slope * axis.slope);
+            let (ac, as_) = (alpha.cos(), alpha.sin());
             let flow = m.mass_flow(t);
             let thrust = flow * m.exhaust_velocity;
-            let (tx, ty) = (thrust * m.gamma.cos(), thrust * m.gamma.sin());
-            self.fu[0] += tx - m.pressure_force;
-            self.fw[0] += ty;
+            let (tx, ty) = (
+                thrust * (m.gamma + alpha).cos(),
+                thrust * (m.gamma + alpha).sin(),
+            );
+            let (px, py) = (m.pressure_force * ac, m.pressure_force * as_);
+            self.fu[0] += tx - px;
+            self.fw[0] += ty - py;
             let (l, al) = (m.l1_station, m.l1_alpha);
-            self.fu[l] += (1.0 - al) * m.pressure_force;
-            self.fu[l + 1] += al * m.pressure_force;
+            self.fu[l] += (1.0 - al) * px;
+            self.fu[l + 1] += al * px;
+            self.fw[l] += (1.0 - al) * py;
+            self.fw[l + 1] += al * py;
             let v0 = vel(0);
             p_thrust = tx * v0.0 + ty * v0.1;
-            p_press = m.pressure_force * (-v0.0 + (1.0 - al) * vel(l).0 + al * vel(l + 1).0);
-            // Coriolis force of the internal flow, 2θ̇ m_f v j with m_f v = ṁ (L₁ − x) (3.36, 5.18)
-            if tt != 0.0 {
+            let (vl, vl1) = (vel(l), vel(l + 1));
+            p_press = px * (-v0.0 + (1.0 - al) * vl.0 + al * vl1.0)
+                + py * (-v0.1 + (1.0 - al) * vl.1 + al * vl1.1);
+            // Coriolis force of the internal flow, 2θ̇ m_f v normal to the mean axis with
+            // m_f v = ṁ (L₁ − x) (3.36, 5.18), θ̇ the mean axis' rate.
+            let rate = tt + alpha_rate;
+            if rate != 0.0 {
                 for i in 0..ns {
-                    let f = 2.0 * tt * m.burn_rate * m.flow_weight[i];
+                    let f = 2.0 * rate * m.burn_rate * m.flow_weight[i];
                     if f != 0.0 {
-                        self.fw[i] += f;
-                        p_cor += f * vel(i).1;
+                        let (fx, fy) = (-f * as_, f * ac);
+                        self.fu[i] += fx;
+                        self.fw[i] += fy;
+                        let vi = vel(i);
+                        p_cor += fx * vi.0 + fy * vi.1;
                     }
                 }
             }

@@ -1,0 +1,681 @@
+//! The finite-element rocket: mesh, constant operators and the generalized forces.
+//!
+//! DOFs: per node (u, w, w′) — u linear, w Hermite cubic, displacements in the *launch axes*
+//! (ξ along the body axis at launch, η across it), rigid motion included — then per discrete
+//! mass (U_j, W_j) in the same axes. Every operator is integrated by 4-point Gauss quadrature
+//! on each part of an element between breakpoints (stage junctions), which is exact for the
+//! piecewise-constant sections (mass integrands are of degree 6).
+
+use data::scene::{InitialShape, Rocket};
+
+use crate::error::FemError;
+
+/// Nodal DOFs: axial u, transverse w, slope w′.
+pub const DOFS_PER_NODE: usize = 3;
+
+/// Symmetric matrix as unique triplets (i, j, value), sorted.
+#[derive(Debug, Clone, Default)]
+pub struct Triplets(pub Vec<(usize, usize, f64)>);
+
+impl Triplets {
+    fn from_map(map: std::collections::BTreeMap<(usize, usize), f64>) -> Self {
+        Triplets(map.into_iter().map(|((i, j), v)| (i, j, v)).collect())
+    }
+
+    /// y += s·A x.
+    pub fn mul_add(&self, s: f64, x: &[f64], y: &mut [f64]) {
+        for &(i, j, v) in &self.0 {
+            y[i] += s * v * x[j];
+        }
+    }
+
+    /// xᵀ A y.
+    pub fn form(&self, x: &[f64], y: &[f64]) -> f64 {
+        self.0.iter().map(|&(i, j, v)| x[i] * v * y[j]).sum()
+    }
+}
+
+/// Shape-function values of a point x on the mesh: u-DOFs with linear weights, w-DOFs (w, w′
+/// of both nodes) with Hermite weights.
+#[derive(Debug, Clone, Copy)]
+pub struct Point {
+    pub x: f64,
+    pub iu: [usize; 2],
+    pub nu: [f64; 2],
+    pub iw: [usize; 4],
+    pub hw: [f64; 4],
+}
+
+/// One quadrature point: abscissa, weight, section (EA, EI), non-burning mass per length and
+/// whether it lies in the burning stage.
+#[derive(Debug, Clone, Copy)]
+struct Quad {
+    element: usize,
+    s: f64,
+    weight: f64,
+    ea: f64,
+    fixed_mass: f64,
+    burning: bool,
+    ei: f64,
+}
+
+/// Discrete mass on springs (spring to the case at its attachment point).
+#[derive(Debug, Clone)]
+pub struct Attached {
+    pub at: Point,
+    pub mass: f64,
+    pub ku: f64,
+    pub kw: f64,
+    pub cu: f64,
+    pub cw: f64,
+}
+
+#[derive(Debug, Clone)]
+pub struct Coupling {
+    pub a: usize,
+    pub b: usize,
+    pub ku: f64,
+    pub kw: f64,
+    pub cu: f64,
+    pub cw: f64,
+}
+
+/// Everything about the discretized rocket that does not change during a run.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub elements: usize,
+    pub nodes: usize,
+    /// Total DOFs (3 per node + 2 per discrete mass).
+    pub n: usize,
+    pub h: f64,
+    pub length: f64,
+    pub l1: f64,
+    pub theta0: f64,
+    pub g: f64,
+    pub gamma: f64,
+    /// Stage-1 mass per length at ignition, casing floor, burn rate (mass / length / time).
+    pub m1_0: f64,
+    pub m1_casing: f64,
+    pub burn_rate: f64,
+    pub exhaust_velocity: f64,
+    /// p·A_f.
+    pub pressure_force: f64,
+    /// Unit-mass matrix of the burning stage (times m₁(t)), non-burning case mass, both
+    /// consistent; discrete masses are the diagonal `masses`.
+    pub m_burn: Triplets,
+    pub m_fixed: Triplets,
+    /// Beam stiffness ∫EA u′δu′ + ∫EI w″δw″.
+    pub k_beam: Triplets,
+    quad: Vec<Quad>,
+    pub masses: Vec<Attached>,
+    pub couplings: Vec<Coupling>,
+    pub pressure_point: Point,
+    /// Reference positions (x on u-DOFs and U_j), unit translations along ξ and η (all
+    /// material / case only).
+    pub x_ref: Vec<f64>,
+    pub t_xi: Vec<f64>,
+    pub t_eta: Vec<f64>,
+    /// Mean-axis functionals of the case with respect to its ignition mass m₀ (see
+    /// [`Model::mean_axis`]).
+    pub m0: f64,
+    pub x_bar: f64,
+    a_c_xi: Vec<f64>,
+    a_c_eta: Vec<f64>,
+    a_s_xi: Vec<f64>,
+    a_s_eta: Vec<f64>,
+    /// Consistent load vectors of the unit jet-Coriolis distribution (1 − x/L₁)₊.
+    pub cor_u: Vec<f64>,
+    pub cor_w: Vec<f64>,
+}
+
+/// Mean axis of the case (ignition mass m₀): centroid c, angle φ from the launch axis, its rate.
+#[derive(Debug, Clone, Copy)]
+pub struct MeanAxis {
+    pub c_xi: f64,
+    pub c_eta: f64,
+    pub phi: f64,
+    pub rate: f64,
+}
+
+impl MeanAxis {
+    /// Position of a material point (reference abscissa x, launch-axis position R) relative to
+    /// the mean axis: (u, w) with r = A(φ)ᵀ(R − c) + (x̄, 0), u = r_ξ − x, w = r_η.
+    pub fn relative(&self, x_bar: f64, x: f64, r_xi: f64, r_eta: f64) -> (f64, f64) {
+        let (c, s) = (self.phi.cos(), self.phi.sin());
+        let (dx, dy) = (r_xi - self.c_xi, r_eta - self.c_eta);
+        (c * dx + s * dy + x_bar - x, -s * dx + c * dy)
+    }
+}
+
+const GAUSS4: [(f64, f64); 4] = [
+    (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+    (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+    (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+    (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+];
+
+/// Linear shape functions and derivatives on an element of length h at s ∈ [0, 1].
+fn linear(s: f64, h: f64) -> ([f64; 2], [f64; 2]) {
+    ([1.0 - s, s], [-1.0 / h, 1.0 / h])
+}
+
+/// Hermite cubic shape functions (w₁, w′₁, w₂, w′₂) and their first and second x-derivatives.
+pub fn hermite(s: f64, h: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    let (s2, s3) = (s * s, s * s * s);
+    let n = [
+        1.0 - 3.0 * s2 + 2.0 * s3,
+        h * (s - 2.0 * s2 + s3),
+        3.0 * s2 - 2.0 * s3,
+        h * (-s2 + s3),
+    ];
+    let d = [
+        (-6.0 * s + 6.0 * s2) / h,
+        1.0 - 4.0 * s + 3.0 * s2,
+        (6.0 * s - 6.0 * s2) / h,
+        -2.0 * s + 3.0 * s2,
+    ];
+    let dd = [
+        (-6.0 + 12.0 * s) / (h * h),
+        (-4.0 + 6.0 * s) / h,
+        (6.0 - 12.0 * s) / (h * h),
+        (-2.0 + 6.0 * s) / h,
+    ];
+    (n, d, dd)
+}
+
+fn dofs_of(e: usize) -> ([usize; 2], [usize; 4]) {
+    let (a, b) = (DOFS_PER_NODE * e, DOFS_PER_NODE * (e + 1));
+    ([a, b], [a + 1, a + 2, b + 1, b + 2])
+}
+
+impl Model {
+    pub fn new(r: &Rocket, elements: usize) -> Result<Self, FemError> {
+        if r.stages.is_empty() {
+            return Err(FemError::unsupported("rocket without stages"));
+        }
+        if r.exit_pressure != 0.0 {
+            return Err(FemError::unsupported(
+                "rocket exit pressure p_e ≠ 0 (the report's vacuum expansion, eq. 5.16, assumes p_e = 0)",
+            ));
+        }
+        if r.stages.iter().skip(1).any(|s| s.burn_rate != 0.0) {
+            return Err(FemError::unsupported(
+                "rocket: only the first (aft) stage may burn",
+            ));
+        }
+        let g = r.gravity;
+        let length = r.length();
+        let h = length / elements as f64;
+        let nodes = elements + 1;
+        let nm = r.discrete_masses.len();
+        let n = DOFS_PER_NODE * nodes + 2 * nm;
+        let l1 = r.stages[0].length;
+        let e_mod = r.youngs_modulus;
+        // Stage intervals and breakpoints.
+        let mut bounds = Vec::new();
+        let mut a = 0.0;
+        for s in &r.stages {
+            bounds.push((a, a + s.length));
+            a += s.length;
+        }
+        let mut quad = Vec::new();
+        for el in 0..elements {
+            let (xa, xb) = (el as f64 * h, (el + 1) as f64 * h);
+            for (k, (st, &(ba, bb))) in r.stages.iter().zip(&bounds).enumerate() {
+                let (lo, hi) = (ba.max(xa), bb.min(xb));
+                if hi - lo <= 1e-12 * h {
+                    continue;
+                }
+                for &(z, wg) in &GAUSS4 {
+                    let x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * z;
+                    quad.push(Quad {
+                        element: el,
+                        s: (x - xa) / h,
+                        weight: 0.5 * (hi - lo) * wg,
+                        ea: e_mod * st.area,
+                        ei: e_mod * st.inertia,
+                        fixed_mass: if k == 0 {
+                            0.0
+                        } else {
+                            st.weight_per_length / g
+                        },
+                        burning: k == 0,
+                    });
+                }
+            }
+        }
+        let mut mb = std::collections::BTreeMap::new();
+        let mut mf = std::collections::BTreeMap::new();
+        let mut kb = std::collections::BTreeMap::new();
+        let mut cor_u = vec![0.0; n];
+        let mut cor_w = vec![0.0; n];
+        for q in &quad {
+            let (nu, du) = linear(q.s, h);
+            let (hw, _, hdd) = hermite(q.s, h);
+            let (iu, iw) = dofs_of(q.element);
+            let (mass_b, mass_f) = (
+                if q.burning { q.weight } else { 0.0 },
+                q.weight * q.fixed_mass,
+            );
+            for a in 0..2 {
+                for b in 0..2 {
+                    *mb.entry((iu[a], iu[b])).or_insert(0.0) += mass_b * nu[a] * nu[b];
+                    *mf.entry((iu[a], iu[b])).or_insert(0.0) += mass_f * nu[a] * nu[b];
+                    *kb.entry((iu[a], iu[b])).or_insert(0.0) += q.weight * q.ea * du[a] * du[b];
+                }
+            }
+            for a in 0..4 {
+                for b in 0..4 {
+                    *mb.entry((iw[a], iw[b])).or_insert(0.0) += mass_b * hw[a] * hw[b];
+                    *mf.entry((iw[a], iw[b])).or_insert(0.0) += mass_f * hw[a] * hw[b];
+                    *kb.entry((iw[a], iw[b])).or_insert(0.0) += q.weight * q.ei * hdd[a] * hdd[b];
+                }
+            }
+            let x = (q.element as f64 + q.s) * h;
+            let flow = if q.burning {
+                (1.0 - x / l1).max(0.0)
+            } else {
+                0.0
+            };
+            for a in 0..2 {
+                cor_u[iu[a]] += q.weight * flow * nu[a];
+            }
+            for a in 0..4 {
+                cor_w[iw[a]] += q.weight * flow * hw[a];
+            }
+        }
+        let point = |x: f64| -> Point {
+            let el = ((x / h).floor() as usize).min(elements - 1);
+            let s = x / h - el as f64;
+            let (nu, _) = linear(s, h);
+            let (hw, _, _) = hermite(s, h);
+            let (iu, iw) = dofs_of(el);
+            Point { x, iu, nu, iw, hw }
+        };
+        let base = DOFS_PER_NODE * nodes;
+        let mut masses = Vec::new();
+        for (k, dm) in r.discrete_masses.iter().enumerate() {
+            if !(0.0..=length).contains(&dm.position) {
+                return Err(FemError::InvalidSettings {
+                    field: "rocket.discrete_mass".into(),
+                    message: format!(
+                        "mass {} at x = {} lies outside the body",
+                        k + 1,
+                        dm.position
+                    ),
+                });
+            }
+            masses.push(Attached {
+                at: point(dm.position),
+                mass: dm.weight / g,
+                ku: dm.axial_stiffness,
+                kw: dm.transverse_stiffness,
+                cu: dm.axial_damping,
+                cw: dm.transverse_damping,
+            });
+        }
+        let mut couplings = Vec::new();
+        for sp in &r.springs {
+            let [a, b] = sp.between;
+            if a >= nm || b >= nm || a == b {
+                return Err(FemError::InvalidSettings {
+                    field: "rocket.spring".into(),
+                    message: format!("spring between masses {a} and {b}: no such pair"),
+                });
+            }
+            couplings.push(Coupling {
+                a,
+                b,
+                ku: sp.axial_stiffness,
+                kw: sp.transverse_stiffness,
+                cu: sp.axial_damping,
+                cw: sp.transverse_damping,
+            });
+        }
+        let mut x_ref = vec![0.0; n];
+        let mut t_xi = vec![0.0; n];
+        let mut t_eta = vec![0.0; n];
+        for i in 0..nodes {
+            x_ref[DOFS_PER_NODE * i] = i as f64 * h;
+            t_xi[DOFS_PER_NODE * i] = 1.0;
+            t_eta[DOFS_PER_NODE * i + 1] = 1.0;
+        }
+        let (t_xi_case, t_eta_case) = (t_xi.clone(), t_eta.clone());
+        for (j, m) in masses.iter().enumerate() {
+            x_ref[base + j] = m.at.x;
+            t_xi[base + j] = 1.0;
+            t_eta[base + nm + j] = 1.0;
+        }
+        let s1 = &r.stages[0];
+        let m1_0 = s1.weight_per_length / g;
+        let m1_casing = s1.casing_weight_per_length.unwrap_or(0.0) / g;
+        let mut model = Model {
+            elements,
+            nodes,
+            n,
+            h,
+            length,
+            l1,
+            theta0: r.launch_angle_deg.to_radians(),
+            g,
+            gamma: r.nozzle_angle_deg.to_radians(),
+            m1_0,
+            m1_casing,
+            burn_rate: s1.burn_rate / g,
+            exhaust_velocity: r.exhaust_velocity,
+            pressure_force: r.chamber_pressure * r.port_area,
+            m_burn: Triplets::from_map(mb),
+            m_fixed: Triplets::from_map(mf),
+            k_beam: Triplets::from_map(kb),
+            quad,
+            masses,
+            couplings,
+            pressure_point: point(l1),
+            x_ref,
+            t_xi,
+            t_eta,
+            m0: 0.0,
+            x_bar: 0.0,
+            a_c_xi: Vec::new(),
+            a_c_eta: Vec::new(),
+            a_s_xi: Vec::new(),
+            a_s_eta: Vec::new(),
+            cor_u,
+            cor_w,
+        };
+        // Mean-axis functionals with the case's ignition mass M₀ (discrete masses excluded).
+        let m0_apply = |m: &Model, x: &[f64]| {
+            let mut y = vec![0.0; n];
+            m.m_fixed.mul_add(1.0, x, &mut y);
+            m.m_burn.mul_add(m.m1_0, x, &mut y);
+            y
+        };
+        let a_xi = m0_apply(&model, &t_xi_case);
+        let a_eta = m0_apply(&model, &t_eta_case);
+        let m0 = crate::linalg::dot(&a_xi, &t_xi_case);
+        let x_bar = crate::linalg::dot(&a_xi, &model.x_ref) / m0;
+        let mut lin_u = vec![0.0; n];
+        let mut lin_w = vec![0.0; n];
+        for i in 0..nodes {
+            lin_u[DOFS_PER_NODE * i] = i as f64 * h - x_bar;
+            lin_w[DOFS_PER_NODE * i + 1] = i as f64 * h - x_bar;
+            lin_w[DOFS_PER_NODE * i + 2] = 1.0;
+        }
+        model.a_s_xi = m0_apply(&model, &lin_u);
+        model.a_s_eta = m0_apply(&model, &lin_w);
+        model.a_c_xi = a_xi.iter().map(|v| v / m0).collect();
+        model.a_c_eta = a_eta.iter().map(|v| v / m0).collect();
+        model.m0 = m0;
+        model.x_bar = x_bar;
+        Ok(model)
+    }
+
+    pub fn base(&self) -> usize {
+        DOFS_PER_NODE * self.nodes
+    }
+    /// DOF of discrete mass j's U (axial) and W (transverse).
+    pub fn mass_dofs(&self, j: usize) -> (usize, usize) {
+        let nm = self.masses.len();
+        (self.base() + j, self.base() + nm + j)
+    }
+
+    pub fn burnout_time(&self) -> f64 {
+        if self.burn_rate > 0.0 {
+            (self.m1_0 - self.m1_casing) / self.burn_rate
+        } else {
+            f64::INFINITY
+        }
+    }
+    pub fn burning(&self, t: f64) -> bool {
+        t < self.burnout_time()
+    }
+    /// Stage-1 mass per length m₁(t).
+    pub fn m1(&self, t: f64) -> f64 {
+        (self.m1_0 - self.burn_rate * t).max(self.m1_casing)
+    }
+    /// Mass flow through the nozzle Q̇ = ṁ L₁ (0 after burn-out).
+    pub fn mass_flow(&self, t: f64) -> f64 {
+        if self.burning(t) {
+            self.burn_rate * self.l1
+        } else {
+            0.0
+        }
+    }
+    pub fn total_mass(&self, t: f64) -> f64 {
+        self.m1(t) * self.l1
+            + self.m_fixed.form(&self.t_xi, &self.t_xi)
+            + self.masses.iter().map(|m| m.mass).sum::<f64>()
+    }
+
+    /// y += s·M(m₁) x (case and discrete masses).
+    pub fn mass_mul_add(&self, m1: f64, s: f64, x: &[f64], y: &mut [f64]) {
+        self.m_fixed.mul_add(s, x, y);
+        self.m_burn.mul_add(s * m1, x, y);
+        for (j, m) in self.masses.iter().enumerate() {
+            let (iu, iw) = self.mass_dofs(j);
+            y[iu] += s * m.mass * x[iu];
+            y[iw] += s * m.mass * x[iw];
+        }
+    }
+
+    /// xᵀ M(m₁) y.
+    pub fn mass_form(&self, m1: f64, x: &[f64], y: &[f64]) -> f64 {
+        let mut v = self.m_fixed.form(x, y) + m1 * self.m_burn.form(x, y);
+        for (j, m) in self.masses.iter().enumerate() {
+            let (iu, iw) = self.mass_dofs(j);
+            v += m.mass * (x[iu] * y[iu] + x[iw] * y[iw]);
+        }
+        v
+    }
+
+    /// Gravity in launch axes (ξ, η) = (−g sin θ₀, −g cos θ₀).
+    pub fn gravity(&self) -> (f64, f64) {
+        (-self.g * self.theta0.sin(), -self.g * self.theta0.cos())
+    }
+
+    /// Mean axis of the case with respect to its ignition mass m₀: the rigid placement that
+    /// best fits the case's material points in the m₀-weighted least-squares sense — centroid
+    /// c = ∫m₀R/m₀ and angle φ = atan2(∫m₀(x − x̄)R_η, ∫m₀(x − x̄)R_ξ) — and the angle's rate.
+    pub fn mean_axis(&self, q: &[f64], v: &[f64]) -> MeanAxis {
+        use crate::linalg::dot;
+        let sx = dot(&self.a_s_xi, &self.x_ref) + dot(&self.a_s_xi, q);
+        let sy = dot(&self.a_s_eta, q);
+        let (dsx, dsy) = (dot(&self.a_s_xi, v), dot(&self.a_s_eta, v));
+        MeanAxis {
+            c_xi: dot(&self.a_c_xi, &self.x_ref) + dot(&self.a_c_xi, q),
+            c_eta: dot(&self.a_c_eta, q),
+            phi: sy.atan2(sx),
+            rate: (sx * dsy - sy * dsx) / (sx * sx + sy * sy),
+        }
+    }
+
+    /// Field values (u, w) at a point.
+    pub fn at(&self, p: &Point, q: &[f64]) -> (f64, f64) {
+        let u = p.nu[0] * q[p.iu[0]] + p.nu[1] * q[p.iu[1]];
+        let w = (0..4).map(|a| p.hw[a] * q[p.iw[a]]).sum();
+        (u, w)
+    }
+
+    /// Adds a point force (f_ξ, f_η) at p to the generalized force vector.
+    pub fn add_point_force(&self, p: &Point, f: (f64, f64), out: &mut [f64]) {
+        for a in 0..2 {
+            out[p.iu[a]] += p.nu[a] * f.0;
+        }
+        for a in 0..4 {
+            out[p.iw[a]] += p.hw[a] * f.1;
+        }
+    }
+
+    /// Point on the mesh at x.
+    pub fn point(&self, x: f64) -> Point {
+        let el = ((x / self.h).floor() as usize).min(self.elements - 1);
+        let s = x / self.h - el as f64;
+        let (nu, _) = linear(s, self.h);
+        let (hw, _, _) = hermite(s, self.h);
+        let (iu, iw) = dofs_of(el);
+        Point { x, iu, nu, iw, hw }
+    }
+
+    /// Strain energy V = ∫½EA u′² + ½EI w″² + ½EA u′w′² (report eq. 3.50, P = EA u′).
+    pub fn strain_energy(&self, q: &[f64]) -> f64 {
+        let mut v = 0.5 * self.k_beam.form(q, q);
+        for qp in &self.quad {
+            let (up, wp) = self.slopes(qp, q);
+            v += qp.weight * 0.5 * qp.ea * up * wp * wp;
+        }
+        v
+    }
+
+    fn slopes(&self, qp: &Quad, q: &[f64]) -> (f64, f64) {
+        let (iu, iw) = dofs_of(qp.element);
+        let (_, du) = linear(qp.s, self.h);
+        let (_, hd, _) = hermite(qp.s, self.h);
+        let up = du[0] * q[iu[0]] + du[1] * q[iu[1]];
+        let wp = (0..4).map(|a| hd[a] * q[iw[a]]).sum::<f64>();
+        (up, wp)
+    }
+
+    /// out −= ∂V/∂q (beam only).
+    pub fn add_elastic_forces(&self, q: &[f64], out: &mut [f64]) {
+        self.k_beam.mul_add(-1.0, q, out);
+        for qp in &self.quad {
+            let (up, wp) = self.slopes(qp, q);
+            let (iu, iw) = dofs_of(qp.element);
+            let (_, du) = linear(qp.s, self.h);
+            let (_, hd, _) = hermite(qp.s, self.h);
+            let fu = qp.weight * 0.5 * qp.ea * wp * wp;
+            let fw = qp.weight * qp.ea * up * wp;
+            for a in 0..2 {
+                out[iu[a]] -= fu * du[a];
+            }
+            for a in 0..4 {
+                out[iw[a]] -= fw * hd[a];
+            }
+        }
+    }
+
+    /// Relative displacement and velocity of each spring (case→mass j, and coupling k), in
+    /// launch axes.
+    fn spring_gap(&self, j: usize, q: &[f64]) -> (f64, f64) {
+        let (iu, iw) = self.mass_dofs(j);
+        let (uc, wc) = self.at(&self.masses[j].at, q);
+        (q[iu] - uc, q[iw] - wc)
+    }
+
+    /// Springs and dampers of the discrete masses, axial / transverse along the mean axis at
+    /// angle φ. Adds the forces to `out`; returns (spring energy, damper power).
+    pub fn add_spring_forces(&self, phi: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> (f64, f64) {
+        let (c, s) = (phi.cos(), phi.sin());
+        let (mut energy, mut power) = (0.0, 0.0);
+        // force on the "plus" side from gap d and rate dd: −k_a (d·e)e − k_t (d·n)n − damping
+        let law = |d: (f64, f64), dd: (f64, f64), ku: f64, kw: f64, cu: f64, cw: f64| {
+            let (da, dt) = (c * d.0 + s * d.1, -s * d.0 + c * d.1);
+            let (ra, rt) = (c * dd.0 + s * dd.1, -s * dd.0 + c * dd.1);
+            let (fa, ft) = (-ku * da - cu * ra, -kw * dt - cw * rt);
+            let f = (c * fa - s * ft, s * fa + c * ft);
+            (
+                f,
+                0.5 * ku * da * da + 0.5 * kw * dt * dt,
+                cu * ra * ra + cw * rt * rt,
+            )
+        };
+        for (j, m) in self.masses.iter().enumerate() {
+            let (iu, iw) = self.mass_dofs(j);
+            let d = self.spring_gap(j, q);
+            let dd = self.spring_gap(j, v);
+            let (f, e, p) = law(d, dd, m.ku, m.kw, m.cu, m.cw);
+            out[iu] += f.0;
+            out[iw] += f.1;
+            self.add_point_force(&m.at, (-f.0, -f.1), out);
+            energy += e;
+            power += p;
+        }
+        for cp in &self.couplings {
+            let (au, aw) = self.mass_dofs(cp.a);
+            let (bu, bw) = self.mass_dofs(cp.b);
+            let d = (q[au] - q[bu], q[aw] - q[bw]);
+            let dd = (v[au] - v[bu], v[aw] - v[bw]);
+            let (f, e, p) = law(d, dd, cp.ku, cp.kw, cp.cu, cp.cw);
+            out[au] += f.0;
+            out[aw] += f.1;
+            out[bu] -= f.0;
+            out[bw] -= f.1;
+            energy += e;
+            power += p;
+        }
+        (energy, power)
+    }
+
+    /// Spring (and damper) stiffness in launch axes (φ = 0): the linear part of
+    /// [`Model::add_spring_forces`], as (i, j, k, c) entries.
+    pub fn spring_entries(&self) -> Vec<(usize, usize, f64, f64)> {
+        let mut e = Vec::new();
+        let mut pair = |a: &[(usize, f64)], k: f64, c: f64| {
+            for &(i, wi) in a {
+                for &(j, wj) in a {
+                    e.push((i, j, k * wi * wj, c * wi * wj));
+                }
+            }
+        };
+        for (j, m) in self.masses.iter().enumerate() {
+            let (iu, iw) = self.mass_dofs(j);
+            let mut au = vec![(iu, 1.0)];
+            au.extend((0..2).map(|a| (m.at.iu[a], -m.at.nu[a])));
+            pair(&au, m.ku, m.cu);
+            let mut aw = vec![(iw, 1.0)];
+            aw.extend((0..4).map(|a| (m.at.iw[a], -m.at.hw[a])));
+            pair(&aw, m.kw, m.cw);
+        }
+        for cp in &self.couplings {
+            let (au, aw) = self.mass_dofs(cp.a);
+            let (bu, bw) = self.mass_dofs(cp.b);
+            pair(&[(au, 1.0), (bu, -1.0)], cp.ku, cp.cu);
+            pair(&[(aw, 1.0), (bw, -1.0)], cp.kw, cp.cw);
+        }
+        e
+    }
+
+    pub fn damped(&self) -> bool {
+        self.masses.iter().any(|m| m.cu > 0.0 || m.cw > 0.0)
+            || self.couplings.iter().any(|c| c.cu > 0.0 || c.cw > 0.0)
+    }
+
+    /// Initial nodal displacements: the scene's w(x, 0) (nodal values and slopes) minus its
+    /// rigid part with respect to m₀ — the m₀-weighted least-squares line, so that the case's
+    /// mean axis starts on the launch axis through the origin. Discrete masses start at rest
+    /// at U = W = 0.
+    pub fn initial_shape(&self, shape: &InitialShape) -> Vec<f64> {
+        let mut q = vec![0.0; self.n];
+        for i in 0..self.nodes {
+            let x = i as f64 * self.h;
+            q[DOFS_PER_NODE * i + 1] = shape.deflection(x, self.length);
+            q[DOFS_PER_NODE * i + 2] = shape_slope(shape, x, self.length);
+        }
+        // Least-squares line c₀ + c₁(x − x̄) with M₀ of the case: ∫m₀(x − x̄) = 0 decouples.
+        use crate::linalg::dot;
+        let c0 = dot(&self.a_c_eta, &q);
+        let mut lin_w = vec![0.0; self.n];
+        for i in 0..self.nodes {
+            lin_w[DOFS_PER_NODE * i + 1] = i as f64 * self.h - self.x_bar;
+            lin_w[DOFS_PER_NODE * i + 2] = 1.0;
+        }
+        let c1 = dot(&self.a_s_eta, &q) / dot(&self.a_s_eta, &lin_w);
+        for i in 0..self.nodes {
+            q[DOFS_PER_NODE * i + 1] -= c0 + c1 * (i as f64 * self.h - self.x_bar);
+            q[DOFS_PER_NODE * i + 2] -= c1;
+        }
+        q
+    }
+}
+
+/// dw/dx of the scene's initial shape.
+fn shape_slope(shape: &InitialShape, x: f64, length: f64) -> f64 {
+    use std::f64::consts::PI;
+    match *shape {
+        InitialShape::Report { a1, a2 } => {
+            a1 * PI / length * (PI * x / length).cos()
+                + a2 * (-6.0 / (PI * length) - 2.0 * PI / length * (2.0 * PI * x / length).cos())
+        }
+        InitialShape::Straight => 0.0,
+    }
+}
