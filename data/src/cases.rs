@@ -198,7 +198,8 @@ case_files!(
     "contact",
     "histories",
     "payload_link",
-    "mobile"
+    "mobile",
+    "mobile_flex"
 );
 
 /// Parses a case file with located errors.
