@@ -199,6 +199,7 @@ case_files!(
     "histories",
     "payload_link",
     "mobile",
+    "mobile_flex",
     "mobile_flex_fem"
 );
 

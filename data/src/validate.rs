@@ -776,7 +776,78 @@ fn check_mobile(c: &mut Checker, m: &MobileManipulator) {
             fb.key("bending_stiffness_out_of_plane"),
             f.bending_stiffness_out_of_plane,
         );
+        if let Some(l) = m
+            .arm
+            .as_ref()
+            .and_then(|a| f.link.checked_sub(1).and_then(|k| a.links.get(k)))
+        {
+            check_flexible_body(c, &b.key("arm").key("links").index(f.link - 1), l);
+        }
     }
+}
+
+/// The flexible link is a uniform beam of the link's mass plus a residual rigid inertia
+/// J_res = J − diag(0, mL²/12, mL²/12) carried by its frame: its mass centre must be the
+/// beam's, (L/2, 0, 0) within 1e-12·L, and J_res must be positive semi-definite.
+fn check_flexible_body(c: &mut Checker, p: &FieldPath, l: &crate::scene::ArmLink) {
+    if !(l.length > 0.0 && l.mass > 0.0) {
+        return; // reported by the link's own checks
+    }
+    let tol = 1e-12 * l.length;
+    let want = [0.5 * l.length, 0.0, 0.0];
+    if l.com
+        .iter()
+        .zip(&want)
+        .any(|(a, b)| !a.is_finite() || (a - b).abs() > tol)
+    {
+        c.fail(
+            p.key("com"),
+            format!(
+                "[{}, {}, {}] is not the middle of a flexible link of length {}",
+                l.com[0], l.com[1], l.com[2], l.length
+            ),
+            format!(
+                "[{}, 0.0, 0.0] (the uniform beam's mass centre, within 1e-12·L)",
+                want[0]
+            ),
+        );
+        return;
+    }
+    let rod = l.mass * l.length * l.length / 12.0;
+    let mut j = l.inertia;
+    j[1][1] -= rod;
+    j[2][2] -= rod;
+    if !positive_semidefinite(&j) {
+        c.fail(
+            p.key("inertia"),
+            format!(
+                "is smaller than the slender rod's (J − diag(0, mL²/12, mL²/12) with mL²/12 = \
+                 {rod:e} is not positive semi-definite)"
+            ),
+            "an inertia of at least the uniform rod's about both transverse axes (the beam \
+             carries mL²/12; the rest is a rigid residual)",
+        );
+    }
+}
+
+/// All principal minors of the symmetric 3×3 matrix ≥ −1e-12 · scale^k (round-off of the
+/// subtraction above).
+fn positive_semidefinite(j: &[[f64; 3]; 3]) -> bool {
+    let s = j
+        .iter()
+        .flatten()
+        .fold(0.0f64, |a, v| a.max(v.abs()))
+        .max(1e-300);
+    let tol = 1e-12;
+    let minor2 = |a: usize, b: usize| j[a][a] * j[b][b] - j[a][b] * j[b][a];
+    let det = j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1])
+        - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
+        + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
+    (0..3).all(|k| j[k][k] >= -tol * s)
+        && [(0, 1), (0, 2), (1, 2)]
+            .iter()
+            .all(|&(a, b)| minor2(a, b) >= -tol * s * s)
+        && det >= -tol * s * s * s
 }
 
 /// Mass ≥ 0 (> 0 when `massive`), finite centre of mass, and an inertia tensor that is

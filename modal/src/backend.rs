@@ -1,12 +1,12 @@
 //! The `data::Backend` implementation: planar chains here, the rocket in [`crate::rocket`], the
-//! 3-D payload link in [`crate::payload_link`].
+//! 3-D payload link in [`crate::payload_link`], the mobile manipulator in [`crate::mobile`].
 
 use data::{
     Backend, BackendError, BackendKind, Discretization, DofPlan, Family, ModalResult, RunResult,
     Scene, Settings, StaticResult,
 };
 
-use crate::{modes, payload_link, rocket, setup, simulate, statics};
+use crate::{mobile, modes, payload_link, rocket, setup, simulate, statics};
 
 /// The assumed-mode backend (unit struct; all state lives in a run).
 #[derive(Debug, Clone, Copy, Default)]
@@ -21,6 +21,7 @@ impl Backend for ModalBackend {
         match scene.family() {
             Family::Rocket => rocket::dof_plan(scene, disc),
             Family::PayloadLink => Ok(payload_link::dof_plan(scene, disc)?),
+            Family::MobileManipulator => Ok(mobile::dof_plan(scene, disc)?),
             _ => Ok(setup::dof_plan(scene, disc)?),
         }
     }
@@ -34,6 +35,7 @@ impl Backend for ModalBackend {
         match scene.family() {
             Family::Rocket => rocket::modes(scene, settings, count),
             Family::PayloadLink => Ok(payload_link::modes(scene, settings, count)?),
+            Family::MobileManipulator => Ok(mobile::modes(scene, settings, count)?),
             _ => Ok(modes::modes(scene, settings, count)?),
         }
     }
@@ -42,6 +44,9 @@ impl Backend for ModalBackend {
         match scene.family() {
             Family::Rocket => Err(BackendError::unsupported("modal: statics of the rocket")),
             Family::PayloadLink => Ok(payload_link::statics(scene, settings)?),
+            Family::MobileManipulator => Err(BackendError::unsupported(
+                "modal: statics of the mobile manipulator (it has no [statics] loads)",
+            )),
             _ => Ok(statics::statics(scene, settings)?),
         }
     }
@@ -50,6 +55,7 @@ impl Backend for ModalBackend {
         match scene.family() {
             Family::Rocket => rocket::simulate(scene, settings),
             Family::PayloadLink => Ok(payload_link::simulate(scene, settings)?),
+            Family::MobileManipulator => Ok(mobile::simulate(scene, settings)?),
             _ => Ok(simulate::simulate(scene, settings)?),
         }
     }

@@ -39,7 +39,8 @@
 //! chain's own factored linearization ([`newton`]: Cholesky of M + cD + c²K with the contact
 //! rows, never M⁻¹K) and keeps it across the drift projections of the contact phase. The
 //! rocket (seed 003) is in [`rocket`], the 3-D
-//! link with an offset payload (seed 002) in [`payload_link`].
+//! link with an offset payload (seed 002) in [`payload_link`], the mobile manipulator with a
+//! flexible pitch link (seed 004) in [`mobile`].
 //!
 //! Contact (Barhorst's work surface, [`contact`]): the gap g = n̂·(r_tip − p₀) is an event
 //! function located by Illinois root finding on the integrator's dense output (bracket
@@ -78,6 +79,7 @@ pub mod error;
 pub mod events;
 pub mod integrate;
 pub mod linalg;
+pub mod mobile;
 pub mod model;
 pub mod modes;
 pub mod newton;

@@ -27,7 +27,7 @@ pub struct MobileManipulator {
     #[serde(default)]
     pub initial: InitialState,
     /// Flexible variant: the named pitch link as a beam (the backends' model; the rigid
-    /// reference refuses it).
+    /// reference ignores it and runs the EI → ∞ limit).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub flexible_link: Option<FlexibleLink>,
 }
@@ -205,7 +205,10 @@ pub struct InitialState {
     pub wheel_rates: [f64; 2],
 }
 
-/// A pitch link modelled as a beam bending in and out of the arm's plane.
+/// A pitch link modelled as a beam bending in and out of the arm's plane: a uniform
+/// Euler–Bernoulli beam of the link's mass clamped at its joint, plus the residual rigid inertia
+/// J − diag(0, mL²/12, mL²/12) (validated: mass centre at (L/2, 0, 0), residual positive
+/// semi-definite), so that EI → ∞ is the rigid link exactly.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FlexibleLink {

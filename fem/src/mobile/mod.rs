@@ -54,8 +54,8 @@ pub mod step;
 
 use std::time::Instant;
 
-use data::results::ledger_term;
 use data::channel::spec;
+use data::results::ledger_term;
 use data::scene::MobileManipulator;
 use data::{
     BackendKind, Cost, Diagnostic, DofPlan, EnergyLedger, Observables, RunResult, Scene, Settings,

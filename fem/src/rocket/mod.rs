@@ -55,9 +55,11 @@ pub mod model;
 
 use std::time::Instant;
 
+use data::channel::spec;
+use data::results::ledger_term;
 use data::{
     BackendKind, Cost, Diagnostic, DofPlan, EnergyLedger, ModalResult, ModeShape, Observables,
-    RunResult, Scene, Settings, StabilityVerdict, channel,
+    RunResult, Scene, Settings, StabilityVerdict,
 };
 use faer::Mat;
 
@@ -372,22 +374,18 @@ fn runaway(t: f64, what: String) -> FemError {
 /// Channel list (the same names and order as the other backends).
 pub fn channel_specs(model: &Model, stations: usize) -> Vec<(String, &'static str)> {
     let mut c = vec![
-        (channel::ROCKET_X.to_string(), "length"),
-        (channel::ROCKET_Y.to_string(), "length"),
-        (channel::ROCKET_THETA.to_string(), "rad"),
-        (channel::ROCKET_MASS.to_string(), "mass"),
-        (channel::ROCKET_VX.to_string(), "length/time"),
-        (channel::ROCKET_VY.to_string(), "length/time"),
+        spec::rocket_x(),
+        spec::rocket_y(),
+        spec::rocket_theta(),
+        spec::rocket_mass(),
+        spec::rocket_vx(),
+        spec::rocket_vy(),
     ];
-    for k in 0..stations {
-        c.push((channel::rocket_axial(k), "length"));
-    }
-    for k in 0..stations {
-        c.push((channel::rocket_transverse(k), "length"));
-    }
+    c.extend((0..stations).map(spec::rocket_axial));
+    c.extend((0..stations).map(spec::rocket_transverse));
     for j in 1..=model.masses.len() {
-        c.push((channel::rocket_mass_axial(j), "length"));
-        c.push((channel::rocket_mass_transverse(j), "length"));
+        c.push(spec::rocket_mass_axial(j));
+        c.push(spec::rocket_mass_transverse(j));
     }
     c
 }
@@ -441,8 +439,8 @@ pub struct Prepared {
 
 pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
     let r = the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))?;
-    match settings.time.method.as_deref() {
-        None | Some("implicit-midpoint") => {}
+    match settings.time.method {
+        None | Some(data::Method::ImplicitMidpoint) => {}
         Some(other) => {
             return Err(FemError::unsupported(format!(
                 "fem rocket: method `{other}`; only `implicit-midpoint` is implemented for the \
@@ -492,9 +490,18 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
     let specs = channel_specs(&stepper.model, stations);
     let mut obs = Observables::with_channels(&specs);
     let mut ledger = EnergyLedger::new(
-        &["kinetic", "strain", "gravity", "discrete_spring"],
-        &["thrust", "pressure", "coriolis"],
-        &["discrete_damper", "mass_outflow"],
+        &[
+            ledger_term::KINETIC,
+            ledger_term::STRAIN,
+            ledger_term::GRAVITY,
+            ledger_term::DISCRETE_SPRING,
+        ],
+        &[
+            ledger_term::THRUST,
+            ledger_term::PRESSURE,
+            ledger_term::CORIOLIS,
+        ],
+        &[ledger_term::DISCRETE_DAMPER, ledger_term::MASS_OUTFLOW],
     );
     let mut buf = Vec::with_capacity(specs.len());
     observe(

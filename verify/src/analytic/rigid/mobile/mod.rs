@@ -6,7 +6,9 @@
 //! platform's no-sideways-slip and rolling constraints A(q) q̇ = 0 are nonholonomic, so there
 //! is no position-level constraint to drift. Equations and frames: [`model`]; the two
 //! formulations (multipliers / null space), inverse dynamics and the ledger: [`forward`]; the
-//! seed's printed expressions next to their corrections: [`seed`].
+//! seed's printed expressions next to their corrections: [`seed`]. A scene's
+//! `[mobile_manipulator.flexible_link]` is ignored: the reference is the flexible variant's
+//! EI → ∞ limit (the backends' beam carries the link's mass, mass centre and inertia exactly).
 //!
 //! The run's observables: `platform.x`, `platform.y`, `platform.heading`, `wheel_right.angle`,
 //! `wheel_left.angle`, `jointI.angle` / `.rate` / `.torque`, `ee.x`, `ee.y`, `ee.z` (tip of link

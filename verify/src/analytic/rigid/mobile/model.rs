@@ -171,13 +171,9 @@ pub struct Frames {
 
 impl Model {
     pub fn from_scene(m: &MobileManipulator) -> Result<Self> {
-        if m.flexible_link.is_some() {
-            return Err(AnalyticError::Unsupported(
-                "mobile reference: the flexible link (the rigid reference models rigid links only; \
-                 remove [mobile_manipulator.flexible_link] for the rigid limit)"
-                    .into(),
-            ));
-        }
+        // A `[mobile_manipulator.flexible_link]` is ignored: the rigid model is its EI → ∞
+        // limit (the backends' beam carries the link's mass m, mass centre L/2 and inertia J
+        // exactly, the elastic deflection vanishing as 1/EI).
         let platform = m.platform.as_ref().map(|p| {
             let axles = p.wheel_count / 2;
             let wheels_per_side = axles as f64;
