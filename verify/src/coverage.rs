@@ -111,9 +111,15 @@ impl CheckKind {
 /// * `linkN.tip_w`, `linkN.tip_twist` — the 3-D link's vertical tip deflection and tip twist, in
 ///   the base's turning frame, which the clamped root fixes the same way in every backend.
 ///
+/// * `rocket.massJ.u`, `rocket.massJ.w`, `rocket.u@K`, `rocket.w@K` — the rocket's elastic
+///   displacements relative to the case's mean axis weighted by its ignition mass
+///   (docs/rocket.md): a function of the deformed shape alone, not of a backend's body frame;
+/// * `ee.x`, `ee.y`, `ee.z`, `platform.x`, `platform.y`, `platform.heading` — the mobile
+///   manipulator's inertial end-effector position and platform pose.
+///
 /// Not invariant: tip deflections and axial displacements in a link's floating frame, field
-/// deflections `linkN.v@K`, rocket body-axis displacements and attitude (their axes depend on
-/// how each backend defines the body frame).
+/// deflections `linkN.v@K`, and the rocket's attitude `rocket.theta` (each backend's body
+/// axis).
 pub fn frame_invariant(channel: &str) -> bool {
     if channel.starts_with(crate::suite::history::ENERGY_PREFIX) {
         return true;
@@ -127,6 +133,12 @@ pub fn frame_invariant(channel: &str) -> bool {
             | data::channel::PAYLOAD_X
             | data::channel::PAYLOAD_Y
             | data::channel::PAYLOAD_Z
+            | data::channel::END_EFFECTOR_X
+            | data::channel::END_EFFECTOR_Y
+            | data::channel::END_EFFECTOR_Z
+            | data::channel::PLATFORM_X
+            | data::channel::PLATFORM_Y
+            | data::channel::PLATFORM_HEADING
     ) {
         return true;
     }
@@ -137,7 +149,13 @@ pub fn frame_invariant(channel: &str) -> bool {
             })
         })
     };
-    indexed("link", &["tip_x", "tip_y", "tip_w", "tip_twist"])
+    let rocket_station = channel
+        .strip_prefix("rocket.u@")
+        .or_else(|| channel.strip_prefix("rocket.w@"))
+        .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
+    rocket_station
+        || indexed("rocket.mass", &["u", "w"])
+        || indexed("link", &["tip_x", "tip_y", "tip_w", "tip_twist"])
         || indexed("joint", &["angle", "rate", "torque"])
         || indexed("contact", &["normal_force"])
 }
