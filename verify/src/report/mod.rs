@@ -339,7 +339,7 @@ fn work_table(w: &CaseWork) -> String {
     let (counter_name, _) = work_counter(&w.points);
     let mut s = format!(
         "<p class=\"muted\">Errors against {}; wall time over repeated sequential runs \
-         (minimum, median, maximum; spread = (max − min)/min); work counters from the \
+         (minimum, median, maximum; spread = (median − min)/min); work counters from the \
          backend's cost report (the work–counter plot uses {counter_name}).</p>\
          <table><tr><th>discretization</th><th>value</th><th>error</th><th>min [s]</th>\
          <th>median [s]</th><th>max [s]</th><th>repeats</th><th>spread</th><th>DOFs</th>\
@@ -662,7 +662,7 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
             any = true;
             let _ = writeln!(
                 b,
-                "<h3 id=\"{}\">{} <span class=\"{s}\">{s}</span></h3>\n<p class=\"why\">{}</p>",
+                "<h3 id=\"{}\">{} <span class=\"{s}\">{s}</span></h3>\n<p class=\"small\">{}</p>",
                 row_anchor(&o.id),
                 esc(&o.id),
                 esc(&o.why),
