@@ -324,8 +324,8 @@ where
                 .configure_mesh()
                 .x_desc(xlabel)
                 .y_desc(ylabel)
-                .label_style(("sans-serif", 14))
-                .axis_desc_style(("sans-serif", 15))
+                .label_style(("sans-serif", 17))
+                .axis_desc_style(("sans-serif", 17))
                 .bold_line_style(RGBColor(225, 225, 225))
                 .x_label_formatter(&|v| axis_tick_label(*v, x_powers))
                 .y_label_formatter(&|v| axis_tick_label(*v, y_powers))
@@ -413,9 +413,9 @@ where
         );
     }
     // The legend, in its own panel right of the chart.
-    let font = ("sans-serif", 14).into_font().color(&BLACK);
+    let font = ("sans-serif", 17).into_font().color(&BLACK);
     for (i, (s, color)) in series.iter().zip(&colors).enumerate() {
-        let y = 24 + 24 * i as i32;
+        let y = 24 + 26 * i as i32;
         let color = *color;
         match s.mark {
             Mark::Points => legend_area.draw(&Circle::new((22, y), 4, color.filled())),
