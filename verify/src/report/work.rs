@@ -1,7 +1,8 @@
 //! Work–precision measurements of the report: the error of each rung of a case's ladder
 //! against its cost, the cost measured two ways so a curve does not hinge on timer noise:
 //!
-//! - wall time as the minimum over repeated sequential runs (the minimum is the run least
+//! - wall time as the minimum over repeated sequential runs (rungs dearer than
+//!   [`MAX_SPENT_S`] keep their one run of the suite) (the minimum is the run least
 //!   disturbed by the machine), with the median and maximum beside it and the spread
 //!   (median − min)/min;
 //! - work counters from the backend's own `Cost` (DOFs, steps, right-hand-side evaluations,
@@ -62,6 +63,17 @@ pub fn time_repeats(mut run: impl FnMut() -> Option<f64>) -> Option<Timing> {
         spent += t;
     }
     Some(timing_of(&mut times))
+}
+
+/// The timing of a rung whose first run (the suite's) took `first` seconds: repeated with
+/// [`time_repeats`] when it is cheaper than [`MAX_SPENT_S`], else that one run alone
+/// (`repeats` = 1, reported as such): a rung of minutes is not worth repeating for a plot,
+/// and its timer noise is small relative to its cost.
+pub fn time_rung(first: f64, run: impl FnMut() -> Option<f64>) -> Option<Timing> {
+    if first > MAX_SPENT_S {
+        return Some(timing_of(&mut [first]));
+    }
+    time_repeats(run)
 }
 
 fn timing_of(times: &mut [f64]) -> Timing {
@@ -263,5 +275,11 @@ mod tests {
         let t = time_repeats(|| Some(2.0)).unwrap();
         assert_eq!(t.repeats, 3);
         assert!(time_repeats(|| None).is_none());
+        // A rung dearer than the budget keeps its one run.
+        let t = time_rung(2.0 * MAX_SPENT_S, || panic!("must not run again")).unwrap();
+        assert_eq!(
+            (t.repeats, t.min_s, t.spread()),
+            (1, 2.0 * MAX_SPENT_S, 0.0)
+        );
     }
 }

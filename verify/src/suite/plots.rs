@@ -15,7 +15,7 @@ use super::quantity::Quantity;
 use super::reference::analytic_value;
 use super::run_cache::{Answer, RunCache, compute};
 use crate::plot::{Mark, Series, StyledSeries, plot, plot_styled};
-use crate::report::work::{CaseWork, Counters, WorkPoint, time_repeats, work_counter};
+use crate::report::work::{CaseWork, Counters, WorkPoint, time_rung, work_counter};
 
 fn scene_of(case: &Case) -> Option<Scene> {
     if case.overrides.is_empty() {
@@ -273,7 +273,10 @@ fn draw_ladder(
             continue;
         };
         let answer = || compute(scene, case.backend, &s, q.analysis(), q.modes_needed());
-        let Some(timing) = time_repeats(|| answer().wall_time_s()) else {
+        let Some(first) = cached.wall_time_s() else {
+            continue;
+        };
+        let Some(timing) = time_rung(first, || answer().wall_time_s()) else {
             continue;
         };
         rungs.push((rung, h, value, cost, timing));
