@@ -21,6 +21,7 @@ pub mod output;
 pub mod plot;
 pub mod progress;
 pub mod registry;
+pub mod report;
 pub mod shard;
 pub mod stability;
 pub mod study;

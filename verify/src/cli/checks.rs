@@ -46,7 +46,9 @@ pub fn verify(
     }
     if let Some(dir) = out {
         plots::draw_all(dir, &cases, &outcomes, &cache);
-        report::write_all(dir, &outcomes)?;
+        for n in report::write_all(dir, &outcomes)? {
+            eprintln!("note: {n}");
+        }
         eprintln!(
             "wrote the verification report to {}/index.html",
             dir.display()
@@ -118,7 +120,10 @@ pub fn merge(dirs: &[PathBuf], format: Format, out: &Path) -> Result<(), CliErro
     print_outcomes(&outcomes, format);
     std::fs::create_dir_all(out)?;
     shard::copy_plots(dirs, out)?;
-    report::write_all(out, &outcomes)?;
+    crate::report::work::copy_work_files(dirs, out)?;
+    for n in report::write_all(out, &outcomes)? {
+        eprintln!("note: {n}");
+    }
     eprintln!(
         "wrote the verification report to {}/index.html",
         out.display()

@@ -40,7 +40,7 @@ pub struct Outcome {
     pub wall_time_s: f64,
 }
 
-fn settings_label(s: &CaseSettings) -> String {
+pub(crate) fn settings_label(s: &CaseSettings) -> String {
     let mut parts = Vec::new();
     if let Some(v) = s.elements {
         parts.push(format!("elements={v}"));

@@ -177,57 +177,12 @@ pub fn json(outcomes: &[Outcome]) -> String {
     serde_json::to_string_pretty(outcomes).expect("serializable outcomes")
 }
 
-fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-}
-
-/// JSON, CSV and an index.html linking them (plots are added by the studies).
-pub fn write_all(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<()> {
+/// JSON, CSV and the HTML pages of [`crate::report`] (the plots are drawn before, by
+/// [`super::plots::draw_all`] or copied from shards). Returns notes on what the pages could
+/// not include.
+pub fn write_all(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<String>> {
+    std::fs::create_dir_all(dir)?;
     write_atomic(dir, "verification.json", json(outcomes).as_bytes())?;
     write_atomic(dir, "verification.csv", csv(outcomes).as_bytes())?;
-    let mut html = String::from(
-        "<!doctype html><html><head><meta charset=\"utf-8\"><title>flexverify report</title>\
-         <style>body{font-family:sans-serif}td,th{padding:2px 8px;border-bottom:1px solid #ddd}\
-         .FAIL,.ERROR{color:#b00;font-weight:bold}</style></head><body>\
-         <h1>flexverify verification report</h1>\
-         <p><a href=\"verification.json\">JSON</a> · <a href=\"verification.csv\">CSV</a></p><table><tr>",
-    );
-    for h in HEADER.iter().chain(["why"].iter()) {
-        html.push_str(&format!("<th>{h}</th>"));
-    }
-    html.push_str("</tr>");
-    for (r, o) in rows(outcomes).into_iter().zip(outcomes) {
-        html.push_str("<tr>");
-        let result = r[9].clone();
-        for (i, cell) in r.into_iter().enumerate() {
-            if i == 9 {
-                html.push_str(&format!(
-                    "<td class=\"{result}\">{}</td>",
-                    html_escape(&cell)
-                ));
-            } else {
-                html.push_str(&format!("<td>{}</td>", html_escape(&cell)));
-            }
-        }
-        html.push_str(&format!("<td>{}</td></tr>", html_escape(&o.why)));
-    }
-    html.push_str("</table>");
-    let plots: Vec<String> = std::fs::read_dir(dir)?
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".svg"))
-        .collect();
-    if !plots.is_empty() {
-        html.push_str("<h2>Plots</h2>");
-        let mut plots = plots;
-        plots.sort();
-        for p in plots {
-            html.push_str(&format!("<div><img src=\"{p}\" alt=\"{p}\"></div>"));
-        }
-    }
-    html.push_str("</body></html>\n");
-    write_atomic(dir, "index.html", html.as_bytes())?;
-    Ok(())
+    crate::report::write_pages(dir, outcomes)
 }

@@ -1,0 +1,171 @@
+//! The HTML report of `verify --out` and of `merge --out`: every page exists, and every
+//! relative link and image of every page points at a file (and anchor) that exists.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Cheap and varied: the cantilever's frequency, static, history and order cases (26 quick
+/// rows, three of them ladders with work–precision and a two-backend Pareto front).
+const FILTER: &str = "cantilever";
+
+fn flexverify(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_flexverify"))
+        .args(args)
+        .output()
+        .expect("run flexverify");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("flexverify-report-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The values of `attr="…"` in an HTML text.
+fn attributes(html: &str, attr: &str) -> Vec<String> {
+    let key = format!("{attr}=\"");
+    html.match_indices(&key)
+        .map(|(i, _)| {
+            let rest = &html[i + key.len()..];
+            rest[..rest.find('"').expect("closing quote")].replace("&amp;", "&")
+        })
+        .collect()
+}
+
+/// Checks every page of a report: the pages and ids it links exist; returns the pages.
+fn check_links(dir: &Path) -> BTreeSet<String> {
+    let pages: BTreeMap<String, String> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".html"))
+        .map(|n| {
+            let text = std::fs::read_to_string(dir.join(&n)).unwrap();
+            (n, text)
+        })
+        .collect();
+    assert!(pages.contains_key("index.html"), "no index.html in {dir:?}");
+    let ids =
+        |page: &str| -> BTreeSet<String> { attributes(&pages[page], "id").into_iter().collect() };
+    let mut checked = 0;
+    for (name, html) in &pages {
+        for link in attributes(html, "href")
+            .into_iter()
+            .chain(attributes(html, "src"))
+        {
+            assert!(
+                !link.contains("://") && !link.starts_with('/'),
+                "{name}: link {link} is not relative"
+            );
+            let (file, anchor) = link.split_once('#').unwrap_or((&link, ""));
+            let target = if file.is_empty() { name.as_str() } else { file };
+            assert!(
+                dir.join(target).is_file(),
+                "{name}: {link} points at no file"
+            );
+            if !anchor.is_empty() {
+                assert!(
+                    pages.contains_key(target) && ids(target).contains(anchor),
+                    "{name}: {link}: no id {anchor} in {target}"
+                );
+            }
+            checked += 1;
+        }
+        assert!(html.contains("</html>"), "{name} is not a whole page");
+    }
+    assert!(checked > 0);
+    pages.into_keys().collect()
+}
+
+#[test]
+fn sys_report_every_page_link_and_image_exists() {
+    let dir = scratch("single");
+    let (code, err) = flexverify(&["verify", "--filter", FILTER, "--out", dir.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let pages = check_links(&dir);
+    // One page per scene of the rows, and the index links each of them.
+    let json = std::fs::read_to_string(dir.join("verification.json")).unwrap();
+    let rows: Vec<serde_json::Value> = serde_json::from_str(&json).unwrap();
+    let scenes: BTreeSet<String> = rows
+        .iter()
+        .map(|r| r["scene"].as_str().unwrap().to_string())
+        .collect();
+    let index = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    for s in &scenes {
+        let page = format!("scene-{s}.html");
+        assert!(pages.contains(&page), "no page for scene {s}");
+        assert!(
+            index.contains(&format!("href=\"{page}\"")),
+            "index does not link {page}"
+        );
+    }
+    assert_eq!(pages.len(), scenes.len() + 1, "{pages:?}");
+    // The summary tables and the coverage matrix are on the index.
+    for heading in ["By check kind", "By scene", "Coverage", "Work–precision"] {
+        assert!(index.contains(heading), "index lacks {heading}");
+    }
+    // The order cases' ladders give a Pareto front of the cantilever's first frequency across
+    // fem and fdm, drawn and shown on the scene page.
+    let scene = std::fs::read_to_string(dir.join("scene-cantilever.html")).unwrap();
+    assert!(scene.contains("src=\"pareto-cantilever-freq1.svg\""));
+    let svg = std::fs::read_to_string(dir.join("pareto-cantilever-freq1.svg")).unwrap();
+    for legend in ["fem", "fdm", "Pareto front"] {
+        assert!(
+            svg.lines().any(|l| l.trim() == legend),
+            "front lacks legend {legend}"
+        );
+    }
+}
+
+#[test]
+fn sys_report_merged_from_shards_has_the_same_pages_and_links() {
+    let filter = "order-cantilever";
+    let single = scratch("merge-single");
+    let (code, err) = flexverify(&[
+        "verify",
+        "--filter",
+        filter,
+        "--out",
+        single.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let parts: Vec<PathBuf> = (1..=2).map(|i| scratch(&format!("part{i}"))).collect();
+    for (i, part) in parts.iter().enumerate() {
+        let shard = format!("{}/2", i + 1);
+        let (code, err) = flexverify(&[
+            "verify",
+            "--filter",
+            filter,
+            "--shard",
+            &shard,
+            "--out",
+            part.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+    }
+    let merged = scratch("merged");
+    let (code, err) = flexverify(&[
+        "merge",
+        parts[0].to_str().unwrap(),
+        parts[1].to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(check_links(&merged), check_links(&single));
+    let files = |d: &Path| -> BTreeSet<String> {
+        std::fs::read_dir(d)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".svg") || n.ends_with(".html"))
+            .collect()
+    };
+    assert_eq!(files(&merged), files(&single));
+}
