@@ -243,7 +243,7 @@ pub struct Frames {
     pub al: [Vec3; 6],
     pub v: [Vec3; 6],
     pub a: [Vec3; 6],
-    /// Inertial axis of joint k (k = 1…4) through o[k].
+    /// Inertial axis of joint k (k = 1…4) through o\[k\].
     pub axis: [Vec3; 5],
     /// Tip of the flexible link: point, prismatic axes R_F e_y, R_F e_z, revolute axes
     /// R_F e_z (v′_N) and R_F R_z(v′_N)(−e_y) (w′_N).
