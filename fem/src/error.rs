@@ -37,6 +37,27 @@ impl FemError {
     pub fn unsupported(what: impl Into<String>) -> Self {
         FemError::Unsupported(what.into())
     }
+
+    /// A runaway as the diagnostic of a run that stops early (its results up to then are
+    /// kept); every other error stays an error.
+    pub fn into_stop_diagnostic(self) -> Result<data::Diagnostic, FemError> {
+        match self {
+            FemError::Runaway {
+                t,
+                what,
+                location,
+                why,
+                remedy,
+            } => Ok(data::Diagnostic {
+                t,
+                what,
+                location,
+                why,
+                remedy,
+            }),
+            other => Err(other),
+        }
+    }
 }
 
 impl From<FemError> for data::BackendError {

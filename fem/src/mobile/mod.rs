@@ -421,27 +421,10 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
     for k in 1..=n_out {
         let t_stop = (k as f64 * output_interval).min(t_end);
         if let Err(e) = advance(&mut stepper, h, t_stop, &breakpoints) {
-            match e {
-                FemError::Runaway {
-                    t,
-                    what,
-                    location,
-                    why,
-                    remedy,
-                } => {
-                    verdict = StabilityVerdict::Stopped {
-                        diagnostic: Diagnostic {
-                            t,
-                            what,
-                            location,
-                            why,
-                            remedy,
-                        },
-                    };
-                    break;
-                }
-                other => return Err(other),
-            }
+            verdict = StabilityVerdict::Stopped {
+                diagnostic: e.into_stop_diagnostic()?,
+            };
+            break;
         }
         sample(&mut stepper, &mut buf);
         if buf.iter().any(|v| !v.is_finite()) {

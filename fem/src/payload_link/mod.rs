@@ -864,27 +864,10 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
                 stepper.state.t = t_stop;
             }
             if let Err(e) = stepped {
-                match e {
-                    FemError::Runaway {
-                        t,
-                        what,
-                        location,
-                        why,
-                        remedy,
-                    } => {
-                        verdict = StabilityVerdict::Stopped {
-                            diagnostic: Diagnostic {
-                                t,
-                                what,
-                                location,
-                                why,
-                                remedy,
-                            },
-                        };
-                        break 'outer;
-                    }
-                    other => return Err(other),
-                }
+                verdict = StabilityVerdict::Stopped {
+                    diagnostic: e.into_stop_diagnostic()?,
+                };
+                break 'outer;
             }
         }
         let torque = stepper.state_torque(&mut mass_lu, &mut scratch);

@@ -528,27 +528,10 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
             let rest = target - stepper.t;
             let hk = if rest < h * (1.0 + 1e-9) { rest } else { h };
             if let Err(e) = stepper.step(hk) {
-                match e {
-                    FemError::Runaway {
-                        t,
-                        what,
-                        location,
-                        why,
-                        remedy,
-                    } => {
-                        verdict = StabilityVerdict::Stopped {
-                            diagnostic: Diagnostic {
-                                t,
-                                what,
-                                location,
-                                why,
-                                remedy,
-                            },
-                        };
-                        break 'outer;
-                    }
-                    other => return Err(other),
-                }
+                verdict = StabilityVerdict::Stopped {
+                    diagnostic: e.into_stop_diagnostic()?,
+                };
+                break 'outer;
             }
             if (stepper.t - target).abs() < 1e-9 * h {
                 stepper.t = target;
