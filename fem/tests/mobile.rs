@@ -73,12 +73,12 @@ fn elem_mobile_beam_stiffness_tip_load_exact() {
         let fl = md.flex.as_ref().unwrap();
         let ne = fl.ne;
         for (field, ei) in [(0, fl.ei_out), (1, fl.ei_in)] {
-            let mut k = fl.stiffness.clone();
+            let mut k = fem::mobile::step::DenseLlt::new(ne);
             let mut rhs = vec![0.0; ne];
             let p = 3.0;
             rhs[ne - 4 + 2 * field] = p;
-            fem::mobile::step::cholesky(&mut k, ne).unwrap();
-            fem::mobile::step::cholesky_solve(&k, ne, &mut rhs);
+            k.factor(&fl.stiffness).unwrap();
+            k.solve(&mut rhs);
             let l = fl.length;
             let tip = p * l.powi(3) / (3.0 * ei);
             let slope = p * l * l / (2.0 * ei);

@@ -182,21 +182,25 @@ pub fn first_flexible_frequency(md: &Model, q: &[f64]) -> Result<f64, FemError> 
         t: 0.0,
         message: format!("fem mobile manipulator: {what} is not positive definite"),
     };
-    step::cholesky(&mut mrr, nr).map_err(|_| singular("the rigid block of the mass matrix"))?;
+    let mut rigid = step::DenseLlt::new(nr);
+    rigid
+        .factor(&mrr)
+        .map_err(|_| singular("the rigid block of the mass matrix"))?;
     let mut meff = vec![0.0; ne * ne];
     let mut col = vec![0.0; nr];
     for j in 0..ne {
         for i in 0..nr {
             col[i] = mass[i * m + nr + j];
         }
-        step::cholesky_solve(&mrr, nr, &mut col);
+        rigid.solve(&mut col);
         for i in 0..ne {
             let mer: f64 = (0..nr).map(|k| mass[(nr + i) * m + k] * col[k]).sum();
             meff[i * ne + j] = mass[(nr + i) * m + nr + j] - mer;
         }
     }
-    let mut k = fl.stiffness.clone();
-    step::cholesky(&mut k, ne).map_err(|_| singular("the elastic stiffness"))?;
+    let mut k = step::DenseLlt::new(ne);
+    k.factor(&fl.stiffness)
+        .map_err(|_| singular("the elastic stiffness"))?;
     // Power iteration on K⁻¹ M_eff: its largest eigenvalue is 1/ω₁².
     let mut x = vec![1.0; ne];
     let mut y = vec![0.0; ne];
@@ -205,7 +209,7 @@ pub fn first_flexible_frequency(md: &Model, q: &[f64]) -> Result<f64, FemError> 
         for i in 0..ne {
             y[i] = (0..ne).map(|j| meff[i * ne + j] * x[j]).sum();
         }
-        step::cholesky_solve(&k, ne, &mut y);
+        k.solve(&mut y);
         let xy: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
         let xx: f64 = x.iter().map(|a| a * a).sum();
         let new = xy / xx;

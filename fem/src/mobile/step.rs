@@ -16,6 +16,9 @@
 //! Works are booked with the scheme's own midpoint quadrature, h τ(t̄)·ν̄ and h b ν̄².
 
 use data::scene::TorqueSchedule;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt;
+use faer::{MatMut, MatRef, Par};
 
 use super::model::{Model, Workspace};
 use crate::error::FemError;
@@ -92,6 +95,7 @@ pub struct Stepper {
     ws: Workspace,
     mass: Vec<f64>,
     newton: Vec<f64>,
+    llt: DenseLlt,
     force: Vec<f64>,
     applied: Vec<f64>,
     tau: Vec<f64>,
@@ -118,6 +122,7 @@ impl Stepper {
             ws: Workspace::new(n),
             mass: vec![0.0; m * m],
             newton: vec![0.0; m * m],
+            llt: DenseLlt::new(m),
             force: vec![0.0; m],
             applied: vec![0.0; m],
             tau: vec![0.0; m],
@@ -187,16 +192,18 @@ impl Stepper {
             }
             if it == 0 {
                 self.form_newton_matrix(h);
-                cholesky(&mut self.newton, m).map_err(|pivot| FemError::Runaway {
-                    t: self.t,
-                    what: "Newton matrix not positive definite".into(),
-                    location: Some(format!("speed {pivot}")),
-                    why: "the reduced mass matrix lost definiteness".into(),
-                    remedy: "check the scene's inertias".into(),
-                })?;
+                self.llt
+                    .factor(&self.newton)
+                    .map_err(|pivot| FemError::Runaway {
+                        t: self.t,
+                        what: "Newton matrix not positive definite".into(),
+                        location: Some(format!("speed {pivot}")),
+                        why: "the reduced mass matrix lost definiteness".into(),
+                        remedy: "check the scene's inertias".into(),
+                    })?;
                 self.counters.factorizations += 1;
             }
-            cholesky_solve(&self.newton, m, &mut self.delta);
+            self.llt.solve(&mut self.delta);
             self.counters.newton += 1;
             let mut size = 0.0f64;
             let mut scale = 1.0f64;
@@ -308,44 +315,71 @@ impl Stepper {
     }
 }
 
-/// In-place Cholesky factorization (lower triangle) of a row-major SPD matrix; Err(pivot) if
-/// a pivot is not positive.
-pub fn cholesky(a: &mut [f64], n: usize) -> Result<(), usize> {
-    for j in 0..n {
-        let mut d = a[j * n + j];
-        for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k];
-        }
-        if !(d > 0.0 && d.is_finite()) {
-            return Err(j);
-        }
-        let d = d.sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / d;
-        }
-    }
-    Ok(())
+/// L Lᵀ factorization of a dense SPD matrix through faer, with its scratch allocated once, so
+/// refactoring and solving in the step loop allocate nothing.
+pub struct DenseLlt {
+    n: usize,
+    factor: Vec<f64>,
+    scratch: StackReq,
+    mem: MemBuffer,
 }
 
-/// Solves L Lᵀ x = b in place with the factor of [`cholesky`].
-pub fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
-    for i in 0..n {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= l[i * n + k] * b[k];
+impl Clone for DenseLlt {
+    fn clone(&self) -> Self {
+        DenseLlt {
+            n: self.n,
+            factor: self.factor.clone(),
+            scratch: self.scratch,
+            mem: MemBuffer::new(self.scratch),
         }
-        b[i] = s / l[i * n + i];
     }
-    for i in (0..n).rev() {
-        let mut s = b[i];
-        for k in i + 1..n {
-            s -= l[k * n + i] * b[k];
+}
+
+impl std::fmt::Debug for DenseLlt {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DenseLlt").field("n", &self.n).finish()
+    }
+}
+
+impl DenseLlt {
+    pub fn new(n: usize) -> Self {
+        let scratch =
+            llt::factor::cholesky_in_place_scratch::<f64>(n, Par::Seq, Default::default())
+                .or(llt::solve::solve_in_place_scratch::<f64>(n, 1, Par::Seq));
+        DenseLlt {
+            n,
+            factor: vec![0.0; n * n],
+            scratch,
+            mem: MemBuffer::new(scratch),
         }
-        b[i] = s / l[i * n + i];
+    }
+
+    /// Factors the row-major matrix `a` (its lower triangle is read); Err(pivot) at the first
+    /// pivot that is not positive.
+    pub fn factor(&mut self, a: &[f64]) -> Result<(), usize> {
+        let n = self.n;
+        self.factor.copy_from_slice(&a[..n * n]);
+        llt::factor::cholesky_in_place(
+            MatMut::from_row_major_slice_mut(&mut self.factor, n, n),
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+            Default::default(),
+        )
+        .map(|_| ())
+        .map_err(|e| match e {
+            llt::factor::LltError::NonPositivePivot { index } => index,
+        })
+    }
+
+    /// Solves L Lᵀ x = b in place with the last factor.
+    pub fn solve(&mut self, b: &mut [f64]) {
+        let n = self.n;
+        llt::solve::solve_in_place(
+            MatRef::from_row_major_slice(&self.factor, n, n),
+            MatMut::from_column_major_slice_mut(&mut b[..n], n, 1),
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+        );
     }
 }
