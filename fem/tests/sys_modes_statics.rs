@@ -367,7 +367,11 @@ fn sys_unsupported_scenes_and_bad_settings_are_refused() {
     // `constrained-arm`, bilateral wall with friction: see `dyn_friction`; the 3-D payload link
     // `single-link-3d`: see `sys_payload_link`; the rocket: see `rocket`; the flexible mobile
     // manipulator: see `mobile`. Its rigid variants have no beam for fem to discretize.)
-    for name in ["mobile-manipulator", "mobile-platform", "mobile-arm-fixed-base"] {
+    for name in [
+        "mobile-manipulator",
+        "mobile-platform",
+        "mobile-arm-fixed-base",
+    ] {
         let sc = data::load_scene(name).unwrap();
         let r = FemBackend.simulate(&sc, &Settings::default());
         assert!(
