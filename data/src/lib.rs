@@ -21,12 +21,10 @@ pub mod locate;
 pub mod reader;
 pub mod results;
 pub mod scene;
+pub mod settings;
 pub mod validate;
 
-pub use backend::{
-    Backend, BackendError, BackendKind, Basis, Discretization, DofGroup, DofPlan, FemElement,
-    Method, Settings, TimeStepping,
-};
+pub use backend::{Backend, BackendError, DofGroup, DofPlan};
 pub use catalog::{CATALOG, catalog_names, catalog_scene, load_scene};
 pub use error::{LoadError, SceneError};
 pub use reader::parse_scene;
@@ -35,3 +33,6 @@ pub use results::{
     Observables, RunResult, StabilityVerdict, StaticResult, ledger_term,
 };
 pub use scene::{Family, Scene};
+pub use settings::{
+    BackendKind, Basis, Discretization, FemElement, Method, Settings, TimeStepping,
+};

@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::backend::{BackendKind, Settings};
+use crate::settings::{BackendKind, Settings};
 
 /// Standard energy-ledger term names (see [`EnergyLedger`]).
 pub mod ledger_term {

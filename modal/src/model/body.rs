@@ -24,7 +24,7 @@
 //! Lagrange terms in body velocities (ν̇ = (V̇, ω̇, ë), V̇ the derivative of the local V):
 //! E = 𝕄 ν̇ + h with h = 𝕄̇ν + (ω J P, −(J P)·V, −∂T/∂e), P = ∂T/∂V.
 
-use super::chain::LinkModel;
+use super::link::LinkModel;
 use crate::linalg::{dot, mat_vec};
 
 /// Work vectors and tip quantities of one body evaluation.

@@ -3,8 +3,10 @@
 pub mod body;
 pub mod chain;
 pub mod integrals;
+pub mod link;
 pub mod section;
 
-pub use chain::{Chain, EnergyParts, JointModel, LinkModel};
+pub use chain::{Chain, EnergyParts};
 pub use integrals::LinkIntegrals;
+pub use link::{JointModel, LinkModel};
 pub use section::{Section, SectionKind, SectionParams};

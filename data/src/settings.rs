@@ -1,0 +1,236 @@
+//! How finely a backend solves a scene: the backend's name, the discretization (elements,
+//! stations, modes, basis) and the time stepping (method, step, tolerances). Parsed once from
+//! the command line or a case row; every backend reads the fields it implements.
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BackendKind {
+    Fem,
+    Fdm,
+    Modal,
+    /// verify's rigid reference, for families that have one (the mobile manipulator); not a
+    /// discretization, so not in [`BackendKind::ALL`].
+    Reference,
+}
+
+impl BackendKind {
+    /// The three discretizations.
+    pub const ALL: [BackendKind; 3] = [BackendKind::Fem, BackendKind::Fdm, BackendKind::Modal];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            BackendKind::Fem => "fem",
+            BackendKind::Fdm => "fdm",
+            BackendKind::Modal => "modal",
+            BackendKind::Reference => "reference",
+        }
+    }
+}
+
+impl std::fmt::Display for BackendKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Assumed-mode basis of the modal backend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Basis {
+    /// x², x³, x⁴, … (seed 000 eq. 49).
+    Poly,
+    /// Clamped-free cantilever eigenfunctions.
+    ClampedFree,
+    /// Eigenfunctions of the cantilever with the scene's tip mass/inertia.
+    TipMass,
+    /// Free-free beam eigenfunctions (rocket).
+    FreeFree,
+}
+
+impl Basis {
+    pub fn name(self) -> &'static str {
+        match self {
+            Basis::Poly => "poly",
+            Basis::ClampedFree => "clamped-free",
+            Basis::TipMass => "tip-mass",
+            Basis::FreeFree => "free-free",
+        }
+    }
+}
+
+/// How finely space is discretized. Each backend reads the field it understands and uses its
+/// documented default when the field is absent.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Discretization {
+    /// FEM: elements per link.
+    pub elements: Option<usize>,
+    /// FDM: stations per link (including both ends).
+    pub stations: Option<usize>,
+    /// Modal: assumed modes per link (per field).
+    pub modes: Option<usize>,
+    pub basis: Option<Basis>,
+    /// FEM: Euler–Bernoulli element (`hermite-cubic` when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element: Option<FemElement>,
+}
+
+/// Euler–Bernoulli beam element of the FEM backend. Both keep the nodal DOFs (v, v′), so tip
+/// bodies, loads and supports attach the same way.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FemElement {
+    /// Hermite cubic: frequency error O(h⁴).
+    #[default]
+    HermiteCubic,
+    /// Hermite cubic plus two interior C¹ bubbles (complete quintic): frequency error O(h⁸).
+    HermiteQuintic,
+}
+
+impl FemElement {
+    /// Accepted spellings, for error messages and CLI help.
+    pub const NAMES: [&'static str; 2] = ["hermite-cubic", "hermite-quintic"];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            FemElement::HermiteCubic => "hermite-cubic",
+            FemElement::HermiteQuintic => "hermite-quintic",
+        }
+    }
+}
+
+/// A time-integration method, as `time.method` (case files) and `--method` (CLI) spell it.
+///
+/// One list for all backends: each backend declares the subset it implements and answers the
+/// others with an error naming that subset. Spellings are parsed here, once ([`Method::NAMES`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum Method {
+    /// fem: energy-consistent implicit midpoint (discrete gradient) for free-joint chains.
+    EnergyMidpoint,
+    /// fem: implicit generalized-α (Chung–Hulbert).
+    GeneralizedAlpha,
+    /// Explicit central difference: fem's velocity-Verlet form; fdm's report scheme.
+    CentralDifference,
+    /// fem: implicit midpoint rule (one-stage Gauss).
+    ImplicitMidpoint,
+    /// fdm: the report's two-step central difference.
+    Report,
+    /// fdm: the report's scheme with a Robert–Asselin filter of coefficient ν (None: the
+    /// backend's default ν). Spelled `robert-asselin` or `robert-asselin=ν`.
+    RobertAsselin { nu: Option<f64> },
+    /// fdm: one-step velocity (kick–drift–kick) form.
+    VelocityForm,
+    /// modal: adaptive Dormand–Prince 5(4).
+    Dopri5,
+    /// modal: adaptive TR-BDF2 (also spelled `tr-bdf2`, `sdirk`).
+    TrBdf2,
+    /// modal: TR-BDF2 at a fixed step.
+    TrBdf2Fixed,
+    /// modal: trapezoidal rule at a fixed step.
+    Trapezoid,
+}
+
+impl Method {
+    /// Every accepted spelling, for error messages and CLI help.
+    pub const NAMES: &'static str = "energy-midpoint, generalized-alpha, central-difference, \
+        implicit-midpoint (fem); report, central-difference, robert-asselin[=nu], velocity-form \
+        (fdm); dopri5, trbdf2 (also tr-bdf2, sdirk), trbdf2-fixed, trapezoid (modal)";
+
+    /// The canonical spelling (`robert-asselin=ν` with its coefficient when one is given).
+    pub fn name(self) -> String {
+        let fixed = match self {
+            Method::EnergyMidpoint => "energy-midpoint",
+            Method::GeneralizedAlpha => "generalized-alpha",
+            Method::CentralDifference => "central-difference",
+            Method::ImplicitMidpoint => "implicit-midpoint",
+            Method::Report => "report",
+            Method::RobertAsselin { nu: Some(nu) } => return format!("robert-asselin={nu}"),
+            Method::RobertAsselin { nu: None } => "robert-asselin",
+            Method::VelocityForm => "velocity-form",
+            Method::Dopri5 => "dopri5",
+            Method::TrBdf2 => "trbdf2",
+            Method::TrBdf2Fixed => "trbdf2-fixed",
+            Method::Trapezoid => "trapezoid",
+        };
+        fixed.to_string()
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let name = text.trim();
+        Ok(match name {
+            "energy-midpoint" => Method::EnergyMidpoint,
+            "generalized-alpha" => Method::GeneralizedAlpha,
+            "central-difference" => Method::CentralDifference,
+            "implicit-midpoint" => Method::ImplicitMidpoint,
+            "report" => Method::Report,
+            "robert-asselin" => Method::RobertAsselin { nu: None },
+            "velocity-form" => Method::VelocityForm,
+            "dopri5" => Method::Dopri5,
+            "trbdf2" | "tr-bdf2" | "sdirk" => Method::TrBdf2,
+            "trbdf2-fixed" => Method::TrBdf2Fixed,
+            "trapezoid" => Method::Trapezoid,
+            _ => {
+                if let Some(value) = name.strip_prefix("robert-asselin=") {
+                    let nu = value
+                        .trim()
+                        .parse::<f64>()
+                        .map_err(|_| format!("cannot read the Robert–Asselin ν in `{name}`"))?;
+                    return Ok(Method::RobertAsselin { nu: Some(nu) });
+                }
+                return Err(format!(
+                    "unknown time-integration method `{name}`; accepted: {}",
+                    Method::NAMES
+                ));
+            }
+        })
+    }
+}
+
+impl TryFrom<String> for Method {
+    type Error = String;
+
+    fn try_from(text: String) -> Result<Self, String> {
+        text.parse()
+    }
+}
+
+impl From<Method> for String {
+    fn from(m: Method) -> String {
+        m.name()
+    }
+}
+
+/// How time is integrated.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TimeStepping {
+    /// Fixed step (or initial step of an adaptive method).
+    pub dt: Option<f64>,
+    /// Overrides the scene's end time.
+    pub t_end: Option<f64>,
+    /// Integration method (None: the backend's default for the scene). Each backend implements
+    /// some of the [`Method`]s and rejects the others, naming the ones it offers.
+    pub method: Option<Method>,
+    /// Relative / absolute error tolerances of adaptive methods.
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    /// Multiplier (≤ 1) applied to a stability bound when the backend picks the step itself.
+    pub safety_factor: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    pub discretization: Discretization,
+    pub time: TimeStepping,
+}
