@@ -22,6 +22,9 @@ pub enum AnalyticError {
         x: f64,
         value: f64,
     },
+    /// A linear system is singular (or its solution not finite).
+    #[error("{what}: singular {size} × {size} system")]
+    Singular { what: &'static str, size: usize },
     /// An iteration did not converge.
     #[error("{what}: no convergence after {iterations} iterations")]
     NoConvergence {

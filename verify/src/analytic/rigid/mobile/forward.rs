@@ -178,7 +178,7 @@ impl Reference {
             }
             rhs[i] = (0..n).map(|a| cols[i][a] * (force[a] - bias[a])).sum();
         }
-        solve(&mut red, &mut rhs, m)?;
+        solve(&red, &mut rhs, m)?;
         dy[..n].copy_from_slice(&qd[..n]);
         dy[n..n + m].copy_from_slice(&rhs[..m]);
         dy[n + m..n + m + N_WORK].copy_from_slice(&power);
@@ -232,8 +232,8 @@ impl Reference {
     pub fn dae_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<()> {
         let n = self.model.layout.n;
         let (q, qd) = (&y[..n], &y[n..2 * n]);
-        let (mut k, mut r, power) = self.kkt(t, q, qd);
-        solve(&mut k, &mut r, self.kkt_size())?;
+        let (k, mut r, power) = self.kkt(t, q, qd);
+        solve(&k, &mut r, self.kkt_size())?;
         dy[..n].copy_from_slice(qd);
         dy[n..2 * n].copy_from_slice(&r[..n]);
         dy[2 * n..2 * n + N_WORK].copy_from_slice(&power);
@@ -263,7 +263,7 @@ impl Reference {
             }
             r[n + c] = -aq;
         }
-        solve(&mut k, &mut r, n + N_CONSTRAINTS)?;
+        solve(&k, &mut r, n + N_CONSTRAINTS)?;
         for j in 0..n {
             qd[j] += r[j];
         }
@@ -362,7 +362,7 @@ impl Reference {
             drift,
             position_gap,
             rate_gap,
-            end_effector: self.model.end_effector(q),
+            end_effector: self.model.end_effector(q).into(),
         })
     }
 

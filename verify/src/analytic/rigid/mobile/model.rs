@@ -35,6 +35,7 @@
 //! ẋ = u cos ψ, ẏ = u sin ψ, and the identity on the wheel and joint rates, so Sᵀ B = I.
 
 use data::scene::{MobileManipulator, RigidBody};
+use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
 
 use crate::analytic::error::{AnalyticError, Result};
 
@@ -43,61 +44,16 @@ pub const MAX_Q: usize = 9;
 /// Number of constraints of the platform.
 pub const N_CONSTRAINTS: usize = 3;
 
-pub type Vec3 = [f64; 3];
-pub type Mat3 = [[f64; 3]; 3];
+pub type Vec3 = Vector3<f64>;
+pub type Mat3 = Matrix3<f64>;
 
-pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-pub(crate) fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub(crate) fn scale(s: f64, a: Vec3) -> Vec3 {
-    [s * a[0], s * a[1], s * a[2]]
-}
-pub(crate) fn mat_vec(m: &Mat3, v: Vec3) -> Vec3 {
-    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
-}
-fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
-        }
-    }
-    c
-}
-fn transpose(a: &Mat3) -> Mat3 {
-    let mut t = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            t[i][j] = a[j][i];
-        }
-    }
-    t
-}
 fn rot_z(t: f64) -> Mat3 {
-    let (s, c) = t.sin_cos();
-    [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+    Rotation3::from_axis_angle(&Vector3::z_axis(), t).into_inner()
 }
 /// Rotation by θ about −y: x ↦ (cos θ, 0, sin θ).
 fn rot_pitch(t: f64) -> Mat3 {
-    let (s, c) = t.sin_cos();
-    [[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]]
+    Rotation3::from_axis_angle(&-Vector3::y_axis(), t).into_inner()
 }
-
-const EZ: Vec3 = [0.0, 0.0, 1.0];
-const MINUS_EY: Vec3 = [0.0, -1.0, 0.0];
 
 /// Where each coordinate sits in q (None when that part of the system is absent).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -226,13 +182,13 @@ impl Model {
             m: n - if pl.is_some() { N_CONSTRAINTS } else { 0 },
         };
         let (mut bodies, mut mount, mut base_height, mut lengths, mut friction) =
-            (Vec::new(), [0.0; 3], 0.0, [0.0; 3], [0.0; 4]);
+            (Vec::new(), Vector3::zeros(), 0.0, [0.0; 3], [0.0; 4]);
         if let Some(a) = &m.arm {
             let body = |frame: usize, b: &RigidBody| Body {
                 frame,
                 mass: b.mass,
-                com: b.com,
-                inertia: b.inertia,
+                com: Vector3::from(b.com),
+                inertia: Matrix3::from_fn(|i, j| b.inertia[i][j]),
             };
             if a.links.len() != 3 {
                 return Err(AnalyticError::Unsupported(format!(
@@ -246,7 +202,7 @@ impl Model {
                 lengths[k] = l.length;
             }
             bodies.push(body(5, &a.gripper));
-            mount = a.mount;
+            mount = Vector3::from(a.mount);
             base_height = a.base_height;
             friction = a.joint_friction;
         }
@@ -268,16 +224,16 @@ impl Model {
         let mut f = Frames::default();
         match self.layout.platform {
             Some(p) => {
-                f.o[0] = [q[p], q[p + 1], 0.0];
+                f.o[0] = Vector3::new(q[p], q[p + 1], 0.0);
                 f.r[0] = rot_z(q[p + 2]);
-                f.w[0] = [0.0, 0.0, qd[p + 2]];
-                f.al[0] = [0.0, 0.0, qdd[p + 2]];
-                f.v[0] = [qd[p], qd[p + 1], 0.0];
-                f.a[0] = [qdd[p], qdd[p + 1], 0.0];
+                f.w[0] = Vector3::new(0.0, 0.0, qd[p + 2]);
+                f.al[0] = Vector3::new(0.0, 0.0, qdd[p + 2]);
+                f.v[0] = Vector3::new(qd[p], qd[p + 1], 0.0);
+                f.a[0] = Vector3::new(qdd[p], qdd[p + 1], 0.0);
             }
             None => {
                 let [x, y, psi] = self.ground_pose;
-                f.o[0] = [x, y, 0.0];
+                f.o[0] = Vector3::new(x, y, 0.0);
                 f.r[0] = rot_z(psi);
             }
         }
@@ -286,19 +242,16 @@ impl Model {
         };
         let offsets = [
             self.mount,
-            [0.0, 0.0, self.base_height],
-            [self.lengths[0], 0.0, 0.0],
-            [self.lengths[1], 0.0, 0.0],
-            [self.lengths[2], 0.0, 0.0],
+            Vector3::new(0.0, 0.0, self.base_height),
+            Vector3::new(self.lengths[0], 0.0, 0.0),
+            Vector3::new(self.lengths[1], 0.0, 0.0),
+            Vector3::new(self.lengths[2], 0.0, 0.0),
         ];
         for k in 1..6 {
-            let d = mat_vec(&f.r[k - 1], offsets[k - 1]);
-            f.o[k] = add(f.o[k - 1], d);
-            f.v[k] = add(f.v[k - 1], cross(f.w[k - 1], d));
-            f.a[k] = add(
-                add(f.a[k - 1], cross(f.al[k - 1], d)),
-                cross(f.w[k - 1], cross(f.w[k - 1], d)),
-            );
+            let d = f.r[k - 1] * offsets[k - 1];
+            f.o[k] = f.o[k - 1] + d;
+            f.v[k] = f.v[k - 1] + f.w[k - 1].cross(&d);
+            f.a[k] = f.a[k - 1] + f.al[k - 1].cross(&d) + f.w[k - 1].cross(&f.w[k - 1].cross(&d));
             if k == 5 {
                 f.r[k] = f.r[k - 1];
                 f.w[k] = f.w[k - 1];
@@ -306,36 +259,33 @@ impl Model {
                 continue;
             }
             let (u, rot) = if k == 1 {
-                (EZ, rot_z(q[a0]))
+                (Vector3::z(), rot_z(q[a0]))
             } else {
-                (MINUS_EY, rot_pitch(q[a0 + k - 1]))
+                (-Vector3::y(), rot_pitch(q[a0 + k - 1]))
             };
             let (th_d, th_dd) = (qd[a0 + k - 1], qdd[a0 + k - 1]);
-            let axis = mat_vec(&f.r[k - 1], u);
+            let axis = f.r[k - 1] * u;
             f.axis[k] = axis;
-            f.r[k] = mat_mul(&f.r[k - 1], &rot);
-            f.w[k] = add(f.w[k - 1], scale(th_d, axis));
-            f.al[k] = add(
-                add(f.al[k - 1], cross(f.w[k - 1], scale(th_d, axis))),
-                scale(th_dd, axis),
-            );
+            f.r[k] = f.r[k - 1] * rot;
+            f.w[k] = f.w[k - 1] + axis * th_d;
+            f.al[k] = f.al[k - 1] + f.w[k - 1].cross(&(axis * th_d)) + axis * th_dd;
         }
         f
     }
 
     /// Inertial position of a body's mass centre.
     fn com_position(f: &Frames, b: &Body) -> Vec3 {
-        add(f.o[b.frame], mat_vec(&f.r[b.frame], b.com))
+        f.o[b.frame] + f.r[b.frame] * b.com
     }
 
     /// Linear and angular Jacobian columns of coordinate j for a point p moving with frame k.
     fn jacobian(&self, f: &Frames, k: usize, p: Vec3, j: usize) -> (Vec3, Vec3) {
-        let zero = [0.0; 3];
+        let zero = Vector3::zeros();
         if let Some(pl) = self.layout.platform {
             match j.checked_sub(pl) {
-                Some(0) => return ([1.0, 0.0, 0.0], zero),
-                Some(1) => return ([0.0, 1.0, 0.0], zero),
-                Some(2) => return (cross(EZ, sub(p, f.o[0])), EZ),
+                Some(0) => return (Vector3::x(), zero),
+                Some(1) => return (Vector3::y(), zero),
+                Some(2) => return (Vector3::z().cross(&(p - f.o[0])), Vector3::z()),
                 Some(3) | Some(4) => return (zero, zero),
                 _ => {}
             }
@@ -347,7 +297,7 @@ impl Model {
             let frame = i + 1;
             if k >= frame {
                 let w = f.axis[frame];
-                return (cross(w, sub(p, f.o[frame])), w);
+                return (w.cross(&(p - f.o[frame])), w);
             }
         }
         (zero, zero)
@@ -358,8 +308,8 @@ impl Model {
         self.platform.as_ref().map(|p| Body {
             frame: 0,
             mass: p.mass,
-            com: [p.com_offset, 0.0, 0.0],
-            inertia: [[0.0; 3], [0.0; 3], [0.0, 0.0, p.yaw_inertia]],
+            com: Vector3::new(p.com_offset, 0.0, 0.0),
+            inertia: Matrix3::from_diagonal(&Vector3::new(0.0, 0.0, p.yaw_inertia)),
         })
     }
 
@@ -380,8 +330,8 @@ impl Model {
         for b in self.all_bodies() {
             let p = Self::com_position(&f, &b);
             let r = &f.r[b.frame];
-            let iw = mat_mul(&mat_mul(r, &b.inertia), &transpose(r));
-            let mut cols = [([0.0; 3], [0.0; 3]); MAX_Q];
+            let iw = r * b.inertia * r.transpose();
+            let mut cols = [(Vector3::zeros(), Vector3::zeros()); MAX_Q];
             for (j, c) in cols.iter_mut().enumerate().take(n) {
                 *c = self.jacobian(&f, b.frame, p, j);
             }
@@ -389,7 +339,7 @@ impl Model {
                 for j in i..n {
                     let (vi, wi) = cols[i];
                     let (vj, wj) = cols[j];
-                    let e = b.mass * dot(vi, vj) + dot(wi, mat_vec(&iw, wj));
+                    let e = b.mass * vi.dot(&vj) + wi.dot(&(iw * wj));
                     m[i][j] += e;
                     if j != i {
                         m[j][i] += e;
@@ -419,16 +369,16 @@ impl Model {
         let g = if gravity { self.gravity } else { 0.0 };
         for b in self.all_bodies() {
             let r = &f.r[b.frame];
-            let rc = mat_vec(r, b.com);
-            let p = add(f.o[b.frame], rc);
+            let rc = r * b.com;
+            let p = f.o[b.frame] + rc;
             let (w, al) = (f.w[b.frame], f.al[b.frame]);
-            let acc = add(add(f.a[b.frame], cross(al, rc)), cross(w, cross(w, rc)));
-            let force = scale(b.mass, add(acc, [0.0, 0.0, g]));
-            let iw = mat_mul(&mat_mul(r, &b.inertia), &transpose(r));
-            let moment = add(mat_vec(&iw, al), cross(w, mat_vec(&iw, w)));
+            let acc = f.a[b.frame] + al.cross(&rc) + w.cross(&w.cross(&rc));
+            let force = (acc + Vector3::new(0.0, 0.0, g)) * b.mass;
+            let iw = r * b.inertia * r.transpose();
+            let moment = iw * al + w.cross(&(iw * w));
             for (j, o) in out.iter_mut().enumerate().take(n) {
                 let (jv, jw) = self.jacobian(&f, b.frame, p, j);
-                *o += dot(jv, force) + dot(jw, moment);
+                *o += jv.dot(&force) + jw.dot(&moment);
             }
         }
         if let (Some(pl), Some(p)) = (self.layout.platform, &self.platform) {
@@ -445,11 +395,11 @@ impl Model {
         let mut t = 0.0;
         for b in self.all_bodies() {
             let r = &f.r[b.frame];
-            let rc = mat_vec(r, b.com);
+            let rc = r * b.com;
             let w = f.w[b.frame];
-            let v = add(f.v[b.frame], cross(w, rc));
-            let iw = mat_mul(&mat_mul(r, &b.inertia), &transpose(r));
-            t += 0.5 * b.mass * dot(v, v) + 0.5 * dot(w, mat_vec(&iw, w));
+            let v = f.v[b.frame] + w.cross(&rc);
+            let iw = r * b.inertia * r.transpose();
+            t += 0.5 * b.mass * v.dot(&v) + 0.5 * w.dot(&(iw * w));
         }
         if let (Some(pl), Some(p)) = (self.layout.platform, &self.platform) {
             t += 0.5 * p.side_spin_inertia * (qd[pl + 3].powi(2) + qd[pl + 4].powi(2));
@@ -575,39 +525,31 @@ impl Model {
     }
 }
 
-/// Solves the dense system a x = b (size k ≤ 12) by Gaussian elimination with partial
-/// pivoting, in place (`b` receives x). Errors on a singular pivot.
-pub fn solve<const N: usize>(a: &mut [[f64; N]; N], b: &mut [f64; N], k: usize) -> Result<()> {
-    for col in 0..k {
-        let piv = (col..k)
-            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
-            .unwrap_or(col);
-        if a[piv][col].abs() < 1e-300 || !a[piv][col].is_finite() {
-            return Err(AnalyticError::NonFinite {
-                what: "mobile reference: pivot of a singular system",
-                x: col as f64,
-                value: a[piv][col],
-            });
-        }
-        a.swap(col, piv);
-        b.swap(col, piv);
-        let pivot_row = a[col];
-        for i in col + 1..k {
-            let f = a[i][col] / pivot_row[col];
-            if f != 0.0 {
-                for (x, p) in a[i][col..k].iter_mut().zip(&pivot_row[col..k]) {
-                    *x -= f * p;
-                }
-                b[i] -= f * b[col];
-            }
-        }
-    }
-    for i in (0..k).rev() {
-        let mut s = b[i];
-        for j in i + 1..k {
-            s -= a[i][j] * b[j];
-        }
-        b[i] = s / a[i][i];
-    }
+/// Largest linear system of the reference: the KKT system of n coordinates and the constraints.
+const MAX_SYSTEM: usize = MAX_Q + N_CONSTRAINTS;
+
+/// Solves the dense system a x = b of size k ≤ N (the leading k × k block of `a`; `b` receives
+/// x) by nalgebra's partially pivoted LU, on the block bordered by the identity to the fixed
+/// size [`MAX_SYSTEM`], so that the factorization is allocation-free. Errors on a singular or
+/// non-finite system.
+pub fn solve<const N: usize>(a: &[[f64; N]; N], b: &mut [f64; N], k: usize) -> Result<()> {
+    const { assert!(N <= MAX_SYSTEM) };
+    let k = k.min(N);
+    let matrix =
+        SMatrix::<f64, MAX_SYSTEM, MAX_SYSTEM>::from_fn(|i, j| match (i < k && j < k, i == j) {
+            (true, _) => a[i][j],
+            (false, true) => 1.0,
+            (false, false) => 0.0,
+        });
+    let rhs = SVector::<f64, MAX_SYSTEM>::from_fn(|i, _| if i < k { b[i] } else { 0.0 });
+    let x = matrix
+        .lu()
+        .solve(&rhs)
+        .filter(|x| x.iter().all(|v| v.is_finite()))
+        .ok_or(AnalyticError::Singular {
+            what: "mobile reference",
+            size: k,
+        })?;
+    b[..k].copy_from_slice(&x.as_slice()[..k]);
     Ok(())
 }
