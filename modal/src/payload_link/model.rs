@@ -20,6 +20,7 @@
 //! * gravity g(μ w + m_p p₃).
 
 use data::scene::{LinkField, PayloadLink, PrescribedMotion, TorqueLaw};
+use nalgebra::{Matrix3, Vector3};
 
 use super::basis::{Clamp, FieldBasis};
 use crate::basis::quadrature::Quadrature;
@@ -471,35 +472,20 @@ pub fn field_index(f: LinkField) -> usize {
 pub fn payload_rotation_energy(inertia: &[[f64; 3]; 3], w: f64, z: [f64; 3], zd: [f64; 3]) -> f64 {
     let [vs, ws, phi] = z;
     let [vsd, wsd, phid] = zd;
-    let beta = [0.0, -ws, vs];
-    let ez = [0.0, 0.0, 1.0];
-    let ex = [1.0, 0.0, 0.0];
-    let om1 = [phid, -wsd, vsd];
-    let om2 = [0.5 * (vs * wsd - ws * vsd), vs * phid, ws * phid];
-    let a0 = scale(w, ez);
-    let b_ez = cross(beta, ez);
-    let ex_ez = cross(ex, ez);
-    let a1 = sub(sub(om1, scale(w, b_ez)), scale(phi * w, ex_ez));
-    let inner = sub(om1, scale(w, b_ez));
-    let a2 = add(
-        add(
-            sub(om2, cross(beta, om1)),
-            scale(0.5 * w, cross(beta, b_ez)),
-        ),
-        add(
-            scale(-phi, cross(ex, inner)),
-            scale(0.5 * phi * phi * w, cross(ex, ex_ez)),
-        ),
-    );
-    let ia = |a: [f64; 3]| -> [f64; 3] {
-        [
-            inertia[0][0] * a[0] + inertia[0][1] * a[1] + inertia[0][2] * a[2],
-            inertia[1][0] * a[0] + inertia[1][1] * a[1] + inertia[1][2] * a[2],
-            inertia[2][0] * a[0] + inertia[2][1] * a[1] + inertia[2][2] * a[2],
-        ]
-    };
-    let ia0 = ia(a0);
-    0.5 * dot3(a0, ia0) + dot3(ia0, a1) + 0.5 * dot3(a1, ia(a1)) + dot3(ia0, a2)
+    let ip = Matrix3::from_fn(|i, j| inertia[i][j]);
+    let beta = Vector3::new(0.0, -ws, vs);
+    let (ex, ez) = (Vector3::x(), Vector3::z());
+    let om1 = Vector3::new(phid, -wsd, vsd);
+    let om2 = Vector3::new(0.5 * (vs * wsd - ws * vsd), vs * phid, ws * phid);
+    let a0 = ez * w;
+    let b_ez = beta.cross(&ez);
+    let ex_ez = ex.cross(&ez);
+    let inner = om1 - b_ez * w;
+    let a1 = inner - ex_ez * (phi * w);
+    let a2 = (om2 - beta.cross(&om1) + beta.cross(&b_ez) * (0.5 * w))
+        + (ex.cross(&inner) * -phi + ex.cross(&ex_ez) * (0.5 * phi * phi * w));
+    let ia0 = ip * a0;
+    0.5 * a0.dot(&ia0) + ia0.dot(&a1) + 0.5 * a1.dot(&(ip * a1)) + ia0.dot(&a2)
 }
 
 /// The coefficients of [`payload_rotation_energy`] = ½żᵀMż + W(bᵀż + zᵀGż) + ½W²(J₀ + 2hᵀz + zᵀNz),
@@ -516,13 +502,11 @@ pub struct RotationForm {
 
 impl RotationForm {
     pub fn of(inertia: &[[f64; 3]; 3]) -> Self {
-        let f = |w: f64, z: [f64; 3], zd: [f64; 3]| payload_rotation_energy(inertia, w, z, zd);
-        let e = |k: usize| {
-            let mut v = [0.0; 3];
-            v[k] = 1.0;
-            v
+        let f = |w: f64, z: Vector3<f64>, zd: Vector3<f64>| {
+            payload_rotation_energy(inertia, w, z.into(), zd.into())
         };
-        let o = [0.0; 3];
+        let e = |k: usize| Vector3::ith(k, 1.0);
+        let o = Vector3::zeros();
         let f00 = f(1.0, o, o);
         let mut r = RotationForm {
             m: [[0.0; 3]; 3],
@@ -534,17 +518,17 @@ impl RotationForm {
         };
         for a in 0..3 {
             r.b[a] = f(1.0, o, e(a)) - f00 - f(0.0, o, e(a));
-            r.h[a] = 0.5 * (f(1.0, e(a), o) - f(1.0, scale(-1.0, e(a)), o));
+            r.h[a] = 0.5 * (f(1.0, e(a), o) - f(1.0, -e(a), o));
             for c in 0..3 {
-                r.m[a][c] = f(0.0, o, add(e(a), e(c))) - f(0.0, o, e(a)) - f(0.0, o, e(c));
+                r.m[a][c] = f(0.0, o, e(a) + e(c)) - f(0.0, o, e(a)) - f(0.0, o, e(c));
                 if a == c {
                     r.m[a][c] = 2.0 * f(0.0, o, e(a));
                 }
                 r.g[a][c] = f(1.0, e(a), e(c)) - f(1.0, e(a), o) - f(1.0, o, e(c)) + f00;
                 r.n[a][c] = if a == c {
-                    f(1.0, e(a), o) + f(1.0, scale(-1.0, e(a)), o) - 2.0 * f00
+                    f(1.0, e(a), o) + f(1.0, -e(a), o) - 2.0 * f00
                 } else {
-                    f(1.0, add(e(a), e(c)), o) - f(1.0, e(a), o) - f(1.0, e(c), o) + f00
+                    f(1.0, e(a) + e(c), o) - f(1.0, e(a), o) - f(1.0, e(c), o) + f00
                 };
             }
         }
@@ -570,24 +554,4 @@ impl RotationForm {
         }
         r
     }
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn scale(s: f64, a: [f64; 3]) -> [f64; 3] {
-    [s * a[0], s * a[1], s * a[2]]
-}
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
