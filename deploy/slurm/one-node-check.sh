@@ -127,6 +127,42 @@ if diff <(strip_csv "$WORK/single/verification.csv") <(strip_csv "$out/merged/ve
 else
     echo "verification.csv: DIFFERS"; status=1
 fi
+# Full suite: the refinement ladders (ladders/converge-*.json and .csv) without their timings.
+strip_study() {
+    python3 - "$1" <<'PY'
+import csv, json, sys
+path = sys.argv[1]
+if path.endswith(".json"):
+    def strip(v):
+        if isinstance(v, dict):
+            return {k: strip(x) for k, x in v.items() if k not in ("wall_time_s", "timing")}
+        if isinstance(v, list):
+            return [strip(x) for x in v]
+        return v
+    print(json.dumps(strip(json.load(open(path))), sort_keys=True, indent=1))
+else:
+    timing = {"wall_s", "wall_median_s", "wall_max_s", "repeats", "spread"}
+    rows = list(csv.reader(open(path, newline="")))
+    keep = [i for i, h in enumerate(rows[0]) if h not in timing]
+    for r in rows:
+        print([r[i] for i in keep])
+PY
+}
+single_ladders=$(cd "$WORK/single" && ls ladders/*.json ladders/*.csv 2>/dev/null || true)
+merged_ladders=$(cd "$out/merged" && ls ladders/*.json ladders/*.csv 2>/dev/null || true)
+if [ "$single_ladders" != "$merged_ladders" ]; then
+    echo "ladders: the runs wrote different files"; status=1
+elif [ -n "$single_ladders" ]; then
+    same=0
+    for f in $single_ladders; do
+        if diff <(strip_study "$WORK/single/$f") <(strip_study "$out/merged/$f") >/dev/null; then
+            same=$((same + 1))
+        else
+            echo "$f: DIFFERS"; status=1
+        fi
+    done
+    echo "ladders: $same of $(echo "$single_ladders" | wc -w) files identical apart from timings"
+fi
 rows=$(python3 -c 'import json,sys; print(len(json.load(open(sys.argv[1]))))' "$out/merged/verification.json")
 echo "rows: $rows; single run exit $single_code, merge job exit $merged_code"
 [ "$single_code" = "$merged_code" ] || { echo "exit statuses differ"; status=1; }

@@ -8,6 +8,11 @@
 //! rows of one unsharded run bit for bit, apart from wall times. The modulo split spreads the
 //! expensive families (catalog order groups them) over all shards, with no cost model to keep.
 //!
+//! The full suite's refinement ladders (one study per scene, ids `ladder-<scene>`, selected by
+//! the same filter) are split the same way, separately from the cases: shard i runs the
+//! ladders at positions k with k mod n = i − 1 and stores its studies in its file; [`merge`]
+//! returns them in selection order.
+//!
 //! `converge --shard I/N` splits the same way over the study's rungs (every backend's ladder,
 //! in order, flattened): a [`ConvergeShardFile`] holds the rungs' measurements, and
 //! [`merge_converge`] hands them to the study in place of fresh runs, so the merged study is
@@ -28,14 +33,14 @@ use thiserror::Error;
 
 use data::{BackendKind, Settings};
 
-use crate::study::{Refine, RungMeasurement};
+use crate::study::{LadderSpec, Refine, RungMeasurement, Study};
 use crate::suite::Suite;
 use crate::suite::evaluate::Outcome;
 
 /// Format tag written into every `verify` shard file; bumped when the layout changes.
-pub const SHARD_FORMAT: &str = "flexverify-verify-shard/1";
+pub const SHARD_FORMAT: &str = "flexverify-verify-shard/2";
 /// Format tag of `converge` shard files.
-pub const CONVERGE_SHARD_FORMAT: &str = "flexverify-converge-shard/1";
+pub const CONVERGE_SHARD_FORMAT: &str = "flexverify-converge-shard/2";
 
 /// Shard `index` of `count` (1-based: `--shard 1/3`, `2/3`, `3/3`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -121,6 +126,10 @@ pub struct ShardFile {
     pub selection: Vec<String>,
     /// This shard's rows, in selection order.
     pub outcomes: Vec<Outcome>,
+    /// Every ladder of the selection (full suite), in order (not only this shard's).
+    pub ladder_selection: Vec<LadderSpec>,
+    /// This shard's ladder studies, in selection order.
+    pub ladders: Vec<Study>,
 }
 
 impl ShardFile {
@@ -130,6 +139,8 @@ impl ShardFile {
         shard: Shard,
         selection: Vec<String>,
         outcomes: Vec<Outcome>,
+        ladder_selection: Vec<LadderSpec>,
+        ladders: Vec<Study>,
     ) -> Self {
         ShardFile {
             format: SHARD_FORMAT.to_string(),
@@ -139,6 +150,8 @@ impl ShardFile {
             shard,
             selection,
             outcomes,
+            ladder_selection,
+            ladders,
         }
     }
 
@@ -262,10 +275,18 @@ fn same_version(path: &Path, version: &str) -> Result<(), MergeError> {
     })
 }
 
-/// The rows of the whole selection, in selection order, from one file per shard.
-pub fn merge(
-    files: &[(PathBuf, ShardFile)],
-) -> Result<(Suite, Option<String>, Vec<Outcome>), MergeError> {
+/// What the shards of one `verify` selection give together.
+pub struct Merged {
+    pub suite: Suite,
+    pub filter: Option<String>,
+    /// The rows of the whole selection, in selection order.
+    pub outcomes: Vec<Outcome>,
+    /// The ladder studies of the whole selection, in selection order.
+    pub ladders: Vec<Study>,
+}
+
+/// The rows and ladders of the whole selection, in selection order, from one file per shard.
+pub fn merge(files: &[(PathBuf, ShardFile)]) -> Result<Merged, MergeError> {
     let Some((first_path, first)) = files.first() else {
         return Err(MergeError::NoShards("the given folders".into()));
     };
@@ -314,9 +335,23 @@ pub fn merge(
                 format!("{} cases", file.selection.len()),
             ));
         }
+        if file.ladder_selection != first.ladder_selection {
+            return Err(differ(
+                "ladder selections",
+                format!("{} ladders", first.ladder_selection.len()),
+                format!("{} ladders", file.ladder_selection.len()),
+            ));
+        }
         let share = file.shard.share(&file.selection);
+        let ladder_share = file.shard.share(&file.ladder_selection);
         if file.outcomes.len() != share.len()
             || file.outcomes.iter().zip(&share).any(|(o, id)| &o.id != id)
+            || file.ladders.len() != ladder_share.len()
+            || file
+                .ladders
+                .iter()
+                .zip(&ladder_share)
+                .any(|(study, spec)| study.scene != spec.scene || study.quantity != spec.quantity)
         {
             return Err(MergeError::WrongRows {
                 path: path.clone(),
@@ -346,7 +381,15 @@ pub fn merge(
     let outcomes = (0..first.selection.len())
         .map(|k| by_index[&(k % count + 1)].1.outcomes[k / count].clone())
         .collect();
-    Ok((first.suite, first.filter.clone(), outcomes))
+    let ladders = (0..first.ladder_selection.len())
+        .map(|k| by_index[&(k % count + 1)].1.ladders[k / count].clone())
+        .collect();
+    Ok(Merged {
+        suite: first.suite,
+        filter: first.filter.clone(),
+        outcomes,
+        ladders,
+    })
 }
 
 /// One rung of a sharded study: its place in the flattened ladders and its measurement.

@@ -1,8 +1,19 @@
 //! Refinement studies (`flexverify converge`, `flexverify recommend`, the full suite's
 //! ladders): refinement ladders, observed orders, Richardson references and work-precision
-//! (error against wall time).
+//! (error against cost).
 //!
 //! Ladders are run sequentially so that the wall times are not distorted by sharing cores.
+//! Each rung's cost is measured two ways, with the suite's rule
+//! ([`crate::report::work::time_rung`]): the wall time as the minimum of repeats (at least 5
+//! and 0.2 s; a rung whose first run took more than 3 s is timed once, and its `repeats` says
+//! so), with median, maximum and spread; and the backend's work counters (DOFs, steps, RHS
+//! evaluations, factorizations, Newton iterations), exact and machine independent.
+//!
+//! `recommend` picks, in each backend's ladder, the rung meeting the tolerance with the least
+//! work (the ladder's work counter, so the pick inside a ladder never depends on the timer);
+//! across backends, the pick with the smallest minimum wall time, unless the timings cannot
+//! separate them (the runner-up's minimum within the winner's spread), in which case the one
+//! with fewer DOFs wins.
 
 use std::path::Path;
 
@@ -13,6 +24,7 @@ use crate::error::Error;
 use crate::output::{Column, csv_table, fitted_table, text_table, wrap, write_atomic};
 use crate::plot::{Series, plot};
 use crate::progress::Progress;
+use crate::report::work::{Counters, FirstRun, Timing, time_rung, work_counter_of};
 use crate::suite::evaluate::{falling_prefix, fit_order, measure, richardson};
 use crate::suite::quantity::Quantity;
 use crate::suite::reference::{analytic_value, default_analytic_id};
@@ -29,7 +41,7 @@ pub enum Refine {
 }
 
 /// One rung of a refinement ladder.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Rung {
     pub backend: BackendKind,
     /// Human-readable discretization, e.g. "elements=8".
@@ -39,7 +51,12 @@ pub struct Rung {
     pub value: f64,
     /// |value − reference| / scale.
     pub error: Option<f64>,
+    /// Minimum wall time over the repeats of [`Rung::timing`].
     pub wall_time_s: f64,
+    /// Repeated timings: minimum, median, maximum and the number of repeats.
+    pub timing: Timing,
+    /// The backend's work counters of this rung.
+    pub counters: Counters,
     #[serde(skip)]
     pub settings: Settings,
     /// Peak |channel| of this run, for time-history quantities.
@@ -48,7 +65,7 @@ pub struct Rung {
 }
 
 /// The study of one backend.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Ladder {
     pub backend: BackendKind,
     pub rungs: Vec<Rung>,
@@ -69,7 +86,7 @@ pub struct Ladder {
 /// Where a ladder says the quantity converges to: its Richardson extrapolation, with the
 /// distance of its finest rung from that value as the uncertainty (the finest rung's own error
 /// estimate, an upper bound on the extrapolation's once the ladder is asymptotic).
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 pub struct Estimate {
     pub backend: BackendKind,
     pub value: f64,
@@ -78,7 +95,7 @@ pub struct Estimate {
 
 /// Two ladders whose estimates differ by more than their uncertainties allow: the backends
 /// converge to different answers, so neither may be scored against the other.
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 pub struct Disagreement {
     pub first: Estimate,
     pub second: Estimate,
@@ -104,7 +121,7 @@ impl Disagreement {
     }
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Study {
     pub scene: String,
     pub quantity: String,
@@ -171,33 +188,18 @@ fn time_ladder(base: &Settings, scene: &Scene) -> Vec<(Settings, f64, String)> {
         .collect()
 }
 
-/// Smallest backend wall time over a few repeats (the first call of a process pays one-off
-/// costs, and a shared machine adds noise): repeat until 50 ms have been spent or 5 runs made.
-fn min_wall_time(
-    scene: &Scene,
-    kind: BackendKind,
-    settings: &Settings,
-    q: &Quantity,
-    first: f64,
-) -> f64 {
-    let mut best = first;
-    let mut spent = first;
-    let mut runs = 1;
-    while spent < 0.05 && runs < 5 {
-        let Some(w) = compute(scene, kind, settings, q.analysis(), q.modes_needed()).wall_time_s()
-        else {
-            break;
-        };
-        best = best.min(w);
-        spent += w;
-        runs += 1;
-    }
-    best
+/// One rung's measurement: the quantity's value, the peak |channel| for time histories, the
+/// repeated timings and the work counters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Measured {
+    pub value: f64,
+    pub peak: Option<f64>,
+    pub timing: Timing,
+    pub counters: Counters,
 }
 
-/// One rung's measurement: (value, peak |channel| for time histories, smallest wall time over
-/// a few repeats), or why the backend could not give the quantity at that rung.
-pub type RungMeasurement = Result<(f64, Option<f64>, f64), String>;
+/// One rung's measurement, or why the backend could not give the quantity at that rung.
+pub type RungMeasurement = Result<Measured, String>;
 
 /// A rung to measure: its settings, refinement parameter h and label.
 pub type RungSpec = (Settings, f64, String);
@@ -229,8 +231,21 @@ pub fn measure_rung(
     settings: &Settings,
     q: &Quantity,
 ) -> RungMeasurement {
-    measure(cache, scene, kind, settings, q)
-        .map(|(value, peak, wall)| (value, peak, min_wall_time(scene, kind, settings, q, wall)))
+    let (value, peak, first) = measure(cache, scene, kind, settings, q)?;
+    let counters = cache
+        .get(scene, kind, settings, q.analysis(), q.modes_needed())
+        .counters()
+        .ok_or_else(|| format!("{kind}: no cost counters"))?;
+    // The ladder runs alone, so its first run is a repeat like the others.
+    let repeat = || compute(scene, kind, settings, q.analysis(), q.modes_needed()).wall_time_s();
+    let timing = time_rung(first, FirstRun::Alone, repeat)
+        .ok_or_else(|| format!("{kind}: a timing repeat of the run failed"))?;
+    Ok(Measured {
+        value,
+        peak,
+        timing,
+        counters,
+    })
 }
 
 /// The quantity of a study, parsed against its scene.
@@ -301,16 +316,18 @@ pub fn study_from_rungs(
                 break;
             }
             match measured(kind, rung_index, &settings) {
-                Ok((value, peak, wall_time_s)) => {
+                Ok(m) => {
                     rungs.push(Rung {
-                        wall_time_s,
+                        wall_time_s: m.timing.min_s,
+                        timing: m.timing,
+                        counters: m.counters,
                         backend: kind,
                         discretization: label,
                         h,
-                        value,
+                        value: m.value,
                         error: None,
                         settings,
-                        peak,
+                        peak: m.peak,
                     });
                     progress.advance();
                 }
@@ -466,9 +483,23 @@ fn worst_disagreement(
     worst.map(|(_, d)| d)
 }
 
+/// Short name of a work counter, for table cells.
+fn counter_abbreviation(name: &str) -> &'static str {
+    match name {
+        "RHS evaluations" => "rhs",
+        "steps" => "steps",
+        "factorizations" => "fact",
+        _ => "dofs",
+    }
+}
+
+/// The rungs for the tables: value, error, minimum wall time, repeats, spread and the
+/// ladder's work counter.
 fn rows(study: &Study) -> Vec<Vec<String>> {
     let mut rows = Vec::new();
     for l in &study.ladders {
+        let counters: Vec<Counters> = l.rungs.iter().map(|r| r.counters).collect();
+        let (name, counter) = work_counter_of(&counters);
         for r in &l.rungs {
             rows.push(vec![
                 l.backend.to_string(),
@@ -476,14 +507,72 @@ fn rows(study: &Study) -> Vec<Vec<String>> {
                 format!("{:.10e}", r.value),
                 r.error.map_or("-".into(), |e| format!("{e:.3e}")),
                 format!("{:.4e}", r.wall_time_s),
+                r.timing.repeats.to_string(),
+                format!("{:.0}%", 100.0 * r.timing.spread()),
+                format!("{} {}", counter(&r.counters), counter_abbreviation(name)),
             ]);
         }
     }
     rows
 }
 
-/// Header of the study's CSV (the wide table says `wall [s]`).
-const CSV_HEADER: [&str; 5] = ["backend", "discretization", "value", "error", "wall_s"];
+/// Header of the table rows of [`rows`].
+const TABLE_HEADER: [&str; 8] = [
+    "backend",
+    "discretization",
+    "value",
+    "error",
+    "min wall [s]",
+    "reps",
+    "spread",
+    "work",
+];
+
+/// Header of the study's CSV: the machine-independent columns first, then the timings.
+const CSV_HEADER: [&str; 15] = [
+    "backend",
+    "discretization",
+    "h",
+    "value",
+    "error",
+    "dofs",
+    "steps",
+    "rhs_evaluations",
+    "factorizations",
+    "newton_iterations",
+    "wall_s",
+    "wall_median_s",
+    "wall_max_s",
+    "repeats",
+    "spread",
+];
+
+fn csv_rows(study: &Study) -> Vec<Vec<String>> {
+    let mut rows = Vec::new();
+    for l in &study.ladders {
+        for r in &l.rungs {
+            let c = &r.counters;
+            rows.push(vec![
+                l.backend.to_string(),
+                r.discretization.clone(),
+                format!("{:e}", r.h),
+                format!("{:e}", r.value),
+                r.error.map_or(String::new(), |e| format!("{e:e}")),
+                c.dofs.to_string(),
+                c.steps.to_string(),
+                c.rhs_evaluations.to_string(),
+                c.factorizations.to_string(),
+                c.newton_iterations.to_string(),
+                format!("{:e}", r.timing.min_s),
+                format!("{:e}", r.timing.median_s),
+                format!("{:e}", r.timing.max_s),
+                r.timing.repeats.to_string(),
+                format!("{:e}", r.timing.spread()),
+            ]);
+        }
+    }
+    rows
+}
 
 /// Writes the study as JSON and CSV and draws its convergence and work-precision plots into
 /// `dir`. Returns a note for each plot that could not be drawn (the data files are written
@@ -567,12 +656,47 @@ pub fn write_study(dir: &Path, study: &Study) -> Result<Vec<String>, Error> {
         dir,
         &format!("{stem}-work-precision"),
         &format!("{} {}: work-precision", study.scene, study.quantity),
-        "wall time [s]",
+        "wall time, minimum of repeats [s]",
         "error",
         &series,
         true,
     ) {
         notes.push(format!("work-precision plot not drawn: {e}"));
+    }
+    // The same against each ladder's work counter (named in the legend): exact, and the
+    // primary cost axis for rungs too long to repeat.
+    let work: Vec<(String, Vec<(f64, f64)>)> = study
+        .ladders
+        .iter()
+        .map(|l| {
+            let counters: Vec<Counters> = l.rungs.iter().map(|r| r.counters).collect();
+            let (name, counter) = work_counter_of(&counters);
+            (
+                format!("{} ({name})", l.backend),
+                l.rungs
+                    .iter()
+                    .filter_map(|r| Some((counter(&r.counters) as f64, r.error?)))
+                    .collect(),
+            )
+        })
+        .collect();
+    let series: Vec<Series<'_>> = work
+        .iter()
+        .map(|(l, p)| Series {
+            label: l.clone(),
+            points: p,
+        })
+        .collect();
+    if let Err(e) = plot(
+        dir,
+        &format!("{stem}-work-counters"),
+        &format!("{} {}: error vs work counters", study.scene, study.quantity),
+        "work: the ladder's counter (legend) [-]",
+        "error",
+        &series,
+        true,
+    ) {
+        notes.push(format!("work-counter plot not drawn: {e}"));
     }
     Ok(notes)
 }
@@ -623,7 +747,7 @@ pub fn converge_from_rungs(
 
 /// The study's rungs as CSV.
 pub fn csv(study: &Study) -> String {
-    csv_table(&CSV_HEADER, &rows(study))
+    csv_table(&CSV_HEADER, &csv_rows(study))
 }
 
 /// The study as JSON.
@@ -661,10 +785,7 @@ fn ladder_summary(l: &Ladder) -> String {
 /// Heading, every rung, and each ladder's observed order, lines at full length.
 pub fn wide_table(study: &Study) -> String {
     let mut s = format!("{}\n", heading(study));
-    s.push_str(&text_table(
-        &["backend", "discretization", "value", "error", "wall [s]"],
-        &rows(study),
-    ));
+    s.push_str(&text_table(&TABLE_HEADER, &rows(study)));
     for l in &study.ladders {
         s.push_str(&ladder_summary(l));
         s.push('\n');
@@ -683,7 +804,10 @@ pub fn terminal_table(study: &Study, width: usize) -> String {
         Column::left("discretization").elastic(),
         Column::right("value"),
         Column::right("error"),
-        Column::right("wall [s]"),
+        Column::right("min wall [s]"),
+        Column::right("reps"),
+        Column::right("spread"),
+        Column::right("work"),
     ];
     let mut s = format!("{}\n", wrap(&heading(study), width, 4));
     s.push_str(&fitted_table(&columns, &rows(study), width).to_string());
@@ -704,8 +828,14 @@ pub struct Recommendation {
     pub scene: String,
     pub quantity: String,
     pub tolerance: f64,
-    /// The chosen rung: the smallest wall time among those with error ≤ tolerance.
+    /// The chosen rung (see the module doc): per backend the least-work rung with
+    /// error ≤ tolerance, across backends the smallest minimum wall time.
     pub rung: Rung,
+    /// The other backends' picks, fastest first: how clearly the choice was made.
+    pub runners_up: Vec<Rung>,
+    /// Whether the timings could not separate the chosen rung from a runner-up (its minimum
+    /// within the fastest pick's spread), so fewer DOFs decided.
+    pub decided_by_dofs: bool,
     pub reference: f64,
     pub reference_label: String,
     /// The `flexverify` arguments that re-run the chosen discretization and print the quantity
@@ -748,17 +878,50 @@ pub fn recommend(
     }
     // Each rung with its ladder's reference (the study's, or its own estimate when the
     // models disagree by less than the tolerance).
-    let candidates: Vec<(&Rung, f64)> = study
+    let meets = |r: &&Rung| r.error.is_some_and(|e| e <= tol);
+    let meeting = study
         .ladders
         .iter()
-        .filter_map(|l| Some((l, study.reference.or(l.estimate.map(|e| e.value))?)))
-        .flat_map(|(l, reference)| l.rungs.iter().map(move |r| (r, reference)))
-        .filter(|(r, _)| r.error.is_some_and(|e| e <= tol))
-        .collect();
-    let best = candidates
+        .flat_map(|l| l.rungs.iter().filter(meets))
+        .count();
+    // Per ladder, the rung meeting the tolerance with the least work (first on ties).
+    let mut picks: Vec<(&Rung, f64)> = study
+        .ladders
         .iter()
-        .min_by(|a, b| a.0.wall_time_s.total_cmp(&b.0.wall_time_s));
-    let Some(&(r, reference)) = best else {
+        .filter_map(|l| {
+            let reference = study.reference.or(l.estimate.map(|e| e.value))?;
+            let counters: Vec<Counters> = l.rungs.iter().map(|r| r.counters).collect();
+            let (_, work) = work_counter_of(&counters);
+            let pick = l
+                .rungs
+                .iter()
+                .filter(meets)
+                .min_by_key(|r| work(&r.counters))?;
+            Some((pick, reference))
+        })
+        .collect();
+    // Across backends: fastest minimum wall time, unless the timings cannot tell the picks
+    // apart (within the fastest's spread): then fewer DOFs, then backend order.
+    picks.sort_by(|a, b| a.0.wall_time_s.total_cmp(&b.0.wall_time_s));
+    let chosen = picks.first().map(|&(fastest, _)| {
+        let within = fastest.timing.min_s * (1.0 + fastest.timing.spread());
+        let tied = picks.iter().filter(|(r, _)| r.wall_time_s <= within);
+        let by_dofs = tied
+            .enumerate()
+            .min_by_key(|(i, (r, _))| (r.counters.dofs, *i))
+            .map_or(0, |(i, _)| i);
+        (
+            by_dofs,
+            picks
+                .iter()
+                .filter(|(r, _)| r.wall_time_s <= within)
+                .count()
+                > 1,
+        )
+    });
+    let best = chosen.map(|(i, _)| picks[i]);
+    let decided_by_dofs = chosen.is_some_and(|(_, tied)| tied);
+    let Some((r, reference)) = best else {
         let best_err = study
             .ladders
             .iter()
@@ -801,7 +964,13 @@ pub fn recommend(
             "{what} {} --backend {} --{flag}{until}",
             scene.name, r.backend
         ),
-        meeting: candidates.len(),
+        runners_up: picks
+            .iter()
+            .filter(|(p, _)| !std::ptr::eq(*p, r))
+            .map(|(p, _)| (*p).clone())
+            .collect(),
+        decided_by_dofs,
+        meeting,
         measured: study.ladders.iter().map(|l| l.rungs.len()).sum(),
     })
 }
@@ -814,11 +983,48 @@ impl Recommendation {
         )
     }
 
-    /// The recommendation in three lines at full length.
+    fn cost(r: &Rung) -> String {
+        let c = &r.counters;
+        format!(
+            "wall time {:.3e} s (minimum of {} repeat{}, spread {:.0}%); work: {} DOFs, {} steps, \
+             {} RHS evaluations, {} factorizations",
+            r.timing.min_s,
+            r.timing.repeats,
+            if r.timing.repeats == 1 { "" } else { "s" },
+            100.0 * r.timing.spread(),
+            c.dofs,
+            c.steps,
+            c.rhs_evaluations,
+            c.factorizations
+        )
+    }
+
+    /// How the choice was made against the other backends' picks.
+    fn choice(&self) -> Option<String> {
+        let next = self.runners_up.first()?;
+        let ratio = next.wall_time_s / self.rung.wall_time_s;
+        Some(if self.decided_by_dofs {
+            format!(
+                "timings too close to separate from {} with {} ({:.3e} s): fewer DOFs decided ({} vs {})",
+                next.backend,
+                next.discretization,
+                next.wall_time_s,
+                self.rung.counters.dofs,
+                next.counters.dofs
+            )
+        } else {
+            format!(
+                "next cheapest: {} with {}, {:.3e} s ({ratio:.1}x)",
+                next.backend, next.discretization, next.wall_time_s
+            )
+        })
+    }
+
+    /// The recommendation at full length, one fact per line.
     pub fn wide_text(&self) -> String {
         let r = &self.rung;
-        format!(
-            "recommended: {} with {} — value {:.10e}, measured error {:.3e} ≤ {:.1e} against {} = {:.10e}, wall time {:.3e} s\nre-run: flexverify {}\n{}\n",
+        let mut s = format!(
+            "recommended: {} with {} — value {:.10e}, measured error {:.3e} ≤ {:.1e} against {} = {:.10e}\n{}\n",
             r.backend,
             r.discretization,
             r.value,
@@ -826,16 +1032,24 @@ impl Recommendation {
             self.tolerance,
             self.reference_label,
             self.reference,
-            r.wall_time_s,
+            Self::cost(r),
+        );
+        if let Some(c) = self.choice() {
+            s.push_str(&c);
+            s.push('\n');
+        }
+        s.push_str(&format!(
+            "re-run: flexverify {}\n{}\n",
             self.rerun,
             self.counts()
-        )
+        ));
+        s
     }
 
     /// The recommendation for a terminal of `width` columns: one fact per line.
     pub fn terminal_text(&self, width: usize) -> String {
         let r = &self.rung;
-        let lines = [
+        let mut lines = vec![
             format!("recommended: {} with {}", r.backend, r.discretization),
             format!(
                 "  value {:.10e}, measured error {:.3e} ≤ {:.1e}",
@@ -847,10 +1061,11 @@ impl Recommendation {
                 "  against {} = {:.10e}",
                 self.reference_label, self.reference
             ),
-            format!("  wall time {:.3e} s", r.wall_time_s),
-            format!("re-run: flexverify {}", self.rerun),
-            self.counts(),
+            format!("  {}", Self::cost(r)),
         ];
+        lines.extend(self.choice().map(|c| format!("  {c}")));
+        lines.push(format!("re-run: flexverify {}", self.rerun));
+        lines.push(self.counts());
         lines.iter().map(|l| wrap(l, width, 4) + "\n").collect()
     }
 }
@@ -879,39 +1094,75 @@ pub fn ladder_quantity(scene: &Scene) -> Option<String> {
     })
 }
 
-/// The full suite's survey: every catalog scene through every rung of each backend's space
+/// Id of a scene's refinement ladder in the full suite: what `verify --filter` matches, as
+/// it matches case ids.
+pub fn ladder_id(scene: &str) -> String {
+    format!("ladder-{scene}")
+}
+
+/// One ladder of the full suite: the scene's catalog name and the quantity it follows.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LadderSpec {
+    pub scene: String,
+    pub quantity: String,
+}
+
+/// The full suite's ladders whose [`ladder_id`] contains `filter` (every one without a
+/// filter), in catalog order; scenes without a ladder quantity have none.
+pub fn select_ladders(filter: Option<&str>) -> Result<Vec<LadderSpec>, Error> {
+    let mut out = Vec::new();
+    for name in data::catalog_names() {
+        if !filter.is_none_or(|f| ladder_id(name).contains(f)) {
+            continue;
+        }
+        let scene = data::load_scene(name)?;
+        if let Some(quantity) = ladder_quantity(&scene) {
+            out.push(LadderSpec {
+                scene: name.to_string(),
+                quantity,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The full suite's survey: each selected scene through every rung of each backend's space
 /// ladder (a rung costing more than [`FULL_RUNG_BUDGET_S`] ends its ladder). With `out`, each
-/// study with a measured rung is written to `out/ladders` as soon as it is done (so an
-/// interrupted survey keeps what it finished). Returns the studies and the plot notes of
-/// [`write_study`].
-pub fn full_suite_ladders(
+/// study is written by [`write_ladder`] as soon as it is done (so an interrupted survey keeps
+/// what it finished). Returns the studies and the plot notes of [`write_study`].
+pub fn run_ladders(
+    selection: &[LadderSpec],
     out: Option<&Path>,
     progress: &dyn Progress,
 ) -> Result<(Vec<Study>, Vec<String>), Error> {
     let mut studies = Vec::new();
     let mut notes = Vec::new();
-    for name in data::catalog_names() {
-        let scene = data::load_scene(name)?;
-        let Some(q) = ladder_quantity(&scene) else {
-            continue;
-        };
+    for spec in selection {
+        let scene = data::load_scene(&spec.scene)?;
         let study = run_study(
             &scene,
-            &q,
+            &spec.quantity,
             Refine::Space,
             &BackendKind::ALL,
             &Settings::default(),
             Some(FULL_RUNG_BUDGET_S),
             progress,
         )?;
-        if let Some(dir) = out
-            && study.ladders.iter().any(|l| !l.rungs.is_empty())
-        {
-            notes.extend(write_study(&dir.join("ladders"), &study)?);
+        if let Some(dir) = out {
+            notes.extend(write_ladder(dir, &study)?);
         }
         studies.push(study);
     }
     Ok((studies, notes))
+}
+
+/// Writes a full-suite study into `dir/ladders` (when a rung was measured).
+pub fn write_ladder(dir: &Path, study: &Study) -> Result<Vec<String>, Error> {
+    if study.ladders.iter().any(|l| !l.rungs.is_empty()) {
+        write_study(&dir.join("ladders"), study)
+    } else {
+        Ok(Vec::new())
+    }
 }
 
 const SURVEY_HEADER: [&str; 7] = [
@@ -983,6 +1234,19 @@ mod tests {
                 value: limit + c / (n * n),
                 error: None,
                 wall_time_s: 1.0,
+                timing: Timing {
+                    min_s: 1.0,
+                    median_s: 1.0,
+                    max_s: 1.0,
+                    repeats: 1,
+                },
+                counters: Counters {
+                    dofs: 0,
+                    steps: 0,
+                    rhs_evaluations: 0,
+                    factorizations: 0,
+                    newton_iterations: 0,
+                },
                 settings: Settings::default(),
                 peak: None,
             })

@@ -169,3 +169,68 @@ fn sys_report_merged_from_shards_has_the_same_pages_and_links() {
     };
     assert_eq!(files(&merged), files(&single));
 }
+
+/// A report with failures, one of them a row without plots: the index lists them first and
+/// links each to its line on the scene page, which lists them under its summary. The failing
+/// rows are made by editing a one-shard result (the catalog has no failing row to run) and
+/// merged, which is how the report of a real failing run is written too.
+#[test]
+fn sys_report_failures_link_to_their_rows_and_plots() {
+    let root = scratch("failures");
+    let part = root.join("part");
+    let (code, err) = flexverify(&[
+        "verify",
+        "--filter",
+        "cantilever-modal",
+        "--shard",
+        "1/1",
+        "--out",
+        part.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let file = part.join("shard-1-of-1.json");
+    let mut shard: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    let mut failed = Vec::new();
+    for row in shard["outcomes"].as_array_mut().unwrap() {
+        let id = row["id"].as_str().unwrap().to_string();
+        // A frequency row (no plots) and a history row (plots).
+        if id == "freq-cantilever-modal-cf6-mode2" || id == "hist-cantilever-modal-fem-tip-y" {
+            row["status"] = "fail".into();
+            row["tolerance"] = (row["error"].as_f64().unwrap() / 2.0).into();
+            row["message"] = "error exceeds tolerance (edited for the test)".into();
+            failed.push(id);
+        }
+    }
+    assert_eq!(failed.len(), 2, "rows not found: {failed:?}");
+    std::fs::write(&file, shard.to_string()).unwrap();
+    let report = root.join("report");
+    let (code, err) = flexverify(&[
+        "merge",
+        part.to_str().unwrap(),
+        "--out",
+        report.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{err}");
+    check_links(&report);
+    let index = std::fs::read_to_string(report.join("index.html")).unwrap();
+    let scene = std::fs::read_to_string(report.join("scene-cantilever.html")).unwrap();
+    let failures =
+        &index[index.find("id=\"failures\"").unwrap()..index.find("id=\"kinds\"").unwrap()];
+    for id in &failed {
+        let line = format!("scene-cantilever.html#line-{id}");
+        assert!(failures.contains(&line), "the index does not link {line}");
+        let summary = &scene[..scene.find("id=\"rows\"").unwrap()];
+        assert!(
+            summary.contains(&format!("href=\"#line-{id}\"")),
+            "the scene page's summary does not list {id}"
+        );
+    }
+    // The history row's plot is linked from the failures table by what it shows.
+    assert!(
+        failures.contains("href=\"case-hist-cantilever-modal-fem-tip-y.svg\""),
+        "{failures}"
+    );
+    assert!(failures.contains(">histories</a>"), "{failures}");
+    let _ = std::fs::remove_dir_all(&root);
+}

@@ -60,15 +60,16 @@ pub enum Command {
     Verify {
         #[arg(long, value_enum, default_value_t = Suite::Quick)]
         suite: Suite,
-        /// Run only cases whose id contains this text (a filtered full suite skips the
-        /// refinement ladders).
+        /// Run only cases whose id contains this text; in the full suite also only the
+        /// refinement ladders whose id `ladder-<scene>` contains it (`--filter ladder-` runs
+        /// the ladders alone).
         #[arg(long)]
         filter: Option<String>,
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
         #[arg(long)]
         out: Option<std::path::PathBuf>,
-        /// Run only shard I of N (I/N, 1 <= I <= N) of the selected cases and write its
+        /// Run only shard I of N (I/N, 1 <= I <= N) of the selected cases and ladders and write its
         /// partial result (shard-I-of-N.json, plots) into --out; `flexverify merge` combines
         /// the N parts into the report of one unsharded run.
         #[arg(long, allow_hyphen_values = true, value_parser = parse_shard)]

@@ -4,12 +4,44 @@ use std::path::{Path, PathBuf};
 
 use super::CliError;
 use super::progress::Bar;
+use crate::error::Error;
 use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
 use crate::shard::{self, Shard, ShardFile};
 use crate::stability::{self, Verdict};
-use crate::study;
+use crate::study::{self, LadderSpec, Study};
 use crate::suite::evaluate::{Outcome, Status};
-use crate::suite::{Suite, plots, report, run_cases_with_progress, run_selected, select_cases};
+use crate::suite::{Suite, plots, report, run_selected, select_cases};
+
+/// The cases and (full suite) the refinement ladders whose ids contain `filter`. No case
+/// matching is an error only when no ladder matches either.
+fn select(
+    suite: Suite,
+    filter: Option<&str>,
+) -> Result<(Vec<data::cases::Case>, Vec<LadderSpec>), CliError> {
+    let ladders = match suite {
+        Suite::Full => study::select_ladders(filter)?,
+        Suite::Quick => Vec::new(),
+    };
+    let cases = match select_cases(suite, filter) {
+        Err(Error::NoCaseMatches { .. }) if !ladders.is_empty() => Vec::new(),
+        selected => selected?,
+    };
+    Ok((cases, ladders))
+}
+
+/// The survey table of the ladder studies, after the rows (nothing without ladders).
+fn print_survey(studies: &[Study], format: Format) {
+    if studies.is_empty() {
+        return;
+    }
+    println!();
+    match format {
+        Format::Table => print!("{}", study::survey_terminal_table(studies, TERMINAL_WIDTH)),
+        Format::Wide | Format::Csv | Format::Json => {
+            print!("{}", study::survey_wide_table(studies))
+        }
+    }
+}
 
 pub fn verify(
     suite: Suite,
@@ -19,31 +51,19 @@ pub fn verify(
 ) -> Result<(), CliError> {
     let started = std::time::Instant::now();
     let bar = Bar::new();
-    let (cases, outcomes, cache) = run_cases_with_progress(suite, filter, &bar)?;
+    let (cases, ladders) = select(suite, filter)?;
+    let (outcomes, cache) = run_selected(&cases, &bar);
     bar.clear();
     let wall = started.elapsed().as_secs_f64();
-    match format {
-        Format::Table => print!("{}", report::terminal_table(&outcomes, TERMINAL_WIDTH)),
-        Format::Wide => print!("{}", report::wide_table(&outcomes)),
-        Format::Csv => print!("{}", report::csv(&outcomes)),
-        Format::Json => println!("{}", report::json(&outcomes)),
+    print_outcomes(&outcomes, format);
+    // The full suite's refinement ladders (a study per scene, ids `ladder-<scene>`) run after
+    // the cases, sequentially: their timings must not share the cores.
+    let (studies, notes) = study::run_ladders(&ladders, out, &bar)?;
+    bar.clear();
+    for n in notes {
+        eprintln!("note: {n}");
     }
-    // The refinement ladders are a study of every scene, not a case: `--filter` selects cases,
-    // so a filtered run skips them (it would otherwise cost the whole study's wall time).
-    if suite == Suite::Full && filter.is_none() {
-        let (studies, notes) = study::full_suite_ladders(out, &bar)?;
-        bar.clear();
-        for n in notes {
-            eprintln!("note: {n}");
-        }
-        println!();
-        match format {
-            Format::Table => print!("{}", study::survey_terminal_table(&studies, TERMINAL_WIDTH)),
-            Format::Wide | Format::Csv | Format::Json => {
-                print!("{}", study::survey_wide_table(&studies))
-            }
-        }
-    }
+    print_survey(&studies, format);
     if let Some(dir) = out {
         plots::draw_all(dir, &cases, &outcomes, &cache);
         for n in report::write_all(dir, &outcomes)? {
@@ -71,16 +91,8 @@ pub fn verify_shard(
             "error: --shard needs --out DIR (where the shard writes its partial result)".into(),
         ));
     };
-    if suite == Suite::Full && filter.is_none() {
-        return Err(CliError::Input(
-            "error: --shard splits cases; the unfiltered full suite also runs the refinement \
-             ladders, which are not sharded. Shard the cases with --filter '' (every case, no \
-             ladders)"
-                .into(),
-        ));
-    }
     let started = std::time::Instant::now();
-    let selection = select_cases(suite, filter)?;
+    let (selection, ladder_selection) = select(suite, filter)?;
     let cases = shard.share(&selection);
     let bar = Bar::new();
     let (outcomes, cache) = run_selected(&cases, &bar);
@@ -88,6 +100,12 @@ pub fn verify_shard(
     let wall = started.elapsed().as_secs_f64();
     print_outcomes(&outcomes, format);
     std::fs::create_dir_all(dir)?;
+    let (studies, notes) = study::run_ladders(&shard.share(&ladder_selection), Some(dir), &bar)?;
+    bar.clear();
+    for n in notes {
+        eprintln!("note: {n}");
+    }
+    print_survey(&studies, format);
     plots::draw_all(dir, &cases, &outcomes, &cache);
     let file = ShardFile::new(
         suite,
@@ -95,12 +113,16 @@ pub fn verify_shard(
         shard,
         selection.iter().map(|c| c.id.clone()).collect(),
         outcomes,
+        ladder_selection,
+        studies,
     );
     write_atomic(dir, &shard.file_name(), file.to_json().as_bytes())?;
     eprintln!(
-        "wrote shard {shard} ({} of {} cases) to {}",
+        "wrote shard {shard} ({} of {} cases, {} of {} ladders) to {}",
         file.outcomes.len(),
         selection.len(),
+        file.ladders.len(),
+        file.ladder_selection.len(),
         dir.join(shard.file_name()).display()
     );
     summarize(&file.outcomes, &format!("{wall:.1} s wall, shard {shard}"))
@@ -115,10 +137,16 @@ pub fn merge(dirs: &[PathBuf], format: Format, out: &Path) -> Result<(), CliErro
             return super::studies::merge_converge(&files, dirs, format, out);
         }
     };
-    let (_suite, _filter, outcomes) =
-        shard::merge(&files).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    let merged = shard::merge(&files).map_err(|e| CliError::Input(format!("error: {e}")))?;
+    let outcomes = merged.outcomes;
     print_outcomes(&outcomes, format);
+    print_survey(&merged.ladders, format);
     std::fs::create_dir_all(out)?;
+    for study in &merged.ladders {
+        for n in study::write_ladder(out, study)? {
+            eprintln!("note: {n}");
+        }
+    }
     shard::copy_plots(dirs, out)?;
     crate::report::work::copy_work_files(dirs, out)?;
     for n in report::write_all(out, &outcomes)? {

@@ -160,7 +160,11 @@ pub fn recommend(scene: &str, quantity: &str, tol: f64, opts: &CommonOpts) -> Re
     let r = recommendation?;
     match opts.format {
         Format::Table => print!("{}", r.terminal_text(TERMINAL_WIDTH)),
-        Format::Wide | Format::Csv | Format::Json => print!("{}", r.wide_text()),
+        Format::Wide | Format::Csv => print!("{}", r.wide_text()),
+        Format::Json => println!(
+            "{}",
+            serde_json::to_string_pretty(&r).expect("serializable recommendation")
+        ),
     }
     Ok(())
 }

@@ -64,6 +64,47 @@ fn row_anchor(id: &str) -> String {
     format!("row-{}", slug(id))
 }
 
+/// Anchor of a case's line in a scene page's rows table (every row has one, with or without
+/// plots).
+fn line_anchor(id: &str) -> String {
+    format!("line-{}", slug(id))
+}
+
+/// A line under a scene page's summary linking to each failed row (empty when none failed).
+fn failed_list(rows: &[&Outcome]) -> String {
+    let failed: Vec<String> = rows
+        .iter()
+        .filter(|o| o.status != Status::Pass)
+        .map(|o| format!("<a href=\"#{}\">{}</a>", line_anchor(&o.id), esc(&o.id)))
+        .collect();
+    if failed.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "<p><span class=\"FAIL\">Failed:</span> {}</p>\n",
+            failed.join(", ")
+        )
+    }
+}
+
+/// What a case plot shows, from its file name (`case-<id><suffix>.svg`) and the row's check.
+fn plot_label(file: &str, check: &str) -> &'static str {
+    let stem = file.trim_end_matches(".svg");
+    if stem.ends_with("-residual") {
+        "ledger residual"
+    } else if stem.ends_with("-convergence") {
+        "convergence"
+    } else if stem.ends_with("-work-precision") {
+        "work–precision"
+    } else if stem.ends_with("-work-counters") {
+        "work counters"
+    } else if check.contains("ledger") {
+        "ledger terms"
+    } else {
+        "histories"
+    }
+}
+
 const STYLE: &str = "body{font-family:'DejaVu Sans',Verdana,sans-serif;margin:24px auto;\
 max-width:1180px;padding:0 16px;color:#222;line-height:1.4}\
 h1{font-size:1.6em;margin-bottom:4px}h2{margin-top:32px;border-bottom:2px solid #ddd}\
@@ -73,7 +114,7 @@ th{background:#f3f3f3}td.num{text-align:right;font-variant-numeric:tabular-nums;
 .pass{color:#1a7f37;font-weight:bold}.FAIL,.ERROR,.gap{color:#c00;font-weight:bold}\
 .exc{color:#a66a00}.muted{color:#777}.why{font-size:0.9em;color:#444;max-width:420px}\
 tr.main td{border-bottom:none;padding-top:7px}tr.whyrow td{font-size:0.86em;color:#444;\
-padding-bottom:7px}td.id,.nowrap{white-space:nowrap}td.ref{text-align:right;\
+padding-bottom:7px}tr.failed td{background:#fff1f0}td.id,.nowrap{white-space:nowrap}td.ref{text-align:right;\
 max-width:230px}.small{font-size:0.85em}\
 .chip{display:inline-block;width:10px;height:10px;border-radius:2px;margin-right:5px}\
 figure{margin:10px 0}figure img{max-width:100%;border:1px solid #ddd}\
@@ -482,7 +523,13 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
         for o in &failures {
             let plots: Vec<String> = case_plots(dir, &o.id)
                 .iter()
-                .map(|f| format!("<a href=\"{f}\">{}</a>", esc(f.trim_end_matches(".svg"))))
+                .map(|f| {
+                    format!(
+                        "<a class=\"nowrap\" href=\"{f}\" title=\"{t}\">{}</a>",
+                        plot_label(f, &o.check),
+                        t = esc(f)
+                    )
+                })
                 .collect();
             let _ = writeln!(
                 b,
@@ -491,7 +538,7 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
                  <td class=\"why\">{m}</td><td>{p}</td></tr>",
                 s = status_name(o.status),
                 page = scene_page(&o.scene),
-                a = row_anchor(&o.id),
+                a = line_anchor(&o.id),
                 id = esc(&o.id),
                 scene = esc(&o.scene),
                 e = o.error.map_or("-".into(), |e| format!("{e:.2e}")),
@@ -604,7 +651,7 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
             "<nav><a href=\"index.html\">← index</a><a href=\"#rows\">Rows</a>\
              <a href=\"#plots\">Plots</a><a href=\"#fronts\">Work–precision</a></nav>\n\
              <h1>{}</h1>\n<p class=\"summary\">{} rows: <span class=\"pass\">{p} passed</span>, \
-             <span class=\"{}\">{f} failed</span>.</p>\n<h2 id=\"rows\">Rows</h2>\n\
+             <span class=\"{}\">{f} failed</span>.</p>\n{}<h2 id=\"rows\">Rows</h2>\n\
              <p class=\"muted\">Each row, then on a line of its own the check kind and why \
              the tolerance is what it is.</p>\n\
              <table><tr><th>status</th><th>case</th><th>backend</th><th>quantity</th>\
@@ -612,7 +659,8 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
              <th>wall [s]</th></tr>\n",
             esc(sc),
             rows.len(),
-            if f > 0 { "FAIL" } else { "muted" }
+            if f > 0 { "FAIL" } else { "muted" },
+            failed_list(&rows),
         );
         for o in &rows {
             let has_plots = !case_plots(dir, &o.id).is_empty();
@@ -623,13 +671,20 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
             };
             let _ = writeln!(
                 b,
-                "<tr class=\"main\"><td class=\"{s}\">{s}</td><td class=\"id\">{id}</td>\
+                "<tr class=\"main{failed}\" id=\"{line}\"><td class=\"{s}\">{s}</td>\
+                 <td class=\"id\">{id}</td>\
                  <td>{backend}</td><td>{q}</td><td class=\"num\">{v}</td>\
                  <td class=\"ref\">{r}<br><span class=\"muted\">{rl}</span></td>\
                  <td class=\"num\">{e}</td><td class=\"num\">{t:.1e} {norm}</td>\
-                 <td class=\"num\">{w:.3}</td></tr>\n<tr class=\"whyrow\"><td></td>\
+                 <td class=\"num\">{w:.3}</td></tr>\n<tr class=\"whyrow{failed}\"><td></td>\
                  <td colspan=\"8\"><b>{check}</b>: {why}{msg}</td></tr>",
                 s = status_name(o.status),
+                failed = if o.status == Status::Pass {
+                    ""
+                } else {
+                    " failed"
+                },
+                line = line_anchor(&o.id),
                 check = esc(&o.check),
                 backend = backend_cell(&o.backend),
                 q = esc(&o.quantity),

@@ -2,7 +2,7 @@
 //! against its cost, the cost measured two ways so a curve does not hinge on timer noise:
 //!
 //! - wall time as the minimum over repeated sequential runs (rungs dearer than
-//!   [`MAX_SPENT_S`] keep their one run of the suite) (the minimum is the run least
+//!   [`MAX_SPENT_S`] keep their one run, and say so: `repeats` = 1) (the minimum is the run least
 //!   disturbed by the machine), with the median and maximum beside it and the spread
 //!   (median − min)/min;
 //! - work counters from the backend's own `Cost` (DOFs, steps, right-hand-side evaluations,
@@ -49,9 +49,13 @@ pub const MAX_SPENT_S: f64 = 3.0;
 /// Times `run` (which returns the backend's own wall time of one run, or `None` when it
 /// fails) repeatedly: at least [`MIN_REPEATS`] runs and [`MIN_SPENT_S`] seconds, at most
 /// [`MAX_REPEATS`] runs, and no more than three once [`MAX_SPENT_S`] is spent.
-pub fn time_repeats(mut run: impl FnMut() -> Option<f64>) -> Option<Timing> {
-    let mut times = Vec::new();
-    let mut spent = 0.0;
+pub fn time_repeats(run: impl FnMut() -> Option<f64>) -> Option<Timing> {
+    repeat_after(Vec::new(), run)
+}
+
+/// [`time_repeats`] counting the timings already in `times` as repeats.
+fn repeat_after(mut times: Vec<f64>, mut run: impl FnMut() -> Option<f64>) -> Option<Timing> {
+    let mut spent: f64 = times.iter().sum();
     while times.len() < MAX_REPEATS {
         let enough = times.len() >= MIN_REPEATS && spent >= MIN_SPENT_S;
         let too_long = times.len() >= 3 && spent >= MAX_SPENT_S;
@@ -65,15 +69,32 @@ pub fn time_repeats(mut run: impl FnMut() -> Option<f64>) -> Option<Timing> {
     Some(timing_of(&mut times))
 }
 
-/// The timing of a rung whose first run (the suite's) took `first` seconds: repeated with
+/// Whether a rung's first run (the one that gave its value) is one of its timing repeats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FirstRun {
+    /// It ran alone (a study's sequential ladder): it is a repeat like the others.
+    Alone,
+    /// It shared the cores with other cases (the suite's parallel run): it only decides
+    /// whether the rung is repeated.
+    Shared,
+}
+
+/// The timing of a rung whose first run took `first` seconds: repeated with
 /// [`time_repeats`] when it is cheaper than [`MAX_SPENT_S`], else that one run alone
-/// (`repeats` = 1, reported as such): a rung of minutes is not worth repeating for a plot,
-/// and its timer noise is small relative to its cost.
-pub fn time_rung(first: f64, run: impl FnMut() -> Option<f64>) -> Option<Timing> {
+/// (`repeats` = 1, reported as such): a rung of seconds is not worth repeating for a plot,
+/// its timer noise is small relative to its cost, and its work counters are exact.
+pub fn time_rung(
+    first: f64,
+    first_run: FirstRun,
+    run: impl FnMut() -> Option<f64>,
+) -> Option<Timing> {
     if first > MAX_SPENT_S {
         return Some(timing_of(&mut [first]));
     }
-    time_repeats(run)
+    match first_run {
+        FirstRun::Alone => repeat_after(vec![first], run),
+        FirstRun::Shared => time_repeats(run),
+    }
 }
 
 fn timing_of(times: &mut [f64]) -> Timing {
@@ -121,16 +142,20 @@ pub type CounterOf = fn(&Counters) -> usize;
 /// factorizations that is non-zero on every rung and changes along the ladder; DOFs otherwise
 /// (eigen- and static solves: one factorization each, work growing with the system size).
 pub fn work_counter(points: &[WorkPoint]) -> (&'static str, CounterOf) {
+    let counters: Vec<Counters> = points.iter().map(|p| p.counters).collect();
+    work_counter_of(&counters)
+}
+
+/// [`work_counter`] of the counters of a ladder's rungs.
+pub fn work_counter_of(counters: &[Counters]) -> (&'static str, CounterOf) {
     let choices: [(&'static str, CounterOf); 3] = [
         ("RHS evaluations", |c| c.rhs_evaluations),
         ("steps", |c| c.steps),
         ("factorizations", |c| c.factorizations),
     ];
     for (name, f) in choices {
-        let first = points.first().map(|p| f(&p.counters));
-        if points.iter().all(|p| f(&p.counters) > 0)
-            && points.iter().any(|p| Some(f(&p.counters)) != first)
-        {
+        let first = counters.first().map(f);
+        if counters.iter().all(|c| f(c) > 0) && counters.iter().any(|c| Some(f(c)) != first) {
             return (name, f);
         }
     }
@@ -276,10 +301,32 @@ mod tests {
         assert_eq!(t.repeats, 3);
         assert!(time_repeats(|| None).is_none());
         // A rung dearer than the budget keeps its one run.
-        let t = time_rung(2.0 * MAX_SPENT_S, || panic!("must not run again")).unwrap();
-        assert_eq!(
-            (t.repeats, t.min_s, t.spread()),
-            (1, 2.0 * MAX_SPENT_S, 0.0)
-        );
+        for first_run in [FirstRun::Alone, FirstRun::Shared] {
+            let t = time_rung(2.0 * MAX_SPENT_S, first_run, || {
+                panic!("must not run again")
+            })
+            .unwrap();
+            assert_eq!(
+                (t.repeats, t.min_s, t.spread()),
+                (1, 2.0 * MAX_SPENT_S, 0.0)
+            );
+        }
+        // A study's first run (alone on the machine) is one of the repeats; the suite's
+        // (shared with parallel cases) is not.
+        let mut calls = 0;
+        let t = time_rung(0.5, FirstRun::Alone, || {
+            calls += 1;
+            Some(1.0)
+        })
+        .unwrap();
+        // 0.5 + 1 + 1 + 1 s: four repeats, three of them new, spend more than MAX_SPENT_S.
+        assert_eq!((t.repeats, calls, t.min_s), (4, 3, 0.5));
+        let mut calls = 0;
+        let t = time_rung(0.5, FirstRun::Shared, || {
+            calls += 1;
+            Some(1.0)
+        })
+        .unwrap();
+        assert_eq!((t.repeats, calls, t.min_s), (3, 3, 1.0));
     }
 }

@@ -15,7 +15,7 @@ use super::quantity::Quantity;
 use super::reference::analytic_value;
 use super::run_cache::{Answer, RunCache, compute};
 use crate::plot::{Mark, Series, StyledSeries, plot, plot_styled};
-use crate::report::work::{CaseWork, Counters, WorkPoint, time_rung, work_counter};
+use crate::report::work::{CaseWork, FirstRun, WorkPoint, time_rung, work_counter};
 
 fn scene_of(case: &Case) -> Option<Scene> {
     if case.overrides.is_empty() {
@@ -269,14 +269,14 @@ fn draw_ladder(
             continue;
         };
         let cached = cache.get(scene, case.backend, &s, q.analysis(), q.modes_needed());
-        let Some(cost) = cost_of(&cached) else {
+        let Some(cost) = cached.counters() else {
             continue;
         };
         let answer = || compute(scene, case.backend, &s, q.analysis(), q.modes_needed());
         let Some(first) = cached.wall_time_s() else {
             continue;
         };
-        let Some(timing) = time_rung(first, || answer().wall_time_s()) else {
+        let Some(timing) = time_rung(first, FirstRun::Shared, || answer().wall_time_s()) else {
             continue;
         };
         rungs.push((rung, h, value, cost, timing));
@@ -384,13 +384,4 @@ fn draw_ladder(
             true,
         )
         .is_ok()
-}
-
-fn cost_of(a: &Answer) -> Option<Counters> {
-    match a {
-        Answer::Modes(Ok(r)) => Some((&r.cost).into()),
-        Answer::Statics(Ok(r)) => Some((&r.cost).into()),
-        Answer::Run(Ok(r)) => Some((&r.cost).into()),
-        _ => None,
-    }
 }

@@ -8,6 +8,7 @@ use data::{BackendError, BackendKind, ModalResult, RunResult, Scene, Settings, S
 
 use super::quantity::Analysis;
 use crate::registry::backend;
+use crate::report::work::Counters;
 
 #[derive(Debug, Clone)]
 pub enum Answer {
@@ -76,6 +77,16 @@ impl Answer {
             Answer::Modes(Ok(r)) => Some(r.cost.wall_time_s),
             Answer::Statics(Ok(r)) => Some(r.cost.wall_time_s),
             Answer::Run(Ok(r)) => Some(r.cost.wall_time_s),
+            _ => None,
+        }
+    }
+
+    /// The backend's work counters of a successful answer.
+    pub fn counters(&self) -> Option<Counters> {
+        match self {
+            Answer::Modes(Ok(r)) => Some((&r.cost).into()),
+            Answer::Statics(Ok(r)) => Some((&r.cost).into()),
+            Answer::Run(Ok(r)) => Some((&r.cost).into()),
             _ => None,
         }
     }
