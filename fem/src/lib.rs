@@ -168,6 +168,8 @@
 
 pub mod band;
 pub mod chain;
+/// Modes of chain scenes: K x = ω² M x of the chain linearized about its set points, from the
+/// chain's own Newton-matrix pieces (an `impl Chain` block kept beside the chain's passes).
 #[path = "chain/linearized.rs"]
 pub mod chain_modes;
 pub mod driver;
