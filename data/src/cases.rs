@@ -190,6 +190,7 @@ macro_rules! case_files {
 
 case_files!(
     "frequencies",
+    "chain_modes",
     "statics",
     "dynamics",
     "rocket",

@@ -399,7 +399,10 @@ fn sys_unsupported_scenes_and_bad_settings_are_refused() {
         }
         other => panic!("{other:?}"),
     }
-    // Modes of a free chain: refused with a reason, never a fake result.
-    let r = FemBackend.modes(&data::load_scene("two-link-free").unwrap(), &settings(4), 3);
-    assert!(matches!(r, Err(BackendError::Unsupported(_))));
+    // Modes of a chain whose joint moves by prescription (no rest configuration): refused
+    // with a reason, never a fake result.
+    let mut sc = data::load_scene("two-link-free").unwrap();
+    sc.links[0].joint.prescribed = Some(data::scene::PrescribedMotion::ConstantRate { rate: 1.0 });
+    let r = FemBackend.modes(&sc, &settings(4), 3);
+    assert!(matches!(r, Err(BackendError::Unsupported(_))), "{r:?}");
 }

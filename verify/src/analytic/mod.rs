@@ -10,6 +10,9 @@
 //! * [`timoshenko`] — clamped–free Timoshenko frequencies below and above the cut-off.
 //! * [`statics`] — linear cantilever statics and the large-deflection elastica.
 //! * [`rotating`] — flapwise (Frobenius series) and in-plane rotating-cantilever frequencies.
+//! * [`chain_modes`] — the straight spring-jointed chain of Euler–Bernoulli links (joint
+//!   springs, hub and tip bodies) linearized about its set points: exact dynamic stiffness,
+//!   Wittrick–Williams root count; its clamped (K → ∞) and pinned (K₁ → 0) single-beam limits.
 //! * [`rigid`] — rigid-link limits: torque-driven link, seed 001's friction-constrained link
 //!   (eq. 71), the rigid two-link Barhorst arm, the static normal force of an arm on its tip.
 //! * [`payload_link`] — the 3-D link with an offset payload (seed 002): bending in both planes
@@ -20,6 +23,7 @@
 //!   written here so that no code is shared with a backend.
 
 pub mod beam;
+pub mod chain_modes;
 mod error;
 pub mod numerics;
 pub mod payload_link;
@@ -34,6 +38,7 @@ pub use beam::{
     beam_eigenvalues, bending_frequencies_hz, cantilever_tip_mass_frequencies_hz,
     cantilever_tip_mass_roots,
 };
+pub use chain_modes::{ChainJoint, ChainLink, SpringJointedChain};
 pub use error::{AnalyticError, Result};
 pub use rigid::constrained::{ConstrainedRigidLink, ConstrainedState, evolve_quadratic_friction};
 pub use rigid::resting::{RestingArm, RestingState, resting_from_scene, resting_on_tip};

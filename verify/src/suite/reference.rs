@@ -9,6 +9,9 @@
 //! | `axial-clamped-free` | `axial_freqN` | clamped-free bar (with tip mass when present) |
 //! | `rotating-in-plane` | `freqN` | in-plane bending of the cantilever at the scene's hub rate Ω: ω² = ω_flap² − Ω² (Frobenius series) |
 //! | `static-linear` | `tip_static` | PL³/3EI + qL⁴/8EI for the scene's `[statics]` loads |
+//! | `spring-jointed-chain` | `freqN`, `bending_freqN` | straight chain of Euler–Bernoulli links with the scene's joint springs, hub and tip bodies, linearized about the set points (exact dynamic stiffness, Wittrick–Williams count; `freqN` counts rigid modes as 0) |
+//! | `chain-clamped-limit` | `freqN`, `bending_freqN` | that chain with every joint rigid (K → ∞): clamped–free beam of length ΣLᵢ |
+//! | `chain-pinned-limit` | `freqN`, `bending_freqN` | root joint free (K₁ → 0), the others rigid: pinned–free beam of length ΣLᵢ, rigid mode first |
 //! | `rigid-single-link` | `joint1.angle@T`, `joint1.rate@T` | rigid link + hub + tip mass under the torque law (closed form) |
 //! | `rigid-two-link` | `jointI.angle@T`, `jointI.rate@T` | rigid two-link arm with the scene's springs/dampers (tight RK) |
 //! | `payload-horizontal` | `bending-horizontal_freqN` | 3-D link: bending in the turning plane with the payload's mass, offset and I₃ (hub-coupled for a free base, rotating at a constant rate) |
@@ -166,6 +169,26 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
                 n,
             )
         }
+        "spring-jointed-chain" | "chain-clamped-limit" | "chain-pinned-limit" => {
+            let chain = ana::SpringJointedChain::from_scene(scene).map_err(|e| e.to_string())?;
+            let (n, bending_only) = match q {
+                Quantity::Frequency { n, kind: None } => (*n, false),
+                Quantity::Frequency { n, kind: Some(k) } if k == "bending" => (*n, true),
+                _ => return Err(format!("`{id}` applies to `freqN` and `bending_freqN`")),
+            };
+            let rigid = match id {
+                "spring-jointed-chain" => chain.rigid_modes(),
+                "chain-pinned-limit" => 1,
+                _ => 0,
+            };
+            let count = if bending_only { n + rigid } else { n };
+            let all = match id {
+                "spring-jointed-chain" => chain.frequencies_hz(count),
+                "chain-clamped-limit" => chain.clamped_limit_hz(count),
+                _ => chain.pinned_limit_hz(count),
+            };
+            nth(all, count)
+        }
         "static-linear" => {
             if !matches!(q, Quantity::StaticTip) {
                 return Err("`static-linear` applies to `tip_static`".into());
@@ -308,7 +331,8 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
         }
         other => Err(format!(
             "unknown analytic reference `{other}`; known: clamped-free, tip-mass, timoshenko, \
-             axial-clamped-free, rotating-in-plane, static-linear, rigid-single-link, rigid-two-link, \
+             axial-clamped-free, rotating-in-plane, spring-jointed-chain, chain-clamped-limit, \
+             chain-pinned-limit, static-linear, rigid-single-link, rigid-two-link, \
              constrained-rigid-link, rocket-translation, tip-mass-momentum-limit, payload-horizontal, \
              payload-vertical, payload-torsion, payload-axial, payload-static-sag, payload-rigid-base"
         )),
