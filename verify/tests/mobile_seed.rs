@@ -20,6 +20,11 @@ fn arm() -> (Reference, ClosedFormArm) {
 /// A raised, bent configuration with every joint moving.
 const TH: [f64; 4] = [0.4, 0.7, -0.5, 0.9];
 const THD: [f64; 4] = [1.2, -0.8, 1.5, 0.6];
+/// The arm folded back over the turret: link 1 nearly level, links 2 and 3 turned back, so
+/// the mass centres sit close to the yaw axis (small m ρ²) with the links lying flat.
+const FOLDED: [f64; 4] = [0.0, 0.1, -3.0, 0.1];
+/// A bent elbow (θ₃ far from 0).
+const BENT: [f64; 4] = [0.4, 0.3, -1.5, 0.5];
 /// A platform heading that is not special.
 const HEADING: f64 = 0.6;
 
@@ -41,29 +46,129 @@ fn assert_reference_ledger_closes(r: &Reference) {
     assert!(worst <= 1e-10 * scale, "ledger {worst:e} / {scale:e}");
 }
 
-/// Eq. 38: yaw inertia A. Printed: w_c for m_c, m_b r² for ½ m_b r², cos θ₂ for cos(θ₂+θ₃) in
-/// the m₂ term, no rotary inertia of the links. Corrected: equals M_θ₁θ₁ of the reference.
-#[test]
-fn seed_eq38_yaw_inertia() {
-    let (r, cf) = arm();
+/// Absolute pitch angles β and horizontal radii ρ of the mass centres of links 1-3 and the
+/// gripper (the corrected geometry of eqs. 7, 13, 19, 25).
+fn pitch_radii(cf: &ClosedFormArm, th: &[f64; 4]) -> ([f64; 4], [f64; 4]) {
+    let b1 = th[1];
+    let b2 = b1 + th[2];
+    let b3 = b2 + th[3];
+    let beta = [b1, b2, b3, b3];
+    let mut rho = [0.0; 4];
+    let mut base = 0.0;
+    for k in 0..4 {
+        let b = &cf.bodies[k];
+        rho[k] = base + b.com * beta[k].cos();
+        base += b.length * beta[k].cos();
+    }
+    (beta, rho)
+}
+
+/// The corrected eq. 38 is the reference's M_θ₁θ₁, and B = C = D = 0 (eqs. 39-41) hold for
+/// principal axes along the links; every eq. 38 test starts from this.
+fn assert_corrected_yaw_inertia(r: &Reference, cf: &ClosedFormArm, th: &[f64; 4]) -> f64 {
     let mut mm = [[0.0; MAX_Q]; MAX_Q];
-    r.model.mass_matrix(&TH, &mut mm);
-    let corrected = cf.yaw_inertia_corrected(&TH);
+    r.model.mass_matrix(th, &mut mm);
+    let corrected = cf.yaw_inertia_corrected(th);
     assert!(
         rel(corrected, mm[0][0]) < 1e-13,
         "{corrected} vs {}",
         mm[0][0]
     );
-    let printed = cf.yaw_inertia_printed(&TH);
-    assert!(
-        rel(printed, mm[0][0]) > 0.5,
-        "printed {printed} vs {}",
-        mm[0][0]
-    );
-    // B = C = D = 0 (eqs. 39-41) do hold for principal axes along the links.
     for k in 1..4 {
         assert!(mm[0][k].abs() < 1e-15 * mm[0][0]);
     }
+    corrected
+}
+
+/// Eq. 38 (and 32): the printed yaw inertia A has w_c = m_c g, the gripper's weight, where its
+/// mass m_c belongs. With only that error, A is off by (g − 1) m_c ρ_c², which matters when the
+/// gripper is far from the yaw axis (arm stretched out).
+#[test]
+fn seed_eq38_gripper_weight_in_yaw_inertia() {
+    let (r, cf) = arm();
+    let corrected = assert_corrected_yaw_inertia(&r, &cf, &TH);
+    let (_, rho) = pitch_radii(&cf, &TH);
+    let mc = cf.bodies[3].mass;
+    let printed = corrected - mc * rho[3] * rho[3] + mc * cf.gravity * rho[3] * rho[3];
+    assert!(
+        rel(printed, corrected) > 0.5,
+        "w_c for m_c: {printed} vs {corrected}"
+    );
+    // Also the printed eq. 38 as a whole (all its errors together) is far off.
+    let whole = cf.yaw_inertia_printed(&TH);
+    assert!(
+        rel(whole, corrected) > 0.5,
+        "printed {whole} vs {corrected}"
+    );
+    assert_reference_ledger_closes(&r);
+}
+
+/// Eq. 38 (and 32): the base disc enters as m_b r², though eq. 6 gives I_b = ½ m_b r². With only
+/// that error A is off by J_turret,zz, which matters most with the arm folded close to the yaw
+/// axis (A small).
+#[test]
+fn seed_eq38_base_disc_inertia() {
+    let (r, cf) = arm();
+    let folded = FOLDED;
+    let corrected = assert_corrected_yaw_inertia(&r, &cf, &folded);
+    let printed = corrected - cf.turret_jzz + 2.0 * cf.turret_jzz;
+    assert!(
+        rel(printed, corrected) > 0.1,
+        "m_b r²: {printed} vs {corrected}"
+    );
+    assert_reference_ledger_closes(&r);
+}
+
+/// Eq. 38: the m₂ term is printed m₂(l₂ cos θ₂ + 2 l₁ cos θ₂)²/4, i.e. link 2 at the pitch of
+/// link 1; eq. 32 has (l₂ cos(θ₂ + θ₃) + 2 l₁ cos θ₂)²/4 = m₂ ρ₂² (uniform rod, centre l₂/2). The
+/// two agree at θ₃ = 0 and disagree as soon as the elbow bends.
+#[test]
+fn seed_eq38_link2_pitch_angle() {
+    let (r, cf) = arm();
+    let corrected = assert_corrected_yaw_inertia(&r, &cf, &BENT);
+    let (l1, l2, m2) = (cf.bodies[0].length, cf.bodies[1].length, cf.bodies[1].mass);
+    assert_eq!(
+        cf.bodies[1].com,
+        0.5 * l2,
+        "the seed's lumped rod: centre at mid-length"
+    );
+    let term = |th: &[f64; 4], elbow: f64| {
+        m2 * (l2 * (th[1] + elbow).cos() + 2.0 * l1 * th[1].cos()).powi(2) / 4.0
+    };
+    let (_, rho) = pitch_radii(&cf, &BENT);
+    let corrected_term = term(&BENT, BENT[2]);
+    assert!(rel(corrected_term, m2 * rho[1] * rho[1]) < 1e-14);
+    let printed = corrected - corrected_term + term(&BENT, 0.0);
+    assert!(
+        rel(printed, corrected) > 0.1,
+        "cos θ₂ for cos(θ₂+θ₃): {printed} vs {corrected}"
+    );
+    // With a straight elbow the printed term is right.
+    let straight = [BENT[0], BENT[1], 0.0, BENT[3]];
+    assert_eq!(term(&straight, straight[2]), term(&straight, 0.0));
+    assert_reference_ledger_closes(&r);
+}
+
+/// Eqs. 32 and 38 carry no rotary inertia of the pitched bodies about the vertical; the
+/// corrected A adds J_xx sin²β + J_zz cos²β per body. It matters when the masses sit near the
+/// yaw axis (the folded arm), where the point-mass terms m ρ² are small.
+#[test]
+fn seed_eq38_link_rotary_inertia() {
+    let (r, cf) = arm();
+    let folded = FOLDED;
+    let corrected = assert_corrected_yaw_inertia(&r, &cf, &folded);
+    let (beta, _) = pitch_radii(&cf, &folded);
+    let rotary: f64 = (0..4)
+        .map(|k| {
+            let (s, c) = beta[k].sin_cos();
+            cf.bodies[k].jxx * s * s + cf.bodies[k].jzz * c * c
+        })
+        .sum();
+    let printed = corrected - rotary;
+    assert!(
+        rel(printed, corrected) > 0.1,
+        "no rotary inertia: {printed} vs {corrected}"
+    );
     assert_reference_ledger_closes(&r);
 }
 
