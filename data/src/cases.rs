@@ -201,7 +201,8 @@ case_files!(
     "payload_link",
     "mobile",
     "mobile_flex",
-    "mobile_flex_fem"
+    "mobile_flex_fem",
+    "convergence_scenes"
 );
 
 /// Parses a case file with located errors.
