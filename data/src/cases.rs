@@ -200,7 +200,8 @@ case_files!(
     "payload_link",
     "mobile",
     "mobile_flex",
-    "mobile_flex_fem"
+    "mobile_flex_fem",
+    "contact_coverage"
 );
 
 /// Parses a case file with located errors.
