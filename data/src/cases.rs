@@ -202,7 +202,8 @@ case_files!(
     "mobile",
     "mobile_flex",
     "mobile_flex_fem",
-    "convergence_scenes"
+    "convergence_scenes",
+    "contact_coverage"
 );
 
 /// Parses a case file with located errors.
