@@ -21,11 +21,10 @@
 //!
 //! Ingredients, each one O(n) pass of [`Chain::residual_parts`]:
 //! * M(q)x = R_in(q, 0, x) (inertial part only, exact: R is affine in q̈);
-//! * ∂T/∂q(q, x) = Ṁ(x)x − R_in(q, x, 0), since R_in(q, x, 0) = Ṁ(x)x − ∂T/∂q, with the
-//!   directional derivative Ṁ(x)x = [M(q + εx)x − M(q − εx)x]/(2ε), ε‖x‖∞ = 10⁻⁵·max(L, 1)
-//!   (central difference: truncation ~10⁻¹⁰, round-off ~10⁻¹¹ relative). Only ∇Φ(q̄) uses it; the
-//!   Gonzalez correction is built from exact values Φ(q₀), Φ(q₁), so this error affects the
-//!   trajectory at that level but never the energy balance;
+//! * ∂T/∂q(q, x) analytic, one forward and one backward sweep
+//!   ([`Chain::add_kinetic_gradient`]: T written in link-frame coordinates, reverse sweep of
+//!   the velocity recursion). The identity R_in(q, x, 0) = Ṁ(x)x − ∂T/∂q with a central
+//!   difference for Ṁ(x)x ([`kinetic_gradient_fd`], 3 inertial passes) is its test oracle;
 //! * ∇g(q̄) = ∂T/∂q(q̄, a) − ∂T/∂q(q̄, b), a = v̄, b = ½(v₁ − v₀) (polarization);
 //! * ∇V(q̄) = conservative part; Q = −(non-conservative part); V(q₁) from [`Chain::energies`].
 //!
@@ -77,13 +76,14 @@ use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::method::{ConstraintView, StepConstraint, StepContext, Stepper, Works};
 
-/// Relative size of the finite-difference perturbation of q for Ṁ(x)x.
+/// Relative size of the finite-difference perturbation of q for Ṁ(x)x in the oracle
+/// [`kinetic_gradient_fd`].
 pub const FD_STEP: f64 = 1e-5;
 /// Newton iterations at most before the step is retried shorter.
 const MAX_ITERATIONS: usize = 30;
 /// Energy defect h v̄ᵀ(residual) accepted per step, relative to the step's energy scale
 /// (kinetic + |potential parts| at both ends + |work of the step|). Where round-off (of the
-/// momentum difference and of the finite-difference Ṁ terms) keeps the defect above this, the
+/// momentum difference) keeps the defect above this, the
 /// iteration stops once the defect no longer falls (measured floor ≈ 1e-13 on `single-link`).
 const ENERGY_TOL: f64 = 1e-14;
 
@@ -110,9 +110,6 @@ pub struct MidpointWork {
     /// Residual of the momentum equation divided by h.
     res: Vec<f64>,
     zero: Vec<f64>,
-    qp: Vec<f64>,
-    tmp: Vec<f64>,
-    tmp2: Vec<f64>,
     /// Whether the previous step's mean acceleration is in `StepState::qdd` (else it holds
     /// the point acceleration of a (re)start), and that step's length.
     have_prev: bool,
@@ -138,10 +135,7 @@ impl MidpointWork {
             grad_g: z.clone(),
             w_dq: z.clone(),
             res: z.clone(),
-            zero: z.clone(),
-            qp: z.clone(),
-            tmp: z.clone(),
-            tmp2: z,
+            zero: z,
             have_prev: false,
             h_prev: 0.0,
             pending: Works::default(),
@@ -167,65 +161,45 @@ impl MidpointWork {
     }
 }
 
-/// Scratch vectors and the output of [`add_kinetic_gradient`].
-struct Scratch<'a> {
-    out: &'a mut [f64],
-    zero: &'a [f64],
-    qp: &'a mut [f64],
-    tmp: &'a mut [f64],
-    tmp2: &'a mut [f64],
+/// ∂T/∂q at (q, x) with T = ½xᵀM(q)x, analytic ([`Chain::add_kinetic_gradient`], the one the
+/// scheme uses). Allocates: for checks, not for step loops.
+pub fn kinetic_gradient(chain: &mut Chain, t: f64, q: &[f64], x: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; q.len()];
+    chain.add_kinetic_gradient(t, q, x, 1.0, &mut out);
+    out
 }
 
-/// Adds `sign`·∂T/∂q(q, x) to `out` (3 inertial passes; 0 if x = 0): the central difference
-/// Ṁ(x)x = [M(q + εx)x − M(q − εx)x]/(2ε) with ε‖x‖∞ = `delta`, minus R_in(q, x, 0).
-fn add_kinetic_gradient(
+/// ∂T/∂q at (q, x) by the identity ∂T/∂q = Ṁ(x)x − R_in(q, x, 0) with the central difference
+/// Ṁ(x)x = [M(q + εx)x − M(q − εx)x]/(2ε), ε‖x‖∞ = `delta` (truncation ~10⁻¹⁰, round-off
+/// ~10⁻¹¹ relative at `delta` = [`FD_STEP`]): 3 inertial passes of the residual, independent of
+/// the analytic sweep — its test oracle. Allocates: for checks, not for step loops.
+pub fn kinetic_gradient_fd(
     chain: &mut Chain,
     t: f64,
     q: &[f64],
     x: &[f64],
     delta: f64,
-    sign: f64,
-    s: Scratch<'_>,
-) -> usize {
-    let xmax = max_abs(x);
-    if xmax == 0.0 {
-        return 0;
-    }
-    let eps = delta / xmax;
-    let n = q.len();
-    for i in 0..n {
-        s.qp[i] = q[i] + eps * x[i];
-    }
-    chain.residual_parts(t, s.qp, s.zero, x, Parts::INERTIA, s.tmp);
-    for i in 0..n {
-        s.qp[i] = q[i] - eps * x[i];
-    }
-    chain.residual_parts(t, s.qp, s.zero, x, Parts::INERTIA, s.tmp2);
-    for i in 0..n {
-        s.out[i] += sign * (s.tmp[i] - s.tmp2[i]) / (2.0 * eps);
-    }
-    chain.residual_parts(t, q, x, s.zero, Parts::INERTIA, s.tmp);
-    for i in 0..n {
-        s.out[i] -= sign * s.tmp[i];
-    }
-    3
-}
-
-/// ∂T/∂q at (q, x) with T = ½xᵀM(q)x, by the scheme's own evaluation (perturbation
-/// `delta` = ε‖x‖∞). Allocates: for checks, not for step loops.
-pub fn kinetic_gradient(chain: &mut Chain, t: f64, q: &[f64], x: &[f64], delta: f64) -> Vec<f64> {
+) -> Vec<f64> {
     let n = q.len();
     let zero = vec![0.0; n];
-    let (mut qp, mut tmp, mut tmp2, mut out) =
-        (zero.clone(), zero.clone(), zero.clone(), zero.clone());
-    let s = Scratch {
-        out: &mut out,
-        zero: &zero,
-        qp: &mut qp,
-        tmp: &mut tmp,
-        tmp2: &mut tmp2,
-    };
-    add_kinetic_gradient(chain, t, q, x, delta, 1.0, s);
+    let mut out = zero.clone();
+    let xmax = max_abs(x);
+    if xmax == 0.0 {
+        return out;
+    }
+    let eps = delta / xmax;
+    let (mut tmp, mut tmp2) = (zero.clone(), zero.clone());
+    let qp: Vec<f64> = q.iter().zip(x).map(|(a, b)| a + eps * b).collect();
+    chain.residual_parts(t, &qp, &zero, x, Parts::INERTIA, &mut tmp);
+    let qm: Vec<f64> = q.iter().zip(x).map(|(a, b)| a - eps * b).collect();
+    chain.residual_parts(t, &qm, &zero, x, Parts::INERTIA, &mut tmp2);
+    for i in 0..n {
+        out[i] = (tmp[i] - tmp2[i]) / (2.0 * eps);
+    }
+    chain.residual_parts(t, q, x, &zero, Parts::INERTIA, &mut tmp);
+    for i in 0..n {
+        out[i] -= tmp[i];
+    }
     out
 }
 
@@ -270,7 +244,6 @@ impl Stepper for EnergyMidpoint {
         // Laws are sampled at the midpoint: exact work for piecewise-constant torques, since
         // steps land on their breakpoints.
         let t_mid = t0 + 0.5 * h;
-        let delta = FD_STEP * cx.length_scale.max(1.0);
         // Start-of-step momentum and potential.
         cx.chain
             .residual_parts(t_mid, &st.q, &w.zero, &st.qd, Parts::INERTIA, &mut w.p0);
@@ -354,15 +327,10 @@ impl Stepper for EnergyMidpoint {
             // ∇g(q̄) = ∂T/∂q(q̄, v̄) − ∂T/∂q(q̄, ½Δv).
             w.grad_g.iter_mut().for_each(|x| *x = 0.0);
             for (x, sign) in [(&w.vbar, 1.0), (&w.half_dv, -1.0)] {
-                let s = Scratch {
-                    out: &mut w.grad_g,
-                    zero: &w.zero,
-                    qp: &mut w.qp,
-                    tmp: &mut w.tmp,
-                    tmp2: &mut w.tmp2,
-                };
-                passes += add_kinetic_gradient(cx.chain, t_mid, &w.qbar, x, delta, sign, s);
+                cx.chain
+                    .add_kinetic_gradient(t_mid, &w.qbar, x, sign, &mut w.grad_g);
             }
+            passes += 2;
             // Metric W = M(q̄).
             cx.chain
                 .residual_parts(t_mid, &w.qbar, &w.zero, &w.dq, Parts::INERTIA, &mut w.w_dq);
