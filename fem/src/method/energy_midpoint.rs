@@ -35,7 +35,11 @@
 //! the derivative of R(q̄, v̄, a), not of the discrete equations, and the correction term is not
 //! differentiated (quasi-Newton), so convergence is linear — about 1e-2..1e-3 per iteration.
 //! The matrix is re-formed every 6th iteration only while the update is above tolerance: the
-//! iterations that only reduce the energy defect keep it, as it still contracts.
+//! iterations that only reduce the energy defect keep it, as it still contracts. Runs without
+//! contact accelerate the iteration (Anderson, depth 3, history restarted with every new
+//! matrix; [`Anderson`]): on `two-link-free-undamped` 7.9 → 7.05 iterations and 1.27 → 1.10
+//! matrices per step; the convergence test is unchanged (update and energy defect at the
+//! evaluated point).
 //! The iterate is accepted at the point where the residual was evaluated, so the
 //! booked energies and works are those of the equations actually solved.
 //!
@@ -114,6 +118,8 @@ pub struct MidpointWork {
     /// the point acceleration of a (re)start), and that step's length.
     have_prev: bool,
     h_prev: f64,
+    /// Anderson acceleration of the quasi-Newton iteration (runs without contact).
+    anderson: Anderson,
     /// Works of the step being taken, added to the ledger on acceptance.
     pending: Works,
     /// Last Gonzalez correction factor relative to the midpoint-gradient work (diagnostic).
@@ -136,6 +142,7 @@ impl MidpointWork {
             w_dq: z.clone(),
             res: z.clone(),
             zero: z,
+            anderson: Anderson::new(n),
             have_prev: false,
             h_prev: 0.0,
             pending: Works::default(),
@@ -159,6 +166,129 @@ impl MidpointWork {
         self.have_prev = true;
         self.h_prev = h;
     }
+}
+
+/// History length of [`Anderson`].
+const ANDERSON_DEPTH: usize = 3;
+
+/// Anderson acceleration (type II, depth [`ANDERSON_DEPTH`]) of the fixed-point iteration
+/// a ↦ a + f(a), f = −S⁻¹·res(a) the quasi-Newton update: with the differences Δa_j, Δf_j of
+/// the last iterates, γ = argmin‖f − ΔF γ‖₂ (normal equations, m ≤ 3) and
+/// a ← a + f − (ΔA + ΔF)γ. The quasi-Newton map is nearly affine (S fixed, residual smooth):
+/// the differences then span its slowly contracting directions and the extrapolation removes
+/// them. Buffers allocated once.
+#[derive(Debug, Clone)]
+struct Anderson {
+    n: usize,
+    len: usize,
+    next: usize,
+    da: Vec<f64>,
+    df: Vec<f64>,
+    a_last: Vec<f64>,
+    f_last: Vec<f64>,
+    have_last: bool,
+}
+
+impl Anderson {
+    fn new(n: usize) -> Self {
+        Anderson {
+            n,
+            len: 0,
+            next: 0,
+            da: vec![0.0; ANDERSON_DEPTH * n],
+            df: vec![0.0; ANDERSON_DEPTH * n],
+            a_last: vec![0.0; n],
+            f_last: vec![0.0; n],
+            have_last: false,
+        }
+    }
+
+    fn reset(&mut self) {
+        self.len = 0;
+        self.next = 0;
+        self.have_last = false;
+    }
+
+    /// Replaces `a` by the accelerated iterate; `delta` = S⁻¹·res(a) (f = −delta).
+    fn advance(&mut self, a: &mut [f64], delta: &[f64]) {
+        let n = self.n;
+        if self.have_last {
+            let col = self.next * n;
+            for i in 0..n {
+                self.da[col + i] = a[i] - self.a_last[i];
+                self.df[col + i] = -delta[i] - self.f_last[i];
+            }
+            self.next = (self.next + 1) % ANDERSON_DEPTH;
+            self.len = (self.len + 1).min(ANDERSON_DEPTH);
+        }
+        self.a_last.copy_from_slice(a);
+        for i in 0..n {
+            self.f_last[i] = -delta[i];
+        }
+        self.have_last = true;
+        let m = self.len;
+        let mut gamma = [0.0; ANDERSON_DEPTH];
+        if m > 0 {
+            let mut g = [[0.0; ANDERSON_DEPTH + 1]; ANDERSON_DEPTH];
+            for j in 0..m {
+                let dj = &self.df[j * n..(j + 1) * n];
+                for k in 0..=j {
+                    let v = dot(dj, &self.df[k * n..(k + 1) * n]);
+                    g[j][k] = v;
+                    g[k][j] = v;
+                }
+                g[j][m] = dot(dj, &self.f_last);
+            }
+            if !solve_small(&mut g, m, &mut gamma) {
+                // Nearly dependent differences (round-off near convergence): plain step.
+                gamma = [0.0; ANDERSON_DEPTH];
+            }
+        }
+        for i in 0..n {
+            let mut x = a[i] + self.f_last[i];
+            for j in 0..m {
+                x -= gamma[j] * (self.da[j * n + i] + self.df[j * n + i]);
+            }
+            a[i] = x;
+        }
+    }
+}
+
+/// Solves the m × m system in the first m columns of `g` (right-hand side in column m) by
+/// Gaussian elimination with partial pivoting; false when a pivot is below 1e-12 of the
+/// largest diagonal (then `x` is not written).
+fn solve_small(
+    g: &mut [[f64; ANDERSON_DEPTH + 1]; ANDERSON_DEPTH],
+    m: usize,
+    x: &mut [f64; ANDERSON_DEPTH],
+) -> bool {
+    let dmax = (0..m).fold(0.0f64, |a, i| a.max(g[i][i].abs()));
+    if dmax.is_nan() || dmax <= 0.0 || !dmax.is_finite() {
+        return false;
+    }
+    for k in 0..m {
+        let p = (k..m)
+            .max_by(|&i, &j| g[i][k].abs().total_cmp(&g[j][k].abs()))
+            .unwrap_or(k);
+        g.swap(k, p);
+        if g[k][k].abs() <= 1e-12 * dmax {
+            return false;
+        }
+        for i in k + 1..m {
+            let l = g[i][k] / g[k][k];
+            for j in k..=m {
+                g[i][j] -= l * g[k][j];
+            }
+        }
+    }
+    for k in (0..m).rev() {
+        let mut v = g[k][m];
+        for j in k + 1..m {
+            v -= g[k][j] * x[j];
+        }
+        x[k] = v / g[k][k];
+    }
+    true
 }
 
 /// ∂T/∂q at (q, x) with T = ½xᵀM(q)x, analytic ([`Chain::add_kinetic_gradient`], the one the
@@ -290,6 +420,10 @@ impl Stepper for EnergyMidpoint {
         let mut polish_tol = 0.0;
         let mut last_defect = f64::INFINITY;
         let mut iterations = 0;
+        // Anderson acceleration where the quasi-Newton map is smooth: no contact (impacts and
+        // releases keep the unilateral-contact iteration's own safeguards; a bordered (a, λ)
+        // system updates λ beside a).
+        let accelerate = !robust && constraint.is_none();
         for it in 0..MAX_ITERATIONS {
             for i in 0..n {
                 let a = st.qdd1[i];
@@ -482,8 +616,16 @@ impl Stepper for EnergyMidpoint {
                 forced += 1;
             }
             last = dq;
-            for i in 0..n {
-                st.qdd1[i] -= cx.newton.delta[i];
+            if accelerate {
+                if formed_it == Some(it) {
+                    // A new matrix is a new fixed-point map: its history starts here.
+                    w.anderson.reset();
+                }
+                w.anderson.advance(&mut st.qdd1, &cx.newton.delta);
+            } else {
+                for i in 0..n {
+                    st.qdd1[i] -= cx.newton.delta[i];
+                }
             }
             lambda -= dlambda;
         }
