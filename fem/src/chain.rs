@@ -196,6 +196,10 @@ pub struct Chain {
     pos: Vec<Vec<[f64; 2]>>,
     /// Local velocity ṗ at each Gauss point (for the Coriolis part of the Newton matrix).
     vel: Vec<Vec<[f64; 2]>>,
+    /// Velocity c = u + ω ẑ×p + ṗ of each Gauss point in its link frame, at the generalized
+    /// velocity of the last [`Chain::add_kinetic_gradient`] call (its own buffer: the Newton
+    /// matrix reads `pos`/`vel` of the last full residual).
+    kin_vel: Vec<Vec<[f64; 2]>>,
     /// Per link, per element, per sub-interval: tail axial load T (foreshortening).
     tail: Vec<Vec<f64>>,
     /// Generalized joint torque each joint's actuator needs (prescribed) or applies (free).
@@ -344,6 +348,7 @@ impl Chain {
             .map(|m| vec![[0.0; 2]; m.n_el * m.element.quad.ng])
             .collect();
         let vel = pos.clone();
+        let kin_vel = pos.clone();
         let tail = models
             .iter()
             .map(|m| vec![0.0; m.n_el * (m.element.quad.ng + 1)])
@@ -358,6 +363,7 @@ impl Chain {
             force,
             pos,
             vel,
+            kin_vel,
             tail,
             joint_torque: vec![0.0; nl],
             tip_load: 0.0,

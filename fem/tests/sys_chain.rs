@@ -142,7 +142,7 @@ fn sys_newton_matrix_is_the_residual_derivative() {
 fn sys_mass_product_and_kinetic_gradient_match_the_reported_kinetic_energy() {
     // The energy-midpoint ingredients against finite differences of `energies()`' kinetic term
     // T(q, x) = ½xᵀM(q)x: M(q)x = ∂T/∂x (T is quadratic in x: central differences are exact up
-    // to round-off), ½xᵀM(q)x = T, and ∂T/∂q from Ṁ(x)x − R_in(q, x, 0).
+    // to round-off), ½xᵀM(q)x = T, and the analytic ∂T/∂q.
     for (name, fs, element) in [
         ("single-link", false, CUBIC),
         ("single-link", true, CUBIC),
@@ -153,13 +153,7 @@ fn sys_mass_product_and_kinetic_gradient_match_the_reported_kinetic_energy() {
         let n = ch.ndof;
         let t = 0.3;
         let mx = fem::method::energy_midpoint::mass_product(&mut ch, t, &q, &x);
-        let dtdq = fem::method::energy_midpoint::kinetic_gradient(
-            &mut ch,
-            t,
-            &q,
-            &x,
-            fem::method::energy_midpoint::FD_STEP,
-        );
+        let dtdq = fem::method::energy_midpoint::kinetic_gradient(&mut ch, t, &q, &x);
         let kinetic = |q: &[f64], x: &[f64]| ch.energies(t, q, x)[0];
         let t0 = kinetic(&q, &x);
         let half_xmx = 0.5 * x.iter().zip(&mx).map(|(a, b)| a * b).sum::<f64>();
@@ -179,8 +173,8 @@ fn sys_mass_product_and_kinetic_gradient_match_the_reported_kinetic_energy() {
             b[i] -= e;
             let fd = (kinetic(&q, &a) - kinetic(&q, &b)) / (2.0 * e);
             worst_m = worst_m.max((fd - mx[i]).abs() / mscale);
-            // ∂T/∂q: fourth-order central difference (the error of the check stays below the
-            // tolerance; the scheme's own ε = 1e-5 difference is accurate to ~1e-10).
+            // ∂T/∂q: fourth-order central difference (truncation ~h⁴ = 1e-12 relative, far
+            // below the tolerance).
             let h = 1e-3;
             let tq = |s: f64| {
                 let mut p = q.clone();
@@ -299,5 +293,54 @@ fn sys_newton_solve_of_real_chain_matrices_is_backward_stable() {
         let bound = n as f64 * f64::EPSILON * norm_s * norm_x;
         eprintln!("{name}: n = {n}, ‖Sx − r‖ = {res:.2e}, bound {bound:.2e}");
         assert!(res <= bound, "{name}: ‖Sx − r‖ = {res:e} > {bound:e}");
+    }
+}
+
+#[test]
+fn sys_analytic_kinetic_gradient_matches_the_finite_difference_identity_at_real_states() {
+    // ∂T/∂q(q, x) of the analytic sweep against Ṁ(x)x − R_in(q, x, 0) with Ṁ(x)x by central
+    // differences of M(q)x (an independent route through the residual's inertial pass), at the
+    // default runs advanced to 0.25 s with x = the run's velocity and x = ½hq̈ (the two vectors
+    // the energy-midpoint step uses). The central difference errs relative to the terms it
+    // differences, ‖x‖∞‖M(q)x‖∞ (links of order 1): truncation ~(ε‖x‖∞)² = FD_STEP² = 1e-10,
+    // round-off ~1e-16/FD_STEP = 1e-11; 1e-8 of that scale leaves a factor 100 for the third
+    // derivatives. (∂T/∂q itself can be far smaller where x is mostly elastic.)
+    use fem::method::energy_midpoint::{
+        FD_STEP, kinetic_gradient, kinetic_gradient_fd, mass_product,
+    };
+    for name in ["two-link-free", "barhorst-case1"] {
+        let sc = data::load_scene(name).unwrap();
+        let mut p = fem::run::prepare(&sc, &data::Settings::default()).unwrap();
+        p.driver.set_stop(0.25);
+        while p.driver.state.t < 0.25 - 1e-12 {
+            p.driver.step().unwrap();
+        }
+        let h = p.h_nominal;
+        let st = &p.driver.state;
+        let (t, q) = (st.t, st.q.clone());
+        let half_dv: Vec<f64> = st.qdd.iter().map(|a| 0.5 * h * a).collect();
+        let mut ch = p.driver.chain.clone();
+        for (label, x) in [("velocity", st.qd.clone()), ("½hq̈", half_dv)] {
+            let exact = kinetic_gradient(&mut ch, t, &q, &x);
+            let oracle = kinetic_gradient_fd(&mut ch, t, &q, &x, FD_STEP);
+            let norm = |v: &[f64]| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+            let scale = norm(&x) * norm(&mass_product(&mut ch, t, &q, &x));
+            let worst = exact
+                .iter()
+                .zip(&oracle)
+                .fold(0.0f64, |a, (e, o)| a.max((e - o).abs()));
+            eprintln!(
+                "{name} x = {label}: |∂T/∂q| {:.3e}, ‖x‖‖Mx‖ {scale:.3e}, analytic − FD {worst:.2e}",
+                norm(&exact)
+            );
+            assert!(
+                norm(&exact) > 0.0,
+                "{name}: zero kinetic gradient at a moving state"
+            );
+            assert!(
+                worst < 1e-8 * scale,
+                "{name} x = {label}: {worst:.3e} of {scale:.3e}"
+            );
+        }
     }
 }

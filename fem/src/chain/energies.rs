@@ -1,8 +1,20 @@
 //! Energies and powers at a state: kinetic, strain, joint-spring and gravity energies, the
-//! power of the applied loads and the dissipated powers (the ledger's terms).
+//! power of the applied loads and the dissipated powers (the ledger's terms), and the gradient
+//! ∂T/∂q of the kinetic energy.
+//!
+//! ∂T/∂q(q, x) of T = ½xᵀM(q)x in one forward and one backward sweep: T is invariant under a
+//! rigid rotation, so it is written in link-frame coordinates. Link i turns at ω_i (linear in
+//! x, free of q); its origin moves at u_i (frame coordinates), u₁ = 0 (fixed root) and
+//! u_{i+1} = A(γ_{i+1})ᵀ c_tip,i with γ_{i+1} = β_tip,i + θ_{i+1}; a point at local position
+//! p = (x + s(x) or x + u(x), v(x)) moves at c = u_i + ω_i ẑ×p + ṗ and T = Σ ½ m|c|² + rotary
+//! terms ½I(φ̇ + β̇)² that do not depend on q. With g = m c: ∂T/∂u_i = Σ g, ∂T/∂p = ω(g_y, −g_x),
+//! ∂T/∂ṗ = g; p_y = N·d, and p_x, ṗ_x reach the transverse DOFs through s(x) = −½∫v′²,
+//! ṡ(x) = −∫v′v̇′ (the same sub-interval quadrature as the residual, applied through the tail
+//! sums of ∂T/∂p_x and ∂T/∂ṗ_x); ∂u_{i+1}/∂γ = −ẑ×u_{i+1}, and the parent receives
+//! A(γ)∂T/∂u_{i+1} at its tip. Exact for the quadrature (no difference step).
 
-use super::geometry::{add, dot, perp, rot, scale};
-use super::{Chain, FrameState, dotn};
+use super::geometry::{add, dot, perp, rot, rot_t, scale};
+use super::{Chain, FrameState, MAX_LINKS, NONE, dotn};
 
 impl Chain {
     /// Stored energies at a state: (kinetic, strain, joint_spring, gravity).
@@ -100,6 +112,170 @@ impl Chain {
             parent = Some((fs, r_tip, v_tip));
         }
         [kin, strain, spring, grav]
+    }
+
+    /// Adds `sign`·∂T/∂q(q, x) to `out`, T = ½xᵀM(q)x the kinetic energy at generalized
+    /// velocity x (module docs; prescribed joints move at their law's rate at t). O(n), no
+    /// allocation.
+    pub fn add_kinetic_gradient(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        x: &[f64],
+        sign: f64,
+        out: &mut [f64],
+    ) {
+        let nl = self.links.len();
+        let mut omega = [0.0; MAX_LINKS];
+        let mut u_frame = [[0.0; 2]; MAX_LINKS];
+        let mut gamma = [0.0; MAX_LINKS];
+        let mut c_tip = [[0.0; 2]; MAX_LINKS];
+        // Forward sweep: frame rates, frame-origin velocities and point velocities.
+        for li in 0..nl {
+            let l = &self.links[li];
+            let tb = &l.element.quad;
+            let (th, dth) = match l.joint.prescribed_at(t) {
+                Some((a, r, _)) => (a, r),
+                None => (q[l.joint.dof], x[l.joint.dof]),
+            };
+            let (w, u) = if li == 0 {
+                (dth, [0.0; 2])
+            } else {
+                let pl = &self.links[li - 1];
+                let k = pl.n_el;
+                let g = Self::val(q, pl.r_dof[k]) + th;
+                gamma[li] = g;
+                (
+                    omega[li - 1] + Self::val(x, pl.r_dof[k]) + dth,
+                    rot_t(g, c_tip[li - 1]),
+                )
+            };
+            omega[li] = w;
+            u_frame[li] = u;
+            let (mut s, mut sd) = (0.0, 0.0);
+            // An extensible link carries its axial field instead of the foreshortening.
+            let fs = l.foreshortening && !l.axial;
+            let ne = l.ne;
+            for e in 0..l.n_el {
+                let dofs = l.elem_dofs(e);
+                let d = Self::elem_v(q, &dofs);
+                let dd = Self::elem_v(x, &dofs);
+                let u_ax = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
+                let ud_ax = [Self::val(x, l.u_dof[e]), Self::val(x, l.u_dof[e + 1])];
+                let xa = e as f64 * l.h;
+                for j in 0..tb.ng + 1 {
+                    if fs {
+                        for k in 0..tb.nsg {
+                            let dn = &tb.sub_dn[j][k];
+                            let wgt = tb.sub_wh[j][k];
+                            let vp = dotn(dn, &d, ne);
+                            s -= 0.5 * wgt * vp * vp;
+                            sd -= wgt * vp * dotn(dn, &dd, ne);
+                        }
+                    }
+                    if j == tb.ng {
+                        continue;
+                    }
+                    let xi = tb.xi[j];
+                    let (ax, axd) = if l.axial {
+                        (
+                            (1.0 - xi) * u_ax[0] + xi * u_ax[1],
+                            (1.0 - xi) * ud_ax[0] + xi * ud_ax[1],
+                        )
+                    } else if fs {
+                        (s, sd)
+                    } else {
+                        (0.0, 0.0)
+                    };
+                    let p = [xa + xi * l.h + ax, dotn(&tb.n[j], &d, ne)];
+                    let pd = [axd, dotn(&tb.n[j], &dd, ne)];
+                    self.kin_vel[li][e * tb.ng + j] = add(u, add(scale(w, perp(p)), pd));
+                }
+            }
+            let k = l.n_el;
+            let (ut, utd) = if l.axial {
+                (Self::val(q, l.u_dof[k]), Self::val(x, l.u_dof[k]))
+            } else if fs {
+                (s, sd)
+            } else {
+                (0.0, 0.0)
+            };
+            let p = [l.length + ut, Self::val(q, l.v_dof[k])];
+            let pd = [utd, Self::val(x, l.v_dof[k])];
+            c_tip[li] = add(u, add(scale(w, perp(p)), pd));
+        }
+        // Backward sweep: g = m c at the points, ∂T/∂u_i accumulated in `big_g`.
+        let mut put = |i: usize, v: f64| {
+            if i != NONE {
+                out[i] += sign * v;
+            }
+        };
+        let mut child = [0.0; 2];
+        for li in (0..nl).rev() {
+            let l = &self.links[li];
+            let tb = &l.element.quad;
+            let w = omega[li];
+            let k = l.n_el;
+            let g_tip = add(scale(l.tip_mass, c_tip[li]), child);
+            let mut big_g = g_tip;
+            put(l.v_dof[k], -w * g_tip[0]);
+            put(l.u_dof[k], w * g_tip[1]);
+            // Tail sums of ∂T/∂p_x and ∂T/∂ṗ_x (foreshortening).
+            let (mut tail_s, mut tail_sd) = (w * g_tip[1], g_tip[0]);
+            // An extensible link carries its axial field instead of the foreshortening.
+            let fs = l.foreshortening && !l.axial;
+            let ne = l.ne;
+            for e in (0..l.n_el).rev() {
+                let dofs = l.elem_dofs(e);
+                let d = Self::elem_v(q, &dofs);
+                let dd = Self::elem_v(x, &dofs);
+                let mut fe = [0.0; super::MAXE];
+                let (mut fu0, mut fu1) = (0.0, 0.0);
+                for j in (0..tb.ng + 1).rev() {
+                    if fs {
+                        for kk in 0..tb.nsg {
+                            let dn = &tb.sub_dn[j][kk];
+                            let c = -tb.sub_wh[j][kk]
+                                * (tail_s * dotn(dn, &d, ne) + tail_sd * dotn(dn, &dd, ne));
+                            for a in 0..ne {
+                                fe[a] += c * dn[a];
+                            }
+                        }
+                    }
+                    if j == 0 {
+                        continue;
+                    }
+                    let gp = j - 1;
+                    let g = scale(l.rho_a * tb.wh[gp], self.kin_vel[li][e * tb.ng + gp]);
+                    big_g = add(big_g, g);
+                    for a in 0..ne {
+                        fe[a] -= w * g[0] * tb.n[gp][a];
+                    }
+                    if l.axial {
+                        let xi = tb.xi[gp];
+                        fu0 += w * g[1] * (1.0 - xi);
+                        fu1 += w * g[1] * xi;
+                    }
+                    tail_s += w * g[1];
+                    tail_sd += g[0];
+                }
+                for a in 0..ne {
+                    put(dofs[a], fe[a]);
+                }
+                if l.axial {
+                    put(l.u_dof[e], fu0);
+                    put(l.u_dof[e + 1], fu1);
+                }
+            }
+            if li > 0 {
+                // u_i = A(γ)ᵀ c_tip,i−1: ∂u_i/∂γ = −ẑ×u_i.
+                let dg = -dot(big_g, perp(u_frame[li]));
+                put(l.joint.dof, dg);
+                let pl = &self.links[li - 1];
+                put(pl.r_dof[pl.n_el], dg);
+                child = rot(gamma[li], big_g);
+            }
+        }
     }
 
     /// Power of the applied transverse loads, Qᵀq̇ (constant loads: exact work over a
