@@ -59,6 +59,7 @@ mod energies;
 mod forces;
 mod geometry;
 mod kinematics;
+pub mod linearized;
 mod newton;
 /// Longest chain the backend builds (fixed-size per-point column buffers, no allocation).
 pub const MAX_LINKS: usize = 6;

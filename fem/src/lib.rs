@@ -168,10 +168,6 @@
 
 pub mod band;
 pub mod chain;
-/// Modes of chain scenes: K x = ω² M x of the chain linearized about its set points, from the
-/// chain's own Newton-matrix pieces (an `impl Chain` block kept beside the chain's passes).
-#[path = "chain/linearized.rs"]
-pub mod chain_modes;
 pub mod driver;
 pub mod element;
 pub mod error;
@@ -315,8 +311,8 @@ impl Backend for FemBackend {
         if rocket::the_rocket(scene).is_some() {
             return Ok(rocket::modes(scene, settings, count)?);
         }
-        if chain_modes::applies(scene) {
-            return Ok(chain_modes::modes(scene, settings, count)?);
+        if chain::linearized::applies(scene) {
+            return Ok(chain::linearized::modes(scene, settings, count)?);
         }
         Ok(self.modes_impl(scene, settings, count)?)
     }

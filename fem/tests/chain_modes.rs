@@ -1,4 +1,4 @@
-//! Linearized modes of the two-link chain (`modes two-link-free`, `fem::chain_modes`): the DOF
+//! Linearized modes of the two-link chain (`modes two-link-free`, `fem::chain::linearized`): the DOF
 //! count, the linearized pieces against the residual, the single-beam limits K → ∞ (clamped–free
 //! beam of length L₁ + L₂) and K₁ → 0 (pinned–free), computed here from the scene, and the
 //! frequencies converging at order 4 with the elements.
