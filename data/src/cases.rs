@@ -193,6 +193,7 @@ case_files!(
     "statics",
     "dynamics",
     "rocket",
+    "rocket_layers",
     "convergence",
     "friction",
     "contact",
