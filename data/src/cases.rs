@@ -194,6 +194,7 @@ case_files!(
     "statics",
     "dynamics",
     "rocket",
+    "rocket_layers",
     "convergence",
     "friction",
     "contact",

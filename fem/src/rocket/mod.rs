@@ -611,12 +611,38 @@ pub fn rocket_modes(model: &Model, count: usize) -> Result<Vec<RocketMode>, FemE
         }
         e[j] = 0.0;
     }
-    let (lam, x) = crate::modes::generalized_eigen(&k, &mm)?;
-    const RIGID: usize = 3;
-    if lam.len() <= RIGID || lam[RIGID - 1].abs() > 1e-6 * lam[RIGID] {
+    // K is singular (three rigid modes): a Cholesky of K may still succeed on round-off pivots
+    // and then ranks the rigid modes' 1/λ as the largest, pushing the elastic ones below the
+    // solver's round-off floor. Solve the shifted pencil (K + σM, M), positive definite, and
+    // shift back; σ of the order of the elastic spectrum (the smallest K_ii/M_ii) keeps the
+    // relative accuracy of the lowest elastic λ near σ/λ·ε.
+    let sigma = (0..n)
+        .filter(|&i| k[(i, i)] > 0.0 && mm[(i, i)] > 0.0)
+        .map(|i| k[(i, i)] / mm[(i, i)])
+        .fold(f64::INFINITY, f64::min);
+    if !sigma.is_finite() {
         return Err(FemError::Numerical {
             t: 0.0,
-            message: "free-free rocket: the three rigid-body modes were not found".into(),
+            message: "free-free rocket: no stiffness on any degree of freedom".into(),
+        });
+    }
+    let mut k_shifted = k.clone();
+    for j in 0..n {
+        for i in 0..n {
+            k_shifted[(i, j)] += sigma * mm[(i, j)];
+        }
+    }
+    let (mut lam, x) = crate::modes::generalized_eigen(&k_shifted, &mm)?;
+    lam.iter_mut().for_each(|l| *l -= sigma);
+    const RIGID: usize = 3;
+    if lam.len() <= RIGID || lam[..RIGID].iter().any(|l| l.abs() > 1e-6 * lam[RIGID]) {
+        return Err(FemError::Numerical {
+            t: 0.0,
+            message: format!(
+                "free-free rocket: the three rigid-body modes were not found (σ = {sigma:.3e}, \
+                 lowest eigenvalues {:?})",
+                &lam[..lam.len().min(5)]
+            ),
         });
     }
     let mut out = Vec::new();

@@ -19,6 +19,9 @@
 //!   with the payload's mass, offset and inertia (rotating, hub-coupled), torsion, axial, linear
 //!   and large-deflection sag (the seed's formula against the elastica), the rigid-base limit.
 //! * [`rocket`] — rigid translation of the variable-mass rocket (rocket equation with gravity).
+//! * [`rocket_modes`] — free-free axial and bending frequencies of the rocket at ignition: the
+//!   stepped beam with its spring-mounted, spring-coupled masses, exact dynamic stiffness and
+//!   the Wittrick–Williams count.
 //! * [`numerics`] — the root finder, the adaptive Runge–Kutta and double-double arithmetic,
 //!   written here so that no code is shared with a backend.
 
@@ -29,6 +32,7 @@ pub mod numerics;
 pub mod payload_link;
 pub mod rigid;
 pub mod rocket;
+pub mod rocket_modes;
 pub mod rotating;
 pub mod statics;
 pub mod timoshenko;

@@ -21,6 +21,7 @@
 //! | `payload-static-sag` | `tip_static` | 3-D link: linear sag w_L under self-weight, payload weight and its offset moment |
 //! | `payload-rigid-base` | `joint1.angle@T`, `joint1.rate@T` | 3-D link, E, G → ∞: (I_B + ρAL³/3 + ρIL + m(L + c)² + I₃) θ̈ = T_mot − b_m θ̇ |
 //! | `rocket-translation` | `rocket.vX@T`, `rocket.vY@T`, `rocket.mass@T` | rocket equation with gravity: material (momentum / mass) velocity |
+//! | `rocket-free-free` | `freqN`, `bending_freqN`, `axial_freqN` | rocket at ignition: stepped free-free beam with the spring-mounted, spring-coupled masses (exact dynamic stiffness, Wittrick–Williams count) |
 
 use data::Scene;
 use data::scene::Link;
@@ -279,6 +280,31 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
                 ],
             )
         }
+        "rocket-free-free" => {
+            use ana::rocket_modes::{FreeFreeRocket, Motion};
+            let Quantity::Frequency { n, kind } = q else {
+                return Err(
+                    "`rocket-free-free` applies to `freqN`, `bending_freqN` and `axial_freqN`"
+                        .into(),
+                );
+            };
+            let body = FreeFreeRocket::from_scene(scene).map_err(|e| e.to_string())?;
+            let of = |m: Motion| body.frequencies_hz(m, *n);
+            match kind.as_deref() {
+                Some("axial") => nth(of(Motion::Axial), *n),
+                Some("bending") => nth(of(Motion::Transverse), *n),
+                // both fields merged into one ascending spectrum
+                None => {
+                    let mut all = of(Motion::Axial).map_err(|e| e.to_string())?;
+                    all.extend(of(Motion::Transverse).map_err(|e| e.to_string())?);
+                    all.sort_by(f64::total_cmp);
+                    nth(Ok(all), *n)
+                }
+                Some(other) => Err(format!(
+                    "`rocket-free-free` has axial and bending modes, not `{other}`"
+                )),
+            }
+        }
         "payload-horizontal" | "payload-vertical" => {
             let p = payload_link(scene)?;
             let plane_name = id.trim_start_matches("payload-");
@@ -333,7 +359,8 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             "unknown analytic reference `{other}`; known: clamped-free, tip-mass, timoshenko, \
              axial-clamped-free, rotating-in-plane, spring-jointed-chain, chain-clamped-limit, \
              chain-pinned-limit, static-linear, rigid-single-link, rigid-two-link, \
-             constrained-rigid-link, rocket-translation, tip-mass-momentum-limit, payload-horizontal, \
+             constrained-rigid-link, rocket-translation, rocket-free-free, tip-mass-momentum-limit, \
+             payload-horizontal, \
              payload-vertical, payload-torsion, payload-axial, payload-static-sag, payload-rigid-base"
         )),
     }
@@ -341,6 +368,18 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
 
 /// The analytic reference that naturally applies to a quantity on a scene, if any.
 pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
+    if scene.rocket.is_some() {
+        return match q {
+            Quantity::Frequency { kind, .. }
+                if kind
+                    .as_deref()
+                    .is_none_or(|k| k == "bending" || k == "axial") =>
+            {
+                Some("rocket-free-free".to_string())
+            }
+            _ => None,
+        };
+    }
     if scene.payload_link.is_some() {
         let id = match q {
             Quantity::Frequency {
