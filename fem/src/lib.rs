@@ -107,7 +107,7 @@
 //!   sections without Kelvin–Voigt. Without contact nothing is allocated.
 //!
 //! ## Bilateral wall with Coulomb friction (seed 001, `constrained-arm`)
-//! [`events::friction`] with the geometry in [`events::wall`] (circle g = R − |r_tip − c|, n̂ = −(r − c)/|r − c|,
+//! [`events::contact::friction`] with the geometry in [`events::wall`] (circle g = R − |r_tip − c|, n̂ = −(r − c)/|r − c|,
 //! t̂ counter-clockwise, κ = 1/|r − c|; or a line). The tip is on the wall from t = 0 and never
 //! released (λ of either sign); the scene's default method becomes `energy-midpoint`.
 //! * Constraint as in the constrained phase above (discrete gradient, g(q₁) = 0 in Newton):
@@ -122,7 +122,7 @@
 //! * Stick–slip: s·v_t = 0 and μ|λ_n| − |λ_t| = 0 located inside the step (secant on the step
 //!   length), Coulomb cone test at the stop, stick = second constraint t̂_s·(r − p_s) = 0 with
 //!   its own discrete gradient (no work), same test at t = 0; events `StickSlip`; phase channel
-//!   1 sliding / 2 sticking; no-chattering rule in [`events::friction`].
+//!   1 sliding / 2 sticking; no-chattering rule in [`events::contact::friction`].
 //! * Refused: the inextensible link on the circle of radius L about its hub (simple flexure =
 //!   the rigid model), Timoshenko links without rotary inertia (M singular).
 //!

@@ -302,7 +302,7 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
             // Impacts, releases and grazing contacts (crate::events::contact, crate::events::massless).
             integ.enable_unilateral_contact()?;
         }
-        // Bilateral wall: on the surface from t = 0, initial Coulomb test (crate::events::friction).
+        // Bilateral wall: on the surface from t = 0, initial Coulomb test (crate::events::contact::friction).
         integ.bilateral_start()?;
     }
     // Explicit central difference: the step under its stability bound; the implicit methods:
@@ -381,7 +381,7 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
         specs.push(channel::spec::contact_max_gap(1));
         specs.push(channel::spec::contact_max_normal_velocity(1));
         if scene.contacts[0].friction > 0.0 {
-            // Friction contact (crate::events::friction): slip velocity, tangential force, work.
+            // Friction contact (crate::events::contact::friction): slip velocity, tangential force, work.
             specs.push(channel::spec::contact_slip_velocity(1));
             specs.push(channel::spec::contact_friction_force(1));
             specs.push(channel::spec::contact_friction_work(1));
@@ -413,7 +413,7 @@ fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<
     }
     if let Some(c) = integ.contact.as_deref() {
         buf.push(c.lambda);
-        buf.push(crate::events::friction::phase(c));
+        buf.push(crate::events::contact::friction::phase(c));
         buf.push(c.gap);
         buf.push(c.normal_velocity);
         buf.push(c.max_gap);

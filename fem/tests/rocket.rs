@@ -233,3 +233,23 @@ fn dyn_rocket_energy_ledger_closes() {
     let closure = run.ledger.relative_closure();
     assert!(closure < 1e-8, "ledger closure {closure:.3e}");
 }
+
+#[test]
+fn sys_rocket_modes_refused_where_mass_to_mass_springs_depend_on_rotation() {
+    // The catalog rocket couples masses at 125, 130 and 135 in by transverse springs, which fem
+    // measures in fixed launch axes: its free-free modes would lose a rigid-body mode.
+    let sc = scene();
+    match FemBackend.modes(&sc, &settings(Some(30), None), 4) {
+        Err(data::BackendError::Unsupported(why)) => {
+            assert!(why.contains("fixed launch axes"), "{why}")
+        }
+        other => panic!("expected a refusal, got {other:?}"),
+    }
+    // Springs between masses at one station, or without transverse stiffness, are invariant.
+    let mut sc = scene();
+    let r = sc.rocket.as_mut().unwrap();
+    for s in &mut r.springs {
+        s.transverse_stiffness = 0.0;
+    }
+    assert!(FemBackend.modes(&sc, &settings(Some(30), None), 4).is_ok());
+}

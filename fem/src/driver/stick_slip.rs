@@ -1,6 +1,6 @@
 //! Stick–slip switching of the bilateral friction contact in the driver: the friction-sign
 //! check of a step, the slip-stop and breakaway event functions located inside the step, and
-//! the Coulomb test at a switch (rules in [`crate::events::friction`]).
+//! the Coulomb test at a switch (rules in [`crate::events::contact::friction`]).
 
 use data::Event;
 
@@ -8,7 +8,7 @@ use crate::driver::Driver;
 use crate::driver::contact_events::Post;
 use crate::error::FemError;
 use crate::events::contact::{Contact, MAX_EVENTS};
-use crate::events::friction::{Forces, MIN_TRIAL, STICK_VT_TOL, Switch, VT_TOL, sign, sticking};
+use crate::events::contact::friction::{Forces, MIN_TRIAL, STICK_VT_TOL, Switch, VT_TOL, sign, sticking};
 use crate::events::wall::row_along;
 use crate::linalg::dot;
 

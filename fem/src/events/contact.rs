@@ -149,13 +149,15 @@
 //!
 //! Bilateral contacts (circle or line wall, Coulomb friction, stick–slip) reuse the gap,
 //! gradient and bordered Newton of this module with the geometry of [`crate::events::wall`] and are
-//! driven by [`crate::events::friction`] (`Contact::bilateral`).
+//! driven by [`crate::events::contact::friction`] (`Contact::bilateral`).
 //!
 //! Refused with `unsupported`: unilateral circle surfaces, friction on a unilateral contact,
 //! more than one contact, contact with prescribed joint motion, contact on Timoshenko links
 //! without rotary inertia and without Kelvin–Voigt damping (above; for a bilateral wall:
 //! without rotary inertia), and contact with any method other than `energy-midpoint` or with
 //! adaptive stepping (`time.rtol`).
+
+pub mod friction;
 
 use data::Event;
 use data::Scene;
@@ -197,9 +199,9 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
     let Some(c) = scene.contacts.first() else {
         return Ok(());
     };
-    // Bilateral contacts (line or circle, with or without friction): `crate::events::friction`.
+    // Bilateral contacts (line or circle, with or without friction): `crate::events::contact::friction`.
     let bilateral = c.mode == ContactMode::Bilateral;
-    crate::events::friction::check(scene)?;
+    crate::events::contact::friction::check(scene)?;
     if let (false, Surface::Circle { .. }) = (bilateral, &c.surface) {
         return Err(FemError::unsupported(format!(
             "fem: unilateral contact with a circular surface (scene `{}`) is not implemented; \
@@ -288,7 +290,7 @@ pub struct Contact {
     pub(crate) pending_release: Option<Event>,
     /// Bilateral contact (circle or line wall, Coulomb friction, stick–slip): None for the
     /// unilateral line contact of this module.
-    pub bilateral: Option<Box<crate::events::friction::Bilateral>>,
+    pub bilateral: Option<Box<crate::events::contact::friction::Bilateral>>,
     pub(crate) jac: Vec<f64>,
     /// ∇g(q̄), ∇̄g, ∇g(q₁) and S⁻¹∇̄g of the constrained Newton iteration.
     pub(crate) g_mid: Vec<f64>,
@@ -326,7 +328,7 @@ impl Contact {
             .iter()
             .position(|l| l.name == c.link)
             .unwrap_or(0);
-        let bilateral = crate::events::friction::Bilateral::from_scene(c, chain.ndof)?;
+        let bilateral = crate::events::contact::friction::Bilateral::from_scene(c, chain.ndof)?;
         let (point, normal) = match c.surface {
             Surface::Line { point, normal } => (point, normal),
             // The circle's normal depends on the tip position: `bilateral.wall` has it.
@@ -667,7 +669,7 @@ impl Contact {
 /// The contact held in a constrained phase, as the method sees it: the force ∇̄g λ with ∇̄g
 /// the Gonzalez discrete gradient of the gap (metric W = M(q̄), as for the potential, so
 /// Δqᵀ∇̄g = g(q₁) − g(q₀) and the constraint does no work), friction and the stick constraint
-/// of a bilateral wall ([`crate::events::friction`]), and the bordered Newton update.
+/// of a bilateral wall ([`crate::events::contact::friction`]), and the bordered Newton update.
 impl StepConstraint for Contact {
     fn value(&self, chain: &Chain, t: f64, q: &[f64]) -> f64 {
         self.gap_at(chain, t, q)
@@ -705,8 +707,8 @@ impl StepConstraint for Contact {
         c.g_mid = g_mid;
         c.g_end = g_end;
         if c.bilateral.is_some() {
-            // Friction (sliding) or the tangential stick constraint: crate::events::friction.
-            return crate::events::friction::midpoint_terms(c, chain, v, gap1, res);
+            // Friction (sliding) or the tangential stick constraint: crate::events::contact::friction.
+            return crate::events::contact::friction::midpoint_terms(c, chain, v, gap1, res);
         }
         gap1
     }
@@ -720,9 +722,9 @@ impl StepConstraint for Contact {
         gap_target: f64,
     ) -> f64 {
         let c = self;
-        if crate::events::friction::sticking(c) {
-            // Sticking friction contact: two multipliers (crate::events::friction).
-            return crate::events::friction::stick_newton_update(newton, c, res, h);
+        if crate::events::contact::friction::sticking(c) {
+            // Sticking friction contact: two multipliers (crate::events::contact::friction).
+            return crate::events::contact::friction::stick_newton_update(newton, c, res, h);
         }
         let n = res.len();
         // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (h²/2) ∇g(q₁)·δa = g(q₁)

@@ -4,8 +4,8 @@
 //! * [`contact`]: the tip contact — gap g and its gradient G, the constraint force of a held
 //!   phase (discrete gradient, bordered Newton update), the index-1 normal force, the plastic
 //!   impact map and the drift projection (seed 000: impact, constrained sliding, release);
-//! * [`friction`]: the bilateral wall's Coulomb friction and stick constraint, the index-1
-//!   wall forces (seed 001: stick–slip);
+//! * [`contact::friction`]: the bilateral wall's Coulomb friction and stick constraint, the
+//!   index-1 wall forces (seed 001: stick–slip), a refinement of the contact it belongs to;
 //! * [`wall`]: circle and line geometry of a bilateral wall;
 //! * [`massless`]: the balances of massless section rotations in contact runs.
 //!
@@ -14,6 +14,5 @@
 //! [`crate::driver::stick_slip`]): it re-solves the step shorter with the method.
 
 pub mod contact;
-pub mod friction;
 pub mod massless;
 pub mod wall;

@@ -582,6 +582,31 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
     })
 }
 
+/// fem's springs between discrete masses act on w_a − w_b in the launch axes, which a rigid
+/// rotation θ stretches by θ(x_a − x_b) when the masses sit at different stations. In a run the
+/// body turns by less than 1e-8 rad and this is negligible; in the free-free eigenproblem it
+/// turns a rigid-body mode into a spurious elastic one, so `modes` is refused for such scenes
+/// (modal measures these springs in its body frame, verify's `rocket-free-free` in fixed axes:
+/// docs/rocket.md).
+fn refuse_rotation_dependent_springs(scene: &Scene) -> Result<(), FemError> {
+    let Some(rocket) = scene.rocket.as_ref() else {
+        return Ok(());
+    };
+    let position = |k: usize| rocket.discrete_masses.get(k).map(|m| m.position);
+    for s in &rocket.springs {
+        let [a, b] = s.between;
+        if s.transverse_stiffness != 0.0 && position(a) != position(b) {
+            return Err(FemError::unsupported(format!(
+                "fem: free-free modes of `{}`: the transverse spring between discrete masses {a} \
+                 and {b} acts in fixed launch axes, so a rigid rotation stretches it and the \
+                 rigid-body modes are lost; use --backend modal (body-frame springs)",
+                scene.name
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Free-free modes at ignition mass, discrete masses on their springs: K φ = ω² M(0) φ with K
 /// the beam and spring stiffness (no thrust prestress). The three rigid-body modes are dropped.
 pub struct RocketMode {
@@ -667,6 +692,7 @@ pub fn rocket_modes(model: &Model, count: usize) -> Result<Vec<RocketMode>, FemE
 
 pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, FemError> {
     let start = Instant::now();
+    refuse_rotation_dependent_springs(scene)?;
     let model = build(scene, settings)?;
     let modes = rocket_modes(&model, count)?;
     let stations = scene.simulation.field_stations.max(2);
