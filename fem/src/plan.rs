@@ -76,6 +76,7 @@ pub fn dof_plan(
     if scene.gravity.is_some() {
         plan.builds.push("gravity".into());
     }
-    plan.builds.extend(crate::events::contact::friction::describe(scene));
+    plan.builds
+        .extend(crate::events::contact::friction::describe(scene));
     Ok(plan)
 }

@@ -7,8 +7,10 @@ use data::Event;
 use crate::driver::Driver;
 use crate::driver::contact_events::Post;
 use crate::error::FemError;
+use crate::events::contact::friction::{
+    Forces, MIN_TRIAL, STICK_VT_TOL, Switch, VT_TOL, sign, sticking,
+};
 use crate::events::contact::{Contact, MAX_EVENTS};
-use crate::events::contact::friction::{Forces, MIN_TRIAL, STICK_VT_TOL, Switch, VT_TOL, sign, sticking};
 use crate::events::wall::row_along;
 use crate::linalg::dot;
 
