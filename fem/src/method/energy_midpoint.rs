@@ -37,7 +37,7 @@
 //! The matrix is re-formed every 6th iteration only while the update is above tolerance: the
 //! iterations that only reduce the energy defect keep it, as it still contracts. Runs without
 //! contact accelerate the iteration (Anderson, depth 3, history restarted with every new
-//! matrix; [`Anderson`]): on `two-link-free-undamped` 7.9 → 7.05 iterations and 1.27 → 1.10
+//! matrix; `Anderson`): on `two-link-free-undamped` 7.9 → 7.05 iterations and 1.27 → 1.10
 //! matrices per step; the convergence test is unchanged (update and energy defect at the
 //! evaluated point).
 //! The iterate is accepted at the point where the residual was evaluated, so the

@@ -312,7 +312,7 @@ impl SpringJointedChain {
         Ok(out)
     }
 
-    /// The first `count` natural frequencies [Hz].
+    /// The first `count` natural frequencies (Hz).
     pub fn frequencies_hz(&self, count: usize) -> Result<Vec<f64>> {
         Ok(self
             .frequencies(count)?
@@ -337,14 +337,14 @@ impl SpringJointedChain {
         Ok((first.ei, first.rho_a, length))
     }
 
-    /// K → ∞ on every joint: the clamped–free beam of length ΣLᵢ [Hz].
+    /// K → ∞ on every joint: the clamped–free beam of length ΣLᵢ (Hz).
     pub fn clamped_limit_hz(&self, count: usize) -> Result<Vec<f64>> {
         let (ei, rho_a, length) = self.uniform_section()?;
         bending_frequencies_hz(BeamSupport::ClampedFree, ei, rho_a, length, count)
     }
 
     /// K₁ → 0, every other K → ∞: the pinned–free beam of length ΣLᵢ, its rigid rotation (0)
-    /// first [Hz].
+    /// first (Hz).
     pub fn pinned_limit_hz(&self, count: usize) -> Result<Vec<f64>> {
         let (ei, rho_a, length) = self.uniform_section()?;
         let mut out = vec![0.0];

@@ -367,7 +367,7 @@ impl FreeFreeRocket {
         Ok(out)
     }
 
-    /// The first `count` elastic natural frequencies [Hz] of `motion`, ascending.
+    /// The first `count` elastic natural frequencies (Hz) of `motion`, ascending.
     pub fn frequencies_hz(&self, motion: Motion, count: usize) -> Result<Vec<f64>> {
         Ok(self
             .elastic_omegas(motion, count)?

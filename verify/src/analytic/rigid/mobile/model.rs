@@ -530,7 +530,7 @@ const MAX_SYSTEM: usize = MAX_Q + N_CONSTRAINTS;
 
 /// Solves the dense system a x = b of size k ≤ N (the leading k × k block of `a`; `b` receives
 /// x) by nalgebra's partially pivoted LU, on the block bordered by the identity to the fixed
-/// size [`MAX_SYSTEM`], so that the factorization is allocation-free. Errors on a singular or
+/// size `MAX_SYSTEM` (n + constraints), so that the factorization is allocation-free. Errors on a singular or
 /// non-finite system.
 pub fn solve<const N: usize>(a: &[[f64; N]; N], b: &mut [f64; N], k: usize) -> Result<()> {
     const { assert!(N <= MAX_SYSTEM) };
