@@ -236,23 +236,14 @@ impl FemBackend {
                 transverse,
             });
         }
-        Ok(ModalResult {
-            backend: BackendKind::Fem,
-            scene: scene.name.clone(),
-            settings: settings.clone(),
-            frequencies_hz: modes
-                .iter()
-                .map(|m| m.omega / (2.0 * std::f64::consts::PI))
-                .collect(),
-            kinds: modes.iter().map(|m| m.kind.to_string()).collect(),
+        Ok(crate::modes::modal_result(
+            scene,
+            settings,
+            modes.iter().map(|m| (m.omega, m.kind.to_string())),
             shapes,
-            cost: Cost {
-                wall_time_s: start.elapsed().as_secs_f64(),
-                dofs: sys.ndof(),
-                factorizations: 1,
-                ..Default::default()
-            },
-        })
+            sys.ndof(),
+            start,
+        ))
     }
 
     fn statics_impl(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, FemError> {

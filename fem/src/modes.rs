@@ -15,6 +15,35 @@ use faer::{Mat, Side};
 use crate::error::FemError;
 use crate::linear::LinearLink;
 
+/// fem's `modes` answer: angular frequencies ω [rad/s] reported in Hz with their kinds and
+/// shapes, the cost of one factorization of a `dofs`-DOF pencil timed from `start`.
+pub fn modal_result(
+    scene: &data::Scene,
+    settings: &data::Settings,
+    modes: impl Iterator<Item = (f64, String)>,
+    shapes: Vec<data::ModeShape>,
+    dofs: usize,
+    start: std::time::Instant,
+) -> data::ModalResult {
+    let (frequencies_hz, kinds) = modes
+        .map(|(omega, kind)| (omega / (2.0 * std::f64::consts::PI), kind))
+        .unzip();
+    data::ModalResult {
+        backend: data::BackendKind::Fem,
+        scene: scene.name.clone(),
+        settings: settings.clone(),
+        frequencies_hz,
+        kinds,
+        shapes,
+        cost: data::Cost {
+            wall_time_s: start.elapsed().as_secs_f64(),
+            dofs,
+            factorizations: 1,
+            ..Default::default()
+        },
+    }
+}
+
 /// Eigenpairs of the generalized symmetric-definite problem, λ ascending, M-orthonormal vectors
 /// in the columns of the returned matrix (fewer than the DOF count when M is singular).
 pub fn generalized_eigen(k: &Mat<f64>, m: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>), FemError> {

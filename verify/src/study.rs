@@ -609,29 +609,19 @@ pub fn write_study(dir: &Path, study: &Study) -> Result<Vec<String>, Error> {
             )
         })
         .collect();
-    let series: Vec<Series<'_>> = conv
-        .iter()
-        .map(|(l, p)| Series {
-            label: l.clone(),
-            points: p,
-        })
-        .collect();
     let xlabel = if study.refine == "time" {
         "dt"
     } else {
         "h (1/elements, 1/(stations-1), 1/modes)"
     };
-    if let Err(e) = plot(
+    draw_error_plot(
         dir,
         &format!("{stem}-convergence"),
         &format!("{} {}: error vs refinement", study.scene, study.quantity),
         xlabel,
-        "error",
-        &series,
-        true,
-    ) {
-        notes.push(format!("convergence plot not drawn: {e}"));
-    }
+        &conv,
+        &mut notes,
+    );
     let work: Vec<(String, Vec<(f64, f64)>)> = study
         .ladders
         .iter()
@@ -645,24 +635,14 @@ pub fn write_study(dir: &Path, study: &Study) -> Result<Vec<String>, Error> {
             )
         })
         .collect();
-    let series: Vec<Series<'_>> = work
-        .iter()
-        .map(|(l, p)| Series {
-            label: l.clone(),
-            points: p,
-        })
-        .collect();
-    if let Err(e) = plot(
+    draw_error_plot(
         dir,
         &format!("{stem}-work-precision"),
         &format!("{} {}: work-precision", study.scene, study.quantity),
         "wall time, minimum of repeats [s]",
-        "error",
-        &series,
-        true,
-    ) {
-        notes.push(format!("work-precision plot not drawn: {e}"));
-    }
+        &work,
+        &mut notes,
+    );
     // The same against each ladder's work counter (named in the legend): exact, and the
     // primary cost axis for rungs too long to repeat.
     let work: Vec<(String, Vec<(f64, f64)>)> = study
@@ -680,25 +660,37 @@ pub fn write_study(dir: &Path, study: &Study) -> Result<Vec<String>, Error> {
             )
         })
         .collect();
-    let series: Vec<Series<'_>> = work
-        .iter()
-        .map(|(l, p)| Series {
-            label: l.clone(),
-            points: p,
-        })
-        .collect();
-    if let Err(e) = plot(
+    draw_error_plot(
         dir,
         &format!("{stem}-work-counters"),
         &format!("{} {}: error vs work counters", study.scene, study.quantity),
         "work: the ladder's counter (legend) [-]",
-        "error",
-        &series,
-        true,
-    ) {
-        notes.push(format!("work-counter plot not drawn: {e}"));
-    }
+        &work,
+        &mut notes,
+    );
     Ok(notes)
+}
+
+/// One log–log plot of labelled lines of (x, error) points; a plot that cannot be drawn
+/// becomes a note instead of an error (the study's data are written regardless).
+fn draw_error_plot(
+    dir: &Path,
+    name: &str,
+    title: &str,
+    xlabel: &str,
+    lines: &[(String, Vec<(f64, f64)>)],
+    notes: &mut Vec<String>,
+) {
+    let series: Vec<Series<'_>> = lines
+        .iter()
+        .map(|(label, points)| Series {
+            label: label.clone(),
+            points,
+        })
+        .collect();
+    if let Err(e) = plot(dir, name, title, xlabel, "error", &series, true) {
+        notes.push(format!("{name}: plot not drawn: {e}"));
+    }
 }
 
 /// A study for `converge`: [`run_study`] without a rung budget, failing when no

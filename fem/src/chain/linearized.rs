@@ -24,7 +24,7 @@
 //! configuration that gravity does not hold) as −√|ω²|.
 
 use data::scene::PrescribedMotion;
-use data::{BackendKind, Cost, ModalResult, ModeShape, Scene, Settings};
+use data::{ModalResult, ModeShape, Scene, Settings};
 use faer::Mat;
 
 use crate::chain::{Chain, NONE, NewtonCoefficients};
@@ -246,21 +246,12 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
             });
         }
     }
-    Ok(ModalResult {
-        backend: BackendKind::Fem,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        frequencies_hz: modes
-            .iter()
-            .map(|m| m.omega / (2.0 * std::f64::consts::PI))
-            .collect(),
-        kinds: modes.iter().map(|m| m.kind.to_string()).collect(),
+    Ok(crate::modes::modal_result(
+        scene,
+        settings,
+        modes.iter().map(|m| (m.omega, m.kind.to_string())),
         shapes,
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: chain.ndof,
-            factorizations: 1,
-            ..Cost::default()
-        },
-    })
+        chain.ndof,
+        start,
+    ))
 }

@@ -422,23 +422,14 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
             }
         })
         .collect();
-    Ok(ModalResult {
-        backend: BackendKind::Fem,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        frequencies_hz: modes
-            .iter()
-            .map(|m| m.omega / (2.0 * std::f64::consts::PI))
-            .collect(),
-        kinds: modes.iter().map(|m| m.kind.clone()).collect(),
+    Ok(crate::modes::modal_result(
+        scene,
+        settings,
+        modes.iter().map(|m| (m.omega, m.kind.clone())),
         shapes,
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: md.n + usize::from(md.free_base()),
-            factorizations: 1,
-            ..Default::default()
-        },
-    })
+        md.n + usize::from(md.free_base()),
+        start,
+    ))
 }
 
 /// Linear gravity sag K_s d = −f_g (zero without gravity).

@@ -717,23 +717,14 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
             }
         })
         .collect();
-    Ok(ModalResult {
-        backend: BackendKind::Fem,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        frequencies_hz: modes
-            .iter()
-            .map(|m| m.omega / (2.0 * std::f64::consts::PI))
-            .collect(),
-        kinds: modes.iter().map(|m| m.kind.to_string()).collect(),
+    Ok(crate::modes::modal_result(
+        scene,
+        settings,
+        modes.iter().map(|m| (m.omega, m.kind.to_string())),
         shapes,
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: model.n,
-            factorizations: 1,
-            ..Default::default()
-        },
-    })
+        model.n,
+        start,
+    ))
 }
 
 /// Momentum P = T_ξᵀM v, T_ηᵀM v (launch axes) — used by tests.
