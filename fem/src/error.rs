@@ -60,6 +60,17 @@ impl FemError {
     }
 }
 
+/// The diagnostic of a run whose sampled state is no longer finite: the implicit step diverged.
+pub fn non_finite_state(t: f64) -> data::Diagnostic {
+    data::Diagnostic {
+        t,
+        what: "non-finite state".into(),
+        location: None,
+        why: "the implicit step diverged".into(),
+        remedy: "reduce --dt".into(),
+    }
+}
+
 impl From<FemError> for data::BackendError {
     fn from(e: FemError) -> Self {
         use data::BackendError as B;

@@ -58,7 +58,7 @@ use data::channel::spec;
 use data::results::ledger_term;
 use data::scene::MobileManipulator;
 use data::{
-    BackendKind, Cost, Diagnostic, DofPlan, EnergyLedger, Observables, RunResult, Scene, Settings,
+    BackendKind, Cost, DofPlan, EnergyLedger, Observables, RunResult, Scene, Settings,
     StabilityVerdict,
 };
 
@@ -433,13 +433,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         sample(&mut stepper, &mut buf);
         if buf.iter().any(|v| !v.is_finite()) {
             verdict = StabilityVerdict::Stopped {
-                diagnostic: Diagnostic {
-                    t: stepper.t,
-                    what: "non-finite state".into(),
-                    location: None,
-                    why: "the implicit step diverged".into(),
-                    remedy: "reduce --dt".into(),
-                },
+                diagnostic: crate::error::non_finite_state(stepper.t),
             };
             break;
         }

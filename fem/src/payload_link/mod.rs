@@ -69,8 +69,8 @@ use std::time::Instant;
 
 use data::scene::{LinkField, LinkInitialShape, PayloadLink};
 use data::{
-    BackendKind, Cost, Diagnostic, DofPlan, EnergyLedger, ModalResult, ModeShape, Observables,
-    RunResult, Scene, Settings, StabilityVerdict, StaticResult, channel, ledger_term,
+    BackendKind, Cost, DofPlan, EnergyLedger, ModalResult, ModeShape, Observables, RunResult,
+    Scene, Settings, StabilityVerdict, StaticResult, channel, ledger_term,
 };
 use faer::Mat;
 use faer::prelude::*;
@@ -865,13 +865,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         sample(&stepper, torque, stations, &mut buf);
         if buf.iter().any(|v| !v.is_finite()) {
             verdict = StabilityVerdict::Stopped {
-                diagnostic: Diagnostic {
-                    t: stepper.state.t,
-                    what: "non-finite state".into(),
-                    location: None,
-                    why: "the implicit step diverged".into(),
-                    remedy: "reduce --dt".into(),
-                },
+                diagnostic: crate::error::non_finite_state(stepper.state.t),
             };
             break;
         }

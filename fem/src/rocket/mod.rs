@@ -58,8 +58,8 @@ use std::time::Instant;
 use data::channel::spec;
 use data::results::ledger_term;
 use data::{
-    BackendKind, Cost, Diagnostic, DofPlan, EnergyLedger, ModalResult, ModeShape, Observables,
-    RunResult, Scene, Settings, StabilityVerdict,
+    BackendKind, Cost, DofPlan, EnergyLedger, ModalResult, ModeShape, Observables, RunResult,
+    Scene, Settings, StabilityVerdict,
 };
 use faer::Mat;
 
@@ -547,13 +547,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         );
         if buf.iter().any(|v| !v.is_finite()) {
             verdict = StabilityVerdict::Stopped {
-                diagnostic: Diagnostic {
-                    t: stepper.t,
-                    what: "non-finite state".into(),
-                    location: None,
-                    why: "the implicit step diverged".into(),
-                    remedy: "reduce --dt".into(),
-                },
+                diagnostic: crate::error::non_finite_state(stepper.t),
             };
             break;
         }
