@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use data::{Cost, RunResult, Scene, Settings, StabilityVerdict};
+use data::{RunResult, Scene, Settings, StabilityVerdict};
 
 use crate::contact::ContactState;
 use crate::error::ModalError;
@@ -225,15 +225,10 @@ pub fn simulate_detailed(
         stepper.reset();
     }
     let st = stepper.stats();
-    let cost = Cost {
-        wall_time_s: wall.elapsed().as_secs_f64(),
-        dofs: rhs.nf(),
-        steps: st.steps,
-        rejected_steps: st.rejected,
-        rhs_evaluations: st.rhs_evals + rhs.event_solves,
-        jacobian_evaluations: st.jacobian_evals,
-        factorizations: st.factorizations,
-        newton_iterations: st.newton_iters,
+    let cost = {
+        let mut cost = st.cost(rhs.nf(), wall);
+        cost.rhs_evaluations += rhs.event_solves;
+        cost
     };
     rhs.load(t, &y);
     let fin = FinalState {

@@ -184,6 +184,23 @@ pub struct StepStats {
     pub newton_failures: usize,
 }
 
+impl StepStats {
+    /// The run's cost record: these counters, the state size `dofs` and the wall time since
+    /// `start`.
+    pub fn cost(&self, dofs: usize, start: std::time::Instant) -> data::Cost {
+        data::Cost {
+            wall_time_s: start.elapsed().as_secs_f64(),
+            dofs,
+            steps: self.steps,
+            rejected_steps: self.rejected,
+            rhs_evaluations: self.rhs_evals,
+            jacobian_evaluations: self.jacobian_evals,
+            factorizations: self.factorizations,
+            newton_iterations: self.newton_iters,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
 pub enum IntegrateError {
     #[error(

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use data::channel::spec;
 use data::{
-    Cost, Diagnostic, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict,
+    Diagnostic, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict,
     ledger_term,
 };
 
@@ -265,16 +265,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
         observables: out.obs,
         ledger: out.ledger,
         events: Vec::new(),
-        cost: Cost {
-            wall_time_s: wall.elapsed().as_secs_f64(),
-            dofs: m,
-            steps: st.steps,
-            rejected_steps: st.rejected,
-            rhs_evaluations: st.rhs_evals,
-            jacobian_evaluations: st.jacobian_evals,
-            factorizations: st.factorizations,
-            newton_iterations: st.newton_iters,
-        },
+        cost: st.cost(m, wall),
         verdict,
     })
 }

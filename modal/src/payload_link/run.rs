@@ -6,8 +6,8 @@ use std::time::Instant;
 
 use data::scene::{LinkField, LinkInitialShape, PrescribedMotion};
 use data::{
-    Cost, Diagnostic, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict,
-    channel, ledger_term,
+    Diagnostic, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict, channel,
+    ledger_term,
 };
 
 use super::dynamics::LinkRhs;
@@ -145,16 +145,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
         observables: out.obs,
         ledger: out.ledger,
         events: Vec::new(),
-        cost: Cost {
-            wall_time_s: wall.elapsed().as_secs_f64(),
-            dofs: rhs.nd,
-            steps: st.steps,
-            rejected_steps: st.rejected,
-            rhs_evaluations: st.rhs_evals,
-            jacobian_evaluations: st.jacobian_evals,
-            factorizations: st.factorizations,
-            newton_iterations: st.newton_iters,
-        },
+        cost: st.cost(rhs.nd, wall),
         verdict,
     })
 }

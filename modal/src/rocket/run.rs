@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use data::{
-    BackendKind, Cost, Diagnostic, EnergyLedger, Event, Observables, RunResult, Settings,
+    BackendKind, Diagnostic, EnergyLedger, Event, Observables, RunResult, Settings,
     StabilityVerdict, channel, ledger_term,
 };
 
@@ -466,16 +466,7 @@ pub fn simulate_detailed(
         }
     }
     let st = stepper.stats();
-    let cost = Cost {
-        wall_time_s: wall.elapsed().as_secs_f64(),
-        dofs: l.dofs(),
-        steps: st.steps,
-        rejected_steps: st.rejected,
-        rhs_evaluations: st.rhs_evals,
-        jacobian_evaluations: st.jacobian_evals,
-        factorizations: st.factorizations,
-        newton_iterations: st.newton_iters,
-    };
+    let cost = st.cost(l.dofs(), wall);
     let hz = |w: &Vec<f64>| w.iter().map(|w| w / (2.0 * std::f64::consts::PI)).collect();
     Ok(DetailedRun {
         run: RunResult {
