@@ -202,7 +202,8 @@ case_files!(
     "mobile",
     "mobile_flex",
     "mobile_flex_fem",
-    "convergence_scenes"
+    "convergence_scenes",
+    "axial_rows"
 );
 
 /// Parses a case file with located errors.
