@@ -204,7 +204,8 @@ case_files!(
     "mobile_flex",
     "mobile_flex_fem",
     "convergence_scenes",
-    "contact_coverage"
+    "contact_coverage",
+    "axial_rows"
 );
 
 /// Parses a case file with located errors.
