@@ -245,7 +245,7 @@ fn axial_shapes(link: &Link, basis: Basis, n: usize, purpose: Purpose) -> ShapeS
 }
 
 /// Axial functions of an extensible link with n transverse modes in dynamics: 2n + 1 (see
-/// [`axial_shapes`]).
+/// `axial_shapes`).
 pub fn axial_count(n: usize) -> usize {
     2 * n + 1
 }
