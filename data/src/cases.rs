@@ -204,8 +204,7 @@ case_files!(
     "mobile_flex",
     "mobile_flex_fem",
     "convergence_scenes",
-    "contact_coverage",
-    "axial_rows"
+    "contact_coverage"
 );
 
 /// Parses a case file with located errors.

@@ -10,9 +10,8 @@
 //!   inextensible link (with foreshortening) and for the linear model, exact at the tip point
 //!   ([`model::body`]);
 //! * strain: U = ½ Σ ∫EI v''² = ½ bᵀ K_b b; for extensible links (`axial`, u = Σψₖaₖ with
-//!   ψ spanning {ξ, …, ξ^(2n+1)} in dynamics, enough to hold u' = −½v'² and so free of
-//!   membrane locking; n bar modes for linear modes, see [`setup`]) also ½∫EA(u' + ½v'²)²
-//!   through the tensors ∫EA ψ'φ'φ' and ∫EA φ'⁴;
+//!   clamped-free bar modes) also ½∫EA(u' + ½v'²)² through the tensors ∫EA ψ'φ'φ' and ∫EA φ'⁴
+//!   (beware membrane locking: with as many axial as bending modes the Ritz model is too stiff);
 //!   joint springs ½K(θ − θ₀)²; gravity −g·Σ∫ρA r;
 //! * dissipation: Kelvin–Voigt γ ∫ v̇''² (damping matrix (γ/EI) K_b), joint dampers D θ̇².
 //!

@@ -223,31 +223,13 @@ fn timoshenko_shapes(
     }
 }
 
-/// Axial shapes of an extensible link. For dynamics, whatever the transverse basis:
-/// span{ξ, …, ξ^(2n+1)} (ξ·Pₖ(2ξ−1), k < [`axial_count`]). The membrane strain u' + ½v'² must
-/// be free to vanish along the link: with the `poly` bending space v ∈ span{ξ², …, ξⁿ⁺¹}, ½v'²
-/// has degree 2n, so u = −½∫₀ˣ v'² lies in this space exactly; the cantilever eigenfunctions
-/// are entire, so the same space holds their ½v'² to spectral accuracy. An axial basis of only
-/// n functions (or the bar modes √2 sin((2k−1)πξ/2), whose u'(L) = 0 forces the tip strain
-/// ½v'(L)² ≠ 0) cannot, and the stiff EA then acts on a spurious stretch and locks the bending
-/// (membrane locking; measured on `spin-up-axial`, EA L²/EI = 2e4: peak tip deflection 0.097 /
-/// 0.180 / 0.233 / 0.243 m at 1 / 2 / 6 / 8 sine modes, 0.3392 / 0.40060 / 0.40077 m at
-/// 1 / 2 / 4 modes with this space, fem's limit 0.40079 m).
-/// For modes (linearized about the undeformed link, where axial and bending decouple) n axial
-/// functions matching the transverse basis: the clamped-free bar modes √2 sin((2k−1)πx/2L),
-/// exact for the bar without tip mass, or ξ·Pₖ(2ξ−1) for `poly`.
-fn axial_shapes(link: &Link, basis: Basis, n: usize, purpose: Purpose) -> ShapeSet {
-    match (purpose, basis) {
-        (Purpose::Dynamics, _) => ShapeSet::axial_poly(link.length, axial_count(n)),
-        (Purpose::Modes, Basis::Poly) => ShapeSet::axial_poly(link.length, n),
-        (Purpose::Modes, _) => ShapeSet::axial_sine(link.length, n),
+/// Axial shapes matching the transverse basis: clamped-free bar modes √2 sin((2k−1)πx/2L)
+/// (exact for the bar without tip mass), or ξ·Pₖ(2ξ−1) for `poly`.
+fn axial_shapes(link: &Link, basis: Basis, n: usize) -> ShapeSet {
+    match basis {
+        Basis::Poly => ShapeSet::axial_poly(link.length, n),
+        _ => ShapeSet::axial_sine(link.length, n),
     }
-}
-
-/// Axial functions of an extensible link with n transverse modes in dynamics: 2n + 1 (see
-/// `axial_shapes`).
-pub fn axial_count(n: usize) -> usize {
-    2 * n + 1
 }
 
 pub fn build_chain_for(
@@ -268,7 +250,7 @@ pub fn build_chain_for(
         } else {
             (shapes(l, i, basis, n)?, None)
         };
-        let axial = l.axial.then(|| axial_shapes(l, basis, n, purpose));
+        let axial = l.axial.then(|| axial_shapes(l, basis, n));
         let ints = LinkIntegrals::new(
             l.length,
             l.mass_per_length,
@@ -385,12 +367,9 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
             plan.add(format!("joint{k} angle"), 1);
         }
         if l.axial {
-            plan.add(format!("link{k} axial functions (poly)"), axial_count(n));
-            plan.builds.push(format!(
-                "link{k}: axial field, von Kármán strain u' + ½v'² (dynamics: span{{ξ…ξ^{}}} \
-                 against membrane locking; modes: {n} bar functions)",
-                axial_count(n)
-            ));
+            plan.add(format!("link{k} axial modes"), n);
+            plan.builds
+                .push(format!("link{k}: axial field, von Kármán strain u' + ½v'²"));
         }
         plan.add(format!("link{k} transverse modes ({})", basis.name()), n);
         if l.shear {
