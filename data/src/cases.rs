@@ -195,6 +195,7 @@ case_files!(
     "dynamics",
     "rocket",
     "rocket_layers",
+    "rocket_free_vibration",
     "convergence",
     "friction",
     "contact",

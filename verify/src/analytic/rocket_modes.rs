@@ -44,6 +44,9 @@ use data::Scene;
 
 use super::error::{AnalyticError, Result, non_negative, positive};
 
+mod free_vibration;
+pub use free_vibration::{FreeVibration, TransverseState};
+
 /// Which decoupled motion of the free-free body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Motion {
@@ -314,7 +317,12 @@ impl FreeFreeRocket {
 
     /// The first `count` elastic natural frequencies [rad/s] of `motion`, ascending.
     pub fn elastic_omegas(&self, motion: Motion, count: usize) -> Result<Vec<f64>> {
-        let rigid = motion.rigid_modes();
+        self.omegas_after(motion, motion.rigid_modes(), count)
+    }
+
+    /// `count` natural frequencies [rad/s] of `motion`, ascending, after the lowest `rigid`
+    /// ones (taken to be at ω = 0).
+    fn omegas_after(&self, motion: Motion, rigid: usize, count: usize) -> Result<Vec<f64>> {
         // a frequency of the order of the lowest member's first mode, to start bracketing
         let scale = self
             .members
@@ -393,13 +401,12 @@ fn clamped_clamped_count(lam: f64) -> usize {
     }
 }
 
-/// Exact dynamic stiffness of a uniform Euler–Bernoulli member (DOFs w₁, θ₁, w₂, θ₂).
-fn bending_member(ei: f64, beta: f64, length: f64) -> Result<[[f64; 4]; 4]> {
+/// Derivatives 0…3 (rows) of the member basis φ1 = cos βx, φ2 = sin βx, φ3 = e^{−βx},
+/// φ4 = e^{−β(L−x)} (columns) at x = 0 and at x = L.
+fn basis_end_values(beta: f64, length: f64) -> ([[f64; 4]; 4], [[f64; 4]; 4]) {
     let b = beta;
     let (c, s) = ((b * length).cos(), (b * length).sin());
     let el = (-b * length).exp();
-    // basis φ1 = cos βx, φ2 = sin βx, φ3 = e^{−βx}, φ4 = e^{−β(L−x)}; derivatives 0..3
-    // at x = 0 and x = L.
     let at0: [[f64; 4]; 4] = [
         [1.0, 0.0, 1.0, el],
         [0.0, b, -b, b * el],
@@ -412,6 +419,12 @@ fn bending_member(ei: f64, beta: f64, length: f64) -> Result<[[f64; 4]; 4]> {
         [-b * b * c, -b * b * s, b * b * el, b * b],
         [b * b * b * s, -b * b * b * c, -b * b * b * el, b * b * b],
     ];
+    (at0, at_l)
+}
+
+/// Exact dynamic stiffness of a uniform Euler–Bernoulli member (DOFs w₁, θ₁, w₂, θ₂).
+fn bending_member(ei: f64, beta: f64, length: f64) -> Result<[[f64; 4]; 4]> {
+    let (at0, at_l) = basis_end_values(beta, length);
     // D: end values; F: end forces (virtual work of ½∫EI w″²).
     let d = [at0[0], at0[1], at_l[0], at_l[1]];
     let mut f = [[0.0; 4]; 4];

@@ -363,6 +363,37 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
         return Ok(());
     }
 
+    if let (
+        Quantity::History {
+            channel,
+            lowpass_hz,
+        },
+        Reference::Analytic { analytic },
+    ) = (&q, &case.reference)
+    {
+        let a = match cache.get(&scene, case.backend, &settings, q.analysis(), 0) {
+            Answer::Run(Ok(r)) => r,
+            Answer::Run(Err(e)) => return Err(format!("{}: {e}", case.backend)),
+            _ => return Err("not a run".to_string()),
+        };
+        let d = super::history::compare_to_function(&a, channel, *lowpass_hz, |times| {
+            super::reference::analytic_history(analytic, &scene, channel, times)
+        })
+        .map_err(|e| format!("{} vs analytic:{analytic}: {e}", case.backend))?;
+        out.wall_time_s += a.cost.wall_time_s;
+        out.value = Some(d.max_abs_diff);
+        out.reference = Some(d.reference_peak);
+        out.reference_label = format!(
+            "history of analytic:{analytic}{}, error = max|Δ| / its peak",
+            lowpass_hz.map_or(String::new(), |f| format!(", both low-passed at {f} Hz"))
+        );
+        if d.reference_peak <= 0.0 {
+            return Err("the reference history is identically zero".into());
+        }
+        out.error = Some(d.max_abs_diff / d.reference_peak);
+        return Ok(());
+    }
+
     let (value, peak, wall) = measure(cache, &scene, case.backend, &settings, &q)?;
     out.value = Some(value);
     out.wall_time_s += wall;

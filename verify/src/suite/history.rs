@@ -11,7 +11,8 @@
 //! max_t |a(t) − b(t)| / max_t |b(t)|
 //! ```
 //!
-//! over the output times of `a` (b linearly interpolated). With a low-pass cut-off f_c both
+//! over the output times of `a` (b linearly interpolated; an analytic reference history is
+//! evaluated at those times). With a low-pass cut-off f_c both
 //! histories are first interpolated onto one uniform grid of as many samples as `a` has over
 //! a's span, then filtered by the zero-phase Butterworth of [`super::filter`], and compared on
 //! that grid.
@@ -75,10 +76,34 @@ pub fn compare(
 ) -> Result<HistoryDeviation, String> {
     let (ta, va) = series(a, channel).ok_or_else(|| format!("no channel `{channel}`"))?;
     let (tb, vb) = series(b, channel).ok_or_else(|| format!("no channel `{channel}`"))?;
+    compare_series(ta, &va, tb, &vb, lowpass_hz)
+}
+
+/// The history of `channel` in run `a` against a reference function of time (an analytic
+/// history), evaluated at a's output times.
+pub fn compare_to_function(
+    a: &RunResult,
+    channel: &str,
+    lowpass_hz: Option<f64>,
+    reference: impl Fn(&[f64]) -> Result<Vec<f64>, String>,
+) -> Result<HistoryDeviation, String> {
+    let (ta, va) = series(a, channel).ok_or_else(|| format!("no channel `{channel}`"))?;
+    let vb = reference(ta)?;
+    compare_series(ta, &va, ta, &vb, lowpass_hz)
+}
+
+/// `max |a − b|` and the peak |b| of two sampled histories (module docs).
+fn compare_series(
+    ta: &[f64],
+    va: &[f64],
+    tb: &[f64],
+    vb: &[f64],
+    lowpass_hz: Option<f64>,
+) -> Result<HistoryDeviation, String> {
     let Some(fc) = lowpass_hz else {
         let mut worst = 0.0f64;
         for (t, x) in ta.iter().zip(va.iter()) {
-            if let Some(y) = data::results::interpolate(tb, &vb, *t) {
+            if let Some(y) = data::results::interpolate(tb, vb, *t) {
                 worst = worst.max((x - y).abs());
             }
         }
@@ -112,8 +137,8 @@ pub fn compare(
         let (dt, _, uniform) = resample_uniform(&ts, &vs, inside).map_err(|e| e.to_string())?;
         lowpass_zero_phase(&uniform, dt, fc).map_err(|e| e.to_string())
     };
-    let fa = on_grid(ta, &va)?;
-    let fb = on_grid(tb, &vb)?;
+    let fa = on_grid(ta, va)?;
+    let fb = on_grid(tb, vb)?;
     let max_abs_diff = fa
         .iter()
         .zip(&fb)
