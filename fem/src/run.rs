@@ -14,7 +14,6 @@ use crate::error::FemError;
 use crate::events::contact::Contact;
 use crate::method::Adaptive;
 use crate::settings::{self, Method};
-use crate::support::check_planar;
 
 /// Safety factor below the central-difference bound when the backend picks the step.
 pub const DEFAULT_SAFETY: f64 = 0.9;
@@ -201,8 +200,7 @@ pub struct Prepared {
 
 /// Builds the chain and the stepper for a scene and settings (step chosen per the documented rule).
 pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
-    check_planar(scene)?;
-    let n_el = settings::elements(&settings.discretization)?;
+    let mut chain = Chain::from_scene(scene, &settings.discretization)?;
     let method = settings::method(&settings.time, default_method(scene))?;
     if method == Method::EnergyMidpoint {
         check_midpoint(scene)?;
@@ -240,12 +238,6 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
                 .into(),
         });
     }
-    let mut chain = Chain::with_element(
-        &scene.links,
-        scene.gravity.as_ref(),
-        n_el,
-        settings.discretization.element,
-    )?;
     if let Some(st) = &scene.statics {
         // The scene's static loads act as a step load in dynamics (scene `cantilever`: the
         // response oscillates about the static deflection).
