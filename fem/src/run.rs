@@ -607,27 +607,38 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         c.flush_pending();
         events.append(&mut c.events);
     }
-    let c = integ.counters;
     let _ = h_nominal;
-    Ok(RunResult {
+    Ok(run_result(
+        scene,
+        settings,
+        obs,
+        ledger,
+        events,
+        integ.counters.cost(integ.chain.ndof, start),
+        verdict,
+    ))
+}
+
+/// The backend's result record of a run (chain, rocket, 3-D link and mobile drivers alike).
+pub(crate) fn run_result(
+    scene: &Scene,
+    settings: &Settings,
+    observables: Observables,
+    ledger: EnergyLedger,
+    events: Vec<Event>,
+    cost: Cost,
+    verdict: StabilityVerdict,
+) -> RunResult {
+    RunResult {
         backend: data::BackendKind::Fem,
         scene: scene.name.clone(),
         settings: settings.clone(),
-        observables: obs,
+        observables,
         ledger,
         events,
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: integ.chain.ndof,
-            steps: c.steps,
-            rejected_steps: c.rejected,
-            rhs_evaluations: c.rhs,
-            jacobian_evaluations: c.jacobians,
-            factorizations: c.factorizations,
-            newton_iterations: c.newton,
-        },
+        cost,
         verdict,
-    })
+    }
 }
 
 #[cfg(test)]

@@ -57,10 +57,7 @@ use std::time::Instant;
 use data::channel::spec;
 use data::results::ledger_term;
 use data::scene::MobileManipulator;
-use data::{
-    BackendKind, Cost, DofPlan, EnergyLedger, Observables, RunResult, Scene, Settings,
-    StabilityVerdict,
-};
+use data::{DofPlan, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict};
 
 pub use model::Model;
 pub use step::{Inputs, Stepper};
@@ -440,24 +437,13 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         obs.push(stepper.t, &buf);
         push_ledger(&mut stepper, &mut ledger);
     }
-    let c = stepper.counters;
-    Ok(RunResult {
-        backend: BackendKind::Fem,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        observables: obs,
+    Ok(crate::run::run_result(
+        scene,
+        settings,
+        obs,
         ledger,
-        events: Vec::new(),
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: stepper.model.layout.m,
-            steps: c.steps,
-            rejected_steps: 0,
-            rhs_evaluations: c.residuals,
-            jacobian_evaluations: c.factorizations,
-            factorizations: c.factorizations,
-            newton_iterations: c.newton,
-        },
+        Vec::new(),
+        stepper.counters.cost(stepper.model.layout.m, start),
         verdict,
-    })
+    ))
 }

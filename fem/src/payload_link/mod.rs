@@ -872,24 +872,15 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         obs.push(stepper.state.t, &buf);
         push_ledger(&stepper, &mut ledger);
     }
-    let c = stepper.counters;
-    Ok(RunResult {
-        backend: BackendKind::Fem,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        observables: obs,
+    Ok(crate::run::run_result(
+        scene,
+        settings,
+        obs,
         ledger,
-        events: Vec::new(),
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: n + usize::from(stepper.model.free_base()),
-            steps: c.steps,
-            rejected_steps: 0,
-            rhs_evaluations: c.residuals,
-            jacobian_evaluations: c.factorizations,
-            factorizations: c.factorizations,
-            newton_iterations: c.newton,
-        },
+        Vec::new(),
+        stepper
+            .counters
+            .cost(n + usize::from(stepper.model.free_base()), start),
         verdict,
-    })
+    ))
 }

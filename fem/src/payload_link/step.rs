@@ -13,6 +13,7 @@
 
 use crate::band::BorderedBand;
 use crate::error::FemError;
+use crate::method::FixedStepCounters;
 
 use super::model::{Band, Model, dot};
 
@@ -39,20 +40,11 @@ pub struct Works {
     pub kelvin_voigt: Vec<f64>,
 }
 
-/// Work counters.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Counters {
-    pub steps: usize,
-    pub newton: usize,
-    pub factorizations: usize,
-    pub residuals: usize,
-}
-
 pub struct Stepper {
     pub model: Model,
     pub state: State,
     pub works: Works,
-    pub counters: Counters,
+    pub counters: FixedStepCounters,
     /// Torque of the base at the last step's midpoint (applied law or what prescription needs).
     pub torque_mid: f64,
     newton: BorderedBand,
@@ -101,7 +93,7 @@ impl Stepper {
                 kelvin_voigt: vec![0.0; kv],
                 ..Default::default()
             },
-            counters: Counters::default(),
+            counters: FixedStepCounters::default(),
             torque_mid: 0.0,
             newton,
             a: z.clone(),
