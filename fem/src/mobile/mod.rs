@@ -63,6 +63,7 @@ pub use model::Model;
 pub use step::{Inputs, Stepper};
 
 use crate::error::FemError;
+use crate::linalg::{dot, max_abs};
 use crate::settings;
 
 /// Elements on the flexible link when `discretization.elements` is absent.
@@ -94,10 +95,7 @@ fn elements(settings: &data::Discretization) -> Result<usize, FemError> {
              Hermite cubics)",
         ));
     }
-    if settings.elements.is_none() {
-        return Ok(DEFAULT_ELEMENTS);
-    }
-    settings::elements(settings)
+    settings::elements_or(settings, DEFAULT_ELEMENTS)
 }
 
 /// DOFs and physics built for the scene.
@@ -207,10 +205,10 @@ pub fn first_flexible_frequency(md: &Model, q: &[f64]) -> Result<f64, FemError> 
             y[i] = (0..ne).map(|j| meff[i * ne + j] * x[j]).sum();
         }
         k.solve(&mut y);
-        let xy: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
-        let xx: f64 = x.iter().map(|a| a * a).sum();
+        let xy = dot(&x, &y);
+        let xx = dot(&x, &x);
         let new = xy / xx;
-        let norm = y.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let norm = max_abs(&y);
         for i in 0..ne {
             x[i] = y[i] / norm;
         }

@@ -569,7 +569,7 @@ pub fn default_step(md: &Model, d0: &[f64], t_end: f64, out: f64) -> Result<f64,
     // Per mode: excitation e_k = |φ·F(0)| + max_i |φ·(F(t_i) − F(t_{i−1}))|.
     let mut exc: Vec<f64> = modes
         .iter()
-        .map(|md_k| model::dot(&md_k.vector, &f0).abs())
+        .map(|md_k| crate::linalg::dot(&md_k.vector, &f0).abs())
         .collect();
     let mut jump = vec![0.0f64; modes.len()];
     fa.copy_from_slice(&f0);

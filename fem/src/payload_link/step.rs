@@ -15,7 +15,8 @@ use crate::band::BorderedBand;
 use crate::error::FemError;
 use crate::method::FixedStepCounters;
 
-use super::model::{Band, Model, dot};
+use super::model::{Band, Model};
+use crate::linalg::{dot, max_abs};
 
 /// Newton iterations before a step is declared failed.
 const MAX_NEWTON: usize = 25;
@@ -264,9 +265,7 @@ impl Stepper {
             self.a_theta = (r1 - r0) / h;
         }
         // Predictor: the previous step's acceleration (kept in `a`).
-        let scale = self.model.length
-            + self.state.theta.abs()
-            + self.state.d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let scale = self.model.length + self.state.theta.abs() + max_abs(&self.state.d);
         let mut converged = false;
         let mut mid = self.midpoint(h);
         for it in 0..MAX_NEWTON {

@@ -84,24 +84,20 @@ pub fn the_rocket(scene: &Scene) -> Option<&data::scene::Rocket> {
     scene.rocket.as_ref()
 }
 
-fn elements(settings: &Settings) -> Result<usize, FemError> {
-    match settings.discretization.elements {
-        None => Ok(DEFAULT_ELEMENTS),
-        Some(_) => crate::settings::elements(&settings.discretization),
-    }
+fn rocket_of(scene: &Scene) -> Result<&data::scene::Rocket, FemError> {
+    the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))
 }
 
 pub fn build(scene: &Scene, settings: &Settings) -> Result<Model, FemError> {
-    let r = the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))?;
-    Model::new(r, elements(settings)?)
+    Model::new(
+        rocket_of(scene)?,
+        crate::settings::elements_or(&settings.discretization, DEFAULT_ELEMENTS)?,
+    )
 }
 
 pub fn dof_plan(scene: &Scene, disc: &data::Discretization) -> Result<DofPlan, FemError> {
-    let r = the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))?;
-    let n_el = match disc.elements {
-        None => DEFAULT_ELEMENTS,
-        Some(_) => crate::settings::elements(disc)?,
-    };
+    let r = rocket_of(scene)?;
+    let n_el = crate::settings::elements_or(disc, DEFAULT_ELEMENTS)?;
     let nm = r.discrete_masses.len();
     let mut plan = DofPlan::default();
     plan.add(
@@ -431,7 +427,7 @@ pub struct Prepared {
 }
 
 pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
-    let r = the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))?;
+    let r = rocket_of(scene)?;
     match settings.time.method {
         None | Some(data::Method::ImplicitMidpoint) => {}
         Some(other) => {
