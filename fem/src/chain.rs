@@ -41,8 +41,8 @@
 //! s(L) moves its descendants' points like an axial tip DOF. Checked against finite
 //! differences of the residual (`sys_foreshortening_tangent`).
 
-use data::FemElement;
 use data::scene::{Gravity, Link, PrescribedMotion, TorqueLaw};
+use data::{Discretization, FemElement, Scene};
 
 use crate::band::BorderedBand;
 use crate::element::tables::dotn;
@@ -216,6 +216,17 @@ impl Chain {
     /// elements per link.
     pub fn new(links: &[Link], gravity: Option<&Gravity>, n_el: usize) -> Result<Self, FemError> {
         Self::with_element(links, gravity, n_el, None)
+    }
+
+    /// The chain of a planar-chain scene at its discretization (elements per link and element
+    /// kind): the scene is checked against what the backend builds ([`check_planar`]) first.
+    /// The scene's static loads are left at zero (dynamics applies them as a step load).
+    ///
+    /// [`check_planar`]: crate::support::check_planar
+    pub fn from_scene(scene: &Scene, disc: &Discretization) -> Result<Self, FemError> {
+        crate::support::check_planar(scene)?;
+        let n_el = crate::settings::elements(disc)?;
+        Self::with_element(&scene.links, scene.gravity.as_ref(), n_el, disc.element)
     }
 
     /// Builds the chain for `links` with `n_el` elements per link of the element `choice`

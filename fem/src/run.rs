@@ -14,7 +14,6 @@ use crate::error::FemError;
 use crate::events::contact::Contact;
 use crate::method::Adaptive;
 use crate::settings::{self, Method};
-use crate::support::check_planar;
 
 /// Safety factor below the central-difference bound when the backend picks the step.
 pub const DEFAULT_SAFETY: f64 = 0.9;
@@ -201,8 +200,7 @@ pub struct Prepared {
 
 /// Builds the chain and the stepper for a scene and settings (step chosen per the documented rule).
 pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
-    check_planar(scene)?;
-    let n_el = settings::elements(&settings.discretization)?;
+    let mut chain = Chain::from_scene(scene, &settings.discretization)?;
     let method = settings::method(&settings.time, default_method(scene))?;
     if method == Method::EnergyMidpoint {
         check_midpoint(scene)?;
@@ -240,12 +238,6 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
                 .into(),
         });
     }
-    let mut chain = Chain::with_element(
-        &scene.links,
-        scene.gravity.as_ref(),
-        n_el,
-        settings.discretization.element,
-    )?;
     if let Some(st) = &scene.statics {
         // The scene's static loads act as a step load in dynamics (scene `cantilever`: the
         // response oscillates about the static deflection).
@@ -615,27 +607,38 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         c.flush_pending();
         events.append(&mut c.events);
     }
-    let c = integ.counters;
     let _ = h_nominal;
-    Ok(RunResult {
+    Ok(run_result(
+        scene,
+        settings,
+        obs,
+        ledger,
+        events,
+        integ.counters.cost(integ.chain.ndof, start),
+        verdict,
+    ))
+}
+
+/// The backend's result record of a run (chain, rocket, 3-D link and mobile drivers alike).
+pub(crate) fn run_result(
+    scene: &Scene,
+    settings: &Settings,
+    observables: Observables,
+    ledger: EnergyLedger,
+    events: Vec<Event>,
+    cost: Cost,
+    verdict: StabilityVerdict,
+) -> RunResult {
+    RunResult {
         backend: data::BackendKind::Fem,
         scene: scene.name.clone(),
         settings: settings.clone(),
-        observables: obs,
+        observables,
         ledger,
         events,
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: integ.chain.ndof,
-            steps: c.steps,
-            rejected_steps: c.rejected,
-            rhs_evaluations: c.rhs,
-            jacobian_evaluations: c.jacobians,
-            factorizations: c.factorizations,
-            newton_iterations: c.newton,
-        },
+        cost,
         verdict,
-    })
+    }
 }
 
 #[cfg(test)]

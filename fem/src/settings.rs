@@ -28,8 +28,16 @@ pub enum Method {
     ImplicitMidpoint,
 }
 
+/// Elements per link of a planar chain or 3-D link: `discretization.elements`, [`DEFAULT_ELEMENTS`]
+/// when unset.
 pub fn elements(disc: &data::Discretization) -> Result<usize, FemError> {
-    let n = disc.elements.unwrap_or(DEFAULT_ELEMENTS);
+    elements_or(disc, DEFAULT_ELEMENTS)
+}
+
+/// Elements per link: `discretization.elements`, `default` (a family's own default) when unset,
+/// checked against 1..=[`MAX_ELEMENTS`].
+pub fn elements_or(disc: &data::Discretization, default: usize) -> Result<usize, FemError> {
+    let n = disc.elements.unwrap_or(default);
     if n == 0 || n > MAX_ELEMENTS {
         return Err(FemError::InvalidSettings {
             field: "discretization.elements".into(),

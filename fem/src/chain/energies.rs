@@ -14,7 +14,86 @@
 //! A(γ)∂T/∂u_{i+1} at its tip. Exact for the quadrature (no difference step).
 
 use super::geometry::{add, dot, perp, rot, rot_t, scale};
-use super::{Chain, FrameState, MAX_LINKS, NONE, dotn};
+use super::{Chain, FrameState, LinkModel, MAX_LINKS, MAXE, NONE, dotn};
+
+impl LinkModel {
+    /// Walks the link's material points at configuration `q` and generalized velocity `x`, in
+    /// link-frame coordinates: at Gauss point j of element e, `point(e, j, p, ṗ, ẋ_e)` with
+    /// p = (x + u(x), v(x)) (extensible link) or (x + s(x), v(x)) (foreshortening,
+    /// s(x) = −½∫v′², ṡ = −∫v′v̇′ on the sub-interval quadrature) or (x, v(x)), and ẋ_e the
+    /// element's velocity vector; after each element `element_done(e, u_e, q_e)` with its nodal
+    /// axial values and its transverse vector. Returns the tip's (p, ṗ). The one point loop of
+    /// [`Chain::energies`] and [`Chain::add_kinetic_gradient`]; no allocation.
+    #[inline]
+    fn walk_points(
+        &self,
+        q: &[f64],
+        x: &[f64],
+        mut point: impl FnMut(usize, usize, [f64; 2], [f64; 2], &[f64; MAXE]),
+        mut element_done: impl FnMut(usize, [f64; 2], &[f64; MAXE]),
+    ) -> ([f64; 2], [f64; 2]) {
+        let tb = &self.element.quad;
+        let (mut s, mut sd) = (0.0, 0.0);
+        // An extensible link carries its axial field instead of the foreshortening.
+        let fs = self.foreshortening && !self.axial;
+        let ne = self.ne;
+        for e in 0..self.n_el {
+            let dofs = self.elem_dofs(e);
+            let d = Chain::elem_v(q, &dofs);
+            let dd = Chain::elem_v(x, &dofs);
+            let u = [
+                Chain::val(q, self.u_dof[e]),
+                Chain::val(q, self.u_dof[e + 1]),
+            ];
+            let ud = [
+                Chain::val(x, self.u_dof[e]),
+                Chain::val(x, self.u_dof[e + 1]),
+            ];
+            let xa = e as f64 * self.h;
+            for j in 0..tb.ng + 1 {
+                if fs {
+                    for k in 0..tb.nsg {
+                        let dn = &tb.sub_dn[j][k];
+                        let wgt = tb.sub_wh[j][k];
+                        let vp = dotn(dn, &d, ne);
+                        s -= 0.5 * wgt * vp * vp;
+                        sd -= wgt * vp * dotn(dn, &dd, ne);
+                    }
+                }
+                if j == tb.ng {
+                    continue;
+                }
+                let xi = tb.xi[j];
+                let (ax, axd) = if self.axial {
+                    (
+                        (1.0 - xi) * u[0] + xi * u[1],
+                        (1.0 - xi) * ud[0] + xi * ud[1],
+                    )
+                } else if fs {
+                    (s, sd)
+                } else {
+                    (0.0, 0.0)
+                };
+                let p = [xa + xi * self.h + ax, dotn(&tb.n[j], &d, ne)];
+                let pd = [axd, dotn(&tb.n[j], &dd, ne)];
+                point(e, j, p, pd, &dd);
+            }
+            element_done(e, u, &d);
+        }
+        let k = self.n_el;
+        let (ut, utd) = if self.axial {
+            (Chain::val(q, self.u_dof[k]), Chain::val(x, self.u_dof[k]))
+        } else if fs {
+            (s, sd)
+        } else {
+            (0.0, 0.0)
+        };
+        (
+            [self.length + ut, Chain::val(q, self.v_dof[k])],
+            [utd, Chain::val(x, self.v_dof[k])],
+        )
+    }
+}
 
 impl Chain {
     /// Stored energies at a state: (kinetic, strain, joint_spring, gravity).
@@ -36,71 +115,33 @@ impl Chain {
             };
             spring += 0.5 * l.joint.stiffness * (th - l.joint.set_point).powi(2);
             kin += 0.5 * l.hub_inertia * w * w;
-            let (mut s, mut sd) = (0.0, 0.0);
             let ne = l.ne;
-            for e in 0..l.n_el {
-                let dofs = l.elem_dofs(e);
-                let d = Self::elem_v(q, &dofs);
-                let dd = Self::elem_v(qd, &dofs);
-                let u = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                let ud = [Self::val(qd, l.u_dof[e]), Self::val(qd, l.u_dof[e + 1])];
-                let xa = e as f64 * l.h;
-                for j in 0..tb.ng + 1 {
-                    if l.foreshortening {
-                        for k in 0..tb.nsg {
-                            let dn = &tb.sub_dn[j][k];
-                            let wgt = tb.sub_wh[j][k];
-                            let vp = dotn(dn, &d, ne);
-                            s -= 0.5 * wgt * vp * vp;
-                            sd -= wgt * vp * dotn(dn, &dd, ne);
-                        }
-                    }
-                    if j == tb.ng {
-                        continue;
-                    }
-                    let xi = tb.xi[j];
-                    let (ax, axd) = if l.axial {
-                        (
-                            (1.0 - xi) * u[0] + xi * u[1],
-                            (1.0 - xi) * ud[0] + xi * ud[1],
-                        )
-                    } else if l.foreshortening {
-                        (s, sd)
-                    } else {
-                        (0.0, 0.0)
-                    };
-                    let p = [xa + xi * l.h + ax, dotn(&tb.n[j], &d, ne)];
-                    let pd = [axd, dotn(&tb.n[j], &dd, ne)];
+            let (p, pd) = l.walk_points(
+                q,
+                qd,
+                |_, j, p, pd, dd| {
                     let v = add(dr0, rot(phi, add(scale(w, perp(p)), pd)));
                     let m = l.rho_a * tb.wh[j];
                     kin += 0.5 * m * dot(v, v);
                     grav -= m * dot(g_in, add(r0, rot(phi, p)));
                     if l.rho_i > 0.0 {
                         // ½ρI(φ̇ + β̇)², β the section angle relative to the frame.
-                        let om = w + dotn(&tb.b[j], &dd, ne);
+                        let om = w + dotn(&tb.b[j], dd, ne);
                         kin += 0.5 * l.rho_i * tb.wh[j] * om * om;
                     }
-                }
-                l.element
-                    .kind
-                    .add_strain_energy(&l.element, u, &d, &mut strain);
-            }
-            let k = l.n_el;
-            let (ut, utd) = if l.axial {
-                (Self::val(q, l.u_dof[k]), Self::val(qd, l.u_dof[k]))
-            } else if l.foreshortening {
-                (s, sd)
-            } else {
-                (0.0, 0.0)
-            };
-            let p = [l.length + ut, Self::val(q, l.v_dof[k])];
-            let pd = [utd, Self::val(qd, l.v_dof[k])];
+                },
+                |_, u, d| {
+                    l.element
+                        .kind
+                        .add_strain_energy(&l.element, u, d, &mut strain)
+                },
+            );
             let v_tip = add(dr0, rot(phi, add(scale(w, perp(p)), pd)));
             let r_tip = add(r0, rot(phi, p));
             kin += 0.5 * l.tip_mass * dot(v_tip, v_tip);
             grav -= l.tip_mass * dot(g_in, r_tip);
-            let slope = Self::val(q, l.r_dof[k]);
-            let dslope = Self::val(qd, l.r_dof[k]);
+            let slope = Self::val(q, l.r_dof[l.n_el]);
+            let dslope = Self::val(qd, l.r_dof[l.n_el]);
             kin += 0.5 * l.tip_inertia * (w + dslope).powi(2);
             let fs = FrameState {
                 phi,
@@ -152,56 +193,14 @@ impl Chain {
             };
             omega[li] = w;
             u_frame[li] = u;
-            let (mut s, mut sd) = (0.0, 0.0);
-            // An extensible link carries its axial field instead of the foreshortening.
-            let fs = l.foreshortening && !l.axial;
-            let ne = l.ne;
-            for e in 0..l.n_el {
-                let dofs = l.elem_dofs(e);
-                let d = Self::elem_v(q, &dofs);
-                let dd = Self::elem_v(x, &dofs);
-                let u_ax = [Self::val(q, l.u_dof[e]), Self::val(q, l.u_dof[e + 1])];
-                let ud_ax = [Self::val(x, l.u_dof[e]), Self::val(x, l.u_dof[e + 1])];
-                let xa = e as f64 * l.h;
-                for j in 0..tb.ng + 1 {
-                    if fs {
-                        for k in 0..tb.nsg {
-                            let dn = &tb.sub_dn[j][k];
-                            let wgt = tb.sub_wh[j][k];
-                            let vp = dotn(dn, &d, ne);
-                            s -= 0.5 * wgt * vp * vp;
-                            sd -= wgt * vp * dotn(dn, &dd, ne);
-                        }
-                    }
-                    if j == tb.ng {
-                        continue;
-                    }
-                    let xi = tb.xi[j];
-                    let (ax, axd) = if l.axial {
-                        (
-                            (1.0 - xi) * u_ax[0] + xi * u_ax[1],
-                            (1.0 - xi) * ud_ax[0] + xi * ud_ax[1],
-                        )
-                    } else if fs {
-                        (s, sd)
-                    } else {
-                        (0.0, 0.0)
-                    };
-                    let p = [xa + xi * l.h + ax, dotn(&tb.n[j], &d, ne)];
-                    let pd = [axd, dotn(&tb.n[j], &dd, ne)];
-                    self.kin_vel[li][e * tb.ng + j] = add(u, add(scale(w, perp(p)), pd));
-                }
-            }
-            let k = l.n_el;
-            let (ut, utd) = if l.axial {
-                (Self::val(q, l.u_dof[k]), Self::val(x, l.u_dof[k]))
-            } else if fs {
-                (s, sd)
-            } else {
-                (0.0, 0.0)
-            };
-            let p = [l.length + ut, Self::val(q, l.v_dof[k])];
-            let pd = [utd, Self::val(x, l.v_dof[k])];
+            let ng = tb.ng;
+            let kin_vel = &mut self.kin_vel[li];
+            let (p, pd) = l.walk_points(
+                q,
+                x,
+                |e, j, p, pd, _| kin_vel[e * ng + j] = add(u, add(scale(w, perp(p)), pd)),
+                |_, _, _| {},
+            );
             c_tip[li] = add(u, add(scale(w, perp(p)), pd));
         }
         // Backward sweep: g = m c at the points, ∂T/∂u_i accumulated in `big_g`.

@@ -205,7 +205,7 @@ pub fn applies(scene: &Scene) -> bool {
 /// `modes` of a chain scene: the lowest `count` linearized frequencies and their shapes.
 pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, FemError> {
     let start = std::time::Instant::now();
-    crate::support::check_planar(scene)?;
+    let mut chain = Chain::from_scene(scene, &settings.discretization)?;
     for (i, l) in scene.links.iter().enumerate() {
         match l.joint.prescribed {
             None | Some(PrescribedMotion::Fixed) => {}
@@ -218,13 +218,6 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
             }
         }
     }
-    let n_el = crate::settings::elements(&settings.discretization)?;
-    let mut chain = Chain::with_element(
-        &scene.links,
-        scene.gravity.as_ref(),
-        n_el,
-        settings.discretization.element,
-    )?;
     let modes = chain.linearized_modes(count)?;
     let reference = chain.reference_configuration();
     let stations = scene.simulation.field_stations;

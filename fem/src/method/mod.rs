@@ -31,6 +31,10 @@ pub mod start;
 
 pub use newton::{JacobianKind, NewtonSystem};
 
+use std::time::Instant;
+
+use data::Cost;
+
 use crate::chain::Chain;
 use crate::error::FemError;
 use crate::settings::Method;
@@ -44,6 +48,49 @@ pub struct Counters {
     pub jacobians: usize,
     pub factorizations: usize,
     pub newton: usize,
+}
+
+impl Counters {
+    /// The run's cost record: `dofs` unknowns, wall time since `start`.
+    pub fn cost(&self, dofs: usize, start: Instant) -> Cost {
+        Cost {
+            wall_time_s: start.elapsed().as_secs_f64(),
+            dofs,
+            steps: self.steps,
+            rejected_steps: self.rejected,
+            rhs_evaluations: self.rhs,
+            jacobian_evaluations: self.jacobians,
+            factorizations: self.factorizations,
+            newton_iterations: self.newton,
+        }
+    }
+}
+
+/// Work counters of the fixed-step implicit-midpoint steppers of the rocket, the 3-D payload
+/// link and the mobile manipulator: every Newton iteration evaluates one residual and
+/// factorizes one Newton matrix (a Jacobian evaluation per factorization); no step is rejected.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FixedStepCounters {
+    pub steps: usize,
+    pub newton: usize,
+    pub residuals: usize,
+    pub factorizations: usize,
+}
+
+impl FixedStepCounters {
+    /// The run's cost record: `dofs` unknowns, wall time since `start`.
+    pub fn cost(&self, dofs: usize, start: Instant) -> Cost {
+        Cost {
+            wall_time_s: start.elapsed().as_secs_f64(),
+            dofs,
+            steps: self.steps,
+            rejected_steps: 0,
+            rhs_evaluations: self.residuals,
+            jacobian_evaluations: self.factorizations,
+            factorizations: self.factorizations,
+            newton_iterations: self.newton,
+        }
+    }
 }
 
 /// Running energy-ledger integrals (cumulative works).

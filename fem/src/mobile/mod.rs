@@ -57,15 +57,13 @@ use std::time::Instant;
 use data::channel::spec;
 use data::results::ledger_term;
 use data::scene::MobileManipulator;
-use data::{
-    BackendKind, Cost, DofPlan, EnergyLedger, Observables, RunResult, Scene, Settings,
-    StabilityVerdict,
-};
+use data::{DofPlan, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict};
 
 pub use model::Model;
 pub use step::{Inputs, Stepper};
 
 use crate::error::FemError;
+use crate::linalg::{dot, max_abs};
 use crate::settings;
 
 /// Elements on the flexible link when `discretization.elements` is absent.
@@ -97,10 +95,7 @@ fn elements(settings: &data::Discretization) -> Result<usize, FemError> {
              Hermite cubics)",
         ));
     }
-    if settings.elements.is_none() {
-        return Ok(DEFAULT_ELEMENTS);
-    }
-    settings::elements(settings)
+    settings::elements_or(settings, DEFAULT_ELEMENTS)
 }
 
 /// DOFs and physics built for the scene.
@@ -210,10 +205,10 @@ pub fn first_flexible_frequency(md: &Model, q: &[f64]) -> Result<f64, FemError> 
             y[i] = (0..ne).map(|j| meff[i * ne + j] * x[j]).sum();
         }
         k.solve(&mut y);
-        let xy: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
-        let xx: f64 = x.iter().map(|a| a * a).sum();
+        let xy = dot(&x, &y);
+        let xx = dot(&x, &x);
         let new = xy / xx;
-        let norm = y.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let norm = max_abs(&y);
         for i in 0..ne {
             x[i] = y[i] / norm;
         }
@@ -440,24 +435,13 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         obs.push(stepper.t, &buf);
         push_ledger(&mut stepper, &mut ledger);
     }
-    let c = stepper.counters;
-    Ok(RunResult {
-        backend: BackendKind::Fem,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        observables: obs,
+    Ok(crate::run::run_result(
+        scene,
+        settings,
+        obs,
         ledger,
-        events: Vec::new(),
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: stepper.model.layout.m,
-            steps: c.steps,
-            rejected_steps: 0,
-            rhs_evaluations: c.residuals,
-            jacobian_evaluations: c.factorizations,
-            factorizations: c.factorizations,
-            newton_iterations: c.newton,
-        },
+        Vec::new(),
+        stepper.counters.cost(stepper.model.layout.m, start),
         verdict,
-    })
+    ))
 }

@@ -727,7 +727,7 @@ impl Model {
             }
             for i in 0..fl.ne {
                 let row = &fl.stiffness[i * fl.ne..(i + 1) * fl.ne];
-                force[l.nu_el + i] += row.iter().zip(e).map(|(k, x)| k * x).sum::<f64>();
+                force[l.nu_el + i] += crate::linalg::dot(row, e);
             }
         }
         if let Some(p) = &self.platform {

@@ -22,6 +22,7 @@ use faer::{MatMut, MatRef, Par};
 
 use super::model::{Model, Workspace};
 use crate::error::FemError;
+use crate::method::FixedStepCounters;
 
 /// Newton iterations per step before the run is stopped.
 pub const MAX_NEWTON: usize = 30;
@@ -74,14 +75,6 @@ pub struct Works {
     pub joint_friction: f64,
 }
 
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Counters {
-    pub steps: usize,
-    pub newton: usize,
-    pub residuals: usize,
-    pub factorizations: usize,
-}
-
 /// State, inputs and preallocated scratch of a run.
 #[derive(Debug, Clone)]
 pub struct Stepper {
@@ -91,7 +84,7 @@ pub struct Stepper {
     pub q: Vec<f64>,
     pub nu: Vec<f64>,
     pub works: Works,
-    pub counters: Counters,
+    pub counters: FixedStepCounters,
     ws: Workspace,
     mass: Vec<f64>,
     newton: Vec<f64>,
@@ -118,7 +111,7 @@ impl Stepper {
             q,
             nu,
             works: Works::default(),
-            counters: Counters::default(),
+            counters: FixedStepCounters::default(),
             ws: Workspace::new(n),
             mass: vec![0.0; m * m],
             newton: vec![0.0; m * m],

@@ -569,7 +569,7 @@ pub fn default_step(md: &Model, d0: &[f64], t_end: f64, out: f64) -> Result<f64,
     // Per mode: excitation e_k = |φ·F(0)| + max_i |φ·(F(t_i) − F(t_{i−1}))|.
     let mut exc: Vec<f64> = modes
         .iter()
-        .map(|md_k| model::dot(&md_k.vector, &f0).abs())
+        .map(|md_k| crate::linalg::dot(&md_k.vector, &f0).abs())
         .collect();
     let mut jump = vec![0.0f64; modes.len()];
     fa.copy_from_slice(&f0);
@@ -872,24 +872,15 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         obs.push(stepper.state.t, &buf);
         push_ledger(&stepper, &mut ledger);
     }
-    let c = stepper.counters;
-    Ok(RunResult {
-        backend: BackendKind::Fem,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        observables: obs,
+    Ok(crate::run::run_result(
+        scene,
+        settings,
+        obs,
         ledger,
-        events: Vec::new(),
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: n + usize::from(stepper.model.free_base()),
-            steps: c.steps,
-            rejected_steps: 0,
-            rhs_evaluations: c.residuals,
-            jacobian_evaluations: c.factorizations,
-            factorizations: c.factorizations,
-            newton_iterations: c.newton,
-        },
+        Vec::new(),
+        stepper
+            .counters
+            .cost(n + usize::from(stepper.model.free_base()), start),
         verdict,
-    })
+    ))
 }

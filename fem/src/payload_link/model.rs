@@ -6,6 +6,7 @@ use data::scene::{LinkField, PayloadLink, PrescribedMotion, TorqueLaw};
 use crate::element::beam3d::{self, NodeLayout, PHI, Row, U, V, V_SLOPE, W, W_SLOPE};
 use crate::element::quadrature::gauss01;
 use crate::error::FemError;
+use crate::linalg::dot;
 
 /// Square band matrix of half-bandwidth b, rows stored contiguously (entry (i, j) at
 /// i·(2b + 1) + j + b − i).
@@ -470,8 +471,4 @@ impl Model {
             _ => r.phi.dot(d),
         }
     }
-}
-
-pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

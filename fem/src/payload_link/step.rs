@@ -13,8 +13,10 @@
 
 use crate::band::BorderedBand;
 use crate::error::FemError;
+use crate::method::FixedStepCounters;
 
-use super::model::{Band, Model, dot};
+use super::model::{Band, Model};
+use crate::linalg::{dot, max_abs};
 
 /// Newton iterations before a step is declared failed.
 const MAX_NEWTON: usize = 25;
@@ -39,20 +41,11 @@ pub struct Works {
     pub kelvin_voigt: Vec<f64>,
 }
 
-/// Work counters.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Counters {
-    pub steps: usize,
-    pub newton: usize,
-    pub factorizations: usize,
-    pub residuals: usize,
-}
-
 pub struct Stepper {
     pub model: Model,
     pub state: State,
     pub works: Works,
-    pub counters: Counters,
+    pub counters: FixedStepCounters,
     /// Torque of the base at the last step's midpoint (applied law or what prescription needs).
     pub torque_mid: f64,
     newton: BorderedBand,
@@ -101,7 +94,7 @@ impl Stepper {
                 kelvin_voigt: vec![0.0; kv],
                 ..Default::default()
             },
-            counters: Counters::default(),
+            counters: FixedStepCounters::default(),
             torque_mid: 0.0,
             newton,
             a: z.clone(),
@@ -272,9 +265,7 @@ impl Stepper {
             self.a_theta = (r1 - r0) / h;
         }
         // Predictor: the previous step's acceleration (kept in `a`).
-        let scale = self.model.length
-            + self.state.theta.abs()
-            + self.state.d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let scale = self.model.length + self.state.theta.abs() + max_abs(&self.state.d);
         let mut converged = false;
         let mut mid = self.midpoint(h);
         for it in 0..MAX_NEWTON {

@@ -58,14 +58,15 @@ use std::time::Instant;
 use data::channel::spec;
 use data::results::ledger_term;
 use data::{
-    BackendKind, Cost, DofPlan, EnergyLedger, ModalResult, ModeShape, Observables, RunResult,
-    Scene, Settings, StabilityVerdict,
+    DofPlan, EnergyLedger, ModalResult, ModeShape, Observables, RunResult, Scene, Settings,
+    StabilityVerdict,
 };
 use faer::Mat;
 
 use crate::band::BorderedBand;
 use crate::error::FemError;
 use crate::linalg::max_abs;
+use crate::method::FixedStepCounters;
 use model::{DOFS_PER_NODE, Model};
 
 /// Elements when `discretization.elements` is absent (h = 5 in on the catalog rocket).
@@ -83,24 +84,20 @@ pub fn the_rocket(scene: &Scene) -> Option<&data::scene::Rocket> {
     scene.rocket.as_ref()
 }
 
-fn elements(settings: &Settings) -> Result<usize, FemError> {
-    match settings.discretization.elements {
-        None => Ok(DEFAULT_ELEMENTS),
-        Some(_) => crate::settings::elements(&settings.discretization),
-    }
+fn rocket_of(scene: &Scene) -> Result<&data::scene::Rocket, FemError> {
+    the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))
 }
 
 pub fn build(scene: &Scene, settings: &Settings) -> Result<Model, FemError> {
-    let r = the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))?;
-    Model::new(r, elements(settings)?)
+    Model::new(
+        rocket_of(scene)?,
+        crate::settings::elements_or(&settings.discretization, DEFAULT_ELEMENTS)?,
+    )
 }
 
 pub fn dof_plan(scene: &Scene, disc: &data::Discretization) -> Result<DofPlan, FemError> {
-    let r = the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))?;
-    let n_el = match disc.elements {
-        None => DEFAULT_ELEMENTS,
-        Some(_) => crate::settings::elements(disc)?,
-    };
+    let r = rocket_of(scene)?;
+    let n_el = crate::settings::elements_or(disc, DEFAULT_ELEMENTS)?;
     let nm = r.discrete_masses.len();
     let mut plan = DofPlan::default();
     plan.add(
@@ -151,14 +148,6 @@ pub struct Works {
     pub outflow: f64,
 }
 
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Counters {
-    pub steps: usize,
-    pub newton: usize,
-    pub residuals: usize,
-    pub factorizations: usize,
-}
-
 /// State and scratch of the implicit-midpoint integration (no allocation per step).
 #[derive(Debug, Clone)]
 pub struct Stepper {
@@ -167,7 +156,7 @@ pub struct Stepper {
     pub q: Vec<f64>,
     pub v: Vec<f64>,
     pub works: Works,
-    pub counters: Counters,
+    pub counters: FixedStepCounters,
     gravity: Vec<f64>,
     springs: Vec<(usize, usize, f64, f64)>,
     jac: BorderedBand,
@@ -194,7 +183,7 @@ impl Stepper {
             q,
             v,
             works: Works::default(),
-            counters: Counters::default(),
+            counters: FixedStepCounters::default(),
             gravity,
             springs,
             jac,
@@ -438,7 +427,7 @@ pub struct Prepared {
 }
 
 pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
-    let r = the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))?;
+    let r = rocket_of(scene)?;
     match settings.time.method {
         None | Some(data::Method::ImplicitMidpoint) => {}
         Some(other) => {
@@ -554,26 +543,15 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
         obs.push(stepper.t, &buf);
         push_ledger(&stepper, &mut ledger);
     }
-    let c = stepper.counters;
-    Ok(RunResult {
-        backend: BackendKind::Fem,
-        scene: scene.name.clone(),
-        settings: settings.clone(),
-        observables: obs,
+    Ok(crate::run::run_result(
+        scene,
+        settings,
+        obs,
         ledger,
-        events: Vec::new(),
-        cost: Cost {
-            wall_time_s: start.elapsed().as_secs_f64(),
-            dofs: stepper.model.n,
-            steps: c.steps,
-            rejected_steps: 0,
-            rhs_evaluations: c.residuals,
-            jacobian_evaluations: c.factorizations,
-            factorizations: c.factorizations,
-            newton_iterations: c.newton,
-        },
+        Vec::new(),
+        stepper.counters.cost(stepper.model.n, start),
         verdict,
-    })
+    ))
 }
 
 /// fem's springs between discrete masses act on w_a − w_b in the launch axes, which a rigid
