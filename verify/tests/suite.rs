@@ -272,3 +272,19 @@ fn conv_history_richardson_is_closer_than_the_rung_spacing_and_can_fail() {
     assert_eq!(o.status, Status::Fail, "coarse error {:?}", o.error);
     assert!(o.error.unwrap() > 10.0 * fine);
 }
+
+#[test]
+fn prop_history_rung_sizes_follow_the_refined_parameter() {
+    use verify::suite::evaluate::history_rung_sizes;
+    let s = |elements: usize, dt: f64| CaseSettings {
+        elements: Some(elements),
+        dt: Some(dt),
+        ..Default::default()
+    };
+    // A space ladder at one pinned step is sized by the elements, a time ladder by dt.
+    let space = history_rung_sizes(&[s(4, 2.5e-4), s(8, 2.5e-4), s(16, 2.5e-4)]).unwrap();
+    assert_eq!(space, vec![0.25, 0.125, 0.0625]);
+    let time = history_rung_sizes(&[s(8, 1e-3), s(8, 5e-4), s(8, 2.5e-4)]).unwrap();
+    assert_eq!(time, vec![1e-3, 5e-4, 2.5e-4]);
+    assert!(history_rung_sizes(&[s(8, 1e-3), s(8, 1e-3)]).is_err());
+}

@@ -432,6 +432,30 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
     Ok(())
 }
 
+/// One way to size a ladder rung (None when the rung leaves that parameter unset).
+type RungSize = fn(&CaseSettings) -> Option<f64>;
+
+/// Rung sizes of a history ladder from the parameter its rungs refine: dt when it changes
+/// along the ladder, otherwise 1/elements, 1/(stations − 1) or 1/modes. A space ladder may so
+/// pin one step on every rung (the time error of a whole history does not cancel between
+/// meshes as a point value's may).
+pub fn history_rung_sizes(ladder: &[CaseSettings]) -> Result<Vec<f64>, String> {
+    let pick: [RungSize; 4] = [
+        |s| s.dt,
+        |s| s.elements.map(|e| 1.0 / e as f64),
+        |s| s.stations.map(|n| 1.0 / (n.max(2) - 1) as f64),
+        |s| s.modes.map(|m| 1.0 / m as f64),
+    ];
+    let size = pick
+        .into_iter()
+        .find(|f| ladder.windows(2).any(|w| f(&w[0]) != f(&w[1])))
+        .ok_or("the ladder's rungs refine no parameter (dt, elements, stations or modes)")?;
+    ladder
+        .iter()
+        .map(|r| size(r).ok_or_else(|| "a ladder rung leaves the refined parameter unset".into()))
+        .collect()
+}
+
 /// A whole history refined over a ladder (see [`super::ladder`]): the observed order of the
 /// successive differences (`order`), or the case's run against the pointwise Richardson
 /// extrapolation of the ladder's histories (`richardson`, norm `relative-to-peak`).
@@ -458,10 +482,7 @@ fn history_ladder(
         Reference::Richardson { richardson } => richardson,
         _ => return Err("a history ladder needs an `order` or `richardson` reference".into()),
     };
-    let h: Vec<f64> = ladder
-        .iter()
-        .map(|r| rung_size(r).ok_or("a ladder rung sets no refinement parameter"))
-        .collect::<Result<_, _>>()?;
+    let h = history_rung_sizes(ladder)?;
     let mut runs = Vec::with_capacity(ladder.len() + 1);
     if matches!(case.reference, Reference::Richardson { .. }) {
         runs.push(run(&case.settings)?);
