@@ -32,6 +32,12 @@
 //!   second-order Butterworth filter (filtfilt: gain 1 at 0 Hz, ½ at F, no lag; ends extended
 //!   by odd reflection, constants kept exactly); F must lie below the Nyquist frequency of the
 //!   output interval. Design and edge handling: `verify::suite::filter`.
+//!
+//! A history quantity (raw or low-passed) may also be refined over a ladder of the case's own
+//! backend: with an `order` reference the observed order of the successive whole-history
+//! differences max_t |H_k − H_{k+1}| must match `order` (no `against`); with a `richardson`
+//! reference the case's run is compared (`relative-to-peak`) with the pointwise Richardson
+//! extrapolation of the ladder's histories. Design: `verify::suite::ladder`.
 
 use serde::{Deserialize, Serialize};
 
@@ -205,7 +211,8 @@ case_files!(
     "mobile_flex",
     "mobile_flex_fem",
     "convergence_scenes",
-    "contact_coverage"
+    "contact_coverage",
+    "two_link_rows"
 );
 
 /// Parses a case file with located errors.

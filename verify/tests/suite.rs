@@ -189,3 +189,102 @@ fn prop_contact_quantities_read_the_events_and_refuse_missing_ones() {
     assert!(q("release_time2").from_run(&run).is_err());
     assert_eq!(q("max_momentum_residual").from_run(&run), Ok(1e-16));
 }
+
+/// The damped two-link arm over its first 0.5 s, fem 4 elements, refined in time.
+fn history_ladder_case(quantity: &str, reference: Reference, tolerance: f64) -> Case {
+    let rung = |dt: f64| CaseSettings {
+        elements: Some(4),
+        dt: Some(dt),
+        t_end: Some(0.5),
+        ..Default::default()
+    };
+    let reference = match reference {
+        Reference::Order { order, against, .. } => Reference::Order {
+            order,
+            against,
+            ladder: [4e-3, 2e-3, 1e-3, 5e-4].map(rung).to_vec(),
+        },
+        _ => Reference::Richardson {
+            richardson: [2e-3, 1e-3, 5e-4].map(rung).to_vec(),
+        },
+    };
+    Case {
+        id: "history-ladder".into(),
+        check: "convergence of a whole history".into(),
+        scene: "two-link-free".into(),
+        overrides: Default::default(),
+        backend: BackendKind::Fem,
+        settings: rung(5e-4),
+        quantity: quantity.into(),
+        reference,
+        norm: Norm::RelativeToPeak,
+        tolerance,
+        why: "energy-midpoint rule: second order in dt on the whole history".into(),
+        suite: SuiteName::Full,
+    }
+}
+
+#[test]
+fn conv_history_ladder_observes_the_time_order_and_can_fail() {
+    let cache = RunCache::default();
+    let order = |p: f64| Reference::Order {
+        order: p,
+        ladder: Vec::new(),
+        against: None,
+    };
+    // The raw history: over 0.5 s a 20 Hz low-pass is dominated by its edges and the start
+    // transient (differences 5.0e-4, 3.2e-4, 6.0e-5: no order), the raw history is not.
+    let quantity = "history:joint1.angle";
+    let o = evaluate(&history_ladder_case(quantity, order(2.0), 0.3), &cache);
+    assert_eq!(o.status, Status::Pass, "{quantity}: {}", o.message);
+    let observed = o.value.unwrap();
+    // Negative control: the same ladder cannot pass as fourth order.
+    let o = evaluate(&history_ladder_case(quantity, order(4.0), 0.3), &cache);
+    assert_eq!(o.status, Status::Fail, "{quantity}: observed {observed}");
+    // An analytic `against` has no meaning for a history ladder: an error, not a pass.
+    let against = Reference::Order {
+        order: 2.0,
+        ladder: Vec::new(),
+        against: Some("rigid-two-link".into()),
+    };
+    let o = evaluate(
+        &history_ladder_case("history:joint1.angle", against, 0.3),
+        &cache,
+    );
+    assert_eq!(o.status, Status::Error);
+}
+
+#[test]
+fn conv_history_richardson_is_closer_than_the_rung_spacing_and_can_fail() {
+    let cache = RunCache::default();
+    let q = "lowpass20:history:joint1.angle";
+    let richardson = || Reference::Richardson {
+        richardson: Vec::new(),
+    };
+    // The finest rung against the extrapolation: about d/(2^p − 1) of the last difference.
+    let o = evaluate(&history_ladder_case(q, richardson(), 1.0), &cache);
+    assert_eq!(o.status, Status::Pass, "{}", o.message);
+    let fine = o.error.unwrap();
+    // A coarser run (dt 4e-3) lies much farther from the same limit: a tight tolerance fails.
+    let mut coarse = history_ladder_case(q, richardson(), 2.0 * fine);
+    coarse.settings.dt = Some(4e-3);
+    let o = evaluate(&coarse, &cache);
+    assert_eq!(o.status, Status::Fail, "coarse error {:?}", o.error);
+    assert!(o.error.unwrap() > 10.0 * fine);
+}
+
+#[test]
+fn prop_history_rung_sizes_follow_the_refined_parameter() {
+    use verify::suite::evaluate::history_rung_sizes;
+    let s = |elements: usize, dt: f64| CaseSettings {
+        elements: Some(elements),
+        dt: Some(dt),
+        ..Default::default()
+    };
+    // A space ladder at one pinned step is sized by the elements, a time ladder by dt.
+    let space = history_rung_sizes(&[s(4, 2.5e-4), s(8, 2.5e-4), s(16, 2.5e-4)]).unwrap();
+    assert_eq!(space, vec![0.25, 0.125, 0.0625]);
+    let time = history_rung_sizes(&[s(8, 1e-3), s(8, 5e-4), s(8, 2.5e-4)]).unwrap();
+    assert_eq!(time, vec![1e-3, 5e-4, 2.5e-4]);
+    assert!(history_rung_sizes(&[s(8, 1e-3), s(8, 1e-3)]).is_err());
+}

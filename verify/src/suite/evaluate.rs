@@ -4,7 +4,7 @@ use data::cases::{Case, CaseSettings, Norm, Reference, scene_with_overrides};
 use data::{BackendError, Scene, Settings, StabilityVerdict, load_scene};
 use serde::{Deserialize, Serialize};
 
-use super::quantity::Quantity;
+use super::quantity::{Analysis, Quantity};
 use super::reference::analytic_value;
 use super::run_cache::{Answer, RunCache};
 
@@ -261,6 +261,18 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
     let q = Quantity::parse(&case.quantity, &scene)?;
     let settings = case.settings.to_settings();
 
+    if let Quantity::History {
+        channel,
+        lowpass_hz,
+    } = &q
+        && matches!(
+            case.reference,
+            Reference::Order { .. } | Reference::Richardson { .. }
+        )
+    {
+        return history_ladder(case, cache, &scene, channel, *lowpass_hz, out);
+    }
+
     if let Reference::Order {
         order,
         ladder,
@@ -448,5 +460,117 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
         }
     };
     out.error = Some(err);
+    Ok(())
+}
+
+/// One way to size a ladder rung (None when the rung leaves that parameter unset).
+type RungSize = fn(&CaseSettings) -> Option<f64>;
+
+/// Rung sizes of a history ladder from the parameter its rungs refine: dt when it changes
+/// along the ladder, otherwise 1/elements, 1/(stations − 1) or 1/modes. A space ladder may so
+/// pin one step on every rung (the time error of a whole history does not cancel between
+/// meshes as a point value's may).
+pub fn history_rung_sizes(ladder: &[CaseSettings]) -> Result<Vec<f64>, String> {
+    let pick: [RungSize; 4] = [
+        |s| s.dt,
+        |s| s.elements.map(|e| 1.0 / e as f64),
+        |s| s.stations.map(|n| 1.0 / (n.max(2) - 1) as f64),
+        |s| s.modes.map(|m| 1.0 / m as f64),
+    ];
+    let size = pick
+        .into_iter()
+        .find(|f| ladder.windows(2).any(|w| f(&w[0]) != f(&w[1])))
+        .ok_or("the ladder's rungs refine no parameter (dt, elements, stations or modes)")?;
+    ladder
+        .iter()
+        .map(|r| size(r).ok_or_else(|| "a ladder rung leaves the refined parameter unset".into()))
+        .collect()
+}
+
+/// A whole history refined over a ladder (see [`super::ladder`]): the observed order of the
+/// successive differences (`order`), or the case's run against the pointwise Richardson
+/// extrapolation of the ladder's histories (`richardson`, norm `relative-to-peak`).
+fn history_ladder(
+    case: &Case,
+    cache: &RunCache,
+    scene: &Scene,
+    channel: &str,
+    lowpass_hz: Option<f64>,
+    out: &mut Outcome,
+) -> Result<(), String> {
+    use super::ladder::{
+        difference_order, extrapolated_history, max_abs_difference, successive_differences,
+    };
+    let run = |s: &CaseSettings| -> Result<data::RunResult, String> {
+        match cache.get(scene, case.backend, &s.to_settings(), Analysis::Simulate, 0) {
+            Answer::Run(Ok(r)) => Ok(r),
+            Answer::Run(Err(e)) => Err(format!("{}: {e}", case.backend)),
+            _ => Err("not a run".to_string()),
+        }
+    };
+    let ladder = match &case.reference {
+        Reference::Order { ladder, .. } => ladder,
+        Reference::Richardson { richardson } => richardson,
+        _ => return Err("a history ladder needs an `order` or `richardson` reference".into()),
+    };
+    let h = history_rung_sizes(ladder)?;
+    let mut runs = Vec::with_capacity(ladder.len() + 1);
+    if matches!(case.reference, Reference::Richardson { .. }) {
+        runs.push(run(&case.settings)?);
+    }
+    for rung in ladder {
+        runs.push(run(rung)?);
+    }
+    out.wall_time_s += runs.iter().map(|r| r.cost.wall_time_s).sum::<f64>();
+    let refs: Vec<&data::RunResult> = runs.iter().collect();
+    let samples = super::history::common_samples(&refs, channel, lowpass_hz)?;
+    let filtered = lowpass_hz.map_or(String::new(), |f| format!(", low-passed at {f} Hz"));
+    match &case.reference {
+        Reference::Order { order, against, .. } => {
+            if against.is_some() {
+                return Err(
+                    "a history ladder takes its order from its own successive differences; \
+                     `against` applies to point quantities"
+                        .into(),
+                );
+            }
+            let d = successive_differences(&samples);
+            let observed = difference_order(&h, &d).ok_or(
+                "cannot observe an order: fewer than three rungs, sizes not decreasing, or a \
+                 zero difference",
+            )?;
+            let listed: Vec<String> = d.iter().map(|x| format!("{x:.3e}")).collect();
+            out.value = Some(observed);
+            out.reference = Some(*order);
+            out.reference_label = format!(
+                "order {order} of the successive whole-history differences max|H_k - H_k+1| \
+                 ({}) over {} rungs{filtered}",
+                listed.join(", "),
+                ladder.len()
+            );
+            out.error = Some((observed - order).abs());
+            out.quantity = format!("order({})", case.quantity);
+        }
+        _ => {
+            if case.norm != Norm::RelativeToPeak {
+                return Err("a Richardson history row is measured `relative-to-peak`".into());
+            }
+            let (ext, p) = extrapolated_history(&h, &samples[1..])
+                .ok_or("the history ladder is not in the asymptotic range (no order observed)")?;
+            let peak = ext.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            if peak <= 0.0 {
+                return Err("the extrapolated history is identically zero".into());
+            }
+            let dev = max_abs_difference(&samples[0], &ext);
+            out.value = Some(dev);
+            out.reference = Some(peak);
+            out.reference_label = format!(
+                "Richardson extrapolation of the histories over {} rungs (p = {p:.2}){filtered}, \
+                 error = max|Δ| / its peak",
+                ladder.len()
+            );
+            out.error = Some(dev / peak);
+        }
+    }
     Ok(())
 }

@@ -120,20 +120,7 @@ fn compare_series(
     }
     let inside = ta.iter().filter(|t| **t >= t0 && **t <= t1).count().max(3);
     let on_grid = |t: &[f64], v: &[f64]| -> Result<Vec<f64>, String> {
-        let (span_t, span_v): (Vec<f64>, Vec<f64>) = t
-            .iter()
-            .zip(v)
-            .filter(|(s, _)| **s >= t0 && **s <= t1)
-            .map(|(s, x)| (*s, *x))
-            .chain([t0, t1].into_iter().filter_map(|s| {
-                // The span ends themselves, so that both grids cover [t0, t1] exactly.
-                data::results::interpolate(t, v, s).map(|x| (s, x))
-            }))
-            .unzip();
-        let mut pts: Vec<(f64, f64)> = span_t.into_iter().zip(span_v).collect();
-        pts.sort_by(|p, q| p.0.total_cmp(&q.0));
-        pts.dedup_by(|p, q| p.0 == q.0);
-        let (ts, vs): (Vec<f64>, Vec<f64>) = pts.into_iter().unzip();
+        let (ts, vs): (Vec<f64>, Vec<f64>) = span_points(t, v, t0, t1).into_iter().unzip();
         let (dt, _, uniform) = resample_uniform(&ts, &vs, inside).map_err(|e| e.to_string())?;
         lowpass_zero_phase(&uniform, dt, fc).map_err(|e| e.to_string())
     };
@@ -148,4 +135,67 @@ fn compare_series(
         max_abs_diff,
         reference_peak,
     })
+}
+
+/// The histories of `channel` in several runs (a refinement ladder) on one grid: `n` equal
+/// steps over the span all runs cover, `n` the number of the first run's samples inside it, each
+/// history linearly interpolated onto the grid and, with a cut-off, low-passed there as in
+/// [`compare`]. Runs that write the same output times (a ladder of one backend) are sampled at
+/// those times.
+pub fn common_samples(
+    runs: &[&RunResult],
+    channel: &str,
+    lowpass_hz: Option<f64>,
+) -> Result<Vec<Vec<f64>>, String> {
+    let all: Vec<_> = runs
+        .iter()
+        .map(|r| series(r, channel).ok_or_else(|| format!("no channel `{channel}`")))
+        .collect::<Result<_, _>>()?;
+    let (Some((first_t, _)), true) = (all.first(), all.iter().all(|(t, _)| !t.is_empty())) else {
+        return Err("no history to compare".into());
+    };
+    let t0 = all.iter().map(|(t, _)| t[0]).fold(f64::MIN, f64::max);
+    let t1 = all
+        .iter()
+        .map(|(t, _)| t[t.len() - 1])
+        .fold(f64::MAX, f64::min);
+    if t1 <= t0 {
+        return Err("the histories do not overlap in time".into());
+    }
+    let inside = first_t
+        .iter()
+        .filter(|t| **t >= t0 && **t <= t1)
+        .count()
+        .max(3);
+    all.iter()
+        .map(|(t, v)| {
+            let (pts_t, pts_v): (Vec<f64>, Vec<f64>) =
+                span_points(t, v, t0, t1).into_iter().unzip();
+            let (dt, _, uniform) =
+                resample_uniform(&pts_t, &pts_v, inside).map_err(|e| e.to_string())?;
+            match lowpass_hz {
+                Some(fc) => lowpass_zero_phase(&uniform, dt, fc).map_err(|e| e.to_string()),
+                None => Ok(uniform),
+            }
+        })
+        .collect()
+}
+
+/// The samples of (t, v) inside [t0, t1] with the span ends interpolated in, sorted by time,
+/// one sample per time.
+fn span_points(t: &[f64], v: &[f64], t0: f64, t1: f64) -> Vec<(f64, f64)> {
+    let mut pts: Vec<(f64, f64)> = t
+        .iter()
+        .zip(v)
+        .filter(|(s, _)| **s >= t0 && **s <= t1)
+        .map(|(s, x)| (*s, *x))
+        .chain(
+            [t0, t1]
+                .into_iter()
+                .filter_map(|s| data::results::interpolate(t, v, s).map(|x| (s, x))),
+        )
+        .collect();
+    pts.sort_by(|p, q| p.0.total_cmp(&q.0));
+    pts.dedup_by(|p, q| p.0 == q.0);
+    pts
 }
