@@ -3,7 +3,9 @@
 //! 20 s spin-up for 4–64 elements, and the full 3 s `single-link` run at default settings with
 //! energy-midpoint (the default there) and generalized-α; whole default runs of the arms
 //! (`two-link-free-undamped` 10 s, `barhorst-case1` 3 s) and the first second of
-//! `two-link-free-undamped` (`arms-1s`).
+//! `two-link-free-undamped` (`arms-1s`); `barhorst-case1` over t ∈ [0, 0.5] s (`contact-0.5s`:
+//! the drop, the first impact at 0.28 s and constrained sliding; the contact maps' sparse mass
+//! solves per constrained step).
 //! Run: `cargo bench -p fem --bench fem_bench -- --quick` (one group: append its name, e.g. `arms`).
 
 use std::hint::black_box;
@@ -121,6 +123,21 @@ fn arms_short(c: &mut Criterion) {
     g.finish();
 }
 
+/// `barhorst-case1` shortened to 0.5 s at default settings: the free drop, the first impact
+/// (0.28 s) and the sliding phases after it, each constrained step with its normal-force
+/// evaluation (sparse mass factorization, `events::mass_solve`) and event location.
+fn contact_short(c: &mut Criterion) {
+    let mut g = c.benchmark_group("contact-0.5s");
+    g.sample_size(10);
+    let sc = data::load_scene("barhorst-case1").unwrap();
+    let mut st = Settings::default();
+    st.time.t_end = Some(0.5);
+    g.bench_function("barhorst-case1", |b| {
+        b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
+    });
+    g.finish();
+}
+
 /// The exact Newton matrix of the free two-link arm with foreshortening (residual pass,
 /// augmented assembly, band LU with the border's Schur complement, one solve) for 4–64
 /// elements per link: linear in the elements.
@@ -168,6 +185,7 @@ criterion_group!(
     spin_up,
     single_link,
     arms,
-    arms_short
+    arms_short,
+    contact_short
 );
 criterion_main!(benches);

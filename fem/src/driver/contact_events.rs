@@ -363,14 +363,14 @@ impl Driver {
                 // state force of a shortened step (the release event function) is continuous
                 // in h and the step multiplier stays finite as h → 0.
                 let inward_only = post != Post::None;
-                let loss = c.project(
+                let (loss, passes) = c.project(
                     &mut self.chain,
                     t,
                     &self.state.q,
                     &mut self.state.qd,
                     inward_only,
                 )?;
-                self.counters.rhs += self.chain.ndof + 1;
+                self.counters.rhs += passes + 1;
                 c.projection_loss += loss;
             }
         } else {

@@ -26,7 +26,8 @@
 //! stays on the surface after an impact), the index-1 value of the constrained dynamics
 //! M q̈ + R(q, q̇, 0) = Gᵀλ, G q̈ + n̂·J̇q̇ = 0:
 //!   λ = (G M⁻¹R(q, q̇, 0) − n̂·J̇q̇) / (G M⁻¹Gᵀ),
-//! with M(q) assembled column by column from exact mass products and factorized by dense LU.
+//! with M(q) the Newton matrix ∂R/∂q̈ assembled sparsely (with foreshortening, its exact
+//! augmented bordered band) and factorized once per configuration by `mass_solve`: O(n).
 //! Positive λ pushes the tip to the free side. It is evaluated at the velocity the constrained
 //! dynamics allows: q̇ projected onto G q̇ = 0 (the plastic projection that ends every
 //! constrained step) and made consistent along the massless directions. At a step end the
@@ -163,9 +164,9 @@ use data::Event;
 use data::Scene;
 use data::scene::{ContactMode, Surface};
 
-use crate::band::DenseLu;
 use crate::chain::{Chain, MAX_LINKS, Parts};
 use crate::error::FemError;
+use crate::events::mass_solve::MassSolver;
 use crate::events::massless::Massless;
 use crate::linalg::dot;
 use crate::method::{ConstraintView, NewtonSystem, StepConstraint};
@@ -297,14 +298,14 @@ pub struct Contact {
     pub(crate) g_bar: Vec<f64>,
     pub(crate) g_end: Vec<f64>,
     pub(crate) s_inv_g: Vec<f64>,
-    mass: DenseLu,
+    /// M(q) + μNNᵀ, sparse ([`crate::events::mass_solve`]).
+    mass: MassSolver,
     /// Exactly massless directions N (Timoshenko sections without rotary inertia, see
     /// [`crate::events::massless`]; None otherwise).
     pub(crate) massless: Option<Massless>,
     /// All massless directions of [`Chain::massless_directions`] (the exact ones and the
     /// frame directions of mass O(s²)): the regularization M + μ N Nᵀ, by DOF.
     reg_dirs: Vec<Vec<(usize, f64)>>,
-    dof_dirs: Vec<Vec<(usize, f64)>>,
     /// Mass scale μ of the regularization M + μNNᵀ.
     mass_scale: f64,
     /// Consistent velocity of the last state-force evaluation.
@@ -328,7 +329,7 @@ impl Contact {
             .iter()
             .position(|l| l.name == c.link)
             .unwrap_or(0);
-        let bilateral = crate::events::contact::friction::Bilateral::from_scene(c, chain.ndof)?;
+        let bilateral = crate::events::contact::friction::Bilateral::from_scene(c, chain)?;
         let (point, normal) = match c.surface {
             Surface::Line { point, normal } => (point, normal),
             // The circle's normal depends on the tip position: `bilateral.wall` has it.
@@ -356,12 +357,6 @@ impl Contact {
         let z = vec![0.0; n];
         let massless = Massless::new(chain);
         let reg_dirs = chain.massless_directions();
-        let mut dof_dirs = vec![Vec::new(); if reg_dirs.is_empty() { 0 } else { n }];
-        for (k, d) in reg_dirs.iter().enumerate() {
-            for &(i, c) in d {
-                dof_dirs[i].push((k, c));
-            }
-        }
         Ok(Some(Contact {
             link,
             normal: [normal[0] / len, normal[1] / len],
@@ -387,10 +382,9 @@ impl Contact {
             g_bar: z.clone(),
             g_end: z.clone(),
             s_inv_g: z.clone(),
-            mass: DenseLu::new(n),
+            mass: MassSolver::new(chain, &reg_dirs),
             massless,
             reg_dirs,
-            dof_dirs,
             mass_scale: 0.0,
             qd_c: z.clone(),
             zero: z.clone(),
@@ -430,42 +424,23 @@ impl Contact {
         self.gap_of(r)
     }
 
-    /// Assembles M(q) column by column from exact mass products M e_j = R_in(q, 0, e_j) and
-    /// factorizes it (dense LU).
-    fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<(), FemError> {
+    /// Forms and factorizes M(q) + μNNᵀ sparsely ([`crate::events::mass_solve`]; reused at
+    /// the same (t, q)). Returns the residual passes used.
+    fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<usize, FemError> {
         let n = chain.ndof;
+        let mut passes = 0;
         if !self.reg_dirs.is_empty() && self.mass_scale == 0.0 {
             // μ: the largest diagonal mass (any positive scale works on the exact directions;
-            // module docs).
+            // module docs), from n mass products once per run.
             for j in 0..n {
                 self.unit[j] = 1.0;
                 chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
                 self.unit[j] = 0.0;
                 self.mass_scale = self.mass_scale.max(self.col[j].abs());
             }
+            passes += n;
         }
-        for j in 0..n {
-            self.unit[j] = 1.0;
-            chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
-            self.unit[j] = 0.0;
-            // M + μ N Nᵀ: regular, and equal to M on the massive subspace (module docs).
-            if !self.reg_dirs.is_empty() {
-                for &(k, cj) in &self.dof_dirs[j] {
-                    for &(i, ci) in &self.reg_dirs[k] {
-                        self.col[i] += self.mass_scale * ci * cj;
-                    }
-                }
-            }
-            self.mass.set_column(j, &self.col);
-        }
-        self.mass.factorize().map_err(|e| match e {
-            FemError::Singular { pivot, .. } => FemError::Singular {
-                what: "mass".into(),
-                pivot,
-                t,
-            },
-            other => other,
-        })
+        Ok(passes + self.mass.factor(chain, t, q, self.mass_scale)?)
     }
 
     /// Makes `qd` consistent with the massless balances Nᵀ R(q, q̇, 0) = 0 by changing it along
@@ -494,8 +469,7 @@ impl Contact {
         q: &[f64],
         qd: &[f64],
     ) -> Result<(f64, f64, usize), FemError> {
-        let mut n = chain.ndof;
-        self.factor_mass(chain, t, q)?;
+        let mut n = self.factor_mass(chain, t, q)?;
         let mut g_row = std::mem::take(&mut self.g_end);
         self.gap = self.gradient(chain, t, q, &mut g_row);
         self.minv_gt.copy_from_slice(&g_row);
@@ -622,7 +596,8 @@ impl Contact {
 
     /// Plastic projection of the velocity onto G q̇ = 0 (q̇ ← q̇ − M⁻¹Gᵀ(G q̇)/(G M⁻¹Gᵀ)),
     /// only when `inward_only` is false or G q̇ < 0; returns the kinetic energy it removes,
-    /// ½(G q̇)²/(G M⁻¹Gᵀ) ≥ 0. Records the gap and the drift G q̇ before the projection.
+    /// ½(G q̇)²/(G M⁻¹Gᵀ) ≥ 0, and the residual passes of the mass factorization. Records the
+    /// gap and the drift G q̇ before the projection.
     pub(crate) fn project(
         &mut self,
         chain: &mut Chain,
@@ -630,8 +605,8 @@ impl Contact {
         q: &[f64],
         qd: &mut [f64],
         inward_only: bool,
-    ) -> Result<f64, FemError> {
-        self.factor_mass(chain, t, q)?;
+    ) -> Result<(f64, usize), FemError> {
+        let passes = self.factor_mass(chain, t, q)?;
         let mut g_row = std::mem::take(&mut self.g_end);
         self.gap = self.gradient(chain, t, q, &mut g_row);
         let vn = dot(&g_row, qd);
@@ -650,7 +625,7 @@ impl Contact {
         }
         self.normal_velocity = dot(&g_row, qd);
         self.g_end = g_row;
-        Ok(loss)
+        Ok((loss, passes))
     }
 
     /// Reports a pending release (the free motion after it was stepped).

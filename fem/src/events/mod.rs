@@ -7,6 +7,7 @@
 //! * [`contact::friction`]: the bilateral wall's Coulomb friction and stick constraint, the
 //!   index-1 wall forces (seed 001: stick–slip), a refinement of the contact it belongs to;
 //! * [`wall`]: circle and line geometry of a bilateral wall;
+//! * `mass_solve`: solves with the mass matrix M(q) of these maps (sparse, O(n));
 //! * [`massless`]: the balances of massless section rotations in contact runs.
 //!
 //! Locating the events (roots of the gap, the normal force, the slip velocity and the
@@ -14,5 +15,6 @@
 //! [`crate::driver::stick_slip`]): it re-solves the step shorter with the method.
 
 pub mod contact;
+pub(crate) mod mass_solve;
 pub mod massless;
 pub mod wall;

@@ -23,7 +23,7 @@
 //! ∫μ|λ||v_t| dt to second order (Δq = h v̄).
 //!
 //! **Index-1 forces at a state** (channels, event functions, phase decisions), from the dense
-//! M(q) (exact mass products, LU), R(q, q̇, 0) and the tip's convective acceleration a_c = J̇q̇:
+//! M(q) (the sparse mass matrix, `mass_solve`), R(q, q̇, 0) and the tip's convective acceleration a_c = J̇q̇:
 //! * sliding: λ (G M⁻¹Gᵀ − μ s σ G M⁻¹Tᵀ) = G M⁻¹R − n̂·a_c + κ v_t². If
 //!   G M⁻¹Gᵀ ≤ μ|G M⁻¹Tᵀ| (Painlevé: no or several λ) the run stops with that diagnosis;
 //!   otherwise both brackets are positive and σ = sign of the right-hand side;
@@ -87,10 +87,10 @@
 use data::Scene;
 use data::scene::{ContactMode, Surface};
 
-use crate::band::DenseLu;
-use crate::chain::{Chain, MAX_LINKS, Parts};
+use crate::chain::{Chain, MAX_LINKS};
 use crate::error::FemError;
 use crate::events::contact::Contact;
+use crate::events::mass_solve::MassSolver;
 use crate::events::wall::{Wall, row_along, rows};
 use crate::linalg::dot;
 use crate::method::{ConstraintView, NewtonSystem};
@@ -258,10 +258,8 @@ pub struct Bilateral {
     pub(crate) minv_g: Vec<f64>,
     pub(crate) minv_t: Vec<f64>,
     pub(crate) minv_r: Vec<f64>,
-    pub(crate) mass: DenseLu,
+    pub(crate) mass: MassSolver,
     pub(crate) zero: Vec<f64>,
-    pub(crate) unit: Vec<f64>,
-    pub(crate) col: Vec<f64>,
 }
 
 pub(crate) fn sign(x: f64) -> f64 {
@@ -269,8 +267,12 @@ pub(crate) fn sign(x: f64) -> f64 {
 }
 
 impl Bilateral {
-    /// The bilateral contact of the scene (None for a unilateral one), for `n` DOFs.
-    pub fn from_scene(c: &data::scene::Contact, n: usize) -> Result<Option<Box<Self>>, FemError> {
+    /// The bilateral contact of the scene (None for a unilateral one) on `chain`.
+    pub fn from_scene(
+        c: &data::scene::Contact,
+        chain: &Chain,
+    ) -> Result<Option<Box<Self>>, FemError> {
+        let n = chain.ndof;
         if c.mode != ContactMode::Bilateral {
             return Ok(None);
         }
@@ -311,10 +313,8 @@ impl Bilateral {
             minv_g: z.clone(),
             minv_t: z.clone(),
             minv_r: z.clone(),
-            mass: DenseLu::new(n),
-            zero: z.clone(),
-            unit: z.clone(),
-            col: z,
+            mass: MassSolver::new(chain, &[]),
+            zero: z,
         })))
     }
 
@@ -323,22 +323,10 @@ impl Bilateral {
         self.mu > 0.0
     }
 
-    /// M(q) column by column from exact mass products, factorized (dense LU).
+    /// M(q) assembled sparsely and factorized ([`crate::events::mass_solve`]; reused at the
+    /// same (t, q)).
     fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<(), FemError> {
-        for j in 0..q.len() {
-            self.unit[j] = 1.0;
-            chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
-            self.unit[j] = 0.0;
-            self.mass.set_column(j, &self.col);
-        }
-        self.mass.factorize().map_err(|e| match e {
-            FemError::Singular { pivot, .. } => FemError::Singular {
-                what: "mass".into(),
-                pivot,
-                t,
-            },
-            other => other,
-        })
+        self.mass.factor(chain, t, q, 0.0).map(|_| ())
     }
 
     /// Index-1 forces at (q, q̇) (module docs): the held-tip pair when `held`, else the sliding
