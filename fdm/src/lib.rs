@@ -189,6 +189,7 @@ pub mod chain;
 pub mod driver;
 pub mod error;
 pub mod events;
+pub mod foreshortening;
 pub mod link;
 pub mod method;
 pub mod output;

@@ -11,8 +11,10 @@
 //! Y₀ = θ̇L₁ cos φ + β̇ξ,     Y₁ = θ̇V sin φ + V̇ cos φ + ẇ,     Y₂ = Ṡ sin φ − θ̇S cos φ − β̇σ,
 //!
 //! (V = v_{r₁}, S = s₁(L₁)), the kinetic energy kept is the expansion to second order in the
-//! deflections (as the single link, [`crate::link`]): ½m[(X₀+X₁)² + (Y₀+Y₁)²] + m(X₀X₂ + Y₀Y₂)
-//! per point. Summed over the lumped masses:
+//! deflections: ½m[(X₀+X₁)² + (Y₀+Y₁)²] + m(X₀X₂ + Y₀Y₂) per point. The chain leaves out the
+//! third- and fourth-order remainder (m(X₁X₂ + Y₁Y₂) + ½m(X₂² + Y₂²) per point, and link 1's
+//! ΔT of [`crate::link`]), which the single link, fem and modal keep. Summed over the lumped
+//! masses:
 //!
 //! T = ½J₁θ̇² + Σᵢ ½mᵢ[θ̇²vᵢ² + (θ̇xᵢ + v̇ᵢ)²] − θ̇²Φ₁
 //!   + ½M₂[(θ̇L₁ + V̇)² + θ̇²V²] + β̇(bQ₂ − aΣmw) + bΣmẇ + ½β̇²Σmw² + ½Σm(β̇ξ + ẇ)²

@@ -2,35 +2,34 @@
 //! cantilever: `spin-up`, `spin-up-linear`, `single-link`.
 //!
 //! Discrete Lagrangian (stations 0…r, v₀ = 0, clamped ghost v₋₁ = v₁, free-end ghosts as in the
-//! report's 5.32; trapezoid-lumped masses m_i, tip mass at station r):
+//! report's 5.32; trapezoid-lumped masses m_i, tip mass at station r). Station i sits at
+//! (X_i, v_i) = (x_i − s_i, v_i) in the hub frame, s_i = ½h Σ_{seg<i} g_seg², g = Δv/h, when
+//! `foreshortening` is on (s ≡ 0 for the linear model); the kinetic energy is the exact one of
+//! these points,
 //!
-//! T = ½Jθ̇² + ½ Σ m_i [θ̇² v_i² + (v̇_i + θ̇ x_i)²] − θ̇² Φ(v),
-//! Φ = Σ m_i x_i s_i = ½ Σ_seg h W_seg g_seg²,  W_seg = Σ_{i > seg} m_i x_i,  g = Δv/h,
+//! T = ½Jθ̇² + ½ Σ m_i [(ṡ_i + θ̇ v_i)² + (v̇_i + θ̇ X_i)²],   ṡ = B v̇,  B = ∂s/∂v,
 //! V = ½ Σ_{i=0}^{r−1} c_i h EI κ_i²  (c₀ = ½, κ₀ = 2v₁/h², κ_r = 0),
 //! D = ½ Σ c_i h γ κ̇_i²  (Kelvin–Voigt).
 //!
-//! T is the kinetic energy of the point (x − s, v) of the rotating frame to second order in v,
-//! with s = ½∫₀ˣ v'² when `foreshortening` is on (Φ ≡ 0 for the linear model, which then has
-//! only the centrifugal softening −θ̇² m v and must diverge above the first frequency).
-//! Lagrange's equations give, per station,
-//!   m_k (v̈_k + θ̈ x_k) = F_k ≡ θ̇² (m_k v_k − ∂Φ/∂v_k) − ∂V/∂v_k − ∂D/∂v̇_k,
-//! and for the hub, with p_θ = I θ̇ + Σ m_i x_i v̇_i, I = J + Σ m_i (x_i² + v_i²) − 2Φ,
-//!   (J + Σ m_i v_i² − 2Φ) θ̈ = τ − İ θ̇ − Σ x_i F_i      (v̈ eliminated, as in 5.38/5.40).
-//! With a prescribed joint the second line gives the torque the motor needed.
+//! Lagrange's equations are Σ_i m_i a_i·∂r_i/∂q = Q with a_i the inertial acceleration of
+//! point i; with s̈ = B v̈ + c, c_i = h Σ_{seg<i} ġ_seg² ([`crate::foreshortening`]) they read
 //!
-//! Model order: T above is the exact kinetic energy ½Σm|ṙ|² of the points (x_i − s_i, v_i),
-//! s_i = ½h Σ_{seg<i} g_seg², *truncated to second order in v*. The remainder
-//!   ΔT = ½ Σ m_i [θ̇² s_i² + 2θ̇(v_i ṡ_i − s_i v̇_i) + ṡ_i²]
-//! (third and fourth order; its ṡ² part would make the mass matrix dense, M + Jᵀ diag(m) J with
-//! J = ∂s/∂v, and couple the hub row) is not kept, while fem (T = ½Σm|ṙ|² exactly) and modal
-//! (`exact_inextensible_terms`) keep it. This is a difference of model, not of discretization,
-//! and it is what separates fdm from fem and modal on `spin-up` (tested:
-//! `elem_link_kinetic_energy_is_the_exact_one_less_the_inextensible_remainder`). Measured with
-//! `flexverify converge spin-up --quantity peak:link1.tip_deflection`: fdm's Richardson limit
-//! (11…161 stations, order 2.00) is 0.40032746 m; modal's limit is 0.40077 m with ΔT and
-//! 0.40032742 m with ΔT removed (4…8 modes), i.e. ΔT alone moves the peak by 4.4e-4 m (1.1e-3
-//! relative) and the truncated models agree to 1e-7. Without stiffening (Φ ≡ 0, s ≡ 0) ΔT
-//! vanishes and the backends agree (`spin-up-linear`).
+//!   A v̈ + θ̈ d = F ≡ Q + θ̇² m v + 2θ̇ m ṡ − Bᵀ m (c + 2θ̇ v̇ + θ̇² X),
+//!   (J + Σ m (X² + v²)) θ̈ + dᵀ v̈ = τ − Σ m [v c + 2θ̇ v v̇ − 2θ̇ X ṡ],
+//!
+//! A = diag(m) + Bᵀ diag(m) B,  d = m X + Bᵀ m v,  Q = −∂V/∂v − ∂D/∂v̇. With a prescribed joint
+//! v̈ = A⁻¹(F − θ̈ d) and the second line gives the torque the motor needed; a free hub is the
+//! bordered solve v̈ = A⁻¹F − θ̈ A⁻¹d, θ̈ from the hub row. A⁻¹ costs O(r) per right-hand side
+//! through the tridiagonal system of the constraint's axial forces
+//! ([`crate::foreshortening::Foreshortening`]); without foreshortening A = diag(m).
+//! To second order in v the model is the report's T = ½Jθ̇² + ½Σm[θ̇²v² + (v̇ + θ̇x)²] − θ̇²Φ,
+//! Φ = Σ m x s = ½ Σ_seg h W_seg g_seg² (W_seg = Σ_{i > seg} m_i x_i, the centrifugal tension's
+//! potential); the exact T adds ΔT = ½ Σ m [θ̇² s² + 2θ̇(v ṡ − s v̇) + ṡ²], as fem (½Σm|ṙ|²) and
+//! modal (`exact_inextensible_terms`) do. On `spin-up` ΔT moves the peak tip deflection by
+//! 1.1e-3 relative: fdm's Richardson limit of 11…161 stations (order 2.00) is 0.40076871 m
+//! against modal's 0.4007687 m (`flexverify converge spin-up --quantity
+//! peak:link1.tip_deflection --backend fdm`); the second-order model (ΔT dropped) converges
+//! to 0.40032746 m.
 //!
 //! Step bound: θ̇²∂²Φ is the string stiffness of the centrifugal tension N = θ̇²W, so the
 //! linearized operator is M⁻¹(K_b + θ̇²∂²Φ − θ̇²M); its Gershgorin discs give, per station,
@@ -42,6 +41,7 @@ use data::scene::{PrescribedMotion, TorqueLaw};
 use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
+use crate::foreshortening::Foreshortening;
 use crate::system::{Bound, BoundKind, System};
 
 mod outputs;
@@ -84,8 +84,14 @@ pub struct FloatingLink {
     /// per unit θ̇² (zero without foreshortening): θ̇² ∂²Φ is the centrifugal tension
     /// N(x) = θ̇² W(x) acting as a string, N/h · [−1 2 −1].
     geo_row: Vec<f64>,
+    /// foreshortening kinematics and the factorized mass operator diag(m) + Bᵀ m B
+    fore: Foreshortening,
     // scratch
     f: Vec<f64>,
+    /// hub–deflection coupling d = m X + Bᵀ m v
+    coupling: Vec<f64>,
+    /// axial loads per station, then A⁻¹d
+    axial: Vec<f64>,
     power: [f64; 3],
     torque: f64,
     /// Hub rate of the latest force evaluation (the bound of a torque-driven hub uses it).
@@ -172,9 +178,12 @@ impl FloatingLink {
             theta0: j.initial_angle,
             rate0: j.initial_rate,
             drive,
-            m,
             wseg,
             field_stations: scene.simulation.field_stations.max(2),
+            fore: Foreshortening::new(h, &m),
+            m,
+            coupling: vec![0.0; r],
+            axial: vec![0.0; r],
             f: vec![0.0; r],
             power: [0.0; 3],
             torque: 0.0,
@@ -294,11 +303,8 @@ impl FloatingLink {
         e
     }
 
-    /// Φ and its gradient added (times `scale`) into f.
-    fn add_phi(&self, vs: &[f64], scale: f64, f: &mut [f64]) -> f64 {
-        Self::add_phi_stencil(self.h, &self.wseg, vs, scale, f)
-    }
-
+    /// Adds scale · ∂Φ/∂v into f and returns Φ = ½ Σ_seg h W_seg g_seg² (W_seg = Σ_{i > seg} mᵢxᵢ):
+    /// the geometric stiffness of the centrifugal tension, for the step bound.
     fn add_phi_stencil(h: f64, wseg: &[f64], vs: &[f64], scale: f64, f: &mut [f64]) -> f64 {
         let mut phi = 0.0;
         for seg in 0..wseg.len() {
@@ -324,23 +330,33 @@ impl FloatingLink {
         e
     }
 
-    fn phi(&self, vs: &[f64]) -> f64 {
-        (0..self.r)
-            .map(|seg| {
-                let g = (Self::at(vs, seg + 1) - Self::at(vs, seg)) / self.h;
-                0.5 * self.h * self.wseg[seg] * g * g
-            })
-            .sum()
+    /// T = ½Jθ̇² + ½ Σ mᵢ [(ṡᵢ + θ̇vᵢ)² + (v̇ᵢ + θ̇(xᵢ − sᵢ))²] (s ≡ 0 without foreshortening).
+    fn kinetic_energy(&self, rate: f64, vs: &[f64], vd: &[f64]) -> f64 {
+        let (mut s, mut sd) = (0.0, 0.0);
+        let mut ke = 0.5 * self.hub * rate * rate;
+        for k in 0..self.r {
+            if self.foreshortening {
+                let g = (vs[k] - Self::at(vs, k)) / self.h;
+                let gd = (vd[k] - Self::at(vd, k)) / self.h;
+                s += 0.5 * self.h * g * g;
+                sd += self.h * g * gd;
+            }
+            let x = (k + 1) as f64 * self.h;
+            ke +=
+                0.5 * self.m[k] * ((sd + rate * vs[k]).powi(2) + (vd[k] + rate * (x - s)).powi(2));
+        }
+        ke
     }
 
-    fn phi_dot(&self, vs: &[f64], vd: &[f64]) -> f64 {
-        let mut s = 0.0;
-        for seg in 0..self.r {
-            let g = (Self::at(vs, seg + 1) - Self::at(vs, seg)) / self.h;
-            let gd = (Self::at(vd, seg + 1) - Self::at(vd, seg)) / self.h;
-            s += self.h * self.wseg[seg] * g * gd;
+    /// out = A⁻¹ f: the foreshortening mass operator, or diag(m) without foreshortening.
+    fn mass_solve(fs: &mut Foreshortening, on: bool, m: &[f64], f: &[f64], out: &mut [f64]) {
+        if on {
+            fs.solve(f, out);
+        } else {
+            for k in 0..m.len() {
+                out[k] = f[k] / m[k];
+            }
         }
-        s
     }
 
     /// Applied hub torque (law + spring + damper) and its parts for the ledger.
@@ -420,6 +436,8 @@ impl System for FloatingLink {
         self.last_rate = rate;
         let (vs, vd) = (&q[vr.clone()], &v[vr.clone()]);
         let mut f = std::mem::take(&mut self.f);
+        let mut d = std::mem::take(&mut self.coupling);
+        let mut y = std::mem::take(&mut self.axial);
         f.iter_mut().for_each(|x| *x = 0.0);
         Self::add_bending(self.h, self.ei, vs, &mut f);
         let mut p_kv = 0.0;
@@ -427,46 +445,75 @@ impl System for FloatingLink {
             // −∂D/∂v̇ with D = ½ Σ c_i h γ κ̇_i² (the same stencil on v̇); dissipated power 2D.
             p_kv = 2.0 * Self::add_bending(self.h, self.gamma, vd, &mut f);
         }
-        let mut phi = 0.0;
-        if self.foreshortening {
-            phi = self.add_phi(vs, -rate * rate, &mut f);
-        }
-        let mut sum_mv2 = 0.0;
-        let mut sum_mvvd = 0.0;
-        for k in 0..self.r {
-            f[k] += rate * rate * self.m[k] * vs[k];
-            sum_mv2 += self.m[k] * vs[k] * vs[k];
-            sum_mvvd += self.m[k] * vs[k] * vd[k];
-        }
-        let phid = if self.foreshortening {
-            self.phi_dot(vs, vd)
-        } else {
-            0.0
-        };
-        let idot = 2.0 * sum_mvvd - 2.0 * phid;
-        let xf: f64 = (0..self.r).map(|k| (k + 1) as f64 * self.h * f[k]).sum();
-        let jeff = self.hub + sum_mv2 - 2.0 * phi;
+        // f ← Q + θ̇² m v + 2θ̇ m ṡ − Bᵀ m (c + 2θ̇ v̇ + θ̇² X),  d = m X + Bᵀ m v,
+        // a_θθ = J + Σ m (X² + v²),  r_θ = −Σ m [v c + 2θ̇ v v̇ − 2θ̇ X ṡ]   (module docs)
         let (ext, spring, damper) = self.applied(t, th, rate);
+        let fs = &mut self.fore;
+        if self.foreshortening {
+            fs.set_state(vs, vd);
+            fs.factor();
+        }
+        let (mut a_hub, mut r_hub) = (self.hub, 0.0);
+        for k in 0..self.r {
+            let x = (k + 1) as f64 * self.h;
+            let m = self.m[k];
+            let (s, sd, c) = if self.foreshortening {
+                (fs.s[k], fs.sd[k], fs.c[k])
+            } else {
+                (0.0, 0.0, 0.0)
+            };
+            let big_x = x - s;
+            f[k] += m * (rate * rate * vs[k] + 2.0 * rate * sd);
+            y[k] = m * (c + 2.0 * rate * vd[k] + rate * rate * big_x);
+            a_hub += m * (big_x * big_x + vs[k] * vs[k]);
+            r_hub -= m * (vs[k] * c + 2.0 * rate * (vs[k] * vd[k] - big_x * sd));
+            d[k] = m * big_x;
+        }
+        if self.foreshortening {
+            fs.bt_mul_add(&y, -1.0, &mut f);
+            for k in 0..self.r {
+                y[k] = self.m[k] * vs[k];
+            }
+            fs.bt_mul_add(&y, 1.0, &mut d);
+        }
+        // A u = f − θ̈ d with A = diag(m) + Bᵀ m B (O(r) through `Foreshortening`)
+        let vacc = &mut a[vr.clone()];
         let thdd = match pres {
             Some(acc) => {
-                self.torque = jeff * acc + idot * rate + xf;
+                for k in 0..self.r {
+                    f[k] -= acc * d[k];
+                }
+                Self::mass_solve(fs, self.foreshortening, &self.m, &f, vacc);
+                let du: f64 = (0..self.r).map(|k| d[k] * vacc[k]).sum();
+                self.torque = a_hub * acc + du - r_hub;
                 acc
             }
             None => {
                 let tau = ext + spring + damper;
                 self.torque = ext;
-                (tau - idot * rate - xf) / jeff
+                // bordered solve: u = A⁻¹f − θ̈ A⁻¹d, θ̈ from the hub row
+                Self::mass_solve(fs, self.foreshortening, &self.m, &d, &mut y);
+                Self::mass_solve(fs, self.foreshortening, &self.m, &f, vacc);
+                let (mut dy1, mut dy2) = (0.0, 0.0);
+                for k in 0..self.r {
+                    dy1 += d[k] * vacc[k];
+                    dy2 += d[k] * y[k];
+                }
+                let thdd = (tau + r_hub - dy1) / (a_hub - dy2);
+                for k in 0..self.r {
+                    vacc[k] -= thdd * y[k];
+                }
+                thdd
             }
         };
         if !self.prescribed() {
             a[0] = thdd;
         }
-        for k in 0..self.r {
-            a[vr.start + k] = f[k] / self.m[k] - thdd * (k + 1) as f64 * self.h;
-        }
         // powers: input (applied or prescribed torque), joint damper, Kelvin–Voigt
         self.power = [self.torque * rate, damper * -rate, p_kv];
         self.f = f;
+        self.coupling = d;
+        self.axial = y;
     }
 
     fn powers(&self, out: &mut [f64]) {
@@ -514,14 +561,7 @@ impl System for FloatingLink {
         let (th, rate, _) = self.hub_state(t, q, v);
         let vr = self.vrange();
         let (vs, vd) = (&q[vr.clone()], &v[vr]);
-        let mut ke = 0.5 * self.hub * rate * rate;
-        for k in 0..self.r {
-            let x = (k + 1) as f64 * self.h;
-            ke += 0.5 * self.m[k] * ((rate * vs[k]).powi(2) + (vd[k] + rate * x).powi(2));
-        }
-        if self.foreshortening {
-            ke -= rate * rate * self.phi(vs);
-        }
+        let ke = self.kinetic_energy(rate, vs, vd);
         let strain = Self::bending_energy(self.h, self.ei, vs);
         out[0] = ke;
         out[1] = strain;
