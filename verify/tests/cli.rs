@@ -371,3 +371,20 @@ fn cli_default_outputs_fit_120_columns() {
     assert!(wide.lines().any(|l| l.contains("analytic:clamped-free")));
     assert!(wide.lines().any(|l| l.chars().count() > 120), "{wide}");
 }
+
+#[test]
+fn cli_closed_output_pipe_ends_quietly_with_the_sigpipe_status() {
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flexverify"))
+        .arg("scenes")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run flexverify");
+    // The reader goes away before anything is written, as `flexverify scenes | head -0` does.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("wait for flexverify");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(141), "{err}");
+    assert!(err.is_empty(), "nothing on stderr, got:\n{err}");
+}

@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use super::CliError;
 use super::progress::Bar;
+use super::stdout::{out, outln};
 use crate::error::Error;
 use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
 use crate::shard::{self, Shard, ShardFile};
@@ -34,11 +35,11 @@ fn print_survey(studies: &[Study], format: Format) {
     if studies.is_empty() {
         return;
     }
-    println!();
+    outln!();
     match format {
-        Format::Table => print!("{}", study::survey_terminal_table(studies, TERMINAL_WIDTH)),
+        Format::Table => out!("{}", study::survey_terminal_table(studies, TERMINAL_WIDTH)),
         Format::Wide | Format::Csv | Format::Json => {
-            print!("{}", study::survey_wide_table(studies))
+            out!("{}", study::survey_wide_table(studies))
         }
     }
 }
@@ -164,10 +165,10 @@ pub fn merge(dirs: &[PathBuf], format: Format, out: &Path) -> Result<(), CliErro
 
 fn print_outcomes(outcomes: &[Outcome], format: Format) {
     match format {
-        Format::Table => print!("{}", report::terminal_table(outcomes, TERMINAL_WIDTH)),
-        Format::Wide => print!("{}", report::wide_table(outcomes)),
-        Format::Csv => print!("{}", report::csv(outcomes)),
-        Format::Json => println!("{}", report::json(outcomes)),
+        Format::Table => out!("{}", report::terminal_table(outcomes, TERMINAL_WIDTH)),
+        Format::Wide => out!("{}", report::wide_table(outcomes)),
+        Format::Csv => out!("{}", report::csv(outcomes)),
+        Format::Json => outln!("{}", report::json(outcomes)),
     }
 }
 
@@ -214,10 +215,10 @@ pub fn stability(
         )));
     }
     match format {
-        Format::Table => print!("{}", stability::terminal_table(&verdicts, TERMINAL_WIDTH)),
-        Format::Wide => print!("{}", stability::wide_table(&verdicts)),
-        Format::Csv => print!("{}", stability::csv(&verdicts)),
-        Format::Json => println!("{}", stability::json(&verdicts)),
+        Format::Table => out!("{}", stability::terminal_table(&verdicts, TERMINAL_WIDTH)),
+        Format::Wide => out!("{}", stability::wide_table(&verdicts)),
+        Format::Csv => out!("{}", stability::csv(&verdicts)),
+        Format::Json => outln!("{}", stability::json(&verdicts)),
     }
     if let Some(dir) = out {
         stability::write_all(dir, &verdicts)?;
@@ -246,12 +247,12 @@ pub fn stability(
 pub fn coverage(format: Format) -> Result<(), CliError> {
     let c = crate::coverage::analyse_embedded().map_err(|e| CliError::Input(e.to_string()))?;
     match format {
-        Format::Json => println!(
+        Format::Json => outln!(
             "{}",
             serde_json::to_string_pretty(&c)
-                .map_err(|e| CliError::Failed(format!("error: cannot serialize: {e}")))?
+                .map_err(|e| CliError::Output(format!("error: cannot serialize: {e}")))?
         ),
-        _ => print!("{}", crate::coverage::report(&c)),
+        _ => out!("{}", crate::coverage::report(&c)),
     }
     let unexcused = c.unexcused().count();
     if unexcused + c.stale_exceptions.len() > 0 {

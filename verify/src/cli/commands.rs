@@ -4,6 +4,7 @@ use data::{BackendError, BackendKind, Scene, StabilityVerdict, load_scene};
 
 use super::CliError;
 use super::args::{Cli, Command, CommonOpts};
+use super::stdout::{out, outln};
 use crate::output::{
     Column, Format, SWITCHING_HEADER, TERMINAL_WIDTH, csv_table, fitted_table, ledger_csv,
     observables_csv, switching_rows, text_table, wrap, write_atomic,
@@ -62,8 +63,8 @@ const LEDGER_WARNING: f64 = 1e-3;
 
 fn print_json<T: serde::Serialize>(value: &T) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(value)
-        .map_err(|e| CliError::Failed(format!("error: cannot serialize result: {e}")))?;
-    println!("{text}");
+        .map_err(|e| CliError::Output(format!("error: cannot serialize result: {e}")))?;
+    outln!("{text}");
     Ok(())
 }
 
@@ -88,17 +89,17 @@ fn scenes(format: Format) -> Result<(), CliError> {
                 Column::left("").elastic(),
             ];
             for line in fitted_table(&columns, &rows, TERMINAL_WIDTH).rows {
-                println!("{line}");
+                outln!("{line}");
             }
         }
         Format::Wide => {
             let w0 = rows.iter().map(|r| r[0].len()).max().unwrap_or(5);
             let w1 = rows.iter().map(|r| r[1].len()).max().unwrap_or(6);
             for r in &rows {
-                println!("{:<w0$}  {:<w1$}  {}", r[0], r[1], r[2]);
+                outln!("{:<w0$}  {:<w1$}  {}", r[0], r[1], r[2]);
             }
         }
-        Format::Csv => print!("{}", csv_table(&header, &rows)),
+        Format::Csv => out!("{}", csv_table(&header, &rows)),
         Format::Json => {
             let v: Vec<_> = rows
                 .iter()
@@ -182,7 +183,7 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                     ]);
                 }
             }
-            print!("{}", csv_table(&["section", "item", "value"], &rows));
+            out!("{}", csv_table(&["section", "item", "value"], &rows));
             Ok(())
         }
         Format::Table | Format::Wide => {
@@ -268,11 +269,11 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 }
             }
             if opts.format == Format::Wide {
-                print!("{text}");
+                out!("{text}");
             } else {
                 for line in text.lines() {
                     let indent = line.len() - line.trim_start().len();
-                    println!("{}", wrap(line, TERMINAL_WIDTH, indent + 4));
+                    outln!("{}", wrap(line, TERMINAL_WIDTH, indent + 4));
                 }
             }
             Ok(())
@@ -341,8 +342,8 @@ fn modes(name: &str, count: usize, opts: &CommonOpts) -> Result<(), CliError> {
     let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
     match opts.format {
         // At most four columns of numbers: the full table fits a terminal.
-        Format::Table | Format::Wide => print!("{}", text_table(&header, &rows)),
-        Format::Csv => print!("{}", csv_table(&header, &rows)),
+        Format::Table | Format::Wide => out!("{}", text_table(&header, &rows)),
+        Format::Csv => out!("{}", csv_table(&header, &rows)),
         Format::Json => print_json(&results.iter().map(|(_, r)| r).collect::<Vec<_>>())?,
     }
     Ok(())
@@ -366,8 +367,8 @@ fn statics(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     let header = ["backend", "tip deflection", "tip rotation", "dofs"];
     match opts.format {
         // At most four columns of numbers: the full table fits a terminal.
-        Format::Table | Format::Wide => print!("{}", text_table(&header, &rows)),
-        Format::Csv => print!("{}", csv_table(&header, &rows)),
+        Format::Table | Format::Wide => out!("{}", text_table(&header, &rows)),
+        Format::Csv => out!("{}", csv_table(&header, &rows)),
         Format::Json => print_json(&results.iter().map(|(_, r)| r).collect::<Vec<_>>())?,
     }
     Ok(())
@@ -414,7 +415,7 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
         Format::Json => print_json(&results.iter().map(|(_, r)| r).collect::<Vec<_>>())?,
         Format::Csv => {
             for (_, r) in &results {
-                print!("{}", observables_csv(&r.observables));
+                out!("{}", observables_csv(&r.observables));
             }
         }
         Format::Table | Format::Wide => {
@@ -453,10 +454,10 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 })
                 .collect();
             if wide {
-                print!("{}", text_table(&header, &rows));
+                out!("{}", text_table(&header, &rows));
             } else {
                 let columns = header.map(Column::right);
-                print!("{}", fitted_table(&columns, &rows, TERMINAL_WIDTH));
+                out!("{}", fitted_table(&columns, &rows, TERMINAL_WIDTH));
             }
             // Final values of every channel, one column per backend.
             let mut names: Vec<String> = Vec::new();
@@ -483,13 +484,13 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 })
                 .collect();
             let header: Vec<&str> = header.iter().map(|s| s.as_str()).collect();
-            println!();
+            outln!();
             if wide {
-                print!("{}", text_table(&header, &rows));
+                out!("{}", text_table(&header, &rows));
             } else {
                 let mut columns: Vec<Column> = header.iter().map(|h| Column::right(h)).collect();
                 columns[0] = Column::left(header[0]).elastic();
-                print!("{}", fitted_table(&columns, &rows, TERMINAL_WIDTH));
+                out!("{}", fitted_table(&columns, &rows, TERMINAL_WIDTH));
             }
             if !scene.contacts.is_empty() {
                 // The terminal table names the columns briefly; `--format wide` and the
@@ -507,11 +508,11 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 .map(Column::right);
                 for (k, r) in &results {
                     let rows = switching_rows(&r.events);
-                    println!("\n{k}: {} switching events", rows.len());
+                    outln!("\n{k}: {} switching events", rows.len());
                     if wide {
-                        print!("{}", text_table(&SWITCHING_HEADER, &rows));
+                        out!("{}", text_table(&SWITCHING_HEADER, &rows));
                     } else {
-                        print!("{}", fitted_table(&short, &rows, TERMINAL_WIDTH));
+                        out!("{}", fitted_table(&short, &rows, TERMINAL_WIDTH));
                     }
                 }
             }

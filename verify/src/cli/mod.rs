@@ -1,14 +1,16 @@
 //! The `flexverify` command line: argument definitions, dispatch, printing, and the mapping of
 //! library errors to exit statuses. The only module that knows clap and the terminal.
 //!
-//! Exit status: 0 success; 1 a verification check failed (or output could not be written);
-//! 2 bad input (scene file, arguments); 3 unsupported (a backend or subcommand cannot do what
-//! was asked); 4 a run stopped early with a diagnostic (its partial results are still written).
+//! Exit status: 0 success; 1 a verification check failed; 2 bad input (scene file,
+//! arguments); 3 unsupported (a backend or subcommand cannot do what was asked); 4 a run stopped
+//! early with a diagnostic (its partial results are still written); 5 output could not be
+//! written; 141 the reader of standard output closed the pipe ([`stdout`]).
 
 pub mod args;
 mod checks;
 mod commands;
 mod progress;
+mod stdout;
 mod studies;
 
 pub use args::{Cli, Command, CommonOpts};
@@ -28,7 +30,13 @@ pub enum CliError {
     Failed(String),
     #[error("{0}")]
     Stopped(String),
+    /// A result or file could not be written (serialized, created, renamed).
+    #[error("{0}")]
+    Output(String),
 }
+
+/// Exit status of [`CliError::Output`].
+const OUTPUT_STATUS: u8 = 5;
 
 impl CliError {
     pub fn exit_code(&self) -> u8 {
@@ -37,6 +45,7 @@ impl CliError {
             CliError::Input(_) => 2,
             CliError::Unsupported(_) => 3,
             CliError::Stopped(_) => 4,
+            CliError::Output(_) => OUTPUT_STATUS,
         }
     }
 }
@@ -80,7 +89,7 @@ impl From<crate::Error> for CliError {
 
 impl From<std::io::Error> for CliError {
     fn from(e: std::io::Error) -> Self {
-        CliError::Failed(format!("error: cannot write output: {e}"))
+        CliError::Output(format!("error: cannot write output: {e}"))
     }
 }
 

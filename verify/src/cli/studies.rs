@@ -7,6 +7,7 @@ use data::{BackendKind, Settings, load_scene};
 use super::CliError;
 use super::args::CommonOpts;
 use super::progress::Bar;
+use super::stdout::{out, outln};
 use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
 use crate::progress::Progress;
 use crate::shard::{ConvergeShardFile, MeasuredRung, Shard};
@@ -41,10 +42,10 @@ fn write_and_print(study: &Study, out: Option<&Path>, format: Format) -> Result<
         eprintln!("wrote the study and its plots to {}", dir.display());
     }
     match format {
-        Format::Json => println!("{}", study::json(study)),
-        Format::Csv => print!("{}", study::csv(study)),
-        Format::Wide => print!("{}", study::wide_table(study)),
-        Format::Table => print!("{}", study::terminal_table(study, TERMINAL_WIDTH)),
+        Format::Json => outln!("{}", study::json(study)),
+        Format::Csv => out!("{}", study::csv(study)),
+        Format::Wide => out!("{}", study::wide_table(study)),
+        Format::Table => out!("{}", study::terminal_table(study, TERMINAL_WIDTH)),
     }
     Ok(())
 }
@@ -159,9 +160,9 @@ pub fn recommend(scene: &str, quantity: &str, tol: f64, opts: &CommonOpts) -> Re
     bar.clear();
     let r = recommendation?;
     match opts.format {
-        Format::Table => print!("{}", r.terminal_text(TERMINAL_WIDTH)),
-        Format::Wide | Format::Csv => print!("{}", r.wide_text()),
-        Format::Json => println!(
+        Format::Table => out!("{}", r.terminal_text(TERMINAL_WIDTH)),
+        Format::Wide | Format::Csv => out!("{}", r.wide_text()),
+        Format::Json => outln!(
             "{}",
             serde_json::to_string_pretty(&r).expect("serializable recommendation")
         ),
