@@ -25,7 +25,8 @@ use crate::output::{Column, csv_table, fitted_table, text_table, wrap, write_ato
 use crate::plot::{Series, plot};
 use crate::progress::Progress;
 use crate::report::work::{Counters, FirstRun, Timing, time_rung, work_counter_of};
-use crate::suite::evaluate::{falling_prefix, fit_order, measure, richardson};
+use crate::suite::evaluate::measure;
+use crate::suite::order::{falling_prefix, fit_order, richardson};
 use crate::suite::quantity::Quantity;
 use crate::suite::reference::{analytic_value, default_analytic_id};
 use crate::suite::run_cache::{RunCache, compute};

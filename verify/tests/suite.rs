@@ -2,7 +2,8 @@
 
 use data::BackendKind;
 use data::cases::{Case, CaseSettings, Norm, Reference, SuiteName, all_cases, stability_cases};
-use verify::suite::evaluate::{Status, evaluate, fit_order, richardson};
+use verify::suite::evaluate::{Status, evaluate};
+use verify::suite::order::{fit_order, richardson};
 use verify::suite::run_cache::RunCache;
 
 #[test]

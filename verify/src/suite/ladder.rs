@@ -4,7 +4,7 @@
 //! A point value of an undamped flexible arm does not converge regularly: the elastic vibration
 //! rings at every resolved frequency and the sign of the difference between rungs changes from
 //! one output time to the next. The history as a whole (low-passed or raw) can still converge,
-//! and that is what these checks measure. Rung k (size h_k, from `evaluate::history_rung_sizes`)
+//! and that is what these checks measure. Rung k (size h_k, from `super::evaluate::history_rung_sizes`)
 //! gives the samples H_k(t) on one common grid ([`super::history::common_samples`]).
 //!
 //! # Observed order
@@ -29,7 +29,7 @@
 //!
 //! and the case's own run is compared with H_∞ as max_t |H_case − H_∞| / max_t |H_∞|.
 
-use super::evaluate::fit_order;
+use super::order::fit_order;
 
 /// Range of orders searched by [`difference_order`].
 pub const P_RANGE: (f64, f64) = (0.05, 12.0);

@@ -7,6 +7,7 @@ pub mod evaluate;
 pub mod filter;
 pub mod history;
 pub mod ladder;
+pub mod order;
 pub mod plots;
 pub mod quantity;
 pub mod reference;

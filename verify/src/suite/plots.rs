@@ -10,7 +10,8 @@ use std::path::Path;
 use data::cases::{Case, CaseSettings, Reference, scene_with_overrides};
 use data::{RunResult, Scene, load_scene};
 
-use super::evaluate::{Outcome, richardson, rung_size};
+use super::evaluate::{Outcome, rung_size};
+use super::order::richardson;
 use super::quantity::Quantity;
 use super::reference::analytic_value;
 use super::run_cache::{Answer, RunCache, compute};
