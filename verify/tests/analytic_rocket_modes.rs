@@ -241,3 +241,104 @@ fn ana_rocket_modes_catalog() {
         assert!(axial.windows(2).all(|w| w[1] > w[0]) && axial[0] > 0.0);
     }
 }
+
+/// Transverse ω² of a rigid body (mass `mb`, rotary inertia `ib` about its centroid `xb`)
+/// carrying masses `m` at `x` on case springs `ka` and one spring `kc` between them, by the
+/// 4-DOF eigenproblem (translation a and rotation θ of the body, mass displacements q₁, q₂).
+/// `body_axes`: the coupling acts on q₁ − q₂ − φ(x₁ − x₂), φ the whole body's mean-axis angle
+/// Σ m (x − x_c) y / Σ m (x − x_c)²; otherwise on q₁ − q₂.
+fn rigid_body_omegas2(
+    (mb, ib, xb): (f64, f64, f64),
+    m: [f64; 2],
+    x: [f64; 2],
+    (ka, kc): (f64, f64),
+    body_axes: bool,
+) -> Vec<f64> {
+    let xc = (mb * xb + m[0] * x[0] + m[1] * x[1]) / (mb + m[0] + m[1]);
+    let ic = ib + mb * (xb - xc).powi(2) + m[0] * (x[0] - xc).powi(2) + m[1] * (x[1] - xc).powi(2);
+    // ∇φ over (a, θ, q₁, q₂)
+    let grad_phi = [
+        mb * (xb - xc) / ic,
+        ib / ic,
+        m[0] * (x[0] - xc) / ic,
+        m[1] * (x[1] - xc) / ic,
+    ];
+    let mut k = [[0.0; 4]; 4];
+    let mut add = |g: [f64; 4], s: f64| {
+        for i in 0..4 {
+            for j in 0..4 {
+                k[i][j] += s * g[i] * g[j];
+            }
+        }
+    };
+    for j in 0..2 {
+        let mut g = [-1.0, -(x[j] - xb), 0.0, 0.0];
+        g[2 + j] = 1.0;
+        add(g, ka);
+    }
+    let mut h = [0.0, 0.0, 1.0, -1.0];
+    if body_axes {
+        for (hi, gi) in h.iter_mut().zip(grad_phi) {
+            *hi -= (x[0] - x[1]) * gi;
+        }
+    }
+    add(h, kc);
+    let mass = [mb, ib, m[0], m[1]];
+    let a = faer::Mat::<f64>::from_fn(4, 4, |i, j| k[i][j] / (mass[i] * mass[j]).sqrt());
+    let mut ev: Vec<f64> = a
+        .self_adjoint_eigenvalues(faer::Side::Lower)
+        .expect("4x4 eigenvalues");
+    ev.sort_by(f64::total_cmp);
+    ev
+}
+
+#[test]
+fn ana_rocket_modes_springs_between_masses_ride_with_the_body() {
+    // A nearly rigid body as heavy as its two masses: the coupling spring's frame matters. The
+    // exact count with body-axis springs must give two rigid modes and the rigid-body model's
+    // two elastic frequencies.
+    let (len, rho_a) = (10.0, 0.1);
+    let seg = [Segment {
+        length: len,
+        ea: 1e9,
+        ei: 1e9,
+        rho_a,
+    }];
+    let (m, x) = ([0.5, 0.3], [2.0, 7.0]);
+    let (ka, kc) = (1.0, 0.7);
+    let masses = [0, 1].map(|j| SprungMass {
+        position: x[j],
+        mass: m[j],
+        axial_stiffness: ka,
+        transverse_stiffness: ka,
+    });
+    let coupling = [Coupling {
+        between: [0, 1],
+        axial_stiffness: kc,
+        transverse_stiffness: kc,
+    }];
+    let body = FreeFreeRocket::new(&seg, &masses, &coupling).unwrap();
+    let got = body.elastic_omegas(Motion::Transverse, 2).unwrap();
+    let mb = rho_a * len;
+    let rigid = (mb, mb * len * len / 12.0, len / 2.0);
+    let want = rigid_body_omegas2(rigid, m, x, (ka, kc), true);
+    assert!(want[0].abs() < 1e-12 && want[1].abs() < 1e-12, "{want:?}");
+    // negative control: in fixed axes the rotation stretches the coupling (one rigid mode
+    // only) and the elastic frequencies move
+    let fixed = rigid_body_omegas2(rigid, m, x, (ka, kc), false);
+    assert!(
+        fixed[1] > 1e-3 * fixed[3],
+        "fixed axes: a soft rotation, {fixed:?}"
+    );
+    for i in 0..2 {
+        let w = want[2 + i].sqrt();
+        assert!(rel(got[i], w) < 1e-6, "elastic {i}: {} vs {w}", got[i]);
+        let f = fixed[2 + i].sqrt();
+        assert!(rel(f, w) > 1e-3, "the frames must differ here: {f} vs {w}");
+    }
+    // below the first elastic frequency only the two rigid modes are counted
+    assert_eq!(
+        body.count_below(Motion::Transverse, 0.5 * got[0]).unwrap(),
+        2
+    );
+}

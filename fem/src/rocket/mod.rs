@@ -22,15 +22,17 @@
 //! * chamber pressure −pA_f at x = 0 and +pA_f at x = L₁, along the mean axis;
 //! * jet Coriolis 2φ̇ Q̇(1 − x/L₁) per length on stage 1, normal to the mean axis (φ̇ the mean
 //!   axis' rate), as consistent loads;
-//! * springs and dampers of the discrete masses act along and across the mean axis (with
-//!   k_u = k_w, as in the catalog scenes, the spring is isotropic and the axis does not enter).
+//! * springs and dampers between a discrete mass and the case act along and across the mean
+//!   axis (with k_u = k_w, as in the catalog scenes, the spring is isotropic and the axis does
+//!   not enter); those between two masses in the whole body's axes (case and masses, ignition
+//!   mass; report eqs. 3.50, 5.37), so a rigid rotation stretches none of them.
 //!
 //! ## Time integration
 //! Implicit midpoint rule (one-stage Gauss, second order, no numerical damping) on the first
 //! order form q̇ = v, M(t)v̇ = F(t, q, v): with the midpoint velocity v_m as unknown,
 //! 2M(t_m)(v_m − v₀) = hF(t_m, q₀ + ½hv_m, v_m). Newton with the linear part of the Jacobian,
-//! J = 2M(t_m) + ½h²K + hC (K: beam and springs in launch axes); the loads' dependence on the
-//! mean axis and the cubic strain term are left to the iteration (their Jacobian is 1e-5 of J
+//! J = 2M(t_m) + ½h²K + hC (K: beam and springs in launch axes); the loads' and the mass-to-mass
+//! springs' dependence on the mean axes and the cubic strain term are left to the iteration (their Jacobian is 1e-5 of J
 //! at the catalog scenes). J changes with the mass every step and is refactorized numerically in
 //! a bordered band pattern (symbolic LU once). Steps land on the output times and on burn-out.
 //! Default step [`DEFAULT_STEP`] (the axial fundamental, ≈ 360 Hz, has ≈ 280 steps per
@@ -554,31 +556,6 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
     ))
 }
 
-/// fem's springs between discrete masses act on w_a − w_b in the launch axes, which a rigid
-/// rotation θ stretches by θ(x_a − x_b) when the masses sit at different stations. In a run the
-/// body turns by less than 1e-8 rad and this is negligible; in the free-free eigenproblem it
-/// turns a rigid-body mode into a spurious elastic one, so `modes` is refused for such scenes
-/// (modal measures these springs in its body frame, verify's `rocket-free-free` in fixed axes:
-/// docs/rocket.md).
-fn refuse_rotation_dependent_springs(scene: &Scene) -> Result<(), FemError> {
-    let Some(rocket) = scene.rocket.as_ref() else {
-        return Ok(());
-    };
-    let position = |k: usize| rocket.discrete_masses.get(k).map(|m| m.position);
-    for s in &rocket.springs {
-        let [a, b] = s.between;
-        if s.transverse_stiffness != 0.0 && position(a) != position(b) {
-            return Err(FemError::unsupported(format!(
-                "fem: free-free modes of `{}`: the transverse spring between discrete masses {a} \
-                 and {b} acts in fixed launch axes, so a rigid rotation stretches it and the \
-                 rigid-body modes are lost; use --backend modal (body-frame springs)",
-                scene.name
-            )));
-        }
-    }
-    Ok(())
-}
-
 /// Free-free modes at ignition mass, discrete masses on their springs: K φ = ω² M(0) φ with K
 /// the beam and spring stiffness (no thrust prestress). The three rigid-body modes are dropped.
 pub struct RocketMode {
@@ -595,6 +572,9 @@ pub fn rocket_modes(model: &Model, count: usize) -> Result<Vec<RocketMode>, FemE
         k[(i, j)] += v;
     }
     for (i, j, v, _) in model.spring_entries() {
+        k[(i, j)] += v;
+    }
+    for (i, j, v) in model.coupling_rotation_stiffness() {
         k[(i, j)] += v;
     }
     let mut e = vec![0.0; n];
@@ -664,7 +644,6 @@ pub fn rocket_modes(model: &Model, count: usize) -> Result<Vec<RocketMode>, FemE
 
 pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, FemError> {
     let start = Instant::now();
-    refuse_rotation_dependent_springs(scene)?;
     let model = build(scene, settings)?;
     let modes = rocket_modes(&model, count)?;
     let stations = scene.simulation.field_stations.max(2);

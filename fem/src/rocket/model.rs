@@ -123,9 +123,30 @@ pub struct Model {
     a_c_eta: Vec<f64>,
     a_s_xi: Vec<f64>,
     a_s_eta: Vec<f64>,
+    /// The whole body's (case and discrete masses, ignition mass) first moments about its
+    /// centroid: ψ = atan2(b_s_η·q, b_s_ξ·(x_ref + q)) is the angle of the axes the springs
+    /// between masses ride with ([`Model::add_spring_forces`]).
+    b_s_xi: Vec<f64>,
+    b_s_eta: Vec<f64>,
     /// Consistent load vectors of the unit jet-Coriolis distribution (1 − x/L₁)₊.
     pub cor_u: Vec<f64>,
     pub cor_w: Vec<f64>,
+}
+
+/// The whole body's mean axis at one state (springs between masses ride with it).
+#[derive(Debug, Clone, Copy)]
+struct BodyAxes {
+    psi: f64,
+    sx: f64,
+    sy: f64,
+}
+
+/// A spring between masses in the body axes, and the reference distance Δx = x_a − x_b.
+#[derive(Debug, Clone, Copy)]
+struct Stretch {
+    axial: f64,
+    transverse: f64,
+    dx: f64,
 }
 
 /// Mean axis of the case (ignition mass m₀): centroid c, angle φ from the launch axis, its rate.
@@ -380,6 +401,8 @@ impl Model {
             a_c_eta: Vec::new(),
             a_s_xi: Vec::new(),
             a_s_eta: Vec::new(),
+            b_s_xi: Vec::new(),
+            b_s_eta: Vec::new(),
             cor_u,
             cor_w,
         };
@@ -403,6 +426,25 @@ impl Model {
         }
         model.a_s_xi = m0_apply(&model, &lin_u);
         model.a_s_eta = m0_apply(&model, &lin_w);
+        // the whole body: about its centroid x̄_b, ∫m₀(x − x̄_b)R = a_s·R + m₀(x̄ − x̄_b)c, and
+        // each mass adds M_j(x_j − x̄_b)R_j
+        let masses_total: f64 = model.masses.iter().map(|m| m.mass).sum();
+        let x_body = (m0 * x_bar + model.masses.iter().map(|m| m.mass * m.at.x).sum::<f64>())
+            / (m0 + masses_total);
+        let shift = |a_s: &[f64], a_total: &[f64]| -> Vec<f64> {
+            a_s.iter()
+                .zip(a_total)
+                .map(|(s, t)| s + (x_bar - x_body) * t)
+                .collect()
+        };
+        model.b_s_xi = shift(&model.a_s_xi, &a_xi);
+        model.b_s_eta = shift(&model.a_s_eta, &a_eta);
+        for j in 0..model.masses.len() {
+            let (iu, iw) = model.mass_dofs(j);
+            let moment = model.masses[j].mass * (model.masses[j].at.x - x_body);
+            model.b_s_xi[iu] += moment;
+            model.b_s_eta[iw] += moment;
+        }
         model.a_c_xi = a_xi.iter().map(|v| v / m0).collect();
         model.a_c_eta = a_eta.iter().map(|v| v / m0).collect();
         model.m0 = m0;
@@ -562,8 +604,11 @@ impl Model {
         (q[iu] - uc, q[iw] - wc)
     }
 
-    /// Springs and dampers of the discrete masses, axial / transverse along the mean axis at
-    /// angle φ. Adds the forces to `out`; returns (spring energy, damper power).
+    /// Springs and dampers of the discrete masses: to the case axial / transverse along the
+    /// case's mean axis at angle φ; between masses in the whole body's axes (report eqs. 3.50
+    /// and 5.37: the masses' displacements are body-axis ones, and the body axes weight case
+    /// and masses), so a rigid motion stretches none. Adds the forces to `out`; returns
+    /// (spring energy, damper power).
     pub fn add_spring_forces(&self, phi: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> (f64, f64) {
         let (c, s) = (phi.cos(), phi.sin());
         let (mut energy, mut power) = (0.0, 0.0);
@@ -590,20 +635,124 @@ impl Model {
             energy += e;
             power += p;
         }
+        if self.couplings.is_empty() {
+            return (energy, power);
+        }
+        let body = self.body_axes(q);
         for cp in &self.couplings {
-            let (au, aw) = self.mass_dofs(cp.a);
-            let (bu, bw) = self.mass_dofs(cp.b);
-            let d = (q[au] - q[bu], q[aw] - q[bw]);
-            let dd = (v[au] - v[bu], v[aw] - v[bw]);
-            let (f, e, p) = law(d, dd, cp.ku, cp.kw, cp.cu, cp.cw);
-            out[au] += f.0;
-            out[aw] += f.1;
-            out[bu] -= f.0;
-            out[bw] -= f.1;
-            energy += e;
-            power += p;
+            let st = self.coupling_stretch(cp, &body, q);
+            // d/dt of the stretch is its Jacobian applied to v
+            let rate = self.coupling_rate(cp, &body, &st, v);
+            let (ga, gt) = (
+                cp.ku * st.axial + cp.cu * rate.0,
+                cp.kw * st.transverse + cp.cw * rate.1,
+            );
+            self.add_coupling_force(cp, &body, &st, (-ga, -gt), out);
+            energy += 0.5 * cp.ku * st.axial.powi(2) + 0.5 * cp.kw * st.transverse.powi(2);
+            power += cp.cu * rate.0 * rate.0 + cp.cw * rate.1 * rate.1;
         }
         (energy, power)
+    }
+
+    /// Angle ψ of the whole body's mean axis and the sums (S_ξ, S_η) it is the atan2 of.
+    fn body_axes(&self, q: &[f64]) -> BodyAxes {
+        use crate::linalg::dot;
+        let sx = dot(&self.b_s_xi, &self.x_ref) + dot(&self.b_s_xi, q);
+        let sy = dot(&self.b_s_eta, q);
+        BodyAxes {
+            psi: sy.atan2(sx),
+            sx,
+            sy,
+        }
+    }
+
+    /// A spring between masses a and b in the body axes: the gap D = R_a − R_b turned by −ψ,
+    /// less its reference (x_a − x_b, 0). A rigid motion of the whole body leaves it at zero.
+    fn coupling_stretch(&self, cp: &Coupling, body: &BodyAxes, q: &[f64]) -> Stretch {
+        let (au, aw) = self.mass_dofs(cp.a);
+        let (bu, bw) = self.mass_dofs(cp.b);
+        let dx = self.x_ref[au] - self.x_ref[bu];
+        let d = (dx + q[au] - q[bu], q[aw] - q[bw]);
+        let (c, s) = (body.psi.cos(), body.psi.sin());
+        Stretch {
+            axial: c * d.0 + s * d.1 - dx,
+            transverse: -s * d.0 + c * d.1,
+            dx,
+        }
+    }
+
+    /// J v for the stretch's Jacobian J: the gap's rate turned by −ψ, plus ψ̇ = ∇ψ·v times
+    /// ∂(axial, transverse)/∂ψ = (transverse, −(axial + Δx)).
+    fn coupling_rate(&self, cp: &Coupling, body: &BodyAxes, st: &Stretch, v: &[f64]) -> (f64, f64) {
+        use crate::linalg::dot;
+        let (au, aw) = self.mass_dofs(cp.a);
+        let (bu, bw) = self.mass_dofs(cp.b);
+        let dd = (v[au] - v[bu], v[aw] - v[bw]);
+        let (c, s) = (body.psi.cos(), body.psi.sin());
+        let psi_rate = (body.sx * dot(&self.b_s_eta, v) - body.sy * dot(&self.b_s_xi, v))
+            / (body.sx * body.sx + body.sy * body.sy);
+        (
+            c * dd.0 + s * dd.1 + psi_rate * st.transverse,
+            -s * dd.0 + c * dd.1 - psi_rate * (st.axial + st.dx),
+        )
+    }
+
+    /// Adds Jᵀ(g_a, g_t) to `out` (J the stretch's Jacobian): `g` = (−∂E/∂axial, −∂E/∂transverse)
+    /// gives the generalized spring (and damper) force.
+    fn add_coupling_force(
+        &self,
+        cp: &Coupling,
+        body: &BodyAxes,
+        st: &Stretch,
+        g: (f64, f64),
+        out: &mut [f64],
+    ) {
+        let (au, aw) = self.mass_dofs(cp.a);
+        let (bu, bw) = self.mass_dofs(cp.b);
+        let (c, s) = (body.psi.cos(), body.psi.sin());
+        let f = (c * g.0 - s * g.1, s * g.0 + c * g.1);
+        out[au] += f.0;
+        out[aw] += f.1;
+        out[bu] -= f.0;
+        out[bw] -= f.1;
+        // through ψ: (g_a·transverse − g_t·(axial + Δx)) ∇ψ, ∇ψ = (S_ξ b_s_η − S_η b_s_ξ)/|S|²
+        let along_psi = (g.0 * st.transverse - g.1 * (st.axial + st.dx))
+            / (body.sx * body.sx + body.sy * body.sy);
+        for ((o, e), x) in out.iter_mut().zip(&self.b_s_eta).zip(&self.b_s_xi) {
+            *o += along_psi * (body.sx * e - body.sy * x);
+        }
+    }
+
+    /// The body-axis springs' stiffness at the straight body at rest that the launch-axis
+    /// entries of [`Model::spring_entries`] leave out: k_w(gᵀq)² with g the transverse
+    /// stretch's gradient e_{W_a} − e_{W_b} − Δx ∇ψ, expanded, less the k_w(W_a − W_b)² already
+    /// there. Dense in the case's transverse DOFs (through ∇ψ); used by the eigenproblem only
+    /// (the time step's Newton matrix keeps the banded launch-axis part).
+    pub fn coupling_rotation_stiffness(&self) -> Vec<(usize, usize, f64)> {
+        let rest = self.body_axes(&vec![0.0; self.n]);
+        let grad_psi: Vec<f64> = self.b_s_eta.iter().map(|e| e / rest.sx).collect();
+        let mut out = Vec::new();
+        for cp in &self.couplings {
+            let (_, aw) = self.mass_dofs(cp.a);
+            let (_, bw) = self.mass_dofs(cp.b);
+            let dx = self.x_ref[self.mass_dofs(cp.a).0] - self.x_ref[self.mass_dofs(cp.b).0];
+            let mut g: Vec<f64> = grad_psi.iter().map(|d| -dx * d).collect();
+            g[aw] += 1.0;
+            g[bw] -= 1.0;
+            for i in 0..self.n {
+                for j in 0..self.n {
+                    let mut k = g[i] * g[j];
+                    if (i == aw || i == bw) && (j == aw || j == bw) {
+                        // the launch-axis part k_w(W_a − W_b)² of spring_entries
+                        k -= if i == j { 1.0 } else { -1.0 };
+                    }
+                    if k != 0.0 {
+                        out.push((i, j, cp.kw * k));
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// Spring (and damper) stiffness in launch axes (φ = 0): the linear part of

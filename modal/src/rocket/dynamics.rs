@@ -18,7 +18,7 @@
 //! equations use the gradient of this V, so energy stays consistent.
 
 use super::basis::Basis;
-use super::body::Body;
+use super::body::{Body, Coupling, PointMass};
 use super::integrals::{Moments, QuadTable};
 use crate::linalg::{cholesky_factor, cholesky_substitute, dot, mat_vec};
 
@@ -155,6 +155,9 @@ pub struct Model {
     /// ‖w₀ − Σ b_k W_k‖ / ‖w₀‖ in the m₀-weighted norm (0 for a straight body). What is left
     /// over is the rigid-body part of w₀ (with respect to m₀) and the higher modes.
     pub initial_shape_residual: f64,
+    /// c_p = M_p (x_p − x_c) / I_c: the whole body's mean-axis angle relative to this frame is
+    /// φ = Σ c_p w_p ([`Model::coupling_stretch_w`]).
+    pub mass_tilt: Vec<f64>,
 }
 
 impl Model {
@@ -192,7 +195,9 @@ impl Model {
             .iter()
             .map(|m| StationModes::new(basis, m.x))
             .collect();
+        let mass_tilt = whole_body_tilt(&m0, &body.masses);
         Model {
+            mass_tilt,
             layout: Layout { n, nm },
             m0,
             chi,
@@ -209,6 +214,23 @@ impl Model {
             initial_shape_residual,
             body,
         }
+    }
+
+    /// Transverse stretch of a spring between masses, measured across the whole body's mean
+    /// axis (report eqs. 3.50 and 5.37: the masses' displacements are body-axis ones and the
+    /// body axes are weighted by case *and* masses): w_i − w_j − (x_i − x_j) φ,
+    /// φ = Σ c_p w_p. This frame is the case's mean axis (∫m₀W_k = ∫m₀xW_k = 0), so the case
+    /// adds nothing to φ. Also the rate of stretch when given the rates ẇ.
+    pub fn coupling_stretch_w(&self, c: &Coupling, w: &[f64]) -> f64 {
+        let phi: f64 = self.mass_tilt.iter().zip(w).map(|(a, b)| a * b).sum();
+        let dx = self.body.masses[c.i].x - self.body.masses[c.j].x;
+        w[c.i] - w[c.j] - dx * phi
+    }
+
+    /// ∂(stretch)/∂w_p of [`Model::coupling_stretch_w`] for every mass p.
+    pub fn coupling_gradient_w(&self, c: &Coupling, p: usize) -> f64 {
+        let dx = self.body.masses[c.i].x - self.body.masses[c.j].x;
+        f64::from(u8::from(p == c.i)) - f64::from(u8::from(p == c.j)) - dx * self.mass_tilt[p]
     }
 
     /// Burnt mass per length Δm·s(t) removed from the chamber.
@@ -500,6 +522,19 @@ pub fn strain_energy(model: &Model, a: &[f64], b: &[f64], grad: Option<&mut [f64
     e
 }
 
+/// c_p = M_p (x_p − x_c) / I_c over the ignition case mass and the discrete masses.
+fn whole_body_tilt(m0: &Moments, masses: &[PointMass]) -> Vec<f64> {
+    let total = m0.total + masses.iter().map(|m| m.mass).sum::<f64>();
+    let first = m0.first + masses.iter().map(|m| m.mass * m.x).sum::<f64>();
+    let second = m0.second + masses.iter().map(|m| m.mass * m.x * m.x).sum::<f64>();
+    let centre = first / total;
+    let inertia = second - total * centre * centre;
+    masses
+        .iter()
+        .map(|m| m.mass * (m.x - centre) / inertia)
+        .collect()
+}
+
 /// Potential energy of the discrete springs (to the case and between masses).
 pub fn spring_energy(model: &Model, q: &[f64]) -> f64 {
     let l = model.layout;
@@ -511,9 +546,10 @@ pub fn spring_energy(model: &Model, q: &[f64]) -> f64 {
         e +=
             0.5 * pm.ku * (q[l.mu() + j] - uc).powi(2) + 0.5 * pm.kw * (q[l.mw() + j] - wc).powi(2);
     }
+    let w = &q[l.mw()..l.mw() + l.nm];
     for c in &model.body.couplings {
         e += 0.5 * c.ku * (q[l.mu() + c.i] - q[l.mu() + c.j]).powi(2)
-            + 0.5 * c.kw * (q[l.mw() + c.i] - q[l.mw() + c.j]).powi(2);
+            + 0.5 * c.kw * model.coupling_stretch_w(c, w).powi(2);
     }
     e
 }
@@ -650,16 +686,16 @@ pub fn rhs(model: &Model, ws: &mut Workspace, t: f64, y: &[f64], dydt: &mut [f64
     for c in &body.couplings {
         let (i, j) = (c.i, c.j);
         let dud = v[l.mu() + i] - v[l.mu() + j];
-        let dwd = v[l.mw() + i] - v[l.mw() + j];
+        let dwd = model.coupling_stretch_w(c, &v[l.mw()..l.mw() + nm]);
         let fu = c.ku * (q[l.mu() + i] - q[l.mu() + j]) + c.cu * dud;
-        let fw = c.kw * (q[l.mw() + i] - q[l.mw() + j]) + c.cw * dwd;
+        let fw = c.kw * model.coupling_stretch_w(c, &q[l.mw()..l.mw() + nm]) + c.cw * dwd;
         p_damp += c.cu * dud * dud + c.cw * dwd * dwd;
         r[l.mu() + i] -= fu;
         r[l.mu() + j] += fu;
-        r[l.mw() + i] -= fw;
-        r[l.mw() + j] += fw;
+        for p in 0..nm {
+            r[l.mw() + p] -= fw * model.coupling_gradient_w(c, p);
+        }
     }
-    let _ = nm;
 
     // quadratures (computed before the solve overwrites rhs): momentum and energy flows
     let qd = &mut dydt[l.quad()..];

@@ -16,6 +16,9 @@
 //! R_j = R_O + A(θ)(x_j + u_j, w_j). The generalized coordinates are
 //! `X, Y` (inertial position of O), `θ`, n axial modal coordinates a_k and n transverse b_k with
 //! u = Σ a_k U_k(x), w = Σ b_k W_k(x), and the discrete masses' (u_j, w_j).
+//! A spring between two masses stretches by their gap in the whole body's axes (case and
+//! masses, docs/rocket.md): transversely w_i − w_j − (x_i − x_j)ψ, ψ = Σ M_p(x_p − x_c)w_p / I_c
+//! the whole body's mean-axis angle in this frame (`Model::coupling_stretch_w` in `dynamics`).
 //!
 //! U_k, W_k are the *elastic* free-free eigenfunctions of the constant-mass case at ignition
 //! (stepped EA, EI and mass; discrete masses not included), computed numerically on a fine

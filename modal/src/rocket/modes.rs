@@ -44,12 +44,17 @@ pub fn stiffness_matrix(model: &Model) -> Vec<f64> {
         add_case_spring(l.mw() + j, l.b(), &st.w, pm.kw);
     }
     for c in &model.body.couplings {
-        for (base, s) in [(l.mu(), c.ku), (l.mw(), c.kw)] {
-            let (i, j) = (base + c.i, base + c.j);
-            k[i * nd + i] += s;
-            k[j * nd + j] += s;
-            k[i * nd + j] -= s;
-            k[j * nd + i] -= s;
+        let (i, j) = (l.mu() + c.i, l.mu() + c.j);
+        k[i * nd + i] += c.ku;
+        k[j * nd + j] += c.ku;
+        k[i * nd + j] -= c.ku;
+        k[j * nd + i] -= c.ku;
+        // ½k_w s², s the stretch across the whole body's mean axis: k_w g gᵀ
+        for p in 0..l.nm {
+            for r in 0..l.nm {
+                k[(l.mw() + p) * nd + l.mw() + r] +=
+                    c.kw * model.coupling_gradient_w(c, p) * model.coupling_gradient_w(c, r);
+            }
         }
     }
     k

@@ -21,11 +21,14 @@
 //!   k m ω²/(k − m ω²) of a single hanging mass (or its coupled matrix form); keeping them as
 //!   degrees of freedom is the same equation without the poles.
 //!
-//! The mass-to-mass springs act on q_a − q_b in fixed axes, as in fem: a rigid rotation θ
-//! stretches a transverse one by θ(x_a − x_b), so with such springs the second transverse
-//! "rigid" mode is a soft mode (1.85 Hz on the catalog rocket), which the count below takes as
-//! rigid. modal measures those springs in its body frame (rotation-free); the two definitions
-//! differ by ~7e-5 on the first bending frequency (docs/rocket.md).
+//! **Springs between masses ride with the body** (report eq. 3.50: u_i, w_i are measured in
+//! the body axes). A transverse one stores ½k(q_a − q_b − φ(x_a − x_b))², φ the mean-axis
+//! angle of the whole body (case and masses, ignition mass m₀): a rigid rotation stretches
+//! nothing. The elastic modes are m₀-orthogonal to the rigid rotation r (r = x − x_c on the
+//! case and at the masses, x_c the centre of mass), so φ = 0 on them and the spring reads
+//! ½k(q_a − q_b)² there: the body-frame frequencies are those of the fixed-axis operator K₀
+//! restricted to rᵀMy = 0, K₀y − λMy = μMr. Across the axial direction a rigid motion stretches
+//! no spring; the axial count is unconstrained.
 //!
 //! ## Root count (Wittrick & Williams 1971)
 //!
@@ -37,6 +40,16 @@
 //! interior modes. The rigid-body modes (one axial, two transverse) lie at ω = 0 and are counted
 //! for every ω > 0. Each elastic frequency is found by bisection on J to 1e-14 relative: no root
 //! can be missed or counted twice, coincident roots included.
+//!
+//! **The rotation constraint** (transverse). For the restricted operator, the bordered form
+//! [[K₀ − λM, Mr], [rᵀM, 0]] has the inertia of K₀ − λM plus that of −f(λ),
+//! f(λ) = rᵀM(K₀ − λM)⁻¹Mr, and (Haynsworth) the inertia of K₀ − λM on rᵀMy = 0 plus one
+//! positive and one negative eigenvalue. Counting the rotation as the second rigid mode,
+//! J(ω) = J₀ + s{K(ω)} + [f(λ) > 0]. f needs no member integral: −r/λ solves
+//! (K₀ − λM)y = Mr up to K₀r = g, the forces the mass-to-mass springs exert on a rigidly
+//! rotated body (g_a = −g_b = k(x_a − x_b)), which act at mass DOFs only; with z = K(ω)⁻¹g,
+//! λ f(λ) = −I_c + (gᵀz − gᵀr)/λ, I_c = rᵀMr the rotary inertia about x_c. Without such
+//! springs g = 0 and f = −I_c/λ < 0: the plain count.
 
 use std::f64::consts::PI;
 
@@ -109,6 +122,10 @@ pub struct FreeFreeRocket {
     members: Vec<Member>,
     masses: Vec<(usize, SprungMass)>,
     couplings: Vec<Coupling>,
+    /// Centre of mass x_c of case and masses at ignition.
+    centre: f64,
+    /// Rotary inertia I_c = ∫ρA(x − x_c)² + Σ M_j(x_j − x_c)² about x_c.
+    rotary_inertia: f64,
 }
 
 impl FreeFreeRocket {
@@ -169,7 +186,7 @@ impl FreeFreeRocket {
             }
             segments[e]
         };
-        let members = nodes
+        let members: Vec<Member> = nodes
             .windows(2)
             .map(|w| {
                 let s = stage_of(0.5 * (w[0] + w[1]));
@@ -188,12 +205,30 @@ impl FreeFreeRocket {
                 .min_by(|a, b| (a.1 - x).abs().total_cmp(&(b.1 - x).abs()))
                 .map_or(0, |(i, _)| i)
         };
-        let masses = masses.iter().map(|m| (node_of(m.position), *m)).collect();
+        let masses: Vec<(usize, SprungMass)> =
+            masses.iter().map(|m| (node_of(m.position), *m)).collect();
+        // ∫ρA, ∫ρA x, ∫ρA x² over each uniform member, plus the point masses
+        let (mut m0, mut m1, mut m2) = (0.0_f64, 0.0_f64, 0.0_f64);
+        for (w, m) in nodes.windows(2).zip(&members) {
+            let (a, b): (f64, f64) = (w[0], w[1]);
+            m0 += m.rho_a * (b - a);
+            m1 += m.rho_a * (b * b - a * a) / 2.0;
+            m2 += m.rho_a * (b.powi(3) - a.powi(3)) / 3.0;
+        }
+        for (_, m) in &masses {
+            m0 += m.mass;
+            m1 += m.mass * m.position;
+            m2 += m.mass * m.position * m.position;
+        }
+        let centre = m1 / m0;
+        let rotary_inertia = m2 - m0 * centre * centre;
         Ok(FreeFreeRocket {
             nodes,
             members,
             masses,
             couplings: couplings.to_vec(),
+            centre,
+            rotary_inertia,
         })
     }
 
@@ -312,7 +347,79 @@ impl FreeFreeRocket {
     pub fn count_below(&self, motion: Motion, omega: f64) -> Result<usize> {
         positive("omega", omega)?;
         let (k, n, j0) = self.dynamic_stiffness(motion, omega)?;
-        Ok(j0 + negative_eigenvalues(&k, n)?)
+        let constraint = match motion {
+            Motion::Axial => 0,
+            Motion::Transverse => usize::from(self.rotation_constraint(&k, n, omega)? > 0.0),
+        };
+        Ok(j0 + negative_eigenvalues(&k, n)? + constraint)
+    }
+
+    /// The forces g = K₀r the mass-to-mass transverse springs exert when the body turns
+    /// rigidly (zero everywhere but at the coupled masses' DOFs).
+    fn rotation_spring_forces(&self, n: usize) -> Vec<f64> {
+        let first_mass = n - self.masses.len();
+        let mut g = vec![0.0; n];
+        for c in &self.couplings {
+            let dx = self.masses[c.between[0]].1.position - self.masses[c.between[1]].1.position;
+            g[first_mass + c.between[0]] += c.transverse_stiffness * dx;
+            g[first_mass + c.between[1]] -= c.transverse_stiffness * dx;
+        }
+        g
+    }
+
+    /// Whether transverse springs join masses at different stations (then the rotation
+    /// constraint shapes the modes).
+    fn has_rotation_springs(&self) -> bool {
+        self.couplings.iter().any(|c| {
+            c.transverse_stiffness != 0.0
+                && self.masses[c.between[0]].1.position != self.masses[c.between[1]].1.position
+        })
+    }
+
+    /// The rigid rotation about the centre of mass at the transverse DOFs (w = x − x_c,
+    /// w′ = 1 at the nodes; x_j − x_c at the masses).
+    fn rotation_dofs(&self, n: usize) -> Vec<f64> {
+        let mut r = vec![0.0; n];
+        for (i, x) in self.nodes.iter().enumerate() {
+            r[2 * i] = x - self.centre;
+            r[2 * i + 1] = 1.0;
+        }
+        let first_mass = n - self.masses.len();
+        for (j, (_, m)) in self.masses.iter().enumerate() {
+            r[first_mass + j] = m.position - self.centre;
+        }
+        r
+    }
+
+    /// λ f(λ) = −I_c + (gᵀz − gᵀr)/λ with K(ω) z = g (module docs): its sign adds the rotation
+    /// constraint to the transverse count.
+    fn rotation_constraint(&self, k: &[f64], n: usize, omega: f64) -> Result<f64> {
+        let g = self.rotation_spring_forces(n);
+        if g.iter().all(|&v| v == 0.0) {
+            return Ok(-self.rotary_inertia);
+        }
+        let z = self.rotation_response(k, n, &g)?;
+        let r = self.rotation_dofs(n);
+        let gz: f64 = g.iter().zip(&z).map(|(a, b)| a * b).sum();
+        let gr: f64 = g.iter().zip(&r).map(|(a, b)| a * b).sum();
+        Ok(-self.rotary_inertia + (gz - gr) / (omega * omega))
+    }
+
+    /// z = K(ω)⁻¹ g by a pivoted dense LU.
+    fn rotation_response(&self, k: &[f64], n: usize, g: &[f64]) -> Result<Vec<f64>> {
+        use faer::prelude::Solve;
+        let a = faer::Mat::<f64>::from_fn(n, n, |i, j| k[i * n + j]);
+        let b = faer::Mat::<f64>::from_fn(n, 1, |i, _| g[i]);
+        let z = a.partial_piv_lu().solve(&b);
+        let z: Vec<f64> = (0..n).map(|i| z[(i, 0)]).collect();
+        if let Some((i, v)) = z.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(AnalyticError::NonFinite {
+                what: "response of the dynamic stiffness to the rotation spring forces",
+                x: i as f64,
+                value: *v,
+            });
+        }
+        Ok(z)
     }
 
     /// The first `count` elastic natural frequencies [rad/s] of `motion`, ascending.

@@ -4,7 +4,7 @@
 //! Exit status: 0 success; 1 a verification check failed; 2 bad input (scene file,
 //! arguments); 3 unsupported (a backend or subcommand cannot do what was asked); 4 a run stopped
 //! early with a diagnostic (its partial results are still written); 5 output could not be
-//! written; 141 the reader of standard output closed the pipe ([`stdout`]).
+//! written; 141 the reader of standard output closed the pipe (module `stdout`).
 
 pub mod args;
 mod checks;

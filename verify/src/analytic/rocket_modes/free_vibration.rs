@@ -11,15 +11,16 @@
 //!
 //! started at rest from y₀ = (w₀, 0): w₀ the scene's w(x, 0) less its m₀-weighted
 //! least-squares line (docs/rocket.md § initial state), the masses at zero displacement. y₀ is
-//! then ⟨·⟩-orthogonal to both rigid motions (1 and x), so only elastic modes appear. Where
-//! mass-to-mass transverse springs exist they act in fixed axes (as in fem), rotation stretches
-//! them and is no rigid mode: its soft mode (1.85 Hz on the catalog rocket) is kept in the sum.
+//! then ⟨·⟩-orthogonal to both rigid motions (1 and x), so only elastic modes appear.
 //!
-//! Mode k: the node values (w, w′ at every node, q at every mass) are the null vector of the
-//! dynamic stiffness K(ωₖ) at the bisected root (eigenvector of the smallest |eigenvalue| of
-//! the equilibrated matrix; coincident roots give an eigenspace, orthogonalized in ⟨·⟩), and
-//! each member's interior is the exact solution through its end values. The inner products
-//! are Gauss–Legendre integrals over sub-intervals of each member short against its
+//! Mode k: without springs between masses, the node values (w, w′ at every node, q at every
+//! mass) are the null vector of the dynamic stiffness K(ωₖ) at the bisected root (eigenvector
+//! of the smallest |eigenvalue| of the equilibrated matrix; coincident roots give an
+//! eigenspace, orthogonalized in ⟨·⟩), and each member's interior is the exact solution through
+//! its end values. With them (body-axis springs, parent module) the mode solves
+//! K₀y − λMy = μMr on rᵀMy = 0, so y ∝ z − r with K(ωₖ)z = g: z's members are exact
+//! homogeneous solutions through its end values and r is the rigid line x − x_c. The inner
+//! products are Gauss–Legendre integrals over sub-intervals of each member short against its
 //! wavelength.
 //!
 //! Observables follow the common definition (docs/rocket.md): positions relative to the case's
@@ -44,6 +45,8 @@ struct ModeShape {
     /// Exact member solution: coefficients of cos βξ, sin βξ, e^{−βξ}, e^{−β(L−ξ)}.
     members: Vec<[f64; 4]>,
     betas: Vec<f64>,
+    /// Coefficient of the rigid line x − x_c added on the case.
+    tilt: f64,
     masses: Vec<f64>,
 }
 
@@ -103,11 +106,8 @@ impl FreeVibration {
     /// Free vibration of `body` from the case shape `shape` (rigid part removed here), masses at
     /// rest at zero displacement.
     pub fn new(body: FreeFreeRocket, shape: &dyn Fn(f64) -> f64, modes: usize) -> Result<Self> {
-        // Mass-to-mass transverse springs act in fixed axes (module docs of the parent): a
-        // rigid rotation stretches them, so rotation is then a soft elastic mode, kept here.
-        let rotation_free = body.couplings.iter().all(|c| c.transverse_stiffness == 0.0);
-        let rigid = if rotation_free { 2 } else { 1 };
-        let omegas = body.omegas_after(Motion::Transverse, rigid, modes)?;
+        let omegas =
+            body.omegas_after(Motion::Transverse, Motion::Transverse.rigid_modes(), modes)?;
         let shapes = mode_shapes(&body, &omegas)?;
         let points = quadrature_points(&body, &shapes);
         let m0: f64 = points.iter().map(|p| p.weight).sum();
@@ -234,21 +234,18 @@ impl FreeVibration {
             .rev()
             .find(|&e| x >= nodes[e])
             .unwrap_or(0);
-        member_value(
-            &mode.members[e],
-            mode.betas[e],
-            self.body.members[e].length,
-            x - nodes[e],
-        )
+        case_value(&self.body, mode, e, x - nodes[e])
     }
 }
 
-/// w at ξ along a member from its basis coefficients.
-fn member_value(c: &[f64; 4], beta: f64, length: f64, xi: f64) -> f64 {
+/// w of `mode` at ξ along member `e`.
+fn case_value(body: &FreeFreeRocket, mode: &ModeShape, e: usize, xi: f64) -> f64 {
+    let (c, beta, length) = (&mode.members[e], mode.betas[e], body.members[e].length);
     c[0] * (beta * xi).cos()
         + c[1] * (beta * xi).sin()
         + c[2] * (-beta * xi).exp()
         + c[3] * (-beta * (length - xi)).exp()
+        + mode.tilt * (body.nodes[e] + xi - body.centre)
 }
 
 /// The shapes of the modes at `omegas` (ascending; coincident roots share an eigenspace).
@@ -263,11 +260,20 @@ fn mode_shapes(body: &FreeFreeRocket, omegas: &[f64]) -> Result<Vec<ModeShape>> 
             group += 1;
         }
         let omega = omegas[k..k + group].iter().sum::<f64>() / group as f64;
-        let vectors = null_space(body, omega, group)?;
-        let mut shapes: Vec<ModeShape> = vectors
-            .iter()
-            .map(|v| shape_from_nodes(body, omega, v))
-            .collect::<Result<_>>()?;
+        let mut shapes: Vec<ModeShape> = if body.has_rotation_springs() {
+            if group > 1 {
+                return Err(AnalyticError::Unsupported(format!(
+                    "{group} coincident body-frame modes at {omega} rad/s: the rotation \
+                     constraint's eigenspace is not built"
+                )));
+            }
+            vec![constrained_shape(body, omega)?]
+        } else {
+            null_space(body, omega, group)?
+                .iter()
+                .map(|v| shape_from_nodes(body, omega, v))
+                .collect::<Result<_>>()?
+        };
         orthogonalize(body, &mut shapes);
         for (s, w) in shapes.iter_mut().zip(&omegas[k..k + group]) {
             s.omega = *w;
@@ -327,8 +333,24 @@ fn shape_from_nodes(body: &FreeFreeRocket, omega: f64, v: &[f64]) -> Result<Mode
         omega,
         members,
         betas,
+        tilt: 0.0,
         masses: v[nn..].to_vec(),
     })
+}
+
+/// The body-frame mode at a root of the constrained count: z − r with K(ω)z = g.
+fn constrained_shape(body: &FreeFreeRocket, omega: f64) -> Result<ModeShape> {
+    let (k, n, _) = body.dynamic_stiffness(Motion::Transverse, omega)?;
+    let g = body.rotation_spring_forces(n);
+    let z = body.rotation_response(&k, n, &g)?;
+    let r = body.rotation_dofs(n);
+    let mut shape = shape_from_nodes(body, omega, &z)?;
+    shape.tilt = -1.0;
+    let nn = n - body.masses.len();
+    for (q, rj) in shape.masses.iter_mut().zip(&r[nn..]) {
+        *q -= rj;
+    }
+    Ok(shape)
 }
 
 /// Gram–Schmidt in ⟨·⟩ within one eigenspace (a no-op for a simple root). The shapes share ω,
@@ -366,6 +388,7 @@ fn orthogonalize(body: &FreeFreeRocket, shapes: &mut [ModeShape]) {
                     *x -= r * y;
                 }
             }
+            sb.tilt -= r * sa.tilt;
             for (x, y) in sb.masses.iter_mut().zip(&sa.masses) {
                 *x -= r * y;
             }
@@ -398,10 +421,7 @@ fn quadrature_points(body: &FreeFreeRocket, shapes: &[ModeShape]) -> Vec<Point> 
                 out.push(Point {
                     x: body.nodes[e] + xi,
                     weight: 0.5 * h * w * m.rho_a,
-                    mode_values: shapes
-                        .iter()
-                        .map(|s| member_value(&s.members[e], s.betas[e], m.length, xi))
-                        .collect(),
+                    mode_values: shapes.iter().map(|s| case_value(body, s, e, xi)).collect(),
                 });
             }
         }
