@@ -3,7 +3,8 @@
 //!
 //! Exit status: 0 success; 1 a verification check failed; 2 bad input (scene file,
 //! arguments); 3 unsupported (a backend or subcommand cannot do what was asked); 4 a run stopped
-//! early with a diagnostic (its partial results are still written); 5 output could not be
+//! early or failed numerically, with a diagnostic (its partial results, if any, are still
+//! written); 5 output could not be
 //! written; 141 the reader of standard output closed the pipe (module `stdout`).
 
 pub mod args;
@@ -62,7 +63,7 @@ impl From<data::BackendError> for CliError {
             data::BackendError::Unsupported(_) => CliError::Unsupported(e.to_string()),
             data::BackendError::InvalidSettings { .. }
             | data::BackendError::StabilityBound { .. } => CliError::Input(format!("error: {e}")),
-            data::BackendError::Numerical { .. } => CliError::Failed(format!("error: {e}")),
+            data::BackendError::Numerical { .. } => CliError::Stopped(format!("error: {e}")),
         }
     }
 }
