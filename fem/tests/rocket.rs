@@ -279,3 +279,34 @@ fn elem_rocket_springs_between_masses_ride_with_the_body() {
     let modes = FemBackend.modes(&sc, &settings(Some(30), None), 4).unwrap();
     assert_eq!(modes.frequencies_hz.len(), 4);
 }
+
+#[test]
+fn sys_rocket_mass_held_by_no_spring_is_refused() {
+    // Case II's middle mass hangs on the mass-to-mass springs only; without their transverse
+    // stiffness nothing holds it across the axis.
+    let mut sc = data::load_scene("rocket-case2").unwrap();
+    for s in &mut sc.rocket.as_mut().unwrap().springs {
+        s.transverse_stiffness = 0.0;
+    }
+    for result in [
+        FemBackend
+            .modes(&sc, &settings(Some(30), None), 4)
+            .map(|_| ()),
+        FemBackend
+            .simulate(&sc, &settings(Some(10), Some(1e-4)))
+            .map(|_| ()),
+    ] {
+        match result {
+            Err(data::BackendError::Unsupported(why)) => {
+                assert!(
+                    why.contains("discrete_mass[1]") && why.contains("drift"),
+                    "{why}"
+                )
+            }
+            other => panic!("expected a refusal, got {other:?}"),
+        }
+    }
+    // with its springs it is a regular free-free body
+    let sc = data::load_scene("rocket-case2").unwrap();
+    assert!(FemBackend.modes(&sc, &settings(Some(30), None), 4).is_ok());
+}

@@ -353,6 +353,22 @@ impl Model {
                 cw: sp.transverse_damping,
             });
         }
+        // A mass held by no spring in one direction would drift through the case as a rigid
+        // body of its own (the model has no contact): refused, as modal does.
+        for (j, m) in masses.iter().enumerate() {
+            let held = |own: f64, coupled: fn(&Coupling) -> f64| {
+                own > 0.0
+                    || couplings
+                        .iter()
+                        .any(|c| (c.a == j || c.b == j) && coupled(c) > 0.0)
+            };
+            if !(held(m.ku, |c| c.ku) && held(m.kw, |c| c.kw)) {
+                return Err(FemError::Unsupported(format!(
+                    "rocket.discrete_mass[{j}] has no axial or no transverse spring to the case \
+                     or to another mass: it would drift freely (no contact model)"
+                )));
+            }
+        }
         let mut x_ref = vec![0.0; n];
         let mut t_xi = vec![0.0; n];
         let mut t_eta = vec![0.0; n];
