@@ -267,7 +267,17 @@ fn elem_rocket_springs_between_masses_ride_with_the_body() {
     let mut f = vec![0.0; n];
     let (energy, _) = only_couplings.add_spring_forces(alpha, &q, &vec![0.0; n], &mut f);
     let k = model.couplings.iter().map(|c| c.kw).fold(0.0, f64::max);
-    let launch_axis_stretch = alpha * 5.0; // masses 5 in apart
+    // the largest stretch the rotation would cause in launch axes: α |x_a − x_b|
+    let spacing = model
+        .couplings
+        .iter()
+        .map(|c| (model.x_ref[model.mass_dofs(c.a).0] - model.x_ref[model.mass_dofs(c.b).0]).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        spacing > 0.0,
+        "the catalog rocket couples masses at different stations"
+    );
+    let launch_axis_stretch = alpha * spacing;
     assert!(
         energy <= 1e-20 * k * launch_axis_stretch.powi(2),
         "energy of a rigid motion: {energy:e}"

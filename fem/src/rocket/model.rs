@@ -740,34 +740,29 @@ impl Model {
     }
 
     /// The body-axis springs' stiffness at the straight body at rest that the launch-axis
-    /// entries of [`Model::spring_entries`] leave out: k_w(gᵀq)² with g the transverse
-    /// stretch's gradient e_{W_a} − e_{W_b} − Δx ∇ψ, expanded, less the k_w(W_a − W_b)² already
-    /// there. Dense in the case's transverse DOFs (through ∇ψ); used by the eigenproblem only
-    /// (the time step's Newton matrix keeps the banded launch-axis part).
+    /// entries of [`Model::spring_entries`] leave out. The transverse stretch's gradient there is
+    /// g₀ + d, g₀ = e_{W_a} − e_{W_b} (launch axes) and d = −Δx ∇ψ (∇ψ = b_s_η / S_ξ), so the
+    /// missing part of k_w g gᵀ is k_w(g₀dᵀ + d g₀ᵀ + d dᵀ). Dense in the case's transverse DOFs
+    /// (through ∇ψ); used by the eigenproblem only (the time step's Newton matrix keeps the
+    /// banded launch-axis part).
     pub fn coupling_rotation_stiffness(&self) -> Vec<(usize, usize, f64)> {
         let rest = self.body_axes(&vec![0.0; self.n]);
-        let grad_psi: Vec<f64> = self.b_s_eta.iter().map(|e| e / rest.sx).collect();
         let mut out = Vec::new();
         for cp in &self.couplings {
-            let (_, aw) = self.mass_dofs(cp.a);
-            let (_, bw) = self.mass_dofs(cp.b);
-            let dx = self.x_ref[self.mass_dofs(cp.a).0] - self.x_ref[self.mass_dofs(cp.b).0];
-            let mut g: Vec<f64> = grad_psi.iter().map(|d| -dx * d).collect();
-            g[aw] += 1.0;
-            g[bw] -= 1.0;
-            for i in 0..self.n {
-                for j in 0..self.n {
-                    let mut k = g[i] * g[j];
-                    if (i == aw || i == bw) && (j == aw || j == bw) {
-                        // the launch-axis part k_w(W_a − W_b)² of spring_entries
-                        k -= if i == j { 1.0 } else { -1.0 };
-                    }
-                    if k != 0.0 {
-                        out.push((i, j, cp.kw * k));
-                    }
+            let ((au, aw), (bu, bw)) = (self.mass_dofs(cp.a), self.mass_dofs(cp.b));
+            let dx = self.x_ref[au] - self.x_ref[bu];
+            let d: Vec<f64> = self.b_s_eta.iter().map(|e| -dx * e / rest.sx).collect();
+            for (i, di) in d.iter().enumerate() {
+                for (j, dj) in d.iter().enumerate() {
+                    out.push((i, j, cp.kw * di * dj));
+                }
+                for (w, sign) in [(aw, 1.0), (bw, -1.0)] {
+                    out.push((w, i, cp.kw * sign * di));
+                    out.push((i, w, cp.kw * sign * di));
                 }
             }
         }
+        out.retain(|e| e.2 != 0.0);
         out
     }
 

@@ -230,7 +230,8 @@ impl Model {
     /// ∂(stretch)/∂w_p of [`Model::coupling_stretch_w`] for every mass p.
     pub fn coupling_gradient_w(&self, c: &Coupling, p: usize) -> f64 {
         let dx = self.body.masses[c.i].x - self.body.masses[c.j].x;
-        f64::from(u8::from(p == c.i)) - f64::from(u8::from(p == c.j)) - dx * self.mass_tilt[p]
+        let unit = |m: usize| if p == m { 1.0 } else { 0.0 };
+        unit(c.i) - unit(c.j) - dx * self.mass_tilt[p]
     }
 
     /// Burnt mass per length Δm·s(t) removed from the chamber.

@@ -394,10 +394,10 @@ impl FreeFreeRocket {
     /// λ f(λ) = −I_c + (gᵀz − gᵀr)/λ with K(ω) z = g (module docs): its sign adds the rotation
     /// constraint to the transverse count.
     fn rotation_constraint(&self, k: &[f64], n: usize, omega: f64) -> Result<f64> {
-        let g = self.rotation_spring_forces(n);
-        if g.iter().all(|&v| v == 0.0) {
+        if !self.has_rotation_springs() {
             return Ok(-self.rotary_inertia);
         }
+        let g = self.rotation_spring_forces(n);
         let z = self.rotation_response(k, n, &g)?;
         let r = self.rotation_dofs(n);
         let gz: f64 = g.iter().zip(&z).map(|(a, b)| a * b).sum();
