@@ -162,7 +162,7 @@ pub mod friction;
 
 use data::Event;
 use data::Scene;
-use data::scene::{ContactMode, Surface};
+use data::scene::Surface;
 
 use crate::chain::{Chain, MAX_LINKS, Parts};
 use crate::error::FemError;
@@ -187,70 +187,6 @@ pub const REFINE_MIN: f64 = 1e-5;
 pub const GRAZING_FORCE_LIMIT: f64 = 1e-2;
 /// Diagnostic location of that stop.
 pub const GRAZING_LOCATION: &str = "contact1 (grazing)";
-
-/// Refuses contact features this backend does not model, with a precise message.
-pub fn check(scene: &Scene) -> Result<(), FemError> {
-    if scene.contacts.len() > 1 {
-        return Err(FemError::unsupported(format!(
-            "fem: {} contacts in scene `{}`; one tip contact is implemented",
-            scene.contacts.len(),
-            scene.name
-        )));
-    }
-    let Some(c) = scene.contacts.first() else {
-        return Ok(());
-    };
-    // Bilateral contacts (line or circle, with or without friction): `crate::events::contact::friction`.
-    let bilateral = c.mode == ContactMode::Bilateral;
-    crate::events::contact::friction::check(scene)?;
-    if let (false, Surface::Circle { .. }) = (bilateral, &c.surface) {
-        return Err(FemError::unsupported(format!(
-            "fem: unilateral contact with a circular surface (scene `{}`) is not implemented; \
-             unilateral contact is implemented for a straight line, circles for bilateral \
-             contacts",
-            scene.name
-        )));
-    }
-    if !bilateral && c.friction != 0.0 {
-        return Err(FemError::unsupported(format!(
-            "fem: Coulomb friction (μ = {}) in a unilateral contact (scene `{}`) is not \
-             implemented (impacts with friction); friction is implemented for bilateral contacts",
-            c.friction, scene.name
-        )));
-    }
-    if let Some(i) = scene
-        .links
-        .iter()
-        .position(|l| l.joint.prescribed.is_some())
-    {
-        return Err(FemError::unsupported(format!(
-            "fem: contact combined with prescribed joint motion (link {}) is not implemented",
-            i + 1
-        )));
-    }
-    if let Some(i) = scene
-        .links
-        .iter()
-        .position(|l| l.shear && !l.rotary_inertia && l.kelvin_voigt.unwrap_or(0.0) <= 0.0)
-    {
-        return Err(FemError::unsupported(format!(
-            "fem: contact with Timoshenko link {} (`{}`) without `rotary_inertia` and without \
-             Kelvin–Voigt damping: its section rotations are then algebraic (∂V/∂ψ = 0) and ψ̇ \
-             jumps with the massive velocities at an impact; that condensation is not \
-             implemented (only the damped case, where ψ̇ follows the massless balance \
-             Nᵀ(∂V/∂q + C q̇) = 0); set `kelvin_voigt` > 0 or `rotary_inertia`",
-            i + 1,
-            scene.links[i].name
-        )));
-    }
-    if !scene.links.iter().any(|l| l.name == c.link) {
-        return Err(FemError::InvalidSettings {
-            field: "contact.link".into(),
-            message: format!("no link named `{}`", c.link),
-        });
-    }
-    Ok(())
-}
 
 /// The tip contact: geometry, phase, the quantities of the last evaluation and work buffers.
 #[derive(Debug, Clone)]
@@ -320,7 +256,7 @@ pub struct Contact {
 impl Contact {
     /// The scene's tip contact on `chain` (None without one; nothing is allocated then).
     pub fn from_scene(scene: &Scene, chain: &Chain) -> Result<Option<Self>, FemError> {
-        check(scene)?;
+        crate::support::check_contact(scene)?;
         let Some(c) = scene.contacts.first() else {
             return Ok(None);
         };

@@ -103,59 +103,6 @@ pub const STICK_VT_TOL: f64 = 1e-8;
 /// Shortest trial step of the event location, relative to the step being located.
 pub const MIN_TRIAL: f64 = 1e-3;
 
-/// Refuses what the bilateral contact does not model (called from [`crate::events::contact::check`]).
-pub fn check(scene: &Scene) -> Result<(), FemError> {
-    let Some(c) = scene.contacts.first() else {
-        return Ok(());
-    };
-    if c.mode != ContactMode::Bilateral {
-        return Ok(());
-    }
-    if !(c.friction >= 0.0 && c.friction.is_finite()) {
-        return Err(FemError::InvalidSettings {
-            field: "contact.friction".into(),
-            message: format!("the friction coefficient must be ≥ 0, got {}", c.friction),
-        });
-    }
-    if let Some(i) = scene
-        .links
-        .iter()
-        .position(|l| l.shear && !l.rotary_inertia)
-    {
-        // The index-1 normal and held-tip forces and the Coulomb test use M⁻¹; the unilateral
-        // contact's condensation of massless sections is not carried over to the bilateral
-        // wall.
-        return Err(FemError::unsupported(format!(
-            "fem: bilateral (friction) contact with Timoshenko link {} (`{}`) without \
-             `rotary_inertia`: its section rotations carry no mass, so M is singular and the \
-             index-1 wall forces (G M⁻¹Gᵀ, G M⁻¹Tᵀ, T M⁻¹Tᵀ) are undefined; set \
-             `rotary_inertia = true` with `rotary_inertia_per_length`",
-            i + 1,
-            scene.links[i].name
-        )));
-    }
-    if let (Some(l), Surface::Circle { center, radius }) =
-        (scene.links.iter().find(|l| l.name == c.link), &c.surface)
-    {
-        let first = scene.links.first().is_some_and(|f| f.name == l.name);
-        let tol = 1e-12 * l.length;
-        if first
-            && !l.axial
-            && center[0].hypot(center[1]) <= tol
-            && (radius - l.length).abs() <= tol
-        {
-            return Err(FemError::unsupported(format!(
-                "fem: bilateral circle of radius L about the hub for the inextensible link `{}` \
-                 (simple flexure): its tip can stay at radius L only while the link is straight, \
-                 so the model degenerates to the rigid link (constraint gradient zero, normal \
-                 force undetermined); use `axial = true` (Euler model) or the rigid closed form",
-                l.name
-            )));
-        }
-    }
-    Ok(())
-}
-
 /// The `describe` line of a bilateral contact (None otherwise).
 pub fn describe(scene: &Scene) -> Option<String> {
     let c = scene.contacts.first()?;
