@@ -33,7 +33,7 @@ impl Driver {
     /// Index-1 forces at (q, q̇) (`end`: the trial end q₁, q̇₁ at t₁; else the current state).
     fn contact_forces(&mut self, end: bool, t: f64, held: bool) -> Result<Forces, FemError> {
         self.with_bilateral(|s, c| {
-            let link = c.link;
+            let link = c.constraint.link;
             let b = c.bilateral.as_deref_mut().expect("bilateral contact");
             let (q, qd) = if end {
                 (&s.state.q1, &s.state.qd1)
@@ -56,15 +56,15 @@ impl Driver {
         if c.bilateral.is_none() {
             return Ok(());
         }
-        c.constrained = true;
-        c.gap = c.gap_at(&self.chain, t, &self.state.q);
-        if c.gap.abs() > c.gap_tol {
+        c.phase.constrained = true;
+        c.phase.gap = c.gap_at(&self.chain, t, &self.state.q);
+        if c.phase.gap.abs() > c.phase.gap_tol {
             return Err(FemError::InvalidSettings {
                 field: "contact".into(),
                 message: format!(
                     "the tip starts {:.3e} off the surface of the bilateral contact (tolerance \
                      {:.1e})",
-                    c.gap, c.gap_tol
+                    c.phase.gap, c.phase.gap_tol
                 ),
             });
         }
@@ -84,8 +84,8 @@ impl Driver {
                     -sign(held.lambda_t)
                 };
             }
-            c.n_events += 1;
-            c.events.push(Event::StickSlip {
+            c.record.n_events += 1;
+            c.record.events.push(Event::StickSlip {
                 t,
                 contact: 1,
                 sticking,
@@ -108,11 +108,11 @@ impl Driver {
         let fr = self.contact_forces(false, t, sticking)?;
         let c = self.contact.as_deref_mut().expect("contact");
         let b = c.bilateral.as_deref_mut().expect("bilateral");
-        c.lambda = fr.lambda_n;
-        c.gap = fr.gap;
-        c.normal_velocity = fr.vn;
-        c.max_gap = c.max_gap.max(fr.gap.abs());
-        c.max_normal_velocity = c.max_normal_velocity.max(fr.vn.abs());
+        c.phase.lambda = fr.lambda_n;
+        c.phase.gap = fr.gap;
+        c.phase.normal_velocity = fr.vn;
+        c.record.max_gap = c.record.max_gap.max(fr.gap.abs());
+        c.record.max_normal_velocity = c.record.max_normal_velocity.max(fr.vn.abs());
         b.friction_force = fr.lambda_t;
         b.slip_velocity = fr.vt;
         if b.sticking {
@@ -148,7 +148,7 @@ impl Driver {
         }
         if b.fresh {
             // Newton predictor of a new phase: the index-1 value.
-            c.step_lambda = fr.lambda_n;
+            c.constraint.step_lambda = fr.lambda_n;
         }
         Ok(())
     }
@@ -174,8 +174,8 @@ impl Driver {
     /// else the step is re-solved once with σ flipped (module docs).
     fn sigma_check(&mut self, h: f64) -> Result<(), FemError> {
         let c = self.contact.as_deref_mut().expect("contact");
-        let tiny = c.force_tol;
-        let lam = c.step_lambda;
+        let tiny = c.phase.force_tol;
+        let lam = c.constraint.step_lambda;
         let b = c.bilateral.as_deref_mut().expect("bilateral");
         if b.sticking || b.mu == 0.0 || lam * b.sigma >= 0.0 || lam.abs() <= tiny {
             return Ok(());
@@ -184,7 +184,7 @@ impl Driver {
         let t1 = self.state.t + h;
         let failed = matches!(self.solve(h, t1, t1)?, Some(e) if e.is_infinite());
         let c = self.contact.as_deref_mut().expect("contact");
-        let lam2 = c.step_lambda;
+        let lam2 = c.constraint.step_lambda;
         let sigma = c.bilateral.as_deref().map_or(1.0, |b| b.sigma);
         if failed || (lam2 * sigma < 0.0 && lam2.abs() > tiny) {
             return Err(FemError::Runaway {
@@ -207,7 +207,7 @@ impl Driver {
     fn switch_value(&mut self, kind: Switch, t1: f64) -> Result<f64, FemError> {
         match kind {
             Switch::SlipStop => self.with_bilateral(|s, c| {
-                let link = c.link;
+                let link = c.constraint.link;
                 let b = c.bilateral.as_deref_mut().expect("bilateral");
                 let r = s.chain.tip_jacobian(t1, link, &s.state.q1, &mut b.jac);
                 let f = b.wall.frame(r);
@@ -265,10 +265,10 @@ impl Driver {
     pub(crate) fn bilateral_after_trial(&mut self, h: f64) -> Result<(f64, Post), FemError> {
         let t1 = self.state.t + h;
         let c = self.contact.as_deref_mut().expect("contact");
-        if c.n_events >= MAX_EVENTS {
+        if c.record.n_events >= MAX_EVENTS {
             return Err(FemError::Runaway {
                 t: self.state.t,
-                what: format!("{} stick–slip events", c.n_events),
+                what: format!("{} stick–slip events", c.record.n_events),
                 location: Some("contact1".into()),
                 why: "stick–slip transitions accumulate".into(),
                 remedy: "shorten t_end or add damping".into(),
@@ -277,7 +277,7 @@ impl Driver {
         self.sigma_check(h)?;
         let t0 = self.state.t;
         let c = self.contact.as_deref_mut().expect("contact");
-        let force_tol = c.force_tol;
+        let force_tol = c.phase.force_tol;
         let b = c.bilateral.as_deref_mut().expect("bilateral");
         b.pending = None;
         if b.mu == 0.0 {
@@ -295,8 +295,8 @@ impl Driver {
             b.stick_tangent = held.tangent;
             b.step_lambda_t = held.lambda_t;
             b.inconsistent_slides += 1;
-            c.n_events += 1;
-            c.events.push(Event::StickSlip {
+            c.record.n_events += 1;
+            c.record.events.push(Event::StickSlip {
                 t: t0,
                 contact: 1,
                 sticking: true,
@@ -393,8 +393,8 @@ impl Driver {
             b.sticking = false;
         }
         if kind == Switch::Breakaway || stick {
-            c.n_events += 1;
-            c.events.push(Event::StickSlip {
+            c.record.n_events += 1;
+            c.record.events.push(Event::StickSlip {
                 t,
                 contact: 1,
                 sticking: stick,

@@ -355,7 +355,7 @@ pub(crate) fn midpoint_terms(
     gap1: f64,
     res: &mut [f64],
 ) -> f64 {
-    let link = c.link;
+    let link = c.constraint.link;
     let Some(b) = c.bilateral.as_deref_mut() else {
         return gap1;
     };
@@ -372,7 +372,7 @@ pub(crate) fn midpoint_terms(
         let k = b.mu * b.slip_dir * b.sigma;
         for i in 0..n {
             res[i] += k * v.lambda * b.t_row[i];
-            c.g_bar[i] -= k * b.t_row[i];
+            c.constraint.g_bar[i] -= k * b.t_row[i];
         }
         b.pending_work = k * v.lambda * dot(v.dq, &b.t_row);
         return gap1;
@@ -417,7 +417,7 @@ pub(crate) fn sticking(c: &Contact) -> bool {
 pub fn phase(c: &Contact) -> f64 {
     if sticking(c) {
         2.0
-    } else if c.constrained {
+    } else if c.phase.constrained {
         1.0
     } else {
         0.0
@@ -437,26 +437,26 @@ pub(crate) fn stick_newton_update(
         return 0.0;
     };
     let n = res.len();
-    newton.delta.copy_from_slice(&c.g_bar);
+    newton.delta.copy_from_slice(&c.constraint.g_bar);
     newton.solve();
-    c.s_inv_g.copy_from_slice(&newton.delta);
+    c.constraint.s_inv_g.copy_from_slice(&newton.delta);
     newton.delta.copy_from_slice(&b.h_bar);
     newton.solve();
     b.s_inv_h.copy_from_slice(&newton.delta);
     newton.delta.copy_from_slice(res);
     newton.solve();
     let hh = 0.5 * h * h;
-    let a11 = hh * dot(&c.g_end, &c.s_inv_g);
-    let a12 = hh * dot(&c.g_end, &b.s_inv_h);
-    let a21 = hh * dot(&b.h_end, &c.s_inv_g);
+    let a11 = hh * dot(&c.constraint.g_end, &c.constraint.s_inv_g);
+    let a12 = hh * dot(&c.constraint.g_end, &b.s_inv_h);
+    let a21 = hh * dot(&b.h_end, &c.constraint.s_inv_g);
     let a22 = hh * dot(&b.h_end, &b.s_inv_h);
-    let r1 = b.g1 - hh * dot(&c.g_end, &newton.delta);
+    let r1 = b.g1 - hh * dot(&c.constraint.g_end, &newton.delta);
     let r2 = b.h1 - hh * dot(&b.h_end, &newton.delta);
     let det = a11 * a22 - a12 * a21;
     let dn = (a22 * r1 - a12 * r2) / det;
     let dt = (a11 * r2 - a21 * r1) / det;
     for i in 0..n {
-        newton.delta[i] += c.s_inv_g[i] * dn + b.s_inv_h[i] * dt;
+        newton.delta[i] += c.constraint.s_inv_g[i] * dn + b.s_inv_h[i] * dt;
     }
     b.dlt_pending = dt;
     dn
