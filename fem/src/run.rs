@@ -411,9 +411,9 @@ fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<
         buf.push(c.record.max_gap);
         buf.push(c.record.max_normal_velocity);
         if let Some(b) = c.bilateral.as_deref().filter(|b| b.has_friction()) {
-            buf.push(b.slip_velocity);
-            buf.push(b.friction_force);
-            buf.push(b.friction_work);
+            buf.push(b.phase.slip_velocity);
+            buf.push(b.phase.friction_force);
+            buf.push(b.record.friction_work);
         }
     }
 }
@@ -505,7 +505,7 @@ fn push_ledger(integ: &Driver, ledger: &mut EnergyLedger) {
                 .contact
                 .as_deref()
                 .and_then(|c| c.bilateral.as_deref())
-                .map_or(0.0, |b| b.friction_work),
+                .map_or(0.0, |b| b.record.friction_work),
             _ => w.kelvin_voigt,
         };
     }

@@ -384,7 +384,7 @@ impl Contact {
 
     fn gap_of(&self, r: [f64; 2]) -> f64 {
         if let Some(b) = self.bilateral.as_deref() {
-            return b.wall.gap(r);
+            return b.constraint.wall.gap(r);
         }
         self.constraint.normal[0] * (r[0] - self.constraint.point[0])
             + self.constraint.normal[1] * (r[1] - self.constraint.point[1])
@@ -396,7 +396,7 @@ impl Contact {
         let r = chain.tip_jacobian(t, self.constraint.link, q, &mut self.constraint.jac);
         // A circle's normal is that at the tip (crate::events::wall); a line's is fixed.
         let normal = match self.bilateral.as_deref() {
-            Some(b) => b.wall.frame(r).normal,
+            Some(b) => b.constraint.wall.frame(r).normal,
             None => self.constraint.normal,
         };
         for i in 0..n {
