@@ -281,11 +281,11 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
     }
     let mut integ = Driver::new(chain, method, h_rule.min(out), default_rho_inf(scene))?;
     if let Some(mut c) = contact {
-        c.gap = c.gap_at(&integ.chain, integ.state.t, &integ.state.q);
-        if c.gap < -c.gap_tol && c.bilateral.is_none() {
+        c.phase.gap = c.gap_at(&integ.chain, integ.state.t, &integ.state.q);
+        if c.phase.gap < -c.phase.gap_tol && c.bilateral.is_none() {
             return Err(FemError::InvalidSettings {
                 field: "contact".into(),
-                message: format!("the tip starts {:.3e} inside the surface", -c.gap),
+                message: format!("the tip starts {:.3e} inside the surface", -c.phase.gap),
             });
         }
         let unilateral = c.bilateral.is_none();
@@ -404,16 +404,16 @@ fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<
         }
     }
     if let Some(c) = integ.contact.as_deref() {
-        buf.push(c.lambda);
+        buf.push(c.phase.lambda);
         buf.push(crate::events::contact::friction::phase(c));
-        buf.push(c.gap);
-        buf.push(c.normal_velocity);
-        buf.push(c.max_gap);
-        buf.push(c.max_normal_velocity);
+        buf.push(c.phase.gap);
+        buf.push(c.phase.normal_velocity);
+        buf.push(c.record.max_gap);
+        buf.push(c.record.max_normal_velocity);
         if let Some(b) = c.bilateral.as_deref().filter(|b| b.has_friction()) {
-            buf.push(b.slip_velocity);
-            buf.push(b.friction_force);
-            buf.push(b.friction_work);
+            buf.push(b.phase.slip_velocity);
+            buf.push(b.phase.friction_force);
+            buf.push(b.record.friction_work);
         }
     }
 }
@@ -448,7 +448,7 @@ fn ledger_terms(integ: &Driver) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'
     if integ
         .contact
         .as_deref()
-        .and_then(|c| c.massless.as_ref())
+        .and_then(|c| c.solve.massless.as_ref())
         .is_some_and(|m| m.project)
     {
         diss.push(ledger_term::NUMERICAL_MASSLESS);
@@ -496,15 +496,16 @@ fn push_ledger(integ: &Driver, ledger: &mut EnergyLedger) {
         diss[k] = match term.name.as_str() {
             ledger_term::JOINT_DAMPER => w.joint_damper,
             ledger_term::NUMERICAL_MASSLESS => w.numerical_massless,
-            ledger_term::IMPACT => integ.contact.as_ref().map_or(0.0, |c| c.impact_loss),
-            ledger_term::CONTACT_PROJECTION => {
-                integ.contact.as_ref().map_or(0.0, |c| c.projection_loss)
-            }
+            ledger_term::IMPACT => integ.contact.as_ref().map_or(0.0, |c| c.record.impact_loss),
+            ledger_term::CONTACT_PROJECTION => integ
+                .contact
+                .as_ref()
+                .map_or(0.0, |c| c.record.projection_loss),
             ledger_term::FRICTION => integ
                 .contact
                 .as_deref()
                 .and_then(|c| c.bilateral.as_deref())
-                .map_or(0.0, |b| b.friction_work),
+                .map_or(0.0, |b| b.record.friction_work),
             _ => w.kelvin_voigt,
         };
     }
@@ -541,7 +542,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
             let h_before = integ.h;
             let stepped = integ.step();
             if let Some(c) = integ.contact.as_deref_mut() {
-                events.append(&mut c.events);
+                events.append(&mut c.record.events);
             }
             match stepped {
                 Ok(StopReason::ReachedStop) => break,
@@ -605,7 +606,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
     if let Some(c) = integ.contact.as_deref_mut() {
         // A release located at the last step is reported with the run.
         c.flush_pending();
-        events.append(&mut c.events);
+        events.append(&mut c.record.events);
     }
     let _ = h_nominal;
     Ok(run_result(

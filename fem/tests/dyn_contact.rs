@@ -322,8 +322,8 @@ fn dyn_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     integ.set_stop(10.0);
     while integ.step().unwrap() != fem::driver::StopReason::ReachedStop {}
     let c = integ.contact.as_ref().unwrap();
-    assert!(c.constrained, "not resting on the surface at 4 s");
-    let dynamic = c.lambda;
+    assert!(c.phase.constrained, "not resting on the surface at 4 s");
+    let dynamic = c.phase.lambda;
     let speed = integ.state.qd.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     println!("|q̇|∞ at 10 s: {speed:.3e}");
     assert!(speed < 1e-2, "still moving: |q̇|∞ = {speed:.2e}");

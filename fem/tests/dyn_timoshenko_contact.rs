@@ -212,7 +212,7 @@ fn integ_free(n_el: usize, h: f64, unilateral: bool) -> fem::driver::Driver {
     it.h_nominal = h;
     if unilateral {
         let mut c = Contact::from_scene(&sc, &it.chain).unwrap().unwrap();
-        c.gap = c.gap_at(&it.chain, it.state.t, &it.state.q);
+        c.phase.gap = c.gap_at(&it.chain, it.state.t, &it.state.q);
         it.contact = Some(Box::new(c));
         it.enable_unilateral_contact().unwrap();
     }

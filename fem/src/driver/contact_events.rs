@@ -68,7 +68,7 @@ impl Driver {
                 .state_force(&mut self.chain, t1, &self.state.q1, &self.state.qd1)
                 .map(|(l, _, passes)| {
                     self.counters.rhs += passes;
-                    c.lambda = l;
+                    c.phase.lambda = l;
                     l
                 }),
         };
@@ -217,20 +217,20 @@ impl Driver {
         }
         let (t0, t1) = (self.state.t, self.state.t + h);
         let c = self.contact_mut();
-        if c.n_events >= MAX_EVENTS {
+        if c.record.n_events >= MAX_EVENTS {
             return Err(FemError::Runaway {
                 t: t0,
-                what: format!("{} contact events", c.n_events),
+                what: format!("{} contact events", c.record.n_events),
                 location: Some("contact1".into()),
                 why: "impacts and releases accumulate (Zeno-like)".into(),
                 remedy: "shorten t_end or add damping".into(),
             });
         }
-        let tol_g = c.gap_tol;
-        let constrained = c.constrained;
+        let tol_g = c.phase.gap_tol;
+        let constrained = c.phase.constrained;
         let refine_min = REFINE_MIN * self.h_nominal;
         if !constrained {
-            let g0 = self.contact_mut().gap;
+            let g0 = self.contact_mut().phase.gap;
             let g1 = self.event_value(Watch::Gap, t1)?;
             if g1 >= -tol_g {
                 self.contact_mut().flush_pending();
@@ -255,7 +255,7 @@ impl Driver {
                 return Ok((h, Post::Refine));
             }
             let mut c = self.contact.take().expect("contact");
-            if c.pending_release.take().is_none() {
+            if c.phase.pending_release.take().is_none() {
                 c.push(Event::ContactStart {
                     t: t0,
                     contact: 1,
@@ -269,10 +269,10 @@ impl Driver {
                 }
                 c.state_force(&mut self.chain, t0, &self.state.q, &self.state.qd)
             });
-            c.constrained = true;
+            c.phase.constrained = true;
             if let Ok((l, _, _)) = res {
-                c.lambda = l;
-                c.step_lambda = l.max(0.0);
+                c.phase.lambda = l;
+                c.constraint.step_lambda = l.max(0.0);
             }
             self.contact = Some(c);
             res?;
@@ -291,12 +291,12 @@ impl Driver {
             }
         }
         // Constrained: the normal force at the step end decides.
-        let lam0 = self.contact_mut().lambda;
+        let lam0 = self.contact_mut().phase.lambda;
         let lam1 = self.event_value(Watch::Force, t1)?;
         if lam1 > 0.0 {
             return Ok((h, Post::None));
         }
-        let tol_f = self.contact_mut().force_tol;
+        let tol_f = self.contact_mut().phase.force_tol;
         if lam0 > 0.0 {
             let (hs, width) = self.locate(Watch::Force, 0.0, h, lam0, lam1, tol_f)?;
             return Ok((
@@ -313,7 +313,7 @@ impl Driver {
             return Ok((h, Post::Refine));
         }
         let c = self.contact_mut();
-        if -lam1 > GRAZING_FORCE_LIMIT * c.force_tol / FORCE_TOL {
+        if -lam1 > GRAZING_FORCE_LIMIT * c.phase.force_tol / FORCE_TOL {
             // Far from zero: the free motion and the normal force contradict each other at the
             // shortest step (module docs, "Grazing"): stop rather than release there.
             return Err(FemError::Runaway {
@@ -351,13 +351,16 @@ impl Driver {
     }
 
     fn apply_post(&mut self, c: &mut Contact, t: f64, post: Post) -> Result<(), FemError> {
-        if c.constrained {
+        if c.phase.constrained {
             // Drift of the step end (gap and G q̇ of the state-force evaluation there); at a
             // release the velocity is projected onto G q̇ = 0 if the tip moves inward (module
             // docs).
-            c.drift_velocity = c.normal_velocity;
-            c.max_gap = c.max_gap.max(c.gap.abs());
-            c.max_normal_velocity = c.max_normal_velocity.max(c.drift_velocity.abs());
+            c.phase.drift_velocity = c.phase.normal_velocity;
+            c.record.max_gap = c.record.max_gap.max(c.phase.gap.abs());
+            c.record.max_normal_velocity = c
+                .record
+                .max_normal_velocity
+                .max(c.phase.drift_velocity.abs());
             if matches!(post, Post::Release { .. } | Post::None) {
                 // Drift control: G q̇ = 0 at the start of every constrained step, so that the
                 // state force of a shortened step (the release event function) is continuous
@@ -371,25 +374,25 @@ impl Driver {
                     inward_only,
                 )?;
                 self.counters.rhs += passes + 1;
-                c.projection_loss += loss;
+                c.record.projection_loss += loss;
             }
         } else {
-            c.gap = c.gap_at(&self.chain, t, &self.state.q);
+            c.phase.gap = c.gap_at(&self.chain, t, &self.state.q);
         }
         match post {
             Post::None => return Ok(()),
             Post::Refine => return Ok(()),
             Post::Release { time_tolerance } => {
                 c.flush_pending();
-                c.pending_release = Some(Event::Release {
+                c.phase.pending_release = Some(Event::Release {
                     t,
                     contact: 1,
-                    normal_force: c.lambda,
+                    normal_force: c.phase.lambda,
                     time_tolerance,
                 });
-                c.constrained = false;
-                c.lambda = 0.0;
-                c.step_lambda = 0.0;
+                c.phase.constrained = false;
+                c.phase.lambda = 0.0;
+                c.constraint.step_lambda = 0.0;
             }
             Post::Impact { time_tolerance } => {
                 c.push(Event::ContactStart {
@@ -404,11 +407,11 @@ impl Driver {
                     c.state_force(&mut self.chain, t, &self.state.q, &self.state.qd)?;
                 self.counters.rhs += passes;
                 if l > 0.0 {
-                    c.constrained = true;
-                    c.lambda = l;
-                    c.step_lambda = l;
+                    c.phase.constrained = true;
+                    c.phase.lambda = l;
+                    c.constraint.step_lambda = l;
                 } else {
-                    c.lambda = 0.0;
+                    c.phase.lambda = 0.0;
                 }
             }
         }

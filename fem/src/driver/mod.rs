@@ -166,7 +166,7 @@ impl Driver {
         let Some(ml) = self
             .contact
             .as_deref_mut()
-            .and_then(|c| c.massless.as_mut())
+            .and_then(|c| c.solve.massless.as_mut())
         else {
             return Ok(());
         };
@@ -221,7 +221,7 @@ impl Driver {
         let mut contact = self.contact.take();
         let held = contact
             .as_deref_mut()
-            .filter(|c| c.constrained)
+            .filter(|c| c.phase.constrained)
             .map(|c| c as &mut dyn crate::method::StepConstraint);
         let mut cx = StepContext {
             chain: &mut self.chain,
@@ -257,7 +257,7 @@ impl Driver {
         let Some(ml) = self
             .contact
             .as_deref_mut()
-            .and_then(|c| c.massless.as_mut())
+            .and_then(|c| c.solve.massless.as_mut())
             .filter(|m| m.project)
         else {
             return Ok(());

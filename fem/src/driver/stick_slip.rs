@@ -33,7 +33,7 @@ impl Driver {
     /// Index-1 forces at (q, q̇) (`end`: the trial end q₁, q̇₁ at t₁; else the current state).
     fn contact_forces(&mut self, end: bool, t: f64, held: bool) -> Result<Forces, FemError> {
         self.with_bilateral(|s, c| {
-            let link = c.link;
+            let link = c.constraint.link;
             let b = c.bilateral.as_deref_mut().expect("bilateral contact");
             let (q, qd) = if end {
                 (&s.state.q1, &s.state.qd1)
@@ -56,19 +56,19 @@ impl Driver {
         if c.bilateral.is_none() {
             return Ok(());
         }
-        c.constrained = true;
-        c.gap = c.gap_at(&self.chain, t, &self.state.q);
-        if c.gap.abs() > c.gap_tol {
+        c.phase.constrained = true;
+        c.phase.gap = c.gap_at(&self.chain, t, &self.state.q);
+        if c.phase.gap.abs() > c.phase.gap_tol {
             return Err(FemError::InvalidSettings {
                 field: "contact".into(),
                 message: format!(
                     "the tip starts {:.3e} off the surface of the bilateral contact (tolerance \
                      {:.1e})",
-                    c.gap, c.gap_tol
+                    c.phase.gap, c.phase.gap_tol
                 ),
             });
         }
-        let mu = c.bilateral.as_deref().map_or(0.0, |b| b.mu);
+        let mu = c.bilateral.as_deref().map_or(0.0, |b| b.constraint.mu);
         let vt_tol = VT_TOL * self.length_scale;
         let held = self.contact_forces(false, t, true)?;
         let c = self.contact.as_deref_mut().expect("contact");
@@ -78,24 +78,24 @@ impl Driver {
             if held.vt.abs() <= vt_tol && held.lambda_t.abs() <= mu * held.lambda_n.abs() {
                 sticking = true;
             } else {
-                b.slip_dir = if held.vt.abs() > vt_tol {
+                b.phase.slip_dir = if held.vt.abs() > vt_tol {
                     sign(held.vt)
                 } else {
                     -sign(held.lambda_t)
                 };
             }
-            c.n_events += 1;
-            c.events.push(Event::StickSlip {
+            c.record.n_events += 1;
+            c.record.events.push(Event::StickSlip {
                 t,
                 contact: 1,
                 sticking,
             });
         }
         if sticking {
-            b.sticking = true;
-            b.stick_point = held.tip;
-            b.stick_tangent = held.tangent;
-            b.step_lambda_t = held.lambda_t;
+            b.phase.sticking = true;
+            b.constraint.stick_point = held.tip;
+            b.constraint.stick_tangent = held.tangent;
+            b.constraint.step_lambda_t = held.lambda_t;
         }
         self.record_state()
     }
@@ -108,24 +108,25 @@ impl Driver {
         let fr = self.contact_forces(false, t, sticking)?;
         let c = self.contact.as_deref_mut().expect("contact");
         let b = c.bilateral.as_deref_mut().expect("bilateral");
-        c.lambda = fr.lambda_n;
-        c.gap = fr.gap;
-        c.normal_velocity = fr.vn;
-        c.max_gap = c.max_gap.max(fr.gap.abs());
-        c.max_normal_velocity = c.max_normal_velocity.max(fr.vn.abs());
-        b.friction_force = fr.lambda_t;
-        b.slip_velocity = fr.vt;
-        if b.sticking {
-            let (ts, ps) = (b.stick_tangent, b.stick_point);
+        c.phase.lambda = fr.lambda_n;
+        c.phase.gap = fr.gap;
+        c.phase.normal_velocity = fr.vn;
+        c.record.max_gap = c.record.max_gap.max(fr.gap.abs());
+        c.record.max_normal_velocity = c.record.max_normal_velocity.max(fr.vn.abs());
+        b.phase.friction_force = fr.lambda_t;
+        b.phase.slip_velocity = fr.vt;
+        if b.phase.sticking {
+            let (ts, ps) = (b.constraint.stick_tangent, b.constraint.stick_point);
             let off = ts[0] * (fr.tip[0] - ps[0]) + ts[1] * (fr.tip[1] - ps[1]);
-            b.max_stick_offset = b.max_stick_offset.max(off.abs());
-            b.max_stick_velocity = b.max_stick_velocity.max(fr.vt.abs());
-            b.e0 = b.mu * fr.lambda_n.abs() - fr.lambda_t.abs();
+            b.record.max_stick_offset = b.record.max_stick_offset.max(off.abs());
+            b.record.max_stick_velocity = b.record.max_stick_velocity.max(fr.vt.abs());
+            b.phase.e0 = b.constraint.mu * fr.lambda_n.abs() - fr.lambda_t.abs();
         } else {
-            if b.mu > 0.0 {
-                b.min_painleve_margin = b
+            if b.constraint.mu > 0.0 {
+                b.record.min_painleve_margin = b
+                    .record
                     .min_painleve_margin
-                    .min((fr.gmg - b.mu * fr.gmt.abs()) / fr.gmg);
+                    .min((fr.gmg - b.constraint.mu * fr.gmt.abs()) / fr.gmg);
                 if fr.painleve {
                     return Err(FemError::Runaway {
                         t,
@@ -135,20 +136,20 @@ impl Driver {
                             "G M⁻¹Gᵀ = {:.4e} ≤ μ|G M⁻¹Tᵀ| = {:.4e}: the sliding normal force \
                              has no or several solutions",
                             fr.gmg,
-                            b.mu * fr.gmt.abs()
+                            b.constraint.mu * fr.gmt.abs()
                         ),
                         remedy: "no consistent Coulomb solution in this model; reduce μ".into(),
                     });
                 }
                 if fr.lambda_n != 0.0 {
-                    b.sigma = sign(fr.lambda_n);
+                    b.phase.sigma = sign(fr.lambda_n);
                 }
             }
-            b.e0 = b.slip_dir * fr.vt;
+            b.phase.e0 = b.phase.slip_dir * fr.vt;
         }
-        if b.fresh {
+        if b.phase.fresh {
             // Newton predictor of a new phase: the index-1 value.
-            c.step_lambda = fr.lambda_n;
+            c.constraint.step_lambda = fr.lambda_n;
         }
         Ok(())
     }
@@ -174,18 +175,22 @@ impl Driver {
     /// else the step is re-solved once with σ flipped (module docs).
     fn sigma_check(&mut self, h: f64) -> Result<(), FemError> {
         let c = self.contact.as_deref_mut().expect("contact");
-        let tiny = c.force_tol;
-        let lam = c.step_lambda;
+        let tiny = c.phase.force_tol;
+        let lam = c.constraint.step_lambda;
         let b = c.bilateral.as_deref_mut().expect("bilateral");
-        if b.sticking || b.mu == 0.0 || lam * b.sigma >= 0.0 || lam.abs() <= tiny {
+        if b.phase.sticking
+            || b.constraint.mu == 0.0
+            || lam * b.phase.sigma >= 0.0
+            || lam.abs() <= tiny
+        {
             return Ok(());
         }
-        b.sigma = -b.sigma;
+        b.phase.sigma = -b.phase.sigma;
         let t1 = self.state.t + h;
         let failed = matches!(self.solve(h, t1, t1)?, Some(e) if e.is_infinite());
         let c = self.contact.as_deref_mut().expect("contact");
-        let lam2 = c.step_lambda;
-        let sigma = c.bilateral.as_deref().map_or(1.0, |b| b.sigma);
+        let lam2 = c.constraint.step_lambda;
+        let sigma = c.bilateral.as_deref().map_or(1.0, |b| b.phase.sigma);
         if failed || (lam2 * sigma < 0.0 && lam2.abs() > tiny) {
             return Err(FemError::Runaway {
                 t: self.state.t,
@@ -207,12 +212,14 @@ impl Driver {
     fn switch_value(&mut self, kind: Switch, t1: f64) -> Result<f64, FemError> {
         match kind {
             Switch::SlipStop => self.with_bilateral(|s, c| {
-                let link = c.link;
+                let link = c.constraint.link;
                 let b = c.bilateral.as_deref_mut().expect("bilateral");
-                let r = s.chain.tip_jacobian(t1, link, &s.state.q1, &mut b.jac);
-                let f = b.wall.frame(r);
-                row_along(f.tangent, &b.jac, &mut b.t_row);
-                Ok(b.slip_dir * dot(&b.t_row, &s.state.qd1))
+                let r = s
+                    .chain
+                    .tip_jacobian(t1, link, &s.state.q1, &mut b.constraint.jac);
+                let f = b.constraint.wall.frame(r);
+                row_along(f.tangent, &b.constraint.jac, &mut b.constraint.t_row);
+                Ok(b.phase.slip_dir * dot(&b.constraint.t_row, &s.state.qd1))
             }),
             Switch::Breakaway => {
                 let fr = self.contact_forces(true, t1, true)?;
@@ -220,7 +227,7 @@ impl Driver {
                     .contact
                     .as_deref()
                     .and_then(|c| c.bilateral.as_deref())
-                    .map_or(0.0, |b| b.mu);
+                    .map_or(0.0, |b| b.constraint.mu);
                 Ok(mu * fr.lambda_n.abs() - fr.lambda_t.abs())
             }
         }
@@ -265,10 +272,10 @@ impl Driver {
     pub(crate) fn bilateral_after_trial(&mut self, h: f64) -> Result<(f64, Post), FemError> {
         let t1 = self.state.t + h;
         let c = self.contact.as_deref_mut().expect("contact");
-        if c.n_events >= MAX_EVENTS {
+        if c.record.n_events >= MAX_EVENTS {
             return Err(FemError::Runaway {
                 t: self.state.t,
-                what: format!("{} stick–slip events", c.n_events),
+                what: format!("{} stick–slip events", c.record.n_events),
                 location: Some("contact1".into()),
                 why: "stick–slip transitions accumulate".into(),
                 remedy: "shorten t_end or add damping".into(),
@@ -277,26 +284,26 @@ impl Driver {
         self.sigma_check(h)?;
         let t0 = self.state.t;
         let c = self.contact.as_deref_mut().expect("contact");
-        let force_tol = c.force_tol;
+        let force_tol = c.phase.force_tol;
         let b = c.bilateral.as_deref_mut().expect("bilateral");
-        b.pending = None;
-        if b.mu == 0.0 {
+        b.phase.pending = None;
+        if b.constraint.mu == 0.0 {
             return Ok((h, Post::None));
         }
-        if !b.sticking && b.fresh && b.pending_work < 0.0 {
+        if !b.phase.sticking && b.phase.fresh && b.constraint.pending_work < 0.0 {
             // First step of a slide whose tip moved against s: friction would have done
             // negative work. The discrete Coulomb choice: the tip sticks for this step (held
             // at its start position; the held-tip constraint does no work).
             let held = self.contact_forces(false, t0, true)?;
             let c = self.contact.as_deref_mut().expect("contact");
             let b = c.bilateral.as_deref_mut().expect("bilateral");
-            b.sticking = true;
-            b.stick_point = held.tip;
-            b.stick_tangent = held.tangent;
-            b.step_lambda_t = held.lambda_t;
-            b.inconsistent_slides += 1;
-            c.n_events += 1;
-            c.events.push(Event::StickSlip {
+            b.phase.sticking = true;
+            b.constraint.stick_point = held.tip;
+            b.constraint.stick_tangent = held.tangent;
+            b.constraint.step_lambda_t = held.lambda_t;
+            b.record.inconsistent_slides += 1;
+            c.record.n_events += 1;
+            c.record.events.push(Event::StickSlip {
                 t: t0,
                 contact: 1,
                 sticking: true,
@@ -307,13 +314,13 @@ impl Driver {
         loop {
             let c = self.contact.as_deref_mut().expect("contact");
             let b = c.bilateral.as_deref_mut().expect("bilateral");
-            let (kind, tol) = if b.sticking {
+            let (kind, tol) = if b.phase.sticking {
                 (Switch::Breakaway, force_tol)
             } else {
                 (Switch::SlipStop, VT_TOL * self.length_scale)
             };
-            let f0 = b.e0;
-            let located = !b.fresh && f0 > 0.0;
+            let f0 = b.phase.e0;
+            let located = !b.phase.fresh && f0 > 0.0;
             let f1 = self.switch_value(kind, t1)?;
             if f1 > 0.0 {
                 return Ok((h, Post::None));
@@ -338,7 +345,7 @@ impl Driver {
                 .as_deref_mut()
                 .and_then(|c| c.bilateral.as_deref_mut())
                 .expect("bilateral");
-            b.pending = Some((kind, width, located));
+            b.phase.pending = Some((kind, width, located));
             return Ok((h_acc, Post::None));
         }
     }
@@ -348,13 +355,13 @@ impl Driver {
     pub(crate) fn bilateral_after_accept(&mut self) -> Result<(), FemError> {
         let c = self.contact.as_deref_mut().expect("contact");
         let b = c.bilateral.as_deref_mut().expect("bilateral");
-        b.friction_work += b.pending_work;
-        b.pending_work = 0.0;
-        if b.sticking {
-            b.step_lambda_t = b.lt_eval;
+        b.record.friction_work += b.constraint.pending_work;
+        b.constraint.pending_work = 0.0;
+        if b.phase.sticking {
+            b.constraint.step_lambda_t = b.constraint.lt_eval;
         }
-        b.fresh = false;
-        let Some((kind, _width, located)) = b.pending.take() else {
+        b.phase.fresh = false;
+        let Some((kind, _width, located)) = b.phase.pending.take() else {
             return self.record_state();
         };
         self.apply_switch(kind, located)?;
@@ -371,30 +378,30 @@ impl Driver {
         let vt_tol = STICK_VT_TOL * self.length_scale;
         let c = self.contact.as_deref_mut().expect("contact");
         let b = c.bilateral.as_deref_mut().expect("bilateral");
-        let mu = b.mu;
-        b.fresh = true;
+        let mu = b.constraint.mu;
+        b.phase.fresh = true;
         let moving = !located && held.vt.abs() > vt_tol;
         let stick =
             kind == Switch::SlipStop && !moving && held.lambda_t.abs() <= mu * held.lambda_n.abs();
         if moving && kind == Switch::SlipStop {
-            b.slip_dir = sign(held.vt);
-            b.reversals += 1;
+            b.phase.slip_dir = sign(held.vt);
+            b.record.reversals += 1;
         } else if stick {
-            b.sticking = true;
-            b.stick_point = held.tip;
-            b.stick_tangent = held.tangent;
-            b.step_lambda_t = held.lambda_t;
+            b.phase.sticking = true;
+            b.constraint.stick_point = held.tip;
+            b.constraint.stick_tangent = held.tangent;
+            b.constraint.step_lambda_t = held.lambda_t;
         } else {
             let s = -sign(held.lambda_t);
-            if kind == Switch::SlipStop && s != b.slip_dir {
-                b.reversals += 1;
+            if kind == Switch::SlipStop && s != b.phase.slip_dir {
+                b.record.reversals += 1;
             }
-            b.slip_dir = s;
-            b.sticking = false;
+            b.phase.slip_dir = s;
+            b.phase.sticking = false;
         }
         if kind == Switch::Breakaway || stick {
-            c.n_events += 1;
-            c.events.push(Event::StickSlip {
+            c.record.n_events += 1;
+            c.record.events.push(Event::StickSlip {
                 t,
                 contact: 1,
                 sticking: stick,

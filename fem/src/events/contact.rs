@@ -162,7 +162,7 @@ pub mod friction;
 
 use data::Event;
 use data::Scene;
-use data::scene::{ContactMode, Surface};
+use data::scene::Surface;
 
 use crate::chain::{Chain, MAX_LINKS, Parts};
 use crate::error::FemError;
@@ -188,116 +188,88 @@ pub const GRAZING_FORCE_LIMIT: f64 = 1e-2;
 /// Diagnostic location of that stop.
 pub const GRAZING_LOCATION: &str = "contact1 (grazing)";
 
-/// Refuses contact features this backend does not model, with a precise message.
-pub fn check(scene: &Scene) -> Result<(), FemError> {
-    if scene.contacts.len() > 1 {
-        return Err(FemError::unsupported(format!(
-            "fem: {} contacts in scene `{}`; one tip contact is implemented",
-            scene.contacts.len(),
-            scene.name
-        )));
-    }
-    let Some(c) = scene.contacts.first() else {
-        return Ok(());
-    };
-    // Bilateral contacts (line or circle, with or without friction): `crate::events::contact::friction`.
-    let bilateral = c.mode == ContactMode::Bilateral;
-    crate::events::contact::friction::check(scene)?;
-    if let (false, Surface::Circle { .. }) = (bilateral, &c.surface) {
-        return Err(FemError::unsupported(format!(
-            "fem: unilateral contact with a circular surface (scene `{}`) is not implemented; \
-             unilateral contact is implemented for a straight line, circles for bilateral \
-             contacts",
-            scene.name
-        )));
-    }
-    if !bilateral && c.friction != 0.0 {
-        return Err(FemError::unsupported(format!(
-            "fem: Coulomb friction (μ = {}) in a unilateral contact (scene `{}`) is not \
-             implemented (impacts with friction); friction is implemented for bilateral contacts",
-            c.friction, scene.name
-        )));
-    }
-    if let Some(i) = scene
-        .links
-        .iter()
-        .position(|l| l.joint.prescribed.is_some())
-    {
-        return Err(FemError::unsupported(format!(
-            "fem: contact combined with prescribed joint motion (link {}) is not implemented",
-            i + 1
-        )));
-    }
-    if let Some(i) = scene
-        .links
-        .iter()
-        .position(|l| l.shear && !l.rotary_inertia && l.kelvin_voigt.unwrap_or(0.0) <= 0.0)
-    {
-        return Err(FemError::unsupported(format!(
-            "fem: contact with Timoshenko link {} (`{}`) without `rotary_inertia` and without \
-             Kelvin–Voigt damping: its section rotations are then algebraic (∂V/∂ψ = 0) and ψ̇ \
-             jumps with the massive velocities at an impact; that condensation is not \
-             implemented (only the damped case, where ψ̇ follows the massless balance \
-             Nᵀ(∂V/∂q + C q̇) = 0); set `kelvin_voigt` > 0 or `rotary_inertia`",
-            i + 1,
-            scene.links[i].name
-        )));
-    }
-    if !scene.links.iter().any(|l| l.name == c.link) {
-        return Err(FemError::InvalidSettings {
-            field: "contact.link".into(),
-            message: format!("no link named `{}`", c.link),
-        });
-    }
-    Ok(())
-}
-
-/// The tip contact: geometry, phase, the quantities of the last evaluation and work buffers.
+/// The tip contact, in parts with one job each: the constraint (what a method consumes), the
+/// phase of the impact law, the record of the run, the scratch of the mass solves and, for a
+/// bilateral wall, the friction refinement.
 #[derive(Debug, Clone)]
 pub struct Contact {
+    /// Gap g, its gradient G and discrete gradient ∇̄g, the step multiplier: the rows a
+    /// constrained step adds to the method's equations ([`StepConstraint`]).
+    pub constraint: TipConstraint,
+    /// Phase and state of the impact law (held or free, normal force, gap and drift at the
+    /// current state) and the event tolerances.
+    pub phase: ImpactPhase,
+    /// Ledger terms, drift maxima and events of the run.
+    pub record: ContactRecord,
+    /// Mass factorization and buffers of the index-1 force, the impact map and the projection.
+    pub(crate) solve: ConstrainedSolve,
+    /// Bilateral contact (circle or line wall, Coulomb friction, stick–slip): None for the
+    /// unilateral line contact of this module.
+    pub bilateral: Option<Box<crate::events::contact::friction::Bilateral>>,
+}
+
+/// The constraint g(q) = n̂·(r_tip(q) − p₀) = 0 of a held phase, as a method consumes it: the
+/// surface, the gradient rows of the last evaluation and the Newton multiplier.
+#[derive(Debug, Clone)]
+pub struct TipConstraint {
     /// Link whose tip touches the line.
     pub link: usize,
     /// Unit normal to the free side and a point of the line.
     pub normal: [f64; 2],
     pub point: [f64; 2],
-    /// Tip on the surface (constrained phase).
-    pub constrained: bool,
-    /// Normal force at the current state (index-1 value; 0 in free flight).
-    pub lambda: f64,
     /// Multiplier of the last constrained step (its mean normal force), the Newton unknown.
     pub step_lambda: f64,
-    /// Gap and normal tip velocity G q̇ at the current state.
-    pub gap: f64,
-    pub normal_velocity: f64,
-    /// Cumulative kinetic energy lost in impacts (ledger `impact`).
-    pub impact_loss: f64,
-    /// Cumulative kinetic energy removed by the step-end velocity projections (ledger
-    /// `contact_projection`).
-    pub projection_loss: f64,
-    /// G q̇ at the end of the last constrained step before its projection (velocity drift).
-    pub drift_velocity: f64,
-    /// Largest |g| and |G q̇| at the ends of constrained steps (constraint drift).
-    pub max_gap: f64,
-    pub max_normal_velocity: f64,
-    /// Absolute event tolerances: gap \[length\] and normal force \[force\].
-    pub gap_tol: f64,
-    pub force_tol: f64,
-    /// Events since the driver last drained them, and the total count.
-    pub events: Vec<Event>,
-    pub n_events: usize,
-    /// A located release not yet reported: it is reported once the free motion after it has
-    /// been stepped, and withdrawn when the tip turns out not to leave the surface (module
-    /// docs, "Grazing").
-    pub(crate) pending_release: Option<Event>,
-    /// Bilateral contact (circle or line wall, Coulomb friction, stick–slip): None for the
-    /// unilateral line contact of this module.
-    pub bilateral: Option<Box<crate::events::contact::friction::Bilateral>>,
+    /// Tip Jacobian J = ∂r_tip/∂q (x rows, then y rows).
     pub(crate) jac: Vec<f64>,
     /// ∇g(q̄), ∇̄g, ∇g(q₁) and S⁻¹∇̄g of the constrained Newton iteration.
     pub(crate) g_mid: Vec<f64>,
     pub(crate) g_bar: Vec<f64>,
     pub(crate) g_end: Vec<f64>,
     pub(crate) s_inv_g: Vec<f64>,
+}
+
+/// State of the plastic impact law: phase, index-1 normal force, gap and normal velocity at the
+/// current state, and the absolute tolerances the driver locates events with.
+#[derive(Debug, Clone)]
+pub struct ImpactPhase {
+    /// Tip on the surface (constrained phase).
+    pub constrained: bool,
+    /// Normal force at the current state (index-1 value; 0 in free flight).
+    pub lambda: f64,
+    /// Gap and normal tip velocity G q̇ at the current state.
+    pub gap: f64,
+    pub normal_velocity: f64,
+    /// G q̇ at the end of the last constrained step before its projection (velocity drift).
+    pub drift_velocity: f64,
+    /// Absolute event tolerances: gap \[length\] and normal force \[force\].
+    pub gap_tol: f64,
+    pub force_tol: f64,
+    /// A located release not yet reported: it is reported once the free motion after it has
+    /// been stepped, and withdrawn when the tip turns out not to leave the surface (module
+    /// docs, "Grazing").
+    pub(crate) pending_release: Option<Event>,
+}
+
+/// What the run records of the contact: ledger terms, drift maxima, events.
+#[derive(Debug, Clone)]
+pub struct ContactRecord {
+    /// Cumulative kinetic energy lost in impacts (ledger `impact`).
+    pub impact_loss: f64,
+    /// Cumulative kinetic energy removed by the step-end velocity projections (ledger
+    /// `contact_projection`).
+    pub projection_loss: f64,
+    /// Largest |g| and |G q̇| at the ends of constrained steps (constraint drift).
+    pub max_gap: f64,
+    pub max_normal_velocity: f64,
+    /// Events since the driver last drained them, and the total count.
+    pub events: Vec<Event>,
+    pub n_events: usize,
+}
+
+/// Scratch of the solves with the mass matrix: M(q) + μNNᵀ factorized, the massless balances
+/// and the work vectors of the index-1 force, the impact map and the velocity projection.
+#[derive(Debug, Clone)]
+pub(crate) struct ConstrainedSolve {
     /// M(q) + μNNᵀ, sparse ([`crate::events::mass_solve`]).
     mass: MassSolver,
     /// Exactly massless directions N (Timoshenko sections without rotary inertia, see
@@ -320,7 +292,7 @@ pub struct Contact {
 impl Contact {
     /// The scene's tip contact on `chain` (None without one; nothing is allocated then).
     pub fn from_scene(scene: &Scene, chain: &Chain) -> Result<Option<Self>, FemError> {
-        check(scene)?;
+        crate::support::check_contact(scene)?;
         let Some(c) = scene.contacts.first() else {
             return Ok(None);
         };
@@ -358,40 +330,48 @@ impl Contact {
         let massless = Massless::new(chain);
         let reg_dirs = chain.massless_directions();
         Ok(Some(Contact {
-            link,
-            normal: [normal[0] / len, normal[1] / len],
-            point,
-            constrained: false,
-            lambda: 0.0,
-            step_lambda: 0.0,
-            gap: 0.0,
-            normal_velocity: 0.0,
-            impact_loss: 0.0,
-            projection_loss: 0.0,
-            drift_velocity: 0.0,
-            max_gap: 0.0,
-            max_normal_velocity: 0.0,
-            gap_tol: GAP_TOL * l_max,
-            force_tol: FORCE_TOL * weight,
-            events: Vec::new(),
-            n_events: 0,
-            pending_release: None,
+            constraint: TipConstraint {
+                link,
+                normal: [normal[0] / len, normal[1] / len],
+                point,
+                step_lambda: 0.0,
+                jac: vec![0.0; 2 * n],
+                g_mid: z.clone(),
+                g_bar: z.clone(),
+                g_end: z.clone(),
+                s_inv_g: z.clone(),
+            },
+            phase: ImpactPhase {
+                constrained: false,
+                lambda: 0.0,
+                gap: 0.0,
+                normal_velocity: 0.0,
+                drift_velocity: 0.0,
+                gap_tol: GAP_TOL * l_max,
+                force_tol: FORCE_TOL * weight,
+                pending_release: None,
+            },
+            record: ContactRecord {
+                impact_loss: 0.0,
+                projection_loss: 0.0,
+                max_gap: 0.0,
+                max_normal_velocity: 0.0,
+                events: Vec::new(),
+                n_events: 0,
+            },
+            solve: ConstrainedSolve {
+                mass: MassSolver::new(chain, &reg_dirs),
+                massless,
+                reg_dirs,
+                mass_scale: 0.0,
+                qd_c: z.clone(),
+                zero: z.clone(),
+                unit: z.clone(),
+                col: z.clone(),
+                minv_gt: z.clone(),
+                tmp: z,
+            },
             bilateral,
-            jac: vec![0.0; 2 * n],
-            g_mid: z.clone(),
-            g_bar: z.clone(),
-            g_end: z.clone(),
-            s_inv_g: z.clone(),
-            mass: MassSolver::new(chain, &reg_dirs),
-            massless,
-            reg_dirs,
-            mass_scale: 0.0,
-            qd_c: z.clone(),
-            zero: z.clone(),
-            unit: z.clone(),
-            col: z.clone(),
-            minv_gt: z.clone(),
-            tmp: z,
         }))
     }
 
@@ -399,27 +379,28 @@ impl Contact {
     pub fn gap_at(&self, chain: &Chain, t: f64, q: &[f64]) -> f64 {
         let mut tips = [[0.0; 2]; MAX_LINKS];
         chain.tip_positions(t, q, &mut tips[..chain.links.len()]);
-        self.gap_of(tips[self.link])
+        self.gap_of(tips[self.constraint.link])
     }
 
     fn gap_of(&self, r: [f64; 2]) -> f64 {
         if let Some(b) = self.bilateral.as_deref() {
-            return b.wall.gap(r);
+            return b.constraint.wall.gap(r);
         }
-        self.normal[0] * (r[0] - self.point[0]) + self.normal[1] * (r[1] - self.point[1])
+        self.constraint.normal[0] * (r[0] - self.constraint.point[0])
+            + self.constraint.normal[1] * (r[1] - self.constraint.point[1])
     }
 
     /// Gap and its gradient G = n̂ᵀJ at q, the gradient written to `out`.
     pub fn gradient(&mut self, chain: &Chain, t: f64, q: &[f64], out: &mut [f64]) -> f64 {
         let n = chain.ndof;
-        let r = chain.tip_jacobian(t, self.link, q, &mut self.jac);
+        let r = chain.tip_jacobian(t, self.constraint.link, q, &mut self.constraint.jac);
         // A circle's normal is that at the tip (crate::events::wall); a line's is fixed.
         let normal = match self.bilateral.as_deref() {
-            Some(b) => b.wall.frame(r).normal,
-            None => self.normal,
+            Some(b) => b.constraint.wall.frame(r).normal,
+            None => self.constraint.normal,
         };
         for i in 0..n {
-            out[i] = normal[0] * self.jac[i] + normal[1] * self.jac[n + i];
+            out[i] = normal[0] * self.constraint.jac[i] + normal[1] * self.constraint.jac[n + i];
         }
         self.gap_of(r)
     }
@@ -429,18 +410,25 @@ impl Contact {
     fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<usize, FemError> {
         let n = chain.ndof;
         let mut passes = 0;
-        if !self.reg_dirs.is_empty() && self.mass_scale == 0.0 {
+        if !self.solve.reg_dirs.is_empty() && self.solve.mass_scale == 0.0 {
             // μ: the largest diagonal mass (any positive scale works on the exact directions;
             // module docs), from n mass products once per run.
             for j in 0..n {
-                self.unit[j] = 1.0;
-                chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
-                self.unit[j] = 0.0;
-                self.mass_scale = self.mass_scale.max(self.col[j].abs());
+                self.solve.unit[j] = 1.0;
+                chain.residual_parts(
+                    t,
+                    q,
+                    &self.solve.zero,
+                    &self.solve.unit,
+                    Parts::INERTIA,
+                    &mut self.solve.col,
+                );
+                self.solve.unit[j] = 0.0;
+                self.solve.mass_scale = self.solve.mass_scale.max(self.solve.col[j].abs());
             }
             passes += n;
         }
-        Ok(passes + self.mass.factor(chain, t, q, self.mass_scale)?)
+        Ok(passes + self.solve.mass.factor(chain, t, q, self.solve.mass_scale)?)
     }
 
     /// Makes `qd` consistent with the massless balances Nᵀ R(q, q̇, 0) = 0 by changing it along
@@ -454,7 +442,7 @@ impl Contact {
         q: &[f64],
         qd: &mut [f64],
     ) -> Result<usize, FemError> {
-        match self.massless.as_mut() {
+        match self.solve.massless.as_mut() {
             Some(ml) => ml.make_consistent(chain, t, q, qd),
             None => Ok(0),
         }
@@ -470,11 +458,11 @@ impl Contact {
         qd: &[f64],
     ) -> Result<(f64, f64, usize), FemError> {
         let mut n = self.factor_mass(chain, t, q)?;
-        let mut g_row = std::mem::take(&mut self.g_end);
-        self.gap = self.gradient(chain, t, q, &mut g_row);
-        self.minv_gt.copy_from_slice(&g_row);
-        self.mass.solve_in_place(&mut self.minv_gt);
-        let gmg = dot(&g_row, &self.minv_gt);
+        let mut g_row = std::mem::take(&mut self.constraint.g_end);
+        self.phase.gap = self.gradient(chain, t, q, &mut g_row);
+        self.solve.minv_gt.copy_from_slice(&g_row);
+        self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
+        let gmg = dot(&g_row, &self.solve.minv_gt);
         // The force of the constrained dynamics at the velocity it allows: q̇ projected onto
         // G q̇ = 0 (the plastic projection applied after every constrained step, module docs),
         // and, with massless directions, made consistent with their balances (the stepper's
@@ -482,24 +470,24 @@ impl Contact {
         // step end otherwise entered λ through the velocity terms: measured up to 9.6 lbf
         // between the end of a step and its projected state (`barhorst-case1-tipmass`), a
         // jump that the release location then met at a bracket of 4e-14 s.
-        let mut qd_c = std::mem::take(&mut self.qd_c);
+        let mut qd_c = std::mem::take(&mut self.solve.qd_c);
         qd_c.copy_from_slice(qd);
         let vn = dot(&g_row, &qd_c);
         for i in 0..qd_c.len() {
-            qd_c[i] -= self.minv_gt[i] * vn / gmg;
+            qd_c[i] -= self.solve.minv_gt[i] * vn / gmg;
         }
         n += self.make_consistent(chain, t, q, &mut qd_c)?;
         let qd = &qd_c[..];
         // R(q, q̇, 0): everything but the inertia of q̈.
-        chain.residual(t, q, qd, &self.zero, &mut self.tmp);
-        self.mass.solve_in_place(&mut self.tmp);
-        let [_, _, a] = chain.tip_motion(t, self.link, q, qd, &self.zero);
+        chain.residual(t, q, qd, &self.solve.zero, &mut self.solve.tmp);
+        self.solve.mass.solve_in_place(&mut self.solve.tmp);
+        let [_, _, a] = chain.tip_motion(t, self.constraint.link, q, qd, &self.solve.zero);
         // The normal velocity of the state itself (the drift, before any projection).
-        self.normal_velocity = vn;
-        let conv = self.normal[0] * a[0] + self.normal[1] * a[1];
-        let lambda = (dot(&g_row, &self.tmp) - conv) / gmg;
-        self.g_end = g_row;
-        self.qd_c = qd_c;
+        self.phase.normal_velocity = vn;
+        let conv = self.constraint.normal[0] * a[0] + self.constraint.normal[1] * a[1];
+        let lambda = (dot(&g_row, &self.solve.tmp) - conv) / gmg;
+        self.constraint.g_end = g_row;
+        self.solve.qd_c = qd_c;
         Ok((lambda, gmg, n + 2))
     }
 
@@ -517,8 +505,8 @@ impl Contact {
         // neither the kinetic energy nor G q̇).
         self.make_consistent(chain, t, q, qd)?;
         self.factor_mass(chain, t, q)?;
-        let mut g_row = std::mem::take(&mut self.g_end);
-        self.gap = self.gradient(chain, t, q, &mut g_row);
+        let mut g_row = std::mem::take(&mut self.constraint.g_end);
+        self.phase.gap = self.gradient(chain, t, q, &mut g_row);
         let v_before = dot(&g_row, qd);
         // A normal velocity at the round-off level of G q̇ is no impact.
         let roundoff = 1e-14
@@ -528,16 +516,16 @@ impl Contact {
                 .map(|(g, v)| (g * v).abs())
                 .sum::<f64>();
         if v_before >= -roundoff {
-            self.g_end = g_row;
+            self.constraint.g_end = g_row;
             return Ok(None);
         }
-        self.minv_gt.copy_from_slice(&g_row);
-        self.mass.solve_in_place(&mut self.minv_gt);
-        let gmg = dot(&g_row, &self.minv_gt);
+        self.solve.minv_gt.copy_from_slice(&g_row);
+        self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
+        let gmg = dot(&g_row, &self.solve.minv_gt);
         let impulse = -v_before / gmg;
         let velocity_before = qd.to_vec();
         for i in 0..n {
-            qd[i] += self.minv_gt[i] * impulse;
+            qd[i] += self.solve.minv_gt[i] * impulse;
         }
         // The massless balances hold after the jump too: Nᵀ C Δq̇ = 0 fixes its N-component
         // (zero kinetic energy, no mass product, no normal velocity).
@@ -546,24 +534,31 @@ impl Contact {
         // is the increment applied, M⁻¹GᵀΛ: the difference of the stored velocities would add
         // their rounding (|q̇|·1e-16), which dominates for grazing impacts with tiny Λ.
         for i in 0..n {
-            self.unit[i] = self.minv_gt[i] * impulse;
+            self.solve.unit[i] = self.solve.minv_gt[i] * impulse;
         }
-        chain.residual_parts(t, q, &self.zero, &self.unit, Parts::INERTIA, &mut self.col);
+        chain.residual_parts(
+            t,
+            q,
+            &self.solve.zero,
+            &self.solve.unit,
+            Parts::INERTIA,
+            &mut self.solve.col,
+        );
         // Massive-block balance: M Δq̇ − GᵀΛ ∈ span N, the N-part being −μN NᵀΔq̇ (module
         // docs; zero along the exactly massless directions).
-        self.tmp.copy_from_slice(&self.col);
-        for d in &self.reg_dirs {
-            let w: f64 = d.iter().map(|&(i, c)| c * self.unit[i]).sum();
+        self.solve.tmp.copy_from_slice(&self.solve.col);
+        for d in &self.solve.reg_dirs {
+            let w: f64 = d.iter().map(|&(i, c)| c * self.solve.unit[i]).sum();
             for &(i, c) in d {
-                self.tmp[i] += self.mass_scale * c * w;
+                self.solve.tmp[i] += self.solve.mass_scale * c * w;
             }
         }
-        self.unit.iter_mut().for_each(|x| *x = 0.0);
+        self.solve.unit.iter_mut().for_each(|x| *x = 0.0);
         let (mut res2, mut mom2) = (0.0, 0.0);
         for i in 0..n {
-            let r = self.tmp[i] - g_row[i] * impulse;
+            let r = self.solve.tmp[i] - g_row[i] * impulse;
             res2 += r * r;
-            mom2 += self.col[i] * self.col[i];
+            mom2 += self.solve.col[i] * self.solve.col[i];
         }
         let momentum_residual = if mom2 > 0.0 {
             (res2 / mom2).sqrt()
@@ -578,9 +573,9 @@ impl Contact {
         // closure to 4.7e-5 when the formula was booked).
         let ke_before = chain.energies(t, q, &velocity_before)[0];
         let loss = ke_before - chain.energies(t, q, qd)[0];
-        self.impact_loss += loss;
-        self.normal_velocity = dot(&g_row, qd);
-        self.g_end = g_row;
+        self.record.impact_loss += loss;
+        self.phase.normal_velocity = dot(&g_row, qd);
+        self.constraint.g_end = g_row;
         Ok(Some(Event::Impact {
             t,
             contact: 1,
@@ -589,7 +584,7 @@ impl Contact {
             impulse,
             momentum_residual,
             normal_velocity_before: v_before,
-            normal_velocity_after: self.normal_velocity,
+            normal_velocity_after: self.phase.normal_velocity,
             kinetic_energy_lost: loss,
         }))
     }
@@ -607,37 +602,37 @@ impl Contact {
         inward_only: bool,
     ) -> Result<(f64, usize), FemError> {
         let passes = self.factor_mass(chain, t, q)?;
-        let mut g_row = std::mem::take(&mut self.g_end);
-        self.gap = self.gradient(chain, t, q, &mut g_row);
+        let mut g_row = std::mem::take(&mut self.constraint.g_end);
+        self.phase.gap = self.gradient(chain, t, q, &mut g_row);
         let vn = dot(&g_row, qd);
-        self.drift_velocity = vn;
+        self.phase.drift_velocity = vn;
         let mut loss = 0.0;
         if !inward_only || vn < 0.0 {
-            self.minv_gt.copy_from_slice(&g_row);
-            self.mass.solve_in_place(&mut self.minv_gt);
-            let gmg = dot(&g_row, &self.minv_gt);
+            self.solve.minv_gt.copy_from_slice(&g_row);
+            self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
+            let gmg = dot(&g_row, &self.solve.minv_gt);
             let ke0 = chain.energies(t, q, qd)[0];
             for i in 0..qd.len() {
-                qd[i] -= self.minv_gt[i] * vn / gmg;
+                qd[i] -= self.solve.minv_gt[i] * vn / gmg;
             }
             self.make_consistent(chain, t, q, qd)?;
             loss = ke0 - chain.energies(t, q, qd)[0];
         }
-        self.normal_velocity = dot(&g_row, qd);
-        self.g_end = g_row;
+        self.phase.normal_velocity = dot(&g_row, qd);
+        self.constraint.g_end = g_row;
         Ok((loss, passes))
     }
 
     /// Reports a pending release (the free motion after it was stepped).
     pub fn flush_pending(&mut self) {
-        if let Some(e) = self.pending_release.take() {
+        if let Some(e) = self.phase.pending_release.take() {
             self.push(e);
         }
     }
 
     pub(crate) fn push(&mut self, e: Event) {
-        self.n_events += 1;
-        self.events.push(e);
+        self.record.n_events += 1;
+        self.record.events.push(e);
     }
 }
 
@@ -651,11 +646,11 @@ impl StepConstraint for Contact {
     }
 
     fn multiplier(&self) -> f64 {
-        self.step_lambda
+        self.constraint.step_lambda
     }
 
     fn set_multiplier(&mut self, lambda: f64) {
-        self.step_lambda = lambda;
+        self.constraint.step_lambda = lambda;
     }
 
     fn add_force(&mut self, chain: &Chain, v: &ConstraintView<'_>, res: &mut [f64]) -> f64 {
@@ -665,8 +660,8 @@ impl StepConstraint for Contact {
         let (lambda, denom, g0) = (v.lambda, v.denom, v.g0);
         // Constraint force ∇̄g λ with ∇̄g the discrete gradient of the gap in the same
         // metric: Δqᵀ∇̄g = g(q₁) − g(q₀), so the constraint does no work.
-        let mut g_mid = std::mem::take(&mut c.g_mid);
-        let mut g_end = std::mem::take(&mut c.g_end);
+        let mut g_mid = std::mem::take(&mut c.constraint.g_mid);
+        let mut g_end = std::mem::take(&mut c.constraint.g_end);
         c.gradient(chain, t_mid, v.qbar, &mut g_mid);
         let gap1 = c.gradient(chain, t1, v.q1, &mut g_end);
         let gd = dot(&g_mid, v.dq);
@@ -676,11 +671,11 @@ impl StepConstraint for Contact {
             0.0
         };
         for i in 0..n {
-            c.g_bar[i] = g_mid[i] + corr_g * v.w_dq[i];
-            res[i] -= lambda * c.g_bar[i];
+            c.constraint.g_bar[i] = g_mid[i] + corr_g * v.w_dq[i];
+            res[i] -= lambda * c.constraint.g_bar[i];
         }
-        c.g_mid = g_mid;
-        c.g_end = g_end;
+        c.constraint.g_mid = g_mid;
+        c.constraint.g_end = g_end;
         if c.bilateral.is_some() {
             // Friction (sliding) or the tangential stick constraint: crate::events::contact::friction.
             return crate::events::contact::friction::midpoint_terms(c, chain, v, gap1, res);
@@ -704,17 +699,17 @@ impl StepConstraint for Contact {
         let n = res.len();
         // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (h²/2) ∇g(q₁)·δa = g(q₁)
         // (∂q₁/∂a = h²/2), by the Schur complement with two solves of S.
-        newton.delta.copy_from_slice(&c.g_bar);
+        newton.delta.copy_from_slice(&c.constraint.g_bar);
         newton.solve();
-        c.s_inv_g.copy_from_slice(&newton.delta);
+        c.constraint.s_inv_g.copy_from_slice(&newton.delta);
         newton.delta.copy_from_slice(res);
         newton.solve();
         let half_h2 = 0.5 * h * h;
-        let cx = half_h2 * dot(&c.g_end, &newton.delta);
-        let cy = half_h2 * dot(&c.g_end, &c.s_inv_g);
+        let cx = half_h2 * dot(&c.constraint.g_end, &newton.delta);
+        let cy = half_h2 * dot(&c.constraint.g_end, &c.constraint.s_inv_g);
         let dlambda = (gap1 - gap_target - cx) / cy;
         for i in 0..n {
-            newton.delta[i] += c.s_inv_g[i] * dlambda;
+            newton.delta[i] += c.constraint.s_inv_g[i] * dlambda;
         }
         dlambda
     }

@@ -103,59 +103,6 @@ pub const STICK_VT_TOL: f64 = 1e-8;
 /// Shortest trial step of the event location, relative to the step being located.
 pub const MIN_TRIAL: f64 = 1e-3;
 
-/// Refuses what the bilateral contact does not model (called from [`crate::events::contact::check`]).
-pub fn check(scene: &Scene) -> Result<(), FemError> {
-    let Some(c) = scene.contacts.first() else {
-        return Ok(());
-    };
-    if c.mode != ContactMode::Bilateral {
-        return Ok(());
-    }
-    if !(c.friction >= 0.0 && c.friction.is_finite()) {
-        return Err(FemError::InvalidSettings {
-            field: "contact.friction".into(),
-            message: format!("the friction coefficient must be ≥ 0, got {}", c.friction),
-        });
-    }
-    if let Some(i) = scene
-        .links
-        .iter()
-        .position(|l| l.shear && !l.rotary_inertia)
-    {
-        // The index-1 normal and held-tip forces and the Coulomb test use M⁻¹; the unilateral
-        // contact's condensation of massless sections is not carried over to the bilateral
-        // wall.
-        return Err(FemError::unsupported(format!(
-            "fem: bilateral (friction) contact with Timoshenko link {} (`{}`) without \
-             `rotary_inertia`: its section rotations carry no mass, so M is singular and the \
-             index-1 wall forces (G M⁻¹Gᵀ, G M⁻¹Tᵀ, T M⁻¹Tᵀ) are undefined; set \
-             `rotary_inertia = true` with `rotary_inertia_per_length`",
-            i + 1,
-            scene.links[i].name
-        )));
-    }
-    if let (Some(l), Surface::Circle { center, radius }) =
-        (scene.links.iter().find(|l| l.name == c.link), &c.surface)
-    {
-        let first = scene.links.first().is_some_and(|f| f.name == l.name);
-        let tol = 1e-12 * l.length;
-        if first
-            && !l.axial
-            && center[0].hypot(center[1]) <= tol
-            && (radius - l.length).abs() <= tol
-        {
-            return Err(FemError::unsupported(format!(
-                "fem: bilateral circle of radius L about the hub for the inextensible link `{}` \
-                 (simple flexure): its tip can stay at radius L only while the link is straight, \
-                 so the model degenerates to the rigid link (constraint gradient zero, normal \
-                 force undetermined); use `axial = true` (Euler model) or the rigid closed form",
-                l.name
-            )));
-        }
-    }
-    Ok(())
-}
-
 /// The `describe` line of a bilateral contact (None otherwise).
 pub fn describe(scene: &Scene) -> Option<String> {
     let c = scene.contacts.first()?;
@@ -209,21 +156,75 @@ pub(crate) struct Forces {
     pub(crate) gmt: f64,
 }
 
-/// State of the bilateral (friction) contact; lives in [`Contact::bilateral`].
+/// State of the bilateral (friction) contact; lives in [`Contact::bilateral`]. Parts as in
+/// [`Contact`]: the constraint rows a step consumes, the friction phase, the record of the run
+/// and the scratch of the index-1 wall forces.
 #[derive(Debug, Clone)]
 pub struct Bilateral {
+    /// The wall, the Coulomb coefficient and the rows and multipliers of a step.
+    pub constraint: WallConstraint,
+    /// Stick or slide, its direction, the wall forces at the current state and the switch
+    /// bookkeeping of the event location.
+    pub phase: FrictionPhase,
+    /// Friction work, switch counters and stick drift maxima of the run.
+    pub record: FrictionRecord,
+    /// M(q) factorized and the M⁻¹ products of the index-1 wall forces.
+    pub(crate) solve: WallSolve,
+}
+
+/// The wall constraint as a step consumes it: normal row G and, while sticking, the
+/// tangential row H of t̂_s·(r_tip − p_s) = 0, their discrete gradients and multipliers, and
+/// the Coulomb term of a sliding step.
+#[derive(Debug, Clone)]
+pub struct WallConstraint {
     pub wall: Wall,
     pub mu: f64,
+    /// Stick point p_s and tangent t̂_s of the held tip.
+    pub stick_point: [f64; 2],
+    pub stick_tangent: [f64; 2],
+    /// Tangential multiplier of the last accepted stick step (Newton predictor).
+    pub(crate) step_lambda_t: f64,
+    /// Tangential multiplier of the current Newton iterate, that of the last residual
+    /// evaluation, and the Newton increment not yet applied.
+    pub(crate) lt_iter: f64,
+    pub(crate) lt_eval: f64,
+    pub(crate) dlt_pending: f64,
+    /// g(q₁) and h(q₁) of the last residual evaluation.
+    pub(crate) g1: f64,
+    pub(crate) h1: f64,
+    /// Friction work of the step being solved (booked when it is accepted).
+    pub(crate) pending_work: f64,
+    pub(crate) jac: Vec<f64>,
+    pub(crate) g_row: Vec<f64>,
+    pub(crate) t_row: Vec<f64>,
+    pub(crate) h_bar: Vec<f64>,
+    pub(crate) h_end: Vec<f64>,
+    pub(crate) s_inv_h: Vec<f64>,
+}
+
+/// Phase of the Coulomb law: stick or slide, sliding direction, the wall forces at the
+/// current state and what the event location carries between trials.
+#[derive(Debug, Clone)]
+pub struct FrictionPhase {
     pub sticking: bool,
     /// Sliding direction s = ±1 along t̂.
     pub slip_dir: f64,
     /// Sign of λ used in the friction term of the current step.
     pub sigma: f64,
-    pub stick_point: [f64; 2],
-    pub stick_tangent: [f64; 2],
     /// Tangential force along t̂ and slip velocity v_t at the current state.
     pub friction_force: f64,
     pub slip_velocity: f64,
+    /// Switch found by the last trial: kind, bracket width, located inside the step.
+    pub(crate) pending: Option<(Switch, f64, bool)>,
+    /// Event function at the start of the current step.
+    pub(crate) e0: f64,
+    /// The current step is the first of its phase (not shortened by an event; module docs).
+    pub(crate) fresh: bool,
+}
+
+/// What the run records of the friction contact.
+#[derive(Debug, Clone)]
+pub struct FrictionRecord {
     /// Cumulative friction work (ledger `friction`).
     pub friction_work: f64,
     /// Slip reversals (v_t crossed zero and the cone test sent the tip back, no stick).
@@ -235,26 +236,11 @@ pub struct Bilateral {
     pub max_stick_velocity: f64,
     /// Smallest (G M⁻¹Gᵀ − μ|G M⁻¹Tᵀ|)/(G M⁻¹Gᵀ) met while sliding (Painlevé margin).
     pub min_painleve_margin: f64,
-    /// Tangential multiplier of the last accepted stick step (Newton predictor).
-    pub(crate) step_lambda_t: f64,
-    pub(crate) lt_iter: f64,
-    pub(crate) lt_eval: f64,
-    pub(crate) dlt_pending: f64,
-    pub(crate) g1: f64,
-    pub(crate) h1: f64,
-    pub(crate) pending_work: f64,
-    /// Switch found by the last trial: kind, bracket width, located inside the step.
-    pub(crate) pending: Option<(Switch, f64, bool)>,
-    /// Event function at the start of the current step.
-    pub(crate) e0: f64,
-    /// The current step is the first of its phase (not shortened by an event; module docs).
-    pub(crate) fresh: bool,
-    pub(crate) jac: Vec<f64>,
-    pub(crate) g_row: Vec<f64>,
-    pub(crate) t_row: Vec<f64>,
-    pub(crate) h_bar: Vec<f64>,
-    pub(crate) h_end: Vec<f64>,
-    pub(crate) s_inv_h: Vec<f64>,
+}
+
+/// Scratch of the index-1 wall forces: M(q) factorized and the products M⁻¹Gᵀ, M⁻¹Tᵀ, M⁻¹R.
+#[derive(Debug, Clone)]
+pub(crate) struct WallSolve {
     pub(crate) minv_g: Vec<f64>,
     pub(crate) minv_t: Vec<f64>,
     pub(crate) minv_r: Vec<f64>,
@@ -279,54 +265,62 @@ impl Bilateral {
         let wall = Wall::from_surface(&c.surface)?;
         let z = vec![0.0; n];
         Ok(Some(Box::new(Bilateral {
-            wall,
-            mu: c.friction,
-            sticking: false,
-            slip_dir: 1.0,
-            sigma: 1.0,
-            stick_point: [0.0; 2],
-            stick_tangent: [0.0; 2],
-            friction_force: 0.0,
-            slip_velocity: 0.0,
-            friction_work: 0.0,
-            reversals: 0,
-            inconsistent_slides: 0,
-            max_stick_offset: 0.0,
-            max_stick_velocity: 0.0,
-            min_painleve_margin: f64::INFINITY,
-            step_lambda_t: 0.0,
-            lt_iter: 0.0,
-            lt_eval: 0.0,
-            dlt_pending: 0.0,
-            g1: 0.0,
-            h1: 0.0,
-            pending_work: 0.0,
-            pending: None,
-            e0: 0.0,
-            fresh: true,
-            jac: vec![0.0; 2 * n],
-            g_row: z.clone(),
-            t_row: z.clone(),
-            h_bar: z.clone(),
-            h_end: z.clone(),
-            s_inv_h: z.clone(),
-            minv_g: z.clone(),
-            minv_t: z.clone(),
-            minv_r: z.clone(),
-            mass: MassSolver::new(chain, &[]),
-            zero: z,
+            constraint: WallConstraint {
+                wall,
+                mu: c.friction,
+                stick_point: [0.0; 2],
+                stick_tangent: [0.0; 2],
+                step_lambda_t: 0.0,
+                lt_iter: 0.0,
+                lt_eval: 0.0,
+                dlt_pending: 0.0,
+                g1: 0.0,
+                h1: 0.0,
+                pending_work: 0.0,
+                jac: vec![0.0; 2 * n],
+                g_row: z.clone(),
+                t_row: z.clone(),
+                h_bar: z.clone(),
+                h_end: z.clone(),
+                s_inv_h: z.clone(),
+            },
+            phase: FrictionPhase {
+                sticking: false,
+                slip_dir: 1.0,
+                sigma: 1.0,
+                friction_force: 0.0,
+                slip_velocity: 0.0,
+                pending: None,
+                e0: 0.0,
+                fresh: true,
+            },
+            record: FrictionRecord {
+                friction_work: 0.0,
+                reversals: 0,
+                inconsistent_slides: 0,
+                max_stick_offset: 0.0,
+                max_stick_velocity: 0.0,
+                min_painleve_margin: f64::INFINITY,
+            },
+            solve: WallSolve {
+                minv_g: z.clone(),
+                minv_t: z.clone(),
+                minv_r: z.clone(),
+                mass: MassSolver::new(chain, &[]),
+                zero: z,
+            },
         })))
     }
 
     /// Whether the contact has Coulomb friction (and hence stick–slip).
     pub fn has_friction(&self) -> bool {
-        self.mu > 0.0
+        self.constraint.mu > 0.0
     }
 
     /// M(q) assembled sparsely and factorized ([`crate::events::mass_solve`]; reused at the
     /// same (t, q)).
     fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<(), FemError> {
-        self.mass.factor(chain, t, q, 0.0).map(|_| ())
+        self.solve.mass.factor(chain, t, q, 0.0).map(|_| ())
     }
 
     /// Index-1 forces at (q, q̇) (module docs): the held-tip pair when `held`, else the sliding
@@ -341,25 +335,30 @@ impl Bilateral {
         held: bool,
     ) -> Result<Forces, FemError> {
         self.factor_mass(chain, t, q)?;
-        let r = chain.tip_jacobian(t, link, q, &mut self.jac);
-        let f = self.wall.frame(r);
-        rows(&f, &self.jac, &mut self.g_row, &mut self.t_row);
-        self.minv_g.copy_from_slice(&self.g_row);
-        self.mass.solve_in_place(&mut self.minv_g);
-        self.minv_t.copy_from_slice(&self.t_row);
-        self.mass.solve_in_place(&mut self.minv_t);
-        chain.residual(t, q, qd, &self.zero, &mut self.minv_r);
-        self.mass.solve_in_place(&mut self.minv_r);
-        let [_, v, a] = chain.tip_motion(t, link, q, qd, &self.zero);
+        let r = chain.tip_jacobian(t, link, q, &mut self.constraint.jac);
+        let f = self.constraint.wall.frame(r);
+        rows(
+            &f,
+            &self.constraint.jac,
+            &mut self.constraint.g_row,
+            &mut self.constraint.t_row,
+        );
+        self.solve.minv_g.copy_from_slice(&self.constraint.g_row);
+        self.solve.mass.solve_in_place(&mut self.solve.minv_g);
+        self.solve.minv_t.copy_from_slice(&self.constraint.t_row);
+        self.solve.mass.solve_in_place(&mut self.solve.minv_t);
+        chain.residual(t, q, qd, &self.solve.zero, &mut self.solve.minv_r);
+        self.solve.mass.solve_in_place(&mut self.solve.minv_r);
+        let [_, v, a] = chain.tip_motion(t, link, q, qd, &self.solve.zero);
         let vt = f.tangent[0] * v[0] + f.tangent[1] * v[1];
         let vn = f.normal[0] * v[0] + f.normal[1] * v[1];
         let conv_n = f.normal[0] * a[0] + f.normal[1] * a[1] - f.curvature * vt * vt;
         let conv_t = f.tangent[0] * a[0] + f.tangent[1] * a[1];
-        let gmg = dot(&self.g_row, &self.minv_g);
-        let gmt = dot(&self.g_row, &self.minv_t);
-        let tmt = dot(&self.t_row, &self.minv_t);
-        let rn = dot(&self.g_row, &self.minv_r) - conv_n;
-        let rt = dot(&self.t_row, &self.minv_r) - conv_t;
+        let gmg = dot(&self.constraint.g_row, &self.solve.minv_g);
+        let gmt = dot(&self.constraint.g_row, &self.solve.minv_t);
+        let tmt = dot(&self.constraint.t_row, &self.solve.minv_t);
+        let rn = dot(&self.constraint.g_row, &self.solve.minv_r) - conv_n;
+        let rt = dot(&self.constraint.t_row, &self.solve.minv_r) - conv_t;
         let mut out = Forces {
             vt,
             vn,
@@ -375,11 +374,15 @@ impl Bilateral {
             out.lambda_n = (tmt * rn - gmt * rt) / det;
             out.lambda_t = (gmg * rt - gmt * rn) / det;
         } else {
-            let m = self.mu * gmt.abs();
-            out.painleve = self.mu > 0.0 && gmg <= m;
-            let sigma = if rn == 0.0 { self.sigma } else { sign(rn) };
-            out.lambda_n = rn / (gmg - self.mu * self.slip_dir * sigma * gmt);
-            out.lambda_t = -self.mu * self.slip_dir * out.lambda_n.abs();
+            let m = self.constraint.mu * gmt.abs();
+            out.painleve = self.constraint.mu > 0.0 && gmg <= m;
+            let sigma = if rn == 0.0 {
+                self.phase.sigma
+            } else {
+                sign(rn)
+            };
+            out.lambda_n = rn / (gmg - self.constraint.mu * self.phase.slip_dir * sigma * gmt);
+            out.lambda_t = -self.constraint.mu * self.phase.slip_dir * out.lambda_n.abs();
         }
         if !(out.lambda_n.is_finite() && out.lambda_t.is_finite()) {
             return Err(FemError::Runaway {
@@ -408,69 +411,69 @@ pub(crate) fn midpoint_terms(
     gap1: f64,
     res: &mut [f64],
 ) -> f64 {
-    let link = c.link;
+    let link = c.constraint.link;
     let Some(b) = c.bilateral.as_deref_mut() else {
         return gap1;
     };
-    b.pending_work = 0.0;
-    if b.mu == 0.0 {
+    b.constraint.pending_work = 0.0;
+    if b.constraint.mu == 0.0 {
         return gap1;
     }
     let [t0, t_mid, t1] = v.t;
     let n = res.len();
-    let r = chain.tip_jacobian(t_mid, link, v.qbar, &mut b.jac);
-    if !b.sticking {
-        let f = b.wall.frame(r);
-        row_along(f.tangent, &b.jac, &mut b.t_row);
-        let k = b.mu * b.slip_dir * b.sigma;
+    let r = chain.tip_jacobian(t_mid, link, v.qbar, &mut b.constraint.jac);
+    if !b.phase.sticking {
+        let f = b.constraint.wall.frame(r);
+        row_along(f.tangent, &b.constraint.jac, &mut b.constraint.t_row);
+        let k = b.constraint.mu * b.phase.slip_dir * b.phase.sigma;
         for i in 0..n {
-            res[i] += k * v.lambda * b.t_row[i];
-            c.g_bar[i] -= k * b.t_row[i];
+            res[i] += k * v.lambda * b.constraint.t_row[i];
+            c.constraint.g_bar[i] -= k * b.constraint.t_row[i];
         }
-        b.pending_work = k * v.lambda * dot(v.dq, &b.t_row);
+        b.constraint.pending_work = k * v.lambda * dot(v.dq, &b.constraint.t_row);
         return gap1;
     }
     if v.it == 0 {
-        b.lt_iter = b.step_lambda_t;
+        b.constraint.lt_iter = b.constraint.step_lambda_t;
     } else {
-        b.lt_iter -= b.dlt_pending;
+        b.constraint.lt_iter -= b.constraint.dlt_pending;
     }
-    b.dlt_pending = 0.0;
-    b.lt_eval = b.lt_iter;
-    let ts = b.stick_tangent;
-    let ps = b.stick_point;
-    row_along(ts, &b.jac, &mut b.h_bar);
-    let r1 = chain.tip_jacobian(t1, link, v.q1, &mut b.jac);
-    row_along(ts, &b.jac, &mut b.h_end);
+    b.constraint.dlt_pending = 0.0;
+    b.constraint.lt_eval = b.constraint.lt_iter;
+    let ts = b.constraint.stick_tangent;
+    let ps = b.constraint.stick_point;
+    row_along(ts, &b.constraint.jac, &mut b.constraint.h_bar);
+    let r1 = chain.tip_jacobian(t1, link, v.q1, &mut b.constraint.jac);
+    row_along(ts, &b.constraint.jac, &mut b.constraint.h_end);
     let mut tips = [[0.0; 2]; MAX_LINKS];
     chain.tip_positions(t0, v.q0, &mut tips[..chain.links.len()]);
     let r0 = tips[link];
     let h0 = ts[0] * (r0[0] - ps[0]) + ts[1] * (r0[1] - ps[1]);
     let h1 = ts[0] * (r1[0] - ps[0]) + ts[1] * (r1[1] - ps[1]);
     let corr = if v.denom > 0.0 {
-        (h1 - h0 - dot(&b.h_bar, v.dq)) / v.denom
+        (h1 - h0 - dot(&b.constraint.h_bar, v.dq)) / v.denom
     } else {
         0.0
     };
     for i in 0..n {
-        b.h_bar[i] += corr * v.w_dq[i];
-        res[i] -= b.lt_iter * b.h_bar[i];
+        b.constraint.h_bar[i] += corr * v.w_dq[i];
+        res[i] -= b.constraint.lt_iter * b.constraint.h_bar[i];
     }
-    b.g1 = gap1;
-    b.h1 = h1;
+    b.constraint.g1 = gap1;
+    b.constraint.h1 = h1;
     if h1.abs() > gap1.abs() { h1 } else { gap1 }
 }
 
 /// Whether the contact is a sticking friction contact (two multipliers in Newton).
 pub(crate) fn sticking(c: &Contact) -> bool {
-    c.bilateral.as_deref().is_some_and(|b| b.sticking)
+    c.bilateral.as_deref().is_some_and(|b| b.phase.sticking)
 }
 
 /// Phase channel value: 2 sticking, 1 constrained (sliding), 0 free.
 pub fn phase(c: &Contact) -> f64 {
     if sticking(c) {
         2.0
-    } else if c.constrained {
+    } else if c.phase.constrained {
         1.0
     } else {
         0.0
@@ -490,27 +493,27 @@ pub(crate) fn stick_newton_update(
         return 0.0;
     };
     let n = res.len();
-    newton.delta.copy_from_slice(&c.g_bar);
+    newton.delta.copy_from_slice(&c.constraint.g_bar);
     newton.solve();
-    c.s_inv_g.copy_from_slice(&newton.delta);
-    newton.delta.copy_from_slice(&b.h_bar);
+    c.constraint.s_inv_g.copy_from_slice(&newton.delta);
+    newton.delta.copy_from_slice(&b.constraint.h_bar);
     newton.solve();
-    b.s_inv_h.copy_from_slice(&newton.delta);
+    b.constraint.s_inv_h.copy_from_slice(&newton.delta);
     newton.delta.copy_from_slice(res);
     newton.solve();
     let hh = 0.5 * h * h;
-    let a11 = hh * dot(&c.g_end, &c.s_inv_g);
-    let a12 = hh * dot(&c.g_end, &b.s_inv_h);
-    let a21 = hh * dot(&b.h_end, &c.s_inv_g);
-    let a22 = hh * dot(&b.h_end, &b.s_inv_h);
-    let r1 = b.g1 - hh * dot(&c.g_end, &newton.delta);
-    let r2 = b.h1 - hh * dot(&b.h_end, &newton.delta);
+    let a11 = hh * dot(&c.constraint.g_end, &c.constraint.s_inv_g);
+    let a12 = hh * dot(&c.constraint.g_end, &b.constraint.s_inv_h);
+    let a21 = hh * dot(&b.constraint.h_end, &c.constraint.s_inv_g);
+    let a22 = hh * dot(&b.constraint.h_end, &b.constraint.s_inv_h);
+    let r1 = b.constraint.g1 - hh * dot(&c.constraint.g_end, &newton.delta);
+    let r2 = b.constraint.h1 - hh * dot(&b.constraint.h_end, &newton.delta);
     let det = a11 * a22 - a12 * a21;
     let dn = (a22 * r1 - a12 * r2) / det;
     let dt = (a11 * r2 - a21 * r1) / det;
     for i in 0..n {
-        newton.delta[i] += c.s_inv_g[i] * dn + b.s_inv_h[i] * dt;
+        newton.delta[i] += c.constraint.s_inv_g[i] * dn + b.constraint.s_inv_h[i] * dt;
     }
-    b.dlt_pending = dt;
+    b.constraint.dlt_pending = dt;
     dn
 }
