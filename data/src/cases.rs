@@ -185,6 +185,33 @@ pub struct Case {
     pub suite: SuiteName,
 }
 
+impl Case {
+    /// Every settings table of the row with the backend that runs it: the row's own, its
+    /// ladders' rungs (run by the row's backend) and a reference backend's.
+    pub fn settings_for_backends(&self) -> Vec<(String, BackendKind, &CaseSettings)> {
+        let mut out = vec![("settings".to_string(), self.backend, &self.settings)];
+        let (name, rungs): (&str, &[CaseSettings]) = match &self.reference {
+            Reference::Backend {
+                backend, settings, ..
+            } => {
+                out.push(("reference.settings".to_string(), *backend, settings));
+                ("", &[])
+            }
+            Reference::Order { ladder, .. } => ("ladder", ladder),
+            Reference::Richardson { richardson } => ("richardson", richardson),
+            Reference::Monotone { decreasing, .. } => ("decreasing", decreasing),
+            Reference::Analytic { .. } | Reference::Zero { .. } => ("", &[]),
+        };
+        out.extend(
+            rungs
+                .iter()
+                .enumerate()
+                .map(|(k, rung)| (format!("reference.{name}[{k}]"), self.backend, rung)),
+        );
+        out
+    }
+}
+
 macro_rules! case_files {
     ($($name:literal),* $(,)?) => {
         /// (file name, TOML text) of every embedded case file.
@@ -263,6 +290,20 @@ pub fn parse_cases(text: &str, source_name: &str) -> Result<Vec<Case>, SceneErro
                 "a name from `flexverify scenes`",
             ));
         }
+        for (path, backend, settings) in c.settings_for_backends() {
+            if let Some(field) = settings.to_settings().unread_by(&[backend]).first() {
+                return Err(bad(
+                    &format!("{path}.{field}"),
+                    format!(
+                        "row `{}`: `{field}` applies to {}; the row's backend {backend} does not \
+                         read it",
+                        c.id,
+                        field.readers_text()
+                    ),
+                    "only settings the backend reads (see data::SettingField::readers)",
+                ));
+            }
+        }
         if file.cases[..i].iter().any(|o| o.id == c.id) {
             return Err(bad(
                 "id",
@@ -339,6 +380,26 @@ pub fn stability_cases() -> Result<Vec<StabilityCase>, SceneError> {
             expected: "a [[stability]] table as documented in data/src/cases.rs".into(),
         }
     })?;
+    for (i, c) in file.cases.iter().enumerate() {
+        if let Some(field) = c.settings.to_settings().unread_by(&c.backends).first() {
+            let names: Vec<&str> = c.backends.iter().map(|b| b.name()).collect();
+            let offset = text.find(&format!("id = \"{}\"", c.id)).unwrap_or(0);
+            let (line, column) = crate::error::line_column(text, offset);
+            return Err(SceneError {
+                source_name: "<cases>/stability.toml".into(),
+                line,
+                column,
+                path: format!("stability[{i}].settings.{field}"),
+                message: format!(
+                    "row `{}`: `{field}` applies to {}; none of the row's backends ({}) reads it",
+                    c.id,
+                    field.readers_text(),
+                    names.join(", ")
+                ),
+                expected: "only settings one of the backends reads".into(),
+            });
+        }
+    }
     Ok(file.cases)
 }
 

@@ -298,8 +298,29 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
 }
 
 impl CommonOpts {
-    /// Backend settings from the options.
-    pub fn settings(&self) -> data::Settings {
+    /// Backend settings from the options for the backends `kinds`; a flag that none of them
+    /// reads is refused (each backend then takes its own fields, [`data::Settings::for_backend`]).
+    pub fn settings_for(&self, kinds: &[data::BackendKind]) -> Result<data::Settings, String> {
+        let settings = self.settings();
+        match settings.unread_by(kinds).first() {
+            None => Ok(settings),
+            Some(field) => {
+                let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
+                let requested = match names.as_slice() {
+                    [one] => format!("the requested backend {one} does not"),
+                    many => format!("the requested backends {} do not", many.join(", ")),
+                };
+                Err(format!(
+                    "`{}` applies to {}; {requested} read it",
+                    field.flag(),
+                    field.readers_text()
+                ))
+            }
+        }
+    }
+
+    /// Backend settings from the options, unchecked.
+    fn settings(&self) -> data::Settings {
         data::Settings {
             discretization: data::Discretization {
                 elements: self.elements.map(|n| n as usize),
