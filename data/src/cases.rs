@@ -185,6 +185,14 @@ pub struct Case {
     pub suite: SuiteName,
 }
 
+/// How a case row spells `field` in a refusal (`method = NAME` for the method).
+fn case_key(field: crate::SettingField) -> &'static str {
+    match field {
+        crate::SettingField::Method => "method =",
+        other => other.key(),
+    }
+}
+
 impl Case {
     /// Every settings table of the row with the backend that runs it: the row's own, its
     /// ladders' rungs (run by the row's backend) and a reference backend's.
@@ -291,14 +299,15 @@ pub fn parse_cases(text: &str, source_name: &str) -> Result<Vec<Case>, SceneErro
             ));
         }
         for (path, backend, settings) in c.settings_for_backends() {
-            if let Some(field) = settings.to_settings().unread_by(&[backend]).first() {
+            let settings = settings.to_settings();
+            if let Some(&field) = settings.unread_by(&[backend]).first() {
+                let subject = format!("the row's backend {backend}");
                 return Err(bad(
                     &format!("{path}.{field}"),
                     format!(
-                        "row `{}`: `{field}` applies to {}; the row's backend {backend} does not \
-                         read it",
+                        "row `{}`: {}",
                         c.id,
-                        field.readers_text()
+                        settings.refusal(field, case_key(field), &subject, false)
                     ),
                     "only settings the backend reads (see data::SettingField::readers)",
                 ));
@@ -381,8 +390,10 @@ pub fn stability_cases() -> Result<Vec<StabilityCase>, SceneError> {
         }
     })?;
     for (i, c) in file.cases.iter().enumerate() {
-        if let Some(field) = c.settings.to_settings().unread_by(&c.backends).first() {
+        let settings = c.settings.to_settings();
+        if let Some(&field) = settings.unread_by(&c.backends).first() {
             let names: Vec<&str> = c.backends.iter().map(|b| b.name()).collect();
+            let subject = format!("the row's backends ({})", names.join(", "));
             let offset = text.find(&format!("id = \"{}\"", c.id)).unwrap_or(0);
             let (line, column) = crate::error::line_column(text, offset);
             return Err(SceneError {
@@ -391,10 +402,9 @@ pub fn stability_cases() -> Result<Vec<StabilityCase>, SceneError> {
                 column,
                 path: format!("stability[{i}].settings.{field}"),
                 message: format!(
-                    "row `{}`: `{field}` applies to {}; none of the row's backends ({}) reads it",
+                    "row `{}`: {}",
                     c.id,
-                    field.readers_text(),
-                    names.join(", ")
+                    settings.refusal(field, case_key(field), &subject, true)
                 ),
                 expected: "only settings one of the backends reads".into(),
             });

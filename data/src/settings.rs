@@ -159,6 +159,32 @@ impl Method {
     }
 }
 
+impl Method {
+    /// The backends that implement this method (a family may still refuse it, e.g. a method
+    /// without event location for a contact scene).
+    pub fn backends(self) -> &'static [BackendKind] {
+        use BackendKind::{Fdm, Fem, Modal};
+        match self {
+            Method::EnergyMidpoint | Method::GeneralizedAlpha | Method::ImplicitMidpoint => &[Fem],
+            Method::CentralDifference => &[Fem, Fdm],
+            Method::Report | Method::RobertAsselin { .. } | Method::VelocityForm => &[Fdm],
+            Method::Dopri5 | Method::TrBdf2 | Method::TrBdf2Fixed | Method::Trapezoid => &[Modal],
+        }
+    }
+
+    /// The spellings `backend` implements, for error messages.
+    pub fn names_for(backend: BackendKind) -> &'static str {
+        match backend {
+            BackendKind::Fem => {
+                "energy-midpoint, generalized-alpha, central-difference, implicit-midpoint"
+            }
+            BackendKind::Fdm => "report, central-difference, robert-asselin[=nu], velocity-form",
+            BackendKind::Modal => "dopri5, trbdf2 (also tr-bdf2, sdirk), trbdf2-fixed, trapezoid",
+            BackendKind::Reference => "none (always adaptive Dormand–Prince 5(4))",
+        }
+    }
+}
+
 impl std::fmt::Display for Method {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(&self.name())
@@ -329,12 +355,7 @@ impl SettingField {
 
     /// The readers as prose: "fem", "fem and fdm", "fem, modal and reference".
     pub fn readers_text(self) -> String {
-        let names: Vec<&str> = self.readers().iter().map(|k| k.name()).collect();
-        match names.split_last() {
-            Some((last, [])) => (*last).to_string(),
-            Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
-            None => String::new(),
-        }
+        backends_text(self.readers())
     }
 
     fn is_set(self, s: &Settings) -> bool {
@@ -378,7 +399,44 @@ impl std::fmt::Display for SettingField {
     }
 }
 
+/// Backend names as prose: "fem", "fem and fdm", "fem, modal and reference".
+pub fn backends_text(backends: &[BackendKind]) -> String {
+    let names: Vec<&str> = backends.iter().map(|k| k.name()).collect();
+    match names.split_last() {
+        Some((last, [])) => (*last).to_string(),
+        Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
 impl Settings {
+    /// Whether `backend` reads `field` as set here: the field is one the backend reads and,
+    /// for the method, one the backend implements ([`Method::backends`]).
+    pub fn read_by(&self, field: SettingField, backend: BackendKind) -> bool {
+        field.read_by(backend)
+            && match (field, self.time.method) {
+                (SettingField::Method, Some(m)) => m.backends().contains(&backend),
+                _ => true,
+            }
+    }
+
+    /// Why none of `backends` reads `field` as set here, for a refusal at a boundary: "`--basis`
+    /// applies to modal; the requested backend fem does not read it" (`subject` is how the
+    /// boundary names the backends: "the requested backend fem", "the row's backend fem").
+    pub fn refusal(&self, field: SettingField, flag: &str, subject: &str, plural: bool) -> String {
+        let verb = if plural { "do" } else { "does" };
+        match (field, self.time.method) {
+            (SettingField::Method, Some(m)) => format!(
+                "`{flag} {m}` applies to {}; {subject} {verb} not implement it",
+                backends_text(m.backends())
+            ),
+            _ => format!(
+                "`{flag}` applies to {}; {subject} {verb} not read it",
+                field.readers_text()
+            ),
+        }
+    }
+
     /// The fields that are set, in [`SettingField::ALL`] order.
     pub fn set_fields(&self) -> Vec<SettingField> {
         SettingField::ALL
@@ -391,16 +449,17 @@ impl Settings {
     pub fn unread_by(&self, backends: &[BackendKind]) -> Vec<SettingField> {
         self.set_fields()
             .into_iter()
-            .filter(|f| !backends.iter().any(|&b| f.read_by(b)))
+            .filter(|&f| !backends.iter().any(|&b| self.read_by(f, b)))
             .collect()
     }
 
-    /// The settings `backend` reads: every field it does not read cleared, so that one set of
-    /// options given for several backends reaches each only with its own fields.
+    /// The settings `backend` reads: every field it does not read (and a method it does not
+    /// implement) cleared, so that one set of options given for several backends reaches each
+    /// only with its own fields.
     pub fn for_backend(&self, backend: BackendKind) -> Settings {
         let mut s = self.clone();
         for f in SettingField::ALL {
-            if !f.read_by(backend) {
+            if !self.read_by(f, backend) {
                 f.clear(&mut s);
             }
         }

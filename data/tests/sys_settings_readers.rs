@@ -56,6 +56,52 @@ fn sys_case_row_with_a_foreign_field_is_refused_naming_file_row_and_field() {
 }
 
 #[test]
+fn sys_case_row_with_a_method_its_backend_does_not_implement_is_refused() {
+    for (backend, method, implementers) in [
+        ("fem", "dopri5", "modal"),
+        ("modal", "report", "fdm"),
+        ("fdm", "generalized-alpha", "fem"),
+        ("reference", "dopri5", "modal"),
+    ] {
+        let settings = format!(r#"method = "{method}""#);
+        let err = parse_cases(&case_text(backend, &settings, ANALYTIC), "m.toml").unwrap_err();
+        assert_eq!(err.path, "case[0].settings.method", "{err}");
+        assert!(
+            err.to_string().contains(&format!(
+                "row `row-under-test`: `method = {method}` applies to {implementers}; the row's \
+                 backend {backend} does not implement it"
+            )),
+            "{err}"
+        );
+    }
+    // central-difference is implemented by fem and fdm both.
+    for backend in ["fem", "fdm"] {
+        let settings = r#"method = "central-difference""#;
+        parse_cases(&case_text(backend, settings, ANALYTIC), "m.toml").unwrap();
+    }
+}
+
+#[test]
+fn sys_for_backend_passes_a_method_only_to_the_backends_implementing_it() {
+    let mut s = Settings::default();
+    s.time.method = Some(data::Method::Dopri5);
+    assert_eq!(s.for_backend(BackendKind::Modal).time.method, s.time.method);
+    assert_eq!(s.for_backend(BackendKind::Fem).time.method, None);
+    assert!(s.unread_by(&BackendKind::ALL).is_empty());
+    assert_eq!(
+        s.unread_by(&[BackendKind::Fem, BackendKind::Fdm]),
+        vec![SettingField::Method]
+    );
+    s.time.method = Some(data::Method::CentralDifference);
+    assert!(s.unread_by(&[BackendKind::Fem]).is_empty());
+    assert!(s.unread_by(&[BackendKind::Fdm]).is_empty());
+    assert_eq!(
+        s.unread_by(&[BackendKind::Modal]),
+        vec![SettingField::Method]
+    );
+}
+
+#[test]
 fn sys_case_ladder_and_reference_settings_are_checked_against_their_backend() {
     let ladder = r#"{ order = 4.0, ladder = [{ elements = 4 }, { modes = 8 }] }"#;
     let err = parse_cases(&case_text("fem", "elements = 4", ladder), "l.toml").unwrap_err();
@@ -121,7 +167,10 @@ fn sys_for_backend_keeps_exactly_the_fields_the_backend_reads() {
         let own = all.for_backend(kind);
         let kept = own.set_fields();
         for f in SettingField::ALL {
-            assert_eq!(kept.contains(&f), f.read_by(kind), "{kind} {f}");
+            assert_eq!(kept.contains(&f), all.read_by(f, kind), "{kind} {f}");
+            // Only the method depends on the value (trapezoid: modal's alone).
+            let method_of_another = f == SettingField::Method && kind != BackendKind::Modal;
+            assert_eq!(all.read_by(f, kind), f.read_by(kind) && !method_of_another);
         }
         assert!(own.unread_by(&[kind]).is_empty());
         // Clearing is the only change: what is kept keeps its value.
@@ -136,6 +185,10 @@ fn sys_for_backend_keeps_exactly_the_fields_the_backend_reads() {
         Some(0.5)
     );
     assert!(all.unread_by(&BackendKind::ALL).is_empty());
+    assert_eq!(
+        all.for_backend(BackendKind::Modal).time.method,
+        Some(data::Method::Trapezoid)
+    );
 }
 
 #[test]

@@ -449,7 +449,34 @@ fn cli_flag_no_requested_backend_reads_exits_2_naming_flag_and_readers() {
             "`--stations` applies to fdm; the requested backend fem does not read it",
         ),
     ];
-    for (args, message) in cases {
+    let method_cases: [(&[&str], &str); 2] = [
+        (
+            &[
+                "run",
+                "cantilever",
+                "--backend",
+                "fem",
+                "--method",
+                "dopri5",
+            ],
+            "`--method dopri5` applies to modal; the requested backend fem does not implement \
+             it; fem offers energy-midpoint, generalized-alpha, central-difference, \
+             implicit-midpoint",
+        ),
+        (
+            &[
+                "run",
+                "spin-up",
+                "--backend",
+                "fem,modal",
+                "--method",
+                "velocity-form",
+            ],
+            "`--method velocity-form` applies to fdm; the requested backends fem, modal do not \
+             implement it; fem offers",
+        ),
+    ];
+    for (args, message) in cases.into_iter().chain(method_cases) {
         let (code, out, err) = flexverify(args);
         assert_eq!(code, 2, "{args:?}: {out}{err}");
         assert!(err.contains(message), "{args:?}: {err}");

@@ -304,17 +304,19 @@ impl CommonOpts {
         let settings = self.settings();
         match settings.unread_by(kinds).first() {
             None => Ok(settings),
-            Some(field) => {
+            Some(&field) => {
                 let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
-                let requested = match names.as_slice() {
-                    [one] => format!("the requested backend {one} does not"),
-                    many => format!("the requested backends {} do not", many.join(", ")),
+                let subject = match names.as_slice() {
+                    [one] => format!("the requested backend {one}"),
+                    many => format!("the requested backends {}", many.join(", ")),
                 };
-                Err(format!(
-                    "`{}` applies to {}; {requested} read it",
-                    field.flag(),
-                    field.readers_text()
-                ))
+                let mut message = settings.refusal(field, field.flag(), &subject, kinds.len() > 1);
+                if field == data::SettingField::Method {
+                    for &kind in kinds {
+                        message += &format!("; {kind} offers {}", data::Method::names_for(kind));
+                    }
+                }
+                Err(message)
             }
         }
     }
