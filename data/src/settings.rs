@@ -1,7 +1,9 @@
 //! How finely a backend solves a scene: the backend's name, the discretization (elements,
 //! stations, modes, basis) and the time stepping (method, step, tolerances). Parsed once from
-//! the command line or a case row; [`SettingField::readers`] says which backend reads each field; the boundaries refuse a
-//! field set for a backend that does not read it.
+//! the command line or a case row. [`SettingField::readers`] says which backend reads each
+//! field and [`Method::backends`] which backend implements each method; the boundaries (command
+//! line, case rows) refuse a field or method that no backend it is meant for reads, and
+//! [`Settings::for_backend`] hands each backend only its own fields.
 
 use serde::{Deserialize, Serialize};
 
@@ -61,8 +63,8 @@ impl Basis {
     }
 }
 
-/// How finely space is discretized. Each backend reads the field it understands and uses its
-/// documented default when the field is absent.
+/// How finely space is discretized. Each field belongs to one backend
+/// ([`SettingField::readers`]), which uses its documented default when the field is absent.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Discretization {
     /// FEM: elements per link.
