@@ -185,6 +185,41 @@ pub struct Case {
     pub suite: SuiteName,
 }
 
+/// How a case row spells `field` in a refusal (`method = NAME` for the method).
+fn case_key(field: crate::SettingField) -> &'static str {
+    match field {
+        crate::SettingField::Method => "method =",
+        other => other.key(),
+    }
+}
+
+impl Case {
+    /// Every settings table of the row with the backend that runs it: the row's own, its
+    /// ladders' rungs (run by the row's backend) and a reference backend's.
+    pub fn settings_for_backends(&self) -> Vec<(String, BackendKind, &CaseSettings)> {
+        let mut out = vec![("settings".to_string(), self.backend, &self.settings)];
+        let (name, rungs): (&str, &[CaseSettings]) = match &self.reference {
+            Reference::Backend {
+                backend, settings, ..
+            } => {
+                out.push(("reference.settings".to_string(), *backend, settings));
+                ("", &[])
+            }
+            Reference::Order { ladder, .. } => ("ladder", ladder),
+            Reference::Richardson { richardson } => ("richardson", richardson),
+            Reference::Monotone { decreasing, .. } => ("decreasing", decreasing),
+            Reference::Analytic { .. } | Reference::Zero { .. } => ("", &[]),
+        };
+        out.extend(
+            rungs
+                .iter()
+                .enumerate()
+                .map(|(k, rung)| (format!("reference.{name}[{k}]"), self.backend, rung)),
+        );
+        out
+    }
+}
+
 macro_rules! case_files {
     ($($name:literal),* $(,)?) => {
         /// (file name, TOML text) of every embedded case file.
@@ -263,6 +298,21 @@ pub fn parse_cases(text: &str, source_name: &str) -> Result<Vec<Case>, SceneErro
                 "a name from `flexverify scenes`",
             ));
         }
+        for (path, backend, settings) in c.settings_for_backends() {
+            let settings = settings.to_settings();
+            if let Some(&field) = settings.unread_by(&[backend]).first() {
+                let subject = format!("the row's backend {backend}");
+                return Err(bad(
+                    &format!("{path}.{field}"),
+                    format!(
+                        "row `{}`: {}",
+                        c.id,
+                        settings.refusal(field, case_key(field), &subject, false)
+                    ),
+                    "only settings the backend reads (see data::SettingField::readers)",
+                ));
+            }
+        }
         if file.cases[..i].iter().any(|o| o.id == c.id) {
             return Err(bad(
                 "id",
@@ -339,6 +389,27 @@ pub fn stability_cases() -> Result<Vec<StabilityCase>, SceneError> {
             expected: "a [[stability]] table as documented in data/src/cases.rs".into(),
         }
     })?;
+    for (i, c) in file.cases.iter().enumerate() {
+        let settings = c.settings.to_settings();
+        if let Some(&field) = settings.unread_by(&c.backends).first() {
+            let names: Vec<&str> = c.backends.iter().map(|b| b.name()).collect();
+            let subject = format!("the row's backends ({})", names.join(", "));
+            let offset = text.find(&format!("id = \"{}\"", c.id)).unwrap_or(0);
+            let (line, column) = crate::error::line_column(text, offset);
+            return Err(SceneError {
+                source_name: "<cases>/stability.toml".into(),
+                line,
+                column,
+                path: format!("stability[{i}].settings.{field}"),
+                message: format!(
+                    "row `{}`: {}",
+                    c.id,
+                    settings.refusal(field, case_key(field), &subject, true)
+                ),
+                expected: "only settings one of the backends reads".into(),
+            });
+        }
+    }
     Ok(file.cases)
 }
 

@@ -34,5 +34,5 @@ pub use results::{
 };
 pub use scene::{Family, Scene};
 pub use settings::{
-    BackendKind, Basis, Discretization, FemElement, Method, Settings, TimeStepping,
+    BackendKind, Basis, Discretization, FemElement, Method, SettingField, Settings, TimeStepping,
 };

@@ -1,6 +1,9 @@
 //! How finely a backend solves a scene: the backend's name, the discretization (elements,
 //! stations, modes, basis) and the time stepping (method, step, tolerances). Parsed once from
-//! the command line or a case row; every backend reads the fields it implements.
+//! the command line or a case row. [`SettingField::readers`] says which backend reads each
+//! field and [`Method::backends`] which backend implements each method; the boundaries (command
+//! line, case rows) refuse a field or method that no backend it is meant for reads, and
+//! [`Settings::for_backend`] hands each backend only its own fields.
 
 use serde::{Deserialize, Serialize};
 
@@ -60,8 +63,8 @@ impl Basis {
     }
 }
 
-/// How finely space is discretized. Each backend reads the field it understands and uses its
-/// documented default when the field is absent.
+/// How finely space is discretized. Each field belongs to one backend
+/// ([`SettingField::readers`]), which uses its documented default when the field is absent.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Discretization {
     /// FEM: elements per link.
@@ -158,6 +161,32 @@ impl Method {
     }
 }
 
+impl Method {
+    /// The backends that implement this method (a family may still refuse it, e.g. a method
+    /// without event location for a contact scene).
+    pub fn backends(self) -> &'static [BackendKind] {
+        use BackendKind::{Fdm, Fem, Modal};
+        match self {
+            Method::EnergyMidpoint | Method::GeneralizedAlpha | Method::ImplicitMidpoint => &[Fem],
+            Method::CentralDifference => &[Fem, Fdm],
+            Method::Report | Method::RobertAsselin { .. } | Method::VelocityForm => &[Fdm],
+            Method::Dopri5 | Method::TrBdf2 | Method::TrBdf2Fixed | Method::Trapezoid => &[Modal],
+        }
+    }
+
+    /// The spellings `backend` implements, for error messages.
+    pub fn names_for(backend: BackendKind) -> &'static str {
+        match backend {
+            BackendKind::Fem => {
+                "energy-midpoint, generalized-alpha, central-difference, implicit-midpoint"
+            }
+            BackendKind::Fdm => "report, central-difference, robert-asselin[=nu], velocity-form",
+            BackendKind::Modal => "dopri5, trbdf2 (also tr-bdf2, sdirk), trbdf2-fixed, trapezoid",
+            BackendKind::Reference => "none (always adaptive Dormand–Prince 5(4))",
+        }
+    }
+}
+
 impl std::fmt::Display for Method {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(&self.name())
@@ -233,4 +262,245 @@ pub struct TimeStepping {
 pub struct Settings {
     pub discretization: Discretization,
     pub time: TimeStepping,
+}
+
+/// One user-settable field of [`Settings`], with the backends that read it. The table is the
+/// contract the boundaries enforce: a field set for a backend that does not read it is refused
+/// (command line: [`Settings::unread_by`]; case rows: `cases::parse_cases`) instead of being
+/// silently ignored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SettingField {
+    Elements,
+    Element,
+    Stations,
+    Modes,
+    Basis,
+    Dt,
+    TEnd,
+    Method,
+    Rtol,
+    Atol,
+    SafetyFactor,
+}
+
+impl SettingField {
+    pub const ALL: [SettingField; 11] = [
+        SettingField::Elements,
+        SettingField::Element,
+        SettingField::Stations,
+        SettingField::Modes,
+        SettingField::Basis,
+        SettingField::Dt,
+        SettingField::TEnd,
+        SettingField::Method,
+        SettingField::Rtol,
+        SettingField::Atol,
+        SettingField::SafetyFactor,
+    ];
+
+    /// The key as a case row's `settings = { … }` spells it.
+    pub fn key(self) -> &'static str {
+        match self {
+            SettingField::Elements => "elements",
+            SettingField::Element => "element",
+            SettingField::Stations => "stations",
+            SettingField::Modes => "modes",
+            SettingField::Basis => "basis",
+            SettingField::Dt => "dt",
+            SettingField::TEnd => "t_end",
+            SettingField::Method => "method",
+            SettingField::Rtol => "rtol",
+            SettingField::Atol => "atol",
+            SettingField::SafetyFactor => "safety_factor",
+        }
+    }
+
+    /// The command-line flag.
+    pub fn flag(self) -> &'static str {
+        match self {
+            SettingField::Elements => "--elements",
+            SettingField::Element => "--element",
+            SettingField::Stations => "--stations",
+            SettingField::Modes => "--modes",
+            SettingField::Basis => "--basis",
+            SettingField::Dt => "--dt",
+            SettingField::TEnd => "--t-end",
+            SettingField::Method => "--method",
+            SettingField::Rtol => "--rtol",
+            SettingField::Atol => "--atol",
+            SettingField::SafetyFactor => "--safety-factor",
+        }
+    }
+
+    /// The backends that read this field. fem: elements, element, its fixed and adaptive steps
+    /// (dt, rtol, atol) and the explicit scheme's safety factor; fdm: stations, dt and the
+    /// safety factor of its stability-bound step; modal: modes, basis, dt and the adaptive
+    /// tolerances; verify's rigid reference: only the end time and its Dormand–Prince
+    /// tolerances.
+    pub fn readers(self) -> &'static [BackendKind] {
+        use BackendKind::{Fdm, Fem, Modal, Reference};
+        match self {
+            SettingField::Elements | SettingField::Element => &[Fem],
+            SettingField::Stations => &[Fdm],
+            SettingField::Modes | SettingField::Basis => &[Modal],
+            SettingField::Dt | SettingField::Method => &[Fem, Fdm, Modal],
+            SettingField::TEnd => &[Fem, Fdm, Modal, Reference],
+            SettingField::Rtol | SettingField::Atol => &[Fem, Modal, Reference],
+            SettingField::SafetyFactor => &[Fem, Fdm],
+        }
+    }
+
+    /// Whether `backend` reads this field.
+    pub fn read_by(self, backend: BackendKind) -> bool {
+        self.readers().contains(&backend)
+    }
+
+    /// The readers as prose: "fem", "fem and fdm", "fem, modal and reference".
+    pub fn readers_text(self) -> String {
+        backends_text(self.readers())
+    }
+
+    fn is_set(self, s: &Settings) -> bool {
+        let (d, t) = (&s.discretization, &s.time);
+        match self {
+            SettingField::Elements => d.elements.is_some(),
+            SettingField::Element => d.element.is_some(),
+            SettingField::Stations => d.stations.is_some(),
+            SettingField::Modes => d.modes.is_some(),
+            SettingField::Basis => d.basis.is_some(),
+            SettingField::Dt => t.dt.is_some(),
+            SettingField::TEnd => t.t_end.is_some(),
+            SettingField::Method => t.method.is_some(),
+            SettingField::Rtol => t.rtol.is_some(),
+            SettingField::Atol => t.atol.is_some(),
+            SettingField::SafetyFactor => t.safety_factor.is_some(),
+        }
+    }
+
+    fn clear(self, s: &mut Settings) {
+        let (d, t) = (&mut s.discretization, &mut s.time);
+        match self {
+            SettingField::Elements => d.elements = None,
+            SettingField::Element => d.element = None,
+            SettingField::Stations => d.stations = None,
+            SettingField::Modes => d.modes = None,
+            SettingField::Basis => d.basis = None,
+            SettingField::Dt => t.dt = None,
+            SettingField::TEnd => t.t_end = None,
+            SettingField::Method => t.method = None,
+            SettingField::Rtol => t.rtol = None,
+            SettingField::Atol => t.atol = None,
+            SettingField::SafetyFactor => t.safety_factor = None,
+        }
+    }
+}
+
+impl std::fmt::Display for SettingField {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.key())
+    }
+}
+
+/// Backend names as prose: "fem", "fem and fdm", "fem, modal and reference".
+pub fn backends_text(backends: &[BackendKind]) -> String {
+    let names: Vec<&str> = backends.iter().map(|k| k.name()).collect();
+    match names.split_last() {
+        Some((last, [])) => (*last).to_string(),
+        Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
+impl Settings {
+    /// Whether `backend` reads `field` as set here: the field is one the backend reads and,
+    /// for the method, one the backend implements ([`Method::backends`]).
+    pub fn read_by(&self, field: SettingField, backend: BackendKind) -> bool {
+        field.read_by(backend)
+            && match (field, self.time.method) {
+                (SettingField::Method, Some(m)) => m.backends().contains(&backend),
+                _ => true,
+            }
+    }
+
+    /// Why none of `backends` reads `field` as set here, for a refusal at a boundary: "`--basis`
+    /// applies to modal; the requested backend fem does not read it" (`subject` is how the
+    /// boundary names the backends: "the requested backend fem", "the row's backend fem").
+    pub fn refusal(&self, field: SettingField, flag: &str, subject: &str, plural: bool) -> String {
+        let verb = if plural { "do" } else { "does" };
+        match (field, self.time.method) {
+            (SettingField::Method, Some(m)) => format!(
+                "`{flag} {m}` applies to {}; {subject} {verb} not implement it",
+                backends_text(m.backends())
+            ),
+            _ => format!(
+                "`{flag}` applies to {}; {subject} {verb} not read it",
+                field.readers_text()
+            ),
+        }
+    }
+
+    /// The fields that are set, in [`SettingField::ALL`] order.
+    pub fn set_fields(&self) -> Vec<SettingField> {
+        SettingField::ALL
+            .into_iter()
+            .filter(|f| f.is_set(self))
+            .collect()
+    }
+
+    /// The set fields that none of `backends` reads.
+    pub fn unread_by(&self, backends: &[BackendKind]) -> Vec<SettingField> {
+        self.set_fields()
+            .into_iter()
+            .filter(|&f| !backends.iter().any(|&b| self.read_by(f, b)))
+            .collect()
+    }
+
+    /// The settings `backend` reads: every field it does not read (and a method it does not
+    /// implement) cleared, so that one set of options given for several backends reaches each
+    /// only with its own fields.
+    pub fn for_backend(&self, backend: BackendKind) -> Settings {
+        let mut s = self.clone();
+        for f in SettingField::ALL {
+            if !self.read_by(f, backend) {
+                f.clear(&mut s);
+            }
+        }
+        s
+    }
+
+    /// The field that sets `backend`'s spatial resolution (fem: elements per link, fdm:
+    /// stations per link, modal: modes per link and field); None for verify's rigid reference.
+    pub fn resolution_field(backend: BackendKind) -> Option<SettingField> {
+        match backend {
+            BackendKind::Fem => Some(SettingField::Elements),
+            BackendKind::Fdm => Some(SettingField::Stations),
+            BackendKind::Modal => Some(SettingField::Modes),
+            BackendKind::Reference => None,
+        }
+    }
+
+    /// `backend`'s spatial resolution, when set.
+    pub fn resolution(&self, backend: BackendKind) -> Option<usize> {
+        let d = &self.discretization;
+        match backend {
+            BackendKind::Fem => d.elements,
+            BackendKind::Fdm => d.stations,
+            BackendKind::Modal => d.modes,
+            BackendKind::Reference => None,
+        }
+    }
+
+    /// These settings with `backend`'s spatial resolution set to `n` (unchanged for verify's
+    /// rigid reference, which has none).
+    pub fn with_resolution(&self, backend: BackendKind, n: usize) -> Settings {
+        let mut s = self.clone();
+        let d = &mut s.discretization;
+        match backend {
+            BackendKind::Fem => d.elements = Some(n),
+            BackendKind::Fdm => d.stations = Some(n),
+            BackendKind::Modal => d.modes = Some(n),
+            BackendKind::Reference => {}
+        }
+        s
+    }
 }

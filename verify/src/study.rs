@@ -135,46 +135,28 @@ pub struct Study {
     pub disagreement: Option<Disagreement>,
 }
 
-/// Default refinement ladder of a backend (space) as settings + h.
+/// Default refinement ladder of a backend (space) as settings + h: the backend's resolution
+/// ([`Settings::with_resolution`]) over its rungs, h the reciprocal number of intervals.
 fn space_ladder(kind: BackendKind, base: &Settings) -> Vec<(Settings, f64, String)> {
-    let mut out = Vec::new();
-    let with = |f: &dyn Fn(&mut Settings)| {
-        let mut s = base.clone();
-        f(&mut s);
-        s
-    };
-    match kind {
+    let (rungs, intervals): (&[usize], fn(usize) -> usize) = match kind {
         // The rigid reference has no spatial discretization.
-        BackendKind::Reference => {}
-        BackendKind::Fem => {
-            for n in [2usize, 4, 8, 16, 32, 64] {
-                out.push((
-                    with(&|s| s.discretization.elements = Some(n)),
-                    1.0 / n as f64,
-                    format!("elements={n}"),
-                ));
-            }
-        }
-        BackendKind::Fdm => {
-            for n in [11usize, 21, 41, 81, 161] {
-                out.push((
-                    with(&|s| s.discretization.stations = Some(n)),
-                    1.0 / (n - 1) as f64,
-                    format!("stations={n}"),
-                ));
-            }
-        }
-        BackendKind::Modal => {
-            for n in [1usize, 2, 3, 4, 6, 8] {
-                out.push((
-                    with(&|s| s.discretization.modes = Some(n)),
-                    1.0 / n as f64,
-                    format!("modes={n}"),
-                ));
-            }
-        }
-    }
-    out
+        BackendKind::Reference => return Vec::new(),
+        BackendKind::Fem => (&[2, 4, 8, 16, 32, 64], |n| n),
+        // Stations include both ends.
+        BackendKind::Fdm => (&[11, 21, 41, 81, 161], |n| n - 1),
+        BackendKind::Modal => (&[1, 2, 3, 4, 6, 8], |n| n),
+    };
+    let field = Settings::resolution_field(kind).map_or("", |f| f.key());
+    rungs
+        .iter()
+        .map(|&n| {
+            (
+                base.with_resolution(kind, n),
+                1.0 / intervals(n) as f64,
+                format!("{field}={n}"),
+            )
+        })
+        .collect()
 }
 
 fn time_ladder(base: &Settings, scene: &Scene) -> Vec<(Settings, f64, String)> {
@@ -215,9 +197,10 @@ pub fn rung_specs(
     kinds
         .iter()
         .map(|&kind| {
+            let base = base.for_backend(kind);
             let spec = match refine {
-                Refine::Space => space_ladder(kind, base),
-                Refine::Time => time_ladder(base, scene),
+                Refine::Space => space_ladder(kind, &base),
+                Refine::Time => time_ladder(&base, scene),
             };
             (kind, spec)
         })

@@ -388,3 +388,123 @@ fn cli_closed_output_pipe_ends_quietly_with_the_sigpipe_status() {
     assert_eq!(out.status.code(), Some(141), "{err}");
     assert!(err.is_empty(), "nothing on stderr, got:\n{err}");
 }
+
+#[test]
+fn cli_flag_no_requested_backend_reads_exits_2_naming_flag_and_readers() {
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &["run", "cantilever", "--backend", "fem", "--basis", "poly"],
+            "`--basis` applies to modal; the requested backend fem does not read it",
+        ),
+        (
+            &[
+                "modes",
+                "cantilever",
+                "--backend",
+                "modal",
+                "--elements",
+                "8",
+            ],
+            "`--elements` applies to fem; the requested backend modal does not read it",
+        ),
+        (
+            &[
+                "statics",
+                "cantilever",
+                "--backend",
+                "fem,fdm",
+                "--modes",
+                "4",
+            ],
+            "`--modes` applies to modal; the requested backends fem, fdm do not read it",
+        ),
+        (
+            &["run", "cantilever", "--backend", "fdm", "--rtol", "1e-6"],
+            "`--rtol` applies to fem, modal and reference; the requested backend fdm does not \
+             read it",
+        ),
+        (
+            &[
+                "describe",
+                "cantilever",
+                "--backend",
+                "modal",
+                "--safety-factor",
+                "0.5",
+            ],
+            "`--safety-factor` applies to fem and fdm; the requested backend modal does not \
+             read it",
+        ),
+        (
+            &[
+                "converge",
+                "cantilever",
+                "--quantity",
+                "freq1",
+                "--backend",
+                "fem",
+                "--stations",
+                "11",
+            ],
+            "`--stations` applies to fdm; the requested backend fem does not read it",
+        ),
+    ];
+    let method_cases: [(&[&str], &str); 2] = [
+        (
+            &[
+                "run",
+                "cantilever",
+                "--backend",
+                "fem",
+                "--method",
+                "dopri5",
+            ],
+            "`--method dopri5` applies to modal; the requested backend fem does not implement \
+             it; fem offers energy-midpoint, generalized-alpha, central-difference, \
+             implicit-midpoint",
+        ),
+        (
+            &[
+                "run",
+                "spin-up",
+                "--backend",
+                "fem,modal",
+                "--method",
+                "velocity-form",
+            ],
+            "`--method velocity-form` applies to fdm; the requested backends fem, modal do not \
+             implement it; fem offers",
+        ),
+    ];
+    for (args, message) in cases.into_iter().chain(method_cases) {
+        let (code, out, err) = flexverify(args);
+        assert_eq!(code, 2, "{args:?}: {out}{err}");
+        assert!(err.contains(message), "{args:?}: {err}");
+        assert!(out.is_empty(), "{args:?}: {out}");
+    }
+}
+
+#[test]
+fn cli_flags_for_several_backends_reach_only_the_backends_that_read_them() {
+    let freqs = |args: &[&str]| -> Vec<serde_json::Value> {
+        let mut all = vec!["modes", "cantilever", "--count", "2", "--format", "json"];
+        all.extend_from_slice(args);
+        let (code, out, err) = flexverify(&all);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        v.as_array().unwrap().clone()
+    };
+    let both = freqs(&["--backend", "fem,modal", "--modes", "3", "--elements", "4"]);
+    let fem = freqs(&["--backend", "fem", "--elements", "4"]);
+    let modal = freqs(&["--backend", "modal", "--modes", "3"]);
+    assert_eq!(both.len(), 2);
+    assert_eq!(both[0]["frequencies_hz"].as_array().map(Vec::len), Some(2));
+    assert_eq!(
+        both[0]["frequencies_hz"], fem[0]["frequencies_hz"],
+        "fem with --modes set for modal"
+    );
+    assert_eq!(
+        both[1]["frequencies_hz"], modal[0]["frequencies_hz"],
+        "modal with --elements set for fem"
+    );
+}

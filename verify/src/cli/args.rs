@@ -298,8 +298,31 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
 }
 
 impl CommonOpts {
-    /// Backend settings from the options.
-    pub fn settings(&self) -> data::Settings {
+    /// Backend settings from the options for the backends `kinds`; a flag that none of them
+    /// reads is refused (each backend then takes its own fields, [`data::Settings::for_backend`]).
+    pub fn settings_for(&self, kinds: &[data::BackendKind]) -> Result<data::Settings, String> {
+        let settings = self.settings();
+        match settings.unread_by(kinds).first() {
+            None => Ok(settings),
+            Some(&field) => {
+                let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
+                let subject = match names.as_slice() {
+                    [one] => format!("the requested backend {one}"),
+                    many => format!("the requested backends {}", many.join(", ")),
+                };
+                let mut message = settings.refusal(field, field.flag(), &subject, kinds.len() > 1);
+                if field == data::SettingField::Method {
+                    for &kind in kinds {
+                        message += &format!("; {kind} offers {}", data::Method::names_for(kind));
+                    }
+                }
+                Err(message)
+            }
+        }
+    }
+
+    /// Backend settings from the options, unchecked.
+    fn settings(&self) -> data::Settings {
         data::Settings {
             discretization: data::Discretization {
                 elements: self.elements.map(|n| n as usize),

@@ -1,6 +1,6 @@
 //! One function per subcommand.
 
-use data::{BackendError, BackendKind, Scene, StabilityVerdict, load_scene};
+use data::{BackendError, BackendKind, Scene, Settings, StabilityVerdict, load_scene};
 
 use super::CliError;
 use super::args::{Cli, Command, CommonOpts};
@@ -121,10 +121,11 @@ struct BackendPlan {
 
 fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(name)?;
-    let settings = opts.settings();
+    let kinds = opts.kinds_for(&scene);
+    let settings = checked_settings(opts, &kinds)?;
     let mut plans = Vec::new();
-    for kind in opts.kinds_for(&scene) {
-        match backend(kind).dof_plan(&scene, &settings.discretization) {
+    for kind in kinds {
+        match backend(kind).dof_plan(&scene, &settings.for_backend(kind).discretization) {
             Ok(plan) => plans.push(BackendPlan {
                 backend: kind,
                 dofs: Some(plan.total()),
@@ -281,17 +282,28 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     }
 }
 
-/// Runs `f` for each requested backend; unsupported backends are reported, and the command
+/// The options' settings for `kinds`; a flag none of them reads is bad input (exit 2).
+pub(crate) fn checked_settings(
+    opts: &CommonOpts,
+    kinds: &[BackendKind],
+) -> Result<Settings, CliError> {
+    opts.settings_for(kinds)
+        .map_err(|e| CliError::Input(format!("error: {e}")))
+}
+
+/// Runs `f` for each requested backend with the settings it reads; unsupported backends are reported, and the command
 /// fails with status 3 only when none could answer.
 fn for_backends<T>(
     scene: &Scene,
     opts: &CommonOpts,
-    mut f: impl FnMut(&dyn data::Backend) -> Result<T, BackendError>,
+    mut f: impl FnMut(&dyn data::Backend, &Settings) -> Result<T, BackendError>,
 ) -> Result<Vec<(BackendKind, T)>, CliError> {
+    let kinds = opts.kinds_for(scene);
+    let settings = checked_settings(opts, &kinds)?;
     let mut done = Vec::new();
     let mut unsupported = Vec::new();
-    for kind in opts.kinds_for(scene) {
-        match f(backend(kind).as_ref()) {
+    for kind in kinds {
+        match f(backend(kind).as_ref(), &settings.for_backend(kind)) {
             Ok(v) => done.push((kind, v)),
             Err(BackendError::Unsupported(why)) => {
                 unsupported.push(format!("{kind}: unsupported: {why}"))
@@ -313,8 +325,7 @@ fn for_backends<T>(
 
 fn modes(name: &str, count: usize, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(name)?;
-    let settings = opts.settings();
-    let results = for_backends(&scene, opts, |b| b.modes(&scene, &settings, count))?;
+    let results = for_backends(&scene, opts, |b, settings| b.modes(&scene, settings, count))?;
     if let Some(dir) = &opts.out {
         for (kind, r) in &results {
             let json = serde_json::to_vec_pretty(r).expect("serializable");
@@ -351,8 +362,7 @@ fn modes(name: &str, count: usize, opts: &CommonOpts) -> Result<(), CliError> {
 
 fn statics(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(name)?;
-    let settings = opts.settings();
-    let results = for_backends(&scene, opts, |b| b.statics(&scene, &settings))?;
+    let results = for_backends(&scene, opts, |b, settings| b.statics(&scene, settings))?;
     let rows: Vec<Vec<String>> = results
         .iter()
         .map(|(k, r)| {
@@ -376,8 +386,7 @@ fn statics(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
 
 fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(name)?;
-    let settings = opts.settings();
-    let results = for_backends(&scene, opts, |b| b.simulate(&scene, &settings))?;
+    let results = for_backends(&scene, opts, |b, settings| b.simulate(&scene, settings))?;
     if let Some(dir) = &opts.out {
         for (kind, r) in &results {
             let stem = format!("{}-{kind}", scene.name);

@@ -27,7 +27,7 @@ pub fn converge(
         quantity,
         refine,
         &opts.kinds(),
-        &opts.settings(),
+        &super::commands::checked_settings(opts, &opts.kinds())?,
         &bar,
     )?;
     bar.clear();
@@ -66,7 +66,7 @@ pub fn converge_shard(
     let scene = load_scene(scene_arg)?;
     let q = study::parse_quantity(&scene, quantity)?;
     let kinds = opts.kinds();
-    let base = opts.settings();
+    let base = super::commands::checked_settings(opts, &kinds)?;
     let flat: Vec<(BackendKind, usize, Settings)> =
         study::rung_specs(&scene, refine, &kinds, &base)
             .into_iter()
@@ -155,8 +155,14 @@ pub fn merge_converge(
 pub fn recommend(scene: &str, quantity: &str, tol: f64, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(scene)?;
     let bar = Bar::new();
-    let recommendation =
-        study::recommend(&scene, quantity, tol, &opts.kinds(), &opts.settings(), &bar);
+    let recommendation = study::recommend(
+        &scene,
+        quantity,
+        tol,
+        &opts.kinds(),
+        &super::commands::checked_settings(opts, &opts.kinds())?,
+        &bar,
+    );
     bar.clear();
     let r = recommendation?;
     match opts.format {
