@@ -18,10 +18,10 @@ pub fn check_planar(scene: &Scene) -> Result<(), FemError> {
     // Unilateral frictionless line contact is implemented (`crate::events::contact`); the rest is
     // refused there by name.
     crate::events::contact::check(scene)?;
-    if scene.links.is_empty() {
+    if scene.links().is_empty() {
         return Err(FemError::unsupported("fem: scene has no links".to_string()));
     }
-    for (i, l) in scene.links.iter().enumerate() {
+    for (i, l) in scene.links().iter().enumerate() {
         if l.axial && l.foreshortening {
             return Err(FemError::unsupported(format!(
                 "fem: link {} has both `axial` and `foreshortening`; choose one stiffening model",

@@ -190,14 +190,14 @@ pub const GRAZING_LOCATION: &str = "contact1 (grazing)";
 
 /// Refuses contact features this backend does not model, with a precise message.
 pub fn check(scene: &Scene) -> Result<(), FemError> {
-    if scene.contacts.len() > 1 {
+    if scene.contacts().len() > 1 {
         return Err(FemError::unsupported(format!(
             "fem: {} contacts in scene `{}`; one tip contact is implemented",
-            scene.contacts.len(),
+            scene.contacts().len(),
             scene.name
         )));
     }
-    let Some(c) = scene.contacts.first() else {
+    let Some(c) = scene.contacts().first() else {
         return Ok(());
     };
     // Bilateral contacts (line or circle, with or without friction): `crate::events::contact::friction`.
@@ -219,7 +219,7 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
         )));
     }
     if let Some(i) = scene
-        .links
+        .links()
         .iter()
         .position(|l| l.joint.prescribed.is_some())
     {
@@ -229,7 +229,7 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
         )));
     }
     if let Some(i) = scene
-        .links
+        .links()
         .iter()
         .position(|l| l.shear && !l.rotary_inertia && l.kelvin_voigt.unwrap_or(0.0) <= 0.0)
     {
@@ -240,10 +240,10 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
              implemented (only the damped case, where ψ̇ follows the massless balance \
              Nᵀ(∂V/∂q + C q̇) = 0); set `kelvin_voigt` > 0 or `rotary_inertia`",
             i + 1,
-            scene.links[i].name
+            scene.links()[i].name
         )));
     }
-    if !scene.links.iter().any(|l| l.name == c.link) {
+    if !scene.links().iter().any(|l| l.name == c.link) {
         return Err(FemError::InvalidSettings {
             field: "contact.link".into(),
             message: format!("no link named `{}`", c.link),
@@ -321,11 +321,11 @@ impl Contact {
     /// The scene's tip contact on `chain` (None without one; nothing is allocated then).
     pub fn from_scene(scene: &Scene, chain: &Chain) -> Result<Option<Self>, FemError> {
         check(scene)?;
-        let Some(c) = scene.contacts.first() else {
+        let Some(c) = scene.contacts().first() else {
             return Ok(None);
         };
         let link = scene
-            .links
+            .links()
             .iter()
             .position(|l| l.name == c.link)
             .unwrap_or(0);

@@ -105,7 +105,7 @@ pub const MIN_TRIAL: f64 = 1e-3;
 
 /// Refuses what the bilateral contact does not model (called from [`crate::events::contact::check`]).
 pub fn check(scene: &Scene) -> Result<(), FemError> {
-    let Some(c) = scene.contacts.first() else {
+    let Some(c) = scene.contacts().first() else {
         return Ok(());
     };
     if c.mode != ContactMode::Bilateral {
@@ -118,7 +118,7 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
         });
     }
     if let Some(i) = scene
-        .links
+        .links()
         .iter()
         .position(|l| l.shear && !l.rotary_inertia)
     {
@@ -131,13 +131,13 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
              index-1 wall forces (G M⁻¹Gᵀ, G M⁻¹Tᵀ, T M⁻¹Tᵀ) are undefined; set \
              `rotary_inertia = true` with `rotary_inertia_per_length`",
             i + 1,
-            scene.links[i].name
+            scene.links()[i].name
         )));
     }
     if let (Some(l), Surface::Circle { center, radius }) =
-        (scene.links.iter().find(|l| l.name == c.link), &c.surface)
+        (scene.links().iter().find(|l| l.name == c.link), &c.surface)
     {
-        let first = scene.links.first().is_some_and(|f| f.name == l.name);
+        let first = scene.links().first().is_some_and(|f| f.name == l.name);
         let tol = 1e-12 * l.length;
         if first
             && !l.axial
@@ -158,7 +158,7 @@ pub fn check(scene: &Scene) -> Result<(), FemError> {
 
 /// The `describe` line of a bilateral contact (None otherwise).
 pub fn describe(scene: &Scene) -> Option<String> {
-    let c = scene.contacts.first()?;
+    let c = scene.contacts().first()?;
     if c.mode != ContactMode::Bilateral {
         return None;
     }
