@@ -28,8 +28,10 @@ pub fn rocket_with(
     s: &FdmSettings,
     enforce_bound: bool,
 ) -> Result<(RocketSystem, Outcome), FdmError> {
+    let r = scene
+        .rocket()
+        .ok_or_else(|| FdmError::Unsupported("scene has no [rocket]".into()))?;
     let mut sys = crate::rocket::build(scene, s)?;
-    let r = scene.rocket().expect("checked in build");
     let (q0, v0) = sys.initial_state(&r.initial_shape);
     let ctl = StepControl::for_scene(scene, s, s.method, true, enforce_bound);
     let out = integrate(&mut sys, &q0, &v0, &ctl)?;
