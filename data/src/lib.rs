@@ -32,7 +32,7 @@ pub use results::{
     Channel, Cost, Diagnostic, EnergyLedger, EnergyTerm, Event, ModalResult, ModeShape,
     Observables, RunResult, StabilityVerdict, StaticResult, ledger_term,
 };
-pub use scene::{Family, Scene};
+pub use scene::{Family, Model, PlanarChain, Scene, SceneFile};
 pub use settings::{
     BackendKind, Basis, Discretization, FemElement, Method, SettingField, Settings, TimeStepping,
 };

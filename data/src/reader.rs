@@ -5,8 +5,8 @@ use toml::de::DeTable;
 
 use crate::error::{SceneError, line_column};
 use crate::locate::{FieldPath, Segment, non_finite_numbers, offset_of};
-use crate::scene::Scene;
-use crate::validate::{MAX_FILE_BYTES, validate};
+use crate::scene::{Scene, SceneFile};
+use crate::validate::{MAX_FILE_BYTES, check_file, validate};
 
 /// Parses and validates a scene. `source_name` is used in messages (usually the file path).
 pub fn parse_scene(text: &str, source_name: &str) -> Result<Scene, SceneError> {
@@ -50,7 +50,7 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<Scene, SceneError> {
     }
 
     let deserializer = toml::Deserializer::from(table.clone());
-    let scene: Scene = serde_path_to_error::deserialize(deserializer).map_err(|e| {
+    let file: SceneFile = serde_path_to_error::deserialize(deserializer).map_err(|e| {
         let path = convert_path(e.path());
         let inner = e.inner();
         let message = inner.message().trim().to_string();
@@ -61,14 +61,30 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<Scene, SceneError> {
         err_at(offset, path.to_string(), message, expected)
     })?;
 
-    if let Some(issue) = validate(&scene).into_iter().next() {
+    let to_error = |issue: crate::validate::Issue| {
         let offset = offset_of(&table, &issue.path);
-        return Err(err_at(
+        err_at(
             offset,
             issue.path.to_string(),
             issue.message,
             issue.expected,
-        ));
+        )
+    };
+    if let Some(issue) = check_file(&file).into_iter().next() {
+        return Err(to_error(issue));
+    }
+    // check_file has established exactly one family with only its own tables: the
+    // conversion cannot fail, and a failure would be a reader bug reported as one.
+    let scene = Scene::try_from(file).map_err(|e| {
+        err_at(
+            0,
+            "(document)".into(),
+            e.to_string(),
+            "exactly one model family per scene file".into(),
+        )
+    })?;
+    if let Some(issue) = validate(&scene).into_iter().next() {
+        return Err(to_error(issue));
     }
     Ok(scene)
 }

@@ -6,8 +6,9 @@
 
 use crate::locate::FieldPath;
 use crate::scene::{
-    Contact, InitialShape, Joint, Link, LinkField, LinkInitialShape, MobileManipulator,
-    PayloadLink, PrescribedMotion, RigidBody, Rocket, Scene, Surface, TorqueLaw, TorqueSchedule,
+    Contact, InitialShape, Joint, Link, LinkField, LinkInitialShape, MobileManipulator, Model,
+    PayloadLink, PlanarChain, PrescribedMotion, RigidBody, Rocket, Scene, SceneFile, Surface,
+    TorqueLaw, TorqueSchedule,
 };
 
 /// Largest accepted scene file.
@@ -68,8 +69,10 @@ impl Checker {
     }
 }
 
-/// All semantic problems of a scene, in document order as far as possible.
-pub fn validate(scene: &Scene) -> Vec<Issue> {
+/// Problems of the file as a whole, in document order: name, description, simulation, and
+/// the model families (exactly one; planar-only tables only with links). A file without such
+/// problems converts into a [`Scene`].
+pub fn check_file(scene: &SceneFile) -> Vec<Issue> {
     let mut c = Checker { issues: Vec::new() };
     let root = FieldPath::root();
 
@@ -159,6 +162,24 @@ pub fn validate(scene: &Scene) -> Vec<Issue> {
         }
     }
 
+    c.issues
+}
+
+/// All semantic problems of a scene's model, in document order as far as possible.
+pub fn validate(scene: &Scene) -> Vec<Issue> {
+    let mut c = Checker { issues: Vec::new() };
+    match &scene.model {
+        Model::PlanarChain(chain) => check_planar_chain(&mut c, chain),
+        Model::Rocket(r) => check_rocket(&mut c, &FieldPath::root().key("rocket"), r),
+        Model::PayloadLink(p) => {
+            check_payload_link(&mut c, &FieldPath::root().key("payload_link"), p)
+        }
+        Model::MobileManipulator(m) => check_mobile(&mut c, m),
+    }
+    c.issues
+}
+
+fn check_planar_chain(c: &mut Checker, scene: &PlanarChain) {
     if scene.links.len() > MAX_LINKS {
         c.fail(
             FieldPath::root().key("link"),
@@ -175,7 +196,7 @@ pub fn validate(scene: &Scene) -> Vec<Issue> {
                 "a unique name per link",
             );
         }
-        check_link(&mut c, &p, link);
+        check_link(c, &p, link);
     }
 
     if let Some(g) = &scene.gravity {
@@ -198,7 +219,7 @@ pub fn validate(scene: &Scene) -> Vec<Issue> {
     }
     for (i, contact) in scene.contacts.iter().enumerate() {
         check_contact(
-            &mut c,
+            c,
             &FieldPath::root().key("contact").index(i),
             contact,
             scene,
@@ -235,17 +256,6 @@ pub fn validate(scene: &Scene) -> Vec<Issue> {
             );
         }
     }
-
-    if let Some(r) = &scene.rocket {
-        check_rocket(&mut c, &FieldPath::root().key("rocket"), r);
-    }
-    if let Some(p) = &scene.payload_link {
-        check_payload_link(&mut c, &FieldPath::root().key("payload_link"), p);
-    }
-    if let Some(m) = &scene.mobile_manipulator {
-        check_mobile(&mut c, m);
-    }
-    c.issues
 }
 
 fn check_link(c: &mut Checker, p: &FieldPath, l: &Link) {
@@ -519,7 +529,7 @@ fn check_joint(c: &mut Checker, p: &FieldPath, j: &Joint) {
     }
 }
 
-fn check_contact(c: &mut Checker, p: &FieldPath, ct: &Contact, scene: &Scene) {
+fn check_contact(c: &mut Checker, p: &FieldPath, ct: &Contact, scene: &PlanarChain) {
     if scene.link_index(&ct.link).is_none() {
         let names: Vec<&str> = scene.links.iter().map(|l| l.name.as_str()).collect();
         c.fail(

@@ -21,8 +21,8 @@ fn err(text: &str) -> SceneError {
 #[test]
 fn the_catalog_scene_is_good() {
     let scene = parse_scene(GOOD, "good.toml").expect("catalog scene parses");
-    let m = scene.mobile_manipulator.expect("mobile manipulator");
-    assert_eq!(m.flexible_link.expect("flexible link").link, 2);
+    let m = scene.mobile_manipulator().expect("mobile manipulator");
+    assert_eq!(m.flexible_link.as_ref().expect("flexible link").link, 2);
     assert!(GOOD.contains(LINK2_COM) && GOOD.contains(LINK2_INERTIA));
 }
 

@@ -17,7 +17,7 @@ const INERTIA: &str =
 #[test]
 fn the_catalog_scene_is_good() {
     let scene = parse_scene(GOOD, "good.toml").expect("catalog scene parses");
-    let p = scene.payload_link.expect("payload link");
+    let p = scene.payload_link().expect("payload link");
     assert_eq!(p.fields.len(), 4, "all four fields by default");
     assert!(!p.payload.is_diagonal());
 }

@@ -38,14 +38,14 @@ pub struct Cantilever {
 impl Cantilever {
     /// Accepts single clamped links whose switched-on physics this module builds.
     pub fn from_scene(scene: &Scene, stations: Option<usize>) -> Result<Self, FdmError> {
-        if scene.links.len() != 1 {
+        if scene.links().len() != 1 {
             return Err(FdmError::Unsupported(format!(
                 "fdm: `{}` has {} links; only the single clamped link (cantilever family) is implemented for beams",
                 scene.name,
-                scene.links.len()
+                scene.links().len()
             )));
         }
-        let l = &scene.links[0];
+        let l = &scene.links()[0];
         let spin = match l.joint.prescribed {
             Some(PrescribedMotion::Fixed) => 0.0,
             Some(PrescribedMotion::ConstantRate { rate }) => l.joint.initial_rate + rate,
@@ -65,8 +65,8 @@ impl Cantilever {
                 ("rotary_inertia", l.rotary_inertia),
                 ("kelvin_voigt", l.kelvin_voigt.is_some()),
                 ("tip_inertia", l.tip_inertia.is_some()),
-                ("gravity", scene.gravity.is_some()),
-                ("contact", !scene.contacts.is_empty()),
+                ("gravity", scene.gravity().is_some()),
+                ("contact", !scene.contacts().is_empty()),
             ],
         )?;
         let n = stations.unwrap_or(DEFAULT_STATIONS);
@@ -268,14 +268,13 @@ pub fn statics(
     settings: &Settings,
     s: &FdmSettings,
 ) -> Result<StaticResult, FdmError> {
-    if scene.links.len() == 1 && scene.links[0].shear {
+    if scene.links().len() == 1 && scene.links()[0].shear {
         return timoshenko_statics(scene, settings, s);
     }
     let clock = std::time::Instant::now();
     let c = Cantilever::from_scene(scene, s.stations)?;
     let st = scene
-        .statics
-        .as_ref()
+        .statics()
         .ok_or_else(|| FdmError::Unsupported(format!("`{}` has no [statics] loads", scene.name)))?;
     let w = c.static_deflection(
         st.tip_force.unwrap_or(0.0),
@@ -310,7 +309,7 @@ fn timoshenko_statics(
     s: &FdmSettings,
 ) -> Result<StaticResult, FdmError> {
     let clock = std::time::Instant::now();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     if !matches!(l.joint.prescribed, Some(PrescribedMotion::Fixed)) {
         return Err(FdmError::Unsupported(format!(
             "fdm: statics of the Timoshenko link `{}` need a fixed clamp",
@@ -323,14 +322,13 @@ fn timoshenko_statics(
         &[
             ("axial", l.axial),
             ("tip_inertia", l.tip_inertia.is_some()),
-            ("gravity", scene.gravity.is_some()),
-            ("contact", !scene.contacts.is_empty()),
+            ("gravity", scene.gravity().is_some()),
+            ("contact", !scene.contacts().is_empty()),
         ],
     )?;
     let kga = crate::chain::timoshenko::shear_stiffness(&scene.name, l)?;
     let st = scene
-        .statics
-        .as_ref()
+        .statics()
         .ok_or_else(|| FdmError::Unsupported(format!("`{}` has no [statics] loads", scene.name)))?;
     let n = s.stations.unwrap_or(DEFAULT_STATIONS);
     let (v, psi) = crate::chain::timoshenko::TimoFields::cantilever_statics(

@@ -232,9 +232,9 @@ impl ModelChoice {
         match scene.family() {
             Family::Rocket => Ok(ModelChoice::Rocket),
             Family::PayloadLink => Ok(ModelChoice::PayloadLink),
-            Family::PlanarChain => Ok(match scene.links.len() {
+            Family::PlanarChain => Ok(match scene.links().len() {
                 1 if matches!(
-                    scene.links[0].joint.prescribed,
+                    scene.links()[0].joint.prescribed,
                     Some(data::scene::PrescribedMotion::Fixed)
                 ) =>
                 {

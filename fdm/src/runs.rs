@@ -28,8 +28,10 @@ pub fn rocket_with(
     s: &FdmSettings,
     enforce_bound: bool,
 ) -> Result<(RocketSystem, Outcome), FdmError> {
+    let r = scene
+        .rocket()
+        .ok_or_else(|| FdmError::Unsupported("scene has no [rocket]".into()))?;
     let mut sys = crate::rocket::build(scene, s)?;
-    let r = scene.rocket.as_ref().expect("checked in build");
     let (q0, v0) = sys.initial_state(&r.initial_shape);
     let ctl = StepControl::for_scene(scene, s, s.method, true, enforce_bound);
     let out = integrate(&mut sys, &q0, &v0, &ctl)?;
@@ -75,7 +77,7 @@ pub fn two_link_chain(
     settings: &Settings,
     s: &FdmSettings,
 ) -> Result<RunResult, FdmError> {
-    if !scene.contacts.is_empty() {
+    if !scene.contacts().is_empty() {
         return Ok(two_link_chain_with_contact(scene, settings, s)?.0);
     }
     let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;

@@ -47,7 +47,7 @@ fn betas(mu: f64, n: usize) -> Vec<f64> {
 }
 
 fn analytic_hz(scene: &Scene, n: usize) -> Vec<f64> {
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let mu = l.tip_mass.unwrap_or(0.0) / l.beam_mass();
     betas(mu, n)
         .iter()
@@ -168,8 +168,8 @@ fn conv_cantilever_tip_mass_frequencies_converge_at_second_order() {
 #[test]
 fn sys_cantilever_statics_converge_to_pl3_3ei_plus_ql4_8ei() {
     let scene = load_scene("cantilever").unwrap();
-    let l = &scene.links[0];
-    let st = scene.statics.as_ref().unwrap();
+    let l = &scene.links()[0];
+    let st = scene.statics().unwrap();
     let (p, q) = (st.tip_force.unwrap(), st.distributed_load.unwrap());
     let ei = l.bending_stiffness;
     let len = l.length;
@@ -234,9 +234,9 @@ fn sys_unsupported_scenes_say_what_is_missing() {
 
 fn rotating_scene(lambda: f64) -> Scene {
     let mut scene = load_scene("rotating-beam").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let omega = lambda * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt();
-    scene.links[0].joint.prescribed =
+    scene.planar_chain_mut().unwrap().links[0].joint.prescribed =
         Some(data::scene::PrescribedMotion::ConstantRate { rate: omega });
     scene
 }
@@ -271,7 +271,7 @@ fn sys_rotating_beam_in_plane_slope_matches_southwell_minus_one() {
     // In-plane: ω² = ω₀² + (α₁ − 1)Ω² + O(Ω⁴) (centrifugal stiffening α₁ minus the rotating
     // frame's softening 1).
     let alpha = southwell_alpha();
-    let l = load_scene("rotating-beam").unwrap().links[0].clone();
+    let l = load_scene("rotating-beam").unwrap().links()[0].clone();
     let scale = l.bending_stiffness / (l.mass_per_length * l.length.powi(4));
     let w2 = |lambda: f64| {
         let r = FdmBackend
@@ -305,7 +305,7 @@ fn conv_rotating_beam_frequencies_second_order_by_richardson() {
             })
             .collect();
         let p = ((f[0] - f[1]) / (f[1] - f[2])).abs().log2();
-        let l = load_scene("rotating-beam").unwrap().links[0].clone();
+        let l = load_scene("rotating-beam").unwrap().links()[0].clone();
         let nondim = 2.0 * std::f64::consts::PI * f[2]
             / (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt();
         eprintln!(

@@ -77,7 +77,7 @@ fn elem_chain_momenta_and_gradient_are_derivatives_of_the_kinetic_energy() {
 fn elem_chain_forces_are_minus_potential_gradients() {
     // accelerations with q̇ = 0 and no dampers: M a = −∂V/∂q; check M a against FD of V.
     let mut scene = load_scene("two-link-free-undamped").unwrap();
-    scene.links[1].joint.set_point = Some(0.3);
+    scene.planar_chain_mut().unwrap().links[1].joint.set_point = Some(0.3);
     let mut sys = TwoLinkChain::from_scene(&scene, Some(9)).unwrap();
     let n = sys.dofs();
     let (q, _) = common::moving_chain_state(sys.dofs());
@@ -384,7 +384,7 @@ fn conv_chain_joint_angles_second_order_in_space() {
 
 /// Rigid two-link arm (uniform rods, joint springs/dampers): RK4 on (θ₁, θ₂, θ̇₁, θ̇₂).
 fn rigid_two_link(scene: &data::Scene, t_end: f64, dt: f64, samples: &[f64]) -> Vec<[f64; 2]> {
-    let (l1, l2) = (&scene.links[0], &scene.links[1]);
+    let (l1, l2) = (&scene.links()[0], &scene.links()[1]);
     let (m1, m2) = (
         l1.mass_per_length * l1.length,
         l2.mass_per_length * l2.length,
@@ -450,7 +450,7 @@ fn dyn_chain_rigid_limit_follows_rigid_two_link_model() {
     // EI × 1e4 (first bending frequency × 100): the joint angles of two-link-free must follow
     // the rigid arm. 11 stations, 0.5 s (the step shrinks 100×).
     let stiff = |sc: &mut data::Scene| {
-        for l in &mut sc.links {
+        for l in &mut sc.planar_chain_mut().unwrap().links {
             l.bending_stiffness *= 1e4;
         }
     };

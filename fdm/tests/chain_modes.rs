@@ -13,7 +13,7 @@ use fdm::FdmBackend;
 /// The straight chain's beams: (length, EI, ρA) of links 1 and 2.
 fn beams(scene: &Scene) -> [(f64, f64, f64); 2] {
     [0, 1].map(|k| {
-        let l = &scene.links[k];
+        let l = &scene.links()[k];
         (l.length, l.bending_stiffness, l.mass_per_length)
     })
 }
@@ -147,7 +147,7 @@ fn fdm_flexible(scene: &Scene, stations: usize, count: usize) -> (Vec<f64>, usiz
 /// The straight scene (both joints at angle 0) with springs scaled by `spring`.
 fn straight(spring: f64) -> Scene {
     let mut scene = load_scene("two-link-free").unwrap();
-    for l in &mut scene.links {
+    for l in &mut scene.planar_chain_mut().unwrap().links {
         let j = &mut l.joint;
         j.set_point = Some(0.0);
         j.initial_angle = 0.0;
@@ -231,7 +231,7 @@ fn conv_chain_modes_stiff_joints_tend_to_the_clamped_free_beam() {
     assert!((x[0] - 1.8751).abs() < 1e-4);
     // the determinant with rigid joints, and with springs × 1e7, gives the same frequencies
     let scene0 = straight(1.0);
-    let k_scene = [0, 1].map(|i| scene0.links[i].joint.stiffness.unwrap());
+    let k_scene = [0, 1].map(|i| scene0.links()[i].joint.stiffness.unwrap());
     let search =
         |k: [Option<f64>; 2]| roots(|w| det(b0, k, w), 0.5 * clamped[0], 0.01 * clamped[0], 3);
     for (a, e) in search([None, None]).iter().zip(&clamped) {
@@ -262,7 +262,7 @@ fn conv_chain_modes_scene_springs_match_the_spring_jointed_beams() {
     // modes are the two spring-dominated joint modes, then the flexible ones.
     let scene = straight(1.0);
     let b = beams(&scene);
-    let k = [0, 1].map(|i| scene.links[i].joint.stiffness);
+    let k = [0, 1].map(|i| scene.links()[i].joint.stiffness);
     let w1 = (b[0].1 / b[0].2).sqrt() / (b[0].0 * b[0].0);
     let exact = roots(|w| det(b, k, w), 0.05 * w1, 0.01 * w1, 4);
     // all four O(h²) (observed 1.89–2.02: joint modes and flexible modes alike)

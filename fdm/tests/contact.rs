@@ -218,21 +218,21 @@ fn conv_contact_tipmass_first_impulse_converges_at_first_order() {
 fn prop_contact_unsupported_settings_are_typed_errors() {
     let mut scene = load_scene("barhorst-case1").unwrap();
     let s = settings(11, 0.1);
-    scene.contacts[0].friction = 0.3;
+    scene.planar_chain_mut().unwrap().contacts[0].friction = 0.3;
     let e = FdmBackend.simulate(&scene, &s).unwrap_err();
     assert!(
         matches!(&e, BackendError::Unsupported(m) if m.contains("friction")),
         "{e}"
     );
     let mut scene = load_scene("barhorst-case1").unwrap();
-    scene.contacts[0].mode = data::scene::ContactMode::Bilateral;
+    scene.planar_chain_mut().unwrap().contacts[0].mode = data::scene::ContactMode::Bilateral;
     let e = FdmBackend.simulate(&scene, &s).unwrap_err();
     assert!(
         matches!(&e, BackendError::Unsupported(m) if m.contains("bilateral")),
         "{e}"
     );
     let mut scene = load_scene("barhorst-case1").unwrap();
-    scene.contacts[0].surface = data::scene::Surface::Circle {
+    scene.planar_chain_mut().unwrap().contacts[0].surface = data::scene::Surface::Circle {
         center: [0.0, 0.0],
         radius: 6.0,
     };
@@ -253,8 +253,8 @@ fn elem_contact_gravity_force_is_minus_the_potential_gradient() {
     // the free chain under gravity conserves T + V_g + strain + springs when undamped: the
     // gravity force is −∂V_g/∂q of the stored `gravity` term (foreshortening included)
     let mut scene = load_scene("barhorst-case1").unwrap();
-    scene.contacts.clear();
-    for l in &mut scene.links {
+    scene.planar_chain_mut().unwrap().contacts.clear();
+    for l in &mut scene.planar_chain_mut().unwrap().links {
         l.kelvin_voigt = None;
         l.joint.damping = None;
     }

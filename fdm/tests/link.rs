@@ -83,11 +83,11 @@ fn sys_link_ledger_books_only_the_scene_terms() {
     assert_eq!(r.cost.dofs, 40);
     // every term switched on, and the ledger still closes with them
     let all = |sc: &mut data::Scene| {
-        let j = &mut sc.links[0].joint;
+        let j = &mut sc.planar_chain_mut().unwrap().links[0].joint;
         j.stiffness = Some(2.0);
         j.damping = Some(0.05);
         j.set_point = Some(0.3);
-        sc.links[0].kelvin_voigt = Some(1e-4);
+        sc.planar_chain_mut().unwrap().links[0].kelvin_voigt = Some(1e-4);
     };
     let r = run("single-link", all, &s);
     assert_eq!(
@@ -111,7 +111,7 @@ fn sys_link_ledger_books_only_the_scene_terms() {
         "single-link",
         |sc| {
             all(sc);
-            sc.links[0].joint.torque = None;
+            sc.planar_chain_mut().unwrap().links[0].joint.torque = None;
         },
         &s,
     );
@@ -187,9 +187,13 @@ fn dyn_single_link_report_scheme_parasitic_velocity_form_closes_energy() {
     assert!(c < 1e-4);
     // Rigid limit: EI × 1e3; θ(t) = τ t² / (2 I), I = J + ρA L³/3 + M L² for t < 0.5 s.
     s.time.t_end = Some(0.4);
-    let stiff = run("single-link", |sc| sc.links[0].bending_stiffness *= 1e3, &s);
+    let stiff = run(
+        "single-link",
+        |sc| sc.planar_chain_mut().unwrap().links[0].bending_stiffness *= 1e3,
+        &s,
+    );
     let scene = load_scene("single-link").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let i = l.joint.hub_inertia.unwrap()
         + l.mass_per_length * l.length.powi(3) / 3.0
         + l.tip_mass.unwrap() * l.length.powi(2);
@@ -214,7 +218,7 @@ fn dyn_single_link_kelvin_voigt_dissipation_in_ledger() {
     s.time.t_end = Some(1.5);
     let out = run(
         "single-link",
-        |sc| sc.links[0].kelvin_voigt = Some(1e-4),
+        |sc| sc.planar_chain_mut().unwrap().links[0].kelvin_voigt = Some(1e-4),
         &s,
     );
     assert!(
@@ -248,7 +252,7 @@ fn dyn_spin_up_at_lambda_12_completes_with_the_tension_bound() {
     let out = run(
         "spin-up",
         |sc| {
-            sc.links[0].joint.prescribed =
+            sc.planar_chain_mut().unwrap().links[0].joint.prescribed =
                 Some(data::scene::PrescribedMotion::SpinUp { omega_s, t_s: 15.0 })
         },
         &Settings::default(),
@@ -259,7 +263,7 @@ fn dyn_spin_up_at_lambda_12_completes_with_the_tension_bound() {
         out.verdict
     );
     let scene = load_scene("spin-up").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let tip = maxabs(&out.observables.get("link1.tip_deflection").unwrap().values);
     // bounded: the tip deflection stays a small part of the link length
     assert!(tip < l.length, "tip {tip}");

@@ -10,7 +10,7 @@ use fdm::payload_link::PayloadLinkModel;
 
 fn scene(name: &str, f: impl Fn(&mut data::scene::PayloadLink)) -> Scene {
     let mut s = load_scene(name).unwrap();
-    f(s.payload_link.as_mut().unwrap());
+    f(s.payload_link_mut().unwrap());
     s
 }
 
@@ -202,7 +202,7 @@ fn dyn_payload_link_ledger_closes_damped_and_undamped() {
 fn conv_payload_link_static_sag_against_the_closed_form() {
     // linear cantilever under self-weight q, payload weight P and offset moment P c
     let s = load_scene("single-link-3d").unwrap();
-    let p = s.payload_link.clone().unwrap();
+    let p = s.payload_link().cloned().unwrap();
     let (l, ei, g) = (p.length, p.bending_stiffness(), p.gravity.unwrap());
     let (q, pw) = (p.mass_per_length() * g, p.payload.mass * g);
     let mc = pw * p.payload.offset;
@@ -257,7 +257,7 @@ fn conv_payload_link_torsion_and_axial_frequencies_against_the_closed_forms() {
     let s = scene("single-link-3d-constant-rate", |p| {
         p.base.prescribed = Some(PrescribedMotion::Fixed)
     });
-    let p = s.payload_link.clone().unwrap();
+    let p = s.payload_link().cloned().unwrap();
     let l = p.length;
     let root = |ratio: f64| {
         bisect(

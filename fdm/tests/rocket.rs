@@ -81,7 +81,7 @@ fn sys_rocket_dof_plan_counts() {
 #[test]
 fn dyn_rocket_step_is_the_reports_bound_recomputed_as_mass_burns() {
     let scene = load_scene("rocket").unwrap();
-    let r = scene.rocket.as_ref().unwrap();
+    let r = scene.rocket().unwrap();
     for (method, factor) in [("report", 0.5), ("velocity-form", 1.0)] {
         let out = run(&scene, method);
         assert!(
@@ -146,7 +146,7 @@ fn dyn_rocket_step_is_the_reports_bound_recomputed_as_mass_burns() {
 #[test]
 fn dyn_rocket_rigid_translation_follows_the_rocket_equation_with_gravity() {
     let scene = load_scene("rocket").unwrap();
-    let r = scene.rocket.as_ref().unwrap();
+    let r = scene.rocket().unwrap();
     let out = run(&scene, "report");
     let g = r.gravity;
     let l1 = r.stages[0].length;
@@ -269,7 +269,7 @@ fn dyn_rocket_discrete_masses_case_i_synchronous_case_ii_longer_cycle() {
     assert!(p2 > 1.5 * p1, "{p1} {p2}");
     // Reference: the mass chain on a rigid case. Case II, symmetric modes (U1 = U3 = a, U2 = b):
     // [k+kc, −kc; −2kc, 2kc] (a, b) = M ω² (a, b); the lower root is the middle-mass mode.
-    let r = s2.rocket.as_ref().unwrap();
+    let r = s2.rocket().unwrap();
     let (k, kc, m) = (
         r.discrete_masses[0].axial_stiffness,
         r.springs[0].axial_stiffness,
@@ -375,7 +375,7 @@ fn dyn_rocket_report_two_step_at_the_reports_own_sigma_blows_up() {
 #[test]
 fn dyn_rocket_parasitic_mode_with_dampers_detected_and_remedied() {
     let mut scene = load_scene("rocket").unwrap();
-    let r = scene.rocket.as_mut().unwrap();
+    let r = scene.rocket_mut().unwrap();
     for m in &mut r.discrete_masses {
         // c/M ≈ 1.3e3 1/s (mount damping ratio ≈ 0.27): the spurious root has |ξ| ≈ 1 + cτ/(2M),
         // so the computational mode grows like e^{ct/(2M)} ≈ e^{64} over 0.1 s
@@ -446,7 +446,7 @@ fn dyn_rocket_junction_between_stations_keeps_mass_and_rocket_equation() {
     // 50 stations: h = 150/49, x = L₁ = 100 falls inside a segment (series-averaged stiffness,
     // length-weighted mass, pressure force split linearly). Mass and rigid motion stay exact.
     let scene = load_scene("rocket").unwrap();
-    let r = scene.rocket.as_ref().unwrap();
+    let r = scene.rocket().unwrap();
     let mut s = Settings::default();
     s.discretization.stations = Some(50);
     s.time.t_end = Some(0.01);
@@ -531,7 +531,7 @@ fn prop_rocket_split_satisfies_5_37_exactly() {
 /// Weighted least-squares line c₀ + c₁x of the scene's initial w(x, 0) with the case's ignition
 /// mass per length (stepped, discrete masses excluded), by a fine trapezoid rule.
 fn rigid_part_of_initial_shape(scene: &Scene) -> (f64, f64) {
-    let r = scene.rocket.as_ref().unwrap();
+    let r = scene.rocket().unwrap();
     let len = r.length();
     let n = 30_000;
     let mass_at = |x: f64| {
@@ -562,7 +562,7 @@ fn rigid_part_of_initial_shape(scene: &Scene) -> (f64, f64) {
 #[test]
 fn sys_rocket_initial_shape_is_elastic_with_respect_to_ignition_mass() {
     let scene = load_scene("rocket").unwrap();
-    let r = scene.rocket.as_ref().unwrap();
+    let r = scene.rocket().unwrap();
     let (_, f) = settings("report");
     let sys = fdm::rocket::build(&scene, &f).unwrap();
     let (q, _) = sys.initial_state(&r.initial_shape);
@@ -604,7 +604,7 @@ fn dyn_rocket_thrust_along_the_mean_axis_leaves_no_lateral_drift() {
     // 0.1 s — as large as the elastic deflections themselves. With the rigid part removed the
     // drift is only what the bending vibration (w' of 1e-6 at the nozzle, averaging out) leaves.
     let scene = load_scene("rocket").unwrap();
-    let r = scene.rocket.as_ref().unwrap();
+    let r = scene.rocket().unwrap();
     let out = run(&scene, "report");
     let o = &out.observables;
     let x = ch(o, "rocket.X");
@@ -633,13 +633,13 @@ fn dyn_rocket_constant_thrust_quasi_static_compression_matches_closed_form() {
     // static value (ω₁ ≈ 2π·340 rad/s, the lowest axial frequency, T = 0.1 s).
     let mut scene = load_scene("rocket").unwrap();
     {
-        let r = scene.rocket.as_mut().unwrap();
+        let r = scene.rocket_mut().unwrap();
         r.stages[0].burn_rate *= 1e-6;
         r.exhaust_velocity *= 1e6;
         r.chamber_pressure = 0.0;
         r.initial_shape = data::scene::InitialShape::Straight;
     }
-    let r = scene.rocket.as_ref().unwrap();
+    let r = scene.rocket().unwrap();
     let g = r.gravity;
     let len = r.length();
     let thrust = r.stages[0].burn_rate / g * r.stages[0].length * r.exhaust_velocity;

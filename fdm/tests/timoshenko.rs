@@ -28,7 +28,7 @@ fn settings(stations: usize, t_end: f64) -> Settings {
 /// `name` with Timoshenko links of shear stiffness κGA.
 fn sheared(name: &str, kga: f64) -> Scene {
     let mut sc = load_scene(name).unwrap();
-    for l in &mut sc.links {
+    for l in &mut sc.planar_chain_mut().unwrap().links {
         l.shear = true;
         l.shear_stiffness = Some(kga);
     }
@@ -38,9 +38,9 @@ fn sheared(name: &str, kga: f64) -> Scene {
 fn chain_with_springs() -> TwoLinkChain {
     // case 1 has K₁ = 0: give joint 1 a spring and a set-point so every term is exercised
     let mut sc = load_scene("barhorst-case1-timoshenko").unwrap();
-    sc.links[0].joint.stiffness = Some(35.0);
-    sc.links[0].joint.set_point = Some(0.3);
-    sc.links[1].joint.set_point = Some(-0.2);
+    sc.planar_chain_mut().unwrap().links[0].joint.stiffness = Some(35.0);
+    sc.planar_chain_mut().unwrap().links[0].joint.set_point = Some(0.3);
+    sc.planar_chain_mut().unwrap().links[1].joint.set_point = Some(-0.2);
     TwoLinkChain::from_scene(&sc, Some(9)).unwrap()
 }
 
@@ -154,7 +154,7 @@ fn elem_timoshenko_condensed_forces_are_minus_condensed_gradients() {
 fn conv_timoshenko_cantilever_tip_deflection_second_order() {
     // the scene's stocky beam (κGA L²/EI ≈ 385), tip load P
     let sc = load_scene("cantilever-timoshenko").unwrap();
-    let l = &sc.links[0];
+    let l = &sc.links()[0];
     let (len, ei, kga, p) = (
         l.length,
         l.bending_stiffness,
@@ -191,12 +191,12 @@ fn sys_timoshenko_cantilever_statics_through_the_backend() {
     // `flexverify statics cantilever-timoshenko --backend fdm`: tip force (the scene's) and a
     // distributed load, against PL³/3EI + PL/κGA and qL⁴/8EI + qL²/2κGA; order 2 for both
     let base = load_scene("cantilever-timoshenko").unwrap();
-    let l = &base.links[0];
+    let l = &base.links()[0];
     let (len, ei, kga) = (l.length, l.bending_stiffness, l.shear_stiffness.unwrap());
-    let p = base.statics.as_ref().unwrap().tip_force.unwrap();
+    let p = base.statics().unwrap().tip_force.unwrap();
     let q = 250.0;
     let mut dist = base.clone();
-    if let Some(st) = dist.statics.as_mut() {
+    if let Some(st) = dist.planar_chain_mut().unwrap().statics.as_mut() {
         st.tip_force = None;
         st.distributed_load = Some(q);
     }
@@ -402,7 +402,7 @@ fn elem_timoshenko_top_frequency_is_the_shear_sawtooth() {
     for kga in [1.0e6, 1.0e8] {
         let sc = sheared("barhorst-case1", kga);
         let sys = TwoLinkChain::from_scene(&sc, Some(21)).unwrap();
-        let (l2, r) = (&sc.links[1], 20.0);
+        let (l2, r) = (&sc.links()[1], 20.0);
         let h = l2.length / r;
         let (ei, rho_a) = (l2.bending_stiffness, l2.mass_per_length);
         let sawtooth = 2.0 / h * (kga / rho_a).sqrt();
@@ -429,20 +429,20 @@ fn prop_timoshenko_unsupported_switches_are_typed_errors() {
     let base = load_scene("barhorst-case1-timoshenko").unwrap();
     let s = settings(11, 0.01);
     let mut sc = base.clone();
-    sc.links[0].rotary_inertia = true;
-    sc.links[0].rotary_inertia_per_length = Some(1e-3);
+    sc.planar_chain_mut().unwrap().links[0].rotary_inertia = true;
+    sc.planar_chain_mut().unwrap().links[0].rotary_inertia_per_length = Some(1e-3);
     match FdmBackend.simulate(&sc, &s) {
         Err(BackendError::Unsupported(m)) => assert!(m.contains("rotary_inertia"), "{m}"),
         other => panic!("{other:?}"),
     }
     let mut sc = base.clone();
-    sc.links[1].shear = false;
+    sc.planar_chain_mut().unwrap().links[1].shear = false;
     match FdmBackend.simulate(&sc, &s) {
         Err(BackendError::Unsupported(m)) => assert!(m.contains("mixes"), "{m}"),
         other => panic!("{other:?}"),
     }
     let mut sc = base.clone();
-    sc.links[0].shear_stiffness = None;
+    sc.planar_chain_mut().unwrap().links[0].shear_stiffness = None;
     assert!(FdmBackend.simulate(&sc, &s).is_err());
     let plan = FdmBackend
         .dof_plan(&base, &Default::default())

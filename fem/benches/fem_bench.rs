@@ -29,7 +29,7 @@ fn assembly(c: &mut Criterion) {
     let sc = data::load_scene("spin-up").unwrap();
     let mut g = c.benchmark_group("assembly");
     for n in MESHES {
-        let mut ch = Chain::new(&sc.links, None, n).unwrap();
+        let mut ch = Chain::new(sc.links(), None, n).unwrap();
         let nd = ch.ndof;
         let q: Vec<f64> = (0..nd).map(|i| 1e-3 * (i as f64).sin()).collect();
         let qd = vec![0.1; nd];
@@ -145,7 +145,7 @@ fn assembly_foreshortening(c: &mut Criterion) {
     let sc = data::load_scene("two-link-free-undamped").unwrap();
     let mut g = c.benchmark_group("assembly-foreshortening");
     for n in MESHES {
-        let mut ch = Chain::new(&sc.links, None, n).unwrap();
+        let mut ch = Chain::new(sc.links(), None, n).unwrap();
         let nd = ch.ndof;
         let q: Vec<f64> = (0..nd).map(|i| 1e-3 * (i as f64).sin()).collect();
         let qd = vec![0.1; nd];

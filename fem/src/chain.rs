@@ -226,7 +226,7 @@ impl Chain {
     pub fn from_scene(scene: &Scene, disc: &Discretization) -> Result<Self, FemError> {
         crate::support::check_planar(scene)?;
         let n_el = crate::settings::elements(disc)?;
-        Self::with_element(&scene.links, scene.gravity.as_ref(), n_el, disc.element)
+        Self::with_element(scene.links(), scene.gravity(), n_el, disc.element)
     }
 
     /// Builds the chain for `links` with `n_el` elements per link of the element `choice`

@@ -201,11 +201,11 @@ pub struct FemBackend;
 /// The single clamped/spinning link that modes and statics linearize.
 fn single_link(scene: &Scene, what: &str) -> Result<(), FemError> {
     support::check_planar(scene)?;
-    if scene.links.len() != 1 {
+    if scene.links().len() != 1 {
         return Err(FemError::unsupported(format!(
             "fem {what}: chains of {} links (linearization of a free chain about its initial \
              configuration is not implemented)",
-            scene.links.len()
+            scene.links().len()
         )));
     }
     Ok(())
@@ -221,7 +221,7 @@ impl FemBackend {
         let start = Instant::now();
         single_link(scene, "modes")?;
         let n_el = settings::elements(&settings.discretization)?;
-        let link = &scene.links[0];
+        let link = &scene.links()[0];
         let omega = linear::hub_rate(link)?;
         let element = element::for_link(link, settings.discretization.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
@@ -250,7 +250,7 @@ impl FemBackend {
         let start = Instant::now();
         single_link(scene, "statics")?;
         let n_el = settings::elements(&settings.discretization)?;
-        let link = &scene.links[0];
+        let link = &scene.links()[0];
         let omega = linear::hub_rate(link)?;
         let element = element::for_link(link, settings.discretization.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;

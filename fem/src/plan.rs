@@ -15,7 +15,7 @@ pub fn dof_plan(
 ) -> Result<DofPlan, FemError> {
     check_planar(scene)?;
     let mut plan = DofPlan::default();
-    for (i, l) in scene.links.iter().enumerate() {
+    for (i, l) in scene.links().iter().enumerate() {
         let li = i + 1;
         if l.joint.prescribed.is_none() {
             plan.add(format!("joint{li} angle"), 1);
@@ -73,7 +73,7 @@ pub fn dof_plan(
         }
         plan.builds.extend(b);
     }
-    if scene.gravity.is_some() {
+    if scene.gravity().is_some() {
         plan.builds.push("gravity".into());
     }
     plan.builds

@@ -55,10 +55,10 @@ pub const STEPS_PER_AXIAL_PERIOD: f64 = 16.0;
 /// (1e-3 … 1.25e-4 s): 16 steps leave ~0.1 % (second order) against 19 % at the bending rule.
 pub fn axial_wall_step(scene: &Scene) -> Option<f64> {
     let c = scene
-        .contacts
+        .contacts()
         .iter()
         .find(|c| c.mode == data::scene::ContactMode::Bilateral)?;
-    let link = scene.links.iter().find(|l| l.name == c.link && l.axial)?;
+    let link = scene.links().iter().find(|l| l.name == c.link && l.axial)?;
     let ea = link.axial_stiffness?;
     let omega_ax = std::f64::consts::PI * (ea / link.mass_per_length).sqrt() / link.length;
     Some(2.0 * std::f64::consts::PI / (STEPS_PER_AXIAL_PERIOD * omega_ax))
@@ -97,7 +97,7 @@ fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
 /// what the ledger checks need) unless a link is extensible, where ρ∞ = 0.9 damps the spurious
 /// high axial frequencies (EA/EI ≫ 1) that the time step cannot resolve.
 pub fn default_rho_inf(scene: &Scene) -> f64 {
-    if scene.links.iter().any(|l| l.axial) {
+    if scene.links().iter().any(|l| l.axial) {
         0.9
     } else {
         1.0
@@ -115,7 +115,7 @@ pub fn default_rho_inf(scene: &Scene) -> f64 {
 pub fn default_method(scene: &Scene) -> Method {
     if check_midpoint(scene).is_ok()
         && scene
-            .contacts
+            .contacts()
             .iter()
             .any(|c| c.mode == data::scene::ContactMode::Bilateral)
     {
@@ -123,7 +123,7 @@ pub fn default_method(scene: &Scene) -> Method {
     }
     if check_midpoint(scene).is_ok()
         && !scene
-            .links
+            .links()
             .iter()
             .any(|l| l.axial || undamped_massless_hub(l))
     {
@@ -140,9 +140,9 @@ fn undissipated_free_chain_frequency(scene: &Scene) -> Option<f64> {
     let dissipates = |l: &data::scene::Link| {
         l.kelvin_voigt.unwrap_or(0.0) > 0.0 || l.joint.damping.unwrap_or(0.0) > 0.0
     };
-    if !scene.contacts.is_empty()
+    if !scene.contacts().is_empty()
         || scene
-            .links
+            .links()
             .iter()
             .any(|l| l.joint.prescribed.is_some() || dissipates(l) || l.foreshortening || l.axial)
     {
@@ -150,7 +150,7 @@ fn undissipated_free_chain_frequency(scene: &Scene) -> Option<f64> {
     }
     let beta1 = pinned_free_beta1();
     scene
-        .links
+        .links()
         .iter()
         .map(|l| {
             beta1 * beta1 * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt()
@@ -177,7 +177,7 @@ fn undamped_massless_hub(l: &data::scene::Link) -> bool {
 /// of its actuator booked with the scheme's quadrature, which is not implemented.
 fn check_midpoint(scene: &Scene) -> Result<(), FemError> {
     if let Some(i) = scene
-        .links
+        .links()
         .iter()
         .position(|l| l.joint.prescribed.is_some())
     {
@@ -219,7 +219,7 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
     }
     if method == Method::CentralDifference
         && let Some(i) = scene
-            .links
+            .links()
             .iter()
             .position(|l| l.shear && !l.rotary_inertia)
     {
@@ -238,7 +238,7 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
                 .into(),
         });
     }
-    if let Some(st) = &scene.statics {
+    if let Some(st) = scene.statics() {
         // The scene's static loads act as a step load in dynamics (scene `cantilever`: the
         // response oscillates about the static deflection).
         chain.tip_load = st.tip_force.unwrap_or(0.0);
@@ -247,7 +247,7 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
     let out = scene.simulation.output_interval;
     let (beta_clamped, beta_pinned) = (clamped_free_beta1(), pinned_free_beta1());
     let omega1 = scene
-        .links
+        .links()
         .iter()
         .map(|l| {
             let beta1 = if l.joint.prescribed.is_some() {
@@ -363,7 +363,7 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
             specs.push(channel::spec::field_deflection(k, s));
         }
     }
-    if !scene.contacts.is_empty() {
+    if !scene.contacts().is_empty() {
         specs.push(channel::spec::contact_normal_force(1));
         specs.push(channel::spec::contact_phase(1));
         // Gap (constraint violation when constrained), normal tip velocity
@@ -372,7 +372,7 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
         specs.push(channel::spec::contact_normal_velocity(1));
         specs.push(channel::spec::contact_max_gap(1));
         specs.push(channel::spec::contact_max_normal_velocity(1));
-        if scene.contacts[0].friction > 0.0 {
+        if scene.contacts()[0].friction > 0.0 {
             // Friction contact (crate::events::contact::friction): slip velocity, tangential force, work.
             specs.push(channel::spec::contact_slip_velocity(1));
             specs.push(channel::spec::contact_friction_force(1));

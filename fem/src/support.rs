@@ -24,10 +24,10 @@ pub fn check_planar(scene: &Scene) -> Result<(), FemError> {
     // Unilateral frictionless line contact and the bilateral wall are implemented
     // (`crate::events::contact`); the rest is refused by name ([`check_contact`]).
     check_contact(scene)?;
-    if scene.links.is_empty() {
+    if scene.links().is_empty() {
         return Err(FemError::unsupported("fem: scene has no links".to_string()));
     }
-    for (i, l) in scene.links.iter().enumerate() {
+    for (i, l) in scene.links().iter().enumerate() {
         if l.axial && l.foreshortening {
             return Err(FemError::unsupported(format!(
                 "fem: link {} has both `axial` and `foreshortening`; choose one stiffening model",
@@ -58,14 +58,14 @@ pub fn check_planar(scene: &Scene) -> Result<(), FemError> {
 
 /// Refuses contact features this backend does not model, with a precise message.
 pub fn check_contact(scene: &Scene) -> Result<(), FemError> {
-    if scene.contacts.len() > 1 {
+    if scene.contacts().len() > 1 {
         return Err(FemError::unsupported(format!(
             "fem: {} contacts in scene `{}`; one tip contact is implemented",
-            scene.contacts.len(),
+            scene.contacts().len(),
             scene.name
         )));
     }
-    let Some(c) = scene.contacts.first() else {
+    let Some(c) = scene.contacts().first() else {
         return Ok(());
     };
     // Bilateral contacts (line or circle, with or without friction): `crate::events::contact::friction`.
@@ -87,7 +87,7 @@ pub fn check_contact(scene: &Scene) -> Result<(), FemError> {
         )));
     }
     if let Some(i) = scene
-        .links
+        .links()
         .iter()
         .position(|l| l.joint.prescribed.is_some())
     {
@@ -97,7 +97,7 @@ pub fn check_contact(scene: &Scene) -> Result<(), FemError> {
         )));
     }
     if let Some(i) = scene
-        .links
+        .links()
         .iter()
         .position(|l| l.shear && !l.rotary_inertia && l.kelvin_voigt.unwrap_or(0.0) <= 0.0)
     {
@@ -108,10 +108,10 @@ pub fn check_contact(scene: &Scene) -> Result<(), FemError> {
              implemented (only the damped case, where ψ̇ follows the massless balance \
              Nᵀ(∂V/∂q + C q̇) = 0); set `kelvin_voigt` > 0 or `rotary_inertia`",
             i + 1,
-            scene.links[i].name
+            scene.links()[i].name
         )));
     }
-    if !scene.links.iter().any(|l| l.name == c.link) {
+    if !scene.links().iter().any(|l| l.name == c.link) {
         return Err(FemError::InvalidSettings {
             field: "contact.link".into(),
             message: format!("no link named `{}`", c.link),
@@ -122,7 +122,7 @@ pub fn check_contact(scene: &Scene) -> Result<(), FemError> {
 
 /// Refuses what the bilateral contact does not model (part of [`check_contact`]).
 pub fn check_bilateral_contact(scene: &Scene) -> Result<(), FemError> {
-    let Some(c) = scene.contacts.first() else {
+    let Some(c) = scene.contacts().first() else {
         return Ok(());
     };
     if c.mode != ContactMode::Bilateral {
@@ -135,7 +135,7 @@ pub fn check_bilateral_contact(scene: &Scene) -> Result<(), FemError> {
         });
     }
     if let Some(i) = scene
-        .links
+        .links()
         .iter()
         .position(|l| l.shear && !l.rotary_inertia)
     {
@@ -148,13 +148,13 @@ pub fn check_bilateral_contact(scene: &Scene) -> Result<(), FemError> {
              index-1 wall forces (G M⁻¹Gᵀ, G M⁻¹Tᵀ, T M⁻¹Tᵀ) are undefined; set \
              `rotary_inertia = true` with `rotary_inertia_per_length`",
             i + 1,
-            scene.links[i].name
+            scene.links()[i].name
         )));
     }
     if let (Some(l), Surface::Circle { center, radius }) =
-        (scene.links.iter().find(|l| l.name == c.link), &c.surface)
+        (scene.links().iter().find(|l| l.name == c.link), &c.surface)
     {
-        let first = scene.links.first().is_some_and(|f| f.name == l.name);
+        let first = scene.links().first().is_some_and(|f| f.name == l.name);
         let tol = 1e-12 * l.length;
         if first
             && !l.axial

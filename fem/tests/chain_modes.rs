@@ -20,8 +20,8 @@ fn settings(n: usize) -> Settings {
 
 fn scene_with_springs(k1: f64, k2: f64) -> Scene {
     let mut sc = data::load_scene("two-link-free").unwrap();
-    sc.links[0].joint.stiffness = Some(k1);
-    sc.links[1].joint.stiffness = Some(k2);
+    sc.planar_chain_mut().unwrap().links[0].joint.stiffness = Some(k1);
+    sc.planar_chain_mut().unwrap().links[1].joint.stiffness = Some(k2);
     sc
 }
 
@@ -37,7 +37,7 @@ fn omegas(scene: &Scene, n: usize, count: usize) -> (Vec<f64>, Vec<String>) {
 
 /// The two links share EI and ρA (the limits below are single uniform beams).
 fn section(scene: &Scene) -> (f64, f64, f64, f64) {
-    let (a, b) = (&scene.links[0], &scene.links[1]);
+    let (a, b) = (&scene.links()[0], &scene.links()[1]);
     assert_eq!(a.bending_stiffness, b.bending_stiffness);
     assert_eq!(a.mass_per_length, b.mass_per_length);
     (
@@ -71,7 +71,7 @@ fn sys_chain_linearization_matches_the_residual() {
     // in q to O(q²) (the foreshortening couplings are quadratic), so central differences of
     // the residual reproduce the pieces to round-off plus O(step²).
     let sc = data::load_scene("two-link-free").unwrap();
-    let mut chain = Chain::with_element(&sc.links, sc.gravity.as_ref(), 4, None).unwrap();
+    let mut chain = Chain::with_element(sc.links(), sc.gravity(), 4, None).unwrap();
     let lin = chain.linearize();
     let n = chain.ndof;
     let q0 = lin.reference.clone();

@@ -43,7 +43,7 @@ fn sci(v: &[f64]) -> String {
 #[test]
 fn conv_quintic_cantilever_frequencies_converge_at_order_eight() {
     let sc = data::load_scene("cantilever").unwrap();
-    let l = &sc.links[0];
+    let l = &sc.links()[0];
     let exact = common::clamped_free_omega(l.bending_stiffness, l.mass_per_length, l.length, 4);
     let meshes = [1usize, 2, 4, 8, 16];
     let errs: Vec<Vec<f64>> = meshes
@@ -107,8 +107,8 @@ fn conv_quintic_cantilever_frequencies_converge_at_order_eight() {
 fn sys_quintic_tip_mass_frequencies_match_transcendental_equation() {
     let mut sc = data::load_scene("cantilever-tip-mass").unwrap();
     for tip_inertia in [None, Some(2e-3)] {
-        sc.links[0].tip_inertia = tip_inertia;
-        let l = &sc.links[0];
+        sc.planar_chain_mut().unwrap().links[0].tip_inertia = tip_inertia;
+        let l = &sc.links()[0];
         let exact = common::tip_mass_omega(
             l.bending_stiffness,
             l.mass_per_length,
@@ -136,8 +136,8 @@ fn sys_quintic_tip_mass_frequencies_match_transcendental_equation() {
 #[test]
 fn sys_quintic_statics_exact_for_tip_and_uniform_load() {
     let sc = data::load_scene("cantilever").unwrap();
-    let l = &sc.links[0];
-    let st = sc.statics.clone().unwrap();
+    let l = &sc.links()[0];
+    let st = sc.statics().cloned().unwrap();
     let (p, q) = (st.tip_force.unwrap(), st.distributed_load.unwrap());
     let (ei, len) = (l.bending_stiffness, l.length);
     let exact = p * len.powi(3) / (3.0 * ei) + q * len.powi(4) / (8.0 * ei);
@@ -231,7 +231,7 @@ fn conv_quintic_dynamics_converges_to_the_refined_cubic_hub_angle_history() {
     // One step for every run, T₁/400 of the scene's first flexible period
     // (clamped–free β₁L = 1.8751: ω₁ = β₁² √(EI/ρA)); the comparison is spatial only.
     let sc = data::load_scene("single-link").unwrap();
-    let l = &sc.links[0];
+    let l = &sc.links()[0];
     let beta1 = 1.875_104_068_711_961 / l.length;
     let omega1 = beta1 * beta1 * (l.bending_stiffness / l.mass_per_length).sqrt();
     let dt = 2.0 * std::f64::consts::PI / omega1 / 400.0;

@@ -47,7 +47,7 @@ fn elem_tip_jacobian_matches_finite_differences_and_forward_velocity() {
 }
 
 fn check_tip_jacobian(sc: &Scene) {
-    let mut chain = Chain::new(&sc.links, sc.gravity.as_ref(), 6).unwrap();
+    let mut chain = Chain::new(sc.links(), sc.gravity(), 6).unwrap();
     let n = chain.ndof;
     let q = bent_state(&chain);
     let mut jac = vec![0.0; 2 * n];
@@ -328,7 +328,7 @@ fn dyn_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     println!("|q̇|∞ at 10 s: {speed:.3e}");
     assert!(speed < 1e-2, "still moving: |q̇|∞ = {speed:.2e}");
     let mut q = integ.state.q.clone();
-    let mut chain = Chain::new(&sc.links, sc.gravity.as_ref(), 4).unwrap();
+    let mut chain = Chain::new(sc.links(), sc.gravity(), 4).unwrap();
     let stat = static_contact_force(&mut chain, &mut q, 1, -1.0);
     let rel = (dynamic - stat).abs() / stat;
     assert!(
@@ -337,10 +337,10 @@ fn dyn_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     );
     // Rigid straight arm (elbow and links rigid): moments about the hub,
     // N·(L₁ + L₂) = g(ρA L₁·L₁/2 + ρA L₂·(L₁ + L₂/2)), independent of the arm angle.
-    let (l1, l2) = (sc.links[0].length, sc.links[1].length);
+    let (l1, l2) = (sc.links()[0].length, sc.links()[1].length);
     let (m1, m2) = (
-        sc.links[0].mass_per_length * l1,
-        sc.links[1].mass_per_length * l2,
+        sc.links()[0].mass_per_length * l1,
+        sc.links()[1].mass_per_length * l2,
     );
     let g = 32.17;
     let rigid = g * (m1 * 0.5 * l1 + m2 * (l1 + 0.5 * l2)) / (l1 + l2);
@@ -391,8 +391,8 @@ fn sys_contact_refusals_are_precise() {
     // A unilateral circle contact (the constrained arm's wall made unilateral, frictionless):
     // refused by name (bilateral circles are `fem::friction`, tests/dyn_friction.rs).
     let mut arm = scene("constrained-arm");
-    arm.contacts[0].mode = data::scene::ContactMode::Unilateral;
-    arm.contacts[0].friction = 0.0;
+    arm.planar_chain_mut().unwrap().contacts[0].mode = data::scene::ContactMode::Unilateral;
+    arm.planar_chain_mut().unwrap().contacts[0].friction = 0.0;
     match FemBackend.simulate(&arm, &Settings::default()) {
         Err(BackendError::Unsupported(m)) => assert!(m.contains("circular"), "{m}"),
         other => panic!("{other:?}"),

@@ -61,11 +61,11 @@ fn stick_slips(r: &RunResult) -> Vec<(f64, bool)> {
 /// (M + ρAL/3)Lθ̇²; derivation in verify's `constrained-rigid-link`, recomputed here so that
 /// fem's tests do not depend on verify).
 fn rigid_closed_form(scene: &Scene) -> impl Fn(f64) -> (f64, f64) + use<> {
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let (len, ra, m) = (l.length, l.mass_per_length, l.tip_mass.unwrap_or(0.0));
     let j = l.joint.hub_inertia.unwrap_or(0.0) + ra * len.powi(3) / 3.0 + m * len * len;
     let tau = l.joint.torque.as_ref().unwrap().torque(0.0);
-    let mu = scene.contacts[0].friction;
+    let mu = scene.contacts()[0].friction;
     let (a, b) = (tau / j, mu * (m + ra * len / 3.0) * len * len / j);
     let c = (a * b).sqrt();
     move |t: f64| ((c * t).cosh().ln() / b, (a / b).sqrt() * (c * t).tanh())
@@ -75,20 +75,22 @@ fn rigid_closed_form(scene: &Scene) -> impl Fn(f64) -> (f64, f64) + use<> {
 /// bottom, with bending Kelvin–Voigt damping: a pendulum whose tip slides on the wall with
 /// friction until it sticks.
 fn pendulum(scene: &mut Scene) {
-    scene.gravity = Some(Gravity {
+    scene.planar_chain_mut().unwrap().gravity = Some(Gravity {
         vector: [0.0, -9.81],
     });
-    scene.links[0].joint.torque = Some(TorqueLaw::Constant {
+    scene.planar_chain_mut().unwrap().links[0].joint.torque = Some(TorqueLaw::Constant {
         value: 0.0,
         until: None,
     });
-    scene.links[0].joint.initial_angle = -std::f64::consts::FRAC_PI_2 + 0.5;
-    scene.links[0].kelvin_voigt = Some(0.5);
+    scene.planar_chain_mut().unwrap().links[0]
+        .joint
+        .initial_angle = -std::f64::consts::FRAC_PI_2 + 0.5;
+    scene.planar_chain_mut().unwrap().links[0].kelvin_voigt = Some(0.5);
 }
 
 /// EI, EA (and κGA) scaled by `scale`.
 fn stiffened(mut scene: Scene, scale: f64) -> Scene {
-    let l = &mut scene.links[0];
+    let l = &mut scene.planar_chain_mut().unwrap().links[0];
     l.bending_stiffness *= scale;
     *l.axial_stiffness.as_mut().unwrap() *= scale;
     if let Some(k) = l.shear_stiffness.as_mut() {
@@ -102,7 +104,7 @@ fn elem_circle_gap_gradient_matches_finite_differences() {
     // G = n̂ᵀJ of the circle (normal at the tip) against central differences of g(q), at a
     // bent, rotated, stretched state of the arm (every DOF non-zero).
     let scene = arm();
-    let chain = Chain::new(&scene.links, None, 4).unwrap();
+    let chain = Chain::new(scene.links(), None, 4).unwrap();
     let mut c = Contact::from_scene(&scene, &chain).unwrap().unwrap();
     let n = chain.ndof;
     let q: Vec<f64> = (0..n)
@@ -132,7 +134,7 @@ fn dyn_friction_arm_constraint_ledger_and_coulomb_law() {
     // It slides at t = 0 (no normal load at rest), then sticks and slips many times.
     let scene = arm();
     let r = sim(&scene, &settings(8, None, None));
-    let len = scene.links[0].length;
+    let len = scene.links()[0].length;
     // Bilateral constraint: |g| at the step ends at the Newton tolerance (1e-11 L), measured
     // at round-off (3e-16 m).
     let max_gap = *channel(&r, "contact1.max_gap").last().unwrap();
@@ -169,7 +171,7 @@ fn dyn_friction_arm_constraint_ledger_and_coulomb_law() {
     assert!(*w.last().unwrap() > 0.0);
     // Coulomb law at every sample: |friction force| = μ|N| opposing v_t while sliding; inside
     // the cone while sticking.
-    let mu = scene.contacts[0].friction;
+    let mu = scene.contacts()[0].friction;
     let (nf, ft, vt, phase) = (
         channel(&r, "contact1.normal_force"),
         channel(&r, FRICTION_FORCE_CHANNEL),
@@ -201,7 +203,7 @@ fn dyn_friction_work_equals_integral_of_mu_n_vt() {
     // 0.2 s of sliding: the difference is the scheme's O(h²) (halving h divides it by ~4).
     let mut scene = arm();
     pendulum(&mut scene);
-    let mu = scene.contacts[0].friction;
+    let mu = scene.contacts()[0].friction;
     let mut diffs = Vec::new();
     for dt in [2e-4, 1e-4] {
         scene.simulation.output_interval = dt;
@@ -252,7 +254,7 @@ fn dyn_friction_stick_slip_pendulum_sticks_and_stays() {
     // model, not chattering.
     let mut scene = arm();
     pendulum(&mut scene);
-    scene.contacts[0].friction = 0.3;
+    scene.planar_chain_mut().unwrap().contacts[0].friction = 0.3;
     let r = sim(&scene, &settings(4, Some(5e-4), Some(1.5)));
     let ev = stick_slips(&r);
     println!("{ev:?}");
@@ -262,7 +264,7 @@ fn dyn_friction_stick_slip_pendulum_sticks_and_stays() {
     assert!(sticking && t_stick > 0.3 && t_stick < 1.2, "{ev:?}");
     assert!(r.observables.time.last().unwrap() - t_stick > 0.5);
     let time = &r.observables.time;
-    let mu = scene.contacts[0].friction;
+    let mu = scene.contacts()[0].friction;
     let (nf, ft, vt, phase) = (
         channel(&r, "contact1.normal_force"),
         channel(&r, FRICTION_FORCE_CHANNEL),
@@ -340,7 +342,7 @@ fn dyn_friction_timoshenko_approaches_rigid_closed_form() {
     // Timoshenko arm (κGA = 1e4·EI/L², rotary inertia ρI = 1e-6 kg m: fem needs the section
     // rotations to carry mass for its index-1 forces, see the crate docs).
     let mut scene = arm();
-    let l = &mut scene.links[0];
+    let l = &mut scene.planar_chain_mut().unwrap().links[0];
     l.shear = true;
     l.shear_stiffness = Some(1e4 * l.bending_stiffness / (l.length * l.length));
     l.rotary_inertia = true;
@@ -353,14 +355,14 @@ fn dyn_friction_refusals() {
     // Simple flexure (inextensible link) on the circle of radius L about its hub: the rigid
     // model in disguise, refused by name.
     let mut scene = arm();
-    scene.links[0].axial = false;
-    scene.links[0].foreshortening = true;
+    scene.planar_chain_mut().unwrap().links[0].axial = false;
+    scene.planar_chain_mut().unwrap().links[0].foreshortening = true;
     match FemBackend.simulate(&scene, &settings(4, None, Some(0.1))) {
         Err(BackendError::Unsupported(m)) => assert!(m.contains("rigid"), "{m}"),
         other => panic!("expected Unsupported, got {other:?}"),
     }
     // A wall of another radius: the straight link starts off it, a typed error.
-    scene.contacts[0].surface = data::scene::Surface::Circle {
+    scene.planar_chain_mut().unwrap().contacts[0].surface = data::scene::Surface::Circle {
         center: [0.0, 0.0],
         radius: 0.99,
     };
@@ -375,8 +377,8 @@ fn dyn_friction_refusals() {
     }
     // Timoshenko without rotary inertia: M singular in the section rotations.
     let mut scene = arm();
-    scene.links[0].shear = true;
-    scene.links[0].shear_stiffness = Some(5e5);
+    scene.planar_chain_mut().unwrap().links[0].shear = true;
+    scene.planar_chain_mut().unwrap().links[0].shear_stiffness = Some(5e5);
     match FemBackend.simulate(&scene, &settings(4, None, Some(0.1))) {
         Err(BackendError::Unsupported(m)) => assert!(m.contains("rotary_inertia"), "{m}"),
         other => panic!("expected Unsupported, got {other:?}"),
@@ -388,11 +390,11 @@ fn dyn_friction_refusals() {
 fn inclined(mu: f64) -> Scene {
     let mut scene = arm();
     let h = std::f64::consts::FRAC_1_SQRT_2;
-    scene.contacts[0].surface = data::scene::Surface::Line {
+    scene.planar_chain_mut().unwrap().contacts[0].surface = data::scene::Surface::Line {
         point: [1.0, 0.0],
         normal: [-h, -h],
     };
-    scene.contacts[0].friction = mu;
+    scene.planar_chain_mut().unwrap().contacts[0].friction = mu;
     scene
 }
 
@@ -414,7 +416,7 @@ fn dyn_friction_inclined_line_bilateral_ledger_closes() {
         channel(&r, "contact1.phase"),
     );
     for k in 1..n.len() {
-        let cone = scene.contacts[0].friction * n[k].abs();
+        let cone = scene.contacts()[0].friction * n[k].abs();
         if phase[k] == 1.0 {
             assert!((ft[k].abs() - cone).abs() <= 1e-12 * (1.0 + n[k].abs()));
         } else {
@@ -432,9 +434,9 @@ fn dyn_friction_timoshenko_approaches_euler_on_the_frictionless_wall() {
     // rad (the same to 2 digits at 8 elements). (The end value alone is not monotone: the
     // undamped bending vibration's phase shifts with k.)
     let mut base = arm();
-    base.contacts[0].friction = 0.0;
-    base.links[0].rotary_inertia = true;
-    base.links[0].rotary_inertia_per_length = Some(1e-6);
+    base.planar_chain_mut().unwrap().contacts[0].friction = 0.0;
+    base.planar_chain_mut().unwrap().links[0].rotary_inertia = true;
+    base.planar_chain_mut().unwrap().links[0].rotary_inertia_per_length = Some(1e-6);
     let st = settings(4, None, Some(0.5));
     let euler = sim(&base, &st);
     let th_e = channel(&euler, "joint1.angle").to_vec();
@@ -442,7 +444,7 @@ fn dyn_friction_timoshenko_approaches_euler_on_the_frictionless_wall() {
         .iter()
         .map(|&k| {
             let mut sc = base.clone();
-            let l = &mut sc.links[0];
+            let l = &mut sc.planar_chain_mut().unwrap().links[0];
             l.shear = true;
             l.shear_stiffness = Some(k * l.bending_stiffness / (l.length * l.length));
             let r = sim(&sc, &st);

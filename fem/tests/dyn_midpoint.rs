@@ -65,8 +65,8 @@ fn dyn_midpoint_ledger_closes_with_a_heavy_tip_mass() {
     // deflection; generalized-α at the default step closes only to 7.7e-2 here. Measured with
     // energy-midpoint at default settings: 4.0e-12.
     let mut sc = data::load_scene("single-link").unwrap();
-    let m = sc.links[0].tip_mass.unwrap();
-    sc.links[0].tip_mass = Some(100.0 * m);
+    let m = sc.links()[0].tip_mass.unwrap();
+    sc.planar_chain_mut().unwrap().links[0].tip_mass = Some(100.0 * m);
     let r = sim(&sc, &Settings::default());
     let c = r.ledger.relative_closure();
     eprintln!("100x tip mass: closure {c:.3e}, {} steps", r.cost.steps);

@@ -38,7 +38,7 @@ fn dyn_payload_ledger_closes_with_and_without_dissipation() {
     assert!(c < 1e-7, "damped closure {c:.3e}");
     // Undamped: the same scene without any dissipation; the bang-bang torque still works.
     let mut sc = scene("single-link-3d");
-    let pl = sc.payload_link.as_mut().unwrap();
+    let pl = sc.payload_link_mut().unwrap();
     pl.kelvin_voigt = None;
     pl.base.damping = None;
     let undamped = run(&sc, 8, 0.6);
@@ -51,7 +51,7 @@ fn dyn_payload_ledger_closes_with_and_without_dissipation() {
 fn dyn_payload_stiff_rod_follows_the_rigid_body() {
     // (I_B + ρAL³/3 + ρIL + m_p(L + c)² + I_zz) θ̈ = T_mot − b_m θ̇, solved piecewise in closed form.
     let sc = scene("single-link-3d-stiff");
-    let l = sc.payload_link.clone().unwrap();
+    let l = sc.payload_link().cloned().unwrap();
     let inertia = l.base_inertia()
         + l.mass_per_length() * l.length.powi(3) / 3.0
         + l.density * l.second_moment() * l.length
@@ -94,7 +94,7 @@ fn dyn_payload_vertical_excitation_leaves_the_turning_plane_at_constant_rate() {
     let dt = Some(1e-4);
     let with = run_dt(&scene("single-link-3d-constant-rate"), 6, 0.2, dt);
     let mut sc = scene("single-link-3d-constant-rate");
-    sc.payload_link.as_mut().unwrap().gravity = None;
+    sc.payload_link_mut().unwrap().gravity = None;
     let without = run_dt(&sc, 6, 0.2, dt);
     let wmax = history(&with, "link1.tip_w")
         .iter()
@@ -126,7 +126,7 @@ fn first_of(md: &Model, kind: &str) -> f64 {
 #[test]
 fn conv_payload_frequencies_converge_at_the_element_orders() {
     let sc = scene("single-link-3d-constant-rate");
-    let l = sc.payload_link.clone().unwrap();
+    let l = sc.payload_link().cloned().unwrap();
     // Torsion with the payload's axial inertia: ζ tan ζ = ρJL/I_px, ω = (ζ/L)√(G/ρ) (the
     // diagonal payload and the circular section leave torsion uncoupled and rate-independent).
     let ratio = l.density * l.polar_moment() * l.length / l.payload.inertia[0][0];

@@ -337,8 +337,8 @@ fn dyn_cantilever_step_load_overshoots_the_static_deflection() {
     // at half the first period (0.06 s < t_end = 0.1 s), and the load's work closes the ledger.
     let sc = data::load_scene("cantilever").unwrap();
     let r = run("cantilever", 16, None, None, None).unwrap();
-    let l = &sc.links[0];
-    let st = sc.statics.clone().unwrap();
+    let l = &sc.links()[0];
+    let st = sc.statics().cloned().unwrap();
     let stat = st.tip_force.unwrap() * l.length.powi(3) / (3.0 * l.bending_stiffness)
         + st.distributed_load.unwrap() * l.length.powi(4) / (8.0 * l.bending_stiffness);
     let ratio = peak(channel(&r, "link1.tip_deflection")) / stat;

@@ -17,7 +17,7 @@ use fem::linear::LinearLink;
 /// Switches Timoshenko shear on for every link: κGA = `ratio`·EI/L², ρI = `rho_i_ratio`·ρA L²
 /// (rotary inertia on when > 0).
 fn make_timoshenko(sc: &mut Scene, ratio: f64, rho_i_ratio: f64) {
-    for l in sc.links.iter_mut() {
+    for l in sc.planar_chain_mut().unwrap().links.iter_mut() {
         l.shear = true;
         l.shear_stiffness = Some(ratio * l.bending_stiffness / (l.length * l.length));
         if rho_i_ratio > 0.0 {
@@ -46,19 +46,23 @@ fn setup(
         make_timoshenko(&mut sc, 30.0, rho_i_ratio);
     } else {
         make_timoshenko(&mut sc, 30.0, rho_i_ratio);
-        sc.links.iter_mut().for_each(|l| l.shear = false);
+        sc.planar_chain_mut()
+            .unwrap()
+            .links
+            .iter_mut()
+            .for_each(|l| l.shear = false);
     }
-    for l in sc.links.iter_mut() {
+    for l in sc.planar_chain_mut().unwrap().links.iter_mut() {
         l.foreshortening = foreshortening && !l.axial;
         l.kelvin_voigt = None;
         l.tip_mass = Some(0.3);
         l.tip_inertia = Some(0.01);
         l.joint.hub_inertia = Some(0.02);
     }
-    sc.gravity = Some(data::scene::Gravity {
+    sc.planar_chain_mut().unwrap().gravity = Some(data::scene::Gravity {
         vector: [0.3, -9.0],
     });
-    let ch = Chain::new(&sc.links, sc.gravity.as_ref(), n_el).unwrap();
+    let ch = Chain::new(sc.links(), sc.gravity(), n_el).unwrap();
     let n = ch.ndof;
     let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
     ch.initial_state(&mut q, &mut qd);
@@ -246,10 +250,10 @@ fn cross_timoshenko_chain_linearized_at_rest_is_the_linear_model() {
     // then node e + 1: v, ψ, u), so M and K compare entry by entry.
     for axial in [false, true] {
         let mut sc = data::load_scene("cantilever-timoshenko").unwrap();
-        sc.links[0].axial = axial;
+        sc.planar_chain_mut().unwrap().links[0].axial = axial;
         let n_el = 6;
-        let mut ch = Chain::new(&sc.links, None, n_el).unwrap();
-        let lin = LinearLink::assemble(&sc.links[0], n_el, 0.0, &Timoshenko).unwrap();
+        let mut ch = Chain::new(sc.links(), None, n_el).unwrap();
+        let lin = LinearLink::assemble(&sc.links()[0], n_el, 0.0, &Timoshenko).unwrap();
         let n = ch.ndof;
         assert_eq!(n, lin.ndof());
         assert_eq!(n, n_el * (if axial { 6 } else { 5 }));
@@ -278,7 +282,7 @@ fn cross_timoshenko_chain_linearized_at_rest_is_the_linear_model() {
         let to_mat = |a: &Vec<Vec<f64>>| faer::Mat::from_fn(n, n, |i, j| a[i][j]);
         let (lam, _) = fem::modes::generalized_eigen(&to_mat(&k), &to_mat(&m)).unwrap();
         let modes = fem::modes::link_modes(&lin, 3).unwrap();
-        let l = &sc.links[0];
+        let l = &sc.links()[0];
         let exact = common::timoshenko_omega(
             l.bending_stiffness,
             l.shear_stiffness.unwrap(),
@@ -431,14 +435,19 @@ fn dyn_barhorst_case1_timoshenko_free_fall_closes_its_ledger() {
     // Free fall until just before the first contact (the contact itself is not part of this
     // backend yet: the `[[contact]]` table is removed).
     let mut sc = data::load_scene("barhorst-case1-timoshenko").unwrap();
-    sc.contacts.clear();
+    sc.planar_chain_mut().unwrap().contacts.clear();
     // DOFs: per link 3 interior (v(⅓), v(⅔), ψ(½)) per element and (v, ψ) per node, plus the
     // two joint angles: 2·(3·4 + 2·4) + 2 = 42 (the Euler chain: 2·2·4 + 2 = 18).
-    let ch = Chain::new(&sc.links, sc.gravity.as_ref(), 4).unwrap();
+    let ch = Chain::new(sc.links(), sc.gravity(), 4).unwrap();
     assert_eq!(ch.ndof, 42);
     let mut euler = sc.clone();
-    euler.links.iter_mut().for_each(|l| l.shear = false);
-    assert_eq!(Chain::new(&euler.links, None, 4).unwrap().ndof, 18);
+    euler
+        .planar_chain_mut()
+        .unwrap()
+        .links
+        .iter_mut()
+        .for_each(|l| l.shear = false);
+    assert_eq!(Chain::new(euler.links(), None, 4).unwrap().ndof, 18);
     // Central difference cannot step the massless ψ: refused by name.
     let err = FemBackend
         .simulate(&sc, &settings(4, None, 0.15, Some("central-difference")))
@@ -460,7 +469,7 @@ fn dyn_barhorst_case1_timoshenko_free_fall_closes_its_ledger() {
         // The settled start (massless directions balanced: the tip section of link 1 carries
         // joint 2's spring moment 20·5° = 1.75, the root sections turn their frames against
         // v = −αx) moves the joint angles only by the root shear rotations, O(moment/κGA·L).
-        for (k, l) in sc.links.iter().enumerate() {
+        for (k, l) in sc.links().iter().enumerate() {
             let a0 = channel(&r, &format!("joint{}.angle", k + 1))[0];
             let shift = a0 - l.joint.initial_angle;
             eprintln!(
@@ -493,7 +502,7 @@ fn dyn_timoshenko_undamped_massless_hub_defaults_to_generalized_alpha() {
     // Trapezoidal rule: O(h²) energy error through M(q) (the Euler chain: 0.11 over 10 s).
     assert!(c < 1e-4, "closure {c}");
     // With a hub inertia (or rotary inertia, or damping) the midpoint scheme stays the default.
-    for l in sc.links.iter_mut() {
+    for l in sc.planar_chain_mut().unwrap().links.iter_mut() {
         l.joint.hub_inertia = Some(1e-2);
     }
     assert_eq!(
@@ -514,7 +523,7 @@ fn dyn_constrained_arm_timoshenko_axial_runs_without_contact() {
     // the Euler one as O(EI/(κGA L²)): ~10× closer per decade of κGA.
     let base = {
         let mut sc = data::load_scene("constrained-arm").unwrap();
-        sc.contacts.clear();
+        sc.planar_chain_mut().unwrap().contacts.clear();
         sc
     };
     let euler = sim(&base, &settings(8, None, 0.5, None));
@@ -552,13 +561,13 @@ fn sys_timoshenko_rigid_rotation_kinetic_energy_is_the_rigid_inertia() {
     for shear in [true, false] {
         let mut sc = data::load_scene("single-link").unwrap();
         make_timoshenko(&mut sc, 30.0, 1e-2);
-        let l = &mut sc.links[0];
+        let l = &mut sc.planar_chain_mut().unwrap().links[0];
         l.shear = shear;
         l.tip_mass = Some(0.3);
         l.tip_inertia = Some(0.01);
         l.joint.hub_inertia = Some(0.02);
-        let l = &sc.links[0];
-        let ch = Chain::new(&sc.links, None, 3).unwrap();
+        let l = &sc.links()[0];
+        let ch = Chain::new(sc.links(), None, 3).unwrap();
         let n = ch.ndof;
         let q = vec![0.0; n];
         let mut qd = vec![0.0; n];
@@ -586,9 +595,9 @@ fn dyn_cantilever_timoshenko_step_load_conserves_energy_and_peaks_at_twice_stati
     // system: the ledger closes to round-off. With and without rotary inertia (massless ψ).
     for rot in [true, false] {
         let mut sc = data::load_scene("cantilever-timoshenko").unwrap();
-        sc.links[0].rotary_inertia = rot;
-        let l = &sc.links[0];
-        let p = sc.statics.as_ref().unwrap().tip_force.unwrap();
+        sc.planar_chain_mut().unwrap().links[0].rotary_inertia = rot;
+        let l = &sc.links()[0];
+        let p = sc.statics().unwrap().tip_force.unwrap();
         let stat = p * l.length.powi(3) / (3.0 * l.bending_stiffness)
             + p * l.length / l.shear_stiffness.unwrap();
         let r = sim(&sc, &settings(8, Some(2e-6), 1.3e-3, None));
@@ -645,7 +654,7 @@ fn dyn_barhorst_timoshenko_contact_balances_momentum_with_and_without_section_in
     let st = settings(4, None, 0.3, None);
     for with_inertia in [false, true] {
         let mut sc = sc.clone();
-        for l in &mut sc.links {
+        for l in &mut sc.planar_chain_mut().unwrap().links {
             l.rotary_inertia = with_inertia;
             l.rotary_inertia_per_length = with_inertia.then_some(1e-3);
         }

@@ -44,7 +44,7 @@ fn mass_product(chain: &mut Chain, q: &[f64], x: &[f64]) -> Vec<f64> {
 #[test]
 fn elem_massless_directions_carry_no_mass_and_do_not_move_the_tip() {
     let sc = scene();
-    let mut chain = Chain::new(&sc.links, sc.gravity.as_ref(), 4).unwrap();
+    let mut chain = Chain::new(sc.links(), sc.gravity(), 4).unwrap();
     let n = chain.ndof;
     let q = bent(n, 0.02, 0.0);
     let dirs = chain.exact_massless_directions();
@@ -80,7 +80,7 @@ fn elem_massless_directions_carry_no_mass_and_do_not_move_the_tip() {
 #[test]
 fn dyn_consistent_velocity_satisfies_the_massless_balances_and_keeps_energy() {
     let sc = scene();
-    let mut chain = Chain::new(&sc.links, sc.gravity.as_ref(), 4).unwrap();
+    let mut chain = Chain::new(sc.links(), sc.gravity(), 4).unwrap();
     let mut contact = Contact::from_scene(&sc, &chain).unwrap().unwrap();
     let n = chain.ndof;
     let q = bent(n, 0.02, 0.0);
@@ -187,7 +187,7 @@ fn dyn_timoshenko_contact_runs_with_balanced_impacts_located_releases_and_a_clos
 fn sys_undamped_massless_sections_with_contact_are_refused() {
     use data::BackendError;
     let mut sc = scene();
-    for l in &mut sc.links {
+    for l in &mut sc.planar_chain_mut().unwrap().links {
         l.kelvin_voigt = None;
     }
     match FemBackend.simulate(&sc, &settings(4, 0.01)) {
@@ -206,7 +206,7 @@ fn sys_undamped_massless_sections_with_contact_are_refused() {
 /// on its stepping, with the massless projection of contact runs.
 fn integ_free(n_el: usize, h: f64, unilateral: bool) -> fem::driver::Driver {
     let sc = scene();
-    let chain = Chain::new(&sc.links, sc.gravity.as_ref(), n_el).unwrap();
+    let chain = Chain::new(sc.links(), sc.gravity(), n_el).unwrap();
     let mut it =
         fem::driver::Driver::new(chain, fem::settings::Method::EnergyMidpoint, h, 1.0).unwrap();
     it.h_nominal = h;

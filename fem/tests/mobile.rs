@@ -16,7 +16,7 @@ fn scene() -> Scene {
 
 fn model(elements: usize) -> Model {
     let s = scene();
-    Model::from_scene(s.mobile_manipulator.as_ref().unwrap(), elements).unwrap()
+    Model::from_scene(s.mobile_manipulator().unwrap(), elements).unwrap()
 }
 
 /// A generic state: joints bent, platform turned and moving, the beam deflected in both planes
@@ -325,7 +325,7 @@ fn dyn_mobile_drift_and_ledger_closure() {
 /// The ee position history of a run of `md` with step h over [0, t_end].
 fn ee_history(md: Model, h: f64, t_end: f64) -> Vec<[f64; 3]> {
     let s = scene();
-    let mm = s.mobile_manipulator.as_ref().unwrap();
+    let mm = s.mobile_manipulator().unwrap();
     let inputs = Inputs {
         drive: mm.platform.as_ref().map(|p| p.drive.clone()),
         arm: mm.arm.as_ref().unwrap().torques.clone(),
@@ -356,13 +356,13 @@ fn conv_mobile_rigid_limit_rate() {
     // EI → ∞ limit of the flexible one: the end-effector gap falls ∝ 1/EI. Same step for
     // both, so the time-discretization error of the rigid motion cancels.
     let s = scene();
-    let mut rigid_scene = s.mobile_manipulator.clone().unwrap();
+    let mut rigid_scene = s.mobile_manipulator().cloned().unwrap();
     rigid_scene.flexible_link = None;
     let (h, t_end) = (1e-3, 1.0);
     let rigid = ee_history(Model::from_scene(&rigid_scene, 1).unwrap(), h, t_end);
     let mut gaps = Vec::new();
     for factor in [10.0, 100.0] {
-        let mut mm = s.mobile_manipulator.clone().unwrap();
+        let mut mm = s.mobile_manipulator().cloned().unwrap();
         let f = mm.flexible_link.as_mut().unwrap();
         f.bending_stiffness_in_plane *= factor;
         f.bending_stiffness_out_of_plane *= factor;

@@ -34,7 +34,7 @@ fn elem_rocket_kinetic_energy_matches_direct_quadrature() {
     // ½∫m(x, t)(u̇² + ẇ²)dx + ½ΣM_j(U̇² + Ẇ²) computed here from the scene by Simpson's rule
     // (stage by stage; error ~1e-15 relative at 20 000 intervals for these polynomials).
     let sc = scene();
-    let r = sc.rocket.as_ref().unwrap();
+    let r = sc.rocket().unwrap();
     let model = rocket::build(&sc, &settings(Some(7), None)).unwrap();
     let ud = |x: f64| 3.0 - 0.02 * x;
     let wd = |x: f64| 0.5 + 0.01 * x - 3e-4 * x * x + 2e-6 * x * x * x;
@@ -122,7 +122,7 @@ fn elem_rocket_forces_are_minus_energy_gradient() {
 #[test]
 fn sys_rocket_dof_counts() {
     let sc = scene();
-    let nm = sc.rocket.as_ref().unwrap().discrete_masses.len();
+    let nm = sc.rocket().unwrap().discrete_masses.len();
     for (elements, expect) in [(None, 3 * 31 + 2 * nm), (Some(10), 3 * 11 + 2 * nm)] {
         let plan = FemBackend
             .dof_plan(&sc, &settings(elements, None).discretization)
@@ -142,7 +142,7 @@ fn sys_rocket_uniform_free_free_frequencies() {
     // A uniform case without discrete masses: first bending ω = (β₁L)²√(EI/(mL⁴)) with
     // β₁L = 4.730040745 (cosh βL cos βL = 1), first axial ω = π/L √(EA/m).
     let mut sc = scene();
-    let r = sc.rocket.as_mut().unwrap();
+    let r = sc.rocket_mut().unwrap();
     let s1 = r.stages[0].clone();
     r.stages[1].area = s1.area;
     r.stages[1].inertia = s1.inertia;
@@ -185,9 +185,9 @@ fn dyn_rocket_rigid_translation_follows_rocket_equation() {
     // the burnt mass carries relative to the mean (its elastic axial velocity), so
     // V(t) = v_e ln(M₀/M(t)) − g t, with M(t) = M₀ − ṁL₁t from the scene.
     let mut sc = scene();
-    let r = sc.rocket.as_mut().unwrap();
+    let r = sc.rocket_mut().unwrap();
     r.initial_shape = InitialShape::Straight;
-    let r = sc.rocket.as_ref().unwrap();
+    let r = sc.rocket().unwrap();
     let g = r.gravity;
     let m0: f64 = r
         .stages
@@ -295,7 +295,7 @@ fn sys_rocket_mass_held_by_no_spring_is_refused() {
     // Case II's middle mass hangs on the mass-to-mass springs only; without their transverse
     // stiffness nothing holds it across the axis.
     let mut sc = data::load_scene("rocket-case2").unwrap();
-    for s in &mut sc.rocket.as_mut().unwrap().springs {
+    for s in &mut sc.rocket_mut().unwrap().springs {
         s.transverse_stiffness = 0.0;
     }
     for result in [

@@ -22,16 +22,16 @@ fn setup(
     element: Option<FemElement>,
 ) -> (Chain, Vec<f64>, Vec<f64>, Vec<f64>) {
     let mut sc = data::load_scene(name).unwrap();
-    for l in sc.links.iter_mut() {
+    for l in sc.planar_chain_mut().unwrap().links.iter_mut() {
         l.foreshortening = foreshortening && !l.axial;
         l.tip_mass = Some(0.3);
         l.tip_inertia = Some(0.01);
         l.joint.hub_inertia = Some(0.02);
     }
-    sc.gravity = Some(data::scene::Gravity {
+    sc.planar_chain_mut().unwrap().gravity = Some(data::scene::Gravity {
         vector: [0.3, -9.0],
     });
-    let ch = Chain::with_element(&sc.links, sc.gravity.as_ref(), n_el, element).unwrap();
+    let ch = Chain::with_element(sc.links(), sc.gravity(), n_el, element).unwrap();
     let n = ch.ndof;
     let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
     ch.initial_state(&mut q, &mut qd);
@@ -255,7 +255,7 @@ fn sys_newton_solve_of_real_chain_matrices_is_backward_stable() {
         "spin-up-axial",
     ] {
         let sc = data::load_scene(name).unwrap();
-        let mut ch = Chain::new(&sc.links, sc.gravity.as_ref(), n_el).unwrap();
+        let mut ch = Chain::new(sc.links(), sc.gravity(), n_el).unwrap();
         let n = ch.ndof;
         let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
         ch.initial_state(&mut q, &mut qd);

@@ -141,16 +141,16 @@ fn check(label: &str, ch: &mut Chain, q: &[f64], qd: &[f64], qdd: &[f64], c: New
 /// gravity, foreshortening), as in `sys_chain`.
 fn generic(name: &str, n_el: usize, element: Option<FemElement>) -> (Chain, [Vec<f64>; 3]) {
     let mut sc = data::load_scene(name).unwrap();
-    for l in sc.links.iter_mut() {
+    for l in sc.planar_chain_mut().unwrap().links.iter_mut() {
         l.foreshortening = !l.axial;
         l.tip_mass = Some(0.3);
         l.tip_inertia = Some(0.01);
         l.joint.hub_inertia = Some(0.02);
     }
-    sc.gravity = Some(data::scene::Gravity {
+    sc.planar_chain_mut().unwrap().gravity = Some(data::scene::Gravity {
         vector: [0.3, -9.0],
     });
-    let ch = Chain::with_element(&sc.links, sc.gravity.as_ref(), n_el, element).unwrap();
+    let ch = Chain::with_element(sc.links(), sc.gravity(), n_el, element).unwrap();
     let n = ch.ndof;
     let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
     ch.initial_state(&mut q, &mut qd);

@@ -28,7 +28,7 @@ fn omegas(scene: &data::Scene, n: usize, count: usize) -> Vec<f64> {
 #[test]
 fn conv_cantilever_frequencies_converge_at_order_four() {
     let sc = data::load_scene("cantilever").unwrap();
-    let l = &sc.links[0];
+    let l = &sc.links()[0];
     let exact = common::clamped_free_omega(l.bending_stiffness, l.mass_per_length, l.length, 4);
     let meshes = [4usize, 8, 16];
     let errs: Vec<Vec<f64>> = meshes
@@ -68,7 +68,7 @@ fn conv_cantilever_frequencies_converge_at_order_four() {
 #[test]
 fn sys_cantilever_frequency_accuracy_at_16_and_32_elements() {
     let sc = data::load_scene("cantilever").unwrap();
-    let l = &sc.links[0];
+    let l = &sc.links()[0];
     let exact = common::clamped_free_omega(l.bending_stiffness, l.mass_per_length, l.length, 4);
     let w16 = omegas(&sc, 16, 4);
     let w32 = omegas(&sc, 32, 4);
@@ -93,8 +93,8 @@ fn sys_cantilever_frequency_accuracy_at_16_and_32_elements() {
 fn sys_tip_mass_frequencies_match_transcendental_equation() {
     let mut sc = data::load_scene("cantilever-tip-mass").unwrap();
     for tip_inertia in [None, Some(2e-3)] {
-        sc.links[0].tip_inertia = tip_inertia;
-        let l = &sc.links[0];
+        sc.planar_chain_mut().unwrap().links[0].tip_inertia = tip_inertia;
+        let l = &sc.links()[0];
         let exact = common::tip_mass_omega(
             l.bending_stiffness,
             l.mass_per_length,
@@ -121,7 +121,7 @@ fn sys_tip_mass_frequencies_match_transcendental_equation() {
 #[test]
 fn conv_timoshenko_frequencies_match_transcendental_equation_at_order_four() {
     let sc = data::load_scene("cantilever-timoshenko").unwrap();
-    let l = &sc.links[0];
+    let l = &sc.links()[0];
     let (ei, kga, rho_a, rho_i) = (
         l.bending_stiffness,
         l.shear_stiffness.unwrap(),
@@ -176,16 +176,17 @@ fn sys_timoshenko_thin_limit_reproduces_hermite_cubic_frequencies() {
     let cant = data::load_scene("cantilever").unwrap();
     let n = 8;
     let hermite = omegas(&cant, n, 4);
-    let h = cant.links[0].length / n as f64;
+    let h = cant.links()[0].length / n as f64;
     let mut sc = cant.clone();
-    sc.links[0].shear = true;
+    sc.planar_chain_mut().unwrap().links[0].shear = true;
     // scale = κGA h²/EI. Beyond 1e5 the shear penalty's conditioning (∝ scale) brings the
     // eigen-solve round-off (≈ 1e-8 at 1e6) to the size of the gap itself.
     let scales = [1e2, 1e3, 1e4, 1e5];
     let gaps: Vec<Vec<f64>> = scales
         .iter()
         .map(|&scale| {
-            sc.links[0].shear_stiffness = Some(scale * sc.links[0].bending_stiffness / (h * h));
+            sc.planar_chain_mut().unwrap().links[0].shear_stiffness =
+                Some(scale * sc.links()[0].bending_stiffness / (h * h));
             let w = omegas(&sc, n, 4);
             (0..4).map(|k| (w[k] - hermite[k]) / hermite[k]).collect()
         })
@@ -210,15 +211,16 @@ fn sys_timoshenko_thin_limit_reproduces_hermite_cubic_frequencies() {
 #[test]
 fn sys_rotating_beam_frequencies_rise_with_speed_and_start_at_cantilever() {
     let mut sc = data::load_scene("rotating-beam").unwrap();
-    let speeds = sc.studies.clone().unwrap().rotation_speeds;
-    let l = sc.links[0].clone();
+    let speeds = sc.studies().cloned().unwrap().rotation_speeds;
+    let l = sc.links()[0].clone();
     let scale = (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt();
     let cantilever = omegas(&data::load_scene("cantilever").unwrap(), 16, 1)[0];
     let mut last = 0.0;
     for lambda in speeds {
-        sc.links[0].joint.prescribed = Some(data::scene::PrescribedMotion::ConstantRate {
-            rate: lambda * scale,
-        });
+        sc.planar_chain_mut().unwrap().links[0].joint.prescribed =
+            Some(data::scene::PrescribedMotion::ConstantRate {
+                rate: lambda * scale,
+            });
         let w1 = omegas(&sc, 16, 1)[0];
         if lambda == 0.0 {
             // λ = 0 is the cantilever: the same discrete eigenproblem, equal to round-off.
@@ -232,7 +234,7 @@ fn sys_rotating_beam_frequencies_rise_with_speed_and_start_at_cantilever() {
 #[test]
 fn sys_axial_frequencies_converge_at_order_two() {
     let sc = data::load_scene("cantilever-axial").unwrap();
-    let l = &sc.links[0];
+    let l = &sc.links()[0];
     let exact1 = std::f64::consts::PI / (2.0 * l.length)
         * (l.axial_stiffness.unwrap() / l.mass_per_length).sqrt();
     let mut errs = Vec::new();
@@ -254,8 +256,8 @@ fn sys_axial_frequencies_converge_at_order_two() {
 #[test]
 fn sys_static_tip_deflection_is_exact_for_any_mesh() {
     let sc = data::load_scene("cantilever").unwrap();
-    let l = &sc.links[0];
-    let st = sc.statics.clone().unwrap();
+    let l = &sc.links()[0];
+    let st = sc.statics().cloned().unwrap();
     let (p, q) = (st.tip_force.unwrap(), st.distributed_load.unwrap());
     let (ei, len) = (l.bending_stiffness, l.length);
     let exact = p * len.powi(3) / (3.0 * ei) + q * len.powi(4) / (8.0 * ei);
@@ -277,8 +279,8 @@ fn sys_static_tip_deflection_is_exact_for_any_mesh() {
 #[test]
 fn sys_timoshenko_static_tip_deflection_is_exact() {
     let sc = data::load_scene("cantilever-timoshenko").unwrap();
-    let l = &sc.links[0];
-    let p = sc.statics.clone().unwrap().tip_force.unwrap();
+    let l = &sc.links()[0];
+    let p = sc.statics().cloned().unwrap().tip_force.unwrap();
     let exact = p * l.length.powi(3) / (3.0 * l.bending_stiffness)
         + p * l.length / l.shear_stiffness.unwrap();
     let exact_rot = p * l.length.powi(2) / (2.0 * l.bending_stiffness);
@@ -320,7 +322,7 @@ fn sys_dof_counts_per_scene() {
             .unwrap();
         assert_eq!(plan.total(), expect, "{name}: {plan:?}");
         let has_axial = plan.groups.iter().any(|g| g.what.contains("axial u"));
-        assert_eq!(has_axial, sc.links.iter().any(|l| l.axial), "{name}");
+        assert_eq!(has_axial, sc.links().iter().any(|l| l.axial), "{name}");
     }
 }
 
@@ -402,7 +404,8 @@ fn sys_unsupported_scenes_and_bad_settings_are_refused() {
     // Modes of a chain whose joint moves by prescription (no rest configuration): refused
     // with a reason, never a fake result.
     let mut sc = data::load_scene("two-link-free").unwrap();
-    sc.links[0].joint.prescribed = Some(data::scene::PrescribedMotion::ConstantRate { rate: 1.0 });
+    sc.planar_chain_mut().unwrap().links[0].joint.prescribed =
+        Some(data::scene::PrescribedMotion::ConstantRate { rate: 1.0 });
     let r = FemBackend.modes(&sc, &settings(4), 3);
     assert!(matches!(r, Err(BackendError::Unsupported(_))), "{r:?}");
 }

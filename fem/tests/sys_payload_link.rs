@@ -20,7 +20,7 @@ fn scene(name: &str) -> Scene {
 }
 
 fn link(sc: &Scene) -> PayloadLink {
-    sc.payload_link.clone().expect("payload link")
+    sc.payload_link().cloned().expect("payload link")
 }
 
 type M3 = [[f64; 3]; 3];
@@ -366,13 +366,13 @@ fn sys_payload_dofs_and_terms_follow_the_scene() {
     assert_eq!(plan.total(), 6 * 8);
     // Fields not listed are not built; KV off and gravity off build no operator.
     let mut sc = scene("single-link-3d");
-    let pl = sc.payload_link.as_mut().unwrap();
+    let pl = sc.payload_link_mut().unwrap();
     pl.fields = vec![LinkField::Vertical, LinkField::Torsion];
     pl.gravity = None;
     pl.kelvin_voigt.as_mut().unwrap().vertical = None;
     let plan = fem.dof_plan(&sc, &disc).unwrap();
     assert_eq!(plan.total(), 3 * 8 + 1);
-    let md = Model::assemble(sc.payload_link.as_ref().unwrap(), 8).unwrap();
+    let md = Model::assemble(sc.payload_link().unwrap(), 8).unwrap();
     assert_eq!(md.n, 24);
     assert!(!md.has_gravity && md.fg.iter().all(|&f| f == 0.0));
     let damped: Vec<LinkField> = md.c_field.iter().map(|(f, _)| *f).collect();

@@ -26,12 +26,12 @@ fn freqs(scene: &Scene, modes: usize, basis: Basis, count: usize) -> Vec<f64> {
 
 fn main() {
     let mut clamped = load_scene("cantilever-timoshenko").expect("catalog scene");
-    clamped.links[0].rotary_inertia = false;
+    clamped.planar_chain_mut().unwrap().links[0].rotary_inertia = false;
     let reference = freqs(&clamped, 16, Basis::Poly, 3);
     let mut sprung = clamped.clone();
-    sprung.links[0].joint.prescribed = None;
+    sprung.planar_chain_mut().unwrap().links[0].joint.prescribed = None;
     // Root compliance 1/K ≪ the beam's (L/EI ≈ 6e-4): the spring error is ~1e-7.
-    sprung.links[0].joint.stiffness = Some(1e10);
+    sprung.planar_chain_mut().unwrap().links[0].joint.stiffness = Some(1e10);
     for basis in [Basis::Poly, Basis::ClampedFree] {
         for n in [2, 4, 6, 8, 12, 16] {
             // Eigenvalues below the solver's round-off floor (1e-12 λ_max, reported as 0) are

@@ -158,7 +158,7 @@ pub fn rotating_modes(
     count: usize,
 ) -> Result<ModalResult, ModalError> {
     let mut s = scene.clone();
-    if let Some(l) = s.links.first_mut() {
+    if let Some(l) = s.planar_chain_mut().and_then(|c| c.links.first_mut()) {
         l.joint.prescribed = Some(data::scene::PrescribedMotion::ConstantRate { rate: hub_rate });
     }
     modes(&s, settings, count)

@@ -28,11 +28,11 @@ pub fn check_supported(scene: &Scene, purpose: Purpose) -> Result<(), ModalError
             scene.family()
         )));
     }
-    if scene.links.is_empty() {
+    if scene.links().is_empty() {
         return Err(ModalError::Unsupported("modal: scene has no links".into()));
     }
     crate::contact::check(scene)?;
-    for (i, l) in scene.links.iter().enumerate() {
+    for (i, l) in scene.links().iter().enumerate() {
         if l.shear && l.shear_stiffness.is_none() {
             return Err(ModalError::Unsupported(format!(
                 "modal: link {} has `shear` on but no `shear_stiffness`",
@@ -115,10 +115,10 @@ pub fn modes_per_link(disc: &Discretization) -> Result<usize, ModalError> {
 /// 9.447e-3 / 9.460e-3 (fem: 9.39e-3); the `barhorst-case1` first impact at 6 modes is 2e-4
 /// early with clamped-free, 1e-7 off fem with poly.
 pub fn default_basis(scene: &Scene) -> Basis {
-    let tip_loaded = scene.links.len() > 1
-        || !scene.contacts.is_empty()
+    let tip_loaded = scene.links().len() > 1
+        || !scene.contacts().is_empty()
         || scene
-            .links
+            .links()
             .iter()
             .any(|l| l.tip_mass.is_some_and(|m| m > 0.0) || l.tip_inertia.is_some_and(|j| j > 0.0));
     if !tip_loaded {
@@ -138,7 +138,7 @@ pub fn basis_choice(scene: &Scene, disc: &Discretization) -> Result<Basis, Modal
         )),
         Basis::TipMass => {
             if let Some(l) = scene
-                .links
+                .links()
                 .iter()
                 .find(|l| l.tip_mass.is_none() && l.tip_inertia.is_none())
             {
@@ -243,7 +243,7 @@ pub fn build_chain_for(
     let mut links = Vec::new();
     let mut joints = Vec::new();
     let mut offset = 0;
-    for (i, l) in scene.links.iter().enumerate() {
+    for (i, l) in scene.links().iter().enumerate() {
         let (transverse, rotation) = if l.shear {
             let (v, psi) = timoshenko_shapes(l, i, basis, n)?;
             (v, Some(psi))
@@ -306,7 +306,7 @@ pub fn build_chain_for(
             prescribed: j.prescribed.clone(),
         });
     }
-    let gravity = scene.gravity.as_ref().map(|g| g.vector);
+    let gravity = scene.gravity().map(|g| g.vector);
     let mut chain = Chain::new(links, joints, gravity);
     if purpose == Purpose::Dynamics {
         chain.step_load = step_load(scene, &chain)?;
@@ -319,7 +319,7 @@ pub fn build_chain_for(
 /// length, on the transverse coordinates b of a single clamped link,
 /// f_b = P φ(L) + q ∫₀ᴸ φ dx.
 fn step_load(scene: &Scene, chain: &Chain) -> Result<Option<Vec<f64>>, ModalError> {
-    let Some(st) = &scene.statics else {
+    let Some(st) = scene.statics() else {
         return Ok(None);
     };
     let (p, q) = (
@@ -329,9 +329,9 @@ fn step_load(scene: &Scene, chain: &Chain) -> Result<Option<Vec<f64>>, ModalErro
     if p == 0.0 && q == 0.0 {
         return Ok(None);
     }
-    let clamped_single = scene.links.len() == 1
+    let clamped_single = scene.links().len() == 1
         && matches!(
-            scene.links[0].joint.prescribed,
+            scene.links()[0].joint.prescribed,
             Some(data::scene::PrescribedMotion::Fixed)
         );
     if !clamped_single {
@@ -349,7 +349,7 @@ fn step_load(scene: &Scene, chain: &Chain) -> Result<Option<Vec<f64>>, ModalErro
 /// coordinates of link `l` of a single-link scene: P φ(L) + q ∫₀ᴸ φ dx.
 pub(crate) fn transverse_load(scene: &Scene, l: &LinkModel, p: f64, q: f64) -> Vec<f64> {
     // `phi1` is the mass-weighted ∫ρA φ.
-    let q_per_mass = q / scene.links[0].mass_per_length;
+    let q_per_mass = q / scene.links()[0].mass_per_length;
     (0..l.nb())
         .map(|i| p * l.ints.phi_l[i] + q_per_mass * l.ints.phi1[i])
         .collect()
@@ -361,7 +361,7 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
     let n = modes_per_link(disc)?;
     let basis = basis_choice(scene, disc)?;
     let mut plan = DofPlan::default();
-    for (i, l) in scene.links.iter().enumerate() {
+    for (i, l) in scene.links().iter().enumerate() {
         let k = i + 1;
         if l.joint.prescribed.is_none() {
             plan.add(format!("joint{k} angle"), 1);
@@ -424,10 +424,10 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
                 .push(format!("joint{k}: prescribed motion (torque reported)"));
         }
     }
-    if scene.gravity.is_some() {
+    if scene.gravity().is_some() {
         plan.builds.push("gravity".into());
     }
-    for (c, ct) in scene.contacts.iter().enumerate() {
+    for (c, ct) in scene.contacts().iter().enumerate() {
         if ct.mode == data::scene::ContactMode::Bilateral {
             plan.builds.push(format!(
                 "contact{}: bilateral tip contact of `{}` (constraint g = 0 for all time, \

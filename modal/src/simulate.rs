@@ -90,10 +90,10 @@ pub fn method_choice(scene: &Scene, settings: &Settings) -> Result<Method, Modal
 pub fn default_method(scene: &Scene, settings: &Settings) -> Method {
     let tolerance_given = settings.time.rtol.is_some() || settings.time.atol.is_some();
     let all_damped = scene
-        .links
+        .links()
         .iter()
         .all(|l| l.kelvin_voigt.is_some_and(|g| g > 0.0));
-    if tolerance_given || !scene.contacts.is_empty() || !all_damped {
+    if tolerance_given || !scene.contacts().is_empty() || !all_damped {
         &DOPRI5
     } else {
         &TRBDF2
@@ -110,7 +110,7 @@ pub const STEPS_PER_PERIOD: f64 = 128.0;
 pub fn default_step(scene: &Scene) -> f64 {
     const BETA1: f64 = 1.875_104_068_711_961;
     scene
-        .links
+        .links()
         .iter()
         .map(|l| {
             let omega1 = BETA1

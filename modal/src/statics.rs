@@ -10,14 +10,14 @@ use crate::setup::{build_chain, transverse_load};
 
 pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, ModalError> {
     let wall = std::time::Instant::now();
-    let Some(loads) = &scene.statics else {
+    let Some(loads) = scene.statics() else {
         return Err(ModalError::Unsupported(
             "modal: the scene has no [statics] loads".into(),
         ));
     };
-    if scene.links.len() != 1
+    if scene.links().len() != 1
         || !matches!(
-            scene.links[0].joint.prescribed,
+            scene.links()[0].joint.prescribed,
             Some(data::scene::PrescribedMotion::Fixed)
         )
     {

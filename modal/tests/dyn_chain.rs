@@ -121,13 +121,13 @@ fn with_modes(modes: usize) -> Discretization {
 #[test]
 fn dyn_equations_of_motion_match_the_energy_two_link_with_everything() {
     let mut scene = load_scene("two-link-free-undamped").unwrap();
-    scene.gravity = Some(data::scene::Gravity {
+    scene.planar_chain_mut().unwrap().gravity = Some(data::scene::Gravity {
         vector: [0.3, -32.17],
     });
-    scene.links[0].joint.hub_inertia = Some(0.2);
-    scene.links[0].tip_mass = Some(0.3);
-    scene.links[1].tip_mass = Some(0.2);
-    scene.links[1].tip_inertia = Some(0.01);
+    scene.planar_chain_mut().unwrap().links[0].joint.hub_inertia = Some(0.2);
+    scene.planar_chain_mut().unwrap().links[0].tip_mass = Some(0.3);
+    scene.planar_chain_mut().unwrap().links[1].tip_mass = Some(0.2);
+    scene.planar_chain_mut().unwrap().links[1].tip_inertia = Some(0.01);
     for basis in [Basis::ClampedFree, Basis::Poly] {
         let disc = Discretization {
             modes: Some(3),
@@ -137,7 +137,7 @@ fn dyn_equations_of_motion_match_the_energy_two_link_with_everything() {
         check_lagrange_scene(&scene, &disc, 0.7, 0.05, 2.0);
     }
     // Linear model (no foreshortening) too.
-    for l in &mut scene.links {
+    for l in &mut scene.planar_chain_mut().unwrap().links {
         l.foreshortening = false;
     }
     check_lagrange_scene(&scene, &with_modes(3), 1.1, 0.05, 2.0);
@@ -147,11 +147,11 @@ fn dyn_equations_of_motion_match_the_energy_two_link_with_everything() {
 fn dyn_equations_of_motion_match_the_energy_extensible_links() {
     // Axial fields with von Kármán strain (exact kinetic energy of p = (x + u, v)).
     let mut scene = load_scene("two-link-free-undamped").unwrap();
-    scene.gravity = Some(data::scene::Gravity {
+    scene.planar_chain_mut().unwrap().gravity = Some(data::scene::Gravity {
         vector: [0.0, -32.17],
     });
-    scene.links[1].tip_mass = Some(0.2);
-    for l in &mut scene.links {
+    scene.planar_chain_mut().unwrap().links[1].tip_mass = Some(0.2);
+    for l in &mut scene.planar_chain_mut().unwrap().links {
         l.foreshortening = false;
         l.axial = true;
         l.axial_stiffness = Some(1e5);
@@ -398,7 +398,7 @@ fn sys_default_method_is_adaptive_trbdf2_for_damped_chains_without_contact() {
     }
     // Step of the fixed-step methods when asked for by name: T₁/STEPS_PER_PERIOD of the faster
     // link (the 2 ft link 2): cantilever β₁ = 1.8751.
-    let l = &damped.links[1];
+    let l = &damped.links()[1];
     let omega1 = 1.875_104_068_711_961f64.powi(2)
         * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt();
     let h = std::f64::consts::TAU / omega1 / STEPS_PER_PERIOD;

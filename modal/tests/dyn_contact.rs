@@ -230,7 +230,7 @@ fn dyn_contact_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     // gravity along −x the gravity potential is +Σ mᵢ x_cg,i.
     let mut chain =
         modal::setup::build_chain(&scene, &settings(2, 1e-9, None).discretization).unwrap();
-    let g = -scene.gravity.as_ref().unwrap().vector[1];
+    let g = -scene.gravity().unwrap().vector[1];
     chain.gravity = Some([-1.0, 0.0]);
     let zero = vec![0.0; chain.n];
     chain.evaluate(0.0, &f.q, &zero);
@@ -271,7 +271,7 @@ fn dyn_contact_tipmass_first_impulse_converges_with_modes() {
     // pre-impact normal velocity, v_n⁻ = 2ΔT/Λ). The excess falls like 1/modes: measured
     // 7.103, 5.045, 4.226 (and 3.796, 3.356, 3.133 for 8, 12, 16 modes; limit ≈ 2.46).
     let scene = load_scene("barhorst-case1-tipmass").unwrap();
-    let m_tip = scene.links[1].tip_mass.unwrap();
+    let m_tip = scene.links()[1].tip_mass.unwrap();
     let modes = [2usize, 4, 6];
     let mut excess = Vec::new();
     let mut lam = Vec::new();
@@ -341,7 +341,7 @@ fn dyn_contact_dof_plan_and_unsupported_variants() {
     assert!(plan.builds.iter().any(|b| b.contains("Timoshenko")));
     // Friction on a unilateral contact (impacts with friction) stays refused.
     let mut tipmass = load_scene("barhorst-case1-tipmass").unwrap();
-    tipmass.contacts[0].friction = 0.3;
+    tipmass.planar_chain_mut().unwrap().contacts[0].friction = 0.3;
     match ModalBackend.simulate(&tipmass, &s) {
         Err(data::BackendError::Unsupported(m)) => assert!(m.contains("unilateral"), "{m}"),
         other => panic!("expected Unsupported, got {other:?}"),

@@ -96,25 +96,27 @@ fn print_summary(r: &RunResult, f: &FinalState) {
 /// The arm in a vertical plane without hub torque, released from rest 0.5 rad beside the
 /// bottom: a pendulum whose tip slides on the wall with friction until it sticks.
 fn pendulum(scene: &mut Scene) {
-    scene.gravity = Some(Gravity {
+    scene.planar_chain_mut().unwrap().gravity = Some(Gravity {
         vector: [0.0, -9.81],
     });
-    scene.links[0].joint.torque = Some(TorqueLaw::Constant {
+    scene.planar_chain_mut().unwrap().links[0].joint.torque = Some(TorqueLaw::Constant {
         value: 0.0,
         until: None,
     });
-    scene.links[0].joint.initial_angle = -std::f64::consts::FRAC_PI_2 + 0.5;
+    scene.planar_chain_mut().unwrap().links[0]
+        .joint
+        .initial_angle = -std::f64::consts::FRAC_PI_2 + 0.5;
 }
 
 /// Seed 001 eq. 71 from rest: θ = ln cosh(√(ab) t)/b, θ̇ = √(a/b) tanh(√(ab) t), with
 /// a = τ/J, b = μ(M + ρAL/3)L²/J, J = J_h + ρAL³/3 + ML² (derivation in verify's
 /// `ConstrainedRigidLink`; recomputed here so that modal's tests do not depend on verify).
 fn rigid_closed_form(scene: &Scene) -> impl Fn(f64) -> (f64, f64) + use<> {
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let (len, ra, m) = (l.length, l.mass_per_length, l.tip_mass.unwrap_or(0.0));
     let j = l.joint.hub_inertia.unwrap_or(0.0) + ra * len.powi(3) / 3.0 + m * len * len;
     let tau = l.joint.torque.as_ref().unwrap().torque(0.0);
-    let mu = scene.contacts[0].friction;
+    let mu = scene.contacts()[0].friction;
     let (a, b) = (tau / j, mu * (m + ra * len / 3.0) * len * len / j);
     let c = (a * b).sqrt();
     move |t: f64| ((c * t).cosh().ln() / b, (a / b).sqrt() * (c * t).tanh())
@@ -140,7 +142,7 @@ fn dyn_friction_arm_constraint_ledger_and_friction_work() {
     let scene = arm();
     let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, None)).unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
-    let len = scene.links[0].length;
+    let len = scene.links()[0].length;
     // Drift control: |g| and |G q̇| before each projection stay at round-off (stated: 1e-12 L,
     // 1e-10 L/s; measured 4e-16 and 4e-16).
     assert!(
@@ -171,7 +173,7 @@ fn dyn_friction_arm_constraint_ledger_and_friction_work() {
     assert!(*w.last().unwrap() > 0.0);
     // Coulomb law at every sample: |friction force| = μ|N| opposing v_t while sliding, inside
     // the cone with the tip at rest while sticking.
-    let mu = scene.contacts[0].friction;
+    let mu = scene.contacts()[0].friction;
     let (n, ft, vt) = (
         channel(&r, "contact1.normal_force"),
         channel(&r, FRICTION_FORCE_CHANNEL),
@@ -196,12 +198,12 @@ fn dyn_friction_work_equals_integral_of_mu_n_vt() {
     // signals are smooth enough for the quadrature.
     let mut scene = arm();
     pendulum(&mut scene);
-    scene.links[0].kelvin_voigt = Some(0.5);
+    scene.planar_chain_mut().unwrap().links[0].kelvin_voigt = Some(0.5);
     scene.simulation.output_interval = 2.5e-5;
     let t_end = 0.8;
     let (r, _) = simulate_detailed(&scene, &settings(3, 1e-9, Some(t_end))).unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
-    let mu = scene.contacts[0].friction;
+    let mu = scene.contacts()[0].friction;
     let (n, vt) = (
         channel(&r, "contact1.normal_force"),
         channel(&r, SLIP_VELOCITY_CHANNEL),
@@ -233,7 +235,7 @@ fn dyn_friction_stick_slip_pendulum_sticks_and_stays() {
     // event, the tip sticks and, with |λ_t| < μ|λ_n| from then on, stays stuck.
     let mut scene = arm();
     pendulum(&mut scene);
-    scene.links[0].kelvin_voigt = Some(0.5);
+    scene.planar_chain_mut().unwrap().links[0].kelvin_voigt = Some(0.5);
     let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, Some(1.5))).unwrap();
     print_summary(&r, &f);
     assert_eq!(r.verdict, StabilityVerdict::Completed);
@@ -247,7 +249,7 @@ fn dyn_friction_stick_slip_pendulum_sticks_and_stays() {
     assert!(f.contact.max_stick_velocity < 1e-9, "{:?}", f.contact);
     assert!(f.contact.max_stick_offset < 1e-12, "{:?}", f.contact);
     let time = &r.observables.time;
-    let mu = scene.contacts[0].friction;
+    let mu = scene.contacts()[0].friction;
     let (n, ft, vt, phase) = (
         channel(&r, "contact1.normal_force"),
         channel(&r, FRICTION_FORCE_CHANNEL),
@@ -282,7 +284,7 @@ fn dyn_friction_stick_slip_pendulum_sticks_and_stays() {
 /// the axial vibration riding on λ).
 fn rigid_errors(scene: &Scene, r: &RunResult) -> (f64, f64) {
     let rigid = rigid_closed_form(scene);
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let factor = (l.tip_mass.unwrap_or(0.0) + l.mass_per_length * l.length / 3.0) * l.length;
     let (th, n) = (
         channel(r, "joint1.angle"),
@@ -341,8 +343,11 @@ fn dyn_friction_euler_approaches_rigid_closed_form() {
     // Measured at ×1000: 3.6e-4 rad and 2.2 %.
     assert_rigid_limit("euler", |scale| {
         let mut scene = arm();
-        scene.links[0].bending_stiffness *= scale;
-        *scene.links[0].axial_stiffness.as_mut().unwrap() *= scale;
+        scene.planar_chain_mut().unwrap().links[0].bending_stiffness *= scale;
+        *scene.planar_chain_mut().unwrap().links[0]
+            .axial_stiffness
+            .as_mut()
+            .unwrap() *= scale;
         scene
     });
 }
@@ -354,7 +359,7 @@ fn dyn_friction_timoshenko_approaches_rigid_closed_form() {
     // 2.3 %).
     assert_rigid_limit("timoshenko", |scale| {
         let mut scene = arm();
-        let l = &mut scene.links[0];
+        let l = &mut scene.planar_chain_mut().unwrap().links[0];
         l.shear = true;
         l.shear_stiffness = Some(1e4 * l.bending_stiffness / (l.length * l.length) * scale);
         l.bending_stiffness *= scale;
@@ -368,15 +373,15 @@ fn dyn_friction_simple_flexure_is_the_rigid_model() {
     // Inextensible link (foreshortening, no axial field): on the circle of radius L about its
     // hub it must stay straight, so modal refuses it and names the rigid model.
     let mut scene = arm();
-    scene.links[0].axial = false;
-    scene.links[0].foreshortening = true;
+    scene.planar_chain_mut().unwrap().links[0].axial = false;
+    scene.planar_chain_mut().unwrap().links[0].foreshortening = true;
     match ModalBackend.simulate(&scene, &settings(3, 1e-8, None)) {
         Err(BackendError::Unsupported(m)) => assert!(m.contains("rigid"), "{m}"),
         other => panic!("expected Unsupported, got {other:?}"),
     }
     // A wall of another radius is not degenerate, but the straight initial link then starts
     // off it, which a bilateral contact rejects with a typed error.
-    scene.contacts[0].surface = data::scene::Surface::Circle {
+    scene.planar_chain_mut().unwrap().contacts[0].surface = data::scene::Surface::Circle {
         center: [0.0, 0.0],
         radius: 0.99,
     };
@@ -395,11 +400,11 @@ fn dyn_friction_inclined_line_bilateral_ledger_closes() {
     // for the line geometry as for the circle.
     let mut scene = arm();
     let h = std::f64::consts::FRAC_1_SQRT_2;
-    scene.contacts[0].surface = data::scene::Surface::Line {
+    scene.planar_chain_mut().unwrap().contacts[0].surface = data::scene::Surface::Line {
         point: [1.0, 0.0],
         normal: [-h, -h],
     };
-    scene.contacts[0].friction = 0.3;
+    scene.planar_chain_mut().unwrap().contacts[0].friction = 0.3;
     let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, Some(0.2))).unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     assert!(f.contact.max_gap_violation <= 1e-12, "{:?}", f.contact);
@@ -412,7 +417,7 @@ fn dyn_friction_inclined_line_bilateral_ledger_closes() {
         channel(&r, "contact1.phase"),
     );
     for k in 1..n.len() {
-        let cone = scene.contacts[0].friction * n[k].abs();
+        let cone = scene.contacts()[0].friction * n[k].abs();
         if phase[k] == 1.0 {
             assert!((ft[k].abs() - cone).abs() <= 1e-12 * (1.0 + n[k].abs()));
         } else {

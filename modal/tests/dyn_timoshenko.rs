@@ -86,7 +86,7 @@ fn is_spd(m: &[f64], n: usize) -> bool {
 /// assembled matrices): v = φᵀb, ψ = χᵀc or χᵀT b.
 fn field_strain_energy(scene: &Scene, chain: &Chain, i: usize, q: &[f64]) -> f64 {
     let l = &chain.links[i];
-    let sl = &scene.links[i];
+    let sl = &scene.links()[i];
     let (ei, kga) = (sl.bending_stiffness, sl.shear_stiffness.unwrap());
     let chi = l.section.psi_shapes.as_ref().unwrap();
     let (nb, nc) = (l.nb(), chi.count());
@@ -141,7 +141,7 @@ fn elem_timoshenko_strain_energy_from_fields_and_spd_matrices() {
     for (name, basis, kind) in cases {
         let scene = load_scene(name).unwrap();
         let mut chain = build_chain(&scene, &disc(5, basis)).unwrap();
-        let q = random_state(&chain, 1e-3 * scene.links[0].length, 7);
+        let q = random_state(&chain, 1e-3 * scene.links()[0].length, 7);
         let qd = random_state(&chain, 1e-1, 11);
         chain.evaluate(0.0, &q, &qd);
         let e = chain.energy(&q);
@@ -253,7 +253,7 @@ fn conv_timoshenko_cantilever_frequencies_fall_to_analytic() {
 
 fn scaled_shear(scene: &Scene, factor: f64) -> Scene {
     let mut s = scene.clone();
-    for l in &mut s.links {
+    for l in &mut s.planar_chain_mut().unwrap().links {
         *l.shear_stiffness.as_mut().unwrap() *= factor;
     }
     s
@@ -274,7 +274,7 @@ fn prop_timoshenko_stiff_shear_limit_is_the_euler_model() {
     //     Euler model with the same n. The gap must shrink like 1/κGA: no locking.
     let timo = load_scene("cantilever-timoshenko").unwrap();
     let mut rayleigh = timo.clone();
-    rayleigh.links[0].shear = false;
+    rayleigh.planar_chain_mut().unwrap().links[0].shear = false;
     let n = 6;
     let euler = freqs(&rayleigh, n - 1, Basis::Poly, 3);
     let mut gaps = Vec::new();
@@ -304,7 +304,7 @@ fn prop_timoshenko_stiff_shear_limit_is_the_euler_model() {
 #[test]
 fn sys_timoshenko_tip_inertia_without_rotary_inertia_is_refused() {
     let mut scene = load_scene("barhorst-case1-timoshenko").unwrap();
-    scene.links[1].tip_inertia = Some(0.01);
+    scene.planar_chain_mut().unwrap().links[1].tip_inertia = Some(0.01);
     let err = ModalBackend
         .simulate(&scene, &run_settings(3, None, 1e-6, Some(0.01)))
         .unwrap_err();
@@ -369,7 +369,7 @@ fn dyn_timoshenko_barhorst_impacts_and_ledger() {
 /// (κG/E)·EI/r² with the steel-like κG/E = (5/6)/2.6): section radius of gyration r = L/λ.
 fn timoshenko_arm(lambda: f64) -> Scene {
     let mut s = load_scene("constrained-arm").unwrap();
-    let l = &mut s.links[0];
+    let l = &mut s.planar_chain_mut().unwrap().links[0];
     let r = l.length / lambda;
     l.shear = true;
     l.shear_stiffness = Some((5.0 / 6.0) / 2.6 * l.bending_stiffness / (r * r));
@@ -425,7 +425,7 @@ fn dyn_timoshenko_rotary_inertia_chain_impact_and_ledger() {
     // (no condensation) carrying the Kelvin–Voigt damping on ψ̇' and the joint chaining
     // through ψ₁(L): the ledger must close through free flight and the first impact.
     let mut scene = load_scene("barhorst-case1-timoshenko").unwrap();
-    for l in &mut scene.links {
+    for l in &mut scene.planar_chain_mut().unwrap().links {
         l.rotary_inertia = true;
         l.rotary_inertia_per_length = Some(1e-2);
     }
@@ -463,8 +463,8 @@ fn sys_timoshenko_tip_load_statics_is_exact() {
     // The root-shear polynomial pair (n ≥ 3) contains both fields: exact to round-off. The
     // eigenfunction pair approximates them (measured at n = 8: 5.6e-5 on v(L), 8.0e-4 on ψ(L)).
     let scene = load_scene("cantilever-timoshenko").unwrap();
-    let l = &scene.links[0];
-    let p = scene.statics.as_ref().unwrap().tip_force.unwrap();
+    let l = &scene.links()[0];
+    let p = scene.statics().unwrap().tip_force.unwrap();
     let (len, ei, kga) = (l.length, l.bending_stiffness, l.shear_stiffness.unwrap());
     let v_exact = p * len.powi(3) / (3.0 * ei) + p * len / kga;
     let psi_exact = p * len * len / (2.0 * ei);

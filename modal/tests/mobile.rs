@@ -22,7 +22,7 @@ fn disc(modes: usize) -> Discretization {
 /// and every coupling show): q, ν.
 fn state(model: &MobileModel, scene: &Scene) -> (Vec<f64>, Vec<f64>) {
     let l = model.layout;
-    let mm = scene.mobile_manipulator.as_ref().unwrap();
+    let mm = scene.mobile_manipulator().unwrap();
     let mut q = vec![0.0; l.n];
     let mut nu = vec![0.0; l.m];
     let pseudo = |k: usize| ((k as f64 * 1.618_033_988_75 + 0.3).fract() - 0.5) * 2.0;
@@ -55,8 +55,7 @@ fn sys_mobile_mass_matrix_is_the_kinetic_energy_of_sampled_points() {
     let scene = load_scene("mobile-manipulator-flexible").unwrap();
     for (modes, shapes) in [(3, ShapeChoice::Poly), (4, ShapeChoice::ClampedFree)] {
         let model =
-            MobileModel::from_scene(scene.mobile_manipulator.as_ref().unwrap(), modes, shapes)
-                .unwrap();
+            MobileModel::from_scene(scene.mobile_manipulator().unwrap(), modes, shapes).unwrap();
         let l = model.layout;
         let (q, nu) = state(&model, &scene);
         let mut ws = Workspace::new(&model);
@@ -140,12 +139,8 @@ fn sys_mobile_mass_matrix_is_the_kinetic_energy_of_sampled_points() {
 #[test]
 fn sys_mobile_forces_match_finite_difference_lagrange_equations() {
     let scene = load_scene("mobile-manipulator-flexible").unwrap();
-    let mut model = MobileModel::from_scene(
-        scene.mobile_manipulator.as_ref().unwrap(),
-        3,
-        ShapeChoice::Poly,
-    )
-    .unwrap();
+    let mut model =
+        MobileModel::from_scene(scene.mobile_manipulator().unwrap(), 3, ShapeChoice::Poly).unwrap();
     // The stiffness force −K q would dominate every inertial term at this deflection; the
     // inertial, gravity and friction terms are checked with EI = 0 (K q against ∂U/∂q below).
     let strain_model = model.clone();

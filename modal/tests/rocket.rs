@@ -72,7 +72,7 @@ fn dyn_momentum_balance_holds_to_integrator_tolerance() {
     // trapezoid over the 1e-4 s output grid of the sampled P/M; the elastic velocities differ
     // from P/M by < 1 % and the trapezoid error is ~(Δt)²·V̈ ~ 1e-6 relative.
     let scene = load_scene("rocket").unwrap();
-    let rk = scene.rocket.unwrap();
+    let rk = scene.rocket().unwrap();
     let mdot = rk.stages[0].burn_rate * rk.stages[0].length / rk.gravity;
     let (vx, vy) = (values(r, "rocket.vX"), values(r, "rocket.vY"));
     let mut approx = [0.0, 0.0];
@@ -97,7 +97,7 @@ fn dyn_rigid_translation_follows_rocket_equation() {
         ("rocket-launch-60", &run("rocket-launch-60")),
     ] {
         let scene = load_scene(name).unwrap();
-        let rk = scene.rocket.unwrap();
+        let rk = scene.rocket().unwrap();
         let g = rk.gravity;
         let m0 = (rk
             .stages
@@ -297,7 +297,7 @@ fn sys_dof_counts_per_scene() {
     }
     // no discrete masses and no burn: those groups and loads are not built
     let mut scene = load_scene("rocket").unwrap();
-    let rk = scene.rocket.as_mut().unwrap();
+    let rk = scene.rocket_mut().unwrap();
     rk.discrete_masses.clear();
     rk.springs.clear();
     rk.stages[0].burn_rate = 0.0;
@@ -363,7 +363,7 @@ fn dyn_burnout_ends_thrust_and_restarts_integrator() {
     // Burn-out at 0.02 s (fast burn variant): the mass floors at the casing, thrust stops.
     let mut scene = load_scene("rocket").unwrap();
     scene.simulation.t_end = 0.03;
-    let rk = scene.rocket.as_mut().unwrap();
+    let rk = scene.rocket_mut().unwrap();
     let burnable = rk.stages[0].weight_per_length - rk.stages[0].casing_weight_per_length.unwrap();
     rk.stages[0].burn_rate = burnable / 0.02;
     let settings = Settings {
@@ -384,7 +384,7 @@ fn dyn_burnout_ends_thrust_and_restarts_integrator() {
         .collect();
     assert_eq!(ev.len(), 1);
     assert!((ev[0].time() - 0.02).abs() < 1e-15);
-    let rk = scene.rocket.as_ref().unwrap();
+    let rk = scene.rocket().unwrap();
     let casing = (rk.stages[0].casing_weight_per_length.unwrap() * rk.stages[0].length
         + rk.stages[1].weight_per_length * rk.stages[1].length
         + rk.discrete_masses.iter().map(|m| m.weight).sum::<f64>())
@@ -492,7 +492,7 @@ fn sys_settings_and_scenes_are_checked() {
     .unwrap_err();
     assert!(matches!(e, BackendError::Unsupported(_)));
     let mut s = scene.clone();
-    s.rocket.as_mut().unwrap().exit_pressure = 10.0;
+    s.rocket_mut().unwrap().exit_pressure = 10.0;
     assert!(matches!(
         rocket::simulate(&s, &Settings::default()).unwrap_err(),
         BackendError::Unsupported(m) if m.contains("exit_pressure")
@@ -513,7 +513,7 @@ fn short_settings(modes: usize) -> Settings {
 fn dyn_dampers_dissipate_and_ledger_still_closes() {
     let mut scene = load_scene("rocket").unwrap();
     scene.simulation.t_end = 0.01;
-    let rk = scene.rocket.as_mut().unwrap();
+    let rk = scene.rocket_mut().unwrap();
     for m in &mut rk.discrete_masses {
         m.axial_damping = 5.0;
         m.transverse_damping = 5.0;
@@ -545,7 +545,7 @@ fn dyn_runaway_is_stopped_with_diagnostic() {
     // An initial deflection of 10 in (7 % of the length) is outside the small-deflection
     // model: the run must stop with a diagnostic, keep the output so far, and never emit NaN.
     let mut scene = load_scene("rocket").unwrap();
-    scene.rocket.as_mut().unwrap().initial_shape =
+    scene.rocket_mut().unwrap().initial_shape =
         data::scene::InitialShape::Report { a1: 10.0, a2: 0.0 };
     let r = rocket::simulate(&scene, &short_settings(3)).unwrap();
     match &r.verdict {

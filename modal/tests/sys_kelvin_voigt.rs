@@ -54,7 +54,7 @@ fn sys_kelvin_voigt_power_of_a_velocity_field_matches_quadrature_in_6_and_12_pol
             ..Default::default()
         };
         let chain = build_chain(&scene, &disc).unwrap();
-        for (link, spec) in chain.links.iter().zip(&scene.links) {
+        for (link, spec) in chain.links.iter().zip(scene.links()) {
             let (n, l) = (link.nbc(), spec.length);
             assert_eq!(n, modes);
             // Coefficients of the field: collocation at ξ = i/n, i = 1..n (exact: the field

@@ -24,7 +24,7 @@ fn beam_hz(beta: f64, ei: f64, rho_a: f64, l: f64) -> f64 {
 #[test]
 fn sys_cantilever_clamped_free_basis_is_exact() {
     let scene = load_scene("cantilever").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let res = ModalBackend
         .modes(&scene, &settings(Basis::ClampedFree, 10), 10)
         .unwrap();
@@ -44,7 +44,7 @@ fn sys_cantilever_clamped_free_basis_is_exact() {
 #[test]
 fn sys_rayleigh_ritz_poly_converges_monotonically_from_above() {
     let scene = load_scene("cantilever").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let beta = clamped_free_reference_roots(3);
     let exact: Vec<f64> = beta
         .iter()
@@ -97,7 +97,7 @@ fn sys_rayleigh_ritz_poly_converges_monotonically_from_above() {
 #[test]
 fn sys_tip_mass_basis_is_exact_and_clamped_free_converges_from_above() {
     let scene = load_scene("cantilever-tip-mass").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let mu = l.tip_mass.unwrap() / l.beam_mass();
     let beta = frequency_roots(4, mu, 0.0).unwrap();
     let exact: Vec<f64> = beta
@@ -141,7 +141,7 @@ fn sys_rotating_beam_in_plane_identity_and_convergence() {
     // converges only algebraically: its error must fall monotonically 6 → 12 → 20 modes (from
     // above) and be below 1e-4 at 20 modes even at λ = 12 (measured 2e-5).
     let scene = load_scene("rotating-beam").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let lam_scale = (l.mass_per_length * l.length.powi(4) / l.bending_stiffness).sqrt();
     let beta = clamped_free_reference_roots(3);
     for lam in [0.0, 1.0, 4.0, 12.0] {
@@ -195,12 +195,17 @@ fn sys_rotating_beam_in_plane_identity_and_convergence() {
 #[test]
 fn sys_cantilever_statics_tip_load() {
     let scene = load_scene("cantilever").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let mut s = scene.clone();
-    s.statics.as_mut().unwrap().distributed_load = None;
+    s.planar_chain_mut()
+        .unwrap()
+        .statics
+        .as_mut()
+        .unwrap()
+        .distributed_load = None;
     // Poly basis with n ≥ 2 contains the exact cubic: PL³/3EI to round-off.
     let r = ModalBackend.statics(&s, &settings(Basis::Poly, 4)).unwrap();
-    let p = s.statics.as_ref().unwrap().tip_force.unwrap();
+    let p = s.statics().unwrap().tip_force.unwrap();
     let exact = p * l.length.powi(3) / (3.0 * l.bending_stiffness);
     assert!(
         ((r.tip_deflection - exact) / exact).abs() < 1e-12,
@@ -260,7 +265,7 @@ fn sys_unsupported_and_invalid_requests_are_typed_errors() {
     // Timoshenko links are supported since issue 7 (dyn_timoshenko.rs); a shear link without
     // its κGA is refused with a precise message.
     let mut scene = load_scene("barhorst-case1-timoshenko").unwrap();
-    scene.links[1].shear_stiffness = None;
+    scene.planar_chain_mut().unwrap().links[1].shear_stiffness = None;
     match ModalBackend.simulate(&scene, &s) {
         Err(BackendError::Unsupported(msg)) => {
             assert!(
@@ -297,7 +302,7 @@ fn sys_cantilever_axial_and_bending_frequencies_are_exact() {
     // Both bases are exact eigenfunctions here: axial √2 sin((2k−1)πx/2L) with
     // f = (2k−1)/(4L)·sqrt(EA/ρA), bending clamped-free. Only round-off remains.
     let scene = load_scene("cantilever-axial").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let n = 6;
     let res = ModalBackend
         .modes(&scene, &settings(Basis::ClampedFree, n), 2 * n)

@@ -15,7 +15,7 @@ use modal::simulate::{ChainRhs, simulate};
 /// all vanish and it must equal the exact Jacobian.
 fn rest_rhs(modes: usize, constrained: bool) -> (ChainRhs, Vec<f64>) {
     let mut scene = load_scene("barhorst-case1-tipmass").unwrap();
-    scene.gravity = None;
+    scene.planar_chain_mut().unwrap().gravity = None;
     let disc = Discretization {
         modes: Some(modes),
         ..Default::default()

@@ -19,7 +19,7 @@ use modal::payload_link::model::{
 };
 
 fn link(scene: &Scene) -> &PayloadLink {
-    scene.payload_link.as_ref().unwrap()
+    scene.payload_link().unwrap()
 }
 
 fn settings(modes: usize, basis: Basis) -> Settings {
@@ -374,7 +374,7 @@ fn sys_payload_link_field_forces_are_lagranges_equations_of_the_energies() {
     // Constant base rate with products of inertia and gravity: M q̈ must equal
     // ∂T/∂q − D_q(∂T/∂q̇)[q̇] − ∂V/∂q − C q̇ (θ̈ = 0), every term by differences of the energies.
     let mut scene = load_scene("single-link-3d-constant-rate").unwrap();
-    scene.payload_link.as_mut().unwrap().payload.inertia = [
+    scene.payload_link_mut().unwrap().payload.inertia = [
         [1.0e-4, 1.0e-5, 5.0e-6],
         [1.0e-5, 1.5e-4, 2.0e-6],
         [5.0e-6, 2.0e-6, 1.5e-4],
@@ -467,7 +467,7 @@ fn sys_payload_link_builds_only_what_the_scene_switches_on() {
 
     let mut s = scene.clone();
     {
-        let l = s.payload_link.as_mut().unwrap();
+        let l = s.payload_link_mut().unwrap();
         l.fields = vec![LinkField::Vertical, LinkField::Torsion];
         l.kelvin_voigt.as_mut().unwrap().vertical = None;
         l.gravity = None;
@@ -756,7 +756,7 @@ fn sys_payload_link_fields_split_into_u_v_and_w_phi_with_a_diagonal_payload_iner
         }
     }
     let mut products = scene.clone();
-    products.payload_link.as_mut().unwrap().payload.inertia = [
+    products.payload_link_mut().unwrap().payload.inertia = [
         [1.0e-4, 0.0, 5.0e-6],
         [0.0, 1.5e-4, 0.0],
         [5.0e-6, 0.0, 1.5e-4],
@@ -771,7 +771,7 @@ fn dyn_payload_link_gravity_does_not_move_v_at_constant_rate_with_diagonal_inert
     // not see gravity at all, while the vertical one does.
     let scene = load_scene("single-link-3d-constant-rate").unwrap();
     let mut no_gravity = scene.clone();
-    no_gravity.payload_link.as_mut().unwrap().gravity = None;
+    no_gravity.payload_link_mut().unwrap().gravity = None;
     let s = Settings {
         time: TimeStepping {
             t_end: Some(0.2),
@@ -812,7 +812,7 @@ fn sys_payload_link_gyroscopic_frequencies_reduce_to_the_pencil_at_rest() {
     let scene = load_scene("single-link-3d-constant-rate").unwrap();
     let s = settings(6, Basis::Poly);
     let mut at_rest = scene.clone();
-    at_rest.payload_link.as_mut().unwrap().base.prescribed =
+    at_rest.payload_link_mut().unwrap().base.prescribed =
         Some(data::scene::PrescribedMotion::ConstantRate { rate: 0.0 });
     let plain = ModalBackend.modes(&at_rest, &s, 10).unwrap().frequencies_hz;
     let gyro = modal::payload_link::gyroscopic_frequencies(&at_rest, &s, 10).unwrap();

@@ -33,7 +33,11 @@ fn main() {
         "single-link-3d-constant-rate",
         "single-link-3d-soft-sag",
     ] {
-        let p = data::load_scene(name).unwrap().payload_link.unwrap();
+        let p = data::load_scene(name)
+            .unwrap()
+            .payload_link()
+            .unwrap()
+            .clone();
         let (a, b, g) = sag_parameters(&p);
         let (wl, sl) = linear_sag(&p).unwrap();
         let e = sag_elastica(a, b, g).unwrap();

@@ -1052,14 +1052,14 @@ pub const FULL_RUNG_BUDGET_S: f64 = 10.0;
 /// The quantity a scene's refinement ladder follows in the full suite.
 pub fn ladder_quantity(scene: &Scene) -> Option<String> {
     use data::scene::PrescribedMotion;
-    if let Some(_r) = &scene.rocket {
+    if let Some(_r) = scene.rocket() {
         return Some(format!(
             "{}@{}",
             data::channel::ROCKET_VY,
             scene.simulation.t_end
         ));
     }
-    let first = scene.links.first()?;
+    let first = scene.links().first()?;
     let t = scene.simulation.t_end;
     Some(match first.joint.prescribed {
         Some(PrescribedMotion::Fixed) | Some(PrescribedMotion::ConstantRate { .. }) => {

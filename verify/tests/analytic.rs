@@ -7,7 +7,7 @@ use verify::analytic as ana;
 #[test]
 fn ana_catalog_cantilever_family() {
     let scene = data::load_scene("cantilever").unwrap();
-    let l = &scene.links[0];
+    let l = &scene.links()[0];
     let (ei, ra, len) = (l.bending_stiffness, l.mass_per_length, l.length);
     for kind in [
         ana::BeamSupport::ClampedFree,
@@ -21,7 +21,7 @@ fn ana_catalog_cantilever_family() {
     }
     // Elastica for every load parameter the scene lists: transverse tip deflection below the
     // linear value α/3 (the tip rotates away from the load) and rising with α.
-    let statics = scene.statics.clone().unwrap_or_default();
+    let statics = scene.statics().cloned().unwrap_or_default();
     let mut last = 0.0;
     for &alpha in &statics.elastica_load_parameters {
         let e = ana::cantilever_elastica(alpha).unwrap();
@@ -34,7 +34,7 @@ fn ana_catalog_cantilever_family() {
     }
 
     let tm = data::load_scene("cantilever-tip-mass").unwrap();
-    let l = &tm.links[0];
+    let l = &tm.links()[0];
     let f = ana::cantilever_tip_mass_frequencies_hz(
         l.bending_stiffness,
         l.mass_per_length,
@@ -47,7 +47,7 @@ fn ana_catalog_cantilever_family() {
     println!("tip mass: {f:?} Hz");
 
     let ts = data::load_scene("cantilever-timoshenko").unwrap();
-    let beam = ana::TimoshenkoBeam::from_link(&ts.links[0]).unwrap();
+    let beam = ana::TimoshenkoBeam::from_link(&ts.links()[0]).unwrap();
     let f = ana::timoshenko_clamped_free_hz(&beam, 5).unwrap();
     let eb = ana::bending_frequencies_hz(
         ana::BeamSupport::ClampedFree,
@@ -61,7 +61,7 @@ fn ana_catalog_cantilever_family() {
     assert!(f.iter().zip(&eb).all(|(t, e)| t < e));
 
     let ax = data::load_scene("cantilever-axial").unwrap();
-    let l = &ax.links[0];
+    let l = &ax.links()[0];
     let f = ana::axial_frequencies_hz(l.axial_stiffness.unwrap(), l.mass_per_length, l.length, 3)
         .unwrap();
     println!("axial: {f:?} Hz");
@@ -71,8 +71,7 @@ fn ana_catalog_cantilever_family() {
 fn ana_catalog_rotating_beam_speeds() {
     let scene = data::load_scene("rotating-beam").unwrap();
     let speeds = scene
-        .studies
-        .as_ref()
+        .studies()
         .map(|s| s.rotation_speeds.clone())
         .unwrap_or_default();
     assert!(!speeds.is_empty(), "rotating-beam lists its speeds");
@@ -183,7 +182,7 @@ fn ana_high_modes_are_robust() {
     println!("flapwise lambda = 100: {fast:.6?}");
     assert!(fast[0] > 100.0 && fast.windows(2).all(|w| w[1] > w[0]));
     let ts = data::load_scene("cantilever-timoshenko").unwrap();
-    let beam = ana::TimoshenkoBeam::from_link(&ts.links[0]).unwrap();
+    let beam = ana::TimoshenkoBeam::from_link(&ts.links()[0]).unwrap();
     let f = ana::timoshenko_clamped_free_hz(&beam, 12).unwrap();
     println!(
         "timoshenko 12 modes: {f:.3?} Hz, cut-off {:.3} Hz",

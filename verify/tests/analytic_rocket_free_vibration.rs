@@ -135,7 +135,7 @@ fn ana_free_vibration_expansion_converges_and_keeps_masses_at_rest() {
 #[test]
 fn ana_free_vibration_of_the_catalog_rocket_is_converged_in_modes() {
     let mut scene = data::catalog::load_scene("rocket").expect("catalog rocket");
-    let r = scene.rocket.as_mut().expect("rocket");
+    let r = scene.rocket_mut().expect("rocket");
     r.stages[0].burn_rate = 0.0;
     r.chamber_pressure = 0.0;
     let times: Vec<f64> = (0..=1000).map(|k| 1e-4 * k as f64).collect();

@@ -7,8 +7,7 @@ use verify::analytic::rigid::mobile::{Reference, Tolerances, simulate};
 
 fn reference(name: &str) -> Reference {
     let scene = load_scene(name).expect("catalog scene");
-    Reference::from_scene(scene.mobile_manipulator.as_ref().expect("mobile scene"))
-        .expect("rigid model")
+    Reference::from_scene(scene.mobile_manipulator().expect("mobile scene")).expect("rigid model")
 }
 
 /// A deterministic, non-special state (q, q̇) with q̇ consistent with the constraints.
@@ -220,7 +219,7 @@ fn dyn_mobile_flexible_variant_runs_as_its_rigid_limit() {
     // scene's, bit for bit (the two scene files differ only in that table).
     let flexible = load_scene("mobile-manipulator-flexible").unwrap();
     let mut rigid = flexible.clone();
-    rigid.mobile_manipulator.as_mut().unwrap().flexible_link = None;
+    rigid.mobile_manipulator_mut().unwrap().flexible_link = None;
     let settings = Settings {
         time: TimeStepping {
             t_end: Some(0.5),

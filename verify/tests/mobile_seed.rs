@@ -10,7 +10,7 @@ use verify::analytic::rigid::mobile::{Reference, Tolerances};
 
 fn arm() -> (Reference, ClosedFormArm) {
     let scene = load_scene("mobile-arm-fixed-base").unwrap();
-    let mm = scene.mobile_manipulator.as_ref().unwrap();
+    let mm = scene.mobile_manipulator().unwrap();
     (
         Reference::from_scene(mm).unwrap(),
         ClosedFormArm::from_scene(mm).expect("closed form applies"),
@@ -199,7 +199,7 @@ fn seed_eq30_gripper_weight_for_mass() {
     // mass centre at the link tip, as the seed has it): V(m_c) − V(0) = m_c g (z_axis + …),
     // z_axis the constant height of the first pitch axis.
     let scene = load_scene("mobile-arm-fixed-base").unwrap();
-    let mut with = scene.mobile_manipulator.clone().unwrap();
+    let mut with = scene.mobile_manipulator().cloned().unwrap();
     with.arm.as_mut().unwrap().gripper.com = [0.0; 3];
     let mut without = with.clone();
     without.arm.as_mut().unwrap().gripper.mass = 0.0;
@@ -226,13 +226,7 @@ fn seed_eq30_gripper_weight_for_mass() {
 fn seed_eq11_inertia_m_x_squared() {
     let (r, cf) = arm();
     let scene = load_scene("mobile-arm-fixed-base").unwrap();
-    let a = scene
-        .mobile_manipulator
-        .as_ref()
-        .unwrap()
-        .arm
-        .as_ref()
-        .unwrap();
+    let a = scene.mobile_manipulator().unwrap().arm.as_ref().unwrap();
     let jyy = [
         a.links[0].inertia[1][1],
         a.links[1].inertia[1][1],
@@ -253,7 +247,7 @@ fn seed_eq11_inertia_m_x_squared() {
 #[test]
 fn seed_eq66_67_platform_accelerations() {
     let scene = load_scene("mobile-platform").unwrap();
-    let mut mm = scene.mobile_manipulator.clone().unwrap();
+    let mut mm = scene.mobile_manipulator().cloned().unwrap();
     // The closed forms hold for the mass centre on the middle axle.
     mm.platform.as_mut().unwrap().chassis_com_offset = 0.0;
     let r = Reference::from_scene(&mm).unwrap();
@@ -318,7 +312,7 @@ fn seed_eq66_67_platform_accelerations() {
 fn seed_decoupled_arm_and_platform() {
     let full = {
         let s = load_scene("mobile-manipulator").unwrap();
-        Reference::from_scene(s.mobile_manipulator.as_ref().unwrap()).unwrap()
+        Reference::from_scene(s.mobile_manipulator().unwrap()).unwrap()
     };
     let (fixed, _) = arm();
     // Platform at rest heading 0, accelerating forward by u̇ = 1 m/s² (φ̈ = u̇/r both sides);

@@ -135,7 +135,11 @@ fn sys_stability_scenes_of_the_payload_link_load() {
         .map(|c| c.id)
         .collect();
     for name in ["single-link-3d-thin", "single-link-3d-heavy-payload"] {
-        let p = data::load_scene(name).unwrap().payload_link.unwrap();
+        let p = data::load_scene(name)
+            .unwrap()
+            .payload_link()
+            .unwrap()
+            .clone();
         assert!(
             !p.payload.is_diagonal(),
             "{name}: products of inertia excite torsion"
@@ -146,8 +150,9 @@ fn sys_stability_scenes_of_the_payload_link_load() {
     // a station spacing above ~1.6 R (at 41 stations h = 17 R).
     let p = data::load_scene("single-link-3d-thin")
         .unwrap()
-        .payload_link
-        .unwrap();
+        .payload_link()
+        .unwrap()
+        .clone();
     let h = p.length / 40.0;
     let torsion = h * (p.density * p.polar_moment() / p.torsional_stiffness()).sqrt();
     let bending = h * h * (p.mass_per_length() / (4.0 * p.bending_stiffness())).sqrt();
@@ -155,8 +160,9 @@ fn sys_stability_scenes_of_the_payload_link_load() {
     // The heavy payload is ten times the rod.
     let p = data::load_scene("single-link-3d-heavy-payload")
         .unwrap()
-        .payload_link
-        .unwrap();
+        .payload_link()
+        .unwrap()
+        .clone();
     assert!(p.payload.mass >= 10.0 * p.mass_per_length() * p.length * 0.99);
 }
 
@@ -171,7 +177,11 @@ fn sys_reference_numbers_of_the_catalog_scenes() {
         "single-link-3d-soft-sag",
         "single-link-3d-stiff",
     ] {
-        let mut p = data::load_scene(name).unwrap().payload_link.unwrap();
+        let mut p = data::load_scene(name)
+            .unwrap()
+            .payload_link()
+            .unwrap()
+            .clone();
         if !p.payload.is_diagonal() {
             p.payload.inertia = diag;
         }

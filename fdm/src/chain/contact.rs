@@ -67,7 +67,7 @@ pub struct TipContact {
 impl TipContact {
     /// The scene's contact, if any; `unsupported: …` for what this model does not carry.
     pub fn from_scene(scene: &Scene) -> Result<Option<Self>, FdmError> {
-        let Some(c) = scene.contacts.first() else {
+        let Some(c) = scene.contacts().first() else {
             return Ok(None);
         };
         let unsupported = |what: String| {
@@ -77,8 +77,8 @@ impl TipContact {
                 scene.name
             )))
         };
-        if scene.contacts.len() > 1 {
-            return unsupported(format!("{} contacts", scene.contacts.len()));
+        if scene.contacts().len() > 1 {
+            return unsupported(format!("{} contacts", scene.contacts().len()));
         }
         if scene.link_index(&c.link) != Some(1) {
             return unsupported(format!("contact of link `{}`", c.link));

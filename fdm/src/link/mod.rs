@@ -102,15 +102,15 @@ pub struct FloatingLink {
 
 impl FloatingLink {
     pub fn from_scene(scene: &Scene, stations: Option<usize>) -> Result<Self, FdmError> {
-        if scene.links.len() != 1 {
+        if scene.links().len() != 1 {
             return Err(FdmError::Unsupported(format!(
                 "fdm: `{}` has {} links; chains of floating-frame links (joint coupling through the \
                  tip slope) are not implemented in fdm",
                 scene.name,
-                scene.links.len()
+                scene.links().len()
             )));
         }
-        let l = &scene.links[0];
+        let l = &scene.links()[0];
         FdmError::check_switches(
             &format!("`{}`", scene.name),
             "floating link",
@@ -119,8 +119,8 @@ impl FloatingLink {
                 ("shear", l.shear),
                 ("rotary_inertia", l.rotary_inertia),
                 ("tip_inertia", l.tip_inertia.is_some()),
-                ("gravity", scene.gravity.is_some()),
-                ("contact", !scene.contacts.is_empty()),
+                ("gravity", scene.gravity().is_some()),
+                ("contact", !scene.contacts().is_empty()),
             ],
         )?;
         let j = &l.joint;

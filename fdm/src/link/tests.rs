@@ -66,11 +66,13 @@ const RAMP_GAIN: f64 = 5.0;
 /// any step (0.5…1.05 × the bound alike, issue 15).
 fn spinning(omega: f64, stations: usize) -> (FloatingLink, Scene) {
     let mut scene = data::load_scene("spin-up").unwrap();
-    scene.links[0].joint.prescribed = Some(PrescribedMotion::SpinUp {
+    scene.planar_chain_mut().unwrap().links[0].joint.prescribed = Some(PrescribedMotion::SpinUp {
         omega_s: RAMP_GAIN,
         t_s: RAMP,
     });
-    scene.links[0].joint.initial_rate = omega - RAMP_GAIN;
+    scene.planar_chain_mut().unwrap().links[0]
+        .joint
+        .initial_rate = omega - RAMP_GAIN;
     let link = FloatingLink::from_scene(&scene, Some(stations)).unwrap();
     (link, scene)
 }
@@ -319,11 +321,11 @@ fn sys_link_bordered_mass_solve_matches_dense() {
     use faer::Mat;
     use faer::prelude::Solve;
     let mut scene = data::load_scene("single-link").unwrap();
-    scene.links[0].foreshortening = true;
+    scene.planar_chain_mut().unwrap().links[0].foreshortening = true;
     let stiffness = 7.5;
-    scene.links[0].joint.stiffness = Some(stiffness);
-    scene.links[0].joint.torque = None;
-    scene.links[0].joint.damping = None;
+    scene.planar_chain_mut().unwrap().links[0].joint.stiffness = Some(stiffness);
+    scene.planar_chain_mut().unwrap().links[0].joint.torque = None;
+    scene.planar_chain_mut().unwrap().links[0].joint.damping = None;
     let mut link = FloatingLink::from_scene(&scene, Some(21)).unwrap();
     assert!(!link.prescribed());
     let (vs, vd) = lagging_state(&link);
@@ -332,7 +334,7 @@ fn sys_link_bordered_mass_solve_matches_dense() {
     q[1..].copy_from_slice(&vs);
     v[1..].copy_from_slice(&vd);
     v[0] = 1.7;
-    let set_point = scene.links[0].joint.set_point.unwrap_or(0.0);
+    let set_point = scene.links()[0].joint.set_point.unwrap_or(0.0);
     let delta = 0.25;
     let (mut a0, mut a1) = (vec![0.0; n], vec![0.0; n]);
     q[0] = set_point;

@@ -122,7 +122,7 @@ pub struct PayloadLinkModel {
 
 impl PayloadLinkModel {
     pub fn from_scene(scene: &Scene, stations: Option<usize>) -> Result<Self, FdmError> {
-        let p = scene.payload_link.as_ref().ok_or_else(|| {
+        let p = scene.payload_link().ok_or_else(|| {
             FdmError::Unsupported(format!("fdm: `{}` has no [payload_link]", scene.name))
         })?;
         Self::build(

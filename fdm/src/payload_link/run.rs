@@ -309,7 +309,9 @@ pub fn simulate(
 ) -> Result<RunResult, FdmError> {
     let clock = Instant::now();
     let model = PayloadLinkModel::from_scene(scene, s.stations)?;
-    let p = scene.payload_link.as_ref().expect("checked in from_scene");
+    let p = scene.payload_link().ok_or_else(|| {
+        FdmError::Unsupported(format!("fdm: `{}` has no [payload_link]", scene.name))
+    })?;
     let sag = p.initial_shape == data::scene::LinkInitialShape::StaticSag;
     let t_end = s.t_end.unwrap_or(scene.simulation.t_end);
     let interval = scene.simulation.output_interval;

@@ -11,7 +11,7 @@ use super::{PayloadLinkModel, apply};
 fn model(name: &str, payload: bool) -> PayloadLinkModel {
     let mut scene = load_scene(name).unwrap();
     if !payload {
-        let p = &mut scene.payload_link.as_mut().unwrap().payload;
+        let p = &mut scene.payload_link_mut().unwrap().payload;
         p.mass = 0.0;
         p.offset = 0.0;
         p.inertia = [[0.0; 3]; 3];
@@ -178,7 +178,7 @@ fn kinetic_direct(
 #[test]
 fn elem_payload_kinetic_energy_matches_the_kinematics_to_second_order() {
     let scene = load_scene("single-link-3d").unwrap();
-    let p = scene.payload_link.clone().unwrap();
+    let p = scene.payload_link().cloned().unwrap();
     let m = model("single-link-3d", true);
     let rate = 1.3;
     let diff = |eps: f64| {
@@ -203,11 +203,11 @@ fn elem_payload_kinetic_energy_second_order_part_is_exact_without_payload_rotati
     // direct T still differ only at third order; the zero-field limit agrees to round-off.
     let mut scene = load_scene("single-link-3d").unwrap();
     {
-        let pl = &mut scene.payload_link.as_mut().unwrap().payload;
+        let pl = &mut scene.payload_link_mut().unwrap().payload;
         pl.offset = 0.0;
         pl.inertia = [[0.0; 3]; 3];
     }
-    let p = scene.payload_link.clone().unwrap();
+    let p = scene.payload_link().cloned().unwrap();
     let m = PayloadLinkModel::from_scene(&scene, Some(11)).unwrap();
     let zero = vec![0.0; m.n];
     let (a, b) = (
@@ -317,7 +317,7 @@ fn elem_payload_elastic_and_gravity_forces_are_the_potential_gradient() {
 #[test]
 fn elem_payload_step_bounds_are_the_reports_per_field() {
     let scene = load_scene("single-link-3d").unwrap();
-    let p = scene.payload_link.clone().unwrap();
+    let p = scene.payload_link().cloned().unwrap();
     let m = PayloadLinkModel::from_scene(&scene, Some(21)).unwrap();
     let h = m.h;
     for (f, sigma, station) in m.field_bounds() {

@@ -16,8 +16,7 @@ pub const DEFAULT_STATIONS: usize = 76;
 
 pub fn build(scene: &Scene, s: &FdmSettings) -> Result<RocketSystem, FdmError> {
     let r = scene
-        .rocket
-        .as_ref()
+        .rocket()
         .ok_or_else(|| FdmError::Unsupported("scene has no [rocket]".into()))?;
     let n = s.stations.unwrap_or(DEFAULT_STATIONS);
     let model = RocketModel::new(r, n)?;
@@ -26,8 +25,7 @@ pub fn build(scene: &Scene, s: &FdmSettings) -> Result<RocketSystem, FdmError> {
 
 pub fn dof_plan(scene: &Scene, stations: Option<usize>) -> Result<DofPlan, FdmError> {
     let r = scene
-        .rocket
-        .as_ref()
+        .rocket()
         .ok_or_else(|| FdmError::Unsupported("scene has no [rocket]".into()))?;
     let n = stations.unwrap_or(DEFAULT_STATIONS);
     let mut plan = DofPlan::default();

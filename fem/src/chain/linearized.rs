@@ -199,14 +199,14 @@ impl Chain {
 /// free joint (a single link on a fixed or constant-rate hub is the linear link of
 /// [`crate::linear`]).
 pub fn applies(scene: &Scene) -> bool {
-    scene.links.len() > 1 || scene.links.iter().any(|l| l.joint.prescribed.is_none())
+    scene.links().len() > 1 || scene.links().iter().any(|l| l.joint.prescribed.is_none())
 }
 
 /// `modes` of a chain scene: the lowest `count` linearized frequencies and their shapes.
 pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, FemError> {
     let start = std::time::Instant::now();
     let mut chain = Chain::from_scene(scene, &settings.discretization)?;
-    for (i, l) in scene.links.iter().enumerate() {
+    for (i, l) in scene.links().iter().enumerate() {
         match l.joint.prescribed {
             None | Some(PrescribedMotion::Fixed) => {}
             Some(_) => {

@@ -293,11 +293,11 @@ impl Contact {
     /// The scene's tip contact on `chain` (None without one; nothing is allocated then).
     pub fn from_scene(scene: &Scene, chain: &Chain) -> Result<Option<Self>, FemError> {
         crate::support::check_contact(scene)?;
-        let Some(c) = scene.contacts.first() else {
+        let Some(c) = scene.contacts().first() else {
             return Ok(None);
         };
         let link = scene
-            .links
+            .links()
             .iter()
             .position(|l| l.name == c.link)
             .unwrap_or(0);

@@ -73,7 +73,7 @@ pub const STEPS_PER_PERIOD: f64 = 40.0;
 
 /// The scene's mobile manipulator (None for other families).
 pub fn scene_model(scene: &Scene) -> Option<&MobileManipulator> {
-    scene.mobile_manipulator.as_ref()
+    scene.mobile_manipulator()
 }
 
 fn the_scene(scene: &Scene) -> Result<&MobileManipulator, FemError> {

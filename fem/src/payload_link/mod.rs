@@ -88,7 +88,7 @@ pub const PHASE_ERROR_TOLERANCE: f64 = 1e-4;
 
 /// The scene's payload link (None for other families).
 pub fn link(scene: &Scene) -> Option<&PayloadLink> {
-    scene.payload_link.as_ref()
+    scene.payload_link()
 }
 
 fn the_link(scene: &Scene) -> Result<&PayloadLink, FemError> {

@@ -83,7 +83,7 @@ const NEWTON_ACCEPT: f64 = 1e-10;
 const NEWTON_MAX: usize = 12;
 
 pub fn the_rocket(scene: &Scene) -> Option<&data::scene::Rocket> {
-    scene.rocket.as_ref()
+    scene.rocket()
 }
 
 fn rocket_of(scene: &Scene) -> Result<&data::scene::Rocket, FemError> {

@@ -261,13 +261,12 @@ pub fn assert_releases_located(releases: &[(f64, f64, f64)], weight: f64) {
 /// from the scene itself.
 pub fn weight(scene: &data::Scene) -> f64 {
     let mass: f64 = scene
-        .links
+        .links()
         .iter()
         .map(|l| l.mass_per_length * l.length + l.tip_mass.unwrap_or(0.0))
         .sum();
     let g = scene
-        .gravity
-        .as_ref()
+        .gravity()
         .map_or(0.0, |g| g.vector[0].hypot(g.vector[1]));
     mass * g
 }

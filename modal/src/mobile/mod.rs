@@ -122,8 +122,7 @@ pub fn shape_choice(disc: &Discretization) -> Result<(usize, ShapeChoice), Modal
 /// The scene's model and inputs.
 pub fn set_up(scene: &Scene, disc: &Discretization) -> Result<(MobileModel, Inputs), ModalError> {
     let mm = scene
-        .mobile_manipulator
-        .as_ref()
+        .mobile_manipulator()
         .ok_or_else(|| ModalError::Unsupported("not a mobile-manipulator scene".into()))?;
     let (n, choice) = shape_choice(disc)?;
     let model = MobileModel::from_scene(mm, n, choice)?;
@@ -175,8 +174,7 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
     let start = std::time::Instant::now();
     let (model, inputs) = set_up(scene, &settings.discretization)?;
     let mm = scene
-        .mobile_manipulator
-        .as_ref()
+        .mobile_manipulator()
         .ok_or_else(|| ModalError::Unsupported("not a mobile-manipulator scene".into()))?;
     let (Some(fl), Some(e0)) = (&model.flex, model.layout.elastic) else {
         return Err(ModalError::Unsupported(

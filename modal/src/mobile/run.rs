@@ -198,8 +198,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
     }
     let t_end = crate::setup::checked_span(scene, settings)?;
     let mm = scene
-        .mobile_manipulator
-        .as_ref()
+        .mobile_manipulator()
         .ok_or_else(|| ModalError::Unsupported("not a mobile-manipulator scene".into()))?;
     let mut rhs = MobileRhs::new(model, inputs);
     let (n, m) = (rhs.n(), rhs.m());

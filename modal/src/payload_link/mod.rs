@@ -80,8 +80,7 @@ pub fn basis_choice(disc: &Discretization) -> Result<(usize, BasisChoice), Modal
 
 pub fn set_up<'a>(scene: &'a Scene, disc: &Discretization) -> Result<SetUp<'a>, ModalError> {
     let link = scene
-        .payload_link
-        .as_ref()
+        .payload_link()
         .ok_or_else(|| ModalError::Unsupported("not a payload-link scene".into()))?;
     let (n, choice) = basis_choice(disc)?;
     let model = LinkModel::build(link, n, choice, scene.simulation.field_stations)?;
@@ -106,8 +105,7 @@ pub fn static_sag(model: &LinkModel) -> Result<Vec<f64>, ModalError> {
 /// Degrees of freedom and physics built for the scene.
 pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalError> {
     let link = scene
-        .payload_link
-        .as_ref()
+        .payload_link()
         .ok_or_else(|| ModalError::Unsupported("not a payload-link scene".into()))?;
     let (n, choice) = basis_choice(disc)?;
     let mut plan = DofPlan::default();

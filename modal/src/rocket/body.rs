@@ -96,7 +96,7 @@ pub struct Body {
 
 impl Body {
     pub fn from_scene(scene: &data::Scene) -> Result<Body, RocketError> {
-        let r: &Rocket = scene.rocket.as_ref().ok_or_else(|| {
+        let r: &Rocket = scene.rocket().ok_or_else(|| {
             RocketError::Unsupported(format!(
                 "the modal rocket model needs a [rocket] scene; `{}` is a {}",
                 scene.name,

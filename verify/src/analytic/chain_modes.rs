@@ -86,15 +86,14 @@ impl SpringJointedChain {
     /// contain: gravity, extensible, Timoshenko or rotary-inertia links, prescribed joint
     /// motion other than `fixed`, and a reference configuration that is not straight.
     pub fn from_scene(scene: &Scene) -> Result<Self> {
-        if scene.links.is_empty() {
+        if scene.links().is_empty() {
             return Err(AnalyticError::Unsupported(format!(
                 "the spring-jointed chain needs a planar link chain; `{}` has no [[link]]",
                 scene.name
             )));
         }
         if scene
-            .gravity
-            .as_ref()
+            .gravity()
             .is_some_and(|g| g.vector.iter().any(|&x| x != 0.0))
         {
             return Err(AnalyticError::Unsupported(
@@ -103,9 +102,9 @@ impl SpringJointedChain {
                     .into(),
             ));
         }
-        let mut links = Vec::with_capacity(scene.links.len());
-        let mut joints = Vec::with_capacity(scene.links.len());
-        for (i, l) in scene.links.iter().enumerate() {
+        let mut links = Vec::with_capacity(scene.links().len());
+        let mut joints = Vec::with_capacity(scene.links().len());
+        for (i, l) in scene.links().iter().enumerate() {
             if l.axial || l.shear || l.rotary_inertia {
                 return Err(AnalyticError::Unsupported(format!(
                     "link {}: the spring-jointed chain is of inextensible Euler–Bernoulli links \

@@ -613,7 +613,11 @@ mod tests {
     }
 
     fn payload_scene(name: &str) -> PayloadLink {
-        data::load_scene(name).unwrap().payload_link.unwrap()
+        data::load_scene(name)
+            .unwrap()
+            .payload_link()
+            .unwrap()
+            .clone()
     }
 
     #[test]

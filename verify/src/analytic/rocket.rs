@@ -90,7 +90,7 @@ pub struct RocketState {
 impl RocketTranslation {
     /// From a scene with a `[rocket]` table.
     pub fn from_scene(scene: &Scene) -> Result<Self> {
-        let r = scene.rocket.as_ref().ok_or_else(|| {
+        let r = scene.rocket().ok_or_else(|| {
             AnalyticError::Unsupported("rocket translation: the scene has no [rocket]".into())
         })?;
         let g = positive("gravity", r.gravity)?;

@@ -234,7 +234,7 @@ impl FreeFreeRocket {
 
     /// The rocket scene at ignition (stage-1 weight per length before any burn).
     pub fn from_scene(scene: &Scene) -> Result<Self> {
-        let r = scene.rocket.as_ref().ok_or_else(|| {
+        let r = scene.rocket().ok_or_else(|| {
             AnalyticError::Unsupported(format!("`{}` is not a rocket scene", scene.name))
         })?;
         let g = positive("gravity", r.gravity)?;

@@ -209,7 +209,7 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
             for (k, v) in &flags {
                 say!("  {:<width$} {}", k, if *v { "on" } else { "off" });
             }
-            if let Some(p) = &scene.payload_link {
+            if let Some(p) = scene.payload_link() {
                 say!(
                     "rod: L = {}, R = {}, E = {:e}, G = {:e}, ρ = {}; fields {}; payload m = {}, c = {}",
                     p.length,
@@ -226,7 +226,7 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                     p.payload.offset
                 );
             }
-            for (i, l) in scene.links.iter().enumerate() {
+            for (i, l) in scene.links().iter().enumerate() {
                 say!(
                     "link {} `{}`: L = {}, ρA = {}, EI = {}{}{}",
                     i + 1,
@@ -240,7 +240,7 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                         .map_or(String::new(), |v| format!(", tip mass {v}")),
                 );
             }
-            for (i, c) in scene.contacts.iter().enumerate() {
+            for (i, c) in scene.contacts().iter().enumerate() {
                 say!(
                     "contact {}: tip of `{}` against {:?} ({:?}, μ = {})",
                     i + 1,
@@ -410,7 +410,7 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 &format!("{stem}-events.json"),
                 &serde_json::to_vec_pretty(&r.events).expect("serializable"),
             )?;
-            if !scene.contacts.is_empty() {
+            if !scene.contacts().is_empty() {
                 write_atomic(
                     dir,
                     &format!("{stem}-switching.csv"),
@@ -501,7 +501,7 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 columns[0] = Column::left(header[0]).elastic();
                 out!("{}", fitted_table(&columns, &rows, TERMINAL_WIDTH));
             }
-            if !scene.contacts.is_empty() {
+            if !scene.contacts().is_empty() {
                 // The terminal table names the columns briefly; `--format wide` and the
                 // switching CSV spell them out.
                 let short = [

@@ -58,7 +58,7 @@ impl Quantity {
     /// Parses the grammar of `data::cases` against a scene (aliases resolve to its last link).
     pub fn parse(text: &str, scene: &Scene) -> Result<Quantity, String> {
         let t = text.trim();
-        let last = scene.links.len().max(1);
+        let last = scene.links().len().max(1);
         let alias = |c: &str| -> String {
             match c {
                 "tip_deflection" => channel::tip_deflection(last),
@@ -125,11 +125,11 @@ impl Quantity {
         }
         if let Some(rest) = t.strip_prefix("impulse_excess") {
             let contact_link = scene
-                .contacts
+                .contacts()
                 .first()
                 .and_then(|c| scene.link_index(&c.link))
                 .ok_or_else(|| format!("`{text}` needs a scene with a contact"))?;
-            let link = &scene.links[contact_link];
+            let link = &scene.links()[contact_link];
             let tip_mass = link.tip_mass.filter(|m| *m > 0.0).ok_or_else(|| {
                 format!(
                     "`{text}` needs a tip mass on the contact link `{}`",

@@ -33,18 +33,18 @@ use super::quantity::Quantity;
 use crate::analytic as ana;
 
 fn single_link(scene: &Scene) -> Result<&Link, String> {
-    match scene.links.as_slice() {
+    match scene.links() {
         [l] => Ok(l),
         _ => Err(format!(
             "this analytic reference needs a single-link scene; `{}` has {} links",
             scene.name,
-            scene.links.len()
+            scene.links().len()
         )),
     }
 }
 
 fn payload_link(scene: &Scene) -> Result<&PayloadLink, String> {
-    scene.payload_link.as_ref().ok_or_else(|| {
+    scene.payload_link().ok_or_else(|| {
         format!(
             "this analytic reference needs a [payload_link] scene; `{}` is not one",
             scene.name
@@ -196,10 +196,7 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
                 return Err("`static-linear` applies to `tip_static`".into());
             }
             let l = single_link(scene)?;
-            let st = scene
-                .statics
-                .as_ref()
-                .ok_or("the scene has no [statics] loads")?;
+            let st = scene.statics().ok_or("the scene has no [statics] loads")?;
             let mut w = 0.0;
             if let Some(p) = st.tip_force {
                 w += ana::cantilever_tip_load(p, l.bending_stiffness, l.length)
@@ -384,7 +381,7 @@ pub fn analytic_history(
         "rocket-free-vibration" => {
             let fv = ana::rocket_modes::FreeVibration::from_scene(scene, FREE_VIBRATION_MODES)
                 .map_err(|e| e.to_string())?;
-            let r = scene.rocket.as_ref().ok_or("not a rocket scene")?;
+            let r = scene.rocket().ok_or("not a rocket scene")?;
             let stations = scene.simulation.field_stations;
             let mass = (1..=r.discrete_masses.len())
                 .find(|&j| data::channel::rocket_mass_transverse(j) == channel);
@@ -417,7 +414,7 @@ pub fn analytic_history(
 
 /// The analytic reference that naturally applies to a quantity on a scene, if any.
 pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
-    if scene.rocket.is_some() {
+    if scene.rocket().is_some() {
         return match q {
             Quantity::Frequency { kind, .. }
                 if kind
@@ -429,7 +426,7 @@ pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
             _ => None,
         };
     }
-    if scene.payload_link.is_some() {
+    if scene.payload_link().is_some() {
         let id = match q {
             Quantity::Frequency {
                 kind: Some(kind), ..
@@ -443,7 +440,7 @@ pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
         };
         return Some(id);
     }
-    let [l] = scene.links.as_slice() else {
+    let [l] = scene.links() else {
         return None;
     };
     let clamped = matches!(l.joint.prescribed, Some(PrescribedMotion::Fixed));

@@ -105,7 +105,7 @@ pub const MIN_TRIAL: f64 = 1e-3;
 
 /// The `describe` line of a bilateral contact (None otherwise).
 pub fn describe(scene: &Scene) -> Option<String> {
-    let c = scene.contacts.first()?;
+    let c = scene.contacts().first()?;
     if c.mode != ContactMode::Bilateral {
         return None;
     }

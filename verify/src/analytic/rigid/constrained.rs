@@ -141,7 +141,7 @@ impl ConstrainedRigidLink {
     pub fn from_scene(scene: &Scene) -> Result<Self> {
         let link = super::torque_driven_single_link(scene, "constrained rigid link")?;
         let j = &link.joint;
-        let [contact] = scene.contacts.as_slice() else {
+        let [contact] = scene.contacts() else {
             return Err(AnalyticError::Unsupported(
                 "constrained rigid link: exactly one contact is required".into(),
             ));

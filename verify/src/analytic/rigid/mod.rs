@@ -58,13 +58,13 @@ pub(crate) fn reject(cond: bool, what: &str) -> Result<()> {
 /// joint spring/damper or prescribed motion): what the single-link rigid limits require.
 pub(crate) fn torque_driven_single_link<'a>(scene: &'a Scene, who: &str) -> Result<&'a Link> {
     reject(
-        scene.links.len() != 1,
+        scene.links().len() != 1,
         &format!("{who}: the scene must have exactly one link"),
     )?;
-    let link = &scene.links[0];
+    let link = &scene.links()[0];
     let j = &link.joint;
     reject(
-        scene.gravity.is_some(),
+        scene.gravity().is_some(),
         &format!("{who}: gravity (only the horizontal plane is modelled)"),
     )?;
     reject(

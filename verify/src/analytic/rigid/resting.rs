@@ -157,7 +157,7 @@ pub fn resting_on_tip(arm: &RigidTwoLink, h: f64) -> Result<RestingArm> {
 /// Rest states for a two-link scene with one unilateral horizontal line contact on link 2.
 pub fn resting_from_scene(scene: &Scene) -> Result<RestingArm> {
     let mut no_contact = scene.clone();
-    let [contact] = scene.contacts.as_slice() else {
+    let [contact] = scene.contacts() else {
         return Err(AnalyticError::Unsupported(
             "resting arm: exactly one contact is required".into(),
         ));
@@ -174,7 +174,9 @@ pub fn resting_from_scene(scene: &Scene) -> Result<RestingArm> {
         scene.link_index(&contact.link) != Some(1),
         "resting arm: the contact must be on the tip of link 2",
     )?;
-    no_contact.contacts.clear();
+    if let Some(chain) = no_contact.planar_chain_mut() {
+        chain.contacts.clear();
+    }
     let arm = RigidTwoLink::from_scene(&no_contact)?;
     resting_on_tip(&arm, h)
 }

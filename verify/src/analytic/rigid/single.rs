@@ -49,7 +49,7 @@ impl RigidLink {
         let link = super::torque_driven_single_link(scene, "rigid single-link reference")?;
         let j = &link.joint;
         reject(
-            !scene.contacts.is_empty(),
+            !scene.contacts().is_empty(),
             "rigid single-link reference: contact (see rigid::constrained for the circular wall)",
         )?;
         let r = RigidLink {

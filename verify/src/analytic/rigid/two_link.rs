@@ -125,27 +125,27 @@ impl RigidTwoLink {
     /// damping, foreshortening and shear vanish in the rigid limit and are ignored).
     pub fn from_scene(scene: &Scene) -> Result<Self> {
         reject(
-            scene.links.len() != 2,
+            scene.links().len() != 2,
             "rigid two-link reference: the scene must have exactly two links",
         )?;
         reject(
-            !scene.contacts.is_empty(),
+            !scene.contacts().is_empty(),
             "rigid two-link reference: contact (use rigid::resting for the static limit)",
         )?;
         reject(
-            scene.links.iter().any(|l| l.joint.prescribed.is_some()),
+            scene.links().iter().any(|l| l.joint.prescribed.is_some()),
             "rigid two-link reference: prescribed joint motion",
         )?;
         let r = RigidTwoLink {
             links: [
-                body_from_link(&scene.links[0]),
-                body_from_link(&scene.links[1]),
+                body_from_link(&scene.links()[0]),
+                body_from_link(&scene.links()[1]),
             ],
             joints: [
-                joint_from_link(&scene.links[0]),
-                joint_from_link(&scene.links[1]),
+                joint_from_link(&scene.links()[0]),
+                joint_from_link(&scene.links()[1]),
             ],
-            gravity: scene.gravity.as_ref().map_or([0.0, 0.0], |g| g.vector),
+            gravity: scene.gravity().map_or([0.0, 0.0], |g| g.vector),
         };
         r.validate()?;
         Ok(r)
@@ -353,7 +353,7 @@ mod tests {
     /// The rigid arm of a scene, with any contact removed (the free-flight dynamics).
     fn arm(name: &str) -> RigidTwoLink {
         let mut scene = data::load_scene(name).unwrap();
-        scene.contacts.clear();
+        scene.planar_chain_mut().unwrap().contacts.clear();
         RigidTwoLink::from_scene(&scene).unwrap()
     }
 

@@ -76,7 +76,7 @@ impl FreeVibration {
     /// The scene's free vibration on its first `modes` elastic transverse modes. The scene must
     /// have no mass flow, chamber pressure or dampers (the rows switch them off by overrides).
     pub fn from_scene(scene: &Scene, modes: usize) -> Result<Self> {
-        let r = scene.rocket.as_ref().ok_or_else(|| {
+        let r = scene.rocket().ok_or_else(|| {
             AnalyticError::Unsupported(format!("`{}` is not a rocket scene", scene.name))
         })?;
         if r.stages.iter().any(|s| s.burn_rate != 0.0) || r.chamber_pressure != 0.0 {

@@ -51,7 +51,7 @@ fn to_backend_error(e: AnalyticError) -> BackendError {
 /// The rigid reference of a `[mobile_manipulator]` scene as a run result (backend `reference`).
 pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
     let start = Instant::now();
-    let mm = scene.mobile_manipulator.as_ref().ok_or_else(|| {
+    let mm = scene.mobile_manipulator().ok_or_else(|| {
         BackendError::unsupported(format!(
             "reference: no verify reference for the {} family (only the mobile manipulator)",
             scene.family()
@@ -194,7 +194,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, Backend
 
 /// DOF plan of the reference for `describe`.
 pub fn dof_plan(scene: &Scene) -> Result<data::DofPlan, BackendError> {
-    let mm = scene.mobile_manipulator.as_ref().ok_or_else(|| {
+    let mm = scene.mobile_manipulator().ok_or_else(|| {
         BackendError::unsupported(format!(
             "reference: no verify reference for the {} family",
             scene.family()
