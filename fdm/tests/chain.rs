@@ -169,6 +169,29 @@ fn sys_chain_dof_plans() {
 }
 
 #[test]
+fn sys_chain_of_linear_links_is_refused() {
+    // The chain's frames are the links' tip chords: without foreshortening that linear model is
+    // not the clamped-frame beam of the scene (frame-dependent at second order), so a link
+    // without foreshortening is refused by name, in `run` and in `dof_plan` alike.
+    for k in 0..2 {
+        let mut scene = load_scene("two-link-free").unwrap();
+        let link = &mut scene.planar_chain_mut().unwrap().links[k];
+        link.foreshortening = false;
+        let name = link.name.clone();
+        let err = FdmBackend
+            .simulate(&scene, &with(11, 0.01))
+            .expect_err("a linear link in the chain must be refused");
+        let text = err.to_string();
+        assert!(matches!(err, data::BackendError::Unsupported(_)), "{text}");
+        assert!(
+            text.contains(&format!("link `{name}`")) && text.contains("foreshortening"),
+            "{text}"
+        );
+        assert!(FdmBackend.dof_plan(&scene, &Default::default()).is_err());
+    }
+}
+
+#[test]
 fn dyn_chain_short_window_closes_the_ledger_at_small_steps() {
     // 80 steps of τ = 1e-6 s from the scenes' initial state (elbow spring loaded by 60°).
     // This checks that the assembled equations (Lagrange of T − V with D) keep the ledger:
