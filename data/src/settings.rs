@@ -106,7 +106,7 @@ impl FemElement {
 /// A time-integration method, as `time.method` (case files) and `--method` (CLI) spell it.
 ///
 /// One list for all backends: each backend declares the subset it implements and answers the
-/// others with an error naming that subset. Spellings are parsed here, once ([`Method::NAMES`]).
+/// others with an error naming that subset. Spellings are parsed here, once ([`Method::names`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]
 pub enum Method {
@@ -137,9 +137,13 @@ pub enum Method {
 
 impl Method {
     /// Every accepted spelling, for error messages and CLI help.
-    pub const NAMES: &'static str = "energy-midpoint, generalized-alpha, central-difference, \
-        implicit-midpoint (fem); report, central-difference, robert-asselin[=nu], velocity-form \
-        (fdm); dopri5, trbdf2 (also tr-bdf2, sdirk), trbdf2-fixed, trapezoid (modal)";
+    pub fn names() -> String {
+        BackendKind::ALL
+            .iter()
+            .map(|&b| format!("{} ({b})", Method::names_for(b)))
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
 
     /// The canonical spelling (`robert-asselin=ν` with its coefficient when one is given).
     pub fn name(self) -> String {
@@ -220,7 +224,7 @@ impl std::str::FromStr for Method {
                 }
                 return Err(format!(
                     "unknown time-integration method `{name}`; accepted: {}",
-                    Method::NAMES
+                    Method::names()
                 ));
             }
         })

@@ -37,9 +37,7 @@
 //! The matrix is re-formed every 6th iteration only while the update is above tolerance: the
 //! iterations that only reduce the energy defect keep it, as it still contracts. Runs without
 //! contact accelerate the iteration (Anderson, depth 3, history restarted with every step
-//! and new matrix; `Anderson`): on `two-link-free-undamped` 7.9 → 7.05 iterations and 1.27 → 1.10
-//! matrices per step; the convergence test is unchanged (update and energy defect at the
-//! evaluated point).
+//! and new matrix; `Anderson`).
 //! Without contact, a step reuses the factorized matrix of an earlier step (same step size,
 //! formed by this scheme) for up to `MAX_MATRIX_AGE` steps, while the last step needed at most
 //! one iteration more than the last step with a fresh matrix: over a step S changes by O(h),
@@ -47,10 +45,8 @@
 //! The convergence test weighs the update by the iteration's contraction θ (ratio of successive
 //! updates under one matrix): past θ = ½ the remaining error dq/(1 − θ) must be within twice the
 //! tolerance, so a slowly contracting reused matrix (stiff shear) iterates on instead of
-//! stopping at a small update. 10 s runs (`flexverify run SCENE --backend fem`): `two-link-free`
-//! 0.24 matrices and 3.1 iterations per step (a matrix every step: 1.0 and 2.3), 7.3 → 4.1 s
-//! CPU; `two-link-free-undamped` 0.25 and 7.0 (1.1 and 7.1), 14.4 → 9.3 s; joint angles move by
-//! ≤ 9e-10 of their peak.
+//! stopping at a small update. Matrices and iterations per step on the free arms are in
+//! `docs/backends.md`.
 //! The iterate is accepted at the point where the residual was evaluated, so the
 //! booked energies and works are those of the equations actually solved.
 //!

@@ -351,7 +351,7 @@ impl CommonOpts {
     }
 }
 
-/// `--method`: one of [`data::Method::NAMES`].
+/// `--method`: one of [`data::Method::names`].
 fn parse_method(text: &str) -> Result<data::Method, String> {
     text.parse()
 }
