@@ -44,12 +44,14 @@ pub struct BodyScratch {
     cta: Vec<f64>,
     ctad: Vec<f64>,
     bl: Vec<f64>,
-    // Exact-inextensible terms.
-    bq: Vec<f64>,
-    eq: Vec<f64>,
+    // Exact-inextensible terms (see `exact_inextensible_terms`): C (n³), A (n²), D and E (n²),
+    // and the vectors A b, Eq b, z, Rvd b, w.
+    cq: Vec<f64>,
     amat: Vec<f64>,
-    rv: Vec<f64>,
-    rvd: Vec<f64>,
+    dr: Vec<f64>,
+    er: Vec<f64>,
+    ab: Vec<f64>,
+    eqb: Vec<f64>,
     zv: Vec<f64>,
     t1: Vec<f64>,
     t2: Vec<f64>,
@@ -80,11 +82,12 @@ impl BodyScratch {
             cta: z(nb),
             ctad: z(nb),
             bl: z(2 * (3 + na + nb + nc)),
-            bq: z(nb * nb),
-            eq: z(nb * nb),
+            cq: z(nb * nb * nb),
             amat: z(nb * nb),
-            rv: z(nb * nb),
-            rvd: z(nb * nb),
+            dr: z(nb * nb),
+            er: z(nb * nb),
+            ab: z(nb),
+            eqb: z(nb),
             zv: z(nb),
             t1: z(nb),
             t2: z(nb),
@@ -324,12 +327,19 @@ pub fn body_terms(
 /// truncated T loses positive definiteness in the stiff direction "turn the frame, counter-bend
 /// the link" (its inertia there is ∫ρA(ωx + v̇)², while the kept −ω²∫ρA·2xs is negative).
 ///
-/// With Q_ijkl = ∫ρA S_ij S_kl, R_mij = ∫ρA φ_m S_ij and the contractions
-/// Bq = Q:(b⊗b) (= 2∫ρA s S), Eq = Q:(ḃ⊗ḃ), A_jl = ∫ρA (Sb)_j (Sb)_l,
-/// Rv = R·b (= ∫ρA v S), Rvd = R·ḃ, z_p = R_p:(b⊗ḃ), w_j = R_j:(b⊗b):
+/// With Q_ijkl = ∫ρA S_ij S_kl, R_mij = ∫ρA φ_m S_ij, Bq = Q:(b⊗b) (= 2∫ρA s S),
+/// Eq = Q:(ḃ⊗ḃ), A_jl = ∫ρA (Sb)_j (Sb)_l, Rv = R·b (= ∫ρA v S), Rvd = R·ḃ,
+/// z_p = R_p:(b⊗ḃ), w_j = R_j:(b⊗b):
 ///   𝕄_ωω += ¼ bᵀBq b,   𝕄_ωb += Rv b − ½w,   𝕄_bb += A,
 ///   h_ω += ω ḃᵀBq b + ḃ·(Rvd b + Rv ḃ − z),
 ///   h_b += 2ω (Rvd b − z) + Eq b − ½ω² Bq b.
+///
+/// Evaluation (O(n⁴)/2 once, O(n³) after): one contraction of Q with b,
+/// C_ij,l = Σ_k Q_ij,kl b_k (symmetric in ij: n²(n+1)/2 rows of n² products), gives
+/// A_jl = Σ_i b_i C_ij,l and Eq b = Σ_ij ḃ_iḃ_j C_ij; by the symmetries of Q
+/// (Q_ij,kl = Q_ji,kl = Q_kl,ij) Bq b = A b, so bᵀBq b = bᵀA b and ḃᵀBq b = ḃᵀA b, and
+/// neither Bq nor Eq is formed. R enters through D_mj = Σ_l R_mjl b_l and E_mj = Σ_l R_mjl ḃ_l:
+/// Rv b = Dᵀb, w = D b, Rvd b = Dᵀḃ, Rv ḃ = Eᵀb, z = E b.
 fn exact_inextensible_terms(
     it: &super::integrals::LinkIntegrals,
     b: &[f64],
@@ -344,87 +354,76 @@ fn exact_inextensible_terms(
     let na = it.na;
     let d = h.len();
     let ib = 3 + na;
-    // Contractions of Q over its first index pair (symmetric in i, j: upper triangle, weight 2).
-    s.bq.iter_mut().for_each(|v| *v = 0.0);
-    s.eq.iter_mut().for_each(|v| *v = 0.0);
+    // C_ij = Σ_k b_k Q_ij,k· for i ≤ j, mirrored to C_ji.
     for i in 0..n {
         for j in i..n {
-            let wgt = if i == j { 1.0 } else { 2.0 };
-            let (bb, bdbd) = (wgt * b[i] * b[j], wgt * bd[i] * bd[j]);
             let row = &it.q4[(i * n + j) * nn..(i * n + j + 1) * nn];
-            for ((bq, eq), q) in s.bq.iter_mut().zip(s.eq.iter_mut()).zip(row) {
-                *bq += bb * q;
-                *eq += bdbd * q;
+            let cij = &mut s.cq[(i * n + j) * n..(i * n + j + 1) * n];
+            cij.iter_mut().for_each(|v| *v = 0.0);
+            for (bk, qk) in b.iter().zip(row.chunks_exact(n)) {
+                for (c, q) in cij.iter_mut().zip(qk) {
+                    *c += bk * q;
+                }
             }
         }
-    }
-    // A_jl = Σ_i b_i (Σ_k b_k Q_ij,kl).
-    s.amat.iter_mut().for_each(|v| *v = 0.0);
-    for i in 0..n {
-        if b[i] == 0.0 {
-            continue;
+        for j in 0..i {
+            let (lo, hi) = s.cq.split_at_mut((i * n + j) * n);
+            hi[..n].copy_from_slice(&lo[(j * n + i) * n..(j * n + i + 1) * n]);
         }
+    }
+    // A_j· = Σ_i b_i C_ij·;  Eq b = Σ_{i≤j} (2 − δ_ij) ḃ_iḃ_j C_ij.
+    s.amat.iter_mut().for_each(|v| *v = 0.0);
+    s.eqb.iter_mut().for_each(|v| *v = 0.0);
+    for i in 0..n {
+        let bi = b[i];
         for j in 0..n {
-            let row = &it.q4[(i * n + j) * nn..(i * n + j + 1) * nn];
-            let arow = &mut s.amat[j * n..(j + 1) * n];
-            for (k, qk) in row.chunks_exact(n).enumerate() {
-                let c = b[i] * b[k];
-                for (a, q) in arow.iter_mut().zip(qk) {
-                    *a += c * q;
+            let cij = &s.cq[(i * n + j) * n..(i * n + j + 1) * n];
+            for (a, c) in s.amat[j * n..(j + 1) * n].iter_mut().zip(cij) {
+                *a += bi * c;
+            }
+            if j >= i {
+                let wgt = if i == j { 1.0 } else { 2.0 };
+                let e = wgt * bd[i] * bd[j];
+                for (v, c) in s.eqb.iter_mut().zip(cij) {
+                    *v += e * c;
                 }
             }
         }
     }
-    s.rv.iter_mut().for_each(|v| *v = 0.0);
-    s.rvd.iter_mut().for_each(|v| *v = 0.0);
+    mat_vec(&s.amat, n, b, &mut s.ab);
+    // D_m· = R_m b, E_m· = R_m ḃ (R_m symmetric n × n).
     for m in 0..n {
         let r = &it.r3[m * nn..(m + 1) * nn];
-        let (bm, bdm) = (b[m], bd[m]);
-        for ((rv, rvd), q) in s.rv.iter_mut().zip(s.rvd.iter_mut()).zip(r) {
-            *rv += bm * q;
-            *rvd += bdm * q;
-        }
+        mat_vec(r, n, b, &mut s.dr[m * n..(m + 1) * n]);
+        mat_vec(r, n, bd, &mut s.er[m * n..(m + 1) * n]);
     }
+    // w = D b, z = E b, Rvd b = Dᵀḃ (t1), Rv b = Dᵀb, Rv ḃ = Eᵀb.
     for p in 0..n {
-        let r = &it.r3[p * nn..(p + 1) * nn];
-        let (mut zp, mut wp) = (0.0, 0.0);
-        for (i, ri) in r.chunks_exact(n).enumerate() {
-            zp += b[i] * dot(ri, bd);
-            wp += b[i] * dot(ri, b);
-        }
-        s.zv[p] = zp;
-        s.t2[p] = wp;
+        s.t2[p] = dot(&s.dr[p * n..(p + 1) * n], b);
+        s.zv[p] = dot(&s.er[p * n..(p + 1) * n], b);
     }
-    let quadform = |m: &[f64], x: &[f64], y: &[f64]| -> f64 {
-        let mut acc = 0.0;
-        for r in 0..n {
-            acc += x[r] * dot(&m[r * n..(r + 1) * n], y);
-        }
-        acc
-    };
-    let bqbb = quadform(&s.bq, b, b);
-    let bqbdb = quadform(&s.bq, bd, b);
+    let bqbb = dot(b, &s.ab);
+    let bqbdb = dot(bd, &s.ab);
     mb[2 * d + 2] += 0.25 * bqbb;
+    let mut h_om = om * bqbdb;
     for j in 0..n {
-        let rvb = dot(&s.rv[j * n..(j + 1) * n], b);
+        let (mut rvb, mut rvdb, mut rvbd) = (0.0, 0.0, 0.0);
+        for m in 0..n {
+            rvb += b[m] * s.dr[m * n + j];
+            rvdb += bd[m] * s.dr[m * n + j];
+            rvbd += b[m] * s.er[m * n + j];
+        }
         let c = rvb - 0.5 * s.t2[j];
         mb[2 * d + ib + j] += c;
         mb[(ib + j) * d + 2] += c;
         for l in 0..n {
             mb[(ib + j) * d + ib + l] += s.amat[j * n + l];
         }
-    }
-    let mut h_om = om * bqbdb;
-    for j in 0..n {
-        let rvdb = dot(&s.rvd[j * n..(j + 1) * n], b);
-        let rvbd = dot(&s.rv[j * n..(j + 1) * n], bd);
         h_om += bd[j] * (rvdb + rvbd - s.zv[j]);
         s.t1[j] = rvdb;
     }
     h[2] += h_om;
     for p in 0..n {
-        let eqb = dot(&s.eq[p * n..(p + 1) * n], b);
-        let bqb = dot(&s.bq[p * n..(p + 1) * n], b);
-        h[ib + p] += 2.0 * om * (s.t1[p] - s.zv[p]) + eqb - 0.5 * om * om * bqb;
+        h[ib + p] += 2.0 * om * (s.t1[p] - s.zv[p]) + s.eqb[p] - 0.5 * om * om * s.ab[p];
     }
 }

@@ -181,12 +181,14 @@ impl Chain {
                 &mut w.qg,
                 &mut w.scratch,
             );
-            // Project: M += Gᵀ 𝕄 G, f += Gᵀ (Q_g − 𝕄 γ − h).
+            // Project: M += Gᵀ 𝕄 G, f += Gᵀ (Q_g − 𝕄 γ − h). Gᵢ has no column past the
+            // link's own coordinates (`span`): the coordinates are ordered link by link.
             let d = link.body_dim();
+            let span = link.a0 + link.ne();
             for l in 0..d {
                 let mrow = &w.mb[l * d..(l + 1) * d];
-                let xrow = &mut w.x[l * n..(l + 1) * n];
-                for c in 0..n {
+                let xrow = &mut w.x[l * n..l * n + span];
+                for c in 0..span {
                     xrow[c] = mrow[0] * w.gr[c] + mrow[1] * w.gr[n + c] + mrow[2] * w.gr[2 * n + c];
                 }
                 // Elastic body coordinates e = [a, b, c] are contiguous in q from a0.
@@ -196,13 +198,13 @@ impl Chain {
                 w.u[l] = w.qg[l] - w.h[l] - mrow[0] * w.gamma[0] - mrow[1] * w.gamma[1];
             }
             for l in 0..3 {
-                let grow = &w.gr[l * n..(l + 1) * n];
-                let xrow = &w.x[l * n..(l + 1) * n];
-                for r in 0..n {
+                let grow = &w.gr[l * n..l * n + span];
+                let xrow = &w.x[l * n..l * n + span];
+                for r in 0..span {
                     let gr = grow[r];
                     if gr != 0.0 {
-                        let mrow = &mut self.mass[r * n..(r + 1) * n];
-                        for c in 0..n {
+                        let mrow = &mut self.mass[r * n..r * n + span];
+                        for c in 0..span {
                             mrow[c] += gr * xrow[c];
                         }
                         self.force[r] += gr * w.u[l];
@@ -211,9 +213,9 @@ impl Chain {
             }
             for l in 3..d {
                 let gl = link.a0 + l - 3;
-                let xrow = &w.x[l * n..(l + 1) * n];
-                let mrow = &mut self.mass[gl * n..(gl + 1) * n];
-                for c in 0..n {
+                let xrow = &w.x[l * n..l * n + span];
+                let mrow = &mut self.mass[gl * n..gl * n + span];
+                for c in 0..span {
                     mrow[c] += xrow[c];
                 }
                 self.force[gl] += w.u[l];
@@ -268,7 +270,8 @@ impl Chain {
         }
     }
 
-    /// Frame kinematics of link i+1 from link i (whose body terms are already computed).
+    /// Frame kinematics of link i+1 from link i (whose body terms are already computed). The
+    /// columns of Gᵢ₊₁ past link i+1's own coordinates stay zero (never written).
     fn propagate(&mut self, i: usize, q: &[f64], qd: &[f64]) {
         let n = self.n;
         let (head, tail) = self.work.split_at_mut(i + 1);
@@ -280,8 +283,9 @@ impl Chain {
         let (pl, wl, pld) = (sc.p_tip, sc.w_tip, sc.pd_tip);
         let fsf = if li.foreshortening { 1.0 } else { 0.0 };
         // Rows of the tip velocity w_L = B_L Gᵢ q̇ in link-i axes.
+        let span = ln.a0 + ln.ne();
         let (wx, wy) = self.wrows.split_at_mut(n);
-        for c in 0..n {
+        for c in 0..span {
             wx[c] = wi.gr[c] - pl[1] * wi.gr[2 * n + c];
             wy[c] = wi.gr[n + c] + pl[0] * wi.gr[2 * n + c];
         }
@@ -300,7 +304,7 @@ impl Chain {
         let delta_d = dot(rot_l, &qd[li.a0..li.a0 + ne]) + qd[ln.theta];
         let (s, c) = delta.sin_cos();
         // V_{i+1} = R(−δ) w_L.
-        for col in 0..n {
+        for col in 0..span {
             let (x, y) = (wx[col], wy[col]);
             wn.gr[col] = c * x + s * y;
             wn.gr[n + col] = -s * x + c * y;
