@@ -259,7 +259,9 @@ pub fn solve2(a: f64, b: f64, d: f64, r: [f64; 2]) -> [f64; 2] {
 
 /// Root of a scalar function on [a, b] with f(a) > 0 ≥ f(b) (Illinois regula falsi) to the
 /// bracket width `tol`. Returns (t, f(t), final bracket width) with f(t) ≤ 0: the located time
-/// is the first sampled point on the far side of the crossing.
+/// is the first sampled point on the far side of the crossing. An iterate with f = 0 exactly
+/// does not end the search: f may have crossed before it, so the bracket is shrunk to `tol`
+/// like any other (bisection then, as regula falsi returns b itself).
 pub fn locate_crossing(
     mut f: impl FnMut(f64) -> f64,
     mut a: f64,
@@ -271,7 +273,7 @@ pub fn locate_crossing(
     let mut side = 0i8;
     let mut fb_true = fb;
     for _ in 0..200 {
-        if b - a <= tol || fb == 0.0 {
+        if b - a <= tol {
             break;
         }
         let mut c = (a * fb - b * fa) / (fb - fa);
