@@ -11,10 +11,10 @@
 //!        + 2ω[−(Cb)ᵀȧ + (Φₓ + Cᵀa)ᵀḃ] + ȧᵀM_ψȧ + ḃᵀM_φḃ  (+ 2ΔT when f = 1)
 //!
 //! where ΔT = ½∫ρA[ω²s² + 2ω(vṡ − sv̇) + ṡ²] completes it to the exact kinetic energy of the
-//! inextensible link (`exact_inextensible_terms`; needs the tensors ∫ρA S⊗S and ∫ρA φ⊗S, so
-//! a right-hand side costs O(n⁴) per link with foreshortening, O(n²) otherwise). The truncated
-//! form is not positive definite in the stiff direction "turn an inertia-free hub frame and
-//! counter-bend the link", which made two-link runs fail.
+//! inextensible link (`exact_inextensible_terms`; needs the tensors ∫ρA S⊗S and ∫ρA φ⊗S,
+//! contracted once with b per evaluation: n³(n+1)/2 products per link with foreshortening,
+//! O(n²) otherwise). The truncated form is not positive definite in the stiff direction "turn
+//! an inertia-free hub frame and counter-bend the link".
 //!
 //! The −f ω² bᵀSₓb term is the centrifugal (geometric) stiffening; ω² bᵀM_φb the in-plane
 //! softening. The tip mass is an exact point at p(L); the tip inertia rotates with α + v'(L);
