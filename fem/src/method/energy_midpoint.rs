@@ -39,8 +39,8 @@
 //! contact accelerate the iteration (Anderson, depth 3, history restarted with every step
 //! and new matrix; `Anderson`).
 //! Without contact and with a unilateral contact, a step reuses the factorized matrix of an
-//! earlier step (same step size up to the round-off of the stop times, `SAME_STEP`; formed by
-//! this scheme) for up to `MAX_MATRIX_AGE` steps, while the last step needed at most one
+//! earlier step (the same step size, with a contact up to `CLOSE_STEP`; formed by this scheme)
+//! for up to `MAX_MATRIX_AGE` steps, while the last step needed at most one
 //! iteration more than the last step with a fresh matrix: over a step S changes by O(h), far
 //! less than the mismatch of the undifferentiated terms that already sets the contraction.
 //! With a unilateral contact the free and the constrained phases alike reuse it (the
@@ -100,14 +100,13 @@ pub const FD_STEP: f64 = 1e-5;
 const MAX_ITERATIONS: usize = 30;
 /// Steps at most that reuse one Newton matrix in runs without contact.
 const MAX_MATRIX_AGE: usize = 8;
-/// Relative difference of two step sizes that counts as the same step for the reuse of a
-/// Newton matrix: steps that land on output times are the stop time minus the start time,
-/// which differs from the nominal step by the round-off of t (2e-12 of a 0.5 ms step at t = 3).
-const SAME_STEP: f64 = 1e-9;
 /// Relative difference of step sizes up to which a unilateral-contact run reuses a Newton
-/// matrix: the trials of an event location re-solve one stretch with lengths that approach
-/// each other. S changes by about 2Δh/h in its stiffness part, and a matrix that then
-/// contracts too slowly is re-formed by the stale-matrix refresh.
+/// matrix: steps that land on output times (the stop time minus the start time, off the
+/// nominal step by the round-off of t: 2e-12 of a 0.5 ms step at t = 3) and the trials of an
+/// event location, which re-solve one stretch with lengths that approach each other. S changes
+/// by about 2Δh/h in its stiffness part, and a matrix that then contracts too slowly is
+/// re-formed by the stale-matrix refresh. Runs without contact reuse a matrix only at the
+/// bit-identical step size.
 const CLOSE_STEP: f64 = 0.02;
 /// Energy defect h v̄ᵀ(residual) accepted per step, relative to the step's energy scale
 /// (kinetic + |potential parts| at both ends + |work of the step|). Where round-off (of the
@@ -482,7 +481,7 @@ impl Stepper for EnergyMidpoint {
         // the last step took at most one iteration more than the last step with a fresh
         // matrix. Every contact event restarts the stepper (a fresh matrix).
         let reusable = accelerate || robust;
-        let same_step = if robust { CLOSE_STEP } else { SAME_STEP };
+        let same_step = if robust { CLOSE_STEP } else { 0.0 };
         let reuse = reusable
             && (cx.newton.matrix_h - h).abs() <= same_step * h
             && !cx.newton.slow_convergence
