@@ -5,7 +5,8 @@
 //! (`two-link-free-undamped` 10 s, `barhorst-case1` 3 s) and the first second of
 //! `two-link-free-undamped` (`arms-1s`); `barhorst-case1` over t ∈ [0, 0.5] s (`contact-0.5s`:
 //! the drop, the first impact at 0.28 s and constrained sliding; the contact maps' sparse mass
-//! solves per constrained step).
+//! solves per constrained step); `barhorst-case1-timoshenko` over t ∈ [0, 0.35] s
+//! (`contact-timoshenko-0.35s`: its first impact and micro-bounces, bound by event location).
 //! Run: `cargo bench -p fem --bench fem_bench -- --quick` (one group: append its name, e.g. `arms`).
 
 use std::hint::black_box;
@@ -138,6 +139,21 @@ fn contact_short(c: &mut Criterion) {
     g.finish();
 }
 
+/// `barhorst-case1-timoshenko` shortened to 0.35 s at default settings: the drop, the first
+/// impact (0.28 s) and the micro-bounces after it, where located events (each trial a re-solved
+/// shortened step) dominate the cost.
+fn contact_timoshenko_short(c: &mut Criterion) {
+    let mut g = c.benchmark_group("contact-timoshenko-0.35s");
+    g.sample_size(10);
+    let sc = data::load_scene("barhorst-case1-timoshenko").unwrap();
+    let mut st = Settings::default();
+    st.time.t_end = Some(0.35);
+    g.bench_function("barhorst-case1-timoshenko", |b| {
+        b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
+    });
+    g.finish();
+}
+
 /// The exact Newton matrix of the free two-link arm with foreshortening (residual pass,
 /// augmented assembly, band LU with the border's Schur complement, one solve) for 4–64
 /// elements per link: linear in the elements.
@@ -186,6 +202,7 @@ criterion_group!(
     single_link,
     arms,
     arms_short,
-    contact_short
+    contact_short,
+    contact_timoshenko_short
 );
 criterion_main!(benches);

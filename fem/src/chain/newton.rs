@@ -198,9 +198,15 @@ impl Chain {
                     for b in 0..nj {
                         let cb = &jc[b];
                         let mut v = c.c_a * m * dot(ca.j, cb.j);
-                        v += c.c_v * 2.0 * m * dot(ca.j, cb.jdot);
-                        let dja = column_derivative(ca.rotation, ca.pos, ca.j, cb);
-                        v += c.c_q * m * (dot(dja, sub(acc, g_loc)) + dot(ca.j, dacc(cb, acc)));
+                        // A zero coefficient skips its term (the mass matrix of the contact
+                        // maps): adding its ±0 would leave v unchanged.
+                        if c.c_v != 0.0 {
+                            v += c.c_v * 2.0 * m * dot(ca.j, cb.jdot);
+                        }
+                        if c.c_q != 0.0 {
+                            let dja = column_derivative(ca.rotation, ca.pos, ca.j, cb);
+                            v += c.c_q * m * (dot(dja, sub(acc, g_loc)) + dot(ca.j, dacc(cb, acc)));
+                        }
                         if v != 0.0 {
                             s.add(ca.dof, cb.dof, v);
                         }

@@ -38,10 +38,16 @@
 //! iterations that only reduce the energy defect keep it, as it still contracts. Runs without
 //! contact accelerate the iteration (Anderson, depth 3, history restarted with every step
 //! and new matrix; `Anderson`).
-//! Without contact, a step reuses the factorized matrix of an earlier step (same step size,
-//! formed by this scheme) for up to `MAX_MATRIX_AGE` steps, while the last step needed at most
-//! one iteration more than the last step with a fresh matrix: over a step S changes by O(h),
-//! far less than the mismatch of the undifferentiated terms that already sets the contraction.
+//! Without contact and with a unilateral contact, a step reuses the factorized matrix of an
+//! earlier step (the same step size, with a contact up to `CLOSE_STEP`; formed by this scheme)
+//! for up to `MAX_MATRIX_AGE` steps, while the last step needed at most one
+//! iteration more than the last step with a fresh matrix: over a step S changes by O(h), far
+//! less than the mismatch of the undifferentiated terms that already sets the contraction.
+//! With a unilateral contact the free and the constrained phases alike reuse it (the
+//! constraint borders S through its Schur complement, S itself is the same); every contact
+//! event restarts the scheme with a fresh matrix, and the trials of an event location, which
+//! re-solve one stretch with lengths that approach each other, reuse the matrix of a trial
+//! within `CLOSE_STEP` of their length and start from that trial's mean acceleration.
 //! The convergence test weighs the update by the iteration's contraction θ (ratio of successive
 //! updates under one matrix): past θ = ½ the remaining error dq/(1 − θ) must be within twice the
 //! tolerance, so a slowly contracting reused matrix (stiff shear) iterates on instead of
@@ -94,6 +100,14 @@ pub const FD_STEP: f64 = 1e-5;
 const MAX_ITERATIONS: usize = 30;
 /// Steps at most that reuse one Newton matrix in runs without contact.
 const MAX_MATRIX_AGE: usize = 8;
+/// Relative difference of step sizes up to which a unilateral-contact run reuses a Newton
+/// matrix: steps that land on output times (the stop time minus the start time, off the
+/// nominal step by the round-off of t: 2e-12 of a 0.5 ms step at t = 3) and the trials of an
+/// event location, which re-solve one stretch with lengths that approach each other. S changes
+/// by about 2Δh/h in its stiffness part, and a matrix that then contracts too slowly is
+/// re-formed by the stale-matrix refresh. Runs without contact reuse a matrix only at the
+/// bit-identical step size.
+const CLOSE_STEP: f64 = 0.02;
 /// Energy defect h v̄ᵀ(residual) accepted per step, relative to the step's energy scale
 /// (kinetic + |potential parts| at both ends + |work of the step|). Where round-off (of the
 /// momentum difference) keeps the defect above this, the
@@ -127,6 +141,12 @@ pub struct MidpointWork {
     /// the point acceleration of a (re)start), and that step's length.
     have_prev: bool,
     h_prev: f64,
+    /// The last converged solve that was not accepted (a trial of an event location re-solves
+    /// the same stretch with another length): its start time, start velocity, length and mean
+    /// acceleration, the predictor of the next re-solve from the same start.
+    resolve: Option<(f64, f64)>,
+    resolve_qd: Vec<f64>,
+    resolve_a: Vec<f64>,
     /// Anderson acceleration of the quasi-Newton iteration (runs without contact).
     anderson: Anderson,
     /// Steps solved with the current Newton matrix since it was formed by this stepper in a
@@ -164,6 +184,9 @@ impl MidpointWork {
             last_iterations: 0,
             have_prev: false,
             h_prev: 0.0,
+            resolve: None,
+            resolve_qd: vec![0.0; n],
+            resolve_a: vec![0.0; n],
             pending: Works::default(),
             last_correction: 0.0,
         }
@@ -173,6 +196,7 @@ impl MidpointWork {
     pub fn restart(&mut self) {
         self.have_prev = false;
         self.h_prev = 0.0;
+        self.resolve = None;
         self.matrix_age = None;
     }
 
@@ -185,6 +209,7 @@ impl MidpointWork {
         works.kelvin_voigt += p.kelvin_voigt;
         self.have_prev = true;
         self.h_prev = h;
+        self.resolve = None;
     }
 }
 
@@ -421,8 +446,25 @@ impl Stepper for EnergyMidpoint {
         // change of 1e3 ft/s over the next 0.43 ms step, which diverged).
         let robust = cx.newton.unilateral_contact;
         let predict = w.have_prev && (!robust || w.h_prev >= 0.1 * h);
+        // A re-solve of the same stretch (same start time and velocity, a length within a
+        // factor 1.5 of the last converged solve) starts from that solve's mean acceleration:
+        // the trials of an event location differ by less than the step that predicts them.
+        let re_solve = robust
+            && w.resolve.is_some_and(|(t_start, h_solved)| {
+                t_start.to_bits() == t0.to_bits() && (h_solved - h).abs() <= 0.5 * h
+            })
+            && w.resolve_qd
+                .iter()
+                .zip(&st.qd)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
         for i in 0..n {
-            st.qdd1[i] = if predict { st.qdd[i] } else { 0.0 };
+            st.qdd1[i] = if re_solve {
+                w.resolve_a[i]
+            } else if predict {
+                st.qdd[i]
+            } else {
+                0.0
+            };
         }
         let c = NewtonCoefficients {
             c_a: 1.0,
@@ -433,12 +475,15 @@ impl Stepper for EnergyMidpoint {
         // releases keep the unilateral-contact iteration's own safeguards; a bordered (a, λ)
         // system updates λ beside a).
         let accelerate = !robust && constraint.is_none();
-        // Without contact the matrix of an earlier step is reused (module docs) while it was
-        // formed by this stepper at the same step size, is younger than
-        // `MAX_MATRIX_AGE` steps, and the last step took at most one iteration more than the
-        // last step with a fresh matrix.
-        let reuse = accelerate
-            && cx.newton.matrix_h == h
+        // Runs without contact and runs with a unilateral contact (free and constrained
+        // phases alike) reuse the matrix of an earlier step (module docs) while it was formed
+        // by this stepper at the same step size, is younger than `MAX_MATRIX_AGE` steps, and
+        // the last step took at most one iteration more than the last step with a fresh
+        // matrix. Every contact event restarts the stepper (a fresh matrix).
+        let reusable = accelerate || robust;
+        let same_step = if robust { CLOSE_STEP } else { 0.0 };
+        let reuse = reusable
+            && (cx.newton.matrix_h - h).abs() <= same_step * h
             && !cx.newton.slow_convergence
             && w.matrix_age.is_some_and(|age| age < MAX_MATRIX_AGE)
             && w.last_iterations <= w.fresh_iterations + 1;
@@ -679,7 +724,7 @@ impl Stepper for EnergyMidpoint {
         }
         cx.counters.rhs += passes;
         w.matrix_age = match formed_it {
-            _ if !(accelerate && converged) => None,
+            _ if !(reusable && converged) => None,
             Some(0) => {
                 w.fresh_iterations = iterations;
                 Some(0)
@@ -701,6 +746,11 @@ impl Stepper for EnergyMidpoint {
                 why: "the step is too large for the nonlinearity or the solution diverged".into(),
                 remedy: "reduce --dt or give --rtol for adaptive stepping".into(),
             });
+        }
+        if robust {
+            w.resolve = Some((t0, h));
+            w.resolve_qd.copy_from_slice(&st.qd);
+            w.resolve_a.copy_from_slice(&st.qdd1);
         }
         // Works with the scheme's own quadrature: their sum is Δqᵀ Q(t_mid, q̄, v̄).
         let mut pending = Works::default();
