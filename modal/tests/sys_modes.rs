@@ -147,7 +147,7 @@ fn sys_rotating_beam_in_plane_identity_and_convergence() {
     for lam in [0.0, 1.0, 4.0, 12.0] {
         let omega = lam / lam_scale;
         let at = |b: Basis, n: usize| {
-            rotating_modes(&scene, &settings(b, n), omega, 3)
+            rotating_modes(&scene, &settings(b, n).modal().unwrap(), omega, 3)
                 .unwrap()
                 .frequencies_hz
         };
