@@ -53,7 +53,8 @@ impl Method {
     }
 }
 
-/// Validated settings.
+/// The backend's settings validated: [`data::FdmSettings`] with its ranges checked and the
+/// defaults filled in.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FdmSettings {
     /// The settings as requested (None where the default applies), recorded in the results.

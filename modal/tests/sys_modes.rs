@@ -291,10 +291,16 @@ fn sys_unsupported_and_invalid_requests_are_typed_errors() {
     let mut bad = Settings::default();
     // A method of another backend.
     bad.time.method = Some(data::Method::Report);
-    assert!(matches!(
-        ModalBackend.simulate(&load_scene("single-link").unwrap(), &bad),
-        Err(BackendError::InvalidSettings { .. })
-    ));
+    match ModalBackend.simulate(&load_scene("single-link").unwrap(), &bad) {
+        Err(BackendError::InvalidSettings { field, message }) => {
+            assert_eq!(field, "time.method");
+            assert!(
+                message.contains("`report`") && message.contains("dopri5"),
+                "{message}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
 }
 
 #[test]
