@@ -7,11 +7,13 @@
 //! * [`catalog`] — the embedded catalog of `data/scenes/*.toml`;
 //! * [`results`] — observables, energy ledger, events, cost counters, stability verdict;
 //! * [`channel`] — the registry of observable channel names and units;
-//! * [`backend`] — the [`Backend`] trait every solver implements.
+//! * [`backend`] — the [`Backend`] trait every solver implements;
+//! * [`backend_settings`] — each backend's own typed settings and methods.
 //!
 //! No physics lives here: agreement between backends must mean something.
 
 pub mod backend;
+pub mod backend_settings;
 pub mod cases;
 pub mod catalog;
 pub mod channel;
@@ -25,6 +27,9 @@ pub mod settings;
 pub mod validate;
 
 pub use backend::{Backend, BackendError, DofGroup, DofPlan};
+pub use backend_settings::{
+    FdmMethod, FdmSettings, FemMethod, FemSettings, ModalMethod, ModalSettings, SettingsRefusal,
+};
 pub use catalog::{CATALOG, catalog_names, catalog_scene, load_scene};
 pub use error::{LoadError, SceneError};
 pub use reader::parse_scene;

@@ -2,8 +2,10 @@
 //! stations, modes, basis) and the time stepping (method, step, tolerances). Parsed once from
 //! the command line or a case row. [`SettingField::readers`] says which backend reads each
 //! field and [`Method::backends`] which backend implements each method; the boundaries (command
-//! line, case rows) refuse a field or method that no backend it is meant for reads, and
-//! [`Settings::for_backend`] hands each backend only its own fields.
+//! line, case rows) refuse a field or method that no backend it is meant for reads,
+//! [`Settings::for_backend`] keeps one backend's fields of a request meant for several, and
+//! [`Settings::fem`] / [`Settings::fdm`] / [`Settings::modal`] turn them into that backend's typed
+//! settings ([`crate::backend_settings`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -105,8 +107,10 @@ impl FemElement {
 
 /// A time-integration method, as `time.method` (case files) and `--method` (CLI) spell it.
 ///
-/// One list for all backends: each backend declares the subset it implements and answers the
-/// others with an error naming that subset. Spellings are parsed here, once ([`Method::names`]).
+/// The spelling-level union of every backend's methods: each backend's typed settings hold its
+/// own subset ([`crate::FemMethod`], [`crate::FdmMethod`], [`crate::ModalMethod`]), and the
+/// conversion to them refuses the others naming that subset. Spellings are parsed here, once
+/// ([`Method::names`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]
 pub enum Method {
@@ -253,7 +257,7 @@ pub struct TimeStepping {
     /// Overrides the scene's end time.
     pub t_end: Option<f64>,
     /// Integration method (None: the backend's default for the scene). Each backend implements
-    /// some of the [`Method`]s and rejects the others, naming the ones it offers.
+    /// some of the [`Method`]s ([`Method::backends`]).
     pub method: Option<Method>,
     /// Relative / absolute error tolerances of adaptive methods.
     pub rtol: Option<f64>,

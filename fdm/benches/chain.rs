@@ -5,17 +5,18 @@
 //! Run: cargo bench -p fdm --bench chain -- --quick
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use data::{Settings, load_scene};
+use data::load_scene;
 use fdm::FdmSettings;
 use fdm::chain::TwoLinkChain;
 use fdm::driver::{StepControl, integrate};
 
-fn settings(stations: usize, t_end: f64) -> (Settings, FdmSettings) {
-    let mut settings = Settings::default();
-    settings.discretization.stations = Some(stations);
-    settings.time.t_end = Some(t_end);
-    let s = FdmSettings::from_settings(&settings).expect("valid settings");
-    (settings, s)
+fn settings(stations: usize, t_end: f64) -> FdmSettings {
+    let requested = data::FdmSettings {
+        stations: Some(stations),
+        t_end: Some(t_end),
+        ..Default::default()
+    };
+    FdmSettings::from_settings(&requested).expect("valid settings")
 }
 
 fn bench(c: &mut Criterion) {
@@ -23,15 +24,15 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("two_link_free");
     group.sample_size(10);
     for n in [21usize, 41] {
-        let (settings, s) = settings(n, 1.0);
+        let s = settings(n, 1.0);
         group.bench_function(format!("1s_{n}_stations_implicit_damping"), |b| {
             b.iter(|| {
-                let out = fdm::runs::two_link_chain(&scene, &settings, &s).expect("run");
+                let out = fdm::runs::two_link_chain(&scene, &s).expect("run");
                 std::hint::black_box(out.cost.steps)
             })
         });
     }
-    let (_, s) = settings(21, 0.1);
+    let s = settings(21, 0.1);
     group.bench_function("0.1s_21_stations_explicit_damping", |b| {
         b.iter(|| {
             let mut sys = TwoLinkChain::from_scene(&scene, s.stations).expect("chain");

@@ -10,7 +10,8 @@ fn bench(c: &mut Criterion) {
     for (label, method) in [("report", "report"), ("velocity-form", "velocity-form")] {
         let mut settings = Settings::default();
         settings.time.method = Some(method.parse().expect("a method name"));
-        let s = FdmSettings::from_settings(&settings).expect("valid settings");
+        let s = FdmSettings::from_settings(&settings.fdm().expect("fdm settings"))
+            .expect("valid settings");
         c.bench_function(&format!("rocket_0.1s_76_stations_{label}"), |b| {
             b.iter(|| {
                 let (_, out) = fdm::runs::rocket_with(&scene, &s, true).expect("run");
@@ -23,7 +24,8 @@ fn bench(c: &mut Criterion) {
         settings.discretization.stations = Some(n);
         settings.time.t_end = Some(0.01);
         settings.time.method = Some("velocity-form".parse().expect("a method name"));
-        let s = FdmSettings::from_settings(&settings).expect("valid settings");
+        let s = FdmSettings::from_settings(&settings.fdm().expect("fdm settings"))
+            .expect("valid settings");
         c.bench_function(&format!("rocket_0.01s_{n}_stations_velocity-form"), |b| {
             b.iter(|| {
                 let (_, out) = fdm::runs::rocket_with(&scene, &s, true).expect("run");

@@ -9,7 +9,7 @@
 //! EI δ⁴w/h⁴ (tested), so the frequencies converge at O(h²).
 
 use data::{
-    BackendKind, Cost, DofPlan, ModalResult, ModeShape, Scene, Settings, StaticResult,
+    BackendKind, Cost, DofPlan, ModalResult, ModeShape, Scene, StaticResult,
     scene::PrescribedMotion,
 };
 use faer::prelude::Solve;
@@ -217,12 +217,7 @@ pub fn dof_plan(scene: &Scene, stations: Option<usize>) -> Result<DofPlan, FdmEr
     Ok(plan)
 }
 
-pub fn modes(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-    count: usize,
-) -> Result<ModalResult, FdmError> {
+pub fn modes(scene: &Scene, s: &FdmSettings, count: usize) -> Result<ModalResult, FdmError> {
     let clock = std::time::Instant::now();
     let c = Cantilever::from_scene(scene, s.stations)?;
     let (omega, shapes) = c.eigen()?;
@@ -247,7 +242,7 @@ pub fn modes(
     Ok(ModalResult {
         backend: BackendKind::Fdm,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: s.request(),
         frequencies_hz: omega[..count]
             .iter()
             .map(|w| w / (2.0 * std::f64::consts::PI))
@@ -263,13 +258,9 @@ pub fn modes(
     })
 }
 
-pub fn statics(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<StaticResult, FdmError> {
+pub fn statics(scene: &Scene, s: &FdmSettings) -> Result<StaticResult, FdmError> {
     if scene.links().len() == 1 && scene.links()[0].shear {
-        return timoshenko_statics(scene, settings, s);
+        return timoshenko_statics(scene, s);
     }
     let clock = std::time::Instant::now();
     let c = Cantilever::from_scene(scene, s.stations)?;
@@ -286,7 +277,7 @@ pub fn statics(
     Ok(StaticResult {
         backend: BackendKind::Fdm,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: s.request(),
         tip_deflection: w[r],
         tip_rotation: rot,
         cost: Cost {
@@ -303,11 +294,7 @@ pub fn statics(
 /// v₀ = ψ₀ = 0, tip force and lumped distributed load. Reported rotation: ψ(L) (the convention's
 /// "slope"). Section rotary inertia does not enter statics (accepted); axial fields, tip
 /// inertia, gravity and contact are refused as for the Euler beam.
-fn timoshenko_statics(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<StaticResult, FdmError> {
+fn timoshenko_statics(scene: &Scene, s: &FdmSettings) -> Result<StaticResult, FdmError> {
     let clock = std::time::Instant::now();
     let l = &scene.links()[0];
     if !matches!(l.joint.prescribed, Some(PrescribedMotion::Fixed)) {
@@ -342,7 +329,7 @@ fn timoshenko_statics(
     Ok(StaticResult {
         backend: BackendKind::Fdm,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: s.request(),
         tip_deflection: v,
         tip_rotation: psi,
         cost: Cost {

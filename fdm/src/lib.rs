@@ -259,10 +259,7 @@ impl Backend for FdmBackend {
     }
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
-        let s = FdmSettings::from_settings(&Settings {
-            discretization: disc.clone(),
-            ..Settings::default()
-        })?;
+        let s = FdmSettings::from_settings(&disc.fdm()?)?;
         Ok(match ModelChoice::of(scene)? {
             ModelChoice::Rocket => rocket::dof_plan(scene, s.stations)?,
             ModelChoice::Cantilever => beam::dof_plan(scene, s.stations)?,
@@ -284,27 +281,25 @@ impl Backend for FdmBackend {
         settings: &Settings,
         count: usize,
     ) -> Result<ModalResult, BackendError> {
-        let s = FdmSettings::from_settings(settings)?;
+        let s = FdmSettings::from_settings(&settings.fdm()?)?;
         match ModelChoice::of(scene)? {
             ModelChoice::Rocket => Err(BackendError::Unsupported(
                 "fdm modes of the rocket: the variable-mass body has no fixed modes; use `run`"
                     .into(),
             )),
-            ModelChoice::TwoLinkChain => Ok(chain::modes::modes(scene, settings, &s, count)?),
-            ModelChoice::PayloadLink => {
-                Ok(payload_link::analysis::modes(scene, settings, &s, count)?)
-            }
-            _ => Ok(beam::modes(scene, settings, &s, count)?),
+            ModelChoice::TwoLinkChain => Ok(chain::modes::modes(scene, &s, count)?),
+            ModelChoice::PayloadLink => Ok(payload_link::analysis::modes(scene, &s, count)?),
+            _ => Ok(beam::modes(scene, &s, count)?),
         }
     }
 
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
-        let s = FdmSettings::from_settings(settings)?;
+        let s = FdmSettings::from_settings(&settings.fdm()?)?;
         if scene.family() == Family::PlanarChain {
-            return Ok(beam::statics(scene, settings, &s)?);
+            return Ok(beam::statics(scene, &s)?);
         }
         if scene.family() == Family::PayloadLink {
-            return Ok(payload_link::analysis::statics(scene, settings, &s)?);
+            return Ok(payload_link::analysis::statics(scene, &s)?);
         }
         Err(BackendError::Unsupported(format!(
             "fdm statics for {} scenes",
@@ -313,13 +308,13 @@ impl Backend for FdmBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
-        let s = FdmSettings::from_settings(settings)?;
+        let s = FdmSettings::from_settings(&settings.fdm()?)?;
         Ok(match ModelChoice::of(scene)? {
-            ModelChoice::Rocket => runs::rocket(scene, settings, &s)?,
+            ModelChoice::Rocket => runs::rocket(scene, &s)?,
             ModelChoice::Cantilever => return Err(beam::simulate_unsupported(scene).into()),
-            ModelChoice::TwoLinkChain => runs::two_link_chain(scene, settings, &s)?,
-            ModelChoice::SingleLink => runs::single_link(scene, settings, &s)?,
-            ModelChoice::PayloadLink => payload_link::run::simulate(scene, settings, &s)?,
+            ModelChoice::TwoLinkChain => runs::two_link_chain(scene, &s)?,
+            ModelChoice::SingleLink => runs::single_link(scene, &s)?,
+            ModelChoice::PayloadLink => payload_link::run::simulate(scene, &s)?,
         })
     }
 }

@@ -36,16 +36,16 @@ pub struct Outcome {
 }
 
 impl Outcome {
-    /// Wraps the run as the backend-neutral result of `scene` under `settings`.
+    /// Wraps the run as the backend-neutral result of `scene` under the settings `s`.
     pub(crate) fn into_run_result(
         self,
         scene: &data::Scene,
-        settings: &data::Settings,
+        s: &crate::settings::FdmSettings,
     ) -> data::RunResult {
         data::RunResult {
             backend: data::BackendKind::Fdm,
             scene: scene.name.clone(),
-            settings: settings.clone(),
+            settings: s.request(),
             observables: self.observables,
             ledger: self.ledger,
             events: self.events,

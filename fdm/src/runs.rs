@@ -1,7 +1,7 @@
 //! Each model's run, built from the scene: the model, its method (the scene's `time.method` or
 //! the model's default), its events, the step control, then [`crate::driver::run`].
 
-use data::{RunResult, Scene, Settings};
+use data::{RunResult, Scene};
 
 use crate::chain::TwoLinkChain;
 use crate::driver::{StepControl, integrate, run};
@@ -38,17 +38,17 @@ pub fn rocket_with(
     Ok((sys, out))
 }
 
-pub fn rocket(scene: &Scene, settings: &Settings, s: &FdmSettings) -> Result<RunResult, FdmError> {
+pub fn rocket(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError> {
     let (_, out) = rocket_with(scene, s, true)?;
-    Ok(out.into_run_result(scene, settings))
+    Ok(out.into_run_result(scene, s))
 }
 
 /// The method of a run: the scene's `time.method` when set; otherwise the one that converges
 /// for the model — the one-step velocity form when any force depends on the velocities
 /// ([`System::damped`]: damping, or the gyroscopic İθ̇ and θ̇² terms of a free hub), on which
 /// the two-step scheme's computational mode grows; else the report's two-step scheme.
-pub fn default_method(settings: &Settings, s: &FdmSettings, sys: &dyn System) -> Method {
-    if settings.time.method.is_none() && sys.damped() {
+pub fn default_method(s: &FdmSettings, sys: &dyn System) -> Method {
+    if s.requested.method.is_none() && sys.damped() {
         Method::VelocityForm
     } else {
         s.method
@@ -57,31 +57,23 @@ pub fn default_method(settings: &Settings, s: &FdmSettings, sys: &dyn System) ->
 
 /// Runs one link on its hub (method: [`default_method`] — the velocity form for a torque-driven
 /// hub or Kelvin–Voigt damping, the report's two-step scheme for a prescribed undamped hub).
-pub fn single_link(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<RunResult, FdmError> {
+pub fn single_link(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError> {
     let mut sys = FloatingLink::from_scene(scene, s.stations)?;
     let (q0, v0) = sys.initial_state();
-    let method = default_method(settings, s, &sys);
+    let method = default_method(s, &sys);
     let ctl = StepControl::for_scene(scene, s, method, false, true);
-    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, settings))
+    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, s))
 }
 
 /// Runs a two-link chain. Default method (no `time.method`): the one-step velocity form — the
 /// free joints make the inertia forces velocity dependent and damping is on in the damped scene,
 /// both of which grow the two-step scheme's computational mode.
-pub fn two_link_chain(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<RunResult, FdmError> {
+pub fn two_link_chain(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError> {
     if !scene.contacts().is_empty() {
-        return Ok(two_link_chain_with_contact(scene, settings, s)?.0);
+        return Ok(two_link_chain_with_contact(scene, s)?.0);
     }
     let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
-    let method = if settings.time.method.is_none() {
+    let method = if s.requested.method.is_none() {
         Method::VelocityForm
     } else {
         s.method
@@ -92,7 +84,7 @@ pub fn two_link_chain(
     }
     let (q0, v0) = sys.initial_state();
     let ctl = StepControl::for_scene(scene, s, method, false, true);
-    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, settings))
+    Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, s))
 }
 
 /// Runs a two-link chain with its tip contact: the velocity form with every force at the
@@ -100,10 +92,9 @@ pub fn two_link_chain(
 /// ([`TipContactEvents`]). Returns the run and the contact diagnostics.
 pub fn two_link_chain_with_contact(
     scene: &Scene,
-    settings: &Settings,
     s: &FdmSettings,
 ) -> Result<(RunResult, ContactReport), FdmError> {
-    if settings.time.method.is_some() && s.method != Method::VelocityForm {
+    if s.requested.method.is_some() && s.method != Method::VelocityForm {
         return Err(FdmError::Unsupported(format!(
             "fdm: contact with time.method = {}: only velocity-form restarts at a located \
              event (the two-step scheme needs a second level there)",
@@ -113,7 +104,7 @@ pub fn two_link_chain_with_contact(
     let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
     let (q0, v0) = sys.initial_state();
     let mut ctl = StepControl::for_scene(scene, s, Method::VelocityForm, false, true);
-    if sys.timoshenko().is_some() && settings.time.safety_factor.is_none() {
+    if sys.timoshenko().is_some() && s.requested.safety_factor.is_none() {
         ctl.safety = TIMOSHENKO_CONTACT_SAFETY;
     }
     // the step follows the refinement windows after each impact: no step-change events
@@ -128,5 +119,5 @@ pub fn two_link_chain_with_contact(
         &v0,
         &ctl,
     )?;
-    Ok((out.into_run_result(scene, settings), events.report))
+    Ok((out.into_run_result(scene, s), events.report))
 }

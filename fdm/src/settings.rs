@@ -1,6 +1,5 @@
-//! The backend settings this crate reads, validated once.
-
-use data::Settings;
+//! The backend's settings ([`data::FdmSettings`]), validated once: ranges checked, defaults
+//! filled in.
 
 use crate::error::FdmError;
 
@@ -26,16 +25,13 @@ pub enum Method {
 }
 
 impl Method {
-    /// The [`data::Method`] spellings this backend implements.
-    pub const ACCEPTED: &'static str =
-        "report (also central-difference), robert-asselin[=nu], velocity-form";
-
-    /// This backend's reading of a method named in the settings.
-    pub fn from_data(method: data::Method) -> Result<Self, FdmError> {
+    /// The method named in the settings (`central-difference` is the report's scheme; ν of
+    /// Robert–Asselin checked, [`DEFAULT_ASSELIN_NU`] when not given).
+    pub fn from_data(method: data::FdmMethod) -> Result<Self, FdmError> {
         match method {
-            data::Method::Report | data::Method::CentralDifference => Ok(Method::Report),
-            data::Method::VelocityForm => Ok(Method::VelocityForm),
-            data::Method::RobertAsselin { nu } => {
+            data::FdmMethod::Report | data::FdmMethod::CentralDifference => Ok(Method::Report),
+            data::FdmMethod::VelocityForm => Ok(Method::VelocityForm),
+            data::FdmMethod::RobertAsselin { nu } => {
                 let nu = nu.unwrap_or(DEFAULT_ASSELIN_NU);
                 if !(nu > 0.0 && nu < 0.5) {
                     return Err(FdmError::invalid(
@@ -45,13 +41,6 @@ impl Method {
                 }
                 Ok(Method::RobertAsselin { nu })
             }
-            other => Err(FdmError::invalid(
-                "time.method",
-                format!(
-                    "the fdm backend does not implement `{other}`; it offers {}",
-                    Self::ACCEPTED
-                ),
-            )),
         }
     }
 
@@ -64,9 +53,12 @@ impl Method {
     }
 }
 
-/// Validated settings.
+/// The backend's settings validated: [`data::FdmSettings`] with its ranges checked and the
+/// defaults filled in.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FdmSettings {
+    /// The settings as requested (None where the default applies), recorded in the results.
+    pub requested: data::FdmSettings,
     pub stations: Option<usize>,
     pub dt: Option<f64>,
     pub safety: f64,
@@ -77,8 +69,8 @@ pub struct FdmSettings {
 }
 
 impl FdmSettings {
-    pub fn from_settings(s: &Settings) -> Result<Self, FdmError> {
-        if let Some(n) = s.discretization.stations
+    pub fn from_settings(s: &data::FdmSettings) -> Result<Self, FdmError> {
+        if let Some(n) = s.stations
             && !(5..=100_000).contains(&n)
         {
             return Err(FdmError::invalid(
@@ -86,34 +78,40 @@ impl FdmSettings {
                 format!("{n} stations: must lie in 5..=100000"),
             ));
         }
-        if let Some(dt) = s.time.dt
+        if let Some(dt) = s.dt
             && !(dt.is_finite() && dt > 0.0)
         {
             return Err(FdmError::invalid("time.dt", format!("{dt} must be > 0")));
         }
-        let safety = s.time.safety_factor.unwrap_or(1.0);
+        let safety = s.safety_factor.unwrap_or(1.0);
         if !(safety > 0.0 && safety <= 1.0) {
             return Err(FdmError::invalid(
                 "time.safety_factor",
                 format!("{safety} must lie in (0, 1]"),
             ));
         }
-        if let Some(t) = s.time.t_end
+        if let Some(t) = s.t_end
             && !(t.is_finite() && t > 0.0)
         {
             return Err(FdmError::invalid("time.t_end", format!("{t} must be > 0")));
         }
-        let method = match s.time.method {
+        let method = match s.method {
             Some(m) => Method::from_data(m)?,
             None => Method::Report,
         };
         Ok(FdmSettings {
-            stations: s.discretization.stations,
-            dt: s.time.dt,
+            requested: s.clone(),
+            stations: s.stations,
+            dt: s.dt,
             safety,
             method,
-            t_end: s.time.t_end,
+            t_end: s.t_end,
             step_log_change: STEP_LOG_CHANGE,
         })
+    }
+
+    /// The request as the results record it.
+    pub fn request(&self) -> data::Settings {
+        data::Settings::from(&self.requested)
     }
 }

@@ -22,7 +22,11 @@ fn settings(stations: usize, t_end: f64) -> Settings {
 fn run(scene: &str, stations: usize, t_end: f64) -> (RunResult, ContactReport) {
     let scene = load_scene(scene).unwrap();
     let s = settings(stations, t_end);
-    let (r, rep) = simulate(&scene, &s, &FdmSettings::from_settings(&s).unwrap()).unwrap();
+    let (r, rep) = simulate(
+        &scene,
+        &FdmSettings::from_settings(&s.fdm().unwrap()).unwrap(),
+    )
+    .unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed, "{:?}", r.verdict);
     (r, rep)
 }

@@ -279,7 +279,11 @@ fn dyn_timoshenko_case1_impacts_and_ledger() {
     let scene = load_scene("barhorst-case1-timoshenko").unwrap();
     let mut s = settings(21, 0.4);
     s.time.safety_factor = Some(0.1);
-    let (r, rep) = simulate(&scene, &s, &FdmSettings::from_settings(&s).unwrap()).unwrap();
+    let (r, rep) = simulate(
+        &scene,
+        &FdmSettings::from_settings(&s.fdm().unwrap()).unwrap(),
+    )
+    .unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     let c = r.ledger.relative_closure();
     let mut impacts = 0;
@@ -315,7 +319,11 @@ fn dyn_timoshenko_case1_impacts_and_ledger() {
 fn first_events(scene: &Scene, stations: usize, t_end: f64) -> (f64, f64) {
     let mut s = settings(stations, t_end);
     s.time.safety_factor = Some(1.0);
-    let (r, _) = simulate(scene, &s, &FdmSettings::from_settings(&s).unwrap()).unwrap();
+    let (r, _) = simulate(
+        scene,
+        &FdmSettings::from_settings(&s.fdm().unwrap()).unwrap(),
+    )
+    .unwrap();
     let impact = r.events.iter().find_map(|e| match e {
         Event::Impact { t, .. } => Some(*t),
         _ => None,

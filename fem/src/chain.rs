@@ -42,7 +42,7 @@
 //! differences of the residual (`sys_foreshortening_tangent`).
 
 use data::scene::{Gravity, Link, PrescribedMotion, TorqueLaw};
-use data::{Discretization, FemElement, Scene};
+use data::{FemElement, FemSettings, Scene};
 
 use crate::band::BorderedBand;
 use crate::element::tables::dotn;
@@ -223,10 +223,10 @@ impl Chain {
     /// The scene's static loads are left at zero (dynamics applies them as a step load).
     ///
     /// [`check_planar`]: crate::support::check_planar
-    pub fn from_scene(scene: &Scene, disc: &Discretization) -> Result<Self, FemError> {
+    pub fn from_scene(scene: &Scene, settings: &FemSettings) -> Result<Self, FemError> {
         crate::support::check_planar(scene)?;
-        let n_el = crate::settings::elements(disc)?;
-        Self::with_element(scene.links(), scene.gravity(), n_el, disc.element)
+        let n_el = crate::settings::elements(settings)?;
+        Self::with_element(scene.links(), scene.gravity(), n_el, settings.element)
     }
 
     /// Builds the chain for `links` with `n_el` elements per link of the element `choice`

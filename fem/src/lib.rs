@@ -188,8 +188,8 @@ pub mod support;
 use std::time::Instant;
 
 use data::{
-    Backend, BackendError, BackendKind, Cost, Discretization, DofPlan, ModalResult, ModeShape,
-    RunResult, Scene, Settings, StaticResult,
+    Backend, BackendError, BackendKind, Cost, Discretization, DofPlan, FemSettings, ModalResult,
+    ModeShape, RunResult, Scene, Settings, StaticResult,
 };
 
 pub use error::FemError;
@@ -215,15 +215,15 @@ impl FemBackend {
     fn modes_impl(
         &self,
         scene: &Scene,
-        settings: &Settings,
+        settings: &FemSettings,
         count: usize,
     ) -> Result<ModalResult, FemError> {
         let start = Instant::now();
         single_link(scene, "modes")?;
-        let n_el = settings::elements(&settings.discretization)?;
+        let n_el = settings::elements(settings)?;
         let link = &scene.links()[0];
         let omega = linear::hub_rate(link)?;
-        let element = element::for_link(link, settings.discretization.element)?;
+        let element = element::for_link(link, settings.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
         let modes = modes::link_modes(&sys, count)?;
         let stations = scene.simulation.field_stations;
@@ -246,19 +246,23 @@ impl FemBackend {
         ))
     }
 
-    fn statics_impl(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, FemError> {
+    fn statics_impl(
+        &self,
+        scene: &Scene,
+        settings: &FemSettings,
+    ) -> Result<StaticResult, FemError> {
         let start = Instant::now();
         single_link(scene, "statics")?;
-        let n_el = settings::elements(&settings.discretization)?;
+        let n_el = settings::elements(settings)?;
         let link = &scene.links()[0];
         let omega = linear::hub_rate(link)?;
-        let element = element::for_link(link, settings.discretization.element)?;
+        let element = element::for_link(link, settings.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
         let (tip_deflection, tip_rotation) = statics::solve(scene, &sys)?;
         Ok(StaticResult {
             backend: BackendKind::Fem,
             scene: scene.name.clone(),
-            settings: settings.clone(),
+            settings: data::Settings::from(settings),
             tip_deflection,
             tip_rotation,
             cost: Cost {
@@ -277,17 +281,18 @@ impl Backend for FemBackend {
     }
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
+        let settings = &disc.fem()?;
         if mobile::scene_model(scene).is_some() {
-            return Ok(mobile::dof_plan(scene, disc)?);
+            return Ok(mobile::dof_plan(scene, settings)?);
         }
-        let n_el = settings::elements(disc)?;
+        let n_el = settings::elements(settings)?;
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::dof_plan(scene, n_el)?);
         }
         if rocket::the_rocket(scene).is_some() {
-            return Ok(rocket::dof_plan(scene, disc)?);
+            return Ok(rocket::dof_plan(scene, settings)?);
         }
-        Ok(plan::dof_plan(scene, n_el, disc.element)?)
+        Ok(plan::dof_plan(scene, n_el, settings.element)?)
     }
 
     fn modes(
@@ -296,6 +301,7 @@ impl Backend for FemBackend {
         settings: &Settings,
         count: usize,
     ) -> Result<ModalResult, BackendError> {
+        let settings = &settings.fem()?;
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::modes(scene, settings, count)?);
         }
@@ -309,6 +315,7 @@ impl Backend for FemBackend {
     }
 
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
+        let settings = &settings.fem()?;
         if payload_link::link(scene).is_some() {
             return Ok(payload_link::statics(scene, settings)?);
         }
@@ -316,6 +323,7 @@ impl Backend for FemBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+        let settings = &settings.fem()?;
         if mobile::scene_model(scene).is_some() {
             return Ok(mobile::simulate(scene, settings)?);
         }

@@ -19,7 +19,7 @@ use crate::linear::LinearLink;
 /// shapes, the cost of one factorization of a `dofs`-DOF pencil timed from `start`.
 pub fn modal_result(
     scene: &data::Scene,
-    settings: &data::Settings,
+    settings: &data::FemSettings,
     modes: impl Iterator<Item = (f64, String)>,
     shapes: Vec<data::ModeShape>,
     dofs: usize,
@@ -31,7 +31,7 @@ pub fn modal_result(
     data::ModalResult {
         backend: data::BackendKind::Fem,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         frequencies_hz,
         kinds,
         shapes,

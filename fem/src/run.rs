@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use data::{
-    Cost, Diagnostic, EnergyLedger, Event, Observables, RunResult, Scene, Settings,
+    Cost, Diagnostic, EnergyLedger, Event, FemSettings, Observables, RunResult, Scene,
     StabilityVerdict, channel, ledger_term,
 };
 
@@ -199,18 +199,17 @@ pub struct Prepared {
 }
 
 /// Builds the chain and the stepper for a scene and settings (step chosen per the documented rule).
-pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
-    let mut chain = Chain::from_scene(scene, &settings.discretization)?;
-    let method = settings::method(&settings.time, default_method(scene))?;
+pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemError> {
+    let mut chain = Chain::from_scene(scene, settings)?;
+    let method = settings.method.unwrap_or_else(|| default_method(scene));
     if method == Method::EnergyMidpoint {
         check_midpoint(scene)?;
     }
-    let dt_user = settings::positive("time.dt", settings.time.dt)?;
-    let rtol = settings::positive("time.rtol", settings.time.rtol)?;
-    let atol = settings::positive("time.atol", settings.time.atol)?;
-    let t_end =
-        settings::positive("time.t_end", settings.time.t_end)?.unwrap_or(scene.simulation.t_end);
-    let safety = settings.time.safety_factor.unwrap_or(DEFAULT_SAFETY);
+    let dt_user = settings::positive("time.dt", settings.dt)?;
+    let rtol = settings::positive("time.rtol", settings.rtol)?;
+    let atol = settings::positive("time.atol", settings.atol)?;
+    let t_end = settings::positive("time.t_end", settings.t_end)?.unwrap_or(scene.simulation.t_end);
+    let safety = settings.safety_factor.unwrap_or(DEFAULT_SAFETY);
     if !(safety > 0.0 && safety <= 1.0) {
         return Err(FemError::InvalidSettings {
             field: "time.safety_factor".into(),
@@ -514,7 +513,7 @@ fn push_ledger(integ: &Driver, ledger: &mut EnergyLedger) {
 }
 
 /// Runs a scene to t_end; early stops become a `Stopped` verdict with the output so far.
-pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemError> {
+pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
         driver: mut integ,
@@ -623,7 +622,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemErro
 /// The backend's result record of a run (chain, rocket, 3-D link and mobile drivers alike).
 pub(crate) fn run_result(
     scene: &Scene,
-    settings: &Settings,
+    settings: &FemSettings,
     observables: Observables,
     ledger: EnergyLedger,
     events: Vec<Event>,
@@ -633,7 +632,7 @@ pub(crate) fn run_result(
     RunResult {
         backend: data::BackendKind::Fem,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         observables,
         ledger,
         events,
@@ -666,7 +665,7 @@ mod default_step_tests {
         let scene = data::load_scene("constrained-arm").expect("catalog scene");
         let h = axial_wall_step(&scene).expect("bilateral wall on an axial link");
         assert!((h - 1.0 / 8000.0).abs() < 1e-15, "{h}");
-        let p = prepare(&scene, &Settings::default()).expect("prepare");
+        let p = prepare(&scene, &FemSettings::default()).expect("prepare");
         assert_eq!(p.h_nominal, 1.0 / 8000.0);
         // No bilateral wall (unilateral Barhorst surface, free chains): the bending rule only.
         for name in ["barhorst-case1", "single-link", "cantilever-axial"] {

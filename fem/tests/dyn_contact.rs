@@ -317,7 +317,7 @@ fn dyn_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     // 141.8697 (0.62 %), |q̇|∞ = 1.5e-3 at 10 s.
     let sc = scene("barhorst-case1-stiff-elbow");
     let st = settings(Some(4), None);
-    let mut p = fem::run::prepare(&sc, &st).unwrap();
+    let mut p = fem::run::prepare(&sc, &st.fem().unwrap()).unwrap();
     let integ = &mut p.driver;
     integ.set_stop(10.0);
     while integ.step().unwrap() != fem::driver::StopReason::ReachedStop {}
@@ -399,9 +399,9 @@ fn sys_contact_refusals_are_precise() {
     }
     // Without contact nothing is allocated and the DOF count is the chain's.
     let free = scene("two-link-free");
-    let p = fem::run::prepare(&free, &settings(Some(4), Some(0.01))).unwrap();
+    let p = fem::run::prepare(&free, &settings(Some(4), Some(0.01)).fem().unwrap()).unwrap();
     assert!(p.driver.contact.is_none());
-    let pc = fem::run::prepare(&sc, &settings(Some(4), Some(0.01))).unwrap();
+    let pc = fem::run::prepare(&sc, &settings(Some(4), Some(0.01)).fem().unwrap()).unwrap();
     assert_eq!(pc.driver.chain.ndof, p.driver.chain.ndof);
 }
 

@@ -248,7 +248,7 @@ fn sys_newton_solve_of_real_chain_matrices_is_backward_stable() {
     // The Newton matrices of the arms at their default meshes, with the coefficients of a
     // generalized-α step (ρ∞ = 0.9, h = 1e-3): the sparse LU solve leaves a residual at
     // round-off, ‖S x − r‖ ≤ n ε ‖S‖∞ ‖x‖∞ (a backward error of a few ulps per row).
-    let n_el = fem::settings::elements(&data::Discretization::default()).unwrap();
+    let n_el = fem::settings::elements(&data::FemSettings::default()).unwrap();
     for name in [
         "two-link-free",
         "barhorst-case1-timoshenko",
@@ -310,7 +310,7 @@ fn sys_analytic_kinetic_gradient_matches_the_finite_difference_identity_at_real_
     };
     for name in ["two-link-free", "barhorst-case1"] {
         let sc = data::load_scene(name).unwrap();
-        let mut p = fem::run::prepare(&sc, &data::Settings::default()).unwrap();
+        let mut p = fem::run::prepare(&sc, &data::FemSettings::default()).unwrap();
         p.driver.set_stop(0.25);
         while p.driver.state.t < 0.25 - 1e-12 {
             p.driver.step().unwrap();

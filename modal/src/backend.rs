@@ -18,11 +18,12 @@ impl Backend for ModalBackend {
     }
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
+        let settings = &disc.modal()?;
         match scene.family() {
-            Family::Rocket => rocket::dof_plan(scene, disc),
-            Family::PayloadLink => Ok(payload_link::dof_plan(scene, disc)?),
-            Family::MobileManipulator => Ok(mobile::dof_plan(scene, disc)?),
-            _ => Ok(setup::dof_plan(scene, disc)?),
+            Family::Rocket => rocket::dof_plan(scene, settings),
+            Family::PayloadLink => Ok(payload_link::dof_plan(scene, settings)?),
+            Family::MobileManipulator => Ok(mobile::dof_plan(scene, settings)?),
+            _ => Ok(setup::dof_plan(scene, settings)?),
         }
     }
 
@@ -32,6 +33,7 @@ impl Backend for ModalBackend {
         settings: &Settings,
         count: usize,
     ) -> Result<ModalResult, BackendError> {
+        let settings = &settings.modal()?;
         match scene.family() {
             Family::Rocket => rocket::modes(scene, settings, count),
             Family::PayloadLink => Ok(payload_link::modes(scene, settings, count)?),
@@ -41,6 +43,7 @@ impl Backend for ModalBackend {
     }
 
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
+        let settings = &settings.modal()?;
         match scene.family() {
             Family::Rocket => Err(BackendError::unsupported("modal: statics of the rocket")),
             Family::PayloadLink => Ok(payload_link::statics(scene, settings)?),
@@ -52,6 +55,7 @@ impl Backend for ModalBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+        let settings = &settings.modal()?;
         match scene.family() {
             Family::Rocket => rocket::simulate(scene, settings),
             Family::PayloadLink => Ok(payload_link::simulate(scene, settings)?),

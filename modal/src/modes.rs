@@ -10,7 +10,7 @@
 
 use std::time::Instant;
 
-use data::{Cost, ModalResult, ModeShape, Scene, Settings};
+use data::{Cost, ModalResult, ModalSettings, ModeShape, Scene};
 use faer::{Mat, Side};
 
 use crate::error::ModalError;
@@ -18,9 +18,13 @@ use crate::setup::{Purpose, build_chain_for};
 
 /// Natural frequencies \[Hz\], ascending. A statically unstable (divergent) mode is reported as
 /// −sqrt(−λ)/2π.
-pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, ModalError> {
+pub fn modes(
+    scene: &Scene,
+    settings: &ModalSettings,
+    count: usize,
+) -> Result<ModalResult, ModalError> {
     let wall = Instant::now();
-    let mut chain = build_chain_for(scene, &settings.discretization, Purpose::Modes)?;
+    let mut chain = build_chain_for(scene, settings, Purpose::Modes)?;
     let n = chain.n;
     let mut q = vec![0.0; n];
     let mut qd = vec![0.0; n];
@@ -137,7 +141,7 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
     Ok(ModalResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         frequencies_hz: frequencies,
         kinds,
         shapes,
@@ -153,7 +157,7 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
 /// hub law): rotating-beam frequencies \[Hz\] for the λ studies.
 pub fn rotating_modes(
     scene: &Scene,
-    settings: &Settings,
+    settings: &ModalSettings,
     hub_rate: f64,
     count: usize,
 ) -> Result<ModalResult, ModalError> {

@@ -1,7 +1,7 @@
 //! Scene + settings → assumed-mode chain model (bases, integrals, joints), and the DOF plan.
 
 use data::scene::Link;
-use data::{Basis, Discretization, DofPlan, Family, Scene};
+use data::{Basis, DofPlan, Family, ModalSettings, Scene};
 
 use crate::basis::ShapeSet;
 use crate::error::ModalError;
@@ -89,8 +89,8 @@ pub fn check_supported(scene: &Scene, purpose: Purpose) -> Result<(), ModalError
     Ok(())
 }
 
-pub fn modes_per_link(disc: &Discretization) -> Result<usize, ModalError> {
-    let n = disc.modes.unwrap_or(DEFAULT_MODES);
+pub fn modes_per_link(settings: &ModalSettings) -> Result<usize, ModalError> {
+    let n = settings.modes.unwrap_or(DEFAULT_MODES);
     if n == 0 || n > MAX_MODES {
         return Err(ModalError::invalid(
             "discretization.modes",
@@ -128,8 +128,8 @@ pub fn default_basis(scene: &Scene) -> Basis {
     }
 }
 
-pub fn basis_choice(scene: &Scene, disc: &Discretization) -> Result<Basis, ModalError> {
-    let basis = disc.basis.unwrap_or_else(|| default_basis(scene));
+pub fn basis_choice(scene: &Scene, settings: &ModalSettings) -> Result<Basis, ModalError> {
+    let basis = settings.basis.unwrap_or_else(|| default_basis(scene));
     match basis {
         Basis::FreeFree => Err(ModalError::invalid(
             "discretization.basis",
@@ -181,8 +181,8 @@ fn shapes(link: &Link, index: usize, basis: Basis, n: usize) -> Result<ShapeSet,
 /// Builds the chain model. Everything the scene leaves off is not allocated: no foreshortening
 /// integrals without `foreshortening`, no tip terms without a tip mass, no gravity force without
 /// `[gravity]`.
-pub fn build_chain(scene: &Scene, disc: &Discretization) -> Result<Chain, ModalError> {
-    build_chain_for(scene, disc, Purpose::Dynamics)
+pub fn build_chain(scene: &Scene, settings: &ModalSettings) -> Result<Chain, ModalError> {
+    build_chain_for(scene, settings, Purpose::Dynamics)
 }
 
 /// Whether a Timoshenko link's v basis carries the root shear strain v'(0) (see
@@ -234,12 +234,12 @@ fn axial_shapes(link: &Link, basis: Basis, n: usize) -> ShapeSet {
 
 pub fn build_chain_for(
     scene: &Scene,
-    disc: &Discretization,
+    settings: &ModalSettings,
     purpose: Purpose,
 ) -> Result<Chain, ModalError> {
     check_supported(scene, purpose)?;
-    let n = modes_per_link(disc)?;
-    let basis = basis_choice(scene, disc)?;
+    let n = modes_per_link(settings)?;
+    let basis = basis_choice(scene, settings)?;
     let mut links = Vec::new();
     let mut joints = Vec::new();
     let mut offset = 0;
@@ -356,10 +356,10 @@ pub(crate) fn transverse_load(scene: &Scene, l: &LinkModel, p: f64, q: f64) -> V
 }
 
 /// The DOFs of the model (the axial field is listed when on; simulate then reports Unsupported).
-pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalError> {
+pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
     check_supported(scene, Purpose::Modes)?;
-    let n = modes_per_link(disc)?;
-    let basis = basis_choice(scene, disc)?;
+    let n = modes_per_link(settings)?;
+    let basis = basis_choice(scene, settings)?;
     let mut plan = DofPlan::default();
     for (i, l) in scene.links().iter().enumerate() {
         let k = i + 1;
@@ -452,15 +452,18 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
 }
 
 /// The run's end time (settings override the scene), after checking it and any user step.
-pub(crate) fn checked_span(scene: &Scene, settings: &data::Settings) -> Result<f64, ModalError> {
-    let t_end = settings.time.t_end.unwrap_or(scene.simulation.t_end);
+pub(crate) fn checked_span(
+    scene: &Scene,
+    settings: &data::ModalSettings,
+) -> Result<f64, ModalError> {
+    let t_end = settings.t_end.unwrap_or(scene.simulation.t_end);
     if !(t_end > 0.0 && t_end.is_finite()) {
         return Err(ModalError::invalid(
             "time.t_end",
             format!("{t_end} is not a positive time"),
         ));
     }
-    if let Some(dt) = settings.time.dt
+    if let Some(dt) = settings.dt
         && !(dt > 0.0 && dt.is_finite())
     {
         return Err(ModalError::invalid(

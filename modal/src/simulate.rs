@@ -6,14 +6,12 @@
 
 use std::time::Instant;
 
-use data::{RunResult, Scene, Settings, StabilityVerdict};
+use data::{ModalSettings, RunResult, Scene, StabilityVerdict};
 
 use crate::contact::ContactState;
 use crate::error::ModalError;
 use crate::events::{ContactEvents, Halt};
-use crate::integrate::{
-    Build, DOPRI5, METHODS, MethodInfo, TRBDF2, Tolerances, method_for, method_names,
-};
+use crate::integrate::{Build, DOPRI5, MethodInfo, TRBDF2, Tolerances, method_for};
 use crate::output::{Output, runaway, stopped, too_many_events};
 use crate::setup::build_chain;
 
@@ -39,25 +37,11 @@ pub const KELVIN_VOIGT_DEFAULT_TOL: (f64, f64) = (1e-6, 1e-8);
 /// An integration method of the registry ([`crate::integrate::METHODS`]).
 pub type Method = &'static MethodInfo;
 
-/// The registered implementation of `method` (None: the default, Dormand–Prince).
-pub fn parse_method(method: Option<data::Method>) -> Result<Method, ModalError> {
-    let Some(method) = method else {
-        return Ok(METHODS[0]);
-    };
-    method_for(method).ok_or_else(|| {
-        ModalError::invalid(
-            "time.method",
-            format!("`{method}`: the modal backend offers {}", method_names()),
-        )
-    })
-}
-
 /// The method of a run: the one named in the settings, else the default ([`default_method`]).
-pub fn method_choice(scene: &Scene, settings: &Settings) -> Result<Method, ModalError> {
-    match settings.time.method {
-        Some(method) => parse_method(Some(method)),
-        None => Ok(default_method(scene, settings)),
-    }
+pub fn method_choice(scene: &Scene, settings: &ModalSettings) -> Method {
+    settings
+        .method
+        .map_or_else(|| default_method(scene, settings), method_for)
 }
 
 /// The default method: adaptive TR-BDF2 ([`TRBDF2`], tolerances
@@ -87,8 +71,8 @@ pub fn method_choice(scene: &Scene, settings: &Settings) -> Result<Method, Modal
 /// is 8.5e-5 rad off. A tolerance given
 /// (`rtol`/`atol`) without a method asks for Dormand–Prince; a contact scene keeps
 /// Dormand–Prince, whose switching times are located on the tolerance-controlled dense output.
-pub fn default_method(scene: &Scene, settings: &Settings) -> Method {
-    let tolerance_given = settings.time.rtol.is_some() || settings.time.atol.is_some();
+pub fn default_method(scene: &Scene, settings: &ModalSettings) -> Method {
+    let tolerance_given = settings.rtol.is_some() || settings.atol.is_some();
     let all_damped = scene
         .links()
         .iter()
@@ -121,21 +105,20 @@ pub fn default_step(scene: &Scene) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalError> {
+pub fn simulate(scene: &Scene, settings: &ModalSettings) -> Result<RunResult, ModalError> {
     simulate_detailed(scene, settings).map(|(r, _)| r)
 }
 
 /// [`simulate`] that also returns the final state and the contact diagnostics.
 pub fn simulate_detailed(
     scene: &Scene,
-    settings: &Settings,
+    settings: &ModalSettings,
 ) -> Result<(RunResult, FinalState), ModalError> {
     let wall = Instant::now();
-    let chain = build_chain(scene, &settings.discretization)?;
-    let method = method_choice(scene, settings)?;
+    let chain = build_chain(scene, settings)?;
+    let method = method_choice(scene, settings);
     let fixed_step = method.is_fixed_step();
-    let default_kelvin_voigt_method =
-        settings.time.method.is_none() && std::ptr::eq(method, &TRBDF2);
+    let default_kelvin_voigt_method = settings.method.is_none() && std::ptr::eq(method, &TRBDF2);
     let (rtol_default, atol_default) = if default_kelvin_voigt_method {
         KELVIN_VOIGT_DEFAULT_TOL
     } else if fixed_step {
@@ -143,8 +126,8 @@ pub fn simulate_detailed(
     } else {
         (DEFAULT_RTOL, DEFAULT_ATOL)
     };
-    let rtol = settings.time.rtol.unwrap_or(rtol_default);
-    let atol = settings.time.atol.unwrap_or(atol_default);
+    let rtol = settings.rtol.unwrap_or(rtol_default);
+    let atol = settings.atol.unwrap_or(atol_default);
     if !(rtol > 0.0 && atol > 0.0) {
         return Err(ModalError::invalid(
             "time.rtol/atol",
@@ -159,12 +142,8 @@ pub fn simulate_detailed(
     let dim = y.len();
     let tol = Tolerances { rtol, atol };
     let mut stepper = match method.build {
-        Build::Adaptive(build) => build(dim, tol, settings.time.dt),
-        Build::Fixed(build) => build(
-            dim,
-            tol,
-            settings.time.dt.unwrap_or_else(|| default_step(scene)),
-        ),
+        Build::Adaptive(build) => build(dim, tol, settings.dt),
+        Build::Fixed(build) => build(dim, tol, settings.dt.unwrap_or_else(|| default_step(scene))),
     };
     let mut out = Output::new(&rhs, scene, t_end, dim);
 
@@ -247,7 +226,7 @@ pub fn simulate_detailed(
     let result = RunResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         observables: out.obs,
         ledger: out.ledger,
         events: contact.events,

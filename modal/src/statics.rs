@@ -2,13 +2,13 @@
 //! PL³/3EI is reached as the basis is refined, and the polynomial basis with n ≥ 3 contains the
 //! exact cubic tip-load solution).
 
-use data::{Cost, Scene, Settings, StaticResult};
+use data::{Cost, ModalSettings, Scene, StaticResult};
 
 use crate::error::ModalError;
 use crate::linalg::{cholesky_solve, dot};
 use crate::setup::{build_chain, transverse_load};
 
-pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, ModalError> {
+pub fn statics(scene: &Scene, settings: &ModalSettings) -> Result<StaticResult, ModalError> {
     let wall = std::time::Instant::now();
     let Some(loads) = scene.statics() else {
         return Err(ModalError::Unsupported(
@@ -25,7 +25,7 @@ pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, Modal
             "modal: statics only for a single link clamped to the ground".into(),
         ));
     }
-    let chain = build_chain(scene, &settings.discretization)?;
+    let chain = build_chain(scene, settings)?;
     let l = &chain.links[0];
     let nb = l.nb();
     let nbc = l.nbc();
@@ -42,7 +42,7 @@ pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, Modal
     Ok(StaticResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         tip_deflection: dot(&l.ints.phi_l, &b[..nb]),
         // ψ(L) = r(L)ᵀ[b, c] (= v′(L) for Euler links).
         tip_rotation: dot(&l.section.rot_l[l.na()..], &b),

@@ -103,7 +103,7 @@ fn check_lagrange_scene(
     amp_q: f64,
     amp_qd: f64,
 ) {
-    let mut chain = build_chain(scene, disc).unwrap();
+    let mut chain = build_chain(scene, &disc.modal().unwrap()).unwrap();
     let (q, qd) = state(chain.n, seed, amp_q, amp_qd);
     check_lagrange(&mut chain, &q, &qd);
 }
@@ -390,11 +390,18 @@ fn sys_default_method_is_adaptive_trbdf2_for_damped_chains_without_contact() {
         ..Default::default()
     };
     let damped = load_scene("two-link-free").unwrap();
-    assert_eq!(default_method(&damped, &plain), &TRBDF2);
-    assert_eq!(default_method(&damped, &with_rtol), &DOPRI5);
+    assert_eq!(default_method(&damped, &plain.modal().unwrap()), &TRBDF2);
+    assert_eq!(
+        default_method(&damped, &with_rtol.modal().unwrap()),
+        &DOPRI5
+    );
     for name in ["two-link-free-undamped", "single-link", "barhorst-case1"] {
         let scene = load_scene(name).unwrap();
-        assert_eq!(default_method(&scene, &plain), &DOPRI5, "{name}");
+        assert_eq!(
+            default_method(&scene, &plain.modal().unwrap()),
+            &DOPRI5,
+            "{name}"
+        );
     }
     // Step of the fixed-step methods when asked for by name: T₁/STEPS_PER_PERIOD of the faster
     // link (the 2 ft link 2): cantilever β₁ = 1.8751.

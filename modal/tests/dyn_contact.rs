@@ -26,7 +26,7 @@ fn settings(modes: usize, rtol: f64, t_end: Option<f64>) -> Settings {
 
 fn run(name: &str, modes: usize, rtol: f64, t_end: Option<f64>) -> (RunResult, FinalState) {
     let scene = load_scene(name).unwrap();
-    simulate_detailed(&scene, &settings(modes, rtol, t_end)).unwrap()
+    simulate_detailed(&scene, &settings(modes, rtol, t_end).modal().unwrap()).unwrap()
 }
 
 fn summary(r: &RunResult) {
@@ -228,8 +228,11 @@ fn dyn_contact_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     // Static equilibrium about the hub (no hub spring; dampers idle at rest):
     // N·x_tip = Σ Wᵢ x_cg,i. Σ mᵢ x_cg,i from the model's own mass integrals: with a unit
     // gravity along −x the gravity potential is +Σ mᵢ x_cg,i.
-    let mut chain =
-        modal::setup::build_chain(&scene, &settings(2, 1e-9, None).discretization).unwrap();
+    let mut chain = modal::setup::build_chain(
+        &scene,
+        &settings(2, 1e-9, None).discretization.modal().unwrap(),
+    )
+    .unwrap();
     let g = -scene.gravity().unwrap().vector[1];
     chain.gravity = Some([-1.0, 0.0]);
     let zero = vec![0.0; chain.n];
@@ -353,8 +356,11 @@ fn dyn_contact_convective_tip_acceleration_matches_finite_differences() {
     // Ġq̇ of the constraint: c(q, q̇) = Σₖ ∂J/∂qₖ q̇ₖ q̇ against a central difference of J(q) q̇
     // along q̇, for a deformed, moving two-link arm with foreshortening (exact tip kinematics).
     let scene = load_scene("barhorst-case1-tipmass").unwrap();
-    let mut chain =
-        modal::setup::build_chain(&scene, &settings(3, 1e-8, None).discretization).unwrap();
+    let mut chain = modal::setup::build_chain(
+        &scene,
+        &settings(3, 1e-8, None).discretization.modal().unwrap(),
+    )
+    .unwrap();
     let n = chain.n;
     let q: Vec<f64> = (0..n)
         .map(|k| 0.3 * ((k as f64) * 1.7 + 0.4).sin())

@@ -140,7 +140,7 @@ fn friction_ledger(r: &RunResult) -> &[f64] {
 fn dyn_friction_arm_constraint_ledger_and_friction_work() {
     // The scene as given (Euler model: axial field with von Kármán strain), 3 modes per field.
     let scene = arm();
-    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, None)).unwrap();
+    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, None).modal().unwrap()).unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     let len = scene.links()[0].length;
     // Drift control: |g| and |G q̇| before each projection stay at round-off (stated: 1e-12 L,
@@ -201,7 +201,8 @@ fn dyn_friction_work_equals_integral_of_mu_n_vt() {
     scene.planar_chain_mut().unwrap().links[0].kelvin_voigt = Some(0.5);
     scene.simulation.output_interval = 2.5e-5;
     let t_end = 0.8;
-    let (r, _) = simulate_detailed(&scene, &settings(3, 1e-9, Some(t_end))).unwrap();
+    let (r, _) =
+        simulate_detailed(&scene, &settings(3, 1e-9, Some(t_end)).modal().unwrap()).unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     let mu = scene.contacts()[0].friction;
     let (n, vt) = (
@@ -236,7 +237,7 @@ fn dyn_friction_stick_slip_pendulum_sticks_and_stays() {
     let mut scene = arm();
     pendulum(&mut scene);
     scene.planar_chain_mut().unwrap().links[0].kelvin_voigt = Some(0.5);
-    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, Some(1.5))).unwrap();
+    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, Some(1.5)).modal().unwrap()).unwrap();
     print_summary(&r, &f);
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     let ev = stick_slips(&r);
@@ -314,7 +315,7 @@ fn assert_rigid_limit(label: &str, stiffen: impl Fn(f64) -> Scene) {
         let scene = stiffen(scale);
         let mut st = settings(3, 1e-6, Some(0.5));
         st.discretization.basis = Some(data::Basis::Poly);
-        let (r, _) = simulate_detailed(&scene, &st).unwrap();
+        let (r, _) = simulate_detailed(&scene, &st.modal().unwrap()).unwrap();
         assert_eq!(r.verdict, StabilityVerdict::Completed);
         assert!(r.ledger.relative_closure() < 1e-5);
         let (e_theta, e_force) = rigid_errors(&scene, &r);
@@ -405,7 +406,7 @@ fn dyn_friction_inclined_line_bilateral_ledger_closes() {
         normal: [-h, -h],
     };
     scene.planar_chain_mut().unwrap().contacts[0].friction = 0.3;
-    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, Some(0.2))).unwrap();
+    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, Some(0.2)).modal().unwrap()).unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     assert!(f.contact.max_gap_violation <= 1e-12, "{:?}", f.contact);
     assert!(f.contact.max_stick_velocity <= 1e-9, "{:?}", f.contact);

@@ -13,7 +13,7 @@ use modal::rocket::{self, DetailedRun};
 
 fn run(name: &str) -> DetailedRun {
     let scene = load_scene(name).unwrap();
-    rocket::simulate_detailed(&scene, &Settings::default()).unwrap()
+    rocket::simulate_detailed(&scene, &Settings::default().modal().unwrap()).unwrap()
 }
 
 /// The default `rocket` run (0.1 s, 6 + 6 modes, dopri5 at rtol 1e-8), shared by the tests.
@@ -275,7 +275,7 @@ fn sys_dof_counts_per_scene() {
         "rocket-launch-75",
     ] {
         let scene = load_scene(name).unwrap();
-        let plan = rocket::dof_plan(&scene, &disc).unwrap();
+        let plan = rocket::dof_plan(&scene, &disc.modal().unwrap()).unwrap();
         let counts: Vec<(String, usize)> = plan
             .groups
             .iter()
@@ -306,7 +306,9 @@ fn sys_dof_counts_per_scene() {
         &Discretization {
             modes: Some(4),
             ..Default::default()
-        },
+        }
+        .modal()
+        .unwrap(),
     )
     .unwrap();
     assert_eq!(plan.total(), 3 + 4 + 4);
@@ -321,7 +323,7 @@ fn sys_dof_counts_per_scene() {
 #[test]
 fn sys_modes_at_ignition() {
     let scene = load_scene("rocket").unwrap();
-    let m = rocket::modes(&scene, &Settings::default(), 10).unwrap();
+    let m = rocket::modes(&scene, &Settings::default().modal().unwrap(), 10).unwrap();
     assert_eq!(m.frequencies_hz.len(), 10);
     assert!(m.frequencies_hz.windows(2).all(|w| w[0] <= w[1]));
     assert!(m.kinds.iter().all(|k| k == "axial" || k == "bending"));
@@ -336,7 +338,9 @@ fn sys_modes_at_ignition() {
             },
             ..Default::default()
         };
-        rocket::modes(&scene, &s, 6).unwrap().frequencies_hz
+        rocket::modes(&scene, &s.modal().unwrap(), 6)
+            .unwrap()
+            .frequencies_hz
     };
     let (f4, f8, f12) = (with(4), with(8), with(12));
     for k in 0..6 {
@@ -374,7 +378,7 @@ fn dyn_burnout_ends_thrust_and_restarts_integrator() {
         },
         ..Default::default()
     };
-    let r = rocket::simulate_detailed(&scene, &settings).unwrap();
+    let r = rocket::simulate_detailed(&scene, &settings.modal().unwrap()).unwrap();
     assert_eq!(r.run.verdict, StabilityVerdict::Completed);
     let ev: Vec<&Event> = r
         .run
@@ -419,8 +423,8 @@ fn dyn_implicit_method_agrees_with_dopri5() {
             ..Default::default()
         },
     };
-    let a = rocket::simulate_detailed(&scene, &mk("dopri5")).unwrap();
-    let b = rocket::simulate_detailed(&scene, &mk("tr-bdf2")).unwrap();
+    let a = rocket::simulate_detailed(&scene, &mk("dopri5").modal().unwrap()).unwrap();
+    let b = rocket::simulate_detailed(&scene, &mk("tr-bdf2").modal().unwrap()).unwrap();
     assert!(b.run.cost.factorizations > 0 && b.run.cost.jacobian_evaluations > 0);
     let (va, vb) = (values(&a, "rocket.vY"), values(&b, "rocket.vY"));
     let (ua, ub) = (values(&a, "rocket.u@10"), values(&b, "rocket.u@10"));
@@ -450,7 +454,9 @@ fn sys_settings_and_scenes_are_checked() {
             &with_disc(Discretization {
                 modes: Some(modes),
                 ..Default::default()
-            }),
+            })
+            .modal()
+            .unwrap(),
         )
         .unwrap_err();
         assert!(
@@ -462,7 +468,9 @@ fn sys_settings_and_scenes_are_checked() {
         &with_disc(Discretization {
             basis: Some(Basis::ClampedFree),
             ..Default::default()
-        }),
+        })
+        .modal()
+        .unwrap(),
         4,
     )
     .unwrap_err();
@@ -478,23 +486,25 @@ fn sys_settings_and_scenes_are_checked() {
                 ..Default::default()
             },
             ..Default::default()
-        },
+        }
+        .modal()
+        .unwrap(),
     )
     .unwrap_err();
     assert!(matches!(e, BackendError::InvalidSettings { ref field, .. } if field == "time.method"));
-    let e = rocket::modes(&scene, &Settings::default(), 100).unwrap_err();
+    let e = rocket::modes(&scene, &Settings::default().modal().unwrap(), 100).unwrap_err();
     assert!(matches!(e, BackendError::InvalidSettings { .. }));
     // non-rocket scene and unsupported physics
     let e = rocket::dof_plan(
         &load_scene("cantilever").unwrap(),
-        &Discretization::default(),
+        &Discretization::default().modal().unwrap(),
     )
     .unwrap_err();
     assert!(matches!(e, BackendError::Unsupported(_)));
     let mut s = scene.clone();
     s.rocket_mut().unwrap().exit_pressure = 10.0;
     assert!(matches!(
-        rocket::simulate(&s, &Settings::default()).unwrap_err(),
+        rocket::simulate(&s, &Settings::default().modal().unwrap()).unwrap_err(),
         BackendError::Unsupported(m) if m.contains("exit_pressure")
     ));
 }
@@ -519,7 +529,7 @@ fn dyn_dampers_dissipate_and_ledger_still_closes() {
         m.transverse_damping = 5.0;
     }
     rk.springs[0].axial_damping = 2.0;
-    let r = rocket::simulate_detailed(&scene, &short_settings(3)).unwrap();
+    let r = rocket::simulate_detailed(&scene, &short_settings(3).modal().unwrap()).unwrap();
     let l = &r.run.ledger;
     assert_eq!(l.dissipation.len(), 1);
     assert_eq!(l.dissipation[0].name, "discrete_damper");
@@ -536,7 +546,7 @@ fn dyn_dampers_dissipate_and_ledger_still_closes() {
         "closure {:e}",
         l.relative_closure()
     );
-    let plan = rocket::dof_plan(&scene, &Discretization::default()).unwrap();
+    let plan = rocket::dof_plan(&scene, &Discretization::default().modal().unwrap()).unwrap();
     assert!(plan.builds.iter().any(|b| b.contains("damper")));
 }
 
@@ -547,7 +557,7 @@ fn dyn_runaway_is_stopped_with_diagnostic() {
     let mut scene = load_scene("rocket").unwrap();
     scene.rocket_mut().unwrap().initial_shape =
         data::scene::InitialShape::Report { a1: 10.0, a2: 0.0 };
-    let r = rocket::simulate(&scene, &short_settings(3)).unwrap();
+    let r = rocket::simulate(&scene, &short_settings(3).modal().unwrap()).unwrap();
     match &r.verdict {
         StabilityVerdict::Stopped { diagnostic } => {
             assert!(
@@ -572,10 +582,10 @@ fn sys_largest_basis_sets_up() {
     // eigen-solution must still separate the rigid modes and agree with a small basis on the
     // lowest frequencies (Rayleigh–Ritz: from above, converged to 1e-4 at 12 modes).
     let scene = load_scene("rocket").unwrap();
-    let f40 = rocket::modes(&scene, &short_settings(40), 4)
+    let f40 = rocket::modes(&scene, &short_settings(40).modal().unwrap(), 4)
         .unwrap()
         .frequencies_hz;
-    let f12 = rocket::modes(&scene, &short_settings(12), 4)
+    let f12 = rocket::modes(&scene, &short_settings(12).modal().unwrap(), 4)
         .unwrap()
         .frequencies_hz;
     for k in 0..4 {

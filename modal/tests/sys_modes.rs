@@ -147,7 +147,7 @@ fn sys_rotating_beam_in_plane_identity_and_convergence() {
     for lam in [0.0, 1.0, 4.0, 12.0] {
         let omega = lam / lam_scale;
         let at = |b: Basis, n: usize| {
-            rotating_modes(&scene, &settings(b, n), omega, 3)
+            rotating_modes(&scene, &settings(b, n).modal().unwrap(), omega, 3)
                 .unwrap()
                 .frequencies_hz
         };
@@ -291,10 +291,16 @@ fn sys_unsupported_and_invalid_requests_are_typed_errors() {
     let mut bad = Settings::default();
     // A method of another backend.
     bad.time.method = Some(data::Method::Report);
-    assert!(matches!(
-        ModalBackend.simulate(&load_scene("single-link").unwrap(), &bad),
-        Err(BackendError::InvalidSettings { .. })
-    ));
+    match ModalBackend.simulate(&load_scene("single-link").unwrap(), &bad) {
+        Err(BackendError::InvalidSettings { field, message }) => {
+            assert_eq!(field, "time.method");
+            assert!(
+                message.contains("`report`") && message.contains("dopri5"),
+                "{message}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
 }
 
 #[test]

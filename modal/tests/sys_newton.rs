@@ -20,7 +20,7 @@ fn rest_rhs(modes: usize, constrained: bool) -> (ChainRhs, Vec<f64>) {
         modes: Some(modes),
         ..Default::default()
     };
-    let chain = build_chain(&scene, &disc).unwrap();
+    let chain = build_chain(&scene, &disc.modal().unwrap()).unwrap();
     let (n, nf) = (chain.n, chain.free.len());
     let mut rhs = ChainRhs::new(chain);
     let mut contact = ContactState::from_scene(&scene, n, nf).unwrap().unwrap();
@@ -161,7 +161,7 @@ fn sys_trbdf2_contact_run_cost_and_first_impulse() {
             ..Default::default()
         },
     };
-    let r = simulate(&scene, &settings).unwrap();
+    let r = simulate(&scene, &settings.modal().unwrap()).unwrap();
     let c = &r.cost;
     println!("{c:?}");
     assert!(c.jacobian_evaluations <= 40, "{c:?}");

@@ -56,7 +56,11 @@ fn judge(case: &data::cases::StabilityCase, kind: BackendKind) -> Vec<Verdict> {
         Ok(s) => s,
         Err(e) => return vec![mk("invalid case", e, true, 0.0)],
     };
-    let settings = case.settings.to_settings();
+    // Each backend takes the fields it reads (a row may set fields for one of its backends);
+    // the method stays, so that a backend that does not implement it refuses the row's request.
+    let requested = case.settings.to_settings();
+    let mut settings = requested.for_backend(kind);
+    settings.time.method = requested.time.method;
     let b = backend(kind);
     let mut out = Vec::new();
     let result = b.simulate(&scene, &settings);

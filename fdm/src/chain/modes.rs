@@ -14,7 +14,7 @@
 //! gravity) gives a zero frequency (a rigid mode), reported as 0 with kind "rigid" (any mode
 //! below 1 % of the slowest link's √(EI/ρAL⁴)).
 
-use data::{BackendKind, Cost, ModalResult, ModeShape, Scene, Settings};
+use data::{BackendKind, Cost, ModalResult, ModeShape, Scene};
 use faer::{Mat, Side};
 
 use super::TwoLinkChain;
@@ -168,12 +168,7 @@ fn generalized_eigen(k: &Mat<f64>, m: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>),
 }
 
 /// `modes` of a two-link chain scene: the lowest `count` linearized frequencies.
-pub fn modes(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-    count: usize,
-) -> Result<ModalResult, FdmError> {
+pub fn modes(scene: &Scene, s: &FdmSettings, count: usize) -> Result<ModalResult, FdmError> {
     let clock = std::time::Instant::now();
     let mut chain = TwoLinkChain::from_scene(scene, s.stations)?;
     let m = chain.linearized_modes()?;
@@ -203,7 +198,7 @@ pub fn modes(
     Ok(ModalResult {
         backend: BackendKind::Fdm,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: s.request(),
         frequencies_hz: m.omega[..count]
             .iter()
             .map(|w| w / (2.0 * std::f64::consts::PI))

@@ -13,7 +13,7 @@
 //! start of the dynamics).
 
 use data::scene::{LinkField, PrescribedMotion};
-use data::{BackendKind, Cost, ModalResult, ModeShape, Scene, Settings, StaticResult};
+use data::{BackendKind, Cost, ModalResult, ModeShape, Scene, StaticResult};
 use faer::{Mat, Side};
 
 use super::{BaseDrive, PayloadLinkModel, apply};
@@ -159,12 +159,7 @@ pub fn kind_name(f: LinkField) -> &'static str {
 
 /// `modes` of a payload-link scene: the lowest `count` frequencies with their kinds; each
 /// shape is the dominant field at the stations (root included), unit peak.
-pub fn modes(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-    count: usize,
-) -> Result<ModalResult, FdmError> {
+pub fn modes(scene: &Scene, s: &FdmSettings, count: usize) -> Result<ModalResult, FdmError> {
     let clock = std::time::Instant::now();
     let model = PayloadLinkModel::from_scene(scene, s.stations)?;
     let sp = model.spectrum()?;
@@ -201,7 +196,7 @@ pub fn modes(
     Ok(ModalResult {
         backend: BackendKind::Fdm,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: s.request(),
         frequencies_hz: sp.omega[..count]
             .iter()
             .map(|w| w / (2.0 * std::f64::consts::PI))
@@ -218,11 +213,7 @@ pub fn modes(
 }
 
 /// `statics`: the gravity sag, w_L and w′_L.
-pub fn statics(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<StaticResult, FdmError> {
+pub fn statics(scene: &Scene, s: &FdmSettings) -> Result<StaticResult, FdmError> {
     let clock = std::time::Instant::now();
     let model = PayloadLinkModel::from_scene(scene, s.stations)?;
     if model.f_gravity.is_none() {
@@ -236,7 +227,7 @@ pub fn statics(
     Ok(StaticResult {
         backend: BackendKind::Fdm,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: s.request(),
         tip_deflection: apply(&model.tip[2], &q),
         tip_rotation: apply(&model.slope_w, &q),
         cost: Cost {

@@ -8,8 +8,8 @@ use std::time::Instant;
 
 use data::scene::LinkField;
 use data::{
-    Cost, Diagnostic, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict,
-    channel, ledger_term,
+    Cost, Diagnostic, EnergyLedger, Observables, RunResult, Scene, StabilityVerdict, channel,
+    ledger_term,
 };
 
 use super::band::{BandCholesky, Triplets};
@@ -302,11 +302,7 @@ impl PayloadLinkModel {
 }
 
 /// Runs the scene.
-pub fn simulate(
-    scene: &Scene,
-    settings: &Settings,
-    s: &FdmSettings,
-) -> Result<RunResult, FdmError> {
+pub fn simulate(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError> {
     let clock = Instant::now();
     let model = PayloadLinkModel::from_scene(scene, s.stations)?;
     let p = scene.payload_link().ok_or_else(|| {
@@ -481,7 +477,7 @@ pub fn simulate(
     Ok(RunResult {
         backend: data::BackendKind::Fdm,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: s.request(),
         observables: obs,
         ledger,
         events: Vec::new(),

@@ -24,7 +24,7 @@
 //! configuration that gravity does not hold) as −√|ω²|.
 
 use data::scene::PrescribedMotion;
-use data::{ModalResult, ModeShape, Scene, Settings};
+use data::{FemSettings, ModalResult, ModeShape, Scene};
 use faer::Mat;
 
 use crate::chain::{Chain, NONE, NewtonCoefficients};
@@ -203,9 +203,9 @@ pub fn applies(scene: &Scene) -> bool {
 }
 
 /// `modes` of a chain scene: the lowest `count` linearized frequencies and their shapes.
-pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, FemError> {
+pub fn modes(scene: &Scene, settings: &FemSettings, count: usize) -> Result<ModalResult, FemError> {
     let start = std::time::Instant::now();
-    let mut chain = Chain::from_scene(scene, &settings.discretization)?;
+    let mut chain = Chain::from_scene(scene, settings)?;
     for (i, l) in scene.links().iter().enumerate() {
         match l.joint.prescribed {
             None | Some(PrescribedMotion::Fixed) => {}

@@ -57,7 +57,7 @@ use std::time::Instant;
 use data::channel::spec;
 use data::results::ledger_term;
 use data::scene::MobileManipulator;
-use data::{DofPlan, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict};
+use data::{DofPlan, EnergyLedger, FemSettings, Observables, RunResult, Scene, StabilityVerdict};
 
 pub use model::Model;
 pub use step::{Inputs, Stepper};
@@ -88,7 +88,7 @@ fn the_scene(scene: &Scene) -> Result<&MobileManipulator, FemError> {
     Ok(mm)
 }
 
-fn elements(settings: &data::Discretization) -> Result<usize, FemError> {
+fn elements(settings: &data::FemSettings) -> Result<usize, FemError> {
     if settings.element == Some(data::FemElement::HermiteQuintic) {
         return Err(FemError::unsupported(
             "fem mobile manipulator: the hermite-quintic element (the flexible link uses \
@@ -99,9 +99,9 @@ fn elements(settings: &data::Discretization) -> Result<usize, FemError> {
 }
 
 /// DOFs and physics built for the scene.
-pub fn dof_plan(scene: &Scene, disc: &data::Discretization) -> Result<DofPlan, FemError> {
+pub fn dof_plan(scene: &Scene, settings: &data::FemSettings) -> Result<DofPlan, FemError> {
     let mm = the_scene(scene)?;
-    let n_el = elements(disc)?;
+    let n_el = elements(settings)?;
     let md = Model::from_scene(mm, n_el)?;
     let mut plan = DofPlan::default();
     if md.platform.is_some() {
@@ -234,11 +234,11 @@ pub struct Prepared {
     pub output_interval: f64,
 }
 
-pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
+pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemError> {
     let mm = the_scene(scene)?;
-    let n_el = elements(&settings.discretization)?;
-    match settings.time.method {
-        None | Some(data::Method::ImplicitMidpoint) => {}
+    let n_el = elements(settings)?;
+    match settings.method {
+        None | Some(data::FemMethod::ImplicitMidpoint) => {}
         Some(other) => {
             return Err(FemError::unsupported(format!(
                 "fem mobile manipulator: method `{other}`; only `implicit-midpoint` is \
@@ -246,14 +246,13 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
             )));
         }
     }
-    if settings.time.rtol.is_some() || settings.time.atol.is_some() {
+    if settings.rtol.is_some() || settings.atol.is_some() {
         return Err(FemError::unsupported(
             "fem mobile manipulator: adaptive steps (`time.rtol`/`time.atol`); use --dt",
         ));
     }
-    let dt_user = settings::positive("time.dt", settings.time.dt)?;
-    let t_end =
-        settings::positive("time.t_end", settings.time.t_end)?.unwrap_or(scene.simulation.t_end);
+    let dt_user = settings::positive("time.dt", settings.dt)?;
+    let t_end = settings::positive("time.t_end", settings.t_end)?.unwrap_or(scene.simulation.t_end);
     let out = scene.simulation.output_interval;
     let md = Model::from_scene(mm, n_el)?;
     let arm = mm
@@ -398,7 +397,7 @@ pub fn advance(st: &mut Stepper, h: f64, t_stop: f64, breakpoints: &[f64]) -> Re
     Ok(())
 }
 
-pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemError> {
+pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
         mut stepper,

@@ -69,8 +69,8 @@ use std::time::Instant;
 
 use data::scene::{LinkField, LinkInitialShape, PayloadLink};
 use data::{
-    BackendKind, Cost, DofPlan, EnergyLedger, ModalResult, ModeShape, Observables, RunResult,
-    Scene, Settings, StabilityVerdict, StaticResult, channel, ledger_term,
+    BackendKind, Cost, DofPlan, EnergyLedger, FemSettings, ModalResult, ModeShape, Observables,
+    RunResult, Scene, StabilityVerdict, StaticResult, channel, ledger_term,
 };
 use faer::Mat;
 use faer::prelude::*;
@@ -372,10 +372,10 @@ fn slot_of(md: &Model, i: usize) -> usize {
         .unwrap_or(U)
 }
 
-pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, FemError> {
+pub fn modes(scene: &Scene, settings: &FemSettings, count: usize) -> Result<ModalResult, FemError> {
     let start = Instant::now();
     let l = the_link(scene)?;
-    let n_el = settings::elements(&settings.discretization)?;
+    let n_el = settings::elements(settings)?;
     let md = build(l, n_el)?;
     // A free base without spring turns rigidly (ω = 0, kind `rigid`), listed first as by the
     // other backends; a base at a prescribed constant rate keeps the gyroscopic coupling.
@@ -448,16 +448,16 @@ pub fn static_sag(md: &Model) -> Result<Vec<f64>, FemError> {
     Ok((0..n).map(|i| d[(i, 0)]).collect())
 }
 
-pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, FemError> {
+pub fn statics(scene: &Scene, settings: &FemSettings) -> Result<StaticResult, FemError> {
     let start = Instant::now();
     let l = the_link(scene)?;
-    let n_el = settings::elements(&settings.discretization)?;
+    let n_el = settings::elements(settings)?;
     let md = build(l, n_el)?;
     let d = static_sag(&md)?;
     Ok(StaticResult {
         backend: BackendKind::Fem,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         tip_deflection: md.tip.w.dot(&d),
         tip_rotation: md.tip.w_slope.dot(&d),
         cost: Cost {
@@ -663,11 +663,11 @@ pub fn default_step(md: &Model, d0: &[f64], t_end: f64, out: f64) -> Result<f64,
     Ok(lo)
 }
 
-pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
+pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemError> {
     let l = the_link(scene)?;
-    let n_el = settings::elements(&settings.discretization)?;
-    match settings.time.method {
-        None | Some(data::Method::ImplicitMidpoint) => {}
+    let n_el = settings::elements(settings)?;
+    match settings.method {
+        None | Some(data::FemMethod::ImplicitMidpoint) => {}
         Some(other) => {
             return Err(FemError::unsupported(format!(
                 "fem payload link: method `{other}`; only `implicit-midpoint` is implemented \
@@ -675,14 +675,13 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
             )));
         }
     }
-    if settings.time.rtol.is_some() || settings.time.atol.is_some() {
+    if settings.rtol.is_some() || settings.atol.is_some() {
         return Err(FemError::unsupported(
             "fem payload link: adaptive steps (`time.rtol`/`time.atol`); use --dt",
         ));
     }
-    let dt_user = settings::positive("time.dt", settings.time.dt)?;
-    let t_end =
-        settings::positive("time.t_end", settings.time.t_end)?.unwrap_or(scene.simulation.t_end);
+    let dt_user = settings::positive("time.dt", settings.dt)?;
+    let t_end = settings::positive("time.t_end", settings.t_end)?.unwrap_or(scene.simulation.t_end);
     let out = scene.simulation.output_interval;
     let md = build(l, n_el)?;
     let d = if l.initial_shape == LinkInitialShape::StaticSag {
@@ -811,7 +810,7 @@ fn push_ledger(st: &Stepper, ledger: &mut EnergyLedger) {
     ledger.push(s.t, &stored[..k], &input, &diss[..nd]);
 }
 
-pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemError> {
+pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
         mut stepper,

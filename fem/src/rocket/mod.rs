@@ -60,7 +60,7 @@ use std::time::Instant;
 use data::channel::spec;
 use data::results::ledger_term;
 use data::{
-    DofPlan, EnergyLedger, ModalResult, ModeShape, Observables, RunResult, Scene, Settings,
+    DofPlan, EnergyLedger, FemSettings, ModalResult, ModeShape, Observables, RunResult, Scene,
     StabilityVerdict,
 };
 use faer::Mat;
@@ -90,16 +90,16 @@ fn rocket_of(scene: &Scene) -> Result<&data::scene::Rocket, FemError> {
     the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))
 }
 
-pub fn build(scene: &Scene, settings: &Settings) -> Result<Model, FemError> {
+pub fn build(scene: &Scene, settings: &FemSettings) -> Result<Model, FemError> {
     Model::new(
         rocket_of(scene)?,
-        crate::settings::elements_or(&settings.discretization, DEFAULT_ELEMENTS)?,
+        crate::settings::elements_or(settings, DEFAULT_ELEMENTS)?,
     )
 }
 
-pub fn dof_plan(scene: &Scene, disc: &data::Discretization) -> Result<DofPlan, FemError> {
+pub fn dof_plan(scene: &Scene, settings: &data::FemSettings) -> Result<DofPlan, FemError> {
     let r = rocket_of(scene)?;
-    let n_el = crate::settings::elements_or(disc, DEFAULT_ELEMENTS)?;
+    let n_el = crate::settings::elements_or(settings, DEFAULT_ELEMENTS)?;
     let nm = r.discrete_masses.len();
     let mut plan = DofPlan::default();
     plan.add(
@@ -428,10 +428,10 @@ pub struct Prepared {
     pub stations: usize,
 }
 
-pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError> {
+pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemError> {
     let r = rocket_of(scene)?;
-    match settings.time.method {
-        None | Some(data::Method::ImplicitMidpoint) => {}
+    match settings.method {
+        None | Some(data::FemMethod::ImplicitMidpoint) => {}
         Some(other) => {
             return Err(FemError::unsupported(format!(
                 "fem rocket: method `{other}`; only `implicit-midpoint` is implemented for the \
@@ -439,14 +439,14 @@ pub fn prepare(scene: &Scene, settings: &Settings) -> Result<Prepared, FemError>
             )));
         }
     }
-    if settings.time.rtol.is_some() || settings.time.atol.is_some() {
+    if settings.rtol.is_some() || settings.atol.is_some() {
         return Err(FemError::unsupported(
             "fem rocket: adaptive steps (`time.rtol`/`time.atol`); use --dt",
         ));
     }
-    let h = crate::settings::positive("time.dt", settings.time.dt)?.unwrap_or(DEFAULT_STEP);
-    let t_end = crate::settings::positive("time.t_end", settings.time.t_end)?
-        .unwrap_or(scene.simulation.t_end);
+    let h = crate::settings::positive("time.dt", settings.dt)?.unwrap_or(DEFAULT_STEP);
+    let t_end =
+        crate::settings::positive("time.t_end", settings.t_end)?.unwrap_or(scene.simulation.t_end);
     let model = build(scene, settings)?;
     let q = model.initial_shape(&r.initial_shape);
     let v = vec![0.0; model.n];
@@ -469,7 +469,7 @@ fn push_ledger(st: &Stepper, ledger: &mut EnergyLedger) {
     );
 }
 
-pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, FemError> {
+pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
         mut stepper,
@@ -642,7 +642,7 @@ pub fn rocket_modes(model: &Model, count: usize) -> Result<Vec<RocketMode>, FemE
     Ok(out)
 }
 
-pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, FemError> {
+pub fn modes(scene: &Scene, settings: &FemSettings, count: usize) -> Result<ModalResult, FemError> {
     let start = Instant::now();
     let model = build(scene, settings)?;
     let modes = rocket_modes(&model, count)?;

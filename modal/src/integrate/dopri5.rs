@@ -55,7 +55,7 @@ const FAC_MAX: f64 = 10.0; // largest increase per step
 
 /// Registry entry ([`super::METHODS`]).
 pub const DOPRI5: MethodInfo = MethodInfo {
-    method: data::Method::Dopri5,
+    method: data::ModalMethod::Dopri5,
     name: "dopri5",
     build: Build::Adaptive(|dim, tol, h_init| Box::new(Dopri5::new(dim, tol, h_init, None))),
 };

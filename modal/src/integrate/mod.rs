@@ -14,10 +14,11 @@
 //! Both keep all work arrays in the struct: a step performs no heap allocation.
 //!
 //! Every method implements [`Stepper`] (one accepted step, dense output over it, work
-//! counters, restart after a discontinuity) and is registered in [`METHODS`] under its name:
-//! a driver holds a `Box<dyn Stepper>` built from the registry entry and never names a
-//! method. Adding a method is one new file (the method type, its `Stepper` impl and its
-//! [`MethodInfo`]) plus its line in [`METHODS`].
+//! counters, restart after a discontinuity) and is registered in [`METHODS`] under its name,
+//! and [`method_for`] maps the settings' [`data::ModalMethod`] to its entry: a driver holds a
+//! `Box<dyn Stepper>` built from the registry entry and never names a method. Adding a method
+//! is one new file (the method type, its `Stepper` impl and its [`MethodInfo`]) plus its
+//! variant of [`data::ModalMethod`] and its lines in [`METHODS`] and [`method_for`].
 
 mod dopri5;
 mod sdirk;
@@ -73,7 +74,7 @@ pub enum Build {
 #[derive(Clone, Copy)]
 pub struct MethodInfo {
     /// The method as the settings name it (`time.method`).
-    pub method: data::Method,
+    pub method: data::ModalMethod,
     /// Its canonical spelling, for messages.
     pub name: &'static str,
     pub build: Build,
@@ -102,18 +103,14 @@ impl std::fmt::Debug for MethodInfo {
 /// Every integration method of the crate, the first one being the default.
 pub const METHODS: &[&MethodInfo] = &[&DOPRI5, &TRBDF2, &TRBDF2_FIXED, &TRAPEZOID];
 
-/// The registered implementation of `method`, if this crate has one.
-pub fn method_for(method: data::Method) -> Option<&'static MethodInfo> {
-    METHODS.iter().copied().find(|m| m.method == method)
-}
-
-/// The registered names for a message: "`a`, `b`, `c`".
-pub fn method_names() -> String {
-    METHODS
-        .iter()
-        .map(|m| format!("`{}`", m.name))
-        .collect::<Vec<_>>()
-        .join(", ")
+/// The registered implementation of `method`.
+pub fn method_for(method: data::ModalMethod) -> &'static MethodInfo {
+    match method {
+        data::ModalMethod::Dopri5 => &DOPRI5,
+        data::ModalMethod::TrBdf2 => &TRBDF2,
+        data::ModalMethod::TrBdf2Fixed => &TRBDF2_FIXED,
+        data::ModalMethod::Trapezoid => &TRAPEZOID,
+    }
 }
 
 /// [`StopReason`] of a step that ended at `t` with target `t_stop`.

@@ -145,17 +145,17 @@ impl IterationMatrix {
 /// Registry entries ([`super::METHODS`]): adaptive TR-BDF2, fixed-step TR-BDF2 and the
 /// fixed-step trapezoidal rule.
 pub const TRBDF2: MethodInfo = MethodInfo {
-    method: data::Method::TrBdf2,
+    method: data::ModalMethod::TrBdf2,
     name: "trbdf2",
     build: Build::Adaptive(|dim, tol, h_init| Box::new(Sdirk::new(dim, tol, h_init, None))),
 };
 pub const TRBDF2_FIXED: MethodInfo = MethodInfo {
-    method: data::Method::TrBdf2Fixed,
+    method: data::ModalMethod::TrBdf2Fixed,
     name: "trbdf2-fixed",
     build: Build::Fixed(|dim, tol, h| Box::new(Sdirk::fixed_step(dim, tol, h))),
 };
 pub const TRAPEZOID: MethodInfo = MethodInfo {
-    method: data::Method::Trapezoid,
+    method: data::ModalMethod::Trapezoid,
     name: "trapezoid",
     build: Build::Fixed(|dim, tol, h| Box::new(Sdirk::trapezoidal(dim, tol, h))),
 };

@@ -31,7 +31,7 @@ pub mod model;
 pub mod run;
 
 use data::scene::TorqueSchedule;
-use data::{Basis, Discretization, DofPlan, ModalResult, ModeShape, Scene, Settings};
+use data::{Basis, DofPlan, ModalResult, ModalSettings, ModeShape, Scene};
 use faer::Mat;
 
 use crate::error::ModalError;
@@ -82,15 +82,15 @@ impl Inputs {
 }
 
 /// Modes count and shape family of the settings, checked.
-pub fn shape_choice(disc: &Discretization) -> Result<(usize, ShapeChoice), ModalError> {
-    let n = disc.modes.unwrap_or(DEFAULT_MODES);
+pub fn shape_choice(settings: &ModalSettings) -> Result<(usize, ShapeChoice), ModalError> {
+    let n = settings.modes.unwrap_or(DEFAULT_MODES);
     if n == 0 || n > MAX_MODES {
         return Err(ModalError::invalid(
             "discretization.modes",
             format!("{n} modes per direction: the flexible link takes 1 to {MAX_MODES}"),
         ));
     }
-    let choice = match disc.basis {
+    let choice = match settings.basis {
         None | Some(Basis::Poly) => ShapeChoice::Poly,
         Some(Basis::ClampedFree) => ShapeChoice::ClampedFree,
         Some(other) => {
@@ -104,27 +104,18 @@ pub fn shape_choice(disc: &Discretization) -> Result<(usize, ShapeChoice), Modal
             ));
         }
     };
-    for (field, set) in [
-        ("discretization.elements", disc.elements.is_some()),
-        ("discretization.stations", disc.stations.is_some()),
-        ("discretization.element", disc.element.is_some()),
-    ] {
-        if set {
-            return Err(ModalError::invalid(
-                field,
-                "the modal backend discretizes by assumed modes (--modes, --basis)",
-            ));
-        }
-    }
     Ok((n, choice))
 }
 
 /// The scene's model and inputs.
-pub fn set_up(scene: &Scene, disc: &Discretization) -> Result<(MobileModel, Inputs), ModalError> {
+pub fn set_up(
+    scene: &Scene,
+    settings: &ModalSettings,
+) -> Result<(MobileModel, Inputs), ModalError> {
     let mm = scene
         .mobile_manipulator()
         .ok_or_else(|| ModalError::Unsupported("not a mobile-manipulator scene".into()))?;
-    let (n, choice) = shape_choice(disc)?;
+    let (n, choice) = shape_choice(settings)?;
     let model = MobileModel::from_scene(mm, n, choice)?;
     let inputs = Inputs {
         drive: mm.platform.as_ref().map(|p| p.drive.clone()),
@@ -134,8 +125,8 @@ pub fn set_up(scene: &Scene, disc: &Discretization) -> Result<(MobileModel, Inpu
 }
 
 /// Degrees of freedom and physics built for the scene.
-pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalError> {
-    let (model, _) = set_up(scene, disc)?;
+pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
+    let (model, _) = set_up(scene, settings)?;
     let l = model.layout;
     let mut plan = DofPlan::default();
     if l.platform.is_some() {
@@ -153,7 +144,7 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
     if let Some(fl) = &model.flex {
         plan.add(format!("link {} out-of-plane modes (v)", fl.link), l.modes);
         plan.add(format!("link {} in-plane modes (w)", fl.link), l.modes);
-        let (_, choice) = shape_choice(disc)?;
+        let (_, choice) = shape_choice(settings)?;
         plan.builds.push(format!(
             "flexible pitch link {}: Euler–Bernoulli, {} assumed modes, residual rigid inertia",
             fl.link,
@@ -170,9 +161,13 @@ pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalEr
 }
 
 /// Elastic modes about the initial pose with the platform and all joints held.
-pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, ModalError> {
+pub fn modes(
+    scene: &Scene,
+    settings: &ModalSettings,
+    count: usize,
+) -> Result<ModalResult, ModalError> {
     let start = std::time::Instant::now();
-    let (model, inputs) = set_up(scene, &settings.discretization)?;
+    let (model, inputs) = set_up(scene, settings)?;
     let mm = scene
         .mobile_manipulator()
         .ok_or_else(|| ModalError::Unsupported("not a mobile-manipulator scene".into()))?;
@@ -242,7 +237,7 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
     Ok(ModalResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         frequencies_hz,
         kinds,
         shapes,

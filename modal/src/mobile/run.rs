@@ -13,14 +13,14 @@ use std::time::Instant;
 
 use data::channel::spec;
 use data::{
-    Diagnostic, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict,
+    Diagnostic, EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict,
     ledger_term,
 };
 
 use super::model::{MobileModel, Workspace};
 use super::{Inputs, set_up};
 use crate::error::ModalError;
-use crate::integrate::{Build, OdeRhs, Tolerances, method_for, method_names};
+use crate::integrate::{Build, OdeRhs, Tolerances, method_for};
 use crate::linalg::{cholesky_factor, cholesky_substitute};
 
 /// Default (rtol, atol): atol in metres and radians (unit-scaled modal coordinates) and joules.
@@ -172,24 +172,18 @@ impl OdeRhs for MobileRhs {
 }
 
 /// The method named in the settings, or the default: Dormand–Prince 5(4).
-fn method(settings: &Settings) -> Result<&'static crate::integrate::MethodInfo, ModalError> {
-    match settings.time.method {
-        None => Ok(&crate::integrate::DOPRI5),
-        Some(m) => method_for(m).ok_or_else(|| {
-            ModalError::invalid(
-                "time.method",
-                format!("`{m}`: the modal backend offers {}", method_names()),
-            )
-        }),
-    }
+fn method(settings: &ModalSettings) -> &'static crate::integrate::MethodInfo {
+    settings
+        .method
+        .map_or(&crate::integrate::DOPRI5, method_for)
 }
 
-pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalError> {
+pub fn simulate(scene: &Scene, settings: &ModalSettings) -> Result<RunResult, ModalError> {
     let wall = Instant::now();
-    let (model, inputs) = set_up(scene, &settings.discretization)?;
-    let method = method(settings)?;
-    let rtol = settings.time.rtol.unwrap_or(DEFAULT_TOL.0);
-    let atol = settings.time.atol.unwrap_or(DEFAULT_TOL.1);
+    let (model, inputs) = set_up(scene, settings)?;
+    let method = method(settings);
+    let rtol = settings.rtol.unwrap_or(DEFAULT_TOL.0);
+    let atol = settings.atol.unwrap_or(DEFAULT_TOL.1);
     if !(rtol > 0.0 && atol > 0.0 && rtol < 1.0 && atol.is_finite()) {
         return Err(ModalError::invalid(
             "time.rtol/atol",
@@ -207,9 +201,9 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
     initial_state(&rhs.model, mm, &mut y);
     let tol = Tolerances { rtol, atol };
     let mut stepper = match method.build {
-        Build::Adaptive(build) => build(dim, tol, settings.time.dt),
+        Build::Adaptive(build) => build(dim, tol, settings.dt),
         Build::Fixed(build) => {
-            let dt = settings.time.dt.ok_or_else(|| {
+            let dt = settings.dt.ok_or_else(|| {
                 ModalError::invalid(
                     "time.dt",
                     format!(
@@ -260,7 +254,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
     Ok(RunResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         observables: out.obs,
         ledger: out.ledger,
         events: Vec::new(),

@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use data::scene::LinkField;
-use data::{Cost, ModalResult, ModeShape, Scene, Settings, StaticResult};
+use data::{Cost, ModalResult, ModalSettings, ModeShape, Scene, StaticResult};
 use faer::Mat;
 
 use super::model::LinkModel;
@@ -53,9 +53,13 @@ pub fn linear_pencil(model: &LinkModel) -> (Mat<f64>, Mat<f64>, f64) {
     (k, m, rate)
 }
 
-pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalResult, ModalError> {
+pub fn modes(
+    scene: &Scene,
+    settings: &ModalSettings,
+    count: usize,
+) -> Result<ModalResult, ModalError> {
     let wall = Instant::now();
-    let s = set_up(scene, &settings.discretization)?;
+    let s = set_up(scene, settings)?;
     let model = &s.model;
     let (k, m, rate) = linear_pencil(model);
     // At a prescribed constant rate the gyroscopic coupling stays in (its modes' velocity
@@ -134,7 +138,7 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
     Ok(ModalResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         frequencies_hz: frequencies,
         kinds,
         shapes,
@@ -147,15 +151,15 @@ pub fn modes(scene: &Scene, settings: &Settings, count: usize) -> Result<ModalRe
 }
 
 /// The linear gravity sag: `tip_deflection` = w(L), `tip_rotation` = w′(L).
-pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, ModalError> {
+pub fn statics(scene: &Scene, settings: &ModalSettings) -> Result<StaticResult, ModalError> {
     let wall = Instant::now();
-    let s = set_up(scene, &settings.discretization)?;
+    let s = set_up(scene, settings)?;
     let q = static_sag(&s.model)?;
     let dot = |r: &[f64]| r.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>();
     Ok(StaticResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         tip_deflection: dot(&s.model.tip.w),
         tip_rotation: dot(&s.model.tip.slope_w),
         cost: Cost {
@@ -170,10 +174,10 @@ pub fn statics(scene: &Scene, settings: &Settings) -> Result<StaticResult, Modal
 /// base), ascending, `count` of them ([`gyroscopic_modes`]).
 pub fn gyroscopic_frequencies(
     scene: &Scene,
-    settings: &Settings,
+    settings: &ModalSettings,
     count: usize,
 ) -> Result<Vec<f64>, ModalError> {
-    let s = set_up(scene, &settings.discretization)?;
+    let s = set_up(scene, settings)?;
     let (w2, _) = gyroscopic_modes(&s.model)?;
     Ok(w2
         .iter()

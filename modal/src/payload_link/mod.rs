@@ -31,7 +31,7 @@ pub mod model;
 pub mod run;
 
 use data::scene::{LinkField, PayloadLink};
-use data::{Basis, Discretization, DofPlan, Scene};
+use data::{Basis, DofPlan, ModalSettings, Scene};
 
 use crate::error::ModalError;
 use crate::linalg::cholesky_solve;
@@ -50,8 +50,8 @@ pub struct SetUp<'a> {
 }
 
 /// The modes count and basis of the settings, checked.
-pub fn basis_choice(disc: &Discretization) -> Result<(usize, BasisChoice), ModalError> {
-    let n = disc.modes.unwrap_or(DEFAULT_MODES);
+pub fn basis_choice(settings: &ModalSettings) -> Result<(usize, BasisChoice), ModalError> {
+    let n = settings.modes.unwrap_or(DEFAULT_MODES);
     if n == 0 || n > basis::MAX_MODES {
         return Err(ModalError::invalid(
             "discretization.modes",
@@ -61,7 +61,7 @@ pub fn basis_choice(disc: &Discretization) -> Result<(usize, BasisChoice), Modal
             ),
         ));
     }
-    let choice = match disc.basis {
+    let choice = match settings.basis {
         None | Some(Basis::Poly) => BasisChoice::Legendre,
         Some(Basis::ClampedFree) => BasisChoice::ClampedFree,
         Some(other) => {
@@ -78,11 +78,11 @@ pub fn basis_choice(disc: &Discretization) -> Result<(usize, BasisChoice), Modal
     Ok((n, choice))
 }
 
-pub fn set_up<'a>(scene: &'a Scene, disc: &Discretization) -> Result<SetUp<'a>, ModalError> {
+pub fn set_up<'a>(scene: &'a Scene, settings: &ModalSettings) -> Result<SetUp<'a>, ModalError> {
     let link = scene
         .payload_link()
         .ok_or_else(|| ModalError::Unsupported("not a payload-link scene".into()))?;
-    let (n, choice) = basis_choice(disc)?;
+    let (n, choice) = basis_choice(settings)?;
     let model = LinkModel::build(link, n, choice, scene.simulation.field_stations)?;
     Ok(SetUp { link, model })
 }
@@ -103,11 +103,11 @@ pub fn static_sag(model: &LinkModel) -> Result<Vec<f64>, ModalError> {
 }
 
 /// Degrees of freedom and physics built for the scene.
-pub fn dof_plan(scene: &Scene, disc: &Discretization) -> Result<DofPlan, ModalError> {
+pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
     let link = scene
         .payload_link()
         .ok_or_else(|| ModalError::Unsupported("not a payload-link scene".into()))?;
-    let (n, choice) = basis_choice(disc)?;
+    let (n, choice) = basis_choice(settings)?;
     let mut plan = DofPlan::default();
     if link.base.prescribed.is_none() {
         plan.add("base angle θ", 1);

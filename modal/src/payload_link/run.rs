@@ -6,15 +6,15 @@ use std::time::Instant;
 
 use data::scene::{LinkField, LinkInitialShape, PrescribedMotion};
 use data::{
-    Diagnostic, EnergyLedger, Observables, RunResult, Scene, Settings, StabilityVerdict, channel,
-    ledger_term,
+    Diagnostic, EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict,
+    channel, ledger_term,
 };
 
 use super::dynamics::LinkRhs;
 use super::model::LinkModel;
 use super::{SetUp, set_up, static_sag};
 use crate::error::ModalError;
-use crate::integrate::{Build, OdeRhs, TRAPEZOID, TRBDF2, Tolerances, method_for, method_names};
+use crate::integrate::{Build, OdeRhs, TRAPEZOID, TRBDF2, Tolerances, method_for};
 use crate::modes::generalized_eigen;
 
 /// Default (rtol, atol) of the adaptive methods: atol is in metres and radians (coordinates are
@@ -56,20 +56,14 @@ pub fn default_step(model: &LinkModel) -> Result<f64, ModalError> {
     Ok(std::f64::consts::TAU / omega1 / STEPS_PER_PERIOD)
 }
 
-pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalError> {
+pub fn simulate(scene: &Scene, settings: &ModalSettings) -> Result<RunResult, ModalError> {
     let wall = Instant::now();
-    let SetUp { link, model } = set_up(scene, &settings.discretization)?;
-    let method = match settings.time.method {
-        None => default_method(&model),
-        Some(method) => method_for(method).ok_or_else(|| {
-            ModalError::invalid(
-                "time.method",
-                format!("`{method}`: the modal backend offers {}", method_names()),
-            )
-        })?,
-    };
-    let rtol = settings.time.rtol.unwrap_or(DEFAULT_TOL.0);
-    let atol = settings.time.atol.unwrap_or(DEFAULT_TOL.1);
+    let SetUp { link, model } = set_up(scene, settings)?;
+    let method = settings
+        .method
+        .map_or_else(|| default_method(&model), method_for);
+    let rtol = settings.rtol.unwrap_or(DEFAULT_TOL.0);
+    let atol = settings.atol.unwrap_or(DEFAULT_TOL.1);
     if !(rtol > 0.0 && atol > 0.0 && rtol.is_finite() && atol.is_finite()) {
         return Err(ModalError::invalid(
             "time.rtol/atol",
@@ -86,9 +80,9 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
     let dim = y.len();
     let tol = Tolerances { rtol, atol };
     let mut stepper = match method.build {
-        Build::Adaptive(build) => build(dim, tol, settings.time.dt),
+        Build::Adaptive(build) => build(dim, tol, settings.dt),
         Build::Fixed(build) => {
-            let dt = match settings.time.dt {
+            let dt = match settings.dt {
                 Some(dt) => dt,
                 None => default_step(&rhs.model)?,
             };
@@ -141,7 +135,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, ModalEr
     Ok(RunResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         observables: out.obs,
         ledger: out.ledger,
         events: Vec::new(),

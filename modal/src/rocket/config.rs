@@ -1,6 +1,6 @@
 //! Settings the rocket model reads, validated (range errors → `InvalidSetting`).
 
-use data::{Basis as BasisKind, Discretization, Settings};
+use data::{Basis as BasisKind, ModalSettings};
 
 use super::error::RocketError;
 
@@ -22,8 +22,8 @@ pub enum Method {
     TrBdf2,
 }
 
-pub fn modes(disc: &Discretization) -> Result<usize, RocketError> {
-    match disc.basis {
+pub fn modes(settings: &ModalSettings) -> Result<usize, RocketError> {
+    match settings.basis {
         None | Some(BasisKind::FreeFree) => {}
         Some(other) => {
             return Err(RocketError::invalid(
@@ -35,7 +35,7 @@ pub fn modes(disc: &Discretization) -> Result<usize, RocketError> {
             ));
         }
     }
-    let n = disc.modes.unwrap_or(DEFAULT_MODES);
+    let n = settings.modes.unwrap_or(DEFAULT_MODES);
     if n == 0 || n > MAX_MODES {
         return Err(RocketError::invalid(
             "discretization.modes",
@@ -67,11 +67,11 @@ fn positive(field: &str, v: Option<f64>) -> Result<Option<f64>, RocketError> {
     }
 }
 
-pub fn time(scene: &data::Scene, settings: &Settings) -> Result<TimeConfig, RocketError> {
-    let ts = &settings.time;
+pub fn time(scene: &data::Scene, settings: &ModalSettings) -> Result<TimeConfig, RocketError> {
+    let ts = settings;
     let method = match ts.method {
-        None | Some(data::Method::Dopri5) => Method::Dopri5,
-        Some(data::Method::TrBdf2) => Method::TrBdf2,
+        None | Some(data::ModalMethod::Dopri5) => Method::Dopri5,
+        Some(data::ModalMethod::TrBdf2) => Method::TrBdf2,
         Some(other) => {
             return Err(RocketError::invalid(
                 "time.method",

@@ -106,10 +106,10 @@ pub use run::{DetailedRun, MomentumBalance, RocketOde};
 /// DOF table of the rocket model for this scene and discretization.
 pub fn dof_plan(
     scene: &data::Scene,
-    disc: &data::Discretization,
+    settings: &data::ModalSettings,
 ) -> Result<data::DofPlan, data::BackendError> {
     let body = body::Body::from_scene(scene)?;
-    let n = config::modes(disc)?;
+    let n = config::modes(settings)?;
     let mut plan = data::DofPlan::default();
     plan.add("rigid body X, Y, θ", 3);
     plan.add("axial free-free modes", n);
@@ -149,7 +149,7 @@ pub fn dof_plan(
 /// Free-free elastic frequencies (Hz, ascending) at ignition mass, kinds "axial"/"bending".
 pub fn modes(
     scene: &data::Scene,
-    settings: &data::Settings,
+    settings: &data::ModalSettings,
     count: usize,
 ) -> Result<data::ModalResult, data::BackendError> {
     Ok(modes::modes(scene, settings, count)?)
@@ -158,7 +158,7 @@ pub fn modes(
 /// Dynamic response over [0, t_end].
 pub fn simulate(
     scene: &data::Scene,
-    settings: &data::Settings,
+    settings: &data::ModalSettings,
 ) -> Result<data::RunResult, data::BackendError> {
     Ok(run::simulate_detailed(scene, settings)?.run)
 }
@@ -167,7 +167,7 @@ pub fn simulate(
 /// frequencies.
 pub fn simulate_detailed(
     scene: &data::Scene,
-    settings: &data::Settings,
+    settings: &data::ModalSettings,
 ) -> Result<DetailedRun, data::BackendError> {
     Ok(run::simulate_detailed(scene, settings)?)
 }

@@ -7,7 +7,7 @@
 //! each mode is classified by where its kinetic energy lives. Being a Rayleigh–Ritz reduction,
 //! the frequencies converge from above as `discretization.modes` grows.
 
-use data::{BackendKind, Cost, ModalResult, ModeShape, Settings};
+use data::{BackendKind, Cost, ModalResult, ModalSettings, ModeShape};
 
 use super::basis::Basis;
 use super::body::Body;
@@ -67,12 +67,12 @@ fn is_axial(l: Layout, i: usize) -> bool {
 
 pub fn modes(
     scene: &data::Scene,
-    settings: &Settings,
+    settings: &ModalSettings,
     count: usize,
 ) -> Result<ModalResult, RocketError> {
     let wall = std::time::Instant::now();
     let body = Body::from_scene(scene)?;
-    let n = config::modes(&settings.discretization)?;
+    let n = config::modes(settings)?;
     let basis = Basis::new(&body, n)?;
     let model = Model::new(body, &basis);
     let l = model.layout;
@@ -165,7 +165,7 @@ pub fn modes(
     Ok(ModalResult {
         backend: BackendKind::Modal,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: data::Settings::from(settings),
         frequencies_hz: freqs,
         kinds,
         shapes,

@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use data::{
-    BackendKind, Diagnostic, EnergyLedger, Event, Observables, RunResult, Settings,
+    BackendKind, Diagnostic, EnergyLedger, Event, ModalSettings, Observables, RunResult,
     StabilityVerdict, channel, ledger_term,
 };
 
@@ -38,9 +38,9 @@ pub struct RocketOde {
 }
 
 impl RocketOde {
-    pub fn new(scene: &data::Scene, settings: &Settings) -> Result<RocketOde, RocketError> {
+    pub fn new(scene: &data::Scene, settings: &ModalSettings) -> Result<RocketOde, RocketError> {
         let body = Body::from_scene(scene)?;
-        let n = config::modes(&settings.discretization)?;
+        let n = config::modes(settings)?;
         let basis = Basis::new(&body, n)?;
         let model = Model::new(body, &basis);
         let ws = Workspace::new(model.layout);
@@ -320,11 +320,11 @@ fn runaway(model: &Model, y: &[f64]) -> Option<(String, f64)> {
 
 pub fn simulate_detailed(
     scene: &data::Scene,
-    settings: &Settings,
+    settings: &ModalSettings,
 ) -> Result<DetailedRun, RocketError> {
     let wall = Instant::now();
     let body = Body::from_scene(scene)?;
-    let n = config::modes(&settings.discretization)?;
+    let n = config::modes(settings)?;
     let tc: TimeConfig = config::time(scene, settings)?;
     let basis = Basis::new(&body, n)?;
     let model = Model::new(body, &basis);
@@ -472,7 +472,7 @@ pub fn simulate_detailed(
         run: RunResult {
             backend: BackendKind::Modal,
             scene: scene.name.clone(),
-            settings: settings.clone(),
+            settings: data::Settings::from(settings),
             observables: rec.obs,
             ledger: rec.ledger,
             events,
