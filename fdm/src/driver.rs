@@ -29,7 +29,7 @@ use crate::events::{Events, NoEvents, Retake, finish_step};
 use crate::method::{StepState, Stepper, stepper};
 use crate::output::{Outcome, Outputs, Recorder};
 use crate::settings::{FdmSettings, Method};
-use crate::system::{Bound, System};
+use crate::system::{Bound, Overextension, System};
 
 /// How to step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -273,6 +273,12 @@ pub fn run<S: Model, E: Events<S>>(
             };
             break;
         }
+        if let Some(over) = sys.overextended(&st.next.q) {
+            verdict = StabilityVerdict::Stopped {
+                diagnostic: overextension_diagnostic(t + tau_step, over),
+            };
+            break;
+        }
         peak_v = peak_v.max(vmax);
         peak_q = peak_q.max(qmax);
 
@@ -355,6 +361,32 @@ struct Growth {
     worst_q: usize,
     d2: f64,
     peak_v: f64,
+}
+
+/// A link deflected beyond its length: outside the beam model, whatever the step.
+fn overextension_diagnostic(t: f64, o: Overextension) -> Diagnostic {
+    let (why, remedy) = if o.stiffened {
+        (
+            "the deflection is outside the small-strain floating-frame model",
+            "reduce the load",
+        )
+    } else {
+        (
+            "the linear model (no geometric stiffening) has lost its centrifugal stiffness: \
+             spinning above the first bending frequency it grows without bound",
+            "switch on `foreshortening` (geometric stiffening)",
+        )
+    };
+    Diagnostic {
+        t,
+        what: format!(
+            "tip deflection of link {} grew to {:.3e}, beyond the link length {}",
+            o.link, o.deflection, o.length
+        ),
+        location: Some(format!("link {} tip", o.link)),
+        why: why.into(),
+        remedy: remedy.into(),
+    }
 }
 
 fn growth_diagnostic<S: Model + ?Sized>(sys: &S, g: Growth) -> Diagnostic {

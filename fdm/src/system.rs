@@ -108,6 +108,24 @@ pub trait System {
     /// Whether any force depends on the velocities through damping or a velocity-coupled
     /// (gyroscopic) term: the two-step scheme's computational mode can then grow.
     fn damped(&self) -> bool;
+    /// The first link whose transverse tip deflection exceeds its length at q: beyond it the
+    /// beam models (linear or small-strain floating frame) no longer describe the link, and
+    /// the driver stops the run with a diagnostic. Default: no link to check.
+    fn overextended(&self, q: &[f64]) -> Option<Overextension> {
+        let _ = q;
+        None
+    }
+}
+
+/// A link whose transverse tip deflection left the model's range ([`System::overextended`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Overextension {
+    /// 1-based link number.
+    pub link: usize,
+    pub deflection: f64,
+    pub length: f64,
+    /// Whether the link carries geometric stiffening (foreshortening).
+    pub stiffened: bool,
 }
 
 /// The drift velocities of the velocity form for the inertia terms quadratic in q̇

@@ -292,3 +292,34 @@ fn dyn_spin_up_at_lambda_12_completes_with_the_tension_bound() {
     );
     assert!(closure < allowed, "{closure} vs {allowed}");
 }
+
+#[test]
+fn dyn_single_link_deflected_beyond_its_length_stops_with_a_diagnostic() {
+    // EI 1000 times lower: the bang-bang torque spins the linear link above its first bending
+    // frequency, where it has no centrifugal stiffness left; the tip passes the link length.
+    let s = Settings::default();
+    let out = run(
+        "single-link",
+        |sc| sc.planar_chain_mut().unwrap().links[0].bending_stiffness *= 1e-3,
+        &s,
+    );
+    let length = load_scene("single-link").unwrap().links()[0].length;
+    match &out.verdict {
+        StabilityVerdict::Stopped { diagnostic } => {
+            assert!(
+                diagnostic.what.contains("beyond the link length"),
+                "{diagnostic:?}"
+            );
+            assert!(
+                diagnostic.remedy.contains("foreshortening"),
+                "{diagnostic:?}"
+            );
+        }
+        v => panic!("expected a stop, got {v:?}"),
+    }
+    // the results up to the stop are kept, all within the model's range
+    let tip = &out.observables.get("link1.tip_deflection").unwrap().values;
+    assert!(!tip.is_empty());
+    assert!(maxabs(tip) <= length, "{}", maxabs(tip));
+    assert!(maxabs(tip) > 0.5 * length, "{}", maxabs(tip));
+}

@@ -42,7 +42,7 @@ use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
 use crate::foreshortening::Foreshortening;
-use crate::system::{Bound, BoundKind, System};
+use crate::system::{Bound, BoundKind, Overextension, System};
 
 mod outputs;
 
@@ -428,6 +428,16 @@ impl FloatingLink {
 impl System for FloatingLink {
     fn dofs(&self) -> usize {
         self.r + self.v0()
+    }
+
+    fn overextended(&self, q: &[f64]) -> Option<Overextension> {
+        let tip = q[self.vrange()][self.r - 1];
+        (tip.abs() > self.length).then_some(Overextension {
+            link: 1,
+            deflection: tip,
+            length: self.length,
+            stiffened: self.foreshortening,
+        })
     }
 
     fn accel(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) {
