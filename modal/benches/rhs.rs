@@ -8,7 +8,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use data::{Backend, Discretization, Settings, TimeStepping, load_scene};
+use data::{Backend, ModalSettings, Settings, TimeStepping, load_scene};
 use modal::ModalBackend;
 use modal::integrate::OdeRhs;
 use modal::rhs::ChainRhs;
@@ -16,7 +16,7 @@ use modal::setup::build_chain;
 
 fn one_rhs(c: &mut Criterion) {
     let scene = load_scene("two-link-free-undamped").unwrap();
-    let chain = build_chain(&scene, &Discretization::default()).unwrap();
+    let chain = build_chain(&scene, &ModalSettings::default()).unwrap();
     let mut rhs = ChainRhs::new(chain);
     let mut y = rhs.initial_state();
     // A deflected, moving state: every coordinate and rate nonzero (no zero-skipping shortcut).
