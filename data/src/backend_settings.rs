@@ -438,20 +438,7 @@ mod tests {
 
     #[test]
     fn each_method_reaches_exactly_the_backends_that_implement_it() {
-        for name in [
-            "energy-midpoint",
-            "generalized-alpha",
-            "central-difference",
-            "implicit-midpoint",
-            "report",
-            "robert-asselin",
-            "robert-asselin=0.05",
-            "velocity-form",
-            "dopri5",
-            "trbdf2",
-            "trbdf2-fixed",
-            "trapezoid",
-        ] {
+        for name in crate::settings::METHOD_SPELLINGS {
             let m: Method = name.parse().unwrap();
             let s = Settings {
                 time: TimeStepping {

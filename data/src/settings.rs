@@ -201,6 +201,24 @@ impl std::fmt::Display for Method {
     }
 }
 
+/// One spelling of every method (and of fdm's filter with its coefficient), for tests that
+/// walk all of them.
+#[cfg(test)]
+pub(crate) const METHOD_SPELLINGS: [&str; 12] = [
+    "energy-midpoint",
+    "generalized-alpha",
+    "central-difference",
+    "implicit-midpoint",
+    "report",
+    "robert-asselin",
+    "robert-asselin=0.05",
+    "velocity-form",
+    "dopri5",
+    "trbdf2",
+    "trbdf2-fixed",
+    "trapezoid",
+];
+
 impl std::str::FromStr for Method {
     type Err = String;
 
