@@ -170,16 +170,24 @@ impl Method {
 }
 
 impl Method {
-    /// The backends that implement this method (a family may still refuse it, e.g. a method
-    /// without event location for a contact scene).
-    pub fn backends(self) -> &'static [BackendKind] {
-        use BackendKind::{Fdm, Fem, Modal};
-        match self {
-            Method::EnergyMidpoint | Method::GeneralizedAlpha | Method::ImplicitMidpoint => &[Fem],
-            Method::CentralDifference => &[Fem, Fdm],
-            Method::Report | Method::RobertAsselin { .. } | Method::VelocityForm => &[Fdm],
-            Method::Dopri5 | Method::TrBdf2 | Method::TrBdf2Fixed | Method::Trapezoid => &[Modal],
+    /// Whether `backend` implements this method (a family may still refuse it, e.g. a method
+    /// without event location for a contact scene): derived from the typed method lists
+    /// ([`Method::fem`], [`Method::fdm`], [`Method::modal`]).
+    pub fn implemented_by(self, backend: BackendKind) -> bool {
+        match backend {
+            BackendKind::Fem => self.fem().is_some(),
+            BackendKind::Fdm => self.fdm().is_some(),
+            BackendKind::Modal => self.modal().is_some(),
+            BackendKind::Reference => false,
         }
+    }
+
+    /// The backends that implement this method ([`Method::implemented_by`]).
+    pub fn backends(self) -> Vec<BackendKind> {
+        BackendKind::ALL
+            .into_iter()
+            .filter(|&b| self.implemented_by(b))
+            .collect()
     }
 
     /// The spellings `backend` implements, for error messages.
@@ -443,7 +451,7 @@ impl Settings {
     pub fn read_by(&self, field: SettingField, backend: BackendKind) -> bool {
         field.read_by(backend)
             && match (field, self.time.method) {
-                (SettingField::Method, Some(m)) => m.backends().contains(&backend),
+                (SettingField::Method, Some(m)) => m.implemented_by(backend),
                 _ => true,
             }
     }
@@ -456,7 +464,7 @@ impl Settings {
         match (field, self.time.method) {
             (SettingField::Method, Some(m)) => format!(
                 "`{flag} {m}` applies to {}; {subject} {verb} not implement it",
-                backends_text(m.backends())
+                backends_text(&m.backends())
             ),
             _ => format!(
                 "`{flag}` applies to {}; {subject} {verb} not read it",
