@@ -6,17 +6,17 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use data::load_scene;
-use fdm::FdmSettings;
+use fdm::ValidatedSettings;
 use fdm::chain::TwoLinkChain;
 use fdm::driver::{StepControl, integrate};
 
-fn settings(stations: usize, t_end: f64) -> FdmSettings {
+fn settings(stations: usize, t_end: f64) -> ValidatedSettings {
     let requested = data::FdmSettings {
         stations: Some(stations),
         t_end: Some(t_end),
         ..Default::default()
     };
-    FdmSettings::from_settings(&requested).expect("valid settings")
+    ValidatedSettings::from_settings(&requested).expect("valid settings")
 }
 
 fn bench(c: &mut Criterion) {

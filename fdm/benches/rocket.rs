@@ -3,14 +3,14 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use data::{Settings, load_scene};
-use fdm::FdmSettings;
+use fdm::ValidatedSettings;
 
 fn bench(c: &mut Criterion) {
     let scene = load_scene("rocket").expect("catalog scene");
     for (label, method) in [("report", "report"), ("velocity-form", "velocity-form")] {
         let mut settings = Settings::default();
         settings.time.method = Some(method.parse().expect("a method name"));
-        let s = FdmSettings::from_settings(&settings.fdm().expect("fdm settings"))
+        let s = ValidatedSettings::from_settings(&settings.fdm().expect("fdm settings"))
             .expect("valid settings");
         c.bench_function(&format!("rocket_0.1s_76_stations_{label}"), |b| {
             b.iter(|| {
@@ -24,7 +24,7 @@ fn bench(c: &mut Criterion) {
         settings.discretization.stations = Some(n);
         settings.time.t_end = Some(0.01);
         settings.time.method = Some("velocity-form".parse().expect("a method name"));
-        let s = FdmSettings::from_settings(&settings.fdm().expect("fdm settings"))
+        let s = ValidatedSettings::from_settings(&settings.fdm().expect("fdm settings"))
             .expect("valid settings");
         c.bench_function(&format!("rocket_0.01s_{n}_stations_velocity-form"), |b| {
             b.iter(|| {

@@ -16,7 +16,7 @@ use faer::prelude::Solve;
 use faer::{Mat, Side};
 
 use crate::error::FdmError;
-use crate::settings::FdmSettings;
+use crate::settings::ValidatedSettings;
 
 /// Default stations for beams.
 pub const DEFAULT_STATIONS: usize = 41;
@@ -217,7 +217,7 @@ pub fn dof_plan(scene: &Scene, stations: Option<usize>) -> Result<DofPlan, FdmEr
     Ok(plan)
 }
 
-pub fn modes(scene: &Scene, s: &FdmSettings, count: usize) -> Result<ModalResult, FdmError> {
+pub fn modes(scene: &Scene, s: &ValidatedSettings, count: usize) -> Result<ModalResult, FdmError> {
     let clock = std::time::Instant::now();
     let c = Cantilever::from_scene(scene, s.stations)?;
     let (omega, shapes) = c.eigen()?;
@@ -258,7 +258,7 @@ pub fn modes(scene: &Scene, s: &FdmSettings, count: usize) -> Result<ModalResult
     })
 }
 
-pub fn statics(scene: &Scene, s: &FdmSettings) -> Result<StaticResult, FdmError> {
+pub fn statics(scene: &Scene, s: &ValidatedSettings) -> Result<StaticResult, FdmError> {
     if scene.links().len() == 1 && scene.links()[0].shear {
         return timoshenko_statics(scene, s);
     }
@@ -294,7 +294,7 @@ pub fn statics(scene: &Scene, s: &FdmSettings) -> Result<StaticResult, FdmError>
 /// v₀ = ψ₀ = 0, tip force and lumped distributed load. Reported rotation: ψ(L) (the convention's
 /// "slope"). Section rotary inertia does not enter statics (accepted); axial fields, tip
 /// inertia, gravity and contact are refused as for the Euler beam.
-fn timoshenko_statics(scene: &Scene, s: &FdmSettings) -> Result<StaticResult, FdmError> {
+fn timoshenko_statics(scene: &Scene, s: &ValidatedSettings) -> Result<StaticResult, FdmError> {
     let clock = std::time::Instant::now();
     let l = &scene.links()[0];
     if !matches!(l.joint.prescribed, Some(PrescribedMotion::Fixed)) {

@@ -28,7 +28,7 @@ use crate::error::FdmError;
 use crate::events::{Events, NoEvents, Retake, finish_step};
 use crate::method::{StepState, Stepper, stepper};
 use crate::output::{Outcome, Outputs, Recorder};
-use crate::settings::{FdmSettings, Method};
+use crate::settings::{Method, ValidatedSettings};
 use crate::system::{Bound, Overextension, System};
 
 /// How to step.
@@ -51,10 +51,10 @@ pub struct StepControl {
 
 impl StepControl {
     /// The control every scene run uses: step settings from `s` (τ changes logged at
-    /// [`FdmSettings::step_log_change`]), horizon and output grid from the scene.
+    /// [`ValidatedSettings::step_log_change`]), horizon and output grid from the scene.
     pub(crate) fn for_scene(
         scene: &data::Scene,
-        s: &FdmSettings,
+        s: &ValidatedSettings,
         method: Method,
         lookahead: bool,
         enforce_bound: bool,

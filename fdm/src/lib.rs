@@ -205,7 +205,7 @@ use data::{
 };
 
 pub use error::FdmError;
-pub use settings::{FdmSettings, Method};
+pub use settings::{Method, ValidatedSettings};
 
 /// The finite-difference backend.
 #[derive(Debug, Clone, Copy, Default)]
@@ -259,7 +259,7 @@ impl Backend for FdmBackend {
     }
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
-        let s = FdmSettings::from_settings(&disc.fdm()?)?;
+        let s = ValidatedSettings::from_settings(&disc.fdm()?)?;
         Ok(match ModelChoice::of(scene)? {
             ModelChoice::Rocket => rocket::dof_plan(scene, s.stations)?,
             ModelChoice::Cantilever => beam::dof_plan(scene, s.stations)?,
@@ -281,7 +281,7 @@ impl Backend for FdmBackend {
         settings: &Settings,
         count: usize,
     ) -> Result<ModalResult, BackendError> {
-        let s = FdmSettings::from_settings(&settings.fdm()?)?;
+        let s = ValidatedSettings::from_settings(&settings.fdm()?)?;
         match ModelChoice::of(scene)? {
             ModelChoice::Rocket => Err(BackendError::Unsupported(
                 "fdm modes of the rocket: the variable-mass body has no fixed modes; use `run`"
@@ -294,7 +294,7 @@ impl Backend for FdmBackend {
     }
 
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
-        let s = FdmSettings::from_settings(&settings.fdm()?)?;
+        let s = ValidatedSettings::from_settings(&settings.fdm()?)?;
         if scene.family() == Family::PlanarChain {
             return Ok(beam::statics(scene, &s)?);
         }
@@ -308,7 +308,7 @@ impl Backend for FdmBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
-        let s = FdmSettings::from_settings(&settings.fdm()?)?;
+        let s = ValidatedSettings::from_settings(&settings.fdm()?)?;
         Ok(match ModelChoice::of(scene)? {
             ModelChoice::Rocket => runs::rocket(scene, &s)?,
             ModelChoice::Cantilever => return Err(beam::simulate_unsupported(scene).into()),

@@ -40,7 +40,7 @@ impl Outcome {
     pub(crate) fn into_run_result(
         self,
         scene: &data::Scene,
-        s: &crate::settings::FdmSettings,
+        s: &crate::settings::ValidatedSettings,
     ) -> data::RunResult {
         data::RunResult {
             backend: data::BackendKind::Fdm,

@@ -11,7 +11,7 @@ use crate::link::FloatingLink;
 use crate::method::VelocityForm;
 use crate::output::{Outcome, Outputs};
 use crate::rocket::system::RocketSystem;
-use crate::settings::{FdmSettings, Method};
+use crate::settings::{Method, ValidatedSettings};
 use crate::system::System;
 
 /// Default safety factor of a Timoshenko chain with contact (an accuracy choice, not a
@@ -25,7 +25,7 @@ pub const TIMOSHENKO_CONTACT_SAFETY: f64 = 0.1;
 /// false` to show what happens above the bound).
 pub fn rocket_with(
     scene: &Scene,
-    s: &FdmSettings,
+    s: &ValidatedSettings,
     enforce_bound: bool,
 ) -> Result<(RocketSystem, Outcome), FdmError> {
     let r = scene
@@ -38,7 +38,7 @@ pub fn rocket_with(
     Ok((sys, out))
 }
 
-pub fn rocket(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError> {
+pub fn rocket(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult, FdmError> {
     let (_, out) = rocket_with(scene, s, true)?;
     Ok(out.into_run_result(scene, s))
 }
@@ -47,7 +47,7 @@ pub fn rocket(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError> {
 /// for the model — the one-step velocity form when any force depends on the velocities
 /// ([`System::damped`]: damping, or the gyroscopic İθ̇ and θ̇² terms of a free hub), on which
 /// the two-step scheme's computational mode grows; else the report's two-step scheme.
-pub fn default_method(s: &FdmSettings, sys: &dyn System) -> Method {
+pub fn default_method(s: &ValidatedSettings, sys: &dyn System) -> Method {
     if s.requested.method.is_none() && sys.damped() {
         Method::VelocityForm
     } else {
@@ -57,7 +57,7 @@ pub fn default_method(s: &FdmSettings, sys: &dyn System) -> Method {
 
 /// Runs one link on its hub (method: [`default_method`] — the velocity form for a torque-driven
 /// hub or Kelvin–Voigt damping, the report's two-step scheme for a prescribed undamped hub).
-pub fn single_link(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError> {
+pub fn single_link(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult, FdmError> {
     let mut sys = FloatingLink::from_scene(scene, s.stations)?;
     let (q0, v0) = sys.initial_state();
     let method = default_method(s, &sys);
@@ -68,7 +68,7 @@ pub fn single_link(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError
 /// Runs a two-link chain. Default method (no `time.method`): the one-step velocity form — the
 /// free joints make the inertia forces velocity dependent and damping is on in the damped scene,
 /// both of which grow the two-step scheme's computational mode.
-pub fn two_link_chain(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError> {
+pub fn two_link_chain(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult, FdmError> {
     if !scene.contacts().is_empty() {
         return Ok(two_link_chain_with_contact(scene, s)?.0);
     }
@@ -92,7 +92,7 @@ pub fn two_link_chain(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmEr
 /// ([`TipContactEvents`]). Returns the run and the contact diagnostics.
 pub fn two_link_chain_with_contact(
     scene: &Scene,
-    s: &FdmSettings,
+    s: &ValidatedSettings,
 ) -> Result<(RunResult, ContactReport), FdmError> {
     if s.requested.method.is_some() && s.method != Method::VelocityForm {
         return Err(FdmError::Unsupported(format!(

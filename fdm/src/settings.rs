@@ -56,7 +56,7 @@ impl Method {
 /// The backend's settings validated: [`data::FdmSettings`] with its ranges checked and the
 /// defaults filled in.
 #[derive(Debug, Clone, PartialEq)]
-pub struct FdmSettings {
+pub struct ValidatedSettings {
     /// The settings as requested (None where the default applies), recorded in the results.
     pub requested: data::FdmSettings,
     pub stations: Option<usize>,
@@ -68,7 +68,7 @@ pub struct FdmSettings {
     pub step_log_change: f64,
 }
 
-impl FdmSettings {
+impl ValidatedSettings {
     pub fn from_settings(s: &data::FdmSettings) -> Result<Self, FdmError> {
         if let Some(n) = s.stations
             && !(5..=100_000).contains(&n)
@@ -99,7 +99,7 @@ impl FdmSettings {
             Some(m) => Method::from_data(m)?,
             None => Method::Report,
         };
-        Ok(FdmSettings {
+        Ok(ValidatedSettings {
             requested: s.clone(),
             stations: s.stations,
             dt: s.dt,

@@ -7,7 +7,7 @@ use fdm::chain::TwoLinkChain;
 use fdm::events::tip_contact::{ContactReport, EVENT_TIME_TOLERANCE};
 use fdm::output::Outputs;
 use fdm::runs::two_link_chain_with_contact as simulate;
-use fdm::settings::FdmSettings;
+use fdm::settings::ValidatedSettings;
 
 mod common;
 use common::channel;
@@ -24,7 +24,7 @@ fn run(scene: &str, stations: usize, t_end: f64) -> (RunResult, ContactReport) {
     let s = settings(stations, t_end);
     let (r, rep) = simulate(
         &scene,
-        &FdmSettings::from_settings(&s.fdm().unwrap()).unwrap(),
+        &ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap(),
     )
     .unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed, "{:?}", r.verdict);

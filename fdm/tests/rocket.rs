@@ -3,7 +3,7 @@
 
 use data::{Backend, BackendError, Observables, Scene, Settings, StabilityVerdict, load_scene};
 use fdm::system::System;
-use fdm::{FdmBackend, FdmSettings};
+use fdm::{FdmBackend, ValidatedSettings};
 
 /// Total mass at ignition: the stages' weight per length times length, plus the discrete
 /// masses, over g (the scene states weights).
@@ -16,10 +16,10 @@ fn ignition_mass(r: &data::scene::Rocket) -> f64 {
         / r.gravity
 }
 
-fn settings(method: &str) -> (Settings, FdmSettings) {
+fn settings(method: &str) -> (Settings, ValidatedSettings) {
     let mut s = Settings::default();
     s.time.method = Some(method.parse().expect("a method name"));
-    let f = FdmSettings::from_settings(&s.fdm().unwrap()).expect("valid");
+    let f = ValidatedSettings::from_settings(&s.fdm().unwrap()).expect("valid");
     (s, f)
 }
 
@@ -354,13 +354,13 @@ fn dyn_rocket_report_two_step_at_the_reports_own_sigma_blows_up() {
     let (mut s, _) = settings("report");
     let sys = fdm::rocket::build(
         &scene,
-        &FdmSettings::from_settings(&s.fdm().unwrap()).unwrap(),
+        &ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap(),
     )
     .unwrap();
     let sigma = sys.bound(0.0).sigma;
     s.time.dt = Some(0.999 * sigma);
     s.time.t_end = Some(0.005);
-    let f = FdmSettings::from_settings(&s.fdm().unwrap()).unwrap();
+    let f = ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
     let (_, out) = fdm::runs::rocket_with(&scene, &f, false).unwrap();
     match &out.verdict {
         StabilityVerdict::Stopped { diagnostic } => {
@@ -371,7 +371,7 @@ fn dyn_rocket_report_two_step_at_the_reports_own_sigma_blows_up() {
         v => panic!("expected a stop, got {v:?}"),
     }
     s.time.method = Some("velocity-form".parse().expect("a method name"));
-    let f = FdmSettings::from_settings(&s.fdm().unwrap()).unwrap();
+    let f = ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
     let (_, out) = fdm::runs::rocket_with(&scene, &f, true).unwrap();
     assert!(matches!(out.verdict, StabilityVerdict::Completed));
 }
@@ -493,7 +493,7 @@ fn prop_rocket_split_satisfies_5_37_exactly() {
         let n = 5 + (case * 7) % 60;
         let mut s = Settings::default();
         s.discretization.stations = Some(n);
-        let f = FdmSettings::from_settings(&s.fdm().unwrap()).unwrap();
+        let f = ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
         let mut sys = fdm::rocket::build(&scene, &f).unwrap();
         let dofs = sys.dofs();
         let mut q: Vec<f64> = (0..dofs).map(|_| 1e-2 * rng.next()).collect();

@@ -2,7 +2,7 @@
 //! Run: CARGO_TARGET_DIR=/work/targets/fdm cargo test --release -p fdm --test rocket_convergence -- --nocapture
 
 use data::{Settings, load_scene};
-use fdm::FdmSettings;
+use fdm::ValidatedSettings;
 
 fn field(stations: usize, prefix: &str, t_end: f64, method: &str) -> Vec<f64> {
     let scene = load_scene("rocket").unwrap();
@@ -10,7 +10,7 @@ fn field(stations: usize, prefix: &str, t_end: f64, method: &str) -> Vec<f64> {
     s.discretization.stations = Some(stations);
     s.time.t_end = Some(t_end);
     s.time.method = Some(method.parse().expect("a method name"));
-    let f = FdmSettings::from_settings(&s.fdm().unwrap()).unwrap();
+    let f = ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
     let (_, out) = fdm::runs::rocket_with(&scene, &f, true).unwrap();
     let o = &out.observables;
     (0..scene.simulation.field_stations)

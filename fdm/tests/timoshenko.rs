@@ -12,7 +12,7 @@ use fdm::chain::TwoLinkChain;
 use fdm::chain::timoshenko::TimoFields;
 use fdm::output::Outputs;
 use fdm::runs::two_link_chain_with_contact as simulate;
-use fdm::settings::FdmSettings;
+use fdm::settings::ValidatedSettings;
 use fdm::system::System;
 
 mod common;
@@ -281,7 +281,7 @@ fn dyn_timoshenko_case1_impacts_and_ledger() {
     s.time.safety_factor = Some(0.1);
     let (r, rep) = simulate(
         &scene,
-        &FdmSettings::from_settings(&s.fdm().unwrap()).unwrap(),
+        &ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap(),
     )
     .unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
@@ -321,7 +321,7 @@ fn first_events(scene: &Scene, stations: usize, t_end: f64) -> (f64, f64) {
     s.time.safety_factor = Some(1.0);
     let (r, _) = simulate(
         scene,
-        &FdmSettings::from_settings(&s.fdm().unwrap()).unwrap(),
+        &ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap(),
     )
     .unwrap();
     let impact = r.events.iter().find_map(|e| match e {

@@ -20,7 +20,7 @@ use faer::{Mat, Side};
 use super::TwoLinkChain;
 use super::kinetic::{BE, TH};
 use crate::error::FdmError;
-use crate::settings::FdmSettings;
+use crate::settings::ValidatedSettings;
 
 /// Undamped linearized frequencies ω (rad/time, ascending; a statically unstable mode as −√|λ|)
 /// and the M-orthonormal mode vectors (columns over q).
@@ -168,7 +168,7 @@ fn generalized_eigen(k: &Mat<f64>, m: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>),
 }
 
 /// `modes` of a two-link chain scene: the lowest `count` linearized frequencies.
-pub fn modes(scene: &Scene, s: &FdmSettings, count: usize) -> Result<ModalResult, FdmError> {
+pub fn modes(scene: &Scene, s: &ValidatedSettings, count: usize) -> Result<ModalResult, FdmError> {
     let clock = std::time::Instant::now();
     let mut chain = TwoLinkChain::from_scene(scene, s.stations)?;
     let m = chain.linearized_modes()?;

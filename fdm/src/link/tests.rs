@@ -211,7 +211,7 @@ fn dyn_link_tension_bound_is_sharp() {
     let mut s = Settings::default();
     s.time.dt = Some(1.05 * 0.5 * link.bound(RAMP + 0.1).sigma);
     s.time.t_end = Some(RAMP + 0.2);
-    let fs = crate::settings::FdmSettings::from_settings(&s.fdm().unwrap()).unwrap();
+    let fs = crate::settings::ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
     match simulate(&scene, &fs) {
         Err(FdmError::StabilityBound {
             t, kind, location, ..

@@ -18,7 +18,7 @@ use faer::{Mat, Side};
 
 use super::{BaseDrive, PayloadLinkModel, apply};
 use crate::error::FdmError;
-use crate::settings::FdmSettings;
+use crate::settings::ValidatedSettings;
 
 /// Frequencies (rad/s, ascending), mode vectors (columns, over ż) and kinds.
 pub struct Spectrum {
@@ -159,7 +159,7 @@ pub fn kind_name(f: LinkField) -> &'static str {
 
 /// `modes` of a payload-link scene: the lowest `count` frequencies with their kinds; each
 /// shape is the dominant field at the stations (root included), unit peak.
-pub fn modes(scene: &Scene, s: &FdmSettings, count: usize) -> Result<ModalResult, FdmError> {
+pub fn modes(scene: &Scene, s: &ValidatedSettings, count: usize) -> Result<ModalResult, FdmError> {
     let clock = std::time::Instant::now();
     let model = PayloadLinkModel::from_scene(scene, s.stations)?;
     let sp = model.spectrum()?;
@@ -213,7 +213,7 @@ pub fn modes(scene: &Scene, s: &FdmSettings, count: usize) -> Result<ModalResult
 }
 
 /// `statics`: the gravity sag, w_L and w′_L.
-pub fn statics(scene: &Scene, s: &FdmSettings) -> Result<StaticResult, FdmError> {
+pub fn statics(scene: &Scene, s: &ValidatedSettings) -> Result<StaticResult, FdmError> {
     let clock = std::time::Instant::now();
     let model = PayloadLinkModel::from_scene(scene, s.stations)?;
     if model.f_gravity.is_none() {

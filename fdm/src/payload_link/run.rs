@@ -16,12 +16,12 @@ use super::band::{BandCholesky, Triplets};
 use super::{BaseDrive, PayloadLinkModel, apply, dot};
 use crate::error::FdmError;
 use crate::output::sample_field;
-use crate::settings::FdmSettings;
+use crate::settings::ValidatedSettings;
 
 /// The step of a run: τ, the bound σ and the binding (field, station).
 pub fn choose_step(
     model: &PayloadLinkModel,
-    s: &FdmSettings,
+    s: &ValidatedSettings,
 ) -> Result<(f64, f64, LinkField, usize), FdmError> {
     let (field, sigma, station) = model
         .field_bounds()
@@ -302,7 +302,7 @@ impl PayloadLinkModel {
 }
 
 /// Runs the scene.
-pub fn simulate(scene: &Scene, s: &FdmSettings) -> Result<RunResult, FdmError> {
+pub fn simulate(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult, FdmError> {
     let clock = Instant::now();
     let model = PayloadLinkModel::from_scene(scene, s.stations)?;
     let p = scene.payload_link().ok_or_else(|| {

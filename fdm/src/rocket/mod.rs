@@ -7,14 +7,14 @@ pub mod system;
 use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
-use crate::settings::FdmSettings;
+use crate::settings::ValidatedSettings;
 use model::RocketModel;
 use system::RocketSystem;
 
 /// Default stations: h = 2 in over 150 in, as in the report.
 pub const DEFAULT_STATIONS: usize = 76;
 
-pub fn build(scene: &Scene, s: &FdmSettings) -> Result<RocketSystem, FdmError> {
+pub fn build(scene: &Scene, s: &ValidatedSettings) -> Result<RocketSystem, FdmError> {
     let r = scene
         .rocket()
         .ok_or_else(|| FdmError::Unsupported("scene has no [rocket]".into()))?;
