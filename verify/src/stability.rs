@@ -56,11 +56,9 @@ fn judge(case: &data::cases::StabilityCase, kind: BackendKind) -> Vec<Verdict> {
         Ok(s) => s,
         Err(e) => return vec![mk("invalid case", e, true, 0.0)],
     };
-    // Each backend takes the fields it reads (a row may set fields for one of its backends);
-    // the method stays, so that a backend that does not implement it refuses the row's request.
-    let requested = case.settings.to_settings();
-    let mut settings = requested.for_backend(kind);
-    settings.time.method = requested.time.method;
+    // Each backend takes the fields it reads, as on the command line (a row may set fields,
+    // or a method, for one of its backends).
+    let settings = case.settings.to_settings().for_backend(kind);
     let b = backend(kind);
     let mut out = Vec::new();
     let result = b.simulate(&scene, &settings);
