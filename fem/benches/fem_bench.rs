@@ -109,49 +109,43 @@ fn arms(c: &mut Criterion) {
     g.finish();
 }
 
-/// The free two-link arm over its first second at default settings (energy-midpoint, 16
-/// elements per link, exact augmented Newton matrix formed every step): the per-step cost of
-/// the foreshortening chain without the 10 s of the whole run.
+/// One scene at default settings shortened to `t_end`, as its own group: the per-step cost of
+/// a phase without the whole run.
+fn shortened_run(c: &mut Criterion, group: &str, scene: &str, t_end: f64) {
+    let mut g = c.benchmark_group(group);
+    g.sample_size(10);
+    let sc = data::load_scene(scene).unwrap();
+    let mut st = Settings::default();
+    st.time.t_end = Some(t_end);
+    g.bench_function(scene, |b| {
+        b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
+    });
+    g.finish();
+}
+
+/// The free two-link arm over its first second (energy-midpoint, 16 elements per link, the
+/// exact augmented Newton matrix reused across steps): the foreshortening chain's step cost.
 fn arms_short(c: &mut Criterion) {
-    let mut g = c.benchmark_group("arms-1s");
-    g.sample_size(10);
-    let sc = data::load_scene("two-link-free-undamped").unwrap();
-    let mut st = Settings::default();
-    st.time.t_end = Some(1.0);
-    g.bench_function("two-link-free-undamped", |b| {
-        b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
-    });
-    g.finish();
+    shortened_run(c, "arms-1s", "two-link-free-undamped", 1.0);
 }
 
-/// `barhorst-case1` shortened to 0.5 s at default settings: the free drop, the first impact
-/// (0.28 s) and the sliding phases after it, each constrained step with its normal-force
-/// evaluation (sparse mass factorization, `events::mass_solve`) and event location.
+/// `barhorst-case1` over 0.5 s: the free drop, the first impact (0.28 s) and the sliding phases
+/// after it, each constrained step with its normal-force evaluation (sparse mass
+/// factorization, `events::mass_solve`) and event location.
 fn contact_short(c: &mut Criterion) {
-    let mut g = c.benchmark_group("contact-0.5s");
-    g.sample_size(10);
-    let sc = data::load_scene("barhorst-case1").unwrap();
-    let mut st = Settings::default();
-    st.time.t_end = Some(0.5);
-    g.bench_function("barhorst-case1", |b| {
-        b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
-    });
-    g.finish();
+    shortened_run(c, "contact-0.5s", "barhorst-case1", 0.5);
 }
 
-/// `barhorst-case1-timoshenko` shortened to 0.35 s at default settings: the drop, the first
-/// impact (0.28 s) and the micro-bounces after it, where located events (each trial a re-solved
-/// shortened step) dominate the cost.
+/// `barhorst-case1-timoshenko` over 0.35 s: the drop, the first impact (0.28 s) and the
+/// micro-bounces after it, where located events (each trial a re-solved shortened step)
+/// dominate the cost.
 fn contact_timoshenko_short(c: &mut Criterion) {
-    let mut g = c.benchmark_group("contact-timoshenko-0.35s");
-    g.sample_size(10);
-    let sc = data::load_scene("barhorst-case1-timoshenko").unwrap();
-    let mut st = Settings::default();
-    st.time.t_end = Some(0.35);
-    g.bench_function("barhorst-case1-timoshenko", |b| {
-        b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
-    });
-    g.finish();
+    shortened_run(
+        c,
+        "contact-timoshenko-0.35s",
+        "barhorst-case1-timoshenko",
+        0.35,
+    );
 }
 
 /// The exact Newton matrix of the free two-link arm with foreshortening (residual pass,
