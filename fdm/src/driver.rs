@@ -29,7 +29,7 @@ use crate::events::{Events, NoEvents, Retake, finish_step};
 use crate::method::{StepState, Stepper, stepper};
 use crate::output::{Outcome, Outputs, Recorder};
 use crate::settings::{Method, ValidatedSettings};
-use crate::system::{Bound, Overextension, System};
+use crate::system::{Bound, DeflectionModel, Overextension, System};
 
 /// How to step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -365,17 +365,21 @@ struct Growth {
 
 /// A link deflected beyond its length: outside the beam model, whatever the step.
 fn overextension_diagnostic(t: f64, o: Overextension) -> Diagnostic {
-    let (why, remedy) = if o.stiffened {
-        (
+    let (why, remedy) = match o.model {
+        DeflectionModel::SmallStrain => (
             "the deflection is outside the small-strain floating-frame model",
             "reduce the load",
-        )
-    } else {
-        (
+        ),
+        DeflectionModel::Linear => (
             "the linear model (no geometric stiffening) has lost its centrifugal stiffness: \
              spinning above the first bending frequency it grows without bound",
             "switch on `foreshortening` (geometric stiffening)",
-        )
+        ),
+        DeflectionModel::ChordFrames => (
+            "the finite-difference chain measures deflections from each link's tip chord and \
+             holds only while the clamp slope against the chord stays well below 1",
+            "stiffer links, smaller initial angles or joint loads, or the fem or modal backend",
+        ),
     };
     Diagnostic {
         t,

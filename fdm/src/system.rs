@@ -124,8 +124,20 @@ pub struct Overextension {
     pub link: usize,
     pub deflection: f64,
     pub length: f64,
-    /// Whether the link carries geometric stiffening (foreshortening).
-    pub stiffened: bool,
+    /// Which model's range the deflection left.
+    pub model: DeflectionModel,
+}
+
+/// The beam model whose range a deflection left ([`Overextension`]): it decides the diagnostic.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DeflectionModel {
+    /// A linear link (no geometric stiffening): spun above its first bending frequency it has
+    /// no centrifugal stiffness left and grows without bound.
+    Linear,
+    /// A small-strain floating-frame link with foreshortening.
+    SmallStrain,
+    /// The two-link chain's tip-chord frames: deflections small against each link's chord.
+    ChordFrames,
 }
 
 /// The drift velocities of the velocity form for the inertia terms quadratic in q̇

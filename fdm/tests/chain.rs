@@ -528,3 +528,38 @@ fn dyn_chain_two_step_scheme_is_caught_and_velocity_form_is_default() {
     let out = run("two-link-free", |_| {}, &with(11, 0.5));
     assert!(matches!(out.verdict, StabilityVerdict::Completed));
 }
+
+#[test]
+fn dyn_chain_deflected_beyond_its_length_stops_with_a_diagnostic() {
+    // EI 1000 times lower: released from 45°/60° against the joint springs, the soft links
+    // swing far out of the range of the chain's small-slope chord frames (fem and modal
+    // reach tip deflections of two thirds of link 1). The clamp-frame tip deflection L·(−ε)
+    // passes a link length and the run stops, keeping what it computed up to there.
+    let soft = |sc: &mut data::Scene| {
+        for l in &mut sc.planar_chain_mut().unwrap().links {
+            l.bending_stiffness *= 1e-3;
+        }
+    };
+    let out = run("two-link-free", soft, &with(21, 2.0));
+    let scene = load_scene("two-link-free").unwrap();
+    match &out.verdict {
+        StabilityVerdict::Stopped { diagnostic } => {
+            assert!(
+                diagnostic.what.contains("beyond the link length"),
+                "{diagnostic:?}"
+            );
+            assert!(diagnostic.why.contains("tip chord"), "{diagnostic:?}");
+        }
+        v => panic!("expected a stop, got {v:?}"),
+    }
+    for (k, link) in scene.links().iter().enumerate() {
+        let tip = &out
+            .observables
+            .get(&format!("link{}.tip_deflection", k + 1))
+            .unwrap()
+            .values;
+        assert!(!tip.is_empty());
+        let peak = tip.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(peak <= link.length, "link {}: {peak}", k + 1);
+    }
+}

@@ -72,7 +72,7 @@ use data::{DofPlan, Scene};
 use crate::error::FdmError;
 use crate::link::FloatingLink;
 use crate::output::Outputs;
-use crate::system::{Bound, DriftVelocities, System};
+use crate::system::{Bound, DeflectionModel, DriftVelocities, Overextension, System};
 use contact::TipContact;
 use dual::Dual;
 use kinetic::{BE, ChainInertia, TH, seg_energy, seg_grad};
@@ -582,6 +582,16 @@ impl TwoLinkChain {
     pub fn clamp_angle(&self, q: &[f64], link: usize) -> f64 {
         let frame = if link == 0 { q[TH] } else { q[BE] };
         frame + (q[self.first(link)] - q[self.slots[link]]) / (2.0 * self.hs[link])
+    }
+
+    /// The turn −ε of each link's chord against its clamp tangent, ε = (v₁ − x)/(2h) the clamp
+    /// slope in the chord frame (Timoshenko: −ψ₀, the clamp section's rotation): deflections
+    /// in the clamp-tangent frame are u − Xε (small angle).
+    pub(super) fn clamp_frame_turns(&self, q: &[f64]) -> [f64; 2] {
+        match &self.timo {
+            Some(t) => t.clamp_turns(q).map(|z| -z),
+            None => [0, 1].map(|l| -(q[self.first(l)] - q[self.slots[l]]) / (2.0 * self.hs[l])),
+        }
     }
 
     /// Bending energy of one link in the tip-chord frame with the clamp ghost x: the
@@ -1095,6 +1105,23 @@ impl System for TwoLinkChain {
 
     fn monitored(&self) -> std::ops::Range<usize> {
         2..self.dofs()
+    }
+
+    /// The tip sits on the chord (v_r = 0), so its deflection in the clamp-tangent frame — the
+    /// `tip_deflection` channel, fem's and modal's coordinate — is L·(−ε): beyond L once the
+    /// clamp slope against the chord passes 1, where no small-slope beam model holds.
+    fn overextended(&self, q: &[f64]) -> Option<Overextension> {
+        let turns = self.clamp_frame_turns(q);
+        (0..2).find_map(|l| {
+            let length = self.links[l].length;
+            let deflection = length * turns[l];
+            (deflection.abs() > length).then_some(Overextension {
+                link: l + 1,
+                deflection,
+                length,
+                model: DeflectionModel::ChordFrames,
+            })
+        })
     }
 
     fn damped(&self) -> bool {

@@ -75,7 +75,7 @@ impl Outputs for TwoLinkChain {
         out[3] = th2;
         out[4] = th2d;
         out[5] = tau2;
-        let turns = self.timo.as_ref().map(|t| t.clamp_turns(q));
+        let turns = self.clamp_frame_turns(q);
         let s1 = if ine.fs1 {
             seg_energy(vs, ine.h1, None)
         } else {
@@ -98,13 +98,8 @@ impl Outputs for TwoLinkChain {
             .into_iter()
             .enumerate()
         {
-            // deflections reported in the clamp-tangent frame, turned by
-            // ε = (u₁ − x)/(2h) from the chord: u − Xε (small angle)
-            // (Timoshenko: the clamp section is turned by ψ₀ from the chord)
-            let turn = match turns {
-                Some(z) => -z[l],
-                None => -(us[0] - q[self.slots[l]]) / (2.0 * h),
-            };
+            // deflections reported in the clamp-tangent frame: u − Xε (small angle)
+            let turn = turns[l];
             out[k] = tip.0;
             out[k + 1] = tip.1;
             out[k + 2] = us[us.len() - 1] + self.links[l].length * turn;

@@ -42,7 +42,7 @@ use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
 use crate::foreshortening::Foreshortening;
-use crate::system::{Bound, BoundKind, Overextension, System};
+use crate::system::{Bound, BoundKind, DeflectionModel, Overextension, System};
 
 mod outputs;
 
@@ -436,7 +436,11 @@ impl System for FloatingLink {
             link: 1,
             deflection: tip,
             length: self.length,
-            stiffened: self.foreshortening,
+            model: if self.foreshortening {
+                DeflectionModel::SmallStrain
+            } else {
+                DeflectionModel::Linear
+            },
         })
     }
 
