@@ -77,9 +77,9 @@ impl BackendError {
 ///
 /// The methods take the user-facing [`Settings`] (and `dof_plan` its [`Discretization`]) so
 /// that callers hold every backend as one `dyn Backend`; each implementation turns them into
-/// its own typed settings first ([`Settings::fem`], [`Settings::fdm`], [`Settings::modal`]),
-/// which refuses a field it does not read or a method it does not implement
-/// ([`BackendError::InvalidSettings`]), and passes only those inward.
+/// its own typed settings first ([`Settings::fem`], [`Settings::fdm`], [`Settings::modal`],
+/// [`Settings::reference`]), which refuses a field it does not read or a method it does not
+/// implement ([`BackendError::InvalidSettings`]), and passes only those inward.
 ///
 /// `simulate` returns `Ok` also when the run stops early: the result then carries a
 /// [`crate::StabilityVerdict::Stopped`] diagnostic and the output up to that time.

@@ -1,10 +1,11 @@
-//! Each backend's own settings, typed: [`FemSettings`], [`FdmSettings`] and [`ModalSettings`]
-//! hold exactly the fields [`SettingField::readers`] gives that backend, and
-//! [`FemMethod`], [`FdmMethod`] and [`ModalMethod`] exactly the methods it implements.
+//! Each backend's own settings, typed: [`FemSettings`], [`FdmSettings`], [`ModalSettings`] and
+//! [`ReferenceSettings`] (verify's rigid reference) hold exactly the fields
+//! [`SettingField::readers`] gives that backend, and [`FemMethod`], [`FdmMethod`] and
+//! [`ModalMethod`] exactly the methods it implements.
 //!
 //! [`Settings`] stays the request as the user writes it (command line, case rows, the
-//! `settings` object of a result); [`Settings::fem`], [`Settings::fdm`] and [`Settings::modal`]
-//! turn it into one backend's settings and refuse a field that backend does not read or a method
+//! `settings` object of a result); [`Settings::fem`], [`Settings::fdm`], [`Settings::modal`] and
+//! [`Settings::reference`] turn it into one backend's settings and refuse a field that backend does not read or a method
 //! it does not implement ([`SettingsRefusal`]). The way back ([`From`] into [`Settings`]) gives
 //! the request with only that backend's fields, as the result records it.
 //!
@@ -187,6 +188,17 @@ pub struct ModalSettings {
     pub atol: Option<f64>,
 }
 
+/// The settings of verify's rigid reference (None: its default). It has no spatial
+/// discretization and always integrates with adaptive Dormand–Prince 5(4).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReferenceSettings {
+    /// Overrides the scene's end time.
+    pub t_end: Option<f64>,
+    /// Relative / absolute tolerances of the step control.
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+}
+
 /// A field set for a backend that does not read it, or a method it does not implement.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("{message}")]
@@ -293,6 +305,17 @@ impl Settings {
             atol: t.atol,
         })
     }
+
+    /// The rigid reference's settings; refused if a field it does not read is set.
+    pub fn reference(&self) -> Result<ReferenceSettings, SettingsRefusal> {
+        self.refuse_foreign(BackendKind::Reference)?;
+        let t = &self.time;
+        Ok(ReferenceSettings {
+            t_end: t.t_end,
+            rtol: t.rtol,
+            atol: t.atol,
+        })
+    }
 }
 
 impl Discretization {
@@ -378,6 +401,20 @@ impl From<&ModalSettings> for Settings {
     }
 }
 
+impl From<&ReferenceSettings> for Settings {
+    fn from(s: &ReferenceSettings) -> Settings {
+        Settings {
+            discretization: Discretization::default(),
+            time: TimeStepping {
+                t_end: s.t_end,
+                rtol: s.rtol,
+                atol: s.atol,
+                ..TimeStepping::default()
+            },
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -405,13 +442,13 @@ mod tests {
     #[test]
     fn each_backend_takes_exactly_the_fields_it_reads_and_gives_them_back() {
         let all = every_field();
-        for backend in BackendKind::ALL {
+        for backend in [BackendKind::ALL.as_slice(), &[BackendKind::Reference]].concat() {
             let own = all.for_backend(backend);
             let back = match backend {
                 BackendKind::Fem => Settings::from(&own.fem().unwrap()),
                 BackendKind::Fdm => Settings::from(&own.fdm().unwrap()),
                 BackendKind::Modal => Settings::from(&own.modal().unwrap()),
-                BackendKind::Reference => unreachable!(),
+                BackendKind::Reference => Settings::from(&own.reference().unwrap()),
             };
             assert_eq!(back, own, "{backend}");
             for f in back.set_fields() {
@@ -421,7 +458,7 @@ mod tests {
                 BackendKind::Fem => all.fem().map(drop),
                 BackendKind::Fdm => all.fdm().map(drop),
                 BackendKind::Modal => all.modal().map(drop),
-                BackendKind::Reference => unreachable!(),
+                BackendKind::Reference => all.reference().map(drop),
             }
             .unwrap_err();
             assert_eq!(refused.backend, backend);
@@ -448,12 +485,13 @@ mod tests {
                 },
                 ..Settings::default()
             };
-            for backend in BackendKind::ALL {
+            for backend in [BackendKind::ALL.as_slice(), &[BackendKind::Reference]].concat() {
                 let typed = match backend {
                     BackendKind::Fem => s.fem().map(|t| t.method.map(Method::from)),
                     BackendKind::Fdm => s.fdm().map(|t| t.method.map(Method::from)),
                     BackendKind::Modal => s.modal().map(|t| t.method.map(Method::from)),
-                    BackendKind::Reference => unreachable!(),
+                    // the reference implements no method: every one is refused
+                    BackendKind::Reference => s.reference().map(|_| None),
                 };
                 if m.implemented_by(backend) {
                     assert_eq!(typed, Ok(Some(m)), "{name} on {backend}");

@@ -28,7 +28,8 @@ pub mod validate;
 
 pub use backend::{Backend, BackendError, DofGroup, DofPlan};
 pub use backend_settings::{
-    FdmMethod, FdmSettings, FemMethod, FemSettings, ModalMethod, ModalSettings, SettingsRefusal,
+    FdmMethod, FdmSettings, FemMethod, FemSettings, ModalMethod, ModalSettings, ReferenceSettings,
+    SettingsRefusal,
 };
 pub use catalog::{CATALOG, catalog_names, catalog_scene, load_scene};
 pub use error::{LoadError, SceneError};

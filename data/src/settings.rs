@@ -4,8 +4,8 @@
 //! field and [`Method::backends`] which backend implements each method; the boundaries (command
 //! line, case rows) refuse a field or method that no backend it is meant for reads,
 //! [`Settings::for_backend`] keeps one backend's fields of a request meant for several, and
-//! [`Settings::fem`] / [`Settings::fdm`] / [`Settings::modal`] turn them into that backend's typed
-//! settings ([`crate::backend_settings`]).
+//! [`Settings::fem`] / [`Settings::fdm`] / [`Settings::modal`] / [`Settings::reference`] turn
+//! them into that backend's typed settings ([`crate::backend_settings`]).
 
 use serde::{Deserialize, Serialize};
 

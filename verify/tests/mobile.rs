@@ -237,3 +237,39 @@ fn dyn_mobile_flexible_variant_runs_as_its_rigid_limit() {
         assert_eq!(ca.values, cb.values, "{name}");
     }
 }
+
+#[test]
+fn sys_reference_refuses_what_it_does_not_read_and_records_what_it_ran() {
+    let scene = load_scene("mobile-platform").expect("catalog scene");
+    let mut s = Settings::default();
+    s.discretization.elements = Some(4);
+    match simulate(&scene, &s) {
+        Err(data::BackendError::InvalidSettings { field, message }) => {
+            assert_eq!(field, "discretization.elements");
+            assert!(
+                message.contains("the reference backend does not read it"),
+                "{message}"
+            );
+        }
+        other => panic!("expected a refusal, got {:?}", other.map(|r| r.settings)),
+    }
+    let mut s = Settings::default();
+    s.time.method = Some("dopri5".parse().expect("a method name"));
+    let Err(data::BackendError::InvalidSettings { message, .. }) = simulate(&scene, &s) else {
+        panic!("a method is refused");
+    };
+    assert!(
+        message.contains("always adaptive Dormand–Prince"),
+        "{message}"
+    );
+    let s = Settings {
+        time: TimeStepping {
+            t_end: Some(0.05),
+            rtol: Some(1e-9),
+            ..TimeStepping::default()
+        },
+        ..Settings::default()
+    };
+    let run = simulate(&scene, &s).expect("runs");
+    assert_eq!(run.settings, s);
+}

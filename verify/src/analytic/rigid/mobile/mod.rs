@@ -57,26 +57,11 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, Backend
             scene.family()
         ))
     })?;
-    for (field, set) in [
-        ("elements", settings.discretization.elements.is_some()),
-        ("stations", settings.discretization.stations.is_some()),
-        ("modes", settings.discretization.modes.is_some()),
-        ("dt", settings.time.dt.is_some()),
-        ("method", settings.time.method.is_some()),
-    ] {
-        if set {
-            return Err(BackendError::InvalidSettings {
-                field: field.into(),
-                message: "the rigid reference has no spatial discretization and always uses \
-                          adaptive Dormand–Prince 5(4); set only --rtol/--atol/--t-end"
-                    .into(),
-            });
-        }
-    }
+    let settings = settings.reference()?;
     let mut tol = Tolerances::default();
     for (field, v, slot) in [
-        ("rtol", settings.time.rtol, &mut tol.rtol),
-        ("atol", settings.time.atol, &mut tol.atol),
+        ("rtol", settings.rtol, &mut tol.rtol),
+        ("atol", settings.atol, &mut tol.atol),
     ] {
         if let Some(v) = v {
             if !(v.is_finite() && v > 0.0 && v < 1.0) {
@@ -88,7 +73,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, Backend
             *slot = v;
         }
     }
-    let t_end = settings.time.t_end.unwrap_or(scene.simulation.t_end);
+    let t_end = settings.t_end.unwrap_or(scene.simulation.t_end);
     if !(t_end.is_finite() && t_end > 0.0) {
         return Err(BackendError::InvalidSettings {
             field: "t_end".into(),
@@ -176,7 +161,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, Backend
     Ok(RunResult {
         backend: BackendKind::Reference,
         scene: scene.name.clone(),
-        settings: settings.clone(),
+        settings: Settings::from(&settings),
         observables: obs,
         ledger,
         events: Vec::new(),
