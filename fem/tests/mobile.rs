@@ -7,6 +7,7 @@ use data::{Backend, Discretization, Scene, Settings};
 use fem::FemBackend;
 use fem::mobile::model::{Model, Workspace};
 use fem::mobile::{self, Inputs, Stepper};
+use nalgebra::{Matrix3, Vector3};
 
 fn scene() -> Scene {
     data::catalog::catalog_scene("mobile-manipulator-flexible")
@@ -142,20 +143,14 @@ fn sys_mobile_rigid_scene_refused_and_bad_settings() {
 }
 
 /// Skew part of Ṙ Rᵀ as a vector.
-fn omega_of(r0: &[[f64; 3]; 3], r1: &[[f64; 3]; 3], rm: &[[f64; 3]; 3], dt: f64) -> [f64; 3] {
-    let mut w = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            for k in 0..3 {
-                w[i][j] += (r1[i][k] - r0[i][k]) / dt * rm[j][k];
-            }
-        }
-    }
-    [
-        0.5 * (w[2][1] - w[1][2]),
-        0.5 * (w[0][2] - w[2][0]),
-        0.5 * (w[1][0] - w[0][1]),
-    ]
+fn omega_of(r0: &Matrix3<f64>, r1: &Matrix3<f64>, rm: &Matrix3<f64>, dt: f64) -> Vector3<f64> {
+    // Ṙ Rᵀ = [ω]×
+    let w = (r1 - r0) / dt * rm.transpose();
+    0.5 * Vector3::new(
+        w[(2, 1)] - w[(1, 2)],
+        w[(0, 2)] - w[(2, 0)],
+        w[(1, 0)] - w[(0, 1)],
+    )
 }
 
 #[test]
@@ -189,11 +184,11 @@ fn sys_mobile_kinetic_energy_matches_material_points() {
         // ½ ωᵀ R J Rᵀ ω.
         let r = &c.2;
         let wb: Vec<f64> = (0..3)
-            .map(|k| (0..3).map(|i| r[i][k] * w[i]).sum())
+            .map(|k| (0..3).map(|i| r[(i, k)] * w[i]).sum())
             .collect();
         for i in 0..3 {
             for j in 0..3 {
-                t_points += 0.5 * wb[i] * c.3[i][j] * wb[j];
+                t_points += 0.5 * wb[i] * c.3[(i, j)] * wb[j];
             }
         }
     }
@@ -323,7 +318,7 @@ fn dyn_mobile_drift_and_ledger_closure() {
 }
 
 /// The ee position history of a run of `md` with step h over [0, t_end].
-fn ee_history(md: Model, h: f64, t_end: f64) -> Vec<[f64; 3]> {
+fn ee_history(md: Model, h: f64, t_end: f64) -> Vec<Vector3<f64>> {
     let s = scene();
     let mm = s.mobile_manipulator().unwrap();
     let inputs = Inputs {
@@ -343,7 +338,7 @@ fn ee_history(md: Model, h: f64, t_end: f64) -> Vec<[f64; 3]> {
     hist
 }
 
-fn max_gap(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+fn max_gap(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> f64 {
     a.iter()
         .zip(b)
         .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))

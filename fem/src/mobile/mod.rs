@@ -326,7 +326,7 @@ fn sample(st: &mut Stepper, buf: &mut Vec<f64>) {
     for i in 0..4 {
         buf.extend([q[l.q_arm + i], st.nu[l.nu_arm + i], tau[l.nu_arm + i]]);
     }
-    buf.extend(st.model.end_effector(&q));
+    buf.extend(st.model.end_effector(&q).iter());
     if let Some(fl) = &st.model.flex {
         let tip = fl.tip(&q[l.q_el..]);
         buf.extend([tip[2], tip[0]]);

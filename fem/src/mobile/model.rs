@@ -28,69 +28,28 @@
 //! K = ∫ (EI_out N″ᵀN″ on v, EI_in N″ᵀN″ on w) dx, the Euler–Bernoulli strain energy.
 
 use data::scene::{MobileManipulator, RigidBody};
+use nalgebra::{Matrix3, Vector3};
 
 use crate::element::hermite::{HermiteAt, hermite};
 use crate::element::quadrature::gauss01;
 use crate::error::FemError;
 
-pub type Vec3 = [f64; 3];
-pub type Mat3 = [[f64; 3]; 3];
+pub type Vec3 = Vector3<f64>;
+pub type Mat3 = Matrix3<f64>;
 
-pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-pub(crate) fn dot3(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub(crate) fn scale(s: f64, a: Vec3) -> Vec3 {
-    [s * a[0], s * a[1], s * a[2]]
-}
-pub(crate) fn mat_vec(m: &Mat3, v: Vec3) -> Vec3 {
-    [dot3(m[0], v), dot3(m[1], v), dot3(m[2], v)]
-}
-pub(crate) fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
-        }
-    }
-    c
-}
-/// R J Rᵀ.
-pub(crate) fn rotate_inertia(r: &Mat3, j: &Mat3) -> Mat3 {
-    let rj = mat_mul(r, j);
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for k in 0..3 {
-            c[i][k] = rj[i][0] * r[k][0] + rj[i][1] * r[k][1] + rj[i][2] * r[k][2];
-        }
-    }
-    c
-}
-pub(crate) fn rot_z(t: f64) -> Mat3 {
+fn rot_z(t: f64) -> Mat3 {
     let (s, c) = t.sin_cos();
-    [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 /// Rotation by t about −y (= R_y(−t)): x ↦ (cos t, 0, sin t).
-pub(crate) fn rot_pitch(t: f64) -> Mat3 {
+fn rot_pitch(t: f64) -> Mat3 {
     let (s, c) = t.sin_cos();
-    [[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]]
+    Matrix3::new(c, 0.0, -s, 0.0, 1.0, 0.0, s, 0.0, c)
 }
 
-const EY: Vec3 = [0.0, 1.0, 0.0];
-const EZ: Vec3 = [0.0, 0.0, 1.0];
-const MINUS_EY: Vec3 = [0.0, -1.0, 0.0];
+const EY: Vec3 = Vector3::new(0.0, 1.0, 0.0);
+const EZ: Vec3 = Vector3::new(0.0, 0.0, 1.0);
+const MINUS_EY: Vec3 = Vector3::new(0.0, -1.0, 0.0);
 
 /// Gauss points per element (exact for the mass integrands of degree ≤ 7).
 pub const GAUSS: usize = 4;
@@ -265,8 +224,8 @@ impl Default for Partials {
         Partials {
             len: 0,
             idx: [0; MAX_COLS],
-            jv: [[0.0; 3]; MAX_COLS],
-            jw: [[0.0; 3]; MAX_COLS],
+            jv: [Vec3::zeros(); MAX_COLS],
+            jw: [Vec3::zeros(); MAX_COLS],
         }
     }
 }
@@ -283,15 +242,15 @@ impl Partials {
 
 /// Rotates frame (r, w, al) about its local axis `u` by (t, ṫ, ẗ); returns the inertial axis.
 fn revolute(r: &mut Mat3, w: &mut Vec3, al: &mut Vec3, u: Vec3, t: [f64; 3]) -> Vec3 {
-    let axis = mat_vec(r, u);
-    *al = add(add(*al, cross(*w, scale(t[1], axis))), scale(t[2], axis));
-    *w = add(*w, scale(t[1], axis));
+    let axis = *r * u;
+    *al = *al + (*w).cross(&(t[1] * axis)) + (t[2] * axis);
+    *w += t[1] * axis;
     let rot = if u == EZ {
         rot_z(t[0])
     } else {
         rot_pitch(t[0])
     };
-    *r = mat_mul(r, &rot);
+    *r *= rot;
     axis
 }
 
@@ -299,23 +258,23 @@ fn revolute(r: &mut Mat3, w: &mut Vec3, al: &mut Vec3, u: Vec3, t: [f64; 3]) -> 
 pub fn residual_inertia(mass: f64, length: f64, inertia: &Mat3) -> Mat3 {
     let rod = mass * length * length / 12.0;
     let mut j = *inertia;
-    j[1][1] -= rod;
-    j[2][2] -= rod;
+    j[(1, 1)] -= rod;
+    j[(2, 2)] -= rod;
     j
 }
 
 /// Smallest eigenvalue of a symmetric 3 × 3 matrix is ≥ −tol (Sylvester on J + tol I would
 /// not do for semi-definite; the principal minors of J are checked instead).
 fn positive_semidefinite(j: &Mat3, tol: f64) -> bool {
-    let d = [j[0][0], j[1][1], j[2][2]];
+    let d = Vector3::new(j[(0, 0)], j[(1, 1)], j[(2, 2)]);
     let m2 = [
-        j[0][0] * j[1][1] - j[0][1] * j[1][0],
-        j[0][0] * j[2][2] - j[0][2] * j[2][0],
-        j[1][1] * j[2][2] - j[1][2] * j[2][1],
+        j[(0, 0)] * j[(1, 1)] - j[(0, 1)] * j[(1, 0)],
+        j[(0, 0)] * j[(2, 2)] - j[(0, 2)] * j[(2, 0)],
+        j[(1, 1)] * j[(2, 2)] - j[(1, 2)] * j[(2, 1)],
     ];
-    let det = j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1])
-        - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
-        + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
+    let det = j[(0, 0)] * (j[(1, 1)] * j[(2, 2)] - j[(1, 2)] * j[(2, 1)])
+        - j[(0, 1)] * (j[(1, 0)] * j[(2, 2)] - j[(1, 2)] * j[(2, 0)])
+        + j[(0, 2)] * (j[(1, 0)] * j[(2, 1)] - j[(1, 1)] * j[(2, 0)]);
     let s = tol * d.iter().fold(0.0f64, |a, b| a.max(b.abs()));
     d.iter().all(|&x| x >= -s) && m2.iter().all(|&x| x >= -s * s) && det >= -s * s * s
 }
@@ -371,16 +330,16 @@ impl Model {
         let body = |frame: usize, b: &RigidBody| Body {
             frame,
             mass: b.mass,
-            com: b.com,
-            inertia: b.inertia,
+            com: Vector3::from(b.com),
+            inertia: Matrix3::from(b.inertia).transpose(),
         };
         let mut bodies = Vec::new();
         if let Some(p) = &platform {
             bodies.push(Body {
                 frame: 0,
                 mass: p.mass,
-                com: [p.com_offset, 0.0, 0.0],
-                inertia: [[0.0; 3], [0.0; 3], [0.0, 0.0, p.yaw_inertia]],
+                com: Vector3::new(p.com_offset, 0.0, 0.0),
+                inertia: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, p.yaw_inertia),
             });
         }
         bodies.push(body(1, &arm.turret));
@@ -401,7 +360,8 @@ impl Model {
                             l.com
                         )));
                     }
-                    let j_res = residual_inertia(l.mass, l.length, &l.inertia);
+                    let j_res =
+                        residual_inertia(l.mass, l.length, &Matrix3::from(l.inertia).transpose());
                     if !positive_semidefinite(&j_res, 1e-12) {
                         return Err(FemError::unsupported(format!(
                             "fem mobile manipulator: flexible link {}: its inertia minus the \
@@ -426,7 +386,7 @@ impl Model {
                     bodies.push(Body {
                         frame,
                         mass: 0.0,
-                        com: [half, 0.0, 0.0],
+                        com: Vector3::new(half, 0.0, 0.0),
                         inertia: j_res,
                     });
                     let (xs, ws) = gauss01(GAUSS);
@@ -479,7 +439,7 @@ impl Model {
             gravity: m.gravity,
             platform,
             ground_pose: [m.initial.x, m.initial.y, m.initial.heading],
-            mount: arm.mount,
+            mount: Vector3::from(arm.mount),
             base_height: arm.base_height,
             lengths,
             bodies,
@@ -493,57 +453,51 @@ impl Model {
         let mut f = Frames::default();
         let l = self.layout;
         if l.platform {
-            f.o[0] = [q[0], q[1], 0.0];
+            f.o[0] = Vector3::new(q[0], q[1], 0.0);
             f.r[0] = rot_z(q[2]);
-            f.w[0] = [0.0, 0.0, qd[2]];
-            f.al[0] = [0.0, 0.0, qdd[2]];
-            f.v[0] = [qd[0], qd[1], 0.0];
-            f.a[0] = [qdd[0], qdd[1], 0.0];
+            f.w[0] = Vector3::new(0.0, 0.0, qd[2]);
+            f.al[0] = Vector3::new(0.0, 0.0, qdd[2]);
+            f.v[0] = Vector3::new(qd[0], qd[1], 0.0);
+            f.a[0] = Vector3::new(qdd[0], qdd[1], 0.0);
         } else {
             let [x, y, psi] = self.ground_pose;
-            f.o[0] = [x, y, 0.0];
+            f.o[0] = Vector3::new(x, y, 0.0);
             f.r[0] = rot_z(psi);
         }
         let a0 = l.q_arm;
         for k in 1..6 {
             // Offset of frame k's origin in frame k − 1 (with its rates when it is a flexible tip).
-            let mut d = [[0.0; 3]; 3];
+            let mut d = [Vec3::zeros(); 3];
             let mut tip = None;
             match k {
                 1 => d[0] = self.mount,
-                2 => d[0] = [0.0, 0.0, self.base_height],
+                2 => d[0] = Vector3::new(0.0, 0.0, self.base_height),
                 _ => {
-                    d[0] = [self.lengths[k - 3], 0.0, 0.0];
+                    d[0] = Vector3::new(self.lengths[k - 3], 0.0, 0.0);
                     if let Some(fl) = &self.flex
                         && fl.frame == k - 1
                     {
                         let b = l.q_el + fl.ne - 4;
                         d[0][1] = q[b];
                         d[0][2] = q[b + 2];
-                        d[1] = [0.0, qd[b], qd[b + 2]];
-                        d[2] = [0.0, qdd[b], qdd[b + 2]];
+                        d[1] = Vector3::new(0.0, qd[b], qd[b + 2]);
+                        d[2] = Vector3::new(0.0, qdd[b], qdd[b + 2]);
                         tip = Some(b);
                     }
                 }
             }
             let (r, w, al) = (f.r[k - 1], f.w[k - 1], f.al[k - 1]);
-            let dp = mat_vec(&r, d[0]);
-            let dv = mat_vec(&r, d[1]);
-            let da = mat_vec(&r, d[2]);
-            f.o[k] = add(f.o[k - 1], dp);
-            f.v[k] = add(add(f.v[k - 1], cross(w, dp)), dv);
-            f.a[k] = add(
-                add(
-                    add(f.a[k - 1], cross(al, dp)),
-                    cross(w, add(cross(w, dp), scale(2.0, dv))),
-                ),
-                da,
-            );
+            let dp = r * d[0];
+            let dv = r * d[1];
+            let da = r * d[2];
+            f.o[k] = f.o[k - 1] + dp;
+            f.v[k] = f.v[k - 1] + w.cross(&dp) + dv;
+            f.a[k] = f.a[k - 1] + al.cross(&dp) + w.cross(&(w.cross(&dp) + (2.0 * dv))) + da;
             let (mut r, mut w, mut al) = (r, w, al);
             if let Some(b) = tip {
                 f.tip_o = f.o[k];
-                f.tip_axes[0] = mat_vec(&r, EY);
-                f.tip_axes[1] = mat_vec(&r, EZ);
+                f.tip_axes[0] = r * EY;
+                f.tip_axes[1] = r * EZ;
                 f.tip_axes[2] = revolute(
                     &mut r,
                     &mut w,
@@ -597,26 +551,26 @@ impl Model {
         if let Some(pl) = &self.platform {
             let (s, c) = q[2].sin_cos();
             let half = 0.5 * pl.wheel_radius;
-            let v = [half * c, half * s, 0.0];
+            let v = Vector3::new(half * c, half * s, 0.0);
             let yaw = half / pl.half_track;
-            let turn = cross(EZ, sub(p, f.o[0]));
-            out.push(0, add(v, scale(yaw, turn)), [0.0, 0.0, yaw]);
-            out.push(1, sub(v, scale(yaw, turn)), [0.0, 0.0, -yaw]);
+            let turn = EZ.cross(&(p - f.o[0]));
+            out.push(0, v + (yaw * turn), Vector3::new(0.0, 0.0, yaw));
+            out.push(1, v - (yaw * turn), Vector3::new(0.0, 0.0, -yaw));
         }
         for j in 1..5.min(k + 1) {
             let axis = f.axis[j];
-            out.push(l.nu_arm + j - 1, cross(axis, sub(p, f.o[j])), axis);
+            out.push(l.nu_arm + j - 1, axis.cross(&(p - f.o[j])), axis);
         }
         if let Some(fl) = &self.flex
             && k > fl.frame
         {
             let b = l.nu_el + fl.ne - 4;
-            let zero = [0.0; 3];
+            let zero = Vec3::zeros();
             out.push(b, f.tip_axes[0], zero);
             out.push(b + 2, f.tip_axes[1], zero);
-            let arm = sub(p, f.tip_o);
-            out.push(b + 1, cross(f.tip_axes[2], arm), f.tip_axes[2]);
-            out.push(b + 3, cross(f.tip_axes[3], arm), f.tip_axes[3]);
+            let arm = p - f.tip_o;
+            out.push(b + 1, f.tip_axes[2].cross(&arm), f.tip_axes[2]);
+            out.push(b + 3, f.tip_axes[3].cross(&arm), f.tip_axes[3]);
         }
     }
 
@@ -634,12 +588,12 @@ impl Model {
         out: &mut Partials,
     ) {
         self.frame_partials(f, q, fl.frame, p, out);
-        let (ey, ez) = (mat_vec(&f.r[fl.frame], EY), mat_vec(&f.r[fl.frame], EZ));
-        let zero = [0.0; 3];
+        let (ey, ez) = (f.r[fl.frame] * EY, f.r[fl.frame] * EZ);
+        let zero = Vec3::zeros();
         for (field, axis) in [(0, ey), (1, ez)] {
             for a in 0..4 {
                 if let Some(g) = FlexLink::dof(el, a, field) {
-                    out.push(self.layout.nu_el + g, scale(s.n[a], axis), zero);
+                    out.push(self.layout.nu_el + g, s.n[a] * axis, zero);
                 }
             }
         }
@@ -670,17 +624,17 @@ impl Model {
         if let Some(mm) = mass.as_deref_mut() {
             mm[..m * m].fill(0.0);
         }
-        let gvec = [0.0, 0.0, self.gravity];
+        let gvec = Vector3::new(0.0, 0.0, self.gravity);
         let mut jp = Partials::default();
         for b in &self.bodies {
             let r = &f.r[b.frame];
-            let rc = mat_vec(r, b.com);
-            let p = add(f.o[b.frame], rc);
+            let rc = r * b.com;
+            let p = f.o[b.frame] + rc;
             let (w, al) = (f.w[b.frame], f.al[b.frame]);
-            let acc = add(add(f.a[b.frame], cross(al, rc)), cross(w, cross(w, rc)));
-            let iw = rotate_inertia(r, &b.inertia);
-            let lin = scale(b.mass, add(acc, gvec));
-            let ang = add(mat_vec(&iw, al), cross(w, mat_vec(&iw, w)));
+            let acc = f.a[b.frame] + al.cross(&rc) + w.cross(&w.cross(&rc));
+            let iw = r * b.inertia * r.transpose();
+            let lin = b.mass * (acc + gvec);
+            let ang = iw * al + w.cross(&(iw * w));
             self.frame_partials(&f, q, b.frame, p, &mut jp);
             accumulate(&jp, b.mass, &iw, lin, ang, m, force, mass.as_deref_mut());
         }
@@ -691,7 +645,7 @@ impl Model {
             let e = &q[l.q_el..l.q_el + fl.ne];
             let ed = &ws.qd[l.q_el..l.q_el + fl.ne];
             let edd = &ws.qdd[l.q_el..l.q_el + fl.ne];
-            let zero3 = [[0.0; 3]; 3];
+            let zero3 = Mat3::zeros();
             for el in 0..fl.elements {
                 for g in 0..GAUSS {
                     let s = &fl.shapes[g];
@@ -699,26 +653,20 @@ impl Model {
                     let [vv, ww] = fl.field_at(e, el, &s.n);
                     let [vd, wd] = fl.field_at(ed, el, &s.n);
                     let [vdd, wdd] = fl.field_at(edd, el, &s.n);
-                    let d = mat_vec(r, [x, vv, ww]);
-                    let dv = mat_vec(r, [0.0, vd, wd]);
-                    let da = mat_vec(r, [0.0, vdd, wdd]);
-                    let p = add(f.o[fr], d);
-                    let acc = add(
-                        add(
-                            add(f.a[fr], cross(al, d)),
-                            cross(w, add(cross(w, d), scale(2.0, dv))),
-                        ),
-                        da,
-                    );
+                    let d = r * Vector3::new(x, vv, ww);
+                    let dv = r * Vector3::new(0.0, vd, wd);
+                    let da = r * Vector3::new(0.0, vdd, wdd);
+                    let p = f.o[fr] + d;
+                    let acc = f.a[fr] + al.cross(&d) + w.cross(&(w.cross(&d) + (2.0 * dv))) + da;
                     let dm = fl.mu * fl.gauss_w[g];
-                    let lin = scale(dm, add(acc, gvec));
+                    let lin = dm * (acc + gvec);
                     self.beam_partials(&f, q, fl, el, s, p, &mut jp);
                     accumulate(
                         &jp,
                         dm,
                         &zero3,
                         lin,
-                        [0.0; 3],
+                        Vec3::zeros(),
                         m,
                         force,
                         mass.as_deref_mut(),
@@ -762,11 +710,11 @@ impl Model {
         let mut t = 0.0;
         for b in &self.bodies {
             let r = &f.r[b.frame];
-            let rc = mat_vec(r, b.com);
+            let rc = r * b.com;
             let w = f.w[b.frame];
-            let v = add(f.v[b.frame], cross(w, rc));
-            let iw = rotate_inertia(r, &b.inertia);
-            t += 0.5 * b.mass * dot3(v, v) + 0.5 * dot3(w, mat_vec(&iw, w));
+            let v = f.v[b.frame] + w.cross(&rc);
+            let iw = r * b.inertia * r.transpose();
+            t += 0.5 * b.mass * v.dot(&v) + 0.5 * w.dot(&(iw * w));
         }
         if let Some(fl) = &self.flex {
             let l = self.layout;
@@ -778,12 +726,9 @@ impl Model {
                     let x = (el as f64 + fl.gauss_xi[g]) * fl.le;
                     let [vv, ww] = fl.field_at(e, el, &s.n);
                     let [vd, wd] = fl.field_at(ed, el, &s.n);
-                    let d = mat_vec(&f.r[fr], [x, vv, ww]);
-                    let v = add(
-                        add(f.v[fr], cross(f.w[fr], d)),
-                        mat_vec(&f.r[fr], [0.0, vd, wd]),
-                    );
-                    t += 0.5 * fl.mu * fl.gauss_w[g] * dot3(v, v);
+                    let d = f.r[fr] * Vector3::new(x, vv, ww);
+                    let v = f.v[fr] + f.w[fr].cross(&d) + (f.r[fr] * Vector3::new(0.0, vd, wd));
+                    t += 0.5 * fl.mu * fl.gauss_w[g] * v.dot(&v);
                 }
             }
         }
@@ -799,7 +744,7 @@ impl Model {
         let f = self.frames(q, &zeros, &zeros);
         let mut v = 0.0;
         for b in &self.bodies {
-            v += b.mass * self.gravity * add(f.o[b.frame], mat_vec(&f.r[b.frame], b.com))[2];
+            v += b.mass * self.gravity * (f.o[b.frame] + (f.r[b.frame] * b.com))[2];
         }
         if let Some(fl) = &self.flex {
             let e = &q[self.layout.q_el..self.layout.n];
@@ -808,7 +753,7 @@ impl Model {
                     let s = &fl.shapes[g];
                     let x = (el as f64 + fl.gauss_xi[g]) * fl.le;
                     let [vv, ww] = fl.field_at(e, el, &s.n);
-                    let z = f.o[fl.frame][2] + mat_vec(&f.r[fl.frame], [x, vv, ww])[2];
+                    let z = f.o[fl.frame][2] + (f.r[fl.frame] * Vector3::new(x, vv, ww))[2];
                     v += fl.mu * fl.gauss_w[g] * self.gravity * z;
                 }
             }
@@ -840,7 +785,7 @@ impl Model {
         for b in &self.bodies {
             out.push((
                 b.mass,
-                add(f.o[b.frame], mat_vec(&f.r[b.frame], b.com)),
+                f.o[b.frame] + (f.r[b.frame] * b.com),
                 f.r[b.frame],
                 b.inertia,
             ));
@@ -852,8 +797,8 @@ impl Model {
                     let s = &fl.shapes[g];
                     let x = (el as f64 + fl.gauss_xi[g]) * fl.le;
                     let [vv, ww] = fl.field_at(e, el, &s.n);
-                    let p = add(f.o[fl.frame], mat_vec(&f.r[fl.frame], [x, vv, ww]));
-                    out.push((fl.mu * fl.gauss_w[g], p, f.r[fl.frame], [[0.0; 3]; 3]));
+                    let p = f.o[fl.frame] + (f.r[fl.frame] * Vector3::new(x, vv, ww));
+                    out.push((fl.mu * fl.gauss_w[g], p, f.r[fl.frame], Mat3::zeros()));
                 }
             }
         }
@@ -896,20 +841,20 @@ fn accumulate(
     mass: Option<&mut [f64]>,
 ) {
     for a in 0..jp.len {
-        force[jp.idx[a]] += dot3(jp.jv[a], lin) + dot3(jp.jw[a], ang);
+        force[jp.idx[a]] += jp.jv[a].dot(&lin) + jp.jw[a].dot(&ang);
     }
     if let Some(mm) = mass {
-        let rotating = iw.iter().any(|row| row.iter().any(|&x| x != 0.0));
+        let rotating = iw.iter().any(|&x| x != 0.0);
         for a in 0..jp.len {
             let iwa = if rotating {
-                mat_vec(iw, jp.jw[a])
+                iw * jp.jw[a]
             } else {
-                [0.0; 3]
+                Vec3::zeros()
             };
             let ia = jp.idx[a];
             for b in 0..jp.len {
                 let ib = jp.idx[b];
-                mm[ia * m + ib] += mass_el * dot3(jp.jv[a], jp.jv[b]) + dot3(jp.jw[b], iwa);
+                mm[ia * m + ib] += mass_el * jp.jv[a].dot(&jp.jv[b]) + jp.jw[b].dot(&iwa);
             }
         }
     }
