@@ -6,7 +6,9 @@ use toml::de::DeTable;
 use crate::error::{SceneError, line_column};
 use crate::locate::{FieldPath, Segment, non_finite_numbers, offset_of};
 use crate::scene::{Scene, SceneFile};
-use crate::validate::{MAX_FILE_BYTES, check_file, validate};
+use crate::validate::limits::MAX_FILE_BYTES;
+use crate::validate::scene_file::check_file;
+use crate::validate::validate;
 
 /// Parses and validates a scene. `source_name` is used in messages (usually the file path).
 pub fn parse_scene(text: &str, source_name: &str) -> Result<Scene, SceneError> {
@@ -61,7 +63,7 @@ pub fn parse_scene(text: &str, source_name: &str) -> Result<Scene, SceneError> {
         err_at(offset, path.to_string(), message, expected)
     })?;
 
-    let to_error = |issue: crate::validate::Issue| {
+    let to_error = |issue: crate::validate::issue::Issue| {
         let offset = offset_of(&table, &issue.path);
         err_at(
             offset,

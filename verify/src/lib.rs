@@ -5,13 +5,13 @@
 //! work-precision studies, the stability suite, reports — and the `flexverify` command line.
 //!
 //! The library is usable without the command line: [`suite::run_cases`] evaluates
-//! verification cases into [`suite::evaluate::Outcome`]s, [`study::converge`] and
-//! [`study::recommend`] run refinement studies, [`stability::run_stability`] judges the stiff
-//! and extreme cases; each fails only with an [`Error`] and reports long work to a
-//! [`progress::Progress`] observer. Module dependencies run one way: the leaves `analytic`,
-//! `error`, `output`, `plot`, `progress`, `registry` ← `suite` ← `study`; `stability` uses
-//! `suite` only for its [`suite::Suite`] selector; [`cli`] (clap, exit codes, printing, the
-//! progress bar) sits on top of everything and nothing below it depends on it.
+//! verification cases into [`suite::evaluate::Outcome`]s, [`study::run::converge`] and
+//! [`study::recommend::recommend`] run refinement studies, [`stability::run_stability`]
+//! judges the stiff and extreme cases; each fails only with an [`Error`] and reports long
+//! work to a [`progress::Progress`] observer. Module dependencies run one way: the leaves
+//! `analytic`, `error`, `output`, `plot`, `progress`, `registry` ← `suite` ← `study`;
+//! `stability` uses `suite` only for its [`suite::Suite`] selector; [`cli`] (clap, exit codes,
+//! printing, the progress bar) sits on top of everything and nothing below it depends on it.
 
 pub mod analytic;
 pub mod cli;

@@ -33,7 +33,10 @@ use thiserror::Error;
 
 use data::{BackendKind, Settings};
 
-use crate::study::{LadderSpec, Refine, RungMeasurement, Study};
+use crate::study::ladder::Refine;
+use crate::study::measure::RungMeasurement;
+use crate::study::summary::Study;
+use crate::study::survey::LadderSpec;
 use crate::suite::Suite;
 use crate::suite::evaluate::Outcome;
 

@@ -7,7 +7,9 @@ use data::{BackendKind, Settings, load_scene};
 use verify::Error;
 use verify::output::TERMINAL_WIDTH;
 use verify::progress::{Progress, Silent};
-use verify::study::{Refine, converge, recommend};
+use verify::study::ladder::Refine;
+use verify::study::recommend::recommend;
+use verify::study::run::converge;
 use verify::suite::evaluate::Status;
 use verify::suite::{Suite, report, run_cases, run_cases_with_progress};
 

@@ -137,8 +137,8 @@ impl PlanarChain {
 }
 
 /// The layout of a scene file: every family's tables optional at the top level. Reading
-/// checks it ([`crate::validate::check_file`]: exactly one family, planar-only tables only
-/// with links) and converts it into a [`Scene`].
+/// checks it ([`crate::validate::scene_file::check_file`]: exactly one family, planar-only
+/// tables only with links) and converts it into a [`Scene`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {

@@ -5,7 +5,7 @@ use clap::builder::PossibleValue;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 pub use crate::output::Format;
-pub use crate::study::Refine;
+pub use crate::study::ladder::Refine;
 pub use crate::suite::Suite;
 
 #[derive(Debug, Parser)]

@@ -9,7 +9,8 @@ use crate::error::Error;
 use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
 use crate::shard::{self, Shard, ShardFile};
 use crate::stability::{self, Verdict};
-use crate::study::{self, LadderSpec, Study};
+use crate::study::summary::Study;
+use crate::study::survey::{self, LadderSpec};
 use crate::suite::evaluate::{Outcome, Status};
 use crate::suite::{Suite, plots, report, run_selected, select_cases};
 
@@ -20,7 +21,7 @@ fn select(
     filter: Option<&str>,
 ) -> Result<(Vec<data::cases::Case>, Vec<LadderSpec>), CliError> {
     let ladders = match suite {
-        Suite::Full => study::select_ladders(filter)?,
+        Suite::Full => survey::select_ladders(filter)?,
         Suite::Quick => Vec::new(),
     };
     let cases = match select_cases(suite, filter) {
@@ -37,9 +38,9 @@ fn print_survey(studies: &[Study], format: Format) {
     }
     outln!();
     match format {
-        Format::Table => out!("{}", study::survey_terminal_table(studies, TERMINAL_WIDTH)),
+        Format::Table => out!("{}", survey::survey_terminal_table(studies, TERMINAL_WIDTH)),
         Format::Wide | Format::Csv | Format::Json => {
-            out!("{}", study::survey_wide_table(studies))
+            out!("{}", survey::survey_wide_table(studies))
         }
     }
 }
@@ -59,7 +60,7 @@ pub fn verify(
     print_outcomes(&outcomes, format);
     // The full suite's refinement ladders (a study per scene, ids `ladder-<scene>`) run after
     // the cases, sequentially: their timings must not share the cores.
-    let (studies, notes) = study::run_ladders(&ladders, out, &bar)?;
+    let (studies, notes) = survey::run_ladders(&ladders, out, &bar)?;
     bar.clear();
     for n in notes {
         eprintln!("note: {n}");
@@ -101,7 +102,7 @@ pub fn verify_shard(
     let wall = started.elapsed().as_secs_f64();
     print_outcomes(&outcomes, format);
     std::fs::create_dir_all(dir)?;
-    let (studies, notes) = study::run_ladders(&shard.share(&ladder_selection), Some(dir), &bar)?;
+    let (studies, notes) = survey::run_ladders(&shard.share(&ladder_selection), Some(dir), &bar)?;
     bar.clear();
     for n in notes {
         eprintln!("note: {n}");
@@ -144,7 +145,7 @@ pub fn merge(dirs: &[PathBuf], format: Format, out: &Path) -> Result<(), CliErro
     print_survey(&merged.ladders, format);
     std::fs::create_dir_all(out)?;
     for study in &merged.ladders {
-        for n in study::write_ladder(out, study)? {
+        for n in survey::write_ladder(out, study)? {
             eprintln!("note: {n}");
         }
     }

@@ -11,7 +11,10 @@ use super::stdout::{out, outln};
 use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
 use crate::progress::Progress;
 use crate::shard::{ConvergeShardFile, MeasuredRung, Shard};
-use crate::study::{self, Refine, RungMeasurement, Study};
+use crate::study::ladder::{Refine, rung_specs};
+use crate::study::measure::{RungMeasurement, measure_rung, parse_quantity};
+use crate::study::summary::Study;
+use crate::study::{run, table};
 use crate::suite::run_cache::RunCache;
 
 pub fn converge(
@@ -22,7 +25,7 @@ pub fn converge(
 ) -> Result<(), CliError> {
     let scene = load_scene(scene)?;
     let bar = Bar::new();
-    let study = study::converge(
+    let study = run::converge(
         &scene,
         quantity,
         refine,
@@ -36,16 +39,16 @@ pub fn converge(
 
 fn write_and_print(study: &Study, out: Option<&Path>, format: Format) -> Result<(), CliError> {
     if let Some(dir) = out {
-        for n in study::write_study(dir, study)? {
+        for n in table::write_study(dir, study)? {
             eprintln!("note: {n}");
         }
         eprintln!("wrote the study and its plots to {}", dir.display());
     }
     match format {
-        Format::Json => outln!("{}", study::json(study)),
-        Format::Csv => out!("{}", study::csv(study)),
-        Format::Wide => out!("{}", study::wide_table(study)),
-        Format::Table => out!("{}", study::terminal_table(study, TERMINAL_WIDTH)),
+        Format::Json => outln!("{}", table::json(study)),
+        Format::Csv => out!("{}", table::csv(study)),
+        Format::Wide => out!("{}", table::wide_table(study)),
+        Format::Table => out!("{}", table::terminal_table(study, TERMINAL_WIDTH)),
     }
     Ok(())
 }
@@ -64,18 +67,17 @@ pub fn converge_shard(
         ));
     };
     let scene = load_scene(scene_arg)?;
-    let q = study::parse_quantity(&scene, quantity)?;
+    let q = parse_quantity(&scene, quantity)?;
     let kinds = opts.kinds();
     let base = super::commands::checked_settings(opts, &kinds)?;
-    let flat: Vec<(BackendKind, usize, Settings)> =
-        study::rung_specs(&scene, refine, &kinds, &base)
-            .into_iter()
-            .flat_map(|(kind, spec)| {
-                spec.into_iter()
-                    .enumerate()
-                    .map(move |(rung, (settings, _, _))| (kind, rung, settings))
-            })
-            .collect();
+    let flat: Vec<(BackendKind, usize, Settings)> = rung_specs(&scene, refine, &kinds, &base)
+        .into_iter()
+        .flat_map(|(kind, spec)| {
+            spec.into_iter()
+                .enumerate()
+                .map(move |(rung, (settings, _, _))| (kind, rung, settings))
+        })
+        .collect();
     let cache = RunCache::default();
     let bar = Bar::new();
     let mine: Vec<usize> = (0..flat.len()).filter(|&p| shard.owns(p)).collect();
@@ -85,7 +87,7 @@ pub fn converge_shard(
         .map(|position| {
             let (kind, rung, settings) = &flat[position];
             bar.start(&format!("{} {quantity}: {kind} rung {rung}", scene.name));
-            let measurement = study::measure_rung(&cache, &scene, *kind, settings, &q);
+            let measurement = measure_rung(&cache, &scene, *kind, settings, &q);
             bar.advance();
             MeasuredRung {
                 position,
@@ -133,7 +135,7 @@ pub fn merge_converge(
             .cloned()
             .unwrap_or_else(|| Err(format!("{kind}: rung {rung} missing from the shards")))
     };
-    let study = study::converge_from_rungs(
+    let study = run::converge_from_rungs(
         &scene,
         &head.quantity,
         head.refine,
@@ -155,7 +157,7 @@ pub fn merge_converge(
 pub fn recommend(scene: &str, quantity: &str, tol: f64, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(scene)?;
     let bar = Bar::new();
-    let recommendation = study::recommend(
+    let recommendation = crate::study::recommend::recommend(
         &scene,
         quantity,
         tol,

@@ -1,0 +1,61 @@
+//! One rung's measurement: the quantity's value and the rung's cost, measured two ways with
+//! the suite's rule ([`crate::report::work::time_rung`]): the wall time as the minimum of
+//! repeats (at least 5 and 0.2 s; a rung whose first run took more than 3 s is timed once, and
+//! its `repeats` says so), with median, maximum and spread; and the backend's work counters
+//! (DOFs, steps, RHS evaluations, factorizations, Newton iterations), exact and machine
+//! independent.
+
+use data::{BackendKind, Scene, Settings};
+use serde::{Deserialize, Serialize};
+
+use crate::error::Error;
+use crate::report::work::{Counters, FirstRun, Timing, time_rung};
+use crate::suite::evaluate::measure;
+use crate::suite::quantity::Quantity;
+use crate::suite::run_cache::{RunCache, compute};
+
+/// One rung's measurement: the quantity's value, the peak |channel| for time histories, the
+/// repeated timings and the work counters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Measured {
+    pub value: f64,
+    pub peak: Option<f64>,
+    pub timing: Timing,
+    pub counters: Counters,
+}
+
+/// One rung's measurement, or why the backend could not give the quantity at that rung.
+pub type RungMeasurement = Result<Measured, String>;
+
+/// Measures one rung (the quantity must parse: see [`parse_quantity`]).
+pub fn measure_rung(
+    cache: &RunCache,
+    scene: &Scene,
+    kind: BackendKind,
+    settings: &Settings,
+    q: &Quantity,
+) -> RungMeasurement {
+    let (value, peak, first) = measure(cache, scene, kind, settings, q)?;
+    let counters = cache
+        .get(scene, kind, settings, q.analysis(), q.modes_needed())
+        .counters()
+        .ok_or_else(|| format!("{kind}: no cost counters"))?;
+    // The ladder runs alone, so its first run is a repeat like the others.
+    let repeat = || compute(scene, kind, settings, q.analysis(), q.modes_needed()).wall_time_s();
+    let timing = time_rung(first, FirstRun::Alone, repeat)
+        .ok_or_else(|| format!("{kind}: a timing repeat of the run failed"))?;
+    Ok(Measured {
+        value,
+        peak,
+        timing,
+        counters,
+    })
+}
+
+/// The quantity of a study, parsed against its scene.
+pub fn parse_quantity(scene: &Scene, quantity: &str) -> Result<Quantity, Error> {
+    Quantity::parse(quantity, scene).map_err(|reason| Error::InvalidQuantity {
+        quantity: quantity.to_string(),
+        reason: reason.to_string(),
+    })
+}
