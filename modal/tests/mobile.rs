@@ -10,6 +10,7 @@ use data::{Backend, Discretization, Scene, Settings, TimeStepping, load_scene};
 use modal::ModalBackend;
 use modal::mobile::model::{MobileModel, ShapeChoice, Workspace};
 use modal::mobile::set_up;
+use nalgebra::Vector3;
 
 fn disc(modes: usize) -> Discretization {
     Discretization {
@@ -81,42 +82,27 @@ fn sys_mobile_mass_matrix_is_the_kinetic_energy_of_sampled_points() {
             .map(|(&s, nk)| model.kinematics(&shifted(s * eps), &zeros, &zeros, Some(nk)))
             .collect();
         let f0 = model.kinematics(&q, &zeros, &zeros, None);
-        let stencil = |v: [[f64; 3]; 4]| -> [f64; 3] {
-            std::array::from_fn(|k| {
-                (8.0 * (v[1][k] - v[2][k]) - (v[0][k] - v[3][k])) / (12.0 * eps)
-            })
+        let stencil = |v: [Vector3<f64>; 4]| -> Vector3<f64> {
+            (8.0 * (v[1] - v[2]) - (v[0] - v[3])) / (12.0 * eps)
         };
         let mut t = 0.0;
         for b in &model.bodies {
-            let pos = |f: &modal::mobile::model::Frames| -> [f64; 3] {
-                let r = &f.r[b.frame];
-                std::array::from_fn(|k| {
-                    f.o[b.frame][k] + (0..3).map(|c| r[k][c] * b.com[c]).sum::<f64>()
-                })
-            };
+            let pos = |f: &modal::mobile::model::Frames| f.o[b.frame] + f.r[b.frame] * b.com;
             let v = stencil(std::array::from_fn(|s| pos(&fr[s])));
-            // ω from Ṙ Rᵀ (skew), Ṙ by the same stencil row by row.
+            // ω from Ṙ Rᵀ (skew), Ṙ by the same stencil.
             let r0 = &f0.r[b.frame];
-            let rdot: [[f64; 3]; 3] =
-                std::array::from_fn(|i| stencil(std::array::from_fn(|s| fr[s].r[b.frame][i])));
-            let mut w_skew = [[0.0; 3]; 3];
-            for i in 0..3 {
-                for j in 0..3 {
-                    w_skew[i][j] = (0..3).map(|k| rdot[i][k] * r0[j][k]).sum();
-                }
-            }
-            let w = [w_skew[2][1], w_skew[0][2], w_skew[1][0]];
+            let r = |s: usize| fr[s].r[b.frame];
+            let rdot = (8.0 * (r(1) - r(2)) - (r(0) - r(3))) / (12.0 * eps);
+            let w_skew = rdot * r0.transpose();
+            let w = Vector3::new(w_skew[(2, 1)], w_skew[(0, 2)], w_skew[(1, 0)]);
             // ω·R J Rᵀ ω = (Rᵀω)·J(Rᵀω).
-            let wb: [f64; 3] = std::array::from_fn(|k| (0..3).map(|c| r0[c][k] * w[c]).sum());
-            let jw: [f64; 3] =
-                std::array::from_fn(|k| (0..3).map(|c| b.inertia[k][c] * wb[c]).sum());
-            t += 0.5 * b.mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
-                + 0.5 * (0..3).map(|k| wb[k] * jw[k]).sum::<f64>();
+            let wb = r0.transpose() * w;
+            t += 0.5 * b.mass * v.dot(&v) + 0.5 * wb.dot(&(b.inertia * wb));
         }
         let fl = model.flex.as_ref().unwrap();
         for g in 0..fl.nodes.len() {
             let v = stencil(std::array::from_fn(|s| nodes[s].p[g]));
-            t += 0.5 * fl.density * fl.weights[g] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            t += 0.5 * fl.density * fl.weights[g] * v.dot(&v);
         }
         let pl = model.platform.as_ref().unwrap();
         t += 0.5 * pl.side_spin_inertia * (nu[0] * nu[0] + nu[1] * nu[1]);

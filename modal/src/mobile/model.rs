@@ -35,65 +35,27 @@
 //! [`Quadrature::for_wavenumber`].
 
 use data::scene::{MobileManipulator, RigidBody};
+use nalgebra::{Matrix3, Vector3};
 
 use crate::basis::ShapeSet;
 use crate::basis::quadrature::Quadrature;
 use crate::error::ModalError;
 
-pub type Vec3 = [f64; 3];
-pub type Mat3 = [[f64; 3]; 3];
+pub type Vec3 = Vector3<f64>;
+pub type Mat3 = Matrix3<f64>;
 
-pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-pub(crate) fn dot3(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub(crate) fn scale(s: f64, a: Vec3) -> Vec3 {
-    [s * a[0], s * a[1], s * a[2]]
-}
-pub(crate) fn rot(m: &Mat3, v: Vec3) -> Vec3 {
-    [dot3(m[0], v), dot3(m[1], v), dot3(m[2], v)]
-}
-fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
-        }
-    }
-    c
-}
-/// R J Rᵀ.
-fn similar(r: &Mat3, j: &Mat3) -> Mat3 {
-    let rj = mat_mul(r, j);
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for k in 0..3 {
-            c[i][k] = rj[i][0] * r[k][0] + rj[i][1] * r[k][1] + rj[i][2] * r[k][2];
-        }
-    }
-    c
-}
 fn rot_z(t: f64) -> Mat3 {
     let (s, c) = t.sin_cos();
-    [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 /// Rotation by θ about −y (R_y(−θ)): x ↦ (cos θ, 0, sin θ).
 fn rot_pitch(t: f64) -> Mat3 {
     let (s, c) = t.sin_cos();
-    [[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]]
+    Matrix3::new(c, 0.0, -s, 0.0, 1.0, 0.0, s, 0.0, c)
 }
 
-const EZ: Vec3 = [0.0, 0.0, 1.0];
-const MINUS_EY: Vec3 = [0.0, -1.0, 0.0];
+const EZ: Vec3 = Vector3::new(0.0, 0.0, 1.0);
+const MINUS_EY: Vec3 = Vector3::new(0.0, -1.0, 0.0);
 
 /// Where each part of q and ν starts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -283,12 +245,12 @@ impl MobileModel {
             bodies.push(Body {
                 frame: 0,
                 mass: p.mass,
-                com: [p.com_offset, 0.0, 0.0],
-                inertia: [[0.0; 3], [0.0; 3], [0.0, 0.0, p.yaw_inertia]],
+                com: Vector3::new(p.com_offset, 0.0, 0.0),
+                inertia: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, p.yaw_inertia),
             });
         }
         let (mut mount, mut base_height, mut lengths, mut friction) =
-            ([0.0; 3], 0.0, [0.0; 3], [0.0; 4]);
+            (Vec3::zeros(), 0.0, [0.0; 3], [0.0; 4]);
         let mut flex = None;
         if let Some(a) = &m.arm {
             if a.links.len() != 3 {
@@ -300,8 +262,8 @@ impl MobileModel {
             let body = |frame: usize, b: &RigidBody| Body {
                 frame,
                 mass: b.mass,
-                com: b.com,
-                inertia: b.inertia,
+                com: Vector3::from(b.com),
+                inertia: Matrix3::from(b.inertia).transpose(),
             };
             bodies.push(body(1, &a.turret));
             for (k, l) in a.links.iter().enumerate() {
@@ -312,7 +274,7 @@ impl MobileModel {
                         bodies.push(Body {
                             frame: k + 2,
                             mass: 0.0,
-                            com: [0.0; 3],
+                            com: Vec3::zeros(),
                             inertia: fl.residual_inertia,
                         });
                         flex = Some(fl);
@@ -321,7 +283,7 @@ impl MobileModel {
                 }
             }
             bodies.push(body(5, &a.gripper));
-            mount = a.mount;
+            mount = Vector3::from(a.mount);
             base_height = a.base_height;
             friction = a.joint_friction;
         }
@@ -355,16 +317,16 @@ impl MobileModel {
         let mut f = Frames::default();
         match self.layout.platform {
             Some(p) => {
-                f.o[0] = [q[p], q[p + 1], 0.0];
+                f.o[0] = Vector3::new(q[p], q[p + 1], 0.0);
                 f.r[0] = rot_z(q[p + 2]);
-                f.w[0] = [0.0, 0.0, qd[p + 2]];
-                f.al[0] = [0.0, 0.0, qdd[p + 2]];
-                f.v[0] = [qd[p], qd[p + 1], 0.0];
-                f.a[0] = [qdd[p], qdd[p + 1], 0.0];
+                f.w[0] = Vector3::new(0.0, 0.0, qd[p + 2]);
+                f.al[0] = Vector3::new(0.0, 0.0, qdd[p + 2]);
+                f.v[0] = Vector3::new(qd[p], qd[p + 1], 0.0);
+                f.a[0] = Vector3::new(qdd[p], qdd[p + 1], 0.0);
             }
             None => {
                 let [x, y, psi] = self.ground_pose;
-                f.o[0] = [x, y, 0.0];
+                f.o[0] = Vector3::new(x, y, 0.0);
                 f.r[0] = rot_z(psi);
             }
         }
@@ -373,10 +335,10 @@ impl MobileModel {
         };
         let offsets = [
             self.mount,
-            [0.0, 0.0, self.base_height],
-            [self.lengths[0], 0.0, 0.0],
-            [self.lengths[1], 0.0, 0.0],
-            [self.lengths[2], 0.0, 0.0],
+            Vector3::new(0.0, 0.0, self.base_height),
+            Vector3::new(self.lengths[0], 0.0, 0.0),
+            Vector3::new(self.lengths[1], 0.0, 0.0),
+            Vector3::new(self.lengths[2], 0.0, 0.0),
         ];
         let flex_frame = self.flex.as_ref().map(|fl| fl.frame);
         for k in 1..6 {
@@ -400,39 +362,30 @@ impl MobileModel {
                 let (s, c) = tip(q, &fl.slope_tip);
                 let (sd, cd) = tip(qd, &fl.slope_tip);
                 let (sdd, cdd) = tip(qdd, &fl.slope_tip);
-                let d = rot(&f.r[p], [fl.length, vl, wl]);
-                let dd = rot(&f.r[p], [0.0, vld, wld]);
-                let ddd = rot(&f.r[p], [0.0, vldd, wldd]);
-                f.o[k] = add(f.o[p], d);
-                f.v[k] = add(add(f.v[p], cross(f.w[p], d)), dd);
-                f.a[k] = add(
-                    add(
-                        add(f.a[p], cross(f.al[p], d)),
-                        cross(f.w[p], cross(f.w[p], d)),
-                    ),
-                    add(scale(2.0, cross(f.w[p], dd)), ddd),
-                );
+                let d = f.r[p] * Vector3::new(fl.length, vl, wl);
+                let dd = f.r[p] * Vector3::new(0.0, vld, wld);
+                let ddd = f.r[p] * Vector3::new(0.0, vldd, wldd);
+                f.o[k] = f.o[p] + d;
+                f.v[k] = f.v[p] + f.w[p].cross(&d) + dd;
+                f.a[k] = f.a[p]
+                    + f.al[p].cross(&d)
+                    + f.w[p].cross(&f.w[p].cross(&d))
+                    + (2.0 * f.w[p].cross(&dd) + ddd);
                 // Two virtual revolute joints at the tip: s about R_F e_z, then c about
                 // R_F R_z(s) (−e_y).
-                let axis1 = rot(&f.r[p], EZ);
-                let rs = mat_mul(&f.r[p], &rot_z(s));
-                let axis2 = rot(&rs, MINUS_EY);
-                let w1 = add(f.w[p], scale(sd, axis1));
-                let al1 = add(
-                    add(f.al[p], cross(f.w[p], scale(sd, axis1))),
-                    scale(sdd, axis1),
-                );
-                base_r = mat_mul(&rs, &rot_pitch(c));
-                base_w = add(w1, scale(cd, axis2));
-                base_al = add(add(al1, cross(w1, scale(cd, axis2))), scale(cdd, axis2));
+                let axis1 = f.r[p] * EZ;
+                let rs = f.r[p] * rot_z(s);
+                let axis2 = rs * MINUS_EY;
+                let w1 = f.w[p] + (sd * axis1);
+                let al1 = f.al[p] + f.w[p].cross(&(sd * axis1)) + (sdd * axis1);
+                base_r = rs * rot_pitch(c);
+                base_w = w1 + (cd * axis2);
+                base_al = al1 + w1.cross(&(cd * axis2)) + (cdd * axis2);
             } else {
-                let d = rot(&f.r[p], offsets[p]);
-                f.o[k] = add(f.o[p], d);
-                f.v[k] = add(f.v[p], cross(f.w[p], d));
-                f.a[k] = add(
-                    add(f.a[p], cross(f.al[p], d)),
-                    cross(f.w[p], cross(f.w[p], d)),
-                );
+                let d = f.r[p] * offsets[p];
+                f.o[k] = f.o[p] + d;
+                f.v[k] = f.v[p] + f.w[p].cross(&d);
+                f.a[k] = f.a[p] + f.al[p].cross(&d) + f.w[p].cross(&f.w[p].cross(&d));
                 base_r = f.r[p];
                 base_w = f.w[p];
                 base_al = f.al[p];
@@ -449,13 +402,10 @@ impl MobileModel {
                 (MINUS_EY, rot_pitch(q[a0 + k - 1]))
             };
             let (th_d, th_dd) = (qd[a0 + k - 1], qdd[a0 + k - 1]);
-            let axis = rot(&base_r, u);
-            f.r[k] = mat_mul(&base_r, &joint_rot);
-            f.w[k] = add(base_w, scale(th_d, axis));
-            f.al[k] = add(
-                add(base_al, cross(base_w, scale(th_d, axis))),
-                scale(th_dd, axis),
-            );
+            let axis = base_r * u;
+            f.r[k] = base_r * joint_rot;
+            f.w[k] = base_w + (th_d * axis);
+            f.al[k] = base_al + base_w.cross(&(th_d * axis)) + (th_dd * axis);
         }
         if let (Some(fl), Some(nk)) = (&self.flex, nodes) {
             let e0 = self
@@ -474,18 +424,15 @@ impl MobileModel {
                 let (v, w) = field(q);
                 let (vd, wd) = field(qd);
                 let (vdd, wdd) = field(qdd);
-                let d = rot(&f.r[k], [fl.nodes[g], v, w]);
-                let dd = rot(&f.r[k], [0.0, vd, wd]);
-                let ddd = rot(&f.r[k], [0.0, vdd, wdd]);
-                nk.p[g] = add(f.o[k], d);
-                nk.v[g] = add(add(f.v[k], cross(f.w[k], d)), dd);
-                nk.a[g] = add(
-                    add(
-                        add(f.a[k], cross(f.al[k], d)),
-                        cross(f.w[k], cross(f.w[k], d)),
-                    ),
-                    add(scale(2.0, cross(f.w[k], dd)), ddd),
-                );
+                let d = f.r[k] * Vector3::new(fl.nodes[g], v, w);
+                let dd = f.r[k] * Vector3::new(0.0, vd, wd);
+                let ddd = f.r[k] * Vector3::new(0.0, vdd, wdd);
+                nk.p[g] = f.o[k] + d;
+                nk.v[g] = f.v[k] + f.w[k].cross(&d) + dd;
+                nk.a[g] = f.a[k]
+                    + f.al[k].cross(&d)
+                    + f.w[k].cross(&f.w[k].cross(&d))
+                    + (2.0 * f.w[k].cross(&dd) + ddd);
             }
         }
         f
@@ -538,15 +485,15 @@ impl MobileModel {
         let mut t = 0.0;
         for b in &self.bodies {
             let r = &f.r[b.frame];
-            let rc = rot(r, b.com);
+            let rc = r * b.com;
             let w = f.w[b.frame];
-            let v = add(f.v[b.frame], cross(w, rc));
-            let iw = similar(r, &b.inertia);
-            t += 0.5 * b.mass * dot3(v, v) + 0.5 * dot3(w, rot(&iw, w));
+            let v = f.v[b.frame] + w.cross(&rc);
+            let iw = r * b.inertia * r.transpose();
+            t += 0.5 * b.mass * v.dot(&v) + 0.5 * w.dot(&(iw * w));
         }
         if let Some(fl) = &self.flex {
             for g in 0..fl.nodes.len() {
-                t += 0.5 * fl.density * fl.weights[g] * dot3(nodes.v[g], nodes.v[g]);
+                t += 0.5 * fl.density * fl.weights[g] * nodes.v[g].dot(&nodes.v[g]);
             }
         }
         if let (Some(pl), Some(p)) = (self.layout.platform, &self.platform) {
@@ -561,7 +508,7 @@ impl MobileModel {
         let f = self.kinematics(q, &zeros, &zeros, Some(nodes));
         let mut v = 0.0;
         for b in &self.bodies {
-            v += b.mass * self.gravity * add(f.o[b.frame], rot(&f.r[b.frame], b.com))[2];
+            v += b.mass * self.gravity * (f.o[b.frame] + (f.r[b.frame] * b.com))[2];
         }
         if let Some(fl) = &self.flex {
             for g in 0..fl.nodes.len() {
@@ -647,9 +594,9 @@ impl FlexLink {
             }
         }
         let rod = l.mass * length * length / 12.0;
-        let mut residual_inertia = l.inertia;
-        residual_inertia[1][1] -= rod;
-        residual_inertia[2][2] -= rod;
+        let mut residual_inertia = Matrix3::from(l.inertia).transpose();
+        residual_inertia[(1, 1)] -= rod;
+        residual_inertia[(2, 2)] -= rod;
         Ok(FlexLink {
             link: f.link,
             frame: f.link + 1,
@@ -693,13 +640,13 @@ impl Workspace {
         let nb = model.bodies.len();
         let ng = model.node_count();
         let nodes = NodeKinematics {
-            p: vec![[0.0; 3]; ng],
-            v: vec![[0.0; 3]; ng],
-            a: vec![[0.0; 3]; ng],
+            p: vec![Vec3::zeros(); ng],
+            v: vec![Vec3::zeros(); ng],
+            a: vec![Vec3::zeros(); ng],
         };
         Workspace {
-            body_partials: vec![([0.0; 3], [0.0; 3]); l.m * nb],
-            node_partials: vec![[0.0; 3]; l.m * ng],
+            body_partials: vec![(Vec3::zeros(), Vec3::zeros()); l.m * nb],
+            node_partials: vec![Vec3::zeros(); l.m * ng],
             nodes,
             qd: vec![0.0; l.n],
             sdn: vec![0.0; l.n],
@@ -732,45 +679,45 @@ impl MobileModel {
             self.velocities(q, &ws.unit, &mut ws.qd, &mut ws.sdn);
             let f = self.kinematics(q, &ws.qd, &ws.zeros, Some(&mut ws.nodes));
             for (b, body) in self.bodies.iter().enumerate() {
-                let rc = rot(&f.r[body.frame], body.com);
+                let rc = f.r[body.frame] * body.com;
                 let w = f.w[body.frame];
-                ws.body_partials[i * nb + b] = (add(f.v[body.frame], cross(w, rc)), w);
+                ws.body_partials[i * nb + b] = (f.v[body.frame] + w.cross(&rc), w);
             }
             ws.node_partials[i * ng..(i + 1) * ng].copy_from_slice(&ws.nodes.v);
         }
         // Velocity-product accelerations (ν̇ = 0, q̈ = Ṡ ν).
         self.velocities(q, nu, &mut ws.qd, &mut ws.sdn);
         let f = self.kinematics(q, &ws.qd, &ws.sdn, Some(&mut ws.nodes));
-        let g = [0.0, 0.0, self.gravity];
+        let g = Vector3::new(0.0, 0.0, self.gravity);
         ws.mass.fill(0.0);
         ws.force.fill(0.0);
         for (b, body) in self.bodies.iter().enumerate() {
             let r = &f.r[body.frame];
-            let rc = rot(r, body.com);
+            let rc = r * body.com;
             let (w, al) = (f.w[body.frame], f.al[body.frame]);
-            let acc = add(add(f.a[body.frame], cross(al, rc)), cross(w, cross(w, rc)));
-            let lin = scale(body.mass, add(acc, g));
-            let iw = similar(r, &body.inertia);
-            let ang = add(rot(&iw, al), cross(w, rot(&iw, w)));
+            let acc = f.a[body.frame] + al.cross(&rc) + w.cross(&w.cross(&rc));
+            let lin = body.mass * (acc + g);
+            let iw = r * body.inertia * r.transpose();
+            let ang = iw * al + w.cross(&(iw * w));
             for i in 0..m {
                 let (vi, wi) = ws.body_partials[i * nb + b];
-                ws.force[i] -= dot3(vi, lin) + dot3(wi, ang);
-                let iwi = rot(&iw, wi);
+                ws.force[i] -= vi.dot(&lin) + wi.dot(&ang);
+                let iwi = iw * wi;
                 for j in i..m {
                     let (vj, wj) = ws.body_partials[j * nb + b];
-                    ws.mass[i * m + j] += body.mass * dot3(vi, vj) + dot3(wj, iwi);
+                    ws.mass[i * m + j] += body.mass * vi.dot(&vj) + wj.dot(&iwi);
                 }
             }
         }
         if let Some(fl) = &self.flex {
             for gi in 0..ng {
                 let mw = fl.density * fl.weights[gi];
-                let lin = scale(mw, add(ws.nodes.a[gi], g));
+                let lin = mw * (ws.nodes.a[gi] + g);
                 for i in 0..m {
                     let vi = ws.node_partials[i * ng + gi];
-                    ws.force[i] -= dot3(vi, lin);
+                    ws.force[i] -= vi.dot(&lin);
                     for j in i..m {
-                        ws.mass[i * m + j] += mw * dot3(vi, ws.node_partials[j * ng + gi]);
+                        ws.mass[i * m + j] += mw * vi.dot(&ws.node_partials[j * ng + gi]);
                     }
                 }
             }

@@ -375,7 +375,7 @@ impl Output {
             for i in 0..4 {
                 self.row.extend([q[a + i], self.qd[a + i], self.tau[k + i]]);
             }
-            self.row.extend_from_slice(&model.end_effector(q));
+            self.row.extend_from_slice(model.end_effector(q).as_slice());
         }
         if let Some((v, w)) = model.tip_deflection(q) {
             self.row.extend([w, v]);
