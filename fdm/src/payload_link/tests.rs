@@ -5,6 +5,7 @@
 
 use data::load_scene;
 use data::scene::LinkField;
+use nalgebra::{Matrix3, Vector3};
 
 use super::{PayloadLinkModel, apply};
 
@@ -40,42 +41,12 @@ fn kinetic(m: &PayloadLinkModel, q: &[f64], v: &[f64], rate: f64) -> f64 {
     m.kinetic(q, v, rate, &mut s)
 }
 
-type V3 = [f64; 3];
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn mat_vec(a: &[[f64; 3]; 3], x: V3) -> V3 {
-    [0, 1, 2].map(|i| (0..3).map(|j| a[i][j] * x[j]).sum())
-}
-fn mat_t_vec(a: &[[f64; 3]; 3], x: V3) -> V3 {
-    [0, 1, 2].map(|i| (0..3).map(|j| a[j][i] * x[j]).sum())
-}
-fn mat_mul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut c = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            c[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
-        }
-    }
-    c
-}
+type V3 = Vector3<f64>;
+
 /// 1 + [a]× + ½[a]×² (second-order rotation)
-fn rot2(a: V3) -> [[f64; 3]; 3] {
-    let mut r = [[0.0; 3]; 3];
-    for j in 0..3 {
-        let mut e = [0.0; 3];
-        e[j] = 1.0;
-        let c1 = cross(a, e);
-        let c2 = cross(a, c1);
-        for i in 0..3 {
-            r[i][j] = e[i] + c1[i] + 0.5 * c2[i];
-        }
-    }
-    r
+fn rot2(a: V3) -> Matrix3<f64> {
+    let ax = a.cross_matrix();
+    Matrix3::identity() + ax + 0.5 * ax * ax
 }
 
 /// The doc's kinetic energy evaluated from positions and rotation matrices (no hand expansion):
@@ -104,23 +75,21 @@ fn kinetic_direct(
     let (qp, qm) = (at(dt), at(-dt));
     let inertial_velocity = |pos: &dyn Fn(&[f64]) -> V3| -> V3 {
         let (a, b, c) = (pos(&qp), pos(&qm), pos(q));
-        let d = [0, 1, 2].map(|k| (a[k] - b[k]) / (2.0 * dt));
-        let w = cross([0.0, 0.0, rate], c);
-        [d[0] + w[0], d[1] + w[1], d[2] + w[2]]
+        (a - b) / (2.0 * dt) + Vector3::new(0.0, 0.0, rate).cross(&c)
     };
     let mut t = 0.5 * p.base_inertia() * rate * rate;
     use LinkField::*;
     for i in 1..=m.r {
         let x = i as f64 * h;
         let pos = |q: &[f64]| {
-            [
+            Vector3::new(
                 x + st(Axial, i, q) - s_at(i, q),
                 st(Horizontal, i, q),
                 st(Vertical, i, q),
-            ]
+            )
         };
         let vel = inertial_velocity(&pos);
-        t += 0.5 * mass_at(i) * vel.iter().map(|a| a * a).sum::<f64>();
+        t += 0.5 * mass_at(i) * vel.norm_squared();
     }
     // rod rotary inertia in the model's quadrature
     let (ev, gw, gwd): (f64, Vec<f64>, Vec<f64>) = (
@@ -145,14 +114,14 @@ fn kinetic_direct(
     let c = pl.offset;
     let pos_c = |q: &[f64]| {
         let (sv, sw) = (apply(&m.slope_v, q), apply(&m.slope_w, q));
-        [
+        Vector3::new(
             p.length + apply(&m.tip[0], q) - s_at(m.r, q) + c * (1.0 - 0.5 * (sv * sv + sw * sw)),
             apply(&m.tip[1], q) + c * sv,
             apply(&m.tip[2], q) + c * sw,
-        ]
+        )
     };
     let vc = inertial_velocity(&pos_c);
-    t += 0.5 * pl.mass * vc.iter().map(|a| a * a).sum::<f64>();
+    t += 0.5 * pl.mass * vc.norm_squared();
     let (sv, sw, phi) = (
         apply(&m.slope_v, q),
         apply(&m.slope_w, q),
@@ -163,15 +132,15 @@ fn kinetic_direct(
         apply(&m.slope_w, v),
         apply(&m.tip[3], v),
     );
-    let r = mat_mul(&rot2([0.0, -sw, sv]), &rot2([phi, 0.0, 0.0]));
-    let omega = [
+    let r = rot2(Vector3::new(0.0, -sw, sv)) * rot2(Vector3::new(phi, 0.0, 0.0));
+    let omega = Vector3::new(
         rate * 0.0 + phid + 0.5 * (sv * swd - sw * svd),
         -swd + sv * phid,
         rate + svd + sw * phid,
-    ];
-    let body = mat_t_vec(&r, omega);
-    let ib = mat_vec(&pl.inertia, body);
-    t += 0.5 * body.iter().zip(ib).map(|(a, b)| a * b).sum::<f64>();
+    );
+    let body = r.transpose() * omega;
+    let inertia = Matrix3::from(pl.inertia).transpose();
+    t += 0.5 * body.dot(&(inertia * body));
     t
 }
 
