@@ -208,45 +208,13 @@ mod tests {
             .sum()
     }
 
-    /// Symmetric Jacobi eigenvalues of a 7×7 matrix (test-only, no external solver).
-    fn sym_eigenvalues(mut a: Mat7) -> [f64; NDOF] {
-        for _sweep in 0..100 {
-            let off: f64 = (0..NDOF)
-                .flat_map(|i| (0..NDOF).filter(move |&j| j != i).map(move |j| (i, j)))
-                .map(|(i, j)| a[i][j] * a[i][j])
-                .sum();
-            if off < 1e-30 * a.iter().flatten().map(|x| x * x).sum::<f64>() {
-                break;
-            }
-            for p in 0..NDOF {
-                for q in (p + 1)..NDOF {
-                    if a[p][q] == 0.0 {
-                        continue;
-                    }
-                    let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-                    let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                    let t = if theta == 0.0 { 1.0 } else { t };
-                    let c = 1.0 / (t * t + 1.0).sqrt();
-                    let s = t * c;
-                    for k in 0..NDOF {
-                        let (akp, akq) = (a[k][p], a[k][q]);
-                        a[k][p] = c * akp - s * akq;
-                        a[k][q] = s * akp + c * akq;
-                    }
-                    for k in 0..NDOF {
-                        let (apk, aqk) = (a[p][k], a[q][k]);
-                        a[p][k] = c * apk - s * aqk;
-                        a[q][k] = s * apk + c * aqk;
-                    }
-                }
-            }
-        }
-        let mut ev = [0.0; NDOF];
-        for i in 0..NDOF {
-            ev[i] = a[i][i];
-        }
-        ev.sort_by(f64::total_cmp);
-        ev
+    /// Eigenvalues of a symmetric 7×7 matrix, ascending (faer's self-adjoint solver).
+    fn sym_eigenvalues(a: Mat7) -> [f64; NDOF] {
+        let m = faer::Mat::from_fn(NDOF, NDOF, |i, j| a[i][j]);
+        let ev = m
+            .self_adjoint_eigenvalues(faer::Side::Lower)
+            .expect("symmetric eigenvalues");
+        std::array::from_fn(|i| ev[i])
     }
 
     #[test]
