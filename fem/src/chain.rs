@@ -48,6 +48,7 @@ use crate::band::BorderedBand;
 use crate::element::tables::dotn;
 use crate::element::{self, ElementDofs, InteriorField, MeshElement};
 use crate::error::FemError;
+use geometry::V2;
 
 pub use crate::element::{MAXE, NONE};
 pub use augmented::AugmentedLayout;
@@ -160,32 +161,32 @@ pub struct FrameState {
     pub phi: f64,
     pub dphi: f64,
     pub ddphi: f64,
-    pub r: [f64; 2],
-    pub dr: [f64; 2],
-    pub ddr: [f64; 2],
+    pub r: V2,
+    pub dr: V2,
+    pub ddr: V2,
     /// Joint angle θᵢ and its rates.
     pub theta: f64,
     pub dtheta: f64,
     pub ddtheta: f64,
     /// Tip local position/velocity/acceleration (frame coordinates, relative terms only).
-    pub p_tip: [f64; 2],
-    pub dp_tip: [f64; 2],
+    pub p_tip: V2,
+    pub dp_tip: V2,
     /// Full inertial acceleration of the tip in frame coordinates.
-    pub a_tip: [f64; 2],
+    pub a_tip: V2,
     pub slope_tip: f64,
     pub dslope_tip: f64,
     pub ddslope_tip: f64,
     /// Generalized joint moment of the subtree about Rᵢ (inertial + gravity, d'Alembert sign).
     pub subtree_moment: f64,
     /// Subtree resultant force (inertial coordinates, d'Alembert sign).
-    pub subtree_force: [f64; 2],
+    pub subtree_force: V2,
 }
 
 /// The assembled chain model with preallocated work buffers.
 #[derive(Debug, Clone)]
 pub struct Chain {
     pub links: Vec<LinkModel>,
-    pub gravity: [f64; 2],
+    pub gravity: V2,
     pub ndof: usize,
     /// Interior/border split for the Newton matrix.
     pub n_interior: usize,
@@ -193,14 +194,14 @@ pub struct Chain {
     pub frames: Vec<FrameState>,
     /// Per link, per element, per Gauss point: force density f = m(a − g) (frame coords) and
     /// local position p.
-    force: Vec<Vec<[f64; 2]>>,
-    pos: Vec<Vec<[f64; 2]>>,
+    force: Vec<Vec<V2>>,
+    pos: Vec<Vec<V2>>,
     /// Local velocity ṗ at each Gauss point (for the Coriolis part of the Newton matrix).
-    vel: Vec<Vec<[f64; 2]>>,
+    vel: Vec<Vec<V2>>,
     /// Velocity c = u + ω ẑ×p + ṗ of each Gauss point in its link frame, at the generalized
     /// velocity of the last [`Chain::add_kinetic_gradient`] call (its own buffer: the Newton
     /// matrix reads `pos`/`vel` of the last full residual).
-    kin_vel: Vec<Vec<[f64; 2]>>,
+    kin_vel: Vec<Vec<V2>>,
     /// Per link, per element, per sub-interval: tail axial load T (foreshortening).
     tail: Vec<Vec<f64>>,
     /// Generalized joint torque each joint's actuator needs (prescribed) or applies (free).
@@ -353,11 +354,11 @@ impl Chain {
             .unwrap_or(3);
         let force = models
             .iter()
-            .map(|m| vec![[0.0; 2]; m.n_el * m.element.quad.ng])
+            .map(|m| vec![V2::zeros(); m.n_el * m.element.quad.ng])
             .collect();
-        let pos: Vec<Vec<[f64; 2]>> = models
+        let pos: Vec<Vec<V2>> = models
             .iter()
-            .map(|m| vec![[0.0; 2]; m.n_el * m.element.quad.ng])
+            .map(|m| vec![V2::zeros(); m.n_el * m.element.quad.ng])
             .collect();
         let vel = pos.clone();
         let kin_vel = pos.clone();
@@ -367,7 +368,7 @@ impl Chain {
             .collect();
         Ok(Chain {
             links: models,
-            gravity: gravity.map_or([0.0, 0.0], |g| g.vector),
+            gravity: gravity.map_or(V2::zeros(), |g| g.vector.into()),
             ndof: next,
             n_interior,
             half_bandwidth,

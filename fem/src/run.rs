@@ -424,7 +424,7 @@ fn ledger_terms(integ: &Driver) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'
     if chain.links.iter().any(|l| l.joint.stiffness > 0.0) {
         stored.push(ledger_term::JOINT_SPRING);
     }
-    if chain.gravity != [0.0, 0.0] {
+    if chain.gravity != nalgebra::Vector2::zeros() {
         stored.push(ledger_term::GRAVITY);
     }
     let mut inputs = Vec::new();

@@ -13,7 +13,7 @@
 //! sums of ∂T/∂p_x and ∂T/∂ṗ_x); ∂u_{i+1}/∂γ = −ẑ×u_{i+1}, and the parent receives
 //! A(γ)∂T/∂u_{i+1} at its tip. Exact for the quadrature (no difference step).
 
-use super::geometry::{add, dot, perp, rot, rot_t, scale};
+use super::geometry::{V2, perp, rot, rot_t};
 use super::{Chain, FrameState, LinkModel, MAX_LINKS, MAXE, NONE, dotn};
 
 impl LinkModel {
@@ -29,9 +29,9 @@ impl LinkModel {
         &self,
         q: &[f64],
         x: &[f64],
-        mut point: impl FnMut(usize, usize, [f64; 2], [f64; 2], &[f64; MAXE]),
+        mut point: impl FnMut(usize, usize, V2, V2, &[f64; MAXE]),
         mut element_done: impl FnMut(usize, [f64; 2], &[f64; MAXE]),
-    ) -> ([f64; 2], [f64; 2]) {
+    ) -> (V2, V2) {
         let tb = &self.element.quad;
         let (mut s, mut sd) = (0.0, 0.0);
         // An extensible link carries its axial field instead of the foreshortening.
@@ -74,8 +74,8 @@ impl LinkModel {
                 } else {
                     (0.0, 0.0)
                 };
-                let p = [xa + xi * self.h + ax, dotn(&tb.n[j], &d, ne)];
-                let pd = [axd, dotn(&tb.n[j], &dd, ne)];
+                let p = V2::new(xa + xi * self.h + ax, dotn(&tb.n[j], &d, ne));
+                let pd = V2::new(axd, dotn(&tb.n[j], &dd, ne));
                 point(e, j, p, pd, &dd);
             }
             element_done(e, u, &d);
@@ -89,8 +89,8 @@ impl LinkModel {
             (0.0, 0.0)
         };
         (
-            [self.length + ut, Chain::val(q, self.v_dof[k])],
-            [utd, Chain::val(x, self.v_dof[k])],
+            V2::new(self.length + ut, Chain::val(q, self.v_dof[k])),
+            V2::new(utd, Chain::val(x, self.v_dof[k])),
         )
     }
 }
@@ -100,7 +100,7 @@ impl Chain {
     pub fn energies(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; 4] {
         debug_assert_eq!(qd.len(), q.len());
         let g_in = self.gravity;
-        let mut parent: Option<(FrameState, [f64; 2], [f64; 2])> = None;
+        let mut parent: Option<(FrameState, V2, V2)> = None;
         let (mut kin, mut strain, mut spring, mut grav) = (0.0, 0.0, 0.0, 0.0);
         for li in 0..self.links.len() {
             let l = &self.links[li];
@@ -110,7 +110,7 @@ impl Chain {
                 None => (q[l.joint.dof], qd[l.joint.dof]),
             };
             let (phi, w, r0, dr0) = match parent {
-                None => (th, dth, [0.0, 0.0], [0.0, 0.0]),
+                None => (th, dth, V2::new(0.0, 0.0), V2::new(0.0, 0.0)),
                 Some((p, r, dr)) => (p.phi + p.slope_tip + th, p.dphi + p.dslope_tip + dth, r, dr),
             };
             spring += 0.5 * l.joint.stiffness * (th - l.joint.set_point).powi(2);
@@ -120,10 +120,10 @@ impl Chain {
                 q,
                 qd,
                 |_, j, p, pd, dd| {
-                    let v = add(dr0, rot(phi, add(scale(w, perp(p)), pd)));
+                    let v = dr0 + rot(phi, w * perp(p) + pd);
                     let m = l.rho_a * tb.wh[j];
-                    kin += 0.5 * m * dot(v, v);
-                    grav -= m * dot(g_in, add(r0, rot(phi, p)));
+                    kin += 0.5 * m * v.dot(&v);
+                    grav -= m * g_in.dot(&(r0 + rot(phi, p)));
                     if l.rho_i > 0.0 {
                         // ½ρI(φ̇ + β̇)², β the section angle relative to the frame.
                         let om = w + dotn(&tb.b[j], dd, ne);
@@ -136,10 +136,10 @@ impl Chain {
                         .add_strain_energy(&l.element, u, d, &mut strain)
                 },
             );
-            let v_tip = add(dr0, rot(phi, add(scale(w, perp(p)), pd)));
-            let r_tip = add(r0, rot(phi, p));
-            kin += 0.5 * l.tip_mass * dot(v_tip, v_tip);
-            grav -= l.tip_mass * dot(g_in, r_tip);
+            let v_tip = dr0 + rot(phi, w * perp(p) + pd);
+            let r_tip = r0 + rot(phi, p);
+            kin += 0.5 * l.tip_mass * v_tip.dot(&v_tip);
+            grav -= l.tip_mass * g_in.dot(&r_tip);
             let slope = Self::val(q, l.r_dof[l.n_el]);
             let dslope = Self::val(qd, l.r_dof[l.n_el]);
             kin += 0.5 * l.tip_inertia * (w + dslope).powi(2);
@@ -168,9 +168,9 @@ impl Chain {
     ) {
         let nl = self.links.len();
         let mut omega = [0.0; MAX_LINKS];
-        let mut u_frame = [[0.0; 2]; MAX_LINKS];
+        let mut u_frame = [V2::zeros(); MAX_LINKS];
         let mut gamma = [0.0; MAX_LINKS];
-        let mut c_tip = [[0.0; 2]; MAX_LINKS];
+        let mut c_tip = [V2::zeros(); MAX_LINKS];
         // Forward sweep: frame rates, frame-origin velocities and point velocities.
         for li in 0..nl {
             let l = &self.links[li];
@@ -180,7 +180,7 @@ impl Chain {
                 None => (q[l.joint.dof], x[l.joint.dof]),
             };
             let (w, u) = if li == 0 {
-                (dth, [0.0; 2])
+                (dth, V2::zeros())
             } else {
                 let pl = &self.links[li - 1];
                 let k = pl.n_el;
@@ -198,10 +198,10 @@ impl Chain {
             let (p, pd) = l.walk_points(
                 q,
                 x,
-                |e, j, p, pd, _| kin_vel[e * ng + j] = add(u, add(scale(w, perp(p)), pd)),
+                |e, j, p, pd, _| kin_vel[e * ng + j] = u + (w * perp(p) + pd),
                 |_, _, _| {},
             );
-            c_tip[li] = add(u, add(scale(w, perp(p)), pd));
+            c_tip[li] = u + (w * perp(p) + pd);
         }
         // Backward sweep: g = m c at the points, ∂T/∂u_i accumulated in `big_g`.
         let mut put = |i: usize, v: f64| {
@@ -209,13 +209,13 @@ impl Chain {
                 out[i] += sign * v;
             }
         };
-        let mut child = [0.0; 2];
+        let mut child = V2::zeros();
         for li in (0..nl).rev() {
             let l = &self.links[li];
             let tb = &l.element.quad;
             let w = omega[li];
             let k = l.n_el;
-            let g_tip = add(scale(l.tip_mass, c_tip[li]), child);
+            let g_tip = l.tip_mass * c_tip[li] + child;
             let mut big_g = g_tip;
             put(l.v_dof[k], -w * g_tip[0]);
             put(l.u_dof[k], w * g_tip[1]);
@@ -245,8 +245,8 @@ impl Chain {
                         continue;
                     }
                     let gp = j - 1;
-                    let g = scale(l.rho_a * tb.wh[gp], self.kin_vel[li][e * tb.ng + gp]);
-                    big_g = add(big_g, g);
+                    let g = (l.rho_a * tb.wh[gp]) * self.kin_vel[li][e * tb.ng + gp];
+                    big_g += g;
                     for a in 0..ne {
                         fe[a] -= w * g[0] * tb.n[gp][a];
                     }
@@ -268,7 +268,7 @@ impl Chain {
             }
             if li > 0 {
                 // u_i = A(γ)ᵀ c_tip,i−1: ∂u_i/∂γ = −ẑ×u_i.
-                let dg = -dot(big_g, perp(u_frame[li]));
+                let dg = -big_g.dot(&perp(u_frame[li]));
                 put(l.joint.dof, dg);
                 let pl = &self.links[li - 1];
                 put(pl.r_dof[pl.n_el], dg);

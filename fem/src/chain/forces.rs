@@ -2,7 +2,7 @@
 //! chain (element forces from the tabulated point loads, elastic forces through the element,
 //! subtree resultants and joint equations).
 
-use super::geometry::{add, cross, rot, rot_t, scale, sub};
+use super::geometry::{V2, rot, rot_t};
 use super::{Chain, MAXE, NONE, dotn};
 
 /// Which force groups [`Chain::residual_parts`] includes. The energy-consistent integrator
@@ -65,13 +65,13 @@ impl Chain {
         let g_in = if parts.conservative {
             self.gravity
         } else {
-            [0.0; 2]
+            V2::zeros()
         };
         let inertia = if parts.inertia { 1.0 } else { 0.0 };
         let (cons, noncons) = (parts.conservative, parts.nonconservative);
         let nl = self.links.len();
         // Child loads passed to the parent: resultant (inertial) and moment about the child root.
-        let mut child_f = [0.0; 2];
+        let mut child_f = V2::zeros();
         let mut child_m = 0.0;
         for li in (0..nl).rev() {
             let l = &self.links[li];
@@ -80,14 +80,14 @@ impl Chain {
             let g_loc = rot_t(fr.phi, g_in);
             let k = l.n_el;
             // Tip body and child loads (frame coordinates).
-            let f_tipmass = scale(l.tip_mass, sub(scale(inertia, fr.a_tip), g_loc));
+            let f_tipmass = l.tip_mass * (inertia * fr.a_tip - g_loc);
             // An applied tip force enters with the d'Alembert sign (R collects −Q).
             let p_tip = if li + 1 == nl && noncons {
                 self.tip_load
             } else {
                 0.0
             };
-            let f_tip = sub(add(f_tipmass, rot_t(fr.phi, child_f)), [0.0, p_tip]);
+            let f_tip = f_tipmass + rot_t(fr.phi, child_f) - V2::new(0.0, p_tip);
             let m_tip = inertia * l.tip_inertia * (fr.ddphi + fr.ddslope_tip) + child_m;
             let mut add_res = |i: usize, v: f64| {
                 if i != NONE {
@@ -99,7 +99,7 @@ impl Chain {
             add_res(l.r_dof[k], m_tip);
             // Distributed inertia/gravity, elastic and damping forces, element by element
             // (tip to root so the tail load T accumulates).
-            let mut f_sum = [0.0; 2];
+            let mut f_sum = V2::zeros();
             let mut m_sum = 0.0;
             let mut tail = f_tip[0];
             let ne = l.ne;
@@ -111,8 +111,8 @@ impl Chain {
                 for g in 0..tb.ng {
                     let f = self.force[li][e * tb.ng + g];
                     let p = self.pos[li][e * tb.ng + g];
-                    f_sum = add(f_sum, f);
-                    m_sum += cross(p, f);
+                    f_sum += f;
+                    m_sum += p.perp(&f);
                     for a in 0..ne {
                         fe[a] += f[1] * tb.n[g][a];
                     }
@@ -182,9 +182,8 @@ impl Chain {
                 }
             }
             // Subtree resultant and moment about this link's root Rᵢ.
-            let f_total_loc = add(f_sum, f_tip);
-            let moment =
-                m_sum + cross(fr.p_tip, f_tip) + m_tip + inertia * l.hub_inertia * fr.ddphi;
+            let f_total_loc = f_sum + f_tip;
+            let moment = m_sum + fr.p_tip.perp(&f_tip) + m_tip + inertia * l.hub_inertia * fr.ddphi;
             let fr_mut = &mut self.frames[li];
             fr_mut.subtree_moment = moment;
             fr_mut.subtree_force = rot(fr.phi, f_total_loc);

@@ -2,7 +2,7 @@
 //! accelerations at the quadrature points, cumulative foreshortening), and the tip kinematics
 //! that observables and contact read (positions, Jacobian, motion).
 
-use super::geometry::{add, perp, rot, rot_t, scale, sub};
+use super::geometry::{V2, perp, rot, rot_t};
 use super::{Chain, FrameState, MAX_LINKS, MAXE, NONE, Parts, dotn};
 
 impl Chain {
@@ -11,7 +11,7 @@ impl Chain {
         let g_in = if parts.conservative {
             self.gravity
         } else {
-            [0.0; 2]
+            V2::zeros()
         };
         let inertia = if parts.inertia { 1.0 } else { 0.0 };
         let mut parent: Option<FrameState> = None;
@@ -38,11 +38,8 @@ impl Chain {
                     fr.phi = p.phi + p.slope_tip + th;
                     fr.dphi = p.dphi + p.dslope_tip + dth;
                     fr.ddphi = p.ddphi + p.ddslope_tip + ddth;
-                    let pr = add(p.r, rot(p.phi, p.p_tip));
-                    let pdr = add(
-                        p.dr,
-                        rot(p.phi, add(scale(p.dphi, perp(p.p_tip)), p.dp_tip)),
-                    );
+                    let pr = p.r + rot(p.phi, p.p_tip);
+                    let pdr = p.dr + rot(p.phi, p.dphi * perp(p.p_tip) + p.dp_tip);
                     fr.r = pr;
                     fr.dr = pdr;
                     fr.ddr = rot(p.phi, p.a_tip);
@@ -61,9 +58,9 @@ impl Chain {
                 let dd = Self::elem_v(qd, &dofs);
                 let ddd = Self::elem_v(qdd, &dofs);
                 let (ua, ub) = (l.u_dof[e], l.u_dof[e + 1]);
-                let u = [Self::val(q, ua), Self::val(q, ub)];
-                let ud = [Self::val(qd, ua), Self::val(qd, ub)];
-                let udd = [Self::val(qdd, ua), Self::val(qdd, ub)];
+                let u = V2::new(Self::val(q, ua), Self::val(q, ub));
+                let ud = V2::new(Self::val(qd, ua), Self::val(qd, ub));
+                let udd = V2::new(Self::val(qdd, ua), Self::val(qdd, ub));
                 let xa = e as f64 * l.h;
                 for j in 0..tb.ng + 1 {
                     if fs {
@@ -95,13 +92,11 @@ impl Chain {
                     } else {
                         (0.0, 0.0, 0.0)
                     };
-                    let p = [xa + xi * l.h + ax, dotn(n, &d, ne)];
-                    let pd = [axd, dotn(n, &dd, ne)];
-                    let pdd = [axdd, dotn(n, &ddd, ne)];
-                    let a = add(
-                        add(frame_acc, scale(dw, perp(p))),
-                        add(scale(-w * w, p), add(scale(2.0 * w, perp(pd)), pdd)),
-                    );
+                    let p = V2::new(xa + xi * l.h + ax, dotn(n, &d, ne));
+                    let pd = V2::new(axd, dotn(n, &dd, ne));
+                    let pdd = V2::new(axdd, dotn(n, &ddd, ne));
+                    let a =
+                        frame_acc + (dw * perp(p)) + ((-w * w) * p + ((2.0 * w) * perp(pd) + pdd));
                     let m = l.rho_a * tb.wh[g];
                     // Applied uniform transverse load on the last link (frame y), as a density
                     // with the d'Alembert sign: Gauss-4 gives its consistent nodal loads exactly.
@@ -110,10 +105,8 @@ impl Chain {
                     } else {
                         0.0
                     };
-                    self.force[li][e * tb.ng + g] = sub(
-                        scale(m, sub(scale(inertia, a), g_loc)),
-                        [0.0, q_load * tb.wh[g]],
-                    );
+                    self.force[li][e * tb.ng + g] =
+                        m * (inertia * a - g_loc) - V2::new(0.0, q_load * tb.wh[g]);
                     self.pos[li][e * tb.ng + g] = p;
                     self.vel[li][e * tb.ng + g] = pd;
                 }
@@ -131,15 +124,12 @@ impl Chain {
             } else {
                 (0.0, 0.0, 0.0)
             };
-            let p = [l.length + ut, Self::val(q, l.v_dof[k])];
-            let pd = [utd, Self::val(qd, l.v_dof[k])];
-            let pdd = [utdd, Self::val(qdd, l.v_dof[k])];
+            let p = V2::new(l.length + ut, Self::val(q, l.v_dof[k]));
+            let pd = V2::new(utd, Self::val(qd, l.v_dof[k]));
+            let pdd = V2::new(utdd, Self::val(qdd, l.v_dof[k]));
             fr.p_tip = p;
             fr.dp_tip = pd;
-            fr.a_tip = add(
-                add(frame_acc, scale(dw, perp(p))),
-                add(scale(-w * w, p), add(scale(2.0 * w, perp(pd)), pdd)),
-            );
+            fr.a_tip = frame_acc + (dw * perp(p)) + ((-w * w) * p + ((2.0 * w) * perp(pd) + pdd));
             fr.slope_tip = Self::val(q, l.r_dof[k]);
             fr.dslope_tip = Self::val(qd, l.r_dof[k]);
             fr.ddslope_tip = Self::val(qdd, l.r_dof[k]);
@@ -159,14 +149,14 @@ impl Chain {
 
     /// Inertial tip position of every link at a state (forward pass with zero rates).
     pub fn tip_positions(&self, t: f64, q: &[f64], out: &mut [[f64; 2]]) {
-        let mut parent: Option<(f64, [f64; 2])> = None;
+        let mut parent: Option<(f64, V2)> = None;
         for (li, l) in self.links.iter().enumerate() {
             let th = match l.joint.prescribed_at(t) {
                 Some((a, _, _)) => a,
                 None => q[l.joint.dof],
             };
             let (phi, r0) = match parent {
-                None => (th, [0.0, 0.0]),
+                None => (th, V2::new(0.0, 0.0)),
                 Some((pp, r)) => (pp + th, r),
             };
             let k = l.n_el;
@@ -177,9 +167,9 @@ impl Chain {
             } else {
                 0.0
             };
-            let p = [l.length + ax, Self::val(q, l.v_dof[k])];
-            let r = add(r0, rot(phi, p));
-            out[li] = r;
+            let p = V2::new(l.length + ax, Self::val(q, l.v_dof[k]));
+            let r = r0 + rot(phi, p);
+            out[li] = r.into();
             parent = Some((phi + Self::val(q, l.r_dof[k]), r));
         }
     }
@@ -232,10 +222,10 @@ impl Chain {
     pub fn tip_jacobian(&self, t: f64, li: usize, q: &[f64], jac: &mut [f64]) -> [f64; 2] {
         let n = self.ndof;
         jac[..2 * n].iter_mut().for_each(|x| *x = 0.0);
-        let mut origin = [[0.0; 2]; MAX_LINKS];
+        let mut origin = [V2::zeros(); MAX_LINKS];
         let mut angle = [0.0; MAX_LINKS];
-        let mut parent: Option<(f64, [f64; 2])> = None;
-        let mut r = [0.0; 2];
+        let mut parent: Option<(f64, V2)> = None;
+        let mut r = V2::zeros();
         for k in 0..=li {
             let l = &self.links[k];
             let th = match l.joint.prescribed_at(t) {
@@ -243,7 +233,7 @@ impl Chain {
                 None => q[l.joint.dof],
             };
             let (phi, r0) = match parent {
-                None => (th, [0.0, 0.0]),
+                None => (th, V2::new(0.0, 0.0)),
                 Some((pp, rr)) => (pp + th, rr),
             };
             let m = l.n_el;
@@ -254,12 +244,12 @@ impl Chain {
             } else {
                 0.0
             };
-            r = add(r0, rot(phi, [l.length + ax, Self::val(q, l.v_dof[m])]));
+            r = r0 + rot(phi, V2::new(l.length + ax, Self::val(q, l.v_dof[m])));
             origin[k] = r0;
             angle[k] = phi;
             parent = Some((phi + Self::val(q, l.r_dof[m]), r));
         }
-        let put = |jac: &mut [f64], dof: usize, c: [f64; 2]| {
+        let put = |jac: &mut [f64], dof: usize, c: V2| {
             if dof != NONE {
                 jac[dof] += c[0];
                 jac[n + dof] += c[1];
@@ -268,12 +258,12 @@ impl Chain {
         for k in 0..=li {
             let l = &self.links[k];
             let m = l.n_el;
-            put(jac, l.joint.dof, perp(sub(r, origin[k])));
+            put(jac, l.joint.dof, perp(r - origin[k]));
             if k < li {
-                put(jac, l.r_dof[m], perp(sub(r, origin[k + 1])));
+                put(jac, l.r_dof[m], perp(r - origin[k + 1]));
             }
-            put(jac, l.v_dof[m], rot(angle[k], [0.0, 1.0]));
-            let ex = rot(angle[k], [1.0, 0.0]);
+            put(jac, l.v_dof[m], rot(angle[k], V2::new(0.0, 1.0)));
+            let ex = rot(angle[k], V2::new(1.0, 0.0));
             if l.axial {
                 put(jac, l.u_dof[m], ex);
             } else if l.foreshortening {
@@ -293,12 +283,12 @@ impl Chain {
                         }
                     }
                     for a in 0..ne {
-                        put(jac, dofs[a], scale(ds[a], ex));
+                        put(jac, dofs[a], ds[a] * ex);
                     }
                 }
             }
         }
-        r
+        r.into()
     }
 
     /// Tip of link `li`: inertial position, velocity and acceleration at (q, q̇, q̈) from the
@@ -315,11 +305,8 @@ impl Chain {
     ) -> [[f64; 2]; 3] {
         self.forward(t, q, qd, qdd, Parts::INERTIA);
         let fr = self.frames[li];
-        let r = add(fr.r, rot(fr.phi, fr.p_tip));
-        let v = add(
-            fr.dr,
-            rot(fr.phi, add(scale(fr.dphi, perp(fr.p_tip)), fr.dp_tip)),
-        );
-        [r, v, rot(fr.phi, fr.a_tip)]
+        let r = fr.r + rot(fr.phi, fr.p_tip);
+        let v = fr.dr + rot(fr.phi, fr.dphi * perp(fr.p_tip) + fr.dp_tip);
+        [r.into(), v.into(), rot(fr.phi, fr.a_tip).into()]
     }
 }

@@ -3,7 +3,7 @@
 //! Kelvin–Voigt and the foreshortening geometric stiffness, tip and hub bodies, joint springs.
 
 use super::augmented::AugmentedLayout;
-use super::geometry::{add, dot, perp, rot, rot_t, scale, sub};
+use super::geometry::{V2, perp, rot, rot_t};
 use super::{Chain, ElementDofs, FrameState, LinkModel, MAX_COLUMNS, MAX_LINKS, MAXE, NONE, dotn};
 use crate::band::BorderedBand;
 
@@ -14,9 +14,9 @@ struct AncestorColumn {
     /// Rotation about a centre (`vec` = centre, `dvec` = its velocity) or translation along
     /// `vec` (whose frame turns at `rate`).
     rotation: bool,
-    vec: [f64; 2],
-    dvec: [f64; 2],
-    centre_acc: [f64; 2],
+    vec: V2,
+    dvec: V2,
+    centre_acc: V2,
     rate: f64,
     rate_dot: f64,
     /// Position along the chain (smaller = closer to the ground).
@@ -27,11 +27,11 @@ struct AncestorColumn {
 #[derive(Debug, Clone, Copy, Default)]
 struct ColumnAt {
     dof: usize,
-    j: [f64; 2],
-    jdot: [f64; 2],
+    j: V2,
+    jdot: V2,
     rotation: bool,
     pos: f64,
-    centre_acc: [f64; 2],
+    centre_acc: V2,
     /// Angular velocity and acceleration of the frame a translation column is attached to.
     rate: f64,
     rate_dot: f64,
@@ -126,7 +126,7 @@ impl Chain {
                     let fa = &self.frames[k];
                     let tip = self.links[k].n_el;
                     let mut v = Virtual {
-                        j: rot_t(fr.phi, rot(fa.phi, [1.0, 0.0])),
+                        j: rot_t(fr.phi, rot(fa.phi, V2::new(1.0, 0.0))),
                         rate: fa.dphi,
                         rate_dot: fa.ddphi,
                         pos: 2.0 * k as f64 + 0.5,
@@ -145,20 +145,20 @@ impl Chain {
                          jc: &mut [ColumnAt; MAXE + 2 + MAX_COLUMNS],
                          virt: &[Virtual],
                          m: f64,
-                         p: [f64; 2],
-                         pd: [f64; 2],
-                         f: [f64; 2],
-                         local: &[(usize, [f64; 2])]| {
+                         p: V2,
+                         pd: V2,
+                         f: V2,
+                         local: &[(usize, V2)]| {
                 let mut nj = 0;
                 for &(dof, v) in local {
                     if dof != NONE {
                         jc[nj] = ColumnAt {
                             dof,
                             j: v,
-                            jdot: scale(w, perp(v)),
+                            jdot: w * perp(v),
                             rotation: false,
                             pos: local_pos,
-                            centre_acc: [0.0; 2],
+                            centre_acc: V2::zeros(),
                             rate: w,
                             rate_dot: wd,
                         };
@@ -167,11 +167,11 @@ impl Chain {
                 }
                 for col in &cols[..ncols] {
                     jc[nj] = if col.rotation {
-                        let j = perp(sub(p, col.vec));
+                        let j = perp(p - col.vec);
                         ColumnAt {
                             dof: col.dof,
                             j,
-                            jdot: add(scale(w, perp(j)), perp(sub(pd, col.dvec))),
+                            jdot: w * perp(j) + perp(pd - col.dvec),
                             rotation: true,
                             pos: col.pos,
                             centre_acc: col.centre_acc,
@@ -182,30 +182,30 @@ impl Chain {
                         ColumnAt {
                             dof: col.dof,
                             j: col.vec,
-                            jdot: scale(col.rate, perp(col.vec)),
+                            jdot: col.rate * perp(col.vec),
                             rotation: false,
                             pos: col.pos,
-                            centre_acc: [0.0; 2],
+                            centre_acc: V2::zeros(),
                             rate: col.rate,
                             rate_dot: col.rate_dot,
                         }
                     };
                     nj += 1;
                 }
-                let acc = add(scale(1.0 / m, f), g_loc);
+                let acc = (1.0 / m) * f + g_loc;
                 for a in 0..nj {
                     let ca = &jc[a];
                     for b in 0..nj {
                         let cb = &jc[b];
-                        let mut v = c.c_a * m * dot(ca.j, cb.j);
+                        let mut v = c.c_a * m * ca.j.dot(&cb.j);
                         // A zero coefficient skips its term (the mass matrix of the contact
                         // maps): adding its ±0 would leave v unchanged.
                         if c.c_v != 0.0 {
-                            v += c.c_v * 2.0 * m * dot(ca.j, cb.jdot);
+                            v += c.c_v * 2.0 * m * ca.j.dot(&cb.jdot);
                         }
                         if c.c_q != 0.0 {
                             let dja = column_derivative(ca.rotation, ca.pos, ca.j, cb);
-                            v += c.c_q * m * (dot(dja, sub(acc, g_loc)) + dot(ca.j, dacc(cb, acc)));
+                            v += c.c_q * m * (dja.dot(&(acc - g_loc)) + ca.j.dot(&dacc(cb, acc)));
                         }
                         if v != 0.0 {
                             s.add(ca.dof, cb.dof, v);
@@ -249,17 +249,17 @@ impl Chain {
                     let n = tb.n[g];
                     // Translation columns of the point: the v shapes (the ψ DOFs of a
                     // Timoshenko element do not move it), then u.
-                    let mut local = [(NONE, [0.0; 2]); MAXE + 2];
+                    let mut local = [(NONE, V2::zeros()); MAXE + 2];
                     let mut nloc = 0;
                     for a in 0..ne {
                         if !l.element.kind.translates(a) {
                             continue;
                         }
-                        local[nloc] = (dofs[a], [0.0, n[a]]);
+                        local[nloc] = (dofs[a], V2::new(0.0, n[a]));
                         nloc += 1;
                     }
-                    local[nloc] = (l.u_dof[e], [1.0 - xi, 0.0]);
-                    local[nloc + 1] = (l.u_dof[e + 1], [xi, 0.0]);
+                    local[nloc] = (l.u_dof[e], V2::new(1.0 - xi, 0.0));
+                    local[nloc + 1] = (l.u_dof[e + 1], V2::new(xi, 0.0));
                     nloc += 2;
                     let pd = self.vel[li][e * tb.ng + g];
                     let f = self.force[li][e * tb.ng + g];
@@ -291,11 +291,14 @@ impl Chain {
                 s.add_at(lay.theta[li][k], lay.theta[li][k], 1.0);
             }
             if l.tip_mass > 0.0 {
-                let local = [(l.v_dof[k], [0.0, 1.0]), (l.u_dof[k], [1.0, 0.0])];
-                let f = scale(l.tip_mass, sub(fr.a_tip, g_loc));
+                let local = [
+                    (l.v_dof[k], V2::new(0.0, 1.0)),
+                    (l.u_dof[k], V2::new(1.0, 0.0)),
+                ];
+                let f = l.tip_mass * (fr.a_tip - g_loc);
                 let first = if let (true, Some(lay)) = (own_fs, s.layout) {
                     let mut v = Virtual {
-                        j: [1.0, 0.0],
+                        j: V2::new(1.0, 0.0),
                         rate: w,
                         rate_dot: wd,
                         pos: local_pos,
@@ -352,8 +355,8 @@ impl Chain {
         let mut ncols = 0usize;
         // Frame-coordinate position, velocity and acceleration of a point Rc relative to Rᵢ.
         let rel = |o: &FrameState| {
-            let c = rot_t(fr.phi, sub(o.r, fr.r));
-            let cdot = add(scale(-fr.dphi, perp(c)), rot_t(fr.phi, sub(o.dr, fr.dr)));
+            let c = rot_t(fr.phi, o.r - fr.r);
+            let cdot = (-fr.dphi) * perp(c) + rot_t(fr.phi, o.dr - fr.dr);
             let acc = rot_t(fr.phi, o.ddr);
             (c, cdot, acc)
         };
@@ -390,16 +393,16 @@ impl Chain {
                     ncols += 1;
                 }
                 for (dof, e) in [
-                    (al.v_dof[al.n_el], [0.0, 1.0]),
-                    (al.u_dof[al.n_el], [1.0, 0.0]),
+                    (al.v_dof[al.n_el], V2::new(0.0, 1.0)),
+                    (al.u_dof[al.n_el], V2::new(1.0, 0.0)),
                 ] {
                     if dof != NONE {
                         cols[ncols] = AncestorColumn {
                             dof,
                             rotation: false,
                             vec: rot_t(fr.phi, rot(fa.phi, e)),
-                            dvec: [0.0; 2],
-                            centre_acc: [0.0; 2],
+                            dvec: V2::zeros(),
+                            centre_acc: V2::zeros(),
                             rate: fa.dphi,
                             rate_dot: fa.ddphi,
                             pos: 2.0 * aj as f64 + 0.5,
@@ -549,24 +552,24 @@ impl Sink<'_> {
 /// moves the point relative to a's centre (b downstream of it) adds perp(J_b). A translation
 /// upstream of a's centre moves the centre with the point and leaves J_a unchanged.
 #[inline]
-fn column_derivative(a_rotation: bool, a_pos: f64, a_j: [f64; 2], b: &ColumnAt) -> [f64; 2] {
+fn column_derivative(a_rotation: bool, a_pos: f64, a_j: V2, b: &ColumnAt) -> V2 {
     if b.rotation && b.pos <= a_pos {
         perp(a_j)
     } else if a_rotation && b.pos > a_pos {
         perp(b.j)
     } else {
-        [0.0; 2]
+        V2::zeros()
     }
 }
 
 /// ∂a/∂q_b at a point with acceleration `acc`: rigid rotation of the downstream acceleration
 /// field about the centre, or the frame's rigid acceleration field at a displaced point.
 #[inline]
-fn dacc(b: &ColumnAt, acc: [f64; 2]) -> [f64; 2] {
+fn dacc(b: &ColumnAt, acc: V2) -> V2 {
     if b.rotation {
-        perp(sub(acc, b.centre_acc))
+        perp(acc - b.centre_acc)
     } else {
-        add(scale(-b.rate * b.rate, b.j), scale(b.rate_dot, perp(b.j)))
+        (-b.rate * b.rate) * b.j + (b.rate_dot * perp(b.j))
     }
 }
 
@@ -581,7 +584,7 @@ const VIRTUAL_TERMS: usize = MAXE + 1;
 /// σ = ∂s(x)/∂q).
 #[derive(Debug, Clone, Copy)]
 struct Virtual {
-    j: [f64; 2],
+    j: V2,
     rate: f64,
     rate_dot: f64,
     pos: f64,
@@ -594,7 +597,7 @@ struct Virtual {
 impl Default for Virtual {
     fn default() -> Self {
         Virtual {
-            j: [0.0; 2],
+            j: V2::zeros(),
             rate: 0.0,
             rate_dot: 0.0,
             pos: 0.0,
@@ -618,13 +621,10 @@ impl Virtual {
     }
 
     /// (∂a/∂u, ∂a/∂u̇) of the point for this direction (∂a/∂ü = j).
-    fn motion(&self) -> ([f64; 2], [f64; 2]) {
+    fn motion(&self) -> (V2, V2) {
         (
-            add(
-                scale(-self.rate * self.rate, self.j),
-                scale(self.rate_dot, perp(self.j)),
-            ),
-            scale(2.0 * self.rate, perp(self.j)),
+            (-self.rate * self.rate) * self.j + (self.rate_dot * perp(self.j)),
+            (2.0 * self.rate) * perp(self.j),
         )
     }
 
@@ -653,20 +653,20 @@ fn virtual_terms(
     jc: &[ColumnAt],
     virt: &[Virtual],
     m: f64,
-    acc: [f64; 2],
-    f: [f64; 2],
+    acc: V2,
+    f: V2,
     c: NewtonCoefficients,
 ) {
     for u in virt {
         let (dacc_u, two_jdot_u) = u.motion();
         for a in jc {
             let mut k = [
-                m * dot(a.j, dacc_u),
-                m * dot(a.j, two_jdot_u),
-                m * dot(a.j, u.j),
+                m * a.j.dot(&dacc_u),
+                m * a.j.dot(&two_jdot_u),
+                m * a.j.dot(&u.j),
             ];
             if a.rotation && u.pos > a.pos {
-                k[0] += dot(perp(u.j), f);
+                k[0] += perp(u.j).dot(&f);
             }
             let ra = s.index(a.dof);
             u.add_columns(s, ra, 1.0, k);
@@ -675,11 +675,11 @@ fn virtual_terms(
             let dja = if b.rotation && b.pos <= u.pos {
                 perp(u.j)
             } else {
-                [0.0; 2]
+                V2::zeros()
             };
-            let v = c.c_a * m * dot(u.j, b.j)
-                + c.c_v * 2.0 * m * dot(u.j, b.jdot)
-                + c.c_q * (dot(dja, f) + m * dot(u.j, dacc(b, acc)));
+            let v = c.c_a * m * u.j.dot(&b.j)
+                + c.c_v * 2.0 * m * u.j.dot(&b.jdot)
+                + c.c_q * (dja.dot(&f) + m * u.j.dot(&dacc(b, acc)));
             if v != 0.0 {
                 let cb = s.index(b.dof);
                 for &(row, cr) in &u.row[..u.nrow] {
@@ -690,9 +690,9 @@ fn virtual_terms(
         for w in virt {
             let (dacc_w, two_jdot_w) = w.motion();
             let k = [
-                m * dot(u.j, dacc_w),
-                m * dot(u.j, two_jdot_w),
-                m * dot(u.j, w.j),
+                m * u.j.dot(&dacc_w),
+                m * u.j.dot(&two_jdot_w),
+                m * u.j.dot(&w.j),
             ];
             for &(row, cr) in &u.row[..u.nrow] {
                 w.add_columns(s, row, cr, k);
@@ -760,7 +760,7 @@ impl Running {
         pos: f64,
     ) -> Virtual {
         let mut v = Virtual {
-            j: [1.0, 0.0],
+            j: V2::new(1.0, 0.0),
             rate,
             rate_dot,
             pos,
