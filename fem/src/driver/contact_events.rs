@@ -1,6 +1,5 @@
 //! Unilateral contact events in the driver: the gap and the normal force located inside the
-//! step (regula falsi on the step length with the Anderson–Björck scaling of the kept bracket
-//! end, each value a re-solved shortened step), and the
+//! step (Illinois secant on the step length, each value a re-solved shortened step), and the
 //! resets applied at the located state (impact map, release, drift projection) by the contact
 //! object [`crate::events::contact::Contact`] (its module docs state the rules).
 
@@ -14,28 +13,6 @@ use crate::events::contact::{
 
 /// Secant iterations at most per located event.
 const MAX_SECANT: usize = 80;
-
-/// How [`Driver::illinois_on_step`] scales the value of the bracket end it keeps when the
-/// other end is replaced by a point of the same sign twice in a row.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Retained {
-    /// Illinois: by ½.
-    Illinois,
-    /// Anderson–Björck: by m = 1 − f(c)/f(replaced) where the event function flattens
-    /// towards the root, by ½ where it does not (m ≤ 0).
-    AndersonBjorck,
-}
-
-impl Retained {
-    fn factor(self, fc: f64, f_replaced: f64) -> f64 {
-        let m = 1.0 - fc / f_replaced;
-        if self == Retained::AndersonBjorck && m > 0.0 {
-            m
-        } else {
-            0.5
-        }
-    }
-}
 
 /// What happens after the (possibly shortened) step is accepted.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -117,7 +94,7 @@ impl Driver {
 
     /// Illinois secant on the step length for the root of an event function F(h), each value a
     /// re-solved shortened step (`trial`): F(a) = fa > 0, F(b) = fb ≤ 0, F decreasing through
-    /// the root; the kept end's value scaled as `retained` says. Stops at a trial with −tol ≤ F ≤ 0 (or 0 < F ≤ tol when `accept_positive`),
+    /// the root. Stops at a trial with −tol ≤ F ≤ 0 (or 0 < F ≤ tol when `accept_positive`),
     /// which is left solved (`Located::exact`), or when the bracket is narrower than
     /// [`TIME_TOL`]·max(t, 1); `b_solved` says whether the last trial solved is b (true on
     /// entry if F(b) was the last evaluation). A trial whose Newton iteration fails is replaced
@@ -130,7 +107,6 @@ impl Driver {
         tol: f64,
         accept_positive: bool,
         mut b_solved: bool,
-        retained: Retained,
         mut trial: impl FnMut(&mut Self, f64) -> Result<f64, FemError>,
     ) -> Result<Located, FemError> {
         let mut side = 0i32;
@@ -153,7 +129,6 @@ impl Driver {
                 fc = trial(self, c);
             }
             let fc = fc?;
-            let (fa_old, fb_old) = (fa, fb);
             if fc <= 0.0 {
                 b = c;
                 fb = fc;
@@ -167,7 +142,7 @@ impl Driver {
                     });
                 }
                 if side == -1 {
-                    fa *= retained.factor(fc, fb_old);
+                    fa *= 0.5;
                 }
                 side = -1;
             } else {
@@ -184,7 +159,7 @@ impl Driver {
                 fa = fc;
                 b_solved = false;
                 if side == 1 {
-                    fb *= retained.factor(fc, fa_old);
+                    fb *= 0.5;
                 }
                 side = 1;
             }
@@ -201,13 +176,6 @@ impl Driver {
     /// [a0, h] (F(a0) = f0 > 0, F(h) = f1 ≤ 0): to |F| ≤ tol (either side for the gap, the
     /// non-positive side for the force) or a bracket narrower than [`TIME_TOL`]. Leaves the
     /// accepted trial solved in q₁, q̇₁ and returns (h*, bracket width).
-    ///
-    /// The kept bracket end is scaled by Anderson–Björck instead of Illinois' ½: the normal
-    /// force after an impact falls within microseconds and then stays flat (the mesh modes,
-    /// `crate::events::contact`), where halving approaches the root from the flat side one
-    /// trial at a time. Measured on `barhorst-case1-timoshenko` (3 s, trials counted by a
-    /// temporary counter): 8.5 trials per located event with Illinois, 7.7 with
-    /// Anderson–Björck.
     fn locate(
         &mut self,
         watch: Watch,
@@ -217,15 +185,10 @@ impl Driver {
         f1: f64,
         tol: f64,
     ) -> Result<(f64, f64), FemError> {
-        let loc = self.illinois_on_step(
-            (a0, f0),
-            (h, f1),
-            tol,
-            watch == Watch::Gap,
-            true,
-            Retained::AndersonBjorck,
-            |s, c| s.trial(watch, c),
-        )?;
+        let loc =
+            self.illinois_on_step((a0, f0), (h, f1), tol, watch == Watch::Gap, true, |s, c| {
+                s.trial(watch, c)
+            })?;
         let (width, mut b) = (loc.width, loc.h);
         if loc.exact {
             return Ok((b, width));

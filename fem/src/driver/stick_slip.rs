@@ -5,7 +5,7 @@
 use data::Event;
 
 use crate::driver::Driver;
-use crate::driver::contact_events::{Post, Retained};
+use crate::driver::contact_events::Post;
 use crate::error::FemError;
 use crate::events::contact::friction::{
     Forces, MIN_TRIAL, STICK_VT_TOL, Switch, VT_TOL, sign, sticking,
@@ -258,15 +258,9 @@ impl Driver {
         if f_min <= 0.0 {
             return Ok(None);
         }
-        let loc = self.illinois_on_step(
-            (h_min, f_min),
-            (h, f1),
-            tol,
-            false,
-            false,
-            Retained::Illinois,
-            |s, c| s.switch_trial(kind, c),
-        )?;
+        let loc = self.illinois_on_step((h_min, f_min), (h, f1), tol, false, false, |s, c| {
+            s.switch_trial(kind, c)
+        })?;
         if !loc.solved {
             self.switch_trial(kind, loc.h)?;
         }

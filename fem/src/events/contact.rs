@@ -27,10 +27,12 @@
 //! M q̈ + R(q, q̇, 0) = Gᵀλ, G q̈ + n̂·J̇q̇ = 0:
 //!   λ = (G M⁻¹R(q, q̇, 0) − n̂·J̇q̇) / (G M⁻¹Gᵀ),
 //! with M(q) the Newton matrix ∂R/∂q̈ assembled sparsely (with foreshortening, its exact
-//! augmented bordered band) and factorized by `mass_solve`: O(n). M symmetric, one solve
-//! y = M⁻¹Gᵀ gives both terms (G M⁻¹R = yᵀR). A configuration near that of the factorization
-//! at hand (the next step end) refines y against the current M instead of forming a new one
-//! (`Contact::solve_gradient`). Positive λ pushes the tip to the free side. It is evaluated at the velocity the constrained
+//! augmented bordered band) and factorized by `mass_solve`: O(n). At a configuration near
+//! that of the factorization at hand (the next step end), on chains without massless
+//! sections, y = M⁻¹Gᵀ is refined against the current M instead of forming a new one, and
+//! G M⁻¹R = yᵀR (M symmetric); a force within 100 times its error bound of zero is evaluated
+//! again with a factorization at its configuration (`Contact::solve_gradient`). Positive λ
+//! pushes the tip to the free side. It is evaluated at the velocity the constrained
 //! dynamics allows: q̇ projected onto G q̇ = 0 (the plastic projection that ends every
 //! constrained step) and made consistent along the massless directions. At a step end the
 //! drift G q̇ = O(h²) otherwise entered λ through the velocity terms, and λ of the projected
@@ -92,9 +94,9 @@
 //! coupling to the tip through a mass O(s²) is a stiff, unresolved mode of the discretization
 //! (see "Grazing" for where this shows).
 //!
-//! **Events**, located INSIDE the step by re-solving it with a shortened step h* (regula falsi
-//! with Anderson–Björck scaling on the step length, other bracket points where Newton fails):
-//! contact start when |g(q₁(h*))| ≤ [`GAP_TOL`]·L (L the longest link); release when the index-1 normal force
+//! **Events**, located INSIDE the step by re-solving it with a shortened step h* (Illinois
+//! secant on the step length, other bracket points where Newton fails): contact start when
+//! |g(q₁(h*))| ≤ [`GAP_TOL`]·L (L the longest link); release when the index-1 normal force
 //! λ(q₁(h*), q̇₁(h*)) at the end of the shortened step lies in [−[`FORCE_TOL`]·W, 0] (W the
 //! chain's weight, or its mass times 1 length/time² without gravity), or when the bracket is
 //! below [`TIME_TOL`]·max(t, 1) (the event's `time_tolerance` is the final bracket width; the
@@ -184,6 +186,9 @@ pub const TIME_TOL: f64 = 1e-13;
 const REFINE_TOL: f64 = 5e-13;
 /// Contraction per iteration below which a refined mass solve gives up for a new factorization.
 const REFINE_RATE: f64 = 0.1;
+/// A normal force from a refined solve is kept when it exceeds this multiple of its error bound
+/// (else it is evaluated again with a factorization at its configuration).
+const REFINE_MARGIN: f64 = 100.0;
 /// Refinement iterations at most before a new factorization.
 const MAX_REFINE: usize = 6;
 /// Refinement iterations from which the next mass solve forms a new factorization.
@@ -305,6 +310,8 @@ pub(crate) struct ConstrainedSolve {
     /// Configuration (t, q) of `minv_gt` = (M + μNNᵀ)⁻¹Gᵀ (None: not valid).
     minv_key_t: Option<f64>,
     minv_key_q: Vec<f64>,
+    /// Whether `minv_gt` was refined (else solved with a factorization at its configuration).
+    minv_refined: bool,
     /// The last refined solve needed [`SLOW_REFINE`] iterations or more: the factorization
     /// at hand is too far from the configurations asked for, the next solve forms a new one.
     refactor_next: bool,
@@ -394,6 +401,7 @@ impl Contact {
                 dx: z.clone(),
                 minv_key_t: None,
                 minv_key_q: z,
+                minv_refined: false,
                 refactor_next: false,
             },
             bilateral,
@@ -469,29 +477,36 @@ impl Contact {
     /// beyond [`FAR_REFINE`], a contraction slower than [`REFINE_RATE`] per iteration, or
     /// [`MAX_REFINE`] iterations without reaching the tolerance form and factorize M(q) and
     /// solve directly, as does the solve after one that needed [`SLOW_REFINE`] iterations
-    /// (the factorization at hand has fallen too far behind). Measured on `barhorst-case1`
-    /// (3 s): 2771 of 5160 normal-force evaluations refined, 237 refinements given up.
+    /// (the factorization at hand has fallen too far behind). Not with massless section
+    /// rotations (Timoshenko links without rotary inertia): there the residual R carries the
+    /// stiff shear forces, which amplify the refinement's tolerance into the normal force
+    /// (measured: a release located with λ = −2.7e-2 lbf at a bracket of 9e-13 s on
+    /// `barhorst-case1-timoshenko`, 8 elements) — those runs factorize at every configuration.
     fn solve_gradient(
         &mut self,
         chain: &mut Chain,
         t: f64,
         q: &[f64],
         g_row: &[f64],
-    ) -> Result<usize, FemError> {
+        fresh: bool,
+    ) -> Result<(usize, bool), FemError> {
         let sv = &self.solve;
-        if sv.minv_key_t.is_some_and(|k| k.to_bits() == t.to_bits())
+        if !fresh
+            && sv.minv_key_t.is_some_and(|k| k.to_bits() == t.to_bits())
             && sv
                 .minv_key_q
                 .iter()
                 .zip(q)
                 .all(|(a, b)| a.to_bits() == b.to_bits())
         {
-            return Ok(0);
+            return Ok((0, self.solve.minv_refined));
         }
         self.solve.minv_key_t = None;
         let mut passes = 0;
         let mu = self.solve.mass_scale;
-        let stale = self.solve.mass.factored()
+        let stale = !fresh
+            && self.solve.massless.is_none()
+            && self.solve.mass.factored()
             && !self.solve.refactor_next
             && !self.solve.mass.is_at(t, q, mu);
         let mut refined = false;
@@ -530,7 +545,8 @@ impl Contact {
         }
         self.solve.minv_key_t = Some(t);
         self.solve.minv_key_q.copy_from_slice(q);
-        Ok(passes)
+        self.solve.minv_refined = refined;
+        Ok((passes, refined))
     }
 
     /// `col` ← (M(q) + μNNᵀ)·`minv_gt`: one inertial residual pass and the regularization.
@@ -573,39 +589,77 @@ impl Contact {
     ) -> Result<(f64, f64, usize), FemError> {
         let mut g_row = std::mem::take(&mut self.constraint.g_end);
         self.phase.gap = self.gradient(chain, t, q, &mut g_row);
-        let mut n = match self.solve_gradient(chain, t, q, &g_row) {
-            Ok(p) => p,
-            Err(e) => {
-                self.constraint.g_end = g_row;
-                return Err(e);
-            }
-        };
-        let gmg = dot(&g_row, &self.solve.minv_gt);
-        // The force of the constrained dynamics at the velocity it allows: q̇ projected onto
-        // G q̇ = 0 (the plastic projection applied after every constrained step, module docs),
-        // and, with massless directions, made consistent with their balances (the stepper's
-        // end rate there is not determined by its equations). The drift G q̇ = O(h²) of a
-        // step end otherwise entered λ through the velocity terms: measured up to 9.6 lbf
-        // between the end of a step and its projected state (`barhorst-case1-tipmass`), a
-        // jump that the release location then met at a bracket of 4e-14 s.
         let mut qd_c = std::mem::take(&mut self.solve.qd_c);
-        qd_c.copy_from_slice(qd);
-        let vn = dot(&g_row, &qd_c);
-        for i in 0..qd_c.len() {
-            qd_c[i] -= self.solve.minv_gt[i] * vn / gmg;
-        }
-        n += self.make_consistent(chain, t, q, &mut qd_c)?;
-        let qd = &qd_c[..];
-        // R(q, q̇, 0): everything but the inertia of q̈; G M⁻¹R = (M⁻¹Gᵀ)ᵀR (M symmetric).
-        chain.residual(t, q, qd, &self.solve.zero, &mut self.solve.tmp);
-        let [_, _, a] = chain.tip_motion(t, self.constraint.link, q, qd, &self.solve.zero);
-        // The normal velocity of the state itself (the drift, before any projection).
-        self.phase.normal_velocity = vn;
-        let conv = self.constraint.normal[0] * a[0] + self.constraint.normal[1] * a[1];
-        let lambda = (dot(&self.solve.minv_gt, &self.solve.tmp) - conv) / gmg;
+        let out = self.state_force_with(chain, t, q, qd, &g_row, &mut qd_c);
         self.constraint.g_end = g_row;
         self.solve.qd_c = qd_c;
-        Ok((lambda, gmg, n + 2))
+        out
+    }
+
+    /// [`Contact::state_force`] with G in `g_row`; `qd_c` receives the consistent velocity.
+    fn state_force_with(
+        &mut self,
+        chain: &mut Chain,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        g_row: &[f64],
+        qd_c: &mut [f64],
+    ) -> Result<(f64, f64, usize), FemError> {
+        let mut n = 0;
+        let mut fresh = false;
+        loop {
+            let (passes, refined) = self.solve_gradient(chain, t, q, g_row, fresh)?;
+            n += passes;
+            let gmg = dot(g_row, &self.solve.minv_gt);
+            // The force of the constrained dynamics at the velocity it allows: q̇ projected onto
+            // G q̇ = 0 (the plastic projection applied after every constrained step, module
+            // docs), and, with massless directions, made consistent with their balances (the
+            // stepper's end rate there is not determined by its equations). The drift
+            // G q̇ = O(h²) of a step end otherwise entered λ through the velocity terms:
+            // measured up to 9.6 lbf between the end of a step and its projected state
+            // (`barhorst-case1-tipmass`), a jump that the release location then met at a
+            // bracket of 4e-14 s.
+            qd_c.copy_from_slice(qd);
+            let vn = dot(g_row, qd_c);
+            for i in 0..qd_c.len() {
+                qd_c[i] -= self.solve.minv_gt[i] * vn / gmg;
+            }
+            n += self.make_consistent(chain, t, q, qd_c)?;
+            // R(q, q̇, 0): everything but the inertia of q̈; G M⁻¹R = (M⁻¹Gᵀ)ᵀR (M symmetric).
+            chain.residual(t, q, qd_c, &self.solve.zero, &mut self.solve.tmp);
+            let [_, _, a] = chain.tip_motion(t, self.constraint.link, q, qd_c, &self.solve.zero);
+            // The normal velocity of the state itself (the drift, before any projection).
+            self.phase.normal_velocity = vn;
+            let conv = self.constraint.normal[0] * a[0] + self.constraint.normal[1] * a[1];
+            let g_minv_r = if refined {
+                dot(&self.solve.minv_gt, &self.solve.tmp)
+            } else {
+                let r = std::mem::take(&mut self.solve.tmp);
+                self.solve.dx.copy_from_slice(&r);
+                self.solve.tmp = r;
+                self.solve.mass.solve_in_place(&mut self.solve.dx);
+                dot(g_row, &self.solve.dx)
+            };
+            let lambda = (g_minv_r - conv) / gmg;
+            n += 2;
+            if refined {
+                // A refined M⁻¹Gᵀ is exact to REFINE_TOL·‖x‖∞ only, which the stiff elastic
+                // forces in R (shear of Timoshenko links) amplify: near zero — where the release
+                // is decided and located, and λ(h) must be continuous in h — the force is
+                // evaluated again with a factorization at q.
+                let sum_abs = |v: &[f64]| v.iter().map(|x| x.abs()).sum::<f64>();
+                let bound = REFINE_TOL
+                    * max_abs(&self.solve.minv_gt)
+                    * (sum_abs(&self.solve.tmp) + lambda.abs() * sum_abs(g_row))
+                    / gmg.abs();
+                if !(lambda.abs() > REFINE_MARGIN * bound) {
+                    fresh = true;
+                    continue;
+                }
+            }
+            return Ok((lambda, gmg, n));
+        }
     }
 
     /// Perfectly plastic impact at (q, q̇⁻) (module docs): updates `qd` to q̇⁺ and returns the
@@ -635,7 +689,7 @@ impl Contact {
             self.constraint.g_end = g_row;
             return Ok(None);
         }
-        if let Err(e) = self.solve_gradient(chain, t, q, &g_row) {
+        if let Err(e) = self.solve_gradient(chain, t, q, &g_row, false) {
             self.constraint.g_end = g_row;
             return Err(e);
         }
@@ -726,8 +780,8 @@ impl Contact {
         let mut loss = 0.0;
         let mut passes = 0;
         if !inward_only || vn < 0.0 {
-            passes = match self.solve_gradient(chain, t, q, &g_row) {
-                Ok(p) => p,
+            passes = match self.solve_gradient(chain, t, q, &g_row, false) {
+                Ok((p, _)) => p,
                 Err(e) => {
                     self.constraint.g_end = g_row;
                     return Err(e);
