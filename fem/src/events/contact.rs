@@ -531,7 +531,9 @@ impl Contact {
                     self.solve.refactor_next = k + 1 >= SLOW_REFINE;
                     break;
                 }
-                if !(dn <= REFINE_RATE * last) || (k == 0 && dn > FAR_REFINE * xn) {
+                // A NaN correction is no contraction either.
+                let contracting = dn <= REFINE_RATE * last;
+                if !contracting || (k == 0 && dn > FAR_REFINE * xn) {
                     break;
                 }
                 last = dn;
@@ -653,7 +655,8 @@ impl Contact {
                     * max_abs(&self.solve.minv_gt)
                     * (sum_abs(&self.solve.tmp) + lambda.abs() * sum_abs(g_row))
                     / gmg.abs();
-                if !(lambda.abs() > REFINE_MARGIN * bound) {
+                let clear_of_zero = lambda.abs() > REFINE_MARGIN * bound;
+                if !clear_of_zero {
                     fresh = true;
                     continue;
                 }
