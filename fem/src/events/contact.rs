@@ -634,22 +634,21 @@ impl Contact {
             // The normal velocity of the state itself (the drift, before any projection).
             self.phase.normal_velocity = vn;
             let conv = self.constraint.normal[0] * a[0] + self.constraint.normal[1] * a[1];
+            let sv = &mut self.solve;
             let g_minv_r = if refined {
-                dot(&self.solve.minv_gt, &self.solve.tmp)
+                dot(&sv.minv_gt, &sv.tmp)
             } else {
-                let r = std::mem::take(&mut self.solve.tmp);
-                self.solve.dx.copy_from_slice(&r);
-                self.solve.tmp = r;
-                self.solve.mass.solve_in_place(&mut self.solve.dx);
-                dot(g_row, &self.solve.dx)
+                sv.dx.copy_from_slice(&sv.tmp);
+                sv.mass.solve_in_place(&mut sv.dx);
+                dot(g_row, &sv.dx)
             };
             let lambda = (g_minv_r - conv) / gmg;
             n += 2;
             if refined {
-                // A refined M⁻¹Gᵀ is exact to REFINE_TOL·‖x‖∞ only, which the stiff elastic
-                // forces in R (shear of Timoshenko links) amplify: near zero — where the release
-                // is decided and located, and λ(h) must be continuous in h — the force is
-                // evaluated again with a factorization at q.
+                // A refined M⁻¹Gᵀ is exact to REFINE_TOL·‖x‖∞ only, which large elastic forces
+                // in R amplify: near zero — where the release is decided and located, and λ(h)
+                // must be continuous in h — the force is evaluated again with a factorization
+                // at q (and G M⁻¹R by a second solve, as without refinement).
                 let sum_abs = |v: &[f64]| v.iter().map(|x| x.abs()).sum::<f64>();
                 let bound = REFINE_TOL
                     * max_abs(&self.solve.minv_gt)
