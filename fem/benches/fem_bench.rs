@@ -4,8 +4,8 @@
 //! energy-midpoint (the default there) and generalized-α; whole default runs of the arms
 //! (`two-link-free-undamped` 10 s, `barhorst-case1` 3 s) and the first second of
 //! `two-link-free-undamped` (`arms-1s`); `barhorst-case1` over t ∈ [0, 0.5] s (`contact-0.5s`:
-//! the drop, the first impact at 0.28 s and constrained sliding; the contact maps' sparse mass
-//! solves per constrained step); `barhorst-case1-timoshenko` over t ∈ [0, 0.35] s
+//! the drop, the first impact at 0.28 s and constrained sliding; the normal force's mass solve
+//! per constrained step, refined against the last sparse factorization where it can be); `barhorst-case1-timoshenko` over t ∈ [0, 0.35] s
 //! (`contact-timoshenko-0.35s`: its first impact and micro-bounces, bound by event location).
 //! Run: `cargo bench -p fem --bench fem_bench -- --quick` (one group: append its name, e.g. `arms`).
 
@@ -130,8 +130,8 @@ fn arms_short(c: &mut Criterion) {
 }
 
 /// `barhorst-case1` over 0.5 s: the free drop, the first impact (0.28 s) and the sliding phases
-/// after it, each constrained step with its normal-force evaluation (sparse mass
-/// factorization, `events::mass_solve`) and event location.
+/// after it, each constrained step with its normal-force evaluation (one mass solve, refined
+/// against the last sparse factorization, `events::contact`) and event location.
 fn contact_short(c: &mut Criterion) {
     shortened_run(c, "contact-0.5s", "barhorst-case1", 0.5);
 }

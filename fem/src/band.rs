@@ -249,9 +249,17 @@ struct BandLu {
     ni: usize,
     nb: usize,
     b: usize,
-    /// Row i holds columns i − b ..= i + 2b at i·width + (j + b − i).
+    /// Row i holds columns i − b ..= i + 2b at i·width + (j + b − i) (U and, below the
+    /// diagonal, the elimination workspace).
     a: Vec<f64>,
     width: usize,
+    /// Multipliers of L by column: L(k + 1 + m, k) at k·b + m (contiguous for the solves; the
+    /// row interchanges of later columns never move them, as in LAPACK `gbtrf`).
+    l: Vec<f64>,
+    /// Last column of row k of U that the elimination can have made nonzero: k + b without
+    /// row interchanges, up to k + 2b with them. The entries past it are exact zeros, which the
+    /// factorization and the back substitution skip.
+    reach: Vec<usize>,
     piv: Vec<usize>,
     /// B, then W = A⁻¹B, column-major (n_I × n_B).
     w: Vec<f64>,
@@ -270,6 +278,8 @@ impl BandLu {
             b,
             a: vec![0.0; ni * width],
             width,
+            l: vec![0.0; ni * b],
+            reach: vec![0; ni],
             piv: vec![0; ni],
             w: vec![0.0; ni * nb],
             c: vec![0.0; nb * ni],
@@ -309,7 +319,12 @@ impl BandLu {
                 self.schur.set_column(jb, d);
             }
         }
-        // Band LU with row interchanges.
+        // Band LU with row interchanges. Rows are contiguous in `a`: the interchange and the
+        // update of row r by row k work on slices of columns k..=right, right the reach of the
+        // pivot row (its entries further right are zero).
+        for (i, r) in self.reach.iter_mut().enumerate() {
+            *r = (i + b).min(ni - 1);
+        }
         for k in 0..ni {
             let last = (k + b).min(ni - 1);
             let mut p = k;
@@ -329,23 +344,29 @@ impl BandLu {
                 });
             }
             self.piv[k] = p;
-            let right = (k + 2 * b).min(ni - 1);
             if p != k {
-                for j in k..=right {
-                    let (x, y) = (self.at(k, j), self.at(p, j));
-                    self.a.swap(x, y);
-                }
+                let len = self.reach[k].max(self.reach[p]) - k + 1;
+                let (x, y) = (self.at(k, k), self.at(p, k));
+                let (head, tail) = self.a.split_at_mut(y);
+                head[x..x + len].swap_with_slice(&mut tail[..len]);
+                self.reach.swap(k, p);
             }
+            let right = self.reach[k];
+            let len = right - k + 1;
             let d = self.a[self.at(k, k)];
+            let pivot_row = self.at(k, k) + 1;
             for r in k + 1..=last {
                 let pr = self.at(r, k);
                 let l = self.a[pr] / d;
                 self.a[pr] = l;
+                self.l[k * b + (r - k - 1)] = l;
                 if l != 0.0 {
-                    for j in k + 1..=right {
-                        let (x, y) = (self.at(r, j), self.at(k, j));
-                        self.a[x] -= l * self.a[y];
+                    let (head, tail) = self.a.split_at_mut(pr + 1);
+                    let upper = &head[pivot_row..pivot_row + len - 1];
+                    for (x, &y) in tail[..len - 1].iter_mut().zip(upper) {
+                        *x -= l * y;
                     }
+                    self.reach[r] = self.reach[r].max(right);
                 }
             }
         }
@@ -380,17 +401,22 @@ impl BandLu {
             }
             let xk = x[k];
             if xk != 0.0 {
-                for r in k + 1..=(k + b).min(ni - 1) {
-                    x[r] -= self.a[self.at(r, k)] * xk;
+                let cnt = (k + b).min(ni - 1) - k;
+                let lk = &self.l[k * b..k * b + cnt];
+                for (xr, &l) in x[k + 1..k + 1 + cnt].iter_mut().zip(lk) {
+                    *xr -= l * xk;
                 }
             }
         }
         for k in (0..ni).rev() {
+            let cnt = self.reach[k] - k;
+            let diag = self.at(k, k);
+            let row = &self.a[diag + 1..diag + 1 + cnt];
             let mut v = x[k];
-            for j in k + 1..=(k + 2 * b).min(ni - 1) {
-                v -= self.a[self.at(k, j)] * x[j];
+            for (&u, &xj) in row.iter().zip(&x[k + 1..k + 1 + cnt]) {
+                v -= u * xj;
             }
-            x[k] = v / self.a[self.at(k, k)];
+            x[k] = v / self.a[diag];
         }
     }
 

@@ -429,3 +429,41 @@ fn conv_case1_impulse_without_tip_mass_falls_with_the_element_size() {
         assert!((first[k].0 - first[0].0).abs() < 1e-5);
     }
 }
+
+/// The index-1 normal force at a configuration near that of the mass factorization at hand
+/// (refined against the current mass matrix) and at one far from it (a new factorization) equals
+/// the force of a contact that factorizes at that configuration itself.
+#[test]
+fn sys_refined_normal_force_matches_a_fresh_factorization() {
+    use fem::events::contact::Contact;
+    for name in ["barhorst-case1", "barhorst-case1-tipmass"] {
+        let sc = scene(name);
+        let mut chain = Chain::new(sc.links(), sc.gravity(), 8).unwrap();
+        let n = chain.ndof;
+        let q0 = bent_state(&chain);
+        let qd: Vec<f64> = (0..n).map(|i| 0.3 * ((i as f64 * 0.9).cos())).collect();
+        let mut held = Contact::from_scene(&sc, &chain).unwrap().unwrap();
+        held.state_force(&mut chain, 0.0, &q0, &qd).unwrap();
+        // One step's motion (0.5 ms at a few rad/s), then a configuration far away.
+        for (k, size) in [(1, 1e-3), (2, 1e-3), (3, 0.2)] {
+            let q: Vec<f64> = q0
+                .iter()
+                .enumerate()
+                .map(|(i, v)| v + size * k as f64 * ((i as f64 * 2.3).sin() + 0.5))
+                .collect();
+            let (lam, gmg, _) = held.state_force(&mut chain, 0.0, &q, &qd).unwrap();
+            let mut fresh = Contact::from_scene(&sc, &chain).unwrap().unwrap();
+            let (lam_f, gmg_f, _) = fresh.state_force(&mut chain, 0.0, &q, &qd).unwrap();
+            // Force scale: the weight of the two links (ρA = 1.764 slug/ft, 5 ft, g = 32.2).
+            let weight = 1.764 * 5.0 * 32.2;
+            assert!(
+                (lam - lam_f).abs() <= 1e-10 * weight,
+                "{name} {size}: λ {lam} vs {lam_f}"
+            );
+            assert!(
+                (gmg - gmg_f).abs() <= 1e-12 * gmg_f.abs(),
+                "{name} {size}: G M⁻¹Gᵀ {gmg} vs {gmg_f}"
+            );
+        }
+    }
+}

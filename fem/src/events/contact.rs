@@ -27,8 +27,12 @@
 //! M q̈ + R(q, q̇, 0) = Gᵀλ, G q̈ + n̂·J̇q̇ = 0:
 //!   λ = (G M⁻¹R(q, q̇, 0) − n̂·J̇q̇) / (G M⁻¹Gᵀ),
 //! with M(q) the Newton matrix ∂R/∂q̈ assembled sparsely (with foreshortening, its exact
-//! augmented bordered band) and factorized once per configuration by `mass_solve`: O(n).
-//! Positive λ pushes the tip to the free side. It is evaluated at the velocity the constrained
+//! augmented bordered band) and factorized by `mass_solve`: O(n). At a configuration near
+//! that of the factorization at hand (the next step end), on chains without massless
+//! sections, y = M⁻¹Gᵀ is refined against the current M instead of forming a new one, and
+//! G M⁻¹R = yᵀR (M symmetric); a force within 100 times its error bound of zero is evaluated
+//! again with a factorization at its configuration (`Contact::solve_gradient`). Positive λ
+//! pushes the tip to the free side. It is evaluated at the velocity the constrained
 //! dynamics allows: q̇ projected onto G q̇ = 0 (the plastic projection that ends every
 //! constrained step) and made consistent along the massless directions. At a step end the
 //! drift G q̇ = O(h²) otherwise entered λ through the velocity terms, and λ of the projected
@@ -168,7 +172,7 @@ use crate::chain::{Chain, MAX_LINKS, Parts};
 use crate::error::FemError;
 use crate::events::mass_solve::MassSolver;
 use crate::events::massless::Massless;
-use crate::linalg::dot;
+use crate::linalg::{dot, max_abs};
 use crate::method::{ConstraintView, NewtonSystem, StepConstraint};
 
 /// Gap tolerance of a located contact start, relative to the longest link.
@@ -177,6 +181,20 @@ pub const GAP_TOL: f64 = 1e-10;
 pub const FORCE_TOL: f64 = 1e-8;
 /// Smallest event bracket (time) the secant refines to.
 pub const TIME_TOL: f64 = 1e-13;
+/// Relative size of the last correction at which a refined mass solve stops
+/// ([`Contact::solve_gradient`]).
+const REFINE_TOL: f64 = 5e-13;
+/// Contraction per iteration below which a refined mass solve gives up for a new factorization.
+const REFINE_RATE: f64 = 0.1;
+/// A normal force from a refined solve is kept when it exceeds this multiple of its error bound
+/// (else it is evaluated again with a factorization at its configuration).
+const REFINE_MARGIN: f64 = 100.0;
+/// Refinement iterations at most before a new factorization.
+const MAX_REFINE: usize = 6;
+/// Refinement iterations from which the next mass solve forms a new factorization.
+const SLOW_REFINE: usize = 4;
+/// First correction (relative to x) beyond which the factorization at hand is given up at once.
+const FAR_REFINE: f64 = 1e-2;
 /// Most contact events in a run.
 pub const MAX_EVENTS: usize = 20_000;
 /// Shortest step (relative to the nominal one) the stretch of an undetermined grazing contact
@@ -287,6 +305,16 @@ pub(crate) struct ConstrainedSolve {
     col: Vec<f64>,
     minv_gt: Vec<f64>,
     tmp: Vec<f64>,
+    /// Correction of the refined solve.
+    dx: Vec<f64>,
+    /// Configuration (t, q) of `minv_gt` = (M + μNNᵀ)⁻¹Gᵀ (None: not valid).
+    minv_key_t: Option<f64>,
+    minv_key_q: Vec<f64>,
+    /// Whether `minv_gt` was refined (else solved with a factorization at its configuration).
+    minv_refined: bool,
+    /// The last refined solve needed [`SLOW_REFINE`] iterations or more: the factorization
+    /// at hand is too far from the configurations asked for, the next solve forms a new one.
+    refactor_next: bool,
 }
 
 impl Contact {
@@ -369,7 +397,12 @@ impl Contact {
                 unit: z.clone(),
                 col: z.clone(),
                 minv_gt: z.clone(),
-                tmp: z,
+                tmp: z.clone(),
+                dx: z.clone(),
+                minv_key_t: None,
+                minv_key_q: z,
+                minv_refined: false,
+                refactor_next: false,
             },
             bilateral,
         }))
@@ -431,6 +464,105 @@ impl Contact {
         Ok(passes + self.solve.mass.factor(chain, t, q, self.solve.mass_scale)?)
     }
 
+    /// `minv_gt` ← (M(q) + μNNᵀ)⁻¹ `g_row` (G at (t, q)); returns the residual passes used.
+    ///
+    /// Kept while (t, q) is unchanged (the normal force at a step end, then its drift
+    /// projection). Otherwise, with a factorization at hand from an earlier configuration
+    /// (the previous step end: M moves by O(h·q̇) between them), iterative refinement against
+    /// the current matrix, x ← x + M₀⁻¹(Gᵀ − M(q)x) with the exact mass product of one
+    /// inertial residual pass, replaces a new assembly and factorization (one pass and one
+    /// solve each, against an assembly of the exact Newton matrix, a factorization with its
+    /// border solves and a pass). It stops at a correction within [`REFINE_TOL`] of x (the
+    /// round-off floor of the refinement, measured 1e-14..1e-13 relative); a first correction
+    /// beyond [`FAR_REFINE`], a contraction slower than [`REFINE_RATE`] per iteration, or
+    /// [`MAX_REFINE`] iterations without reaching the tolerance form and factorize M(q) and
+    /// solve directly, as does the solve after one that needed [`SLOW_REFINE`] iterations
+    /// (the factorization at hand has fallen too far behind). Not with massless section
+    /// rotations (Timoshenko links without rotary inertia): there the residual R carries the
+    /// stiff shear forces, which amplify the refinement's tolerance into the normal force
+    /// (measured: a release located with λ = −2.7e-2 lbf at a bracket of 9e-13 s on
+    /// `barhorst-case1-timoshenko`, 8 elements) — those runs factorize at every configuration.
+    fn solve_gradient(
+        &mut self,
+        chain: &mut Chain,
+        t: f64,
+        q: &[f64],
+        g_row: &[f64],
+        fresh: bool,
+    ) -> Result<(usize, bool), FemError> {
+        let sv = &self.solve;
+        if !fresh
+            && sv.minv_key_t.is_some_and(|k| k.to_bits() == t.to_bits())
+            && sv
+                .minv_key_q
+                .iter()
+                .zip(q)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        {
+            return Ok((0, self.solve.minv_refined));
+        }
+        self.solve.minv_key_t = None;
+        let mut passes = 0;
+        let mu = self.solve.mass_scale;
+        let stale = !fresh
+            && self.solve.massless.is_none()
+            && self.solve.mass.factored()
+            && !self.solve.refactor_next
+            && !self.solve.mass.is_at(t, q, mu);
+        let mut refined = false;
+        if stale {
+            self.solve.minv_gt.copy_from_slice(g_row);
+            self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
+            let mut last = f64::INFINITY;
+            for k in 0..MAX_REFINE {
+                passes += 1;
+                self.mass_product(chain, t, q);
+                for i in 0..g_row.len() {
+                    self.solve.dx[i] = g_row[i] - self.solve.col[i];
+                }
+                self.solve.mass.solve_in_place(&mut self.solve.dx);
+                let dn = max_abs(&self.solve.dx);
+                for i in 0..g_row.len() {
+                    self.solve.minv_gt[i] += self.solve.dx[i];
+                }
+                let xn = max_abs(&self.solve.minv_gt);
+                if dn <= REFINE_TOL * xn {
+                    refined = true;
+                    self.solve.refactor_next = k + 1 >= SLOW_REFINE;
+                    break;
+                }
+                // A NaN correction is no contraction either.
+                let contracting = dn <= REFINE_RATE * last;
+                if !contracting || (k == 0 && dn > FAR_REFINE * xn) {
+                    break;
+                }
+                last = dn;
+            }
+        }
+        if !refined {
+            self.solve.refactor_next = false;
+            passes += self.factor_mass(chain, t, q)?;
+            self.solve.minv_gt.copy_from_slice(g_row);
+            self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
+        }
+        self.solve.minv_key_t = Some(t);
+        self.solve.minv_key_q.copy_from_slice(q);
+        self.solve.minv_refined = refined;
+        Ok((passes, refined))
+    }
+
+    /// `col` ← (M(q) + μNNᵀ)·`minv_gt`: one inertial residual pass and the regularization.
+    fn mass_product(&mut self, chain: &mut Chain, t: f64, q: &[f64]) {
+        let sv = &mut self.solve;
+        chain.residual_parts(t, q, &sv.zero, &sv.minv_gt, Parts::INERTIA, &mut sv.col);
+        for d in &sv.reg_dirs {
+            let w: f64 = d.iter().map(|&(i, c)| c * sv.minv_gt[i]).sum();
+            for &(i, c) in d {
+                sv.col[i] += sv.mass_scale * c * w;
+            }
+        }
+    }
+
     /// Makes `qd` consistent with the massless balances Nᵀ R(q, q̇, 0) = 0 by changing it along
     /// N only (no kinetic energy, no tip velocity changes: M N = 0, G N = 0); see
     /// [`Massless::make_consistent`]. Returns the residual passes used. No-op without
@@ -457,38 +589,79 @@ impl Contact {
         q: &[f64],
         qd: &[f64],
     ) -> Result<(f64, f64, usize), FemError> {
-        let mut n = self.factor_mass(chain, t, q)?;
         let mut g_row = std::mem::take(&mut self.constraint.g_end);
         self.phase.gap = self.gradient(chain, t, q, &mut g_row);
-        self.solve.minv_gt.copy_from_slice(&g_row);
-        self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
-        let gmg = dot(&g_row, &self.solve.minv_gt);
-        // The force of the constrained dynamics at the velocity it allows: q̇ projected onto
-        // G q̇ = 0 (the plastic projection applied after every constrained step, module docs),
-        // and, with massless directions, made consistent with their balances (the stepper's
-        // end rate there is not determined by its equations). The drift G q̇ = O(h²) of a
-        // step end otherwise entered λ through the velocity terms: measured up to 9.6 lbf
-        // between the end of a step and its projected state (`barhorst-case1-tipmass`), a
-        // jump that the release location then met at a bracket of 4e-14 s.
         let mut qd_c = std::mem::take(&mut self.solve.qd_c);
-        qd_c.copy_from_slice(qd);
-        let vn = dot(&g_row, &qd_c);
-        for i in 0..qd_c.len() {
-            qd_c[i] -= self.solve.minv_gt[i] * vn / gmg;
-        }
-        n += self.make_consistent(chain, t, q, &mut qd_c)?;
-        let qd = &qd_c[..];
-        // R(q, q̇, 0): everything but the inertia of q̈.
-        chain.residual(t, q, qd, &self.solve.zero, &mut self.solve.tmp);
-        self.solve.mass.solve_in_place(&mut self.solve.tmp);
-        let [_, _, a] = chain.tip_motion(t, self.constraint.link, q, qd, &self.solve.zero);
-        // The normal velocity of the state itself (the drift, before any projection).
-        self.phase.normal_velocity = vn;
-        let conv = self.constraint.normal[0] * a[0] + self.constraint.normal[1] * a[1];
-        let lambda = (dot(&g_row, &self.solve.tmp) - conv) / gmg;
+        let out = self.state_force_with(chain, t, q, qd, &g_row, &mut qd_c);
         self.constraint.g_end = g_row;
         self.solve.qd_c = qd_c;
-        Ok((lambda, gmg, n + 2))
+        out
+    }
+
+    /// [`Contact::state_force`] with G in `g_row`; `qd_c` receives the consistent velocity.
+    fn state_force_with(
+        &mut self,
+        chain: &mut Chain,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        g_row: &[f64],
+        qd_c: &mut [f64],
+    ) -> Result<(f64, f64, usize), FemError> {
+        let mut n = 0;
+        let mut fresh = false;
+        loop {
+            let (passes, refined) = self.solve_gradient(chain, t, q, g_row, fresh)?;
+            n += passes;
+            let gmg = dot(g_row, &self.solve.minv_gt);
+            // The force of the constrained dynamics at the velocity it allows: q̇ projected onto
+            // G q̇ = 0 (the plastic projection applied after every constrained step, module
+            // docs), and, with massless directions, made consistent with their balances (the
+            // stepper's end rate there is not determined by its equations). The drift
+            // G q̇ = O(h²) of a step end otherwise entered λ through the velocity terms:
+            // measured up to 9.6 lbf between the end of a step and its projected state
+            // (`barhorst-case1-tipmass`), a jump that the release location then met at a
+            // bracket of 4e-14 s.
+            qd_c.copy_from_slice(qd);
+            let vn = dot(g_row, qd_c);
+            for i in 0..qd_c.len() {
+                qd_c[i] -= self.solve.minv_gt[i] * vn / gmg;
+            }
+            n += self.make_consistent(chain, t, q, qd_c)?;
+            // R(q, q̇, 0): everything but the inertia of q̈; G M⁻¹R = (M⁻¹Gᵀ)ᵀR (M symmetric).
+            chain.residual(t, q, qd_c, &self.solve.zero, &mut self.solve.tmp);
+            let [_, _, a] = chain.tip_motion(t, self.constraint.link, q, qd_c, &self.solve.zero);
+            // The normal velocity of the state itself (the drift, before any projection).
+            self.phase.normal_velocity = vn;
+            let conv = self.constraint.normal[0] * a[0] + self.constraint.normal[1] * a[1];
+            let sv = &mut self.solve;
+            let g_minv_r = if refined {
+                dot(&sv.minv_gt, &sv.tmp)
+            } else {
+                sv.dx.copy_from_slice(&sv.tmp);
+                sv.mass.solve_in_place(&mut sv.dx);
+                dot(g_row, &sv.dx)
+            };
+            let lambda = (g_minv_r - conv) / gmg;
+            n += 2;
+            if refined {
+                // A refined M⁻¹Gᵀ is exact to REFINE_TOL·‖x‖∞ only, which large elastic forces
+                // in R amplify: near zero — where the release is decided and located, and λ(h)
+                // must be continuous in h — the force is evaluated again with a factorization
+                // at q (and G M⁻¹R by a second solve, as without refinement).
+                let sum_abs = |v: &[f64]| v.iter().map(|x| x.abs()).sum::<f64>();
+                let bound = REFINE_TOL
+                    * max_abs(&self.solve.minv_gt)
+                    * (sum_abs(&self.solve.tmp) + lambda.abs() * sum_abs(g_row))
+                    / gmg.abs();
+                let clear_of_zero = lambda.abs() > REFINE_MARGIN * bound;
+                if !clear_of_zero {
+                    fresh = true;
+                    continue;
+                }
+            }
+            return Ok((lambda, gmg, n));
+        }
     }
 
     /// Perfectly plastic impact at (q, q̇⁻) (module docs): updates `qd` to q̇⁺ and returns the
@@ -504,7 +677,6 @@ impl Contact {
         // Massless directions (module docs): q̇⁻ consistent with their balances first (changes
         // neither the kinetic energy nor G q̇).
         self.make_consistent(chain, t, q, qd)?;
-        self.factor_mass(chain, t, q)?;
         let mut g_row = std::mem::take(&mut self.constraint.g_end);
         self.phase.gap = self.gradient(chain, t, q, &mut g_row);
         let v_before = dot(&g_row, qd);
@@ -519,8 +691,10 @@ impl Contact {
             self.constraint.g_end = g_row;
             return Ok(None);
         }
-        self.solve.minv_gt.copy_from_slice(&g_row);
-        self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
+        if let Err(e) = self.solve_gradient(chain, t, q, &g_row, false) {
+            self.constraint.g_end = g_row;
+            return Err(e);
+        }
         let gmg = dot(&g_row, &self.solve.minv_gt);
         let impulse = -v_before / gmg;
         let velocity_before = qd.to_vec();
@@ -601,15 +775,20 @@ impl Contact {
         qd: &mut [f64],
         inward_only: bool,
     ) -> Result<(f64, usize), FemError> {
-        let passes = self.factor_mass(chain, t, q)?;
         let mut g_row = std::mem::take(&mut self.constraint.g_end);
         self.phase.gap = self.gradient(chain, t, q, &mut g_row);
         let vn = dot(&g_row, qd);
         self.phase.drift_velocity = vn;
         let mut loss = 0.0;
+        let mut passes = 0;
         if !inward_only || vn < 0.0 {
-            self.solve.minv_gt.copy_from_slice(&g_row);
-            self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
+            passes = match self.solve_gradient(chain, t, q, &g_row, false) {
+                Ok((p, _)) => p,
+                Err(e) => {
+                    self.constraint.g_end = g_row;
+                    return Err(e);
+                }
+            };
             let gmg = dot(&g_row, &self.solve.minv_gt);
             let ke0 = chain.energies(t, q, qd)[0];
             for i in 0..qd.len() {

@@ -20,8 +20,9 @@
 //! [M  μN; μNᵀ  −μ] [x; y] = [b; 0], whose Schur complement in x is M + μNNᵀ.
 //!
 //! **Reuse.** The factorization is kept with the (t, q) it was formed at; a request at the same
-//! bits (the normal force at an accepted step end, then the drift projection of the same state)
-//! reuses it. The symbolic structure, the storage and the work vectors are allocated once.
+//! bits reuses it, and [`MassSolver::is_at`] tells whether it is of a given configuration (the
+//! contact refines solves at nearby configurations against it, `crate::events::contact`). The
+//! symbolic structure, the storage and the work vectors are allocated once.
 
 use crate::band::BorderedBand;
 use crate::chain::{AugmentedLayout, Chain, NewtonCoefficients};
@@ -111,15 +112,7 @@ impl MassSolver {
         q: &[f64],
         mu: f64,
     ) -> Result<usize, FemError> {
-        let same = self.factored
-            && self.key_t.to_bits() == t.to_bits()
-            && self.key_mu.to_bits() == mu.to_bits()
-            && self
-                .key_q
-                .iter()
-                .zip(q)
-                .all(|(a, b)| a.to_bits() == b.to_bits());
-        if same {
+        if self.is_at(t, q, mu) {
             return Ok(0);
         }
         self.factored = false;
@@ -159,6 +152,22 @@ impl MassSolver {
         self.key_q.copy_from_slice(q);
         self.factored = true;
         Ok(1)
+    }
+
+    /// Whether a factorization is at hand, and whether it is of (t, q, μ) exactly.
+    pub(crate) fn factored(&self) -> bool {
+        self.factored
+    }
+
+    pub(crate) fn is_at(&self, t: f64, q: &[f64], mu: f64) -> bool {
+        self.factored
+            && self.key_t.to_bits() == t.to_bits()
+            && self.key_mu.to_bits() == mu.to_bits()
+            && self
+                .key_q
+                .iter()
+                .zip(q)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
     }
 
     /// b ← (M + μNNᵀ)⁻¹ b with the current factorization (after [`MassSolver::factor`]).
