@@ -210,6 +210,22 @@ pub struct Frames {
     pub tip_axes: [Vec3; 4],
 }
 
+impl Frames {
+    /// Inertial position, velocity and acceleration of a point at `d` = (d, ḋ, d̈) (frame-k
+    /// components) carried by frame k: p = o + Rd, v = v_o + ω×Rd + Rḋ,
+    /// a = a_o + α×Rd + ω×(ω×Rd + 2Rḋ) + Rd̈.
+    fn carry(&self, k: usize, d: [Vec3; 3]) -> [Vec3; 3] {
+        let r = self.r[k];
+        let (dp, dv, da) = (r * d[0], r * d[1], r * d[2]);
+        let w = self.w[k];
+        [
+            self.o[k] + dp,
+            self.v[k] + w.cross(&dp) + dv,
+            self.a[k] + self.al[k].cross(&dp) + w.cross(&(w.cross(&dp) + (2.0 * dv))) + da,
+        ]
+    }
+}
+
 /// Partial velocities of one mass element: speed index, J_v, J_ω.
 #[derive(Debug, Clone, Copy)]
 pub struct Partials {
@@ -487,12 +503,7 @@ impl Model {
                 }
             }
             let (r, w, al) = (f.r[k - 1], f.w[k - 1], f.al[k - 1]);
-            let dp = r * d[0];
-            let dv = r * d[1];
-            let da = r * d[2];
-            f.o[k] = f.o[k - 1] + dp;
-            f.v[k] = f.v[k - 1] + w.cross(&dp) + dv;
-            f.a[k] = f.a[k - 1] + al.cross(&dp) + w.cross(&(w.cross(&dp) + (2.0 * dv))) + da;
+            [f.o[k], f.v[k], f.a[k]] = f.carry(k - 1, d);
             let (mut r, mut w, mut al) = (r, w, al);
             if let Some(b) = tip {
                 f.tip_o = f.o[k];
@@ -640,8 +651,6 @@ impl Model {
         }
         if let Some(fl) = &self.flex {
             let fr = fl.frame;
-            let r = &f.r[fr];
-            let (w, al) = (f.w[fr], f.al[fr]);
             let e = &q[l.q_el..l.q_el + fl.ne];
             let ed = &ws.qd[l.q_el..l.q_el + fl.ne];
             let edd = &ws.qdd[l.q_el..l.q_el + fl.ne];
@@ -653,11 +662,14 @@ impl Model {
                     let [vv, ww] = fl.field_at(e, el, &s.n);
                     let [vd, wd] = fl.field_at(ed, el, &s.n);
                     let [vdd, wdd] = fl.field_at(edd, el, &s.n);
-                    let d = r * Vector3::new(x, vv, ww);
-                    let dv = r * Vector3::new(0.0, vd, wd);
-                    let da = r * Vector3::new(0.0, vdd, wdd);
-                    let p = f.o[fr] + d;
-                    let acc = f.a[fr] + al.cross(&d) + w.cross(&(w.cross(&d) + (2.0 * dv))) + da;
+                    let [p, _, acc] = f.carry(
+                        fr,
+                        [
+                            Vector3::new(x, vv, ww),
+                            Vector3::new(0.0, vd, wd),
+                            Vector3::new(0.0, vdd, wdd),
+                        ],
+                    );
                     let dm = fl.mu * fl.gauss_w[g];
                     let lin = dm * (acc + gvec);
                     self.beam_partials(&f, q, fl, el, s, p, &mut jp);

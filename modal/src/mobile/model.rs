@@ -164,6 +164,21 @@ pub struct Frames {
     pub a: [Vec3; 6],
 }
 
+impl Frames {
+    /// Inertial position, velocity and acceleration of a point at `d` (with rates `dd`, `ddd`,
+    /// all in frame-k components) carried by frame k: p = o + Rd,
+    /// v = v_o + ω×Rd + Rḋ, a = a_o + α×Rd + ω×(ω×Rd) + (2ω×Rḋ + Rd̈).
+    fn carry(&self, k: usize, d: Vec3, dd: Vec3, ddd: Vec3) -> [Vec3; 3] {
+        let (d, dd, ddd) = (self.r[k] * d, self.r[k] * dd, self.r[k] * ddd);
+        let w = self.w[k];
+        [
+            self.o[k] + d,
+            self.v[k] + w.cross(&d) + dd,
+            self.a[k] + self.al[k].cross(&d) + w.cross(&w.cross(&d)) + (2.0 * w.cross(&dd) + ddd),
+        ]
+    }
+}
+
 /// Kinematics of the beam's quadrature nodes (inertial position, velocity, acceleration).
 #[derive(Debug, Clone, Default)]
 pub struct NodeKinematics {
@@ -362,15 +377,12 @@ impl MobileModel {
                 let (s, c) = tip(q, &fl.slope_tip);
                 let (sd, cd) = tip(qd, &fl.slope_tip);
                 let (sdd, cdd) = tip(qdd, &fl.slope_tip);
-                let d = f.r[p] * Vector3::new(fl.length, vl, wl);
-                let dd = f.r[p] * Vector3::new(0.0, vld, wld);
-                let ddd = f.r[p] * Vector3::new(0.0, vldd, wldd);
-                f.o[k] = f.o[p] + d;
-                f.v[k] = f.v[p] + f.w[p].cross(&d) + dd;
-                f.a[k] = f.a[p]
-                    + f.al[p].cross(&d)
-                    + f.w[p].cross(&f.w[p].cross(&d))
-                    + (2.0 * f.w[p].cross(&dd) + ddd);
+                [f.o[k], f.v[k], f.a[k]] = f.carry(
+                    p,
+                    Vector3::new(fl.length, vl, wl),
+                    Vector3::new(0.0, vld, wld),
+                    Vector3::new(0.0, vldd, wldd),
+                );
                 // Two virtual revolute joints at the tip: s about R_F e_z, then c about
                 // R_F R_z(s) (−e_y).
                 let axis1 = f.r[p] * EZ;
@@ -424,15 +436,12 @@ impl MobileModel {
                 let (v, w) = field(q);
                 let (vd, wd) = field(qd);
                 let (vdd, wdd) = field(qdd);
-                let d = f.r[k] * Vector3::new(fl.nodes[g], v, w);
-                let dd = f.r[k] * Vector3::new(0.0, vd, wd);
-                let ddd = f.r[k] * Vector3::new(0.0, vdd, wdd);
-                nk.p[g] = f.o[k] + d;
-                nk.v[g] = f.v[k] + f.w[k].cross(&d) + dd;
-                nk.a[g] = f.a[k]
-                    + f.al[k].cross(&d)
-                    + f.w[k].cross(&f.w[k].cross(&d))
-                    + (2.0 * f.w[k].cross(&dd) + ddd);
+                [nk.p[g], nk.v[g], nk.a[g]] = f.carry(
+                    k,
+                    Vector3::new(fl.nodes[g], v, w),
+                    Vector3::new(0.0, vd, wd),
+                    Vector3::new(0.0, vdd, wdd),
+                );
             }
         }
         f
