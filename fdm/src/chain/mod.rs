@@ -1110,8 +1110,14 @@ impl System for TwoLinkChain {
     /// The tip sits on the chord (v_r = 0), so its deflection in the clamp-tangent frame — the
     /// `tip_deflection` channel, fem's and modal's coordinate — is L·(−ε): beyond L once the
     /// clamp slope against the chord passes 1, where no small-slope beam model holds.
+    /// Timoshenko links take the first segment's slope v₁/h for ε (it differs from the clamp
+    /// section's rotation by the shear angle): the section rotation needs the condensation
+    /// solve, too much for a check made at every step.
     fn overextended(&self, q: &[f64]) -> Option<Overextension> {
-        let turns = self.clamp_frame_turns(q);
+        let turns = match &self.timo {
+            Some(_) => [0, 1].map(|l| -q[self.first(l)] / self.hs[l]),
+            None => self.clamp_frame_turns(q),
+        };
         (0..2).find_map(|l| {
             let length = self.links[l].length;
             let deflection = length * turns[l];
