@@ -283,24 +283,7 @@ mod tests {
                 peak: None,
             })
             .collect();
-        let hs: Vec<f64> = rungs.iter().map(|r| r.h).collect();
-        let values: Vec<f64> = rungs.iter().map(|r| r.value).collect();
-        let extrapolation = richardson(&hs, &values, None);
-        let finest = rungs.last().unwrap().value;
-        Ladder {
-            backend,
-            estimate: extrapolation.map(|(value, _)| Estimate {
-                backend,
-                value,
-                uncertainty: (finest - value).abs(),
-            }),
-            richardson: extrapolation,
-            rungs,
-            observed_order: None,
-            plateau_from: None,
-            monotone_from_above: false,
-            note: None,
-        }
+        summarize_ladder(backend, rungs, None)
     }
 
     fn scale(_: &Ladder, v: f64) -> f64 {
