@@ -234,3 +234,34 @@ fn sys_report_failures_link_to_their_rows_and_plots() {
     assert!(failures.contains(">histories</a>"), "{failures}");
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn sys_report_work_of_a_zero_limit_reads_back_with_absolute_errors() {
+    // The impulse excess tends to 0 (the tip-mass momentum limit): its work–precision errors
+    // are absolute and finite, so the work file reads back (merge and the scene fronts use it).
+    let dir = scratch("zero-limit");
+    let (code, err) = flexverify(&[
+        "verify",
+        "--filter",
+        "limit-impulse-tipmass-fem",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("note:"), "{err}");
+    let (works, notes) = verify::report::work::read_all(&dir);
+    assert!(notes.is_empty(), "{notes:?}");
+    let work = works
+        .iter()
+        .find(|w| w.case == "limit-impulse-tipmass-fem")
+        .expect("the case's work file");
+    assert!(
+        work.reference_label.contains("absolute error"),
+        "{}",
+        work.reference_label
+    );
+    for p in &work.points {
+        assert!(p.error.is_finite(), "{p:?}");
+        assert_eq!(p.error, p.value.abs(), "{p:?}");
+    }
+}

@@ -169,7 +169,8 @@ pub struct WorkPoint {
     /// The rung's settings, e.g. "stations=41" or "elements=4,element=hermite-quintic".
     pub discretization: String,
     pub value: f64,
-    /// |value − reference| / |reference|.
+    /// |value − reference| / |reference|; |value − reference| where the reference is 0 (the
+    /// case's `reference_label` then says so).
     pub error: f64,
     pub timing: Timing,
     pub counters: Counters,

@@ -300,13 +300,23 @@ fn draw_ladder(
                 None => return false,
             },
         };
+    // Relative error, or absolute where the limit is zero (an excess over an analytic limit):
+    // a relative error there is infinite and would not survive the JSON round trip.
+    let (scale, reference_label) = if reference == 0.0 {
+        (
+            1.0,
+            format!("{reference_label} (absolute error: the limit is 0)"),
+        )
+    } else {
+        (reference.abs(), reference_label)
+    };
     let points: Vec<WorkPoint> = rungs
         .iter()
         .map(|(rung, _, value, cost, timing)| WorkPoint {
             backend: case.backend.to_string(),
             discretization: super::evaluate::settings_label(rung),
             value: *value,
-            error: ((value - reference) / reference).abs(),
+            error: (value - reference).abs() / scale,
             timing: *timing,
             counters: *cost,
         })
