@@ -563,3 +563,33 @@ fn dyn_chain_deflected_beyond_its_length_stops_with_a_diagnostic() {
         assert!(peak <= link.length, "link {}: {peak}", k + 1);
     }
 }
+
+#[test]
+fn sys_chain_overextension_is_the_clamp_frame_tip_deflection_past_the_length() {
+    // Link 1's station 1 (q-index 2, chord frame) set to −s·h from the undeformed state turns
+    // the clamp against the chord by ε (Euler: (v₁ − x)/(2h) with the ghost x left at its rest
+    // value 0, so ε = −s/2; Timoshenko: the first segment's slope, ε = −s). The clamp-frame tip
+    // deflection L·(−ε) passes L only once |ε| > 1.
+    for (name, per_h) in [("two-link-free", 0.5), ("barhorst-case1-timoshenko", 1.0)] {
+        let scene = load_scene(name).unwrap();
+        let stations = 11;
+        let sys = TwoLinkChain::from_scene(&scene, Some(stations)).unwrap();
+        let l1 = scene.links()[0].length;
+        let h = l1 / (stations - 1) as f64;
+        let (q0, _) = sys.initial_state();
+        assert!(sys.overextended(&q0).is_none(), "{name}: at rest");
+        let at = |s: f64| {
+            let mut q = q0.clone();
+            q[2] = -s * h;
+            sys.overextended(&q)
+        };
+        // |ε| = per_h · s: just below and just above 1
+        assert!(at(0.95 / per_h).is_none(), "{name}");
+        let o = at(1.05 / per_h).unwrap_or_else(|| panic!("{name}: not caught"));
+        assert_eq!(o.link, 1, "{name}");
+        assert!(
+            (o.deflection - 1.05 * l1).abs() < 1e-9 * l1,
+            "{name}: {o:?}"
+        );
+    }
+}
