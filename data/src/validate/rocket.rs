@@ -74,10 +74,16 @@ pub(super) fn check_rocket(c: &mut Checker, p: &FieldPath, r: &Rocket) {
             );
         }
         c.positive(mp.key("weight"), m.weight);
-        c.non_negative(mp.key("axial_stiffness"), m.axial_stiffness);
-        c.non_negative(mp.key("transverse_stiffness"), m.transverse_stiffness);
-        c.non_negative(mp.key("axial_damping"), m.axial_damping);
-        c.non_negative(mp.key("transverse_damping"), m.transverse_damping);
+        check_coupling(
+            c,
+            &mp,
+            [
+                m.axial_stiffness,
+                m.transverse_stiffness,
+                m.axial_damping,
+                m.transverse_damping,
+            ],
+        );
     }
     for (i, s) in r.springs.iter().enumerate() {
         let sp = p.key("spring").index(i);
@@ -89,13 +95,33 @@ pub(super) fn check_rocket(c: &mut Checker, p: &FieldPath, r: &Rocket) {
                 format!("two different indices in 0..{n}"),
             );
         }
-        c.non_negative(sp.key("axial_stiffness"), s.axial_stiffness);
-        c.non_negative(sp.key("transverse_stiffness"), s.transverse_stiffness);
-        c.non_negative(sp.key("axial_damping"), s.axial_damping);
-        c.non_negative(sp.key("transverse_damping"), s.transverse_damping);
+        check_coupling(
+            c,
+            &sp,
+            [
+                s.axial_stiffness,
+                s.transverse_stiffness,
+                s.axial_damping,
+                s.transverse_damping,
+            ],
+        );
     }
     if let InitialShape::Report { a1, a2 } = r.initial_shape {
         c.finite(p.key("initial_shape").key("a1"), a1);
         c.finite(p.key("initial_shape").key("a2"), a2);
+    }
+}
+
+/// The axial and transverse stiffness and damping of a discrete mass's attachment or of a
+/// spring, in that order: each finite and ≥ 0.
+fn check_coupling(c: &mut Checker, p: &FieldPath, values: [f64; 4]) {
+    let keys = [
+        "axial_stiffness",
+        "transverse_stiffness",
+        "axial_damping",
+        "transverse_damping",
+    ];
+    for (key, v) in keys.into_iter().zip(values) {
+        c.non_negative(p.key(key), v);
     }
 }
