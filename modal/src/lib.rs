@@ -5,21 +5,21 @@
 //! `clamped-free`, `tip-mass`; see [`basis`]). With the frame angle α (joint convention of
 //! scenes.md: αᵢ₊₁ = αᵢ + vᵢ'(Lᵢ) + θᵢ₊₁) the energies are
 //!
-//! * kinetic: T = ½ Σ ∫ρA |ṙ|² dx + tip masses/inertias + hub inertias, r = O + R(α)(x − f·s, v),
-//!   s(x) = ½∫₀ˣ v'² (foreshortening, f = 1 when the scene turns it on); exact for the
-//!   inextensible link (with foreshortening) and for the linear model, exact at the tip point
-//!   ([`model::body`]);
-//! * strain: U = ½ Σ ∫EI v''² = ½ bᵀ K_b b; for extensible links (`axial`, u = Σψₖaₖ with
-//!   clamped-free bar modes) also ½∫EA(u' + ½v'²)² through the tensors ∫EA ψ'φ'φ' and ∫EA φ'⁴
-//!   (beware membrane locking: with as many axial as bending modes the Ritz model is too stiff);
-//!   joint springs ½K(θ − θ₀)²; gravity −g·Σ∫ρA r;
+//! * kinetic: T = ½ Σ ∫ρA |ṙ|² dx + tip masses/inertias + hub inertias,
+//!   r = O + R(α)(x + u − f·s, v), s(x) = ½∫₀ˣ v'² (foreshortening, f = 1 when the scene turns
+//!   it on or the link is extensible), u = Σψₖaₖ the stretch of an extensible link (`axial`);
+//!   exact for every model, and exact at the tip point ([`model::body`]);
+//! * strain: U = ½ Σ ∫EI v''² = ½ bᵀ K_b b; for extensible links also ½∫EA u'² = ½ aᵀK_a a,
+//!   which is the von Kármán ½∫EA(u_x' + ½v'²)² of the axial displacement u_x = u − s: the
+//!   axial basis holds the stretch only, so it need not represent −½v'² (the membrane locking
+//!   of an axial basis that must); joint springs ½K(θ − θ₀)²; gravity −g·Σ∫ρA r;
 //! * dissipation: Kelvin–Voigt γ ∫ v̇''² (damping matrix (γ/EI) K_b), joint dampers D θ̇².
 //!
 //! Timoshenko links (`shear`, [`model::section`]) carry an independent section rotation
 //! ψ = Σ χₖ cₖ (clamped v(0) = ψ(0) = 0): U = ½∫EI ψ'² + ½∫κGA (v' − ψ)², Kelvin–Voigt
 //! γ∫ψ̇'², rotary inertia ½∫ρI (α̇ + ψ̇)², tip inertia ½J(α̇ + ψ̇(L))², and the next link is
-//! clamped to the tip cross-section: αᵢ₊₁ = αᵢ + ψᵢ(Lᵢ) + θᵢ₊₁ (the foreshortening and von
-//! Kármán terms keep the centre-line slope v'). Without rotary inertia ψ is massless and is
+//! clamped to the tip cross-section: αᵢ₊₁ = αᵢ + ψᵢ(Lᵢ) + θᵢ₊₁ (the foreshortening keeps the
+//! centre-line slope v'). Without rotary inertia ψ is massless and is
 //! condensed (ψ = χᵀT b, T = −K_cc⁻¹K_cb; the Kelvin–Voigt relaxation of ψ enters to first
 //! order). Rotary inertia is also accepted on Euler links (ψ = v').
 //!

@@ -343,8 +343,7 @@ impl OdeRhs for ChainRhs {
         let nf = self.nf();
         let dim = self.dim();
         let n = self.chain.n;
-        self.chain
-            .elastic_tangent(&self.q, &mut self.kt, &mut self.dt);
+        self.chain.elastic_tangent(&mut self.kt, &mut self.dt);
         jac.iter_mut().for_each(|v| *v = 0.0);
         for k in 0..nf {
             jac[(nf + k) * dim + k] = 1.0;
@@ -386,8 +385,7 @@ impl OdeRhs for ChainRhs {
         }
         let n = self.chain.n;
         let nf = self.nf();
-        self.chain
-            .elastic_tangent(&self.q, &mut self.kt, &mut self.dt);
+        self.chain.elastic_tangent(&mut self.kt, &mut self.dt);
         let mass = self.chain.mass_matrix();
         for (r, &gr) in self.chain.free.iter().enumerate() {
             for (c, &gc) in self.chain.free.iter().enumerate() {

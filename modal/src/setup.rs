@@ -258,7 +258,7 @@ pub fn build_chain_for(
             l.axial_stiffness.unwrap_or(0.0),
             &transverse,
             axial.as_ref(),
-            l.foreshortening,
+            l.foreshortening || l.axial,
         );
         let na = axial.as_ref().map_or(0, |a| a.count());
         let params = SectionParams {
@@ -286,7 +286,8 @@ pub fn build_chain_for(
             transverse,
             axial,
             ints,
-            foreshortening: l.foreshortening,
+            // An axial field is the stretch beside the foreshortening (crate::model::body).
+            foreshortening: l.foreshortening || l.axial,
             tip_mass: l.tip_mass.unwrap_or(0.0),
             tip_inertia: l.tip_inertia.unwrap_or(0.0),
             hub_inertia: l.joint.hub_inertia.unwrap_or(0.0),
@@ -368,8 +369,10 @@ pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, Moda
         }
         if l.axial {
             plan.add(format!("link{k} axial modes"), n);
-            plan.builds
-                .push(format!("link{k}: axial field, von Kármán strain u' + ½v'²"));
+            plan.builds.push(format!(
+                "link{k}: axial stretch field beside the foreshortening (von Kármán strain \
+                     u' + ½v'² = stretch')"
+            ));
         }
         plan.add(format!("link{k} transverse modes ({})", basis.name()), n);
         if l.shear {

@@ -8,12 +8,16 @@
 //!
 //!   2T = m|V|² + 2ω[−V_x Φ₁ᵀb + V_y(c₀ + Ψ₁ᵀa − ½f bᵀS₁b)] + 2V_x(Ψ₁ᵀȧ − f bᵀS₁ḃ)
 //!        + 2V_y Φ₁ᵀḃ + ω²[c₂ + 2Ψₓᵀa + aᵀM_ψa − f bᵀSₓb + bᵀM_φb]
-//!        + 2ω[−(Cb)ᵀȧ + (Φₓ + Cᵀa)ᵀḃ] + ȧᵀM_ψȧ + ḃᵀM_φḃ  (+ 2ΔT when f = 1)
+//!        + 2ω[−(Cb)ᵀȧ + (Φₓ + Cᵀa)ᵀḃ] + ȧᵀM_ψȧ + ḃᵀM_φḃ  (+ 2ΔT + 2ΔT_us when f = 1)
 //!
 //! where ΔT = ½∫ρA[ω²s² + 2ω(vṡ − sv̇) + ṡ²] completes it to the exact kinetic energy of the
 //! inextensible link (`exact_inextensible_terms`; needs the tensors ∫ρA S⊗S and ∫ρA φ⊗S,
 //! contracted once with b per evaluation: n³(n+1)/2 products per link with foreshortening,
-//! O(n²) otherwise). The truncated form is not positive definite in the stiff direction "turn
+//! O(n²) otherwise), and ΔT_us = −∫ρA[u̇ṡ + ω²us] the coupling of an axial stretch field
+//! with the foreshortening (`stretch_foreshortening_terms`). An extensible link (von Kármán
+//! strain u_x + ½v'² of the axial displacement u_x) is modelled with f = 1 and the stretch
+//! u = u_x + s as its axial field: its strain is u' exactly, so a truncated axial basis does
+//! not have to represent ½v'² (which it cannot: membrane locking). The truncated form is not positive definite in the stiff direction "turn
 //! an inertia-free hub frame and counter-bend the link".
 //!
 //! The −f ω² bᵀSₓb term is the centrifugal (geometric) stiffening; ω² bᵀM_φb the in-plane
@@ -55,6 +59,10 @@ pub struct BodyScratch {
     zv: Vec<f64>,
     t1: Vec<f64>,
     t2: Vec<f64>,
+    // Stretch–foreshortening coupling (see `stretch_foreshortening_terms`): P_k b and P_k ḃ
+    // (na × nb each).
+    pb: Vec<f64>,
+    pbd: Vec<f64>,
     /// Tip position p(L), its velocity ṗ(L) (both in frame axes) and the tip's full local
     /// velocity w = V + ωJp + ṗ.
     pub(crate) p_tip: [f64; 2],
@@ -91,6 +99,8 @@ impl BodyScratch {
             zv: z(nb),
             t1: z(nb),
             t2: z(nb),
+            pb: z(na * nb),
+            pbd: z(na * nb),
             p_tip: [0.0; 2],
             pd_tip: [0.0; 2],
             w_tip: [0.0; 2],
@@ -227,6 +237,9 @@ pub fn body_terms(
 
     if link.foreshortening {
         exact_inextensible_terms(it, b, bd, om, mb, h, s);
+        if na > 0 {
+            stretch_foreshortening_terms(it, a, ad, b, bd, om, mb, h, s);
+        }
     }
 
     // Tip point p(L) = (L + ψ(L)ᵀa − ½f bᵀS_L b, φ(L)ᵀb), exact.
@@ -320,6 +333,56 @@ pub fn body_terms(
                 + g[1] * (it.phi1[k] + link.tip_mass * it.phi_l[k]);
         }
     }
+}
+
+/// Kinetic coupling of the axial stretch u = ψᵀa with the foreshortening s = ½bᵀS b (axial
+/// field on: the axial displacement is u − s, so the strain u' + ½v'² of the von Kármán
+/// model is the stretch u' alone and the axial basis carries no ½v'²). From
+/// ½∫ρA |V + ωJp + ṗ|² with p = (x + u − s, v), the products of u and s give
+///
+///   ΔT_us = −ȧᵀP(b, ḃ) − ½ω² aᵀP(b, b),   P_k(x, y) = Σ_ij P_kij x_i y_j,  P_kij = ∫ρA ψ_k S_ij,
+///
+/// so 𝕄_{a_k b} −= P_k b, 𝕄_ωω −= aᵀP(b, b), and (h = 𝕄̇ν − ∂T/∂e)
+///   h_a,k += −P_k(ḃ, ḃ) + ½ω² P_k(b, b),   h_b += ω² Σ_k a_k P_k b,
+///   h_ω += −ω [ȧᵀP(b, b) + 2 aᵀP(b, ḃ)].
+#[allow(clippy::too_many_arguments)]
+fn stretch_foreshortening_terms(
+    it: &super::integrals::LinkIntegrals,
+    a: &[f64],
+    ad: &[f64],
+    b: &[f64],
+    bd: &[f64],
+    om: f64,
+    mb: &mut [f64],
+    h: &mut [f64],
+    s: &mut BodyScratch,
+) {
+    let (na, nb) = (it.na, it.nb);
+    let nn = nb * nb;
+    let d = h.len();
+    let (ia, ib) = (3, 3 + na);
+    let mut m_omega = 0.0;
+    let mut h_omega = 0.0;
+    for k in 0..na {
+        let pk = &it.p3[k * nn..(k + 1) * nn];
+        let pb = &mut s.pb[k * nb..(k + 1) * nb];
+        let pbd = &mut s.pbd[k * nb..(k + 1) * nb];
+        mat_vec(pk, nb, b, pb);
+        mat_vec(pk, nb, bd, pbd);
+        let pkbb = dot(pb, b);
+        let pkbbd = dot(pb, bd);
+        let pkbdbd = dot(pbd, bd);
+        for j in 0..nb {
+            mb[(ia + k) * d + ib + j] -= pb[j];
+            mb[(ib + j) * d + ia + k] -= pb[j];
+            h[ib + j] += om * om * a[k] * pb[j];
+        }
+        m_omega += a[k] * pkbb;
+        h_omega += ad[k] * pkbb + 2.0 * a[k] * pkbbd;
+        h[ia + k] += -pkbdbd + 0.5 * om * om * pkbb;
+    }
+    mb[2 * d + 2] -= m_omega;
+    h[2] -= om * h_omega;
 }
 
 /// Terms that make the inextensible (foreshortening) kinetic energy exact:

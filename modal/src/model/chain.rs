@@ -14,7 +14,6 @@
 //! O(N²) products of precomputed integrals — no spatial quadrature.
 
 use super::body::{BodyScratch, body_terms};
-use super::integrals::LinkIntegrals;
 use super::link::{JointModel, LinkModel};
 use crate::linalg::{cholesky_solve, cholesky_substitute, dot};
 
@@ -42,8 +41,6 @@ pub(crate) struct LinkWork {
     pub x: Vec<f64>,
     pub u: Vec<f64>,
     pub scratch: BodyScratch,
-    /// nb × nb work matrix of the von Kármán terms (empty without axial field).
-    pub vk: Vec<f64>,
 }
 
 #[derive(Debug, Clone)]
@@ -102,11 +99,6 @@ impl Chain {
                     x: vec![0.0; d * n],
                     u: vec![0.0; d],
                     scratch: BodyScratch::new(l.na(), l.nb(), l.nc()),
-                    vk: if l.na() > 0 {
-                        vec![0.0; l.nb() * l.nb()]
-                    } else {
-                        vec![]
-                    },
                 }
             })
             .collect();
@@ -221,7 +213,6 @@ impl Chain {
                 self.force[gl] += w.u[l];
             }
             // Elastic forces of the bending block x = [b, c]: −K x − D ẋ; axial −K_a a.
-            let nb = link.nb();
             let nbc = link.nbc();
             let xb = &q[link.b0..link.b0 + nbc];
             let xbd = &qd[link.b0..link.b0 + nbc];
@@ -237,17 +228,6 @@ impl Chain {
             for r in 0..na {
                 let row = &link.ints.ka[r * na..(r + 1) * na];
                 self.force[link.a0 + r] -= dot(row, a);
-            }
-            if na > 0 {
-                // von Kármán coupling: −∂/∂q of ½Σ a_k bᵀT3_k b + ⅛ T4(b,b,b,b).
-                let w = &mut self.work[i];
-                vk_forces(
-                    &link.ints,
-                    a,
-                    b,
-                    &mut w.vk,
-                    &mut self.force[link.a0..link.b0 + nb],
-                );
             }
             // Joint laws (free joints only; a prescribed joint's actuator is the unknown torque).
             let j = &self.joints[i];
@@ -384,22 +364,13 @@ impl Chain {
         for (i, link) in self.links.iter().enumerate() {
             let w = &self.work[i];
             e.kinetic += 0.5 * quad(&w.mb, link.body_dim(), &w.nu);
-            let nb = link.nb();
             let nbc = link.nbc();
             e.strain += 0.5 * quad(&link.section.kbc, nbc, &q[link.b0..link.b0 + nbc]);
             let na = link.na();
             if na > 0 {
                 let a = &q[link.a0..link.a0 + na];
-                let b = &q[link.b0..link.b0 + nb];
+                // ½∫EA u'² of the stretch (the von Kármán strain, see super::body).
                 e.strain += 0.5 * quad(&link.ints.ka, na, a);
-                // ½ Σ a_k bᵀT3_k b + ⅛ Σ T4_ijkl b_i b_j b_k b_l.
-                let nn = nb * nb;
-                for (k, ak) in a.iter().enumerate() {
-                    e.strain += 0.5 * ak * quad(&link.ints.t3[k * nn..(k + 1) * nn], nb, b);
-                }
-                for (ij, row) in link.ints.t4.chunks_exact(nn).enumerate() {
-                    e.strain += 0.125 * b[ij / nb] * b[ij % nb] * quad(row, nb, b);
-                }
             }
             let j = &self.joints[i];
             if j.prescribed.is_none() {
@@ -492,12 +463,11 @@ impl Chain {
     /// Tangents of the elastic, Kelvin–Voigt and joint spring/damper forces at q: writes
     /// K_t = −∂F/∂q and D_t = −∂F/∂q̇ of those terms (N × N row-major, overwritten). They are
     /// the stiff part of the force side: the bending block K, D of every link
-    /// ([`super::section`]), the axial stiffness K_a with the von Kármán tangent
-    /// (∂/∂a, ∂/∂b of ½Σ aₖ bᵀT3ₖ b + ⅛T4(b,b,b,b): T3ₖb couples a and b, Σ aₖT3ₖ + 3/2 G(b)
-    /// the b block), and the joint spring and damper of each free joint. Inertial (M(q), the
+    /// ([`super::section`]), the axial stiffness K_a of the stretch (its strain is the von
+    /// Kármán strain, [`super::body`]), and the joint spring and damper of each free joint. Inertial (M(q), the
     /// convective and centrifugal terms), gravity and contact terms are left out: they are
     /// bounded by the rigid-body rates, not by the Ritz frequencies. No allocation.
-    pub fn elastic_tangent(&self, q: &[f64], kt: &mut [f64], dt: &mut [f64]) {
+    pub fn elastic_tangent(&self, kt: &mut [f64], dt: &mut [f64]) {
         let n = self.n;
         kt.iter_mut().for_each(|v| *v = 0.0);
         dt.iter_mut().for_each(|v| *v = 0.0);
@@ -513,39 +483,10 @@ impl Chain {
                     }
                 }
             }
-            let (na, nb) = (link.na(), link.nb());
-            if na > 0 {
-                let ints = &link.ints;
-                let a = &q[link.a0..link.a0 + na];
-                let b = &q[link.b0..link.b0 + nb];
-                let nn = nb * nb;
-                for r in 0..na {
-                    for c in 0..na {
-                        kt[(link.a0 + r) * n + link.a0 + c] = ints.ka[r * na + c];
-                    }
-                }
-                for k in 0..na {
-                    let t = &ints.t3[k * nn..(k + 1) * nn];
-                    for (p, row) in t.chunks_exact(nb).enumerate() {
-                        let tb = dot(row, b);
-                        kt[(link.a0 + k) * n + link.b0 + p] += tb;
-                        kt[(link.b0 + p) * n + link.a0 + k] += tb;
-                        for (m, &tv) in row.iter().enumerate() {
-                            kt[(link.b0 + p) * n + link.b0 + m] += a[k] * tv;
-                        }
-                    }
-                }
-                // 3/2 G with G_pm = Σ_ij b_i b_j T4_ijpm (T4 is fully symmetric).
-                for (ij, row) in ints.t4.chunks_exact(nn).enumerate() {
-                    let c = 1.5 * b[ij / nb] * b[ij % nb];
-                    if c != 0.0 {
-                        for p in 0..nb {
-                            let krow = &mut kt[(link.b0 + p) * n + link.b0..][..nb];
-                            for (kv, t) in krow.iter_mut().zip(&row[p * nb..(p + 1) * nb]) {
-                                *kv += c * t;
-                            }
-                        }
-                    }
+            let na = link.na();
+            for r in 0..na {
+                for c in 0..na {
+                    kt[(link.a0 + r) * n + link.a0 + c] = link.ints.ka[r * na + c];
                 }
             }
             let j = &self.joints[i];
@@ -565,34 +506,5 @@ impl Chain {
     /// Force side f(q, q̇, t) of the last evaluation.
     pub fn force(&self) -> &[f64] {
         &self.force
-    }
-}
-
-/// Adds the von Kármán forces to `f` (the link's slice starting at a0: axial then transverse):
-/// f_a,k −= ½ bᵀT3_k b,  f_b −= Σ_k a_k T3_k b + ½ G b  with G_kl = Σ_ij b_i b_j T4_ijkl.
-fn vk_forces(ints: &LinkIntegrals, a: &[f64], b: &[f64], g: &mut [f64], f: &mut [f64]) {
-    let (na, nb) = (ints.na, ints.nb);
-    let nn = nb * nb;
-    g.iter_mut().for_each(|v| *v = 0.0);
-    for k in 0..na {
-        let t = &ints.t3[k * nn..(k + 1) * nn];
-        let mut btb = 0.0;
-        for (i, row) in t.chunks_exact(nb).enumerate() {
-            let tb = dot(row, b);
-            btb += b[i] * tb;
-            f[na + i] -= a[k] * tb;
-        }
-        f[k] -= 0.5 * btb;
-    }
-    for (ij, row) in ints.t4.chunks_exact(nn).enumerate() {
-        let c = b[ij / nb] * b[ij % nb];
-        if c != 0.0 {
-            for (gv, t) in g.iter_mut().zip(row) {
-                *gv += c * t;
-            }
-        }
-    }
-    for p in 0..nb {
-        f[na + p] -= 0.5 * dot(&g[p * nb..(p + 1) * nb], b);
     }
 }

@@ -13,6 +13,7 @@
 //! | S_L | S(L) = ∫ φ'φ'ᵀ |
 //! | Ψ₁, Ψₓ, M_ψ, K_a | ∫ρA ψ, ∫ρA x ψ, ∫ρA ψψᵀ, ∫EA ψ'ψ'ᵀ |
 //! | C | ∫ρA ψ φᵀ |
+//! | Q, R, P (foreshortening) | ∫ρA S⊗S, ∫ρA φ⊗S, ∫ρA ψ⊗S (the last with the axial field) |
 //!
 //! (S₁ and Sₓ follow from ∫₀ᴸ f(x) S(x) dx = ∫₀ᴸ φ'φ'ᵀ(ξ) ∫_ξᴸ f dx dξ, integration by parts.)
 
@@ -48,10 +49,9 @@ pub struct LinkIntegrals {
     /// na × nb, row-major.
     pub c: Vec<f64>,
     pub psi_l: Vec<f64>,
-    /// von Kármán coupling (axial on): T3_kij = ∫EA ψ_k' φ_i' φ_j' (na × nb × nb) and
-    /// T4_ijkl = ∫EA φ_i' φ_j' φ_k' φ_l' (nb⁴), from U = ½∫EA (u' + ½v'²)².
-    pub t3: Vec<f64>,
-    pub t4: Vec<f64>,
+    /// P_kij = ∫ρA ψ_k S_ij (na × nb × nb; axial field with foreshortening): the kinetic
+    /// coupling of the stretch u = ψᵀa with the foreshortening s = ½bᵀS b.
+    pub p3: Vec<f64>,
 }
 
 impl LinkIntegrals {
@@ -107,12 +107,7 @@ impl LinkIntegrals {
             ka: vec![0.0; na * na],
             c: vec![0.0; na * nb],
             psi_l: vec![0.0; na],
-            t3: vec![0.0; na * nb * nb],
-            t4: if na > 0 {
-                vec![0.0; nb * nb * nb * nb]
-            } else {
-                vec![]
-            },
+            p3: vec![],
         };
         let (mut p, mut dp, mut ddp) = (vec![0.0; nb], vec![0.0; nb], vec![0.0; nb]);
         let (mut u, mut du) = (vec![0.0; na], vec![0.0; na]);
@@ -147,19 +142,6 @@ impl LinkIntegrals {
                     for j in 0..nb {
                         s.c[i * nb + j] += w * rho_a * u[i] * p[j];
                     }
-                    for j in 0..nb {
-                        for k in 0..nb {
-                            s.t3[(i * nb + j) * nb + k] += w * ea * du[i] * dp[j] * dp[k];
-                        }
-                    }
-                }
-                // Unique (ij) ≤ (kl) pairs of the symmetric 4-tensor; mirrored below.
-                let nn = nb * nb;
-                for ij in 0..nn {
-                    let a = w * ea * dp[ij / nb] * dp[ij % nb];
-                    for kl in ij..nn {
-                        s.t4[ij * nn + kl] += a * dp[kl / nb] * dp[kl % nb];
-                    }
                 }
             }
         }
@@ -168,18 +150,11 @@ impl LinkIntegrals {
         if let Some(ax) = axial {
             ax.eval(l, 0, &mut s.psi_l);
         }
-        if na > 0 {
-            let nn = nb * nb;
-            for ij in 0..nn {
-                for kl in 0..ij {
-                    s.t4[ij * nn + kl] = s.t4[kl * nn + ij];
-                }
-            }
-        }
         if foreshortening {
-            let (q4, r3) = foreshortening_tensors(length, rho_a, transverse, &quad);
+            let (q4, r3, p3) = foreshortening_tensors(length, rho_a, transverse, axial, &quad);
             s.q4 = q4;
             s.r3 = r3;
+            s.p3 = p3;
         }
         // Exact symmetry (the quadrature sums are symmetric up to round-off order of addition).
         for mat in [&mut s.mphi, &mut s.kb, &mut s.s1, &mut s.sx, &mut s.sl] {
@@ -205,16 +180,18 @@ fn symmetrize(m: &mut [f64], n: usize) {
     }
 }
 
-/// Q_ijkl = ∫ρA S_ij S_kl and R_mij = ∫ρA φ_m S_ij on the rule `quad` (composite Gauss with
-/// equal panels). S at the nodes is accumulated panel by panel; inside a panel ∫_a^x φ'φ'ᵀ uses
+/// Q_ijkl = ∫ρA S_ij S_kl, R_mij = ∫ρA φ_m S_ij and, with an axial field, P_kij = ∫ρA ψ_k S_ij
+/// on the rule `quad` (composite Gauss with equal panels). S at the nodes is accumulated panel by panel; inside a panel ∫_a^x φ'φ'ᵀ uses
 /// a 10-point Gauss rule on [a, x] (panels are a quarter wavelength or less).
 fn foreshortening_tensors(
     length: f64,
     rho_a: f64,
     shapes: &ShapeSet,
+    axial: Option<&ShapeSet>,
     quad: &Quadrature,
-) -> (Vec<f64>, Vec<f64>) {
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let n = shapes.count();
+    let na = axial.map_or(0, |a| a.count());
     let nq = quad.x.len();
     let points = 10;
     let panels = nq / points;
@@ -247,7 +224,9 @@ fn foreshortening_tensors(
     }
     let mut q4 = vec![0.0; n * n * n * n];
     let mut r3 = vec![0.0; n * n * n];
+    let mut p3 = vec![0.0; na * n * n];
     let mut phi = vec![0.0; n];
+    let mut psi = vec![0.0; na];
     let nn = n * n;
     for q in 0..nq {
         let w = quad.w[q] * rho_a;
@@ -256,6 +235,14 @@ fn foreshortening_tensors(
         for m in 0..n {
             for ij in 0..nn {
                 r3[m * nn + ij] += w * phi[m] * sq[ij];
+            }
+        }
+        if let Some(ax) = axial {
+            ax.eval(quad.x[q], 0, &mut psi);
+            for k in 0..na {
+                for ij in 0..nn {
+                    p3[k * nn + ij] += w * psi[k] * sq[ij];
+                }
             }
         }
         // Unique (ij) ≤ (kl) pairs only; mirrored below.
@@ -275,5 +262,5 @@ fn foreshortening_tensors(
             q4[ij * nn + kl] = q4[kl * nn + ij];
         }
     }
-    (q4, r3)
+    (q4, r3, p3)
 }
