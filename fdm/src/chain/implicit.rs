@@ -15,8 +15,10 @@
 //! pentadiagonal — the bending stencil per link, and the elbow damper couples v_{r−1} with the
 //! adjacent w₁ — so A_BB = D_B + ½τC_BB is SPD pentadiagonal and constant while τ is: its
 //! LDLᵀ is computed once per step length. Per kick: Z = A_BB⁻¹A_BF (|F| columns, A_BF from the
-//! current columns of M), the |F|×|F| Schur complement A_FF − A_BFᵀZ, back substitution: six
-//! banded solves, O(n), no allocation. C itself is read once from
+//! current columns of M), the |F|×|F| Schur complement A_FF − A_BFᵀZ, back substitution, O(n),
+//! no allocation. Only the θ and β columns of M depend on the state; the ghost columns
+//! (x₁, x₂, y) are constant, so their Z columns and their block of the Schur complement are
+//! computed with the factorization, once per step length: three banded solves per kick. C itself is read once from
 //! `TwoLinkChain::add_damping_forces` by probing: each full column alone, the band columns
 //! in five interleaved colours (bandwidth 2).
 //!
@@ -29,6 +31,10 @@
 use super::TwoLinkChain;
 use super::mass::{MAX_FULL, solve_small};
 use crate::system::{DriftVelocities, System};
+
+/// Full columns of M that depend on the state (θ, β come first; the ghost columns after them
+/// are constant).
+const STATE_COLUMNS: usize = 2;
 
 /// C and the banded factorization of the implicit kick (module docs).
 #[derive(Debug, Clone)]
@@ -46,7 +52,11 @@ pub struct ImplicitDamping {
     l1: Vec<f64>,
     l2: Vec<f64>,
     tau: f64,
-    /// scratch: A_BF columns and Z = A_BB⁻¹A_BF over band positions, A_BB⁻¹ r_B, v_{j+1}
+    /// Schur complement block of the constant (ghost) columns, rows and columns ≥ `STATE_COLUMNS`
+    /// (computed with the factorization)
+    s_ghost: [[f64; MAX_FULL]; MAX_FULL],
+    /// scratch: A_BF columns and Z = A_BB⁻¹A_BF over band positions (the ghost columns' kept
+    /// from the factorization), A_BB⁻¹ r_B, v_{j+1}
     abf: [Vec<f64>; MAX_FULL],
     z: [Vec<f64>; MAX_FULL],
     zb: Vec<f64>,
@@ -155,6 +165,7 @@ impl TwoLinkChain {
             l1: vec![0.0; nb],
             l2: vec![0.0; nb],
             tau: f64::NAN,
+            s_ghost: [[0.0; MAX_FULL]; MAX_FULL],
             abf: std::array::from_fn(|_| vec![0.0; nb]),
             z: std::array::from_fn(|_| vec![0.0; nb]),
             zb: vec![0.0; nb],
@@ -207,11 +218,12 @@ impl TwoLinkChain {
     /// docs). O(n), no allocation (the factorization is redone only when τ changes).
     pub fn solve_damped_mass(&mut self, tau: f64, rhs: &[f64], out: &mut [f64]) {
         let mut imp = self.implicit.take().expect("implicit damping");
-        if imp.tau != tau {
+        let nf = self.nfull();
+        let refactor = imp.tau != tau;
+        if refactor {
             imp.factor(|i| self.diag_mass(i), tau);
         }
         let ht = 0.5 * tau;
-        let nf = self.nfull();
         let full = self.full();
         let nb = imp.band.len();
         let ImplicitDamping {
@@ -220,12 +232,14 @@ impl TwoLinkChain {
             d,
             l1,
             l2,
+            s_ghost,
             abf,
             z,
             zb,
             ..
         } = &mut *imp;
-        for c in 0..nf {
+        let solved = if refactor { nf } else { STATE_COLUMNS };
+        for c in 0..solved {
             for b in 0..nb {
                 let i = band[b];
                 abf[c][b] = self.cols[c][i] + ht * cf[c][i];
@@ -233,18 +247,30 @@ impl TwoLinkChain {
             z[c].copy_from_slice(&abf[c]);
             ImplicitDamping::solve(d, l1, l2, &mut z[c]);
         }
+        let schur = |r: usize, c: usize| {
+            self.cols[c][full[r]] + ht * cf[c][full[r]]
+                - (0..nb).map(|b| abf[r][b] * z[c][b]).sum::<f64>()
+        };
+        if refactor {
+            for r in STATE_COLUMNS..nf {
+                for c in STATE_COLUMNS..nf {
+                    s_ghost[r][c] = schur(r, c);
+                }
+            }
+        }
         for b in 0..nb {
             zb[b] = rhs[band[b]];
         }
         ImplicitDamping::solve(d, l1, l2, zb);
-        let mut s = [[0.0; MAX_FULL]; MAX_FULL];
+        let mut s = *s_ghost;
         let mut bf = [0.0; MAX_FULL];
         for r in 0..nf {
             let fr = full[r];
             bf[r] = rhs[fr] - (0..nb).map(|b| abf[r][b] * zb[b]).sum::<f64>();
             for c in 0..nf {
-                s[r][c] = self.cols[c][fr] + ht * cf[c][fr]
-                    - (0..nb).map(|b| abf[r][b] * z[c][b]).sum::<f64>();
+                if r < STATE_COLUMNS || c < STATE_COLUMNS {
+                    s[r][c] = schur(r, c);
+                }
             }
         }
         let x = solve_small(s, bf, nf);
