@@ -866,26 +866,25 @@ impl StepConstraint for Contact {
         &mut self,
         newton: &mut NewtonSystem,
         res: &[f64],
-        h: f64,
+        dq1_da: f64,
         gap1: f64,
         gap_target: f64,
     ) -> f64 {
         let c = self;
         if crate::events::contact::friction::sticking(c) {
             // Sticking friction contact: two multipliers (crate::events::contact::friction).
-            return crate::events::contact::friction::stick_newton_update(newton, c, res, h);
+            return crate::events::contact::friction::stick_newton_update(newton, c, res, dq1_da);
         }
         let n = res.len();
-        // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (h²/2) ∇g(q₁)·δa = g(q₁)
-        // (∂q₁/∂a = h²/2), by the Schur complement with two solves of S.
+        // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (∂q₁/∂a) ∇g(q₁)·δa = g(q₁) − target,
+        // by the Schur complement with two solves of S.
         newton.delta.copy_from_slice(&c.constraint.g_bar);
         newton.solve();
         c.constraint.s_inv_g.copy_from_slice(&newton.delta);
         newton.delta.copy_from_slice(res);
         newton.solve();
-        let half_h2 = 0.5 * h * h;
-        let cx = half_h2 * dot(&c.constraint.g_end, &newton.delta);
-        let cy = half_h2 * dot(&c.constraint.g_end, &c.constraint.s_inv_g);
+        let cx = dq1_da * dot(&c.constraint.g_end, &newton.delta);
+        let cy = dq1_da * dot(&c.constraint.g_end, &c.constraint.s_inv_g);
         let dlambda = (gap1 - gap_target - cx) / cy;
         for i in 0..n {
             newton.delta[i] += c.constraint.s_inv_g[i] * dlambda;

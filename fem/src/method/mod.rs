@@ -201,12 +201,14 @@ pub trait StepConstraint {
     fn add_force(&mut self, chain: &Chain, view: &ConstraintView<'_>, res: &mut [f64]) -> f64;
     /// Bordered Newton update: leaves δa in `newton.delta` (from the residual `res`, the
     /// Newton matrix factorized in `newton`) and returns δλ; `gap1` is the value returned by
-    /// [`StepConstraint::add_force`], `gap_target` what it must reach; ∂q₁/∂a = h²/2.
+    /// [`StepConstraint::add_force`], `gap_target` what it must reach; `dq1_da` = ∂q₁/∂a, the
+    /// sensitivity of the step-end configuration to the method's Newton unknown a (h²/2 for
+    /// the midpoint schemes' mean acceleration, βh²(1−α_f)/(1−α_m) for generalized-α's q̈₁).
     fn newton_update(
         &mut self,
         newton: &mut NewtonSystem,
         res: &[f64],
-        h: f64,
+        dq1_da: f64,
         gap1: f64,
         gap_target: f64,
     ) -> f64;
@@ -248,7 +250,7 @@ pub fn stepper(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper> {
         Method::GeneralizedAlpha => Box::new(generalized_alpha::GeneralizedAlpha::new(rho_inf)),
         Method::CentralDifference => Box::new(central_difference::CentralDifference),
         Method::EnergyMidpoint => Box::new(energy_midpoint::EnergyMidpoint::new(n)),
-        Method::ImplicitMidpoint => Box::new(implicit_midpoint::ImplicitMidpoint),
+        Method::ImplicitMidpoint => Box::new(implicit_midpoint::ImplicitMidpoint::new(n)),
     }
 }
 

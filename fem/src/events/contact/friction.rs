@@ -481,13 +481,14 @@ pub fn phase(c: &Contact) -> f64 {
 }
 
 /// Newton update of a stick step: S δa − ∇̄g δλ_n − ∇̄h δλ_t = F with
-/// (h²/2)∇g(q₁)·δa = g(q₁), (h²/2)∇h(q₁)·δa = h(q₁), by the 2 × 2 Schur complement (three
-/// solves of S). Leaves δa in `delta`, stores δλ_t for the next iterate, returns δλ_n.
+/// k∇g(q₁)·δa = g(q₁), k∇h(q₁)·δa = h(q₁), k = ∂q₁/∂a (`dq1_da`), by the 2 × 2 Schur
+/// complement (three solves of S). Leaves δa in `delta`, stores δλ_t for the next iterate,
+/// returns δλ_n.
 pub(crate) fn stick_newton_update(
     newton: &mut NewtonSystem,
     c: &mut Contact,
     res: &[f64],
-    h: f64,
+    dq1_da: f64,
 ) -> f64 {
     let Some(b) = c.bilateral.as_deref_mut() else {
         return 0.0;
@@ -501,7 +502,7 @@ pub(crate) fn stick_newton_update(
     b.constraint.s_inv_h.copy_from_slice(&newton.delta);
     newton.delta.copy_from_slice(res);
     newton.solve();
-    let hh = 0.5 * h * h;
+    let hh = dq1_da;
     let a11 = hh * dot(&c.constraint.g_end, &c.constraint.s_inv_g);
     let a12 = hh * dot(&c.constraint.g_end, &b.constraint.s_inv_h);
     let a21 = hh * dot(&b.constraint.h_end, &c.constraint.s_inv_g);
