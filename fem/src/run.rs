@@ -111,7 +111,7 @@ pub fn default_rho_inf(scene: &Scene) -> f64 {
 /// keep ρ∞ = 0.9 numerical damping of the unresolved axial modes; undamped massless Timoshenko
 /// hubs: see `undamped_massless_hub`). A bilateral contact (seed 001's wall, always
 /// constrained) takes `energy-midpoint` even with extensible links: contact is implemented on
-/// that scheme only, and its ledger closure is the friction-work check.
+/// the midpoint schemes only, and energy-midpoint's ledger closure is the friction-work check.
 pub fn default_method(scene: &Scene) -> Method {
     if check_midpoint(scene).is_ok()
         && scene

@@ -11,10 +11,18 @@
 //!   fixed or adaptive steps;
 //! * [`central_difference`]: explicit central difference (velocity-Verlet form) under its
 //!   stability bound 2/ω_max;
-//! * [`energy_midpoint`]: the energy-consistent midpoint (discrete-gradient) scheme, the only
-//!   one that accepts a [`StepConstraint`];
+//! * [`energy_midpoint`]: the energy-consistent midpoint (discrete-gradient) scheme;
 //! * [`implicit_midpoint`]: the implicit midpoint rule (one-stage Gauss), fixed or adaptive
 //!   steps.
+//!
+//! A held [`StepConstraint`] is accepted by the two midpoint schemes, whose Newton unknown is
+//! the mean acceleration ā with q₁ = q₀ + h q̇₀ + (h²/2) ā (border factor ∂q₁/∂ā = h²/2, force
+//! the discrete gradient ∇̄g in the metric M(q̄), so it does no work over a step). Generalized-α
+//! refuses one (its index-3 form — λ a Newton unknown, g(q₁) = 0 at the step end, border
+//! factor ∂q₁/∂q̈₁ = βh²(1−α_f)/(1−α_m) — is what [`StepConstraint::newton_update`]'s
+//! `dq1_da` prepares, not implemented); explicit central difference refuses one for good: it
+//! has no Newton iteration to border, and a constraint force would need its own projection
+//! scheme.
 //!
 //! Shared machinery: the Newton matrix S = c_a M + c_v C + c_q K and its solver
 //! ([`newton`]) and the consistent acceleration of a (re)start ([`start`]).
@@ -254,11 +262,13 @@ pub fn stepper(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper> {
     }
 }
 
-/// A method without a bordered (constrained) update refuses a held contact.
+/// A method without a bordered (constrained) update refuses a held contact (`run` refuses
+/// such scenes first; this guards other drivers).
 pub(crate) fn refuse_constraint(method: &str, held: bool) -> Result<(), FemError> {
     if held {
         return Err(FemError::unsupported(format!(
-            "fem {method}: contact constraints are stepped by energy-midpoint only"
+            "fem {method}: contact constraints are stepped by energy-midpoint and \
+             implicit-midpoint only"
         )));
     }
     Ok(())
