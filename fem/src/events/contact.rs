@@ -168,7 +168,8 @@
 //! halved step in free flight and on the friction wall, but only about 2× through the impacts
 //! of `barhorst-case1` (4 elements, 0.45 s: 6.7e-5, 2.4e-5, 1.3e-5, 6.2e-6, 2.9e-6 at
 //! dt = 5e-4 … 3.125e-5): the impacts excite the mesh modes, whose energy error the
-//! non-conserving rule reduces as h² only once h ω resolves them. Switching times agree with
+//! non-conserving rule reduces as h² only once h ω resolves them (highest frequency of that
+//! model 2.05 kHz, h ω_max = 6.4 … 0.4 over those steps). Switching times agree with
 //! energy-midpoint's to O(h²) (`tests/dyn_implicit_midpoint_contact.rs`).
 //!
 //! Refused with `unsupported`: unilateral circle surfaces, friction on a unilateral contact,
