@@ -72,7 +72,8 @@
 //!
 //! ## Contact (seed 000: impact, constrained sliding, release)
 //! Unilateral frictionless contact of the tip of a named link with a fixed line
-//! ([`events::contact`]), with the `energy-midpoint` scheme. Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q
+//! ([`events::contact`]), with the `energy-midpoint` scheme (also `implicit-midpoint`, whose ledger
+//! then closes to O(h²) only: [`method::implicit_midpoint`]). Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q
 //! (exact, [`chain::Chain::tip_jacobian`]).
 //! * Detection inside the step: the step is re-solved shortened (Illinois secant on h) until
 //!   |g(q₁(h))| ≤ 1e-10·L (event `contact-start` with the bracket width as time tolerance).
@@ -103,8 +104,9 @@
 //! * Phase channel `contact1.phase` (0 free, 1 constrained); `contact1.gap`,
 //!   `contact1.normal_velocity`, running maxima `contact1.max_gap`, `contact1.max_normal_velocity`.
 //! * Refused (`unsupported`): unilateral circle surfaces, friction on unilateral contacts,
-//!   several contacts, prescribed joints, other methods, adaptive steps, massless Timoshenko
-//!   sections without Kelvin–Voigt. Without contact nothing is allocated.
+//!   several contacts, prescribed joints, generalized-α and central difference, adaptive
+//!   steps, massless Timoshenko sections without Kelvin–Voigt (with `implicit-midpoint`: at
+//!   all). Without contact nothing is allocated.
 //!
 //! ## Bilateral wall with Coulomb friction (seed 001, `constrained-arm`)
 //! [`events::contact::friction`] with the geometry in [`events::wall`] (circle g = R − |r_tip − c|, n̂ = −(r − c)/|r − c|,

@@ -622,7 +622,7 @@ impl Stepper for EnergyMidpoint {
             let mut dlambda = 0.0;
             if let Some(c) = constraint.as_deref_mut() {
                 // Bordered Newton on (a, λ) (the constraint's Schur complement).
-                dlambda = c.newton_update(cx.newton, &w.res, h, gap1, gap_target);
+                dlambda = c.newton_update(cx.newton, &w.res, 0.5 * h * h, gap1, gap_target);
             } else {
                 cx.newton.delta.copy_from_slice(&w.res);
                 cx.newton.solve();

@@ -14,38 +14,87 @@
 //! the end point leaves the chain's joint torques (the required torque of a prescribed joint)
 //! at t₁. Adaptive steps: local error estimate e = (h²/12)(ā_k − ā_{k−1}) (the third-derivative
 //! term of the rule), as for the energy-consistent midpoint scheme.
+//!
+//! **Held contact** ([`StepConstraint`], [`crate::events::contact`]): the momentum equation
+//! gains the constraint force, R(q̄, v̄, ā, t_mid) − ∇̄g λ = 0, and the unknowns become (ā, λ)
+//! with g(q₁) = target at the step end (index 3; the target is 0, or for a step shortened to
+//! locate an event (1 − (h/h_nominal)²)·g(q₀), as in [`crate::method::energy_midpoint`]).
+//! Since q₁ = q₀ + h q̇₀ + (h²/2) ā, ∂q₁/∂ā = h²/2, the border of the bordered Newton update
+//! ([`StepConstraint::newton_update`], Schur complement, two solves of S per iteration; three
+//! while a friction contact sticks). The force uses the Gonzalez discrete gradient ∇̄g in the
+//! metric W = M(q̄), as energy-midpoint does, not ∇g(q̄): then Δqᵀ∇̄g = g(q₁) − g(q₀) exactly,
+//! the held constraint does no work in the discrete step, and the run's energy error stays the
+//! rule's own O(h²) error of the configuration-dependent mass (the driver's trapezoidal
+//! works), with no constraint work added to it. It costs one inertial pass (W Δq) per
+//! constrained iteration. Friction on a bilateral wall (sliding force −μsσλ̄T(q̄), the stick
+//! constraint with its own discrete gradient, friction work D = μsσλ̄ΔqᵀT(q̄) booked per step)
+//! comes from the same constraint object. A constrained step accepts the iterate at which the
+//! residual and the gap were evaluated (the update below tolerance, |g(q₁) − target| within
+//! the Newton tolerance): its multipliers and friction work are those of the accepted state.
+//! The constraint force enters through λ only (its dependence on ā through ∇̄g(q̄) is not in
+//! S), so a constrained step converges linearly at the rate λh²|∇²g|/|M|.
 
-use crate::chain::NewtonCoefficients;
+use crate::chain::{NewtonCoefficients, Parts};
 use crate::error::FemError;
-use crate::linalg::max_abs;
-use crate::method::{StepConstraint, StepContext, Stepper, refuse_constraint};
+use crate::linalg::{dot, max_abs};
+use crate::method::{ConstraintView, StepConstraint, StepContext, Stepper};
 
 /// Newton iterations at most before the step is retried shorter.
 const MAX_ITERATIONS: usize = 30;
 
-/// The implicit midpoint rule (no state of its own: the previous mean acceleration, kept in
-/// the state's q̈ slot, is the Newton predictor).
-#[derive(Debug, Clone, Copy)]
-pub struct ImplicitMidpoint;
+/// The implicit midpoint rule. The previous mean acceleration, kept in the state's q̈ slot, is
+/// the Newton predictor; the buffers serve a held constraint (allocated once per run).
+#[derive(Debug, Clone)]
+pub struct ImplicitMidpoint {
+    /// Step end q₁ = 2q̄ − q₀ of the iterate (q̄ lives in the state's trial-end slot).
+    q_end: Vec<f64>,
+    /// Δq = q₁ − q₀ and W Δq = M(q̄)Δq.
+    dq: Vec<f64>,
+    w_dq: Vec<f64>,
+    /// Momentum residual with the constraint force.
+    res: Vec<f64>,
+    zero: Vec<f64>,
+}
+
+impl ImplicitMidpoint {
+    /// The method for `n` DOFs.
+    pub fn new(n: usize) -> Self {
+        ImplicitMidpoint {
+            q_end: vec![0.0; n],
+            dq: vec![0.0; n],
+            w_dq: vec![0.0; n],
+            res: vec![0.0; n],
+            zero: vec![0.0; n],
+        }
+    }
+}
 
 impl Stepper for ImplicitMidpoint {
     fn step(
         &mut self,
         cx: &mut StepContext<'_>,
-        constraint: Option<&mut dyn StepConstraint>,
+        mut constraint: Option<&mut dyn StepConstraint>,
         h: f64,
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        refuse_constraint("implicit-midpoint", constraint.is_some())?;
         let st = &mut *cx.state;
         let n = st.q.len();
+        let t0 = st.t;
         let t_mid = st.t + 0.5 * h;
         let c = NewtonCoefficients {
             c_a: 1.0,
             c_v: 0.5 * h,
             c_q: 0.25 * h * h,
         };
+        // Held constraint: g(q₀), the multiplier's start value (the last step's) and the
+        // target of g(q₁) (module docs).
+        let g0 = constraint
+            .as_ref()
+            .map_or(0.0, |k| k.value(cx.chain, t0, &st.q));
+        let mut lambda = constraint.as_ref().map_or(0.0, |k| k.multiplier());
+        let r = (h / cx.h_nominal).min(1.0);
+        let gap_target = g0 * (1.0 - r * r);
         // Predictor: the previous step's mean acceleration (the point value after a start).
         st.qdd1.copy_from_slice(&st.qdd);
         let mut converged = false;
@@ -63,12 +112,68 @@ impl Stepper for ImplicitMidpoint {
             cx.counters.newton += 1;
             cx.newton
                 .form_if_due(it, h, cx.chain, st, cx.counters, c, t1)?;
-            cx.newton.delta.copy_from_slice(&cx.newton.res);
-            cx.newton.solve();
+            let mut dlambda = 0.0;
+            let mut on_surface = true;
+            if let Some(k) = constraint.as_deref_mut() {
+                for i in 0..n {
+                    self.dq[i] = 2.0 * (st.q1[i] - st.q[i]);
+                    self.q_end[i] = st.q[i] + self.dq[i];
+                }
+                // Metric of the discrete gradient, W Δq = M(q̄)Δq (after the matrix was formed:
+                // it reads the point data of the full residual pass).
+                cx.chain.residual_parts(
+                    t_mid,
+                    &st.q1,
+                    &self.zero,
+                    &self.dq,
+                    Parts::INERTIA,
+                    &mut self.w_dq,
+                );
+                cx.counters.rhs += 1;
+                let view = ConstraintView {
+                    it,
+                    t: [t0, t_mid, t1],
+                    q0: &st.q,
+                    q1: &self.q_end,
+                    qbar: &st.q1,
+                    dq: &self.dq,
+                    w_dq: &self.w_dq,
+                    denom: dot(&self.dq, &self.w_dq),
+                    g0,
+                    lambda,
+                };
+                self.res.copy_from_slice(&cx.newton.res);
+                let gap1 = k.add_force(cx.chain, &view, &mut self.res);
+                on_surface = (gap1 - gap_target).abs() <= cx.newton.tol;
+                dlambda = k.newton_update(cx.newton, &self.res, 0.5 * h * h, gap1, gap_target);
+            } else {
+                cx.newton.delta.copy_from_slice(&cx.newton.res);
+                cx.newton.solve();
+            }
+            let dq = max_abs(&cx.newton.delta) * c.c_q;
+            if constraint.is_some() {
+                if !dq.is_finite() || (it > 2 && dq > 10.0 * last) {
+                    break;
+                }
+                last = dq;
+                iterations = it + 1;
+                let tol =
+                    cx.newton.tol + 1e-13 * (c.c_q * max_abs(&st.qdd1) + h * max_abs(&st.qd1));
+                // Accept the iterate where the residual and the gap were evaluated (module
+                // docs): its multipliers and friction work are the constraint's current ones.
+                if dq <= tol && on_surface {
+                    converged = true;
+                    break;
+                }
+                for i in 0..n {
+                    st.qdd1[i] -= cx.newton.delta[i];
+                }
+                lambda -= dlambda;
+                continue;
+            }
             for i in 0..n {
                 st.qdd1[i] -= cx.newton.delta[i];
             }
-            let dq = max_abs(&cx.newton.delta) * c.c_q;
             if !dq.is_finite() || (it > 2 && dq > 10.0 * last) {
                 // Not finite or diverging: the driver retries with a shorter step.
                 break;
@@ -82,6 +187,9 @@ impl Stepper for ImplicitMidpoint {
                 converged = true;
                 break;
             }
+        }
+        if let Some(k) = constraint.filter(|_| converged) {
+            k.set_multiplier(lambda);
         }
         cx.newton.slow_convergence = !converged || iterations > 3;
         if !converged {

@@ -1,0 +1,206 @@
+//! Tip contact stepped by `implicit-midpoint` (issue 17 item 1: the driver's event location
+//! and the contact object are method-agnostic): the switching times of the unilateral
+//! Barhorst surface and of the bilateral friction wall agree with `energy-midpoint` at the
+//! same step to second order (both methods are second order: the difference falls 4× per
+//! halving of the step), the impact map keeps its momentum and energy relations, and the
+//! methods without a bordered update are still refused.
+
+use data::{Backend, BackendError, Event, RunResult, Scene, Settings, StabilityVerdict};
+use fem::FemBackend;
+
+/// The `run` command warns above this ledger closure (verify's `LEDGER_WARNING`).
+const LEDGER_WARNING: f64 = 1e-3;
+
+fn scene(name: &str) -> Scene {
+    data::catalog::load_scene(name).unwrap()
+}
+
+fn run(sc: &Scene, method: &str, elements: Option<usize>, dt: f64, t_end: f64) -> RunResult {
+    let mut st = Settings::default();
+    st.discretization.elements = elements;
+    st.time.dt = Some(dt);
+    st.time.t_end = Some(t_end);
+    st.time.method = Some(method.parse().expect("a method name"));
+    let r = FemBackend.simulate(sc, &st).unwrap();
+    assert_eq!(r.verdict, StabilityVerdict::Completed, "{method} dt = {dt}");
+    r
+}
+
+/// Contact starts and releases (kind, t) of a unilateral run.
+fn switches(r: &RunResult) -> Vec<(&'static str, f64)> {
+    r.events
+        .iter()
+        .filter_map(|e| match e {
+            Event::ContactStart { t, .. } => Some(("start", *t)),
+            Event::Release { t, .. } => Some(("release", *t)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Stick–slip switches (sticking, t) of a friction run.
+fn stick_slips(r: &RunResult) -> Vec<(bool, f64)> {
+    r.events
+        .iter()
+        .filter_map(|e| match e {
+            Event::StickSlip { t, sticking, .. } => Some((*sticking, *t)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Ratios of successive differences: a second-order difference falls 4× per halving.
+fn assert_second_order(what: &str, d: &[f64]) {
+    for k in 0..d.len() - 1 {
+        let ratio = d[k] / d[k + 1];
+        assert!(
+            (3.5..=4.5).contains(&ratio),
+            "{what}: differences {d:?} fall by {ratio:.2} at a halved step (second order: 4)"
+        );
+    }
+}
+
+#[test]
+fn dyn_case1_switching_times_agree_with_energy_midpoint_to_second_order() {
+    let sc = scene("barhorst-case1");
+    let steps = [5e-4, 2.5e-4, 1.25e-4];
+    let mut first_impact = Vec::new();
+    let mut largest = Vec::new();
+    for &dt in &steps {
+        let em = run(&sc, "energy-midpoint", Some(4), dt, 0.45);
+        let im = run(&sc, "implicit-midpoint", Some(4), dt, 0.45);
+        let (a, b) = (switches(&em), switches(&im));
+        // At one step both methods see the same sequence of contact phases (the micro-bounces
+        // after the first impact depend on the step, not on the method).
+        assert!(a.len() >= 4, "dt = {dt}: {} switches", a.len());
+        assert_eq!(
+            a.iter().map(|e| e.0).collect::<Vec<_>>(),
+            b.iter().map(|e| e.0).collect::<Vec<_>>(),
+            "dt = {dt}"
+        );
+        first_impact.push((a[0].1 - b[0].1).abs());
+        largest.push(
+            a.iter()
+                .zip(&b)
+                .fold(0.0f64, |m, (x, y)| m.max((x.1 - y.1).abs())),
+        );
+        // The impact map of the implicit-midpoint run (perfectly plastic, e = 0):
+        // Λ = m_eff|v_n⁻|(1 + e) and ΔT = ½m_eff v_n⁻²(1 − e²), i.e. 2ΔT = Λ|v_n⁻|(1 − e), with
+        // ΔT evaluated from the kinetic energies before and after; v_n⁺ = −e v_n⁻ = 0.
+        let mut scale = 0.0f64;
+        for e in &im.events {
+            let Event::Impact {
+                t,
+                impulse,
+                momentum_residual,
+                normal_velocity_before,
+                normal_velocity_after,
+                kinetic_energy_lost,
+                velocity_before,
+                ..
+            } = e
+            else {
+                continue;
+            };
+            let lv = impulse * normal_velocity_before.abs();
+            scale = scale.max(lv);
+            assert!(
+                *momentum_residual <= 1e-10,
+                "t = {t}: {momentum_residual:.2e}"
+            );
+            let speed = velocity_before.iter().fold(0.0f64, |m, v| m.max(v.abs())) * 5.0;
+            assert!(
+                normal_velocity_after.abs() <= 1e-10 * speed,
+                "t = {t}: v_n⁺ = {normal_velocity_after:.2e}"
+            );
+            // Micro-impacts (Λ|v_n⁻| below 1e-6 of the largest) lose energies at the
+            // round-off of the kinetic energy difference: only their sign of Λ is checked.
+            assert!(*impulse > 0.0, "t = {t}");
+            if lv >= 1e-6 * scale {
+                let rel = (2.0 * kinetic_energy_lost - lv).abs() / lv;
+                assert!(rel <= 1e-7, "t = {t}: 2ΔT/(Λ|v_n⁻|) − 1 = {rel:.2e}");
+            }
+        }
+        let closure = im.ledger.relative_closure();
+        assert!(
+            closure <= LEDGER_WARNING,
+            "dt = {dt}: closure {closure:.3e}"
+        );
+    }
+    // The free fall to the first impact: O(h²) difference of two second-order methods.
+    assert_second_order("first impact time", &first_impact);
+    // All switching times: at least 3× smaller per halving (measured 6.2 and 3.9; a
+    // first-order difference would fall 2×).
+    for k in 0..largest.len() - 1 {
+        assert!(
+            largest[k] >= 3.0 * largest[k + 1],
+            "switching time differences {largest:?}"
+        );
+    }
+}
+
+#[test]
+fn dyn_friction_wall_switches_with_energy_midpoint_to_second_order() {
+    let sc = scene("constrained-arm");
+    let steps = [2.5e-4, 1.25e-4, 6.25e-5];
+    let mut first_stick = Vec::new();
+    let mut closure = Vec::new();
+    for &dt in &steps {
+        let em = run(&sc, "energy-midpoint", None, dt, 0.1);
+        let im = run(&sc, "implicit-midpoint", None, dt, 0.1);
+        let (a, b) = (stick_slips(&em), stick_slips(&im));
+        assert_eq!(
+            a.iter().map(|e| e.0).collect::<Vec<_>>(),
+            b.iter().map(|e| e.0).collect::<Vec<_>>(),
+            "dt = {dt}"
+        );
+        // The start-up switches are made at the ends of first phase steps (friction rule 1,
+        // not located): within one step of each other.
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x.1 - y.1).abs() <= dt, "dt = {dt}: {x:?} {y:?}");
+        }
+        // The first located stick (after the start-up switches, t ≈ 0.0248 s).
+        let k = a
+            .iter()
+            .position(|e| e.0 && e.1 > 0.01)
+            .expect("a stick after the start");
+        first_stick.push((a[k].1 - b[k].1).abs());
+        // Friction work booked per step, the other works by the trapezoidal rule.
+        let c = im.ledger.relative_closure();
+        assert!(c <= LEDGER_WARNING, "dt = {dt}: closure {c:.3e}");
+        closure.push(c);
+    }
+    assert_second_order("first located stick time", &first_stick);
+    // The ledger closes to the rule's O(h²) energy error (M(q) configuration-dependent).
+    assert_second_order("implicit-midpoint ledger closure", &closure);
+}
+
+#[test]
+fn sys_contact_refusals_name_the_method() {
+    let case1 = scene("barhorst-case1");
+    let mut st = Settings::default();
+    st.discretization.elements = Some(4);
+    st.time.t_end = Some(0.01);
+    // Explicit central difference and generalized-α have no bordered update.
+    for method in ["central-difference", "generalized-alpha"] {
+        st.time.method = Some(method.parse().expect("a method name"));
+        match FemBackend.simulate(&case1, &st) {
+            Err(BackendError::Unsupported(m)) => {
+                assert!(m.contains("contact is implemented for"), "{m}")
+            }
+            other => panic!("{method}: {other:?}"),
+        }
+    }
+    // Implicit midpoint: not with adaptive steps, not on massless Timoshenko sections.
+    st.time.method = Some("implicit-midpoint".parse().expect("a method name"));
+    st.time.rtol = Some(1e-4);
+    match FemBackend.simulate(&case1, &st) {
+        Err(BackendError::Unsupported(m)) => assert!(m.contains("adaptive"), "{m}"),
+        other => panic!("{other:?}"),
+    }
+    st.time.rtol = None;
+    match FemBackend.simulate(&scene("barhorst-case1-timoshenko"), &st) {
+        Err(BackendError::Unsupported(m)) => assert!(m.contains("rotary_inertia"), "{m}"),
+        other => panic!("{other:?}"),
+    }
+}
