@@ -514,24 +514,25 @@ impl Stepper for EnergyMidpoint {
             let [k1, s1, sp1, g1] = cx.chain.energies(t1, &st.q1, &st.qd1);
             let v1_pot = s1 + sp1 + g1;
             let scale1 = k1.abs() + s1.abs() + sp1.abs() + g1.abs();
-            // Forces at the midpoint.
-            cx.chain.residual_parts(
+            // Metric W = M(q̄) (the kinematic pass at q̄), then the forces at the midpoint on
+            // its positions and frames.
+            cx.chain
+                .residual_parts(t_mid, &w.qbar, &w.zero, &w.dq, Parts::INERTIA, &mut w.w_dq);
+            cx.chain.residual_parts_at_last_q(
                 t_mid,
                 &w.qbar,
-                &w.zero,
                 &w.zero,
                 Parts::CONSERVATIVE,
                 &mut w.grad_v,
             );
-            cx.chain.residual_parts(
+            cx.chain.residual_parts_at_last_q(
                 t_mid,
                 &w.qbar,
                 &w.vbar,
-                &w.zero,
                 Parts::NONCONSERVATIVE,
                 &mut w.minus_q,
             );
-            passes += 4;
+            passes += 5;
             // ∇g(q̄) = ∂T/∂q(q̄, v̄) − ∂T/∂q(q̄, ½Δv).
             w.grad_g.iter_mut().for_each(|x| *x = 0.0);
             for (x, sign) in [(&w.vbar, 1.0), (&w.half_dv, -1.0)] {
@@ -539,10 +540,6 @@ impl Stepper for EnergyMidpoint {
                     .add_kinetic_gradient(t_mid, &w.qbar, x, sign, &mut w.grad_g);
             }
             passes += 2;
-            // Metric W = M(q̄).
-            cx.chain
-                .residual_parts(t_mid, &w.qbar, &w.zero, &w.dq, Parts::INERTIA, &mut w.w_dq);
-            passes += 1;
             let phi1 = v1_pot - 0.5 * dot(&st.qd, &w.mv1);
             let phi0 = v0_pot - 0.5 * dot(&w.p0, &st.qd1);
             let mut grad_dq = 0.0;
