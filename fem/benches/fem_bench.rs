@@ -6,7 +6,9 @@
 //! `two-link-free-undamped` (`arms-1s`); `barhorst-case1` over t ∈ [0, 0.5] s (`contact-0.5s`:
 //! the drop, the first impact at 0.28 s and constrained sliding; the normal force's mass solve
 //! per constrained step, refined against the last sparse factorization where it can be); `barhorst-case1-timoshenko` over t ∈ [0, 0.35] s
-//! (`contact-timoshenko-0.35s`: its first impact and micro-bounces, bound by event location).
+//! (`contact-timoshenko-0.35s`: its first impact and micro-bounces, bound by event location);
+//! the forces of one energy-midpoint iteration at q̄ with and without the shared kinematic pass
+//! (`midpoint-forces-at-qbar`).
 //! Run: `cargo bench -p fem --bench fem_bench -- --quick` (one group: append its name, e.g. `arms`).
 
 use std::hint::black_box;
@@ -187,6 +189,46 @@ fn assembly_foreshortening(c: &mut Criterion) {
     g.finish();
 }
 
+/// The forces of one energy-midpoint iteration at q̄ (metric product M(q̄)Δq, ∇V, −Q) on the
+/// arms at their default meshes: three full passes (kinematic and force pass each) against one
+/// full pass and two force passes on its kinematics ([`Chain::residual_parts_at_last_q`], what
+/// the scheme does; the outputs are equal).
+fn midpoint_forces(c: &mut Criterion) {
+    use fem::chain::Parts;
+    let mut g = c.benchmark_group("midpoint-forces-at-qbar");
+    for name in ["two-link-free-undamped", "barhorst-case1-timoshenko"] {
+        let sc = data::load_scene(name).unwrap();
+        let mut ch = Chain::new(sc.links(), sc.gravity(), 16).unwrap();
+        let nd = ch.ndof;
+        let (mut q, mut v) = (vec![0.0; nd], vec![0.0; nd]);
+        ch.initial_state(&mut q, &mut v);
+        for i in 0..nd {
+            q[i] += 1e-3 * (i as f64).sin();
+            v[i] = 0.1 * (i as f64).cos();
+        }
+        let dq: Vec<f64> = v.iter().map(|x| 5e-4 * x).collect();
+        let zero = vec![0.0; nd];
+        let (mut w, mut gv, mut mq) = (vec![0.0; nd], vec![0.0; nd], vec![0.0; nd]);
+        g.bench_function(BenchmarkId::new("three-passes", name), |b| {
+            b.iter(|| {
+                ch.residual_parts(1.0, &q, &zero, &zero, Parts::CONSERVATIVE, &mut gv);
+                ch.residual_parts(1.0, &q, &v, &zero, Parts::NONCONSERVATIVE, &mut mq);
+                ch.residual_parts(1.0, &q, &zero, &dq, Parts::INERTIA, &mut w);
+                black_box((&w, &gv, &mq));
+            })
+        });
+        g.bench_function(BenchmarkId::new("one-pass-two-at-last-q", name), |b| {
+            b.iter(|| {
+                ch.residual_parts(1.0, &q, &zero, &dq, Parts::INERTIA, &mut w);
+                ch.residual_parts_at_last_q(1.0, &q, &zero, Parts::CONSERVATIVE, &mut gv);
+                ch.residual_parts_at_last_q(1.0, &q, &v, Parts::NONCONSERVATIVE, &mut mq);
+                black_box((&w, &gv, &mq));
+            })
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
     assembly,
@@ -197,6 +239,7 @@ criterion_group!(
     arms,
     arms_short,
     contact_short,
-    contact_timoshenko_short
+    contact_timoshenko_short,
+    midpoint_forces
 );
 criterion_main!(benches);

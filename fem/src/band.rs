@@ -371,11 +371,9 @@ impl BandLu {
             }
         }
         // W = A⁻¹B and S = D − C W.
-        for jb in 0..nb {
-            let mut col = std::mem::take(&mut self.w);
-            self.band_solve(&mut col[jb * ni..(jb + 1) * ni]);
-            self.w = col;
-        }
+        let mut w = std::mem::take(&mut self.w);
+        self.band_solve_columns(&mut w);
+        self.w = w;
         for jb in 0..nb {
             for r in 0..nb {
                 let cw: f64 = (0..ni)
@@ -389,6 +387,45 @@ impl BandLu {
             self.schur.factorize()?;
         }
         Ok(())
+    }
+
+    /// X ← A⁻¹X for the columns of length n_I in `x` (column-major), all in one sweep over
+    /// the factors: each column sees the operations of [`BandLu::band_solve`] in its order
+    /// (bit-identical), the multipliers and rows of U are read once for all columns.
+    fn band_solve_columns(&self, x: &mut [f64]) {
+        let (ni, b) = (self.ni, self.b);
+        if ni == 0 {
+            return;
+        }
+        for k in 0..ni {
+            let p = self.piv[k];
+            let cnt = (k + b).min(ni - 1) - k;
+            let lk = &self.l[k * b..k * b + cnt];
+            for col in x.chunks_exact_mut(ni) {
+                if p != k {
+                    col.swap(k, p);
+                }
+                let xk = col[k];
+                if xk != 0.0 {
+                    for (xr, &l) in col[k + 1..k + 1 + cnt].iter_mut().zip(lk) {
+                        *xr -= l * xk;
+                    }
+                }
+            }
+        }
+        for k in (0..ni).rev() {
+            let cnt = self.reach[k] - k;
+            let diag = self.at(k, k);
+            let row = &self.a[diag + 1..diag + 1 + cnt];
+            let d = self.a[diag];
+            for col in x.chunks_exact_mut(ni) {
+                let mut v = col[k];
+                for (&u, &xj) in row.iter().zip(&col[k + 1..k + 1 + cnt]) {
+                    v -= u * xj;
+                }
+                col[k] = v / d;
+            }
+        }
     }
 
     /// x ← A⁻¹x for the factorized interior block.

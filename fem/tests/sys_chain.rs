@@ -243,6 +243,52 @@ fn sys_residual_parts_sum_to_the_residual_and_conservative_part_is_grad_v() {
     }
 }
 
+/// The force groups without inertia on the last kinematic pass (the energy-midpoint
+/// iteration's forces at q̄) equal the full passes exactly (`==`: up to the sign of zeros), with
+/// gravity, joint springs and dampers, Kelvin–Voigt, applied loads, foreshortening, axial and
+/// Timoshenko links and a prescribed joint.
+#[test]
+fn sys_residual_parts_at_last_q_equal_the_full_passes() {
+    use fem::chain::Parts;
+    for (name, fs, element) in [
+        ("single-link", true, CUBIC),
+        ("two-link-free", true, QUINTIC),
+        ("barhorst-case1-timoshenko", true, CUBIC),
+        ("rotating-beam-axial", false, CUBIC),
+        ("spin-up", false, CUBIC),
+    ] {
+        // The chain and state of `setup`, with dampers, springs and loads added.
+        let (_, q, qd, qdd) = setup(name, 3, fs, element);
+        let mut sc = data::load_scene(name).unwrap();
+        sc.planar_chain_mut().unwrap().gravity = Some(data::scene::Gravity {
+            vector: [0.3, -9.0],
+        });
+        for l in sc.planar_chain_mut().unwrap().links.iter_mut() {
+            l.foreshortening = fs && !l.axial;
+            l.tip_mass = Some(0.3);
+            l.joint.damping = Some(0.3);
+            l.joint.stiffness = Some(2.0);
+            l.kelvin_voigt = Some(1e-3);
+        }
+        let mut ch = Chain::with_element(sc.links(), sc.gravity(), 3, element).unwrap();
+        ch.distributed_load = 0.7;
+        ch.tip_load = 0.4;
+        let n = ch.ndof;
+        let zero = vec![0.0; n];
+        let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+        let t = 0.7;
+        ch.residual(t, &q, &qd, &qdd, &mut a);
+        for p in [Parts::CONSERVATIVE, Parts::NONCONSERVATIVE] {
+            ch.residual_parts_at_last_q(t, &q, &qd, p, &mut a);
+            ch.residual_parts(t, &q, &qd, &zero, p, &mut b);
+            assert!(a.iter().any(|v| *v != 0.0), "{name}: {p:?} is zero");
+            for i in 0..n {
+                assert!(a[i] == b[i], "{name}: {p:?} dof {i}: {} vs {}", a[i], b[i]);
+            }
+        }
+    }
+}
+
 #[test]
 fn sys_newton_solve_of_real_chain_matrices_is_backward_stable() {
     // The Newton matrices of the arms at their default meshes, with the coefficients of a

@@ -60,8 +60,74 @@ impl Chain {
         parts: Parts,
         res: &mut [f64],
     ) {
-        res.iter_mut().for_each(|x| *x = 0.0);
         self.forward(t, q, qd, qdd, parts);
+        self.backward(t, q, qd, qdd, parts, res);
+    }
+
+    /// The force groups `parts` without inertia (gravity, strain, joint springs, applied
+    /// loads, dampers) at the configuration of the last kinematic pass, which must have been
+    /// at (t, q) (any rates, any groups): equal to [`Chain::residual_parts`] at (t, q, q̇, 0)
+    /// bit for bit up to the sign of exact zeros. The positions and frame angles it reads are
+    /// functions of q alone, and the point loads of these groups (gravity, the distributed
+    /// load) need no rates: only the joint rates are set from `qd`, so the kinematic pass is
+    /// not repeated (the energy-midpoint iteration evaluates three groups at q̄).
+    pub fn residual_parts_at_last_q(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        parts: Parts,
+        res: &mut [f64],
+    ) {
+        debug_assert!(!parts.inertia, "the inertia group needs the kinematic pass");
+        let g_in = if parts.conservative {
+            self.gravity
+        } else {
+            V2::zeros()
+        };
+        let nl = self.links.len();
+        for li in 0..nl {
+            let l = &self.links[li];
+            let tb = &l.element.quad;
+            let fr = &mut self.frames[li];
+            fr.dtheta = match l.joint.prescribed_at(t) {
+                Some((_, dth, _)) => dth,
+                None => qd[l.joint.dof],
+            };
+            // Multiplied by the inertia flag (0) in the force pass.
+            fr.ddphi = 0.0;
+            fr.ddslope_tip = 0.0;
+            fr.a_tip = V2::zeros();
+            let g_loc = rot_t(fr.phi, g_in);
+            let q_load = if li + 1 == nl && parts.nonconservative {
+                self.distributed_load
+            } else {
+                0.0
+            };
+            let force = &mut self.force[li];
+            for e in 0..l.n_el {
+                for g in 0..tb.ng {
+                    let m = l.rho_a * tb.wh[g];
+                    force[e * tb.ng + g] =
+                        m * (V2::zeros() - g_loc) - V2::new(0.0, q_load * tb.wh[g]);
+                }
+            }
+        }
+        self.backward(t, q, qd, &[], parts, res);
+    }
+
+    /// Force (backward) pass of [`Chain::residual_parts`] on the point data of the last
+    /// kinematic pass (`qdd` is read for the section rotary inertia only).
+    fn backward(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        qd: &[f64],
+        qdd: &[f64],
+        parts: Parts,
+        res: &mut [f64],
+    ) {
+        res.iter_mut().for_each(|x| *x = 0.0);
         let g_in = if parts.conservative {
             self.gravity
         } else {

@@ -27,6 +27,9 @@
 //!   difference for Ṁ(x)x ([`kinetic_gradient_fd`], 3 inertial passes) is its test oracle;
 //! * ∇g(q̄) = ∂T/∂q(q̄, a) − ∂T/∂q(q̄, b), a = v̄, b = ½(v₁ − v₀) (polarization);
 //! * ∇V(q̄) = conservative part; Q = −(non-conservative part); V(q₁) from [`Chain::energies`].
+//!   Both on the kinematic pass of the metric product M(q̄)Δq
+//!   ([`Chain::residual_parts_at_last_q`]: positions and frame angles depend on q̄ alone), so
+//!   an iteration makes one kinematic pass at q̄ instead of three.
 //!
 //! Newton on the mean acceleration a = (v₁ − v₀)/h with the generalized-α matrix machinery at
 //! (q̄, v̄, a): S = M + (h/2)C + (h²/4)K (∂q̄/∂a = h²/4, ∂v̄/∂a = h/2), analytic — the
@@ -514,24 +517,25 @@ impl Stepper for EnergyMidpoint {
             let [k1, s1, sp1, g1] = cx.chain.energies(t1, &st.q1, &st.qd1);
             let v1_pot = s1 + sp1 + g1;
             let scale1 = k1.abs() + s1.abs() + sp1.abs() + g1.abs();
-            // Forces at the midpoint.
-            cx.chain.residual_parts(
+            // Metric W = M(q̄) (the kinematic pass at q̄), then the forces at the midpoint on
+            // its positions and frames.
+            cx.chain
+                .residual_parts(t_mid, &w.qbar, &w.zero, &w.dq, Parts::INERTIA, &mut w.w_dq);
+            cx.chain.residual_parts_at_last_q(
                 t_mid,
                 &w.qbar,
-                &w.zero,
                 &w.zero,
                 Parts::CONSERVATIVE,
                 &mut w.grad_v,
             );
-            cx.chain.residual_parts(
+            cx.chain.residual_parts_at_last_q(
                 t_mid,
                 &w.qbar,
                 &w.vbar,
-                &w.zero,
                 Parts::NONCONSERVATIVE,
                 &mut w.minus_q,
             );
-            passes += 4;
+            passes += 5;
             // ∇g(q̄) = ∂T/∂q(q̄, v̄) − ∂T/∂q(q̄, ½Δv).
             w.grad_g.iter_mut().for_each(|x| *x = 0.0);
             for (x, sign) in [(&w.vbar, 1.0), (&w.half_dv, -1.0)] {
@@ -539,10 +543,6 @@ impl Stepper for EnergyMidpoint {
                     .add_kinetic_gradient(t_mid, &w.qbar, x, sign, &mut w.grad_g);
             }
             passes += 2;
-            // Metric W = M(q̄).
-            cx.chain
-                .residual_parts(t_mid, &w.qbar, &w.zero, &w.dq, Parts::INERTIA, &mut w.w_dq);
-            passes += 1;
             let phi1 = v1_pot - 0.5 * dot(&st.qd, &w.mv1);
             let phi0 = v0_pot - 0.5 * dot(&w.p0, &st.qd1);
             let mut grad_dq = 0.0;
