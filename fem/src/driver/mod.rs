@@ -94,7 +94,8 @@ pub struct Driver {
     pending_massless: f64,
     /// Largest link length (scales Newton and error tolerances).
     pub length_scale: f64,
-    /// The scene's tip contact (energy-midpoint only; None without contact, nothing allocated).
+    /// The scene's tip contact (energy-midpoint or implicit-midpoint; None without contact,
+    /// nothing allocated).
     pub contact: Option<Box<Contact>>,
     /// Why the last rejected step was rejected.
     pub last_rejection: Rejection,
