@@ -356,9 +356,10 @@ pub(crate) fn transverse_load(scene: &Scene, l: &LinkModel, p: f64, q: f64) -> V
         .collect()
 }
 
-/// The DOFs of the model (the axial field is listed when on; simulate then reports Unsupported).
+/// The DOFs of the model a run integrates (`modes` may refuse a scene a run accepts: the
+/// spinning extensible link, [`check_supported`]).
 pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
-    check_supported(scene, Purpose::Modes)?;
+    check_supported(scene, Purpose::Dynamics)?;
     let n = modes_per_link(settings)?;
     let basis = basis_choice(scene, settings)?;
     let mut plan = DofPlan::default();

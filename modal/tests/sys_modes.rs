@@ -333,10 +333,18 @@ fn sys_cantilever_axial_and_bending_frequencies_are_exact() {
         assert!(((f - exact) / exact).abs() < 1e-10, "{kind} {f} vs {exact}");
     }
     assert_eq!((na, nb), (n, n));
-    // Modes of the spinning extensible beam need the stretched steady state: not built.
+    // Modes of the spinning extensible beam need the stretched steady state: not built. A run
+    // integrates it, and `describe` plans what the run builds: n axial and n transverse
+    // modes (the prescribed hub has no DOF).
     let spinning = load_scene("rotating-beam-axial").unwrap();
     assert!(matches!(
         ModalBackend.modes(&spinning, &Settings::default(), 3),
         Err(BackendError::Unsupported(_))
     ));
+    let disc = Discretization {
+        modes: Some(n),
+        ..Default::default()
+    };
+    let plan = ModalBackend.dof_plan(&spinning, &disc).unwrap();
+    assert_eq!(plan.total(), 2 * n);
 }
