@@ -145,7 +145,8 @@ fn dyn_equations_of_motion_match_the_energy_two_link_with_everything() {
 
 #[test]
 fn dyn_equations_of_motion_match_the_energy_extensible_links() {
-    // Axial fields with von Kármán strain (exact kinetic energy of p = (x + u, v)).
+    // Axial fields with von Kármán strain: the stretch beside the foreshortening, exact
+    // kinetic energy of p = (x + u − s, v) (crate::model::body).
     let mut scene = load_scene("two-link-free-undamped").unwrap();
     scene.planar_chain_mut().unwrap().gravity = Some(data::scene::Gravity {
         vector: [0.0, -32.17],
@@ -157,6 +158,17 @@ fn dyn_equations_of_motion_match_the_energy_extensible_links() {
         l.axial_stiffness = Some(1e5);
     }
     check_lagrange_scene(&scene, &with_modes(3), 0.9, 0.05, 2.0);
+    // Timoshenko links with the axial field (the foreshortening follows the centre line v'),
+    // with and without rotary inertia (massless section rotations condensed).
+    for rotary in [true, false] {
+        for l in &mut scene.planar_chain_mut().unwrap().links {
+            l.shear = true;
+            l.shear_stiffness = Some(2e5);
+            l.rotary_inertia = rotary;
+            l.rotary_inertia_per_length = Some(1e-4);
+        }
+        check_lagrange_scene(&scene, &with_modes(3), 0.7, 0.05, 2.0);
+    }
 }
 
 #[test]
