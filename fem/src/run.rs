@@ -279,9 +279,11 @@ pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemErr
                 .position(|l| l.shear && !l.rotary_inertia)
         {
             // Measured on `barhorst-case1-timoshenko` (0.5 s): with the massless rotations
-            // projected as for energy-midpoint the trapezoidal works do not match the
-            // projected end rates (ledger closure 6e-2); without the projection their end
-            // rates flip sign every step (615 events against energy-midpoint's 419).
+            // projected as for energy-midpoint (the removed strain energy booked), the
+            // Kelvin–Voigt work on ψ' has no consistent quadrature: 0.16 ft·lbf at the
+            // projected end rates, 24.1 at Δq/h, against energy-midpoint's 18.1 (ledger
+            // residual −18.1 / +5.9 ft·lbf); without the projection the end rates flip sign
+            // every step (615 events against energy-midpoint's 419).
             return Err(FemError::unsupported(format!(
                 "fem implicit-midpoint: contact on link {} (a Timoshenko link without \
                  `rotary_inertia`) is not implemented: the midpoint rule leaves the end rates of \

@@ -469,10 +469,10 @@ impl Driver {
 
     /// Commits q1, q̇1, q̈1 and updates the work integrals.
     fn accept(&mut self, h: f64, t1: f64, t_law: f64) {
+        // The massless projection of the step end is the driver's, whoever books the rest.
+        self.works.numerical_massless += self.pending_massless;
         if self.stepper.commit(h, &mut self.works) {
-            // The method booked its works with its own quadrature (energy-midpoint); the
-            // massless projection of the step end is the driver's.
-            self.works.numerical_massless += self.pending_massless;
+            // The method booked its works with its own quadrature (energy-midpoint).
             self.finish_accept(t1, t_law);
             return;
         }
