@@ -375,14 +375,16 @@ fn cli_default_outputs_fit_120_columns() {
 #[test]
 fn cli_closed_output_pipe_ends_quietly_with_the_sigpipe_status() {
     use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_flexverify"))
+    // The reader is gone before anything is written, as in `flexverify scenes | head -0`:
+    // closed before the child starts, so the outcome does not depend on scheduling.
+    let (reader, writer) = std::io::pipe().expect("pipe");
+    drop(reader);
+    let child = Command::new(env!("CARGO_BIN_EXE_flexverify"))
         .arg("scenes")
-        .stdout(Stdio::piped())
+        .stdout(Stdio::from(writer))
         .stderr(Stdio::piped())
         .spawn()
         .expect("run flexverify");
-    // The reader goes away before anything is written, as `flexverify scenes | head -0` does.
-    drop(child.stdout.take());
     let out = child.wait_with_output().expect("wait for flexverify");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(141), "{err}");
