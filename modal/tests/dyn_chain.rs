@@ -5,6 +5,7 @@ use data::{
     load_scene,
 };
 use modal::ModalBackend;
+use modal::linalg::dot;
 use modal::model::Chain;
 use modal::setup::build_chain;
 
@@ -240,10 +241,6 @@ fn sys_extensible_link_kinetic_energy_is_the_continuum_integral() {
     let rel = (t_model - t_quad).abs() / t_quad;
     println!("T model {t_model:.12e}, quadrature {t_quad:.12e}, relative {rel:.2e}");
     assert!(rel < 1e-10, "relative difference {rel:.3e}");
-}
-
-fn dot(x: &[f64], y: &[f64]) -> f64 {
-    x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
 
 #[test]
