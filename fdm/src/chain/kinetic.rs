@@ -26,7 +26,13 @@
 //! mass (Ψ), outboard first moment (Φ) or 1 (S): O(n) with its gradient.
 //!
 //! T is a quadratic form in q̇, so Lagrange's equations conserve T + V exactly in continuous
-//! time. Its mass matrix is diagonal in the deflections except for the full columns of θ, β
+//! time. It is positive definite only for moderate deflections: the second-order products of
+//! the elbow's rigid velocity with the foreshortening rates, −θ̇L₁ sin φ Ψ̇ + β̇Q₂Ṡ sin φ, are
+//! indefinite, and in the direction "turn the chords, counter-bend link 2" (the deflection
+//! rates cancel each link-2 station's transverse velocity, so those masses barely move) they
+//! outweigh the positive part once the link slopes reach ~0.2. The exact T adds terms such as ½Σmṡ², dense in the deflection
+//! rates, which the chain's O(n) Schur-complement mass solve cannot carry; the contact driver
+//! stops with a diagnostic when G M⁻¹ Gᵀ ≤ 0. Its mass matrix is diagonal in the deflections except for the full columns of θ, β
 //! and V. The chain ([`super`]) uses tip-chord frames, V ≡ 0 there (and w_{r₂} ≡ 0).
 
 use super::dual::Dual;

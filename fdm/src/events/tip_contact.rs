@@ -69,10 +69,13 @@ fn singular(t: f64) -> StabilityVerdict {
             t,
             what: "the constraint's G M⁻¹ Gᵀ is not positive".into(),
             location: Some("contact1".into()),
-            why: "the chain's mass matrix lost positive definiteness (deflections far outside \
-                  the second-order kinetic energy's range)"
+            why: "the mass matrix of the chain's second-order kinetic energy is not positive \
+                  definite at this deflection: its foreshortening-rate terms are indefinite once \
+                  the link slopes grow large, and finer stations reach that sooner"
                 .into(),
-            remedy: "lower the safety factor or refine the stations".into(),
+            remedy: "use fewer stations, or the fem or modal backend (their kinetic energy is \
+                     exact)"
+                .into(),
         },
     }
 }
