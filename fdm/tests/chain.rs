@@ -74,6 +74,22 @@ fn elem_chain_momenta_and_gradient_are_derivatives_of_the_kinetic_energy() {
 }
 
 #[test]
+fn elem_chain_momentum_values_are_the_dual_values_bit_for_bit() {
+    let scene = load_scene("two-link-free").unwrap();
+    let sys = TwoLinkChain::from_scene(&scene, Some(9)).unwrap();
+    let ine = &sys.inertia;
+    let n = ine.dofs();
+    let (q, v) = common::moving_chain_state(sys.dofs());
+    let mut dual = vec![Dual::default(); n];
+    ine.momenta(&q, &v, &v, &mut dual);
+    let mut values = vec![f64::NAN; n];
+    ine.momenta_values(&q, &v, &mut values);
+    for i in 0..n {
+        assert_eq!(values[i].to_bits(), dual[i].re.to_bits(), "p[{i}]");
+    }
+}
+
+#[test]
 fn elem_chain_forces_are_minus_potential_gradients() {
     // accelerations with q̇ = 0 and no dampers: M a = −∂V/∂q; check M a against FD of V.
     let mut scene = load_scene("two-link-free-undamped").unwrap();

@@ -1,7 +1,69 @@
 //! Forward-mode dual numbers a + b ε (ε² = 0): the exact directional derivative (∂p/∂q)·q̇ of the
 //! generalized momenta in one O(n) pass, so that d/dt ∂T/∂q̇ needs no hand-derived Ṁ.
+//!
+//! [`Number`] lets one formula run on either `Dual` (value and directional derivative) or `f64`
+//! (value only, for the columns of M). The real part of every `Dual` operation is the `f64`
+//! operation, so both give the same value bits.
 
 use std::ops::{Add, Mul, Neg, Sub};
+
+/// The arithmetic the momenta formula needs: `f64` (values) or [`Dual`] (values and one
+/// directional derivative).
+pub trait Number:
+    Copy
+    + Default
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Mul<f64, Output = Self>
+    + Add<f64, Output = Self>
+    + Neg<Output = Self>
+{
+    /// The value `re` with derivative `du` along the seeded direction (`f64` drops `du`).
+    fn seed(re: f64, du: f64) -> Self;
+    /// A value with zero derivative.
+    fn constant(re: f64) -> Self;
+    fn sin(self) -> Self;
+    fn cos(self) -> Self;
+    /// The value part.
+    fn value(self) -> f64;
+}
+
+impl Number for f64 {
+    fn seed(re: f64, _du: f64) -> Self {
+        re
+    }
+    fn constant(re: f64) -> Self {
+        re
+    }
+    fn sin(self) -> Self {
+        f64::sin(self)
+    }
+    fn cos(self) -> Self {
+        f64::cos(self)
+    }
+    fn value(self) -> f64 {
+        self
+    }
+}
+
+impl Number for Dual {
+    fn seed(re: f64, du: f64) -> Self {
+        Dual::new(re, du)
+    }
+    fn constant(re: f64) -> Self {
+        Dual::constant(re)
+    }
+    fn sin(self) -> Self {
+        Dual::sin(self)
+    }
+    fn cos(self) -> Self {
+        Dual::cos(self)
+    }
+    fn value(self) -> f64 {
+        self.re
+    }
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Dual {

@@ -35,7 +35,7 @@
 //! stops with a diagnostic when G M⁻¹ Gᵀ ≤ 0. Its mass matrix is diagonal in the deflections except for the full columns of θ, β
 //! and V. The chain ([`super`]) uses tip-chord frames, V ≡ 0 there (and w_{r₂} ≡ 0).
 
-use super::dual::Dual;
+use super::dual::{Dual, Number};
 
 /// The chain's inertia data (lumped masses per station, segment weights).
 #[derive(Debug, Clone)]
@@ -75,13 +75,13 @@ fn slope(u: &[f64], seg: usize, h: f64) -> f64 {
 }
 
 #[inline]
-fn slope_d(u: &[f64], du: &[f64], seg: usize, h: f64) -> Dual {
+fn slope_d<N: Number>(u: &[f64], du: &[f64], seg: usize, h: f64) -> N {
     let (l, ld) = if seg == 0 {
         (0.0, 0.0)
     } else {
         (u[seg - 1], du[seg - 1])
     };
-    Dual::new((u[seg] - l) / h, (du[seg] - ld) / h)
+    N::seed((u[seg] - l) / h, (du[seg] - ld) / h)
 }
 
 /// ½ h Σ c_seg g_seg² (c = None: weights 1).
@@ -111,11 +111,11 @@ pub fn seg_grad(u: &[f64], h: f64, c: Option<&[f64]>, k: usize) -> f64 {
 }
 
 #[inline]
-fn seg_grad_d(u: &[f64], du: &[f64], h: f64, c: Option<&[f64]>, k: usize) -> Dual {
+fn seg_grad_d<N: Number>(u: &[f64], du: &[f64], h: f64, c: Option<&[f64]>, k: usize) -> N {
     let w = |s: usize| c.map_or(1.0, |c| c[s]);
-    let mut d = slope_d(u, du, k, h) * w(k);
+    let mut d = slope_d::<N>(u, du, k, h) * w(k);
     if k + 1 < u.len() {
-        d = d - slope_d(u, du, k + 1, h) * w(k + 1);
+        d = d - slope_d::<N>(u, du, k + 1, h) * w(k + 1);
     }
     d
 }
@@ -207,28 +207,38 @@ impl ChainInertia {
 
     /// p = ∂T/∂q̇ at (q + ε dq, q̇): `out[i].re` the momenta, `out[i].du` = (∂pᵢ/∂q)·dq.
     pub fn momenta(&self, q: &[f64], dq: &[f64], qd: &[f64], out: &mut [Dual]) {
+        self.momenta_in(q, dq, qd, out);
+    }
+
+    /// p = ∂T/∂q̇ at (q, q̇), values only: the first [`Self::dofs`] entries of `out`.
+    pub fn momenta_values(&self, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        self.momenta_in(q, q, qd, out);
+    }
+
+    /// The momenta formula over `f64` or [`Dual`] (`dq` is read only by `Dual`).
+    fn momenta_in<N: Number>(&self, q: &[f64], dq: &[f64], qd: &[f64], out: &mut [N]) {
         let (v, dv, vd) = (&q[self.iv()], &dq[self.iv()], &qd[self.iv()]);
         let (w, dw, wd) = (&q[self.iw()], &dq[self.iw()], &qd[self.iw()]);
         let (thd, bed) = (qd[TH], qd[BE]);
-        let phi = Dual::new(q[BE] - q[TH], dq[BE] - dq[TH]);
+        let phi = N::seed(q[BE] - q[TH], dq[BE] - dq[TH]);
         let (sn, c) = (phi.sin(), phi.cos());
         let r1 = self.r1;
-        let vt = Dual::new(v[r1 - 1], dv[r1 - 1]);
+        let vt = N::seed(v[r1 - 1], dv[r1 - 1]);
         let vtd = vd[r1 - 1];
         let l1 = self.l1;
-        let zero = Dual::default();
+        let zero = N::default();
         // link-1 sums
         let mut smv2 = zero;
         let mut smxvd = 0.0;
         for k in 0..r1 {
-            let vk = Dual::new(v[k], dv[k]);
+            let vk = N::seed(v[k], dv[k]);
             smv2 = smv2 + vk * vk * self.m1[k];
             smxvd += self.m1[k] * self.x1(k) * vd[k];
         }
         let (mut s, mut sd, mut phi1) = (zero, zero, zero);
         if self.fs1 {
             for seg in 0..r1 {
-                let g = slope_d(v, dv, seg, self.h1);
+                let g: N = slope_d(v, dv, seg, self.h1);
                 let gd = slope(vd, seg, self.h1);
                 s = s + g * g * (0.5 * self.h1);
                 sd = sd + g * (self.h1 * gd);
@@ -239,7 +249,7 @@ impl ChainInertia {
         let (mut smw, mut smw2) = (zero, zero);
         let (mut smwd, mut smxiwd) = (0.0, 0.0);
         for j in 0..self.r2 {
-            let wj = Dual::new(w[j], dw[j]);
+            let wj = N::seed(w[j], dw[j]);
             smw = smw + wj * self.m2[j];
             smw2 = smw2 + wj * wj * self.m2[j];
             smwd += self.m2[j] * wd[j];
@@ -248,7 +258,7 @@ impl ChainInertia {
         let (mut psi, mut psid, mut phi2) = (zero, zero, zero);
         if self.fs2 {
             for seg in 0..self.r2 {
-                let g = slope_d(w, dw, seg, self.h2);
+                let g: N = slope_d(w, dw, seg, self.h2);
                 let gd = slope(wd, seg, self.h2);
                 psi = psi + g * g * (0.5 * self.h2 * self.mu2[seg]);
                 psid = psid + g * (self.h2 * self.mu2[seg] * gd);
@@ -258,36 +268,36 @@ impl ChainInertia {
         let a = sn * (thd * l1 + vtd) - c * vt * thd;
         let b = c * (thd * l1 + vtd) + sn * vt * thd;
         let (m2, q2) = (self.mass2, self.q2);
-        out[TH] = Dual::constant(self.hub * thd + thd * self.sum_mx2_1 + smxvd) + smv2 * thd
+        out[TH] = N::constant(self.hub * thd + thd * self.sum_mx2_1 + smxvd) + smv2 * thd
             - phi1 * (2.0 * thd)
             + (vt * vt * thd + l1 * (thd * l1 + vtd)) * m2
-            + (q2 * (c * l1 + sn * vt) - smw * (sn * l1 - c * vt)) * bed
+            + ((c * l1 + sn * vt) * q2 - smw * (sn * l1 - c * vt)) * bed
             + (c * l1 + sn * vt) * smwd
             - s * (2.0 * m2 * thd * l1)
             - sn * psid * l1
             - c * psi * (bed * l1)
             - s * c * (bed * q2);
-        out[BE] = b * q2 - a * smw + smw2 * bed + Dual::constant(bed * self.i2 + smxiwd)
+        out[BE] = b * q2 - a * smw + smw2 * bed + N::constant(bed * self.i2 + smxiwd)
             - c * psi * (thd * l1)
             + sd * sn * q2
             - s * c * (thd * q2)
             - phi2 * (2.0 * bed);
         let bq_sn = sn * (bed * q2);
         for k in 0..r1 {
-            let mut p = Dual::constant(self.m1[k] * (thd * self.x1(k) + vd[k]));
+            let mut p = N::constant(self.m1[k] * (thd * self.x1(k) + vd[k]));
             if self.fs1 {
-                p = p + bq_sn * seg_grad_d(v, dv, self.h1, None, k);
+                p = p + bq_sn * seg_grad_d::<N>(v, dv, self.h1, None, k);
             }
             out[2 + k] = p;
         }
         out[2 + r1 - 1] = out[2 + r1 - 1]
-            + Dual::constant(m2 * (thd * l1 + vtd))
+            + N::constant(m2 * (thd * l1 + vtd))
             + (c * q2 - sn * smw) * bed
             + c * smwd;
         for j in 0..self.r2 {
             let mut p = (b + bed * self.xi2(j) + wd[j]) * self.m2[j];
             if self.fs2 {
-                p = p - sn * seg_grad_d(w, dw, self.h2, Some(&self.mu2), j) * (thd * l1);
+                p = p - sn * seg_grad_d::<N>(w, dw, self.h2, Some(&self.mu2), j) * (thd * l1);
             }
             out[2 + r1 + j] = p;
         }

@@ -19,14 +19,13 @@ impl TwoLinkChain {
         let n = self.dofs();
         let full = [TH, BE];
         for (c, &idx) in full.iter().enumerate() {
-            self.cols[c].iter_mut().for_each(|x| *x = 0.0);
+            self.cols[c][self.inertia.dofs()..n]
+                .iter_mut()
+                .for_each(|x| *x = 0.0);
             self.unit[idx] = 1.0;
             self.inertia
-                .momenta(&self.qk, &self.zeros, &self.unit, &mut self.p);
+                .momenta_values(&self.qk, &self.unit, &mut self.cols[c]);
             self.unit[idx] = 0.0;
-            for i in 0..n {
-                self.cols[c][i] = self.p[i].re;
-            }
             for s in self.ghosts() {
                 self.cols[c][s] = 0.0;
             }

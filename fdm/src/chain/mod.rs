@@ -140,7 +140,6 @@ pub struct TwoLinkChain {
     /// the full columns of M: θ, β, x₁, x₂ and (Euler) the tip ghost y
     cols: [Vec<f64>; 5],
     unit: Vec<f64>,
-    zeros: Vec<f64>,
     rhs: Vec<f64>,
     fv: Vec<f64>,
     fw: Vec<f64>,
@@ -365,7 +364,6 @@ impl TwoLinkChain {
             p: vec![Dual::default(); nd],
             cols: std::array::from_fn(|_| vec![0.0; nd]),
             unit: vec![0.0; nd],
-            zeros: vec![0.0; nd],
             rhs: vec![0.0; nd],
             fv: vec![0.0; r1],
             fw: vec![0.0; r2],
@@ -658,15 +656,11 @@ impl TwoLinkChain {
     }
 
     /// Generalized momenta p = M(q) q̇ of the whole chain (chord-frame kinetic energy plus the
-    /// clamp rotary inertias). Allocates: for checks and output, not for the step loop.
+    /// clamp rotary inertias).
     pub fn momenta(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
         self.chord(q, qd);
-        let zeros = vec![0.0; q.len()];
-        let mut p = vec![Dual::default(); q.len()];
-        self.inertia.momenta(&self.qk, &zeros, &self.vk, &mut p);
-        for i in 0..q.len() {
-            out[i] = p[i].re;
-        }
+        out.iter_mut().for_each(|x| *x = 0.0);
+        self.inertia.momenta_values(&self.qk, &self.vk, out);
         for s in self.ghosts() {
             out[s] = 0.0;
         }
