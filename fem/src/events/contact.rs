@@ -183,8 +183,7 @@
 pub mod friction;
 
 use data::Event;
-use data::Scene;
-use data::scene::Surface;
+use data::scene::{PlanarChain, Surface};
 
 use crate::chain::{Chain, MAX_LINKS, Parts};
 use crate::error::FemError;
@@ -336,17 +335,18 @@ pub(crate) struct ConstrainedSolve {
 }
 
 impl Contact {
-    /// The scene's tip contact on `chain` (None without one; nothing is allocated then).
-    pub fn from_scene(scene: &Scene, chain: &Chain) -> Result<Option<Self>, FemError> {
-        crate::support::check_contact(scene)?;
-        let Some(c) = scene.contacts().first() else {
+    /// The tip contact of the planar chain `pc` (of scene `name`) on its discretization
+    /// `chain` (None without one; nothing is allocated then).
+    pub fn from_planar_chain(
+        name: &str,
+        pc: &PlanarChain,
+        chain: &Chain,
+    ) -> Result<Option<Self>, FemError> {
+        crate::support::check_contact(name, pc)?;
+        let Some(c) = pc.contacts.first() else {
             return Ok(None);
         };
-        let link = scene
-            .links()
-            .iter()
-            .position(|l| l.name == c.link)
-            .unwrap_or(0);
+        let link = pc.links.iter().position(|l| l.name == c.link).unwrap_or(0);
         let bilateral = crate::events::contact::friction::Bilateral::from_scene(c, chain)?;
         let (point, normal) = match c.surface {
             Surface::Line { point, normal } => (point, normal),

@@ -87,7 +87,6 @@
 //! Timoshenko links without rotary inertia are refused here (M is singular in the massless
 //! section rotations, and the index-1 forces need M⁻¹).
 
-use data::Scene;
 use data::scene::{ContactMode, Surface};
 
 use crate::chain::{Chain, MAX_LINKS};
@@ -106,9 +105,9 @@ pub const STICK_VT_TOL: f64 = 1e-8;
 /// Shortest trial step of the event location, relative to the step being located.
 pub const MIN_TRIAL: f64 = 1e-3;
 
-/// The `describe` line of a bilateral contact (None otherwise).
-pub fn describe(scene: &Scene) -> Option<String> {
-    let c = scene.contacts().first()?;
+/// The `describe` line of a planar chain's bilateral contact (None otherwise).
+pub fn describe(contacts: &[data::scene::Contact]) -> Option<String> {
+    let c = contacts.first()?;
     if c.mode != ContactMode::Bilateral {
         return None;
     }
