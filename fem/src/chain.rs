@@ -48,11 +48,11 @@ use crate::band::BorderedBand;
 use crate::element::tables::dotn;
 use crate::element::{self, ElementDofs, InteriorField, MeshElement};
 use crate::error::FemError;
-use geometry::V2;
 
 pub use crate::element::{MAXE, NONE};
 pub use augmented::AugmentedLayout;
 pub use forces::Parts;
+pub use geometry::V2;
 pub use newton::NewtonCoefficients;
 
 mod augmented;

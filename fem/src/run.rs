@@ -9,7 +9,7 @@ use data::{
     StabilityVerdict, channel, ledger_term,
 };
 
-use crate::chain::{Chain, NONE};
+use crate::chain::{Chain, NONE, V2};
 use crate::driver::{Driver, Rejection, StopReason};
 use crate::error::FemError;
 use crate::events::contact::Contact;
@@ -395,7 +395,7 @@ fn channel_specs(
 }
 
 /// Samples the observables at the driver's current state into `buf`.
-fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<f64>) {
+fn sample(integ: &Driver, stations: usize, tips: &mut [V2], buf: &mut Vec<f64>) {
     buf.clear();
     let ch = &integ.chain;
     ch.tip_positions(integ.state.t, &integ.state.q, tips);
@@ -404,8 +404,8 @@ fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<
         buf.push(th);
         buf.push(rate);
         buf.push(ch.joint_torque[i]);
-        buf.push(tips[i][0]);
-        buf.push(tips[i][1]);
+        buf.push(tips[i].x);
+        buf.push(tips[i].y);
         buf.push(ch.tip_deflection(i, &integ.state.q));
         if l.axial {
             buf.push(ch.tip_axial(i, &integ.state.q));
@@ -545,7 +545,7 @@ pub fn simulate(
     let (s, i, d) = ledger_terms(&integ);
     let mut ledger = EnergyLedger::new(&s, &i, &d);
     let mut events = Vec::new();
-    let mut tips = vec![[0.0; 2]; integ.chain.links.len()];
+    let mut tips = vec![V2::zeros(); integ.chain.links.len()];
     let n_out = (t_end / output_interval - 1e-9).ceil().max(1.0) as usize;
     let mut buf = Vec::with_capacity(specs.len());
     sample(&integ, stations, &mut tips, &mut buf);

@@ -5,7 +5,7 @@
 
 use data::{Backend, Event, RunResult, Scene, Settings, StabilityVerdict};
 use fem::FemBackend;
-use fem::chain::Chain;
+use fem::chain::{Chain, V2};
 
 mod common;
 
@@ -52,7 +52,7 @@ fn check_tip_jacobian(sc: &Scene) {
     let q = bent_state(&chain);
     let mut jac = vec![0.0; 2 * n];
     let r = chain.tip_jacobian(0.0, 1, &q, &mut jac);
-    let mut tips = [[0.0; 2]; 2];
+    let mut tips = [V2::zeros(); 2];
     chain.tip_positions(0.0, &q, &mut tips);
     assert!((r[0] - tips[1][0]).abs() < 1e-15 && (r[1] - tips[1][1]).abs() < 1e-15);
     // Central differences of the tip position (truncation ~ε², round-off ~1e-16/ε).
@@ -63,7 +63,7 @@ fn check_tip_jacobian(sc: &Scene) {
         let (mut qp, mut qm) = (q.clone(), q.clone());
         qp[j] += eps;
         qm[j] -= eps;
-        let (mut tp, mut tm) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
+        let (mut tp, mut tm) = ([V2::zeros(); 2], [V2::zeros(); 2]);
         chain.tip_positions(0.0, &qp, &mut tp);
         chain.tip_positions(0.0, &qm, &mut tm);
         for d in 0..2 {
@@ -90,7 +90,7 @@ fn check_tip_jacobian(sc: &Scene) {
     }
     // The convective term n̂·J̇q̇: d/dt (J q̇) along q(t) = q + t q̇ at fixed q̇ is J̇q̇.
     let dt = 1e-5;
-    let mut jv = [[0.0; 2]; 2];
+    let mut jv = [V2::zeros(); 2];
     for (k, s) in [1.0, -1.0].into_iter().enumerate() {
         let qs: Vec<f64> = (0..n).map(|i| q[i] + s * dt * qd[i]).collect();
         let [_, vs, _] = chain.tip_motion(0.0, 1, &qs, &qd, &zero);
