@@ -60,7 +60,12 @@ fn one_step(c: &mut Criterion) {
     let sc = data::load_scene("spin-up").unwrap();
     let mut g = c.benchmark_group("step");
     for n in MESHES {
-        let mut p = prepare(&sc, &settings(n, 1e-2).fem().expect("fem settings")).unwrap();
+        let mut p = prepare(
+            &sc,
+            sc.planar_chain().expect("planar chain"),
+            &settings(n, 1e-2).fem().expect("fem settings"),
+        )
+        .unwrap();
         p.driver.set_stop(1e9);
         g.bench_with_input(BenchmarkId::new("generalized-alpha", n), &n, |b, _| {
             b.iter(|| black_box(p.driver.step().unwrap()))

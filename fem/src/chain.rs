@@ -41,18 +41,18 @@
 //! s(L) moves its descendants' points like an axial tip DOF. Checked against finite
 //! differences of the residual (`sys_foreshortening_tangent`).
 
-use data::scene::{Gravity, Link, PrescribedMotion, TorqueLaw};
-use data::{FemElement, FemSettings, Scene};
+use data::scene::{Gravity, Link, PlanarChain, PrescribedMotion, TorqueLaw};
+use data::{FemElement, FemSettings};
 
 use crate::band::BorderedBand;
 use crate::element::tables::dotn;
 use crate::element::{self, ElementDofs, InteriorField, MeshElement};
 use crate::error::FemError;
-use geometry::V2;
 
 pub use crate::element::{MAXE, NONE};
 pub use augmented::AugmentedLayout;
 pub use forces::Parts;
+pub use geometry::V2;
 pub use newton::NewtonCoefficients;
 
 mod augmented;
@@ -219,15 +219,20 @@ impl Chain {
         Self::with_element(links, gravity, n_el, None)
     }
 
-    /// The chain of a planar-chain scene at its discretization (elements per link and element
-    /// kind): the scene is checked against what the backend builds ([`check_planar`]) first.
-    /// The scene's static loads are left at zero (dynamics applies them as a step load).
+    /// The chain of the planar chain `pc` of scene `name` at its discretization (elements per
+    /// link and element kind): the chain is checked against what the backend builds
+    /// ([`check_planar`]) first. Its static loads are left at zero (dynamics applies them as a
+    /// step load).
     ///
     /// [`check_planar`]: crate::support::check_planar
-    pub fn from_scene(scene: &Scene, settings: &FemSettings) -> Result<Self, FemError> {
-        crate::support::check_planar(scene)?;
+    pub fn from_planar_chain(
+        name: &str,
+        pc: &PlanarChain,
+        settings: &FemSettings,
+    ) -> Result<Self, FemError> {
+        crate::support::check_planar(name, pc)?;
         let n_el = crate::settings::elements(settings)?;
-        Self::with_element(scene.links(), scene.gravity(), n_el, settings.element)
+        Self::with_element(&pc.links, pc.gravity.as_ref(), n_el, settings.element)
     }
 
     /// Builds the chain for `links` with `n_el` elements per link of the element `choice`

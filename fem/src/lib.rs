@@ -189,6 +189,7 @@ pub mod support;
 
 use std::time::Instant;
 
+use data::scene::{Link, Model, PlanarChain};
 use data::{
     Backend, BackendError, BackendKind, Cost, Discretization, DofPlan, FemSettings, ModalResult,
     ModeShape, RunResult, Scene, Settings, StaticResult,
@@ -200,30 +201,30 @@ pub use error::FemError;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct FemBackend;
 
-/// The single clamped/spinning link that modes and statics linearize.
-fn single_link(scene: &Scene, what: &str) -> Result<(), FemError> {
-    support::check_planar(scene)?;
-    if scene.links().len() != 1 {
-        return Err(FemError::unsupported(format!(
+/// The single clamped/spinning link of `pc` (scene `name`) that modes and statics linearize.
+fn single_link<'a>(name: &str, pc: &'a PlanarChain, what: &str) -> Result<&'a Link, FemError> {
+    support::check_planar(name, pc)?;
+    match pc.links.as_slice() {
+        [link] => Ok(link),
+        links => Err(FemError::unsupported(format!(
             "fem {what}: chains of {} links (linearization of a free chain about its initial \
              configuration is not implemented)",
-            scene.links().len()
-        )));
+            links.len()
+        ))),
     }
-    Ok(())
 }
 
 impl FemBackend {
     fn modes_impl(
         &self,
         scene: &Scene,
+        pc: &PlanarChain,
         settings: &FemSettings,
         count: usize,
     ) -> Result<ModalResult, FemError> {
         let start = Instant::now();
-        single_link(scene, "modes")?;
+        let link = single_link(&scene.name, pc, "modes")?;
         let n_el = settings::elements(settings)?;
-        let link = &scene.links()[0];
         let omega = linear::hub_rate(link)?;
         let element = element::for_link(link, settings.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
@@ -251,16 +252,16 @@ impl FemBackend {
     fn statics_impl(
         &self,
         scene: &Scene,
+        pc: &PlanarChain,
         settings: &FemSettings,
     ) -> Result<StaticResult, FemError> {
         let start = Instant::now();
-        single_link(scene, "statics")?;
+        let link = single_link(&scene.name, pc, "statics")?;
         let n_el = settings::elements(settings)?;
-        let link = &scene.links()[0];
         let omega = linear::hub_rate(link)?;
         let element = element::for_link(link, settings.element)?;
         let sys = linear::LinearLink::assemble(link, n_el, omega, element)?;
-        let (tip_deflection, tip_rotation) = statics::solve(scene, &sys)?;
+        let (tip_deflection, tip_rotation) = statics::solve(pc, &sys)?;
         Ok(StaticResult {
             backend: BackendKind::Fem,
             scene: scene.name.clone(),
@@ -277,6 +278,7 @@ impl FemBackend {
     }
 }
 
+// Each entry dispatches on the scene's model family once and hands the family on.
 impl Backend for FemBackend {
     fn kind(&self) -> BackendKind {
         BackendKind::Fem
@@ -284,17 +286,18 @@ impl Backend for FemBackend {
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
         let settings = &disc.fem()?;
-        if mobile::scene_model(scene).is_some() {
-            return Ok(mobile::dof_plan(scene, settings)?);
+        match &scene.model {
+            Model::PlanarChain(pc) => {
+                let n_el = settings::elements(settings)?;
+                Ok(plan::dof_plan(&scene.name, pc, n_el, settings.element)?)
+            }
+            Model::PayloadLink(_) => {
+                let n_el = settings::elements(settings)?;
+                Ok(payload_link::dof_plan(scene, n_el)?)
+            }
+            Model::Rocket(_) => Ok(rocket::dof_plan(scene, settings)?),
+            Model::MobileManipulator(_) => Ok(mobile::dof_plan(scene, settings)?),
         }
-        let n_el = settings::elements(settings)?;
-        if payload_link::link(scene).is_some() {
-            return Ok(payload_link::dof_plan(scene, n_el)?);
-        }
-        if rocket::the_rocket(scene).is_some() {
-            return Ok(rocket::dof_plan(scene, settings)?);
-        }
-        Ok(plan::dof_plan(scene, n_el, settings.element)?)
     }
 
     fn modes(
@@ -304,37 +307,35 @@ impl Backend for FemBackend {
         count: usize,
     ) -> Result<ModalResult, BackendError> {
         let settings = &settings.fem()?;
-        if payload_link::link(scene).is_some() {
-            return Ok(payload_link::modes(scene, settings, count)?);
+        match &scene.model {
+            Model::PlanarChain(pc) if chain::linearized::applies(pc) => {
+                Ok(chain::linearized::modes(scene, pc, settings, count)?)
+            }
+            Model::PlanarChain(pc) => Ok(self.modes_impl(scene, pc, settings, count)?),
+            Model::PayloadLink(_) => Ok(payload_link::modes(scene, settings, count)?),
+            Model::Rocket(_) => Ok(rocket::modes(scene, settings, count)?),
+            Model::MobileManipulator(_) => Err(support::unsupported_family(scene).into()),
         }
-        if rocket::the_rocket(scene).is_some() {
-            return Ok(rocket::modes(scene, settings, count)?);
-        }
-        if chain::linearized::applies(scene) {
-            return Ok(chain::linearized::modes(scene, settings, count)?);
-        }
-        Ok(self.modes_impl(scene, settings, count)?)
     }
 
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
         let settings = &settings.fem()?;
-        if payload_link::link(scene).is_some() {
-            return Ok(payload_link::statics(scene, settings)?);
+        match &scene.model {
+            Model::PlanarChain(pc) => Ok(self.statics_impl(scene, pc, settings)?),
+            Model::PayloadLink(_) => Ok(payload_link::statics(scene, settings)?),
+            Model::Rocket(_) | Model::MobileManipulator(_) => {
+                Err(support::unsupported_family(scene).into())
+            }
         }
-        Ok(self.statics_impl(scene, settings)?)
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
         let settings = &settings.fem()?;
-        if mobile::scene_model(scene).is_some() {
-            return Ok(mobile::simulate(scene, settings)?);
+        match &scene.model {
+            Model::PlanarChain(pc) => Ok(run::simulate(scene, pc, settings)?),
+            Model::PayloadLink(_) => Ok(payload_link::simulate(scene, settings)?),
+            Model::Rocket(_) => Ok(rocket::simulate(scene, settings)?),
+            Model::MobileManipulator(_) => Ok(mobile::simulate(scene, settings)?),
         }
-        if payload_link::link(scene).is_some() {
-            return Ok(payload_link::simulate(scene, settings)?);
-        }
-        if rocket::the_rocket(scene).is_some() {
-            return Ok(rocket::simulate(scene, settings)?);
-        }
-        Ok(run::simulate(scene, settings)?)
     }
 }

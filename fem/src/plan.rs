@@ -1,21 +1,24 @@
 //! DOF plan: what the backend builds for a scene (reported by `describe`, asserted in tests).
 
-use data::{DofPlan, FemElement, Scene};
+use data::scene::PlanarChain;
+use data::{DofPlan, FemElement};
 
 use crate::element;
 use crate::error::FemError;
 use crate::support::check_planar;
 
-/// DOFs per field and the physics built, for `n_el` elements per link of the chosen element
-/// (interior DOFs of the quintic and Timoshenko elements are counted: they are global DOFs).
+/// DOFs per field and the physics built for the planar chain `pc` of scene `name`, for `n_el`
+/// elements per link of the chosen element (interior DOFs of the quintic and Timoshenko
+/// elements are counted: they are global DOFs).
 pub fn dof_plan(
-    scene: &Scene,
+    name: &str,
+    pc: &PlanarChain,
     n_el: usize,
     element: Option<FemElement>,
 ) -> Result<DofPlan, FemError> {
-    check_planar(scene)?;
+    check_planar(name, pc)?;
     let mut plan = DofPlan::default();
-    for (i, l) in scene.links().iter().enumerate() {
+    for (i, l) in pc.links.iter().enumerate() {
         let li = i + 1;
         if l.joint.prescribed.is_none() {
             plan.add(format!("joint{li} angle"), 1);
@@ -73,10 +76,10 @@ pub fn dof_plan(
         }
         plan.builds.extend(b);
     }
-    if scene.gravity().is_some() {
+    if pc.gravity.is_some() {
         plan.builds.push("gravity".into());
     }
     plan.builds
-        .extend(crate::events::contact::friction::describe(scene));
+        .extend(crate::events::contact::friction::describe(&pc.contacts));
     Ok(plan)
 }

@@ -3,12 +3,13 @@
 
 use std::time::Instant;
 
+use data::scene::{Contact as SceneContact, ContactMode, Link, PlanarChain};
 use data::{
     Cost, Diagnostic, EnergyLedger, Event, FemSettings, Observables, RunResult, Scene,
     StabilityVerdict, channel, ledger_term,
 };
 
-use crate::chain::{Chain, NONE};
+use crate::chain::{Chain, NONE, V2};
 use crate::driver::{Driver, Rejection, StopReason};
 use crate::error::FemError;
 use crate::events::contact::Contact;
@@ -53,12 +54,12 @@ pub const STEPS_PER_AXIAL_PERIOD: f64 = 16.0;
 /// alone leaves unresolved. Measured on `constrained-arm` (ω_ax = 3142 rad/s, bending rule 1 ms):
 /// θ(2 s) = 7.57e-3, 8.91e-3, 9.35e-3, 9.39e-3 rad at 2, 4, 8, 16 steps per axial period
 /// (1e-3 … 1.25e-4 s): 16 steps leave ~0.1 % (second order) against 19 % at the bending rule.
-pub fn axial_wall_step(scene: &Scene) -> Option<f64> {
-    let c = scene
-        .contacts()
+pub fn axial_wall_step(pc: &PlanarChain) -> Option<f64> {
+    let c = pc
+        .contacts
         .iter()
-        .find(|c| c.mode == data::scene::ContactMode::Bilateral)?;
-    let link = scene.links().iter().find(|l| l.name == c.link && l.axial)?;
+        .find(|c| c.mode == ContactMode::Bilateral)?;
+    let link = pc.links.iter().find(|l| l.name == c.link && l.axial)?;
     let ea = link.axial_stiffness?;
     let omega_ax = std::f64::consts::PI * (ea / link.mass_per_length).sqrt() / link.length;
     Some(2.0 * std::f64::consts::PI / (STEPS_PER_AXIAL_PERIOD * omega_ax))
@@ -96,8 +97,8 @@ fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
 /// Generalized-α spectral radius: 1 (trapezoidal, exactly energy-conserving for linear systems,
 /// what the ledger checks need) unless a link is extensible, where ρ∞ = 0.9 damps the spurious
 /// high axial frequencies (EA/EI ≫ 1) that the time step cannot resolve.
-pub fn default_rho_inf(scene: &Scene) -> f64 {
-    if scene.links().iter().any(|l| l.axial) {
+pub fn default_rho_inf(links: &[Link]) -> f64 {
+    if links.iter().any(|l| l.axial) {
         0.9
     } else {
         1.0
@@ -112,20 +113,14 @@ pub fn default_rho_inf(scene: &Scene) -> f64 {
 /// hubs: see `undamped_massless_hub`). A bilateral contact (seed 001's wall, always
 /// constrained) takes `energy-midpoint` even with extensible links: contact is implemented on
 /// the midpoint schemes only, and energy-midpoint's ledger closure is the friction-work check.
-pub fn default_method(scene: &Scene) -> Method {
-    if check_midpoint(scene).is_ok()
-        && scene
-            .contacts()
-            .iter()
-            .any(|c| c.mode == data::scene::ContactMode::Bilateral)
+pub fn default_method(pc: &PlanarChain) -> Method {
+    if check_midpoint(&pc.links).is_ok()
+        && pc.contacts.iter().any(|c| c.mode == ContactMode::Bilateral)
     {
         return Method::EnergyMidpoint;
     }
-    if check_midpoint(scene).is_ok()
-        && !scene
-            .links()
-            .iter()
-            .any(|l| l.axial || undamped_massless_hub(l))
+    if check_midpoint(&pc.links).is_ok()
+        && !pc.links.iter().any(|l| l.axial || undamped_massless_hub(l))
     {
         Method::EnergyMidpoint
     } else {
@@ -136,21 +131,19 @@ pub fn default_method(scene: &Scene) -> Method {
 /// For a chain of linear beams whose joints are all free and in which nothing dissipates (no
 /// joint damper, no Kelvin–Voigt, no contact), the first pinned-free frequency of its most flexible link: the
 /// slowest flexible mode, whose phase error [`UNDAMPED_STEPS_PER_PERIOD`] bounds.
-fn undissipated_free_chain_frequency(scene: &Scene) -> Option<f64> {
-    let dissipates = |l: &data::scene::Link| {
-        l.kelvin_voigt.unwrap_or(0.0) > 0.0 || l.joint.damping.unwrap_or(0.0) > 0.0
-    };
-    if !scene.contacts().is_empty()
-        || scene
-            .links()
+fn undissipated_free_chain_frequency(pc: &PlanarChain) -> Option<f64> {
+    let dissipates =
+        |l: &Link| l.kelvin_voigt.unwrap_or(0.0) > 0.0 || l.joint.damping.unwrap_or(0.0) > 0.0;
+    if !pc.contacts.is_empty()
+        || pc
+            .links
             .iter()
             .any(|l| l.joint.prescribed.is_some() || dissipates(l) || l.foreshortening || l.axial)
     {
         return None;
     }
     let beta1 = pinned_free_beta1();
-    scene
-        .links()
+    pc.links
         .iter()
         .map(|l| {
             beta1 * beta1 * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt()
@@ -164,7 +157,7 @@ fn undissipated_free_chain_frequency(scene: &Scene) -> Option<f64> {
 /// The energy-midpoint Newton iteration stalls on it (measured: Timoshenko
 /// `two-link-free-undamped`, κGA = 100 EI/L², stopped at t = 0.32 s at the default step), while
 /// generalized-α runs it (closure 5e-6): such scenes default to generalized-α.
-fn undamped_massless_hub(l: &data::scene::Link) -> bool {
+fn undamped_massless_hub(l: &Link) -> bool {
     l.shear
         && !l.rotary_inertia
         && l.joint.prescribed.is_none()
@@ -175,12 +168,8 @@ fn undamped_massless_hub(l: &data::scene::Link) -> bool {
 
 /// The energy-midpoint scheme needs every joint free: a prescribed joint would need the work
 /// of its actuator booked with the scheme's quadrature, which is not implemented.
-fn check_midpoint(scene: &Scene) -> Result<(), FemError> {
-    if let Some(i) = scene
-        .links()
-        .iter()
-        .position(|l| l.joint.prescribed.is_some())
-    {
+fn check_midpoint(links: &[Link]) -> Result<(), FemError> {
+    if let Some(i) = links.iter().position(|l| l.joint.prescribed.is_some()) {
         return Err(FemError::unsupported(format!(
             "fem energy-midpoint: prescribed joint motion (link {}); use generalized-alpha",
             i + 1
@@ -198,12 +187,17 @@ pub struct Prepared {
     pub h_nominal: f64,
 }
 
-/// Builds the chain and the stepper for a scene and settings (step chosen per the documented rule).
-pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemError> {
-    let mut chain = Chain::from_scene(scene, settings)?;
-    let method = settings.method.unwrap_or_else(|| default_method(scene));
+/// Builds the chain and the stepper for the planar chain `pc` of `scene` and the settings
+/// (step chosen per the documented rule).
+pub fn prepare(
+    scene: &Scene,
+    pc: &PlanarChain,
+    settings: &FemSettings,
+) -> Result<Prepared, FemError> {
+    let mut chain = Chain::from_planar_chain(&scene.name, pc, settings)?;
+    let method = settings.method.unwrap_or_else(|| default_method(pc));
     if method == Method::EnergyMidpoint {
-        check_midpoint(scene)?;
+        check_midpoint(&pc.links)?;
     }
     let dt_user = settings::positive("time.dt", settings.dt)?;
     let rtol = settings::positive("time.rtol", settings.rtol)?;
@@ -217,10 +211,7 @@ pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemErr
         });
     }
     if method == Method::CentralDifference
-        && let Some(i) = scene
-            .links()
-            .iter()
-            .position(|l| l.shear && !l.rotary_inertia)
+        && let Some(i) = pc.links.iter().position(|l| l.shear && !l.rotary_inertia)
     {
         return Err(FemError::unsupported(format!(
             "fem central-difference: link {} is a Timoshenko link without `rotary_inertia`: \
@@ -237,7 +228,7 @@ pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemErr
                 .into(),
         });
     }
-    if let Some(st) = scene.statics() {
+    if let Some(st) = &pc.statics {
         // The scene's static loads act as a step load in dynamics (scene `cantilever`: the
         // response oscillates about the static deflection).
         chain.tip_load = st.tip_force.unwrap_or(0.0);
@@ -245,8 +236,8 @@ pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemErr
     }
     let out = scene.simulation.output_interval;
     let (beta_clamped, beta_pinned) = (clamped_free_beta1(), pinned_free_beta1());
-    let omega1 = scene
-        .links()
+    let omega1 = pc
+        .links
         .iter()
         .map(|l| {
             let beta1 = if l.joint.prescribed.is_some() {
@@ -258,12 +249,12 @@ pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemErr
         })
         .fold(0.0f64, f64::max);
     let mut h_rule = (2.0 * std::f64::consts::PI / (STEPS_PER_PERIOD * omega1))
-        .min(axial_wall_step(scene).unwrap_or(f64::INFINITY));
-    if let Some(omega_flexible) = undissipated_free_chain_frequency(scene) {
+        .min(axial_wall_step(pc).unwrap_or(f64::INFINITY));
+    if let Some(omega_flexible) = undissipated_free_chain_frequency(pc) {
         h_rule =
             h_rule.min(2.0 * std::f64::consts::PI / (UNDAMPED_STEPS_PER_PERIOD * omega_flexible));
     }
-    let contact = Contact::from_scene(scene, &chain)?;
+    let contact = Contact::from_planar_chain(&scene.name, pc, &chain)?;
     if contact.is_some() {
         if !matches!(method, Method::EnergyMidpoint | Method::ImplicitMidpoint) {
             return Err(FemError::unsupported(format!(
@@ -273,10 +264,7 @@ pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemErr
             )));
         }
         if method == Method::ImplicitMidpoint
-            && let Some(i) = scene
-                .links()
-                .iter()
-                .position(|l| l.shear && !l.rotary_inertia)
+            && let Some(i) = pc.links.iter().position(|l| l.shear && !l.rotary_inertia)
         {
             // Measured on `barhorst-case1-timoshenko` (0.5 s): with the massless rotations
             // projected as for energy-midpoint (the removed strain energy booked), the
@@ -299,7 +287,7 @@ pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemErr
             ));
         }
     }
-    let mut integ = Driver::new(chain, method, h_rule.min(out), default_rho_inf(scene))?;
+    let mut integ = Driver::new(chain, method, h_rule.min(out), default_rho_inf(&pc.links))?;
     if let Some(mut c) = contact {
         c.phase.gap = c.gap_at(&integ.chain, integ.state.t, &integ.state.q);
         if c.phase.gap < -c.phase.gap_tol && c.bilateral.is_none() {
@@ -365,8 +353,12 @@ fn fit(h: f64, out: f64) -> f64 {
     }
 }
 
-/// Channel layout of the observables.
-fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, &'static str)> {
+/// Channel layout of the observables of `chain` with the scene's `contacts`.
+fn channel_specs(
+    contacts: &[SceneContact],
+    chain: &Chain,
+    stations: usize,
+) -> Vec<(String, &'static str)> {
     let mut specs = Vec::new();
     for (i, l) in chain.links.iter().enumerate() {
         let k = i + 1;
@@ -383,7 +375,7 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
             specs.push(channel::spec::field_deflection(k, s));
         }
     }
-    if !scene.contacts().is_empty() {
+    if let Some(contact) = contacts.first() {
         specs.push(channel::spec::contact_normal_force(1));
         specs.push(channel::spec::contact_phase(1));
         // Gap (constraint violation when constrained), normal tip velocity
@@ -392,7 +384,7 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
         specs.push(channel::spec::contact_normal_velocity(1));
         specs.push(channel::spec::contact_max_gap(1));
         specs.push(channel::spec::contact_max_normal_velocity(1));
-        if scene.contacts()[0].friction > 0.0 {
+        if contact.friction > 0.0 {
             // Friction contact (crate::events::contact::friction): slip velocity, tangential force, work.
             specs.push(channel::spec::contact_slip_velocity(1));
             specs.push(channel::spec::contact_friction_force(1));
@@ -403,7 +395,7 @@ fn channel_specs(scene: &Scene, chain: &Chain, stations: usize) -> Vec<(String, 
 }
 
 /// Samples the observables at the driver's current state into `buf`.
-fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<f64>) {
+fn sample(integ: &Driver, stations: usize, tips: &mut [V2], buf: &mut Vec<f64>) {
     buf.clear();
     let ch = &integ.chain;
     ch.tip_positions(integ.state.t, &integ.state.q, tips);
@@ -412,8 +404,8 @@ fn sample(integ: &Driver, stations: usize, tips: &mut [[f64; 2]], buf: &mut Vec<
         buf.push(th);
         buf.push(rate);
         buf.push(ch.joint_torque[i]);
-        buf.push(tips[i][0]);
-        buf.push(tips[i][1]);
+        buf.push(tips[i].x);
+        buf.push(tips[i].y);
         buf.push(ch.tip_deflection(i, &integ.state.q));
         if l.axial {
             buf.push(ch.tip_axial(i, &integ.state.q));
@@ -533,8 +525,13 @@ fn push_ledger(integ: &Driver, ledger: &mut EnergyLedger) {
     ledger.push(integ.state.t, &stored[..ns], &inputs[..ni], &diss[..nd]);
 }
 
-/// Runs a scene to t_end; early stops become a `Stopped` verdict with the output so far.
-pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemError> {
+/// Runs the planar chain `pc` of `scene` to t_end; early stops become a `Stopped` verdict with
+/// the output so far.
+pub fn simulate(
+    scene: &Scene,
+    pc: &PlanarChain,
+    settings: &FemSettings,
+) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
         driver: mut integ,
@@ -542,13 +539,13 @@ pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemE
         output_interval,
         stations,
         h_nominal,
-    } = prepare(scene, settings)?;
-    let specs = channel_specs(scene, &integ.chain, stations);
+    } = prepare(scene, pc, settings)?;
+    let specs = channel_specs(&pc.contacts, &integ.chain, stations);
     let mut obs = Observables::with_channels(&specs);
     let (s, i, d) = ledger_terms(&integ);
     let mut ledger = EnergyLedger::new(&s, &i, &d);
     let mut events = Vec::new();
-    let mut tips = vec![[0.0; 2]; integ.chain.links.len()];
+    let mut tips = vec![V2::zeros(); integ.chain.links.len()];
     let n_out = (t_end / output_interval - 1e-9).ceil().max(1.0) as usize;
     let mut buf = Vec::with_capacity(specs.len());
     sample(&integ, stations, &mut tips, &mut buf);
@@ -684,14 +681,16 @@ mod default_step_tests {
     fn sys_default_step_resolves_the_axial_mode_under_a_bilateral_wall() {
         // constrained-arm: EA = 1e6, ρA = 1, L = 1 → ω_ax = π·1000 rad/s, 16 steps a period.
         let scene = data::load_scene("constrained-arm").expect("catalog scene");
-        let h = axial_wall_step(&scene).expect("bilateral wall on an axial link");
+        let pc = scene.planar_chain().expect("planar chain");
+        let h = axial_wall_step(pc).expect("bilateral wall on an axial link");
         assert!((h - 1.0 / 8000.0).abs() < 1e-15, "{h}");
-        let p = prepare(&scene, &FemSettings::default()).expect("prepare");
+        let p = prepare(&scene, pc, &FemSettings::default()).expect("prepare");
         assert_eq!(p.h_nominal, 1.0 / 8000.0);
         // No bilateral wall (unilateral Barhorst surface, free chains): the bending rule only.
         for name in ["barhorst-case1", "single-link", "cantilever-axial"] {
             let scene = data::load_scene(name).expect("catalog scene");
-            assert!(axial_wall_step(&scene).is_none(), "{name}");
+            let pc = scene.planar_chain().expect("planar chain");
+            assert!(axial_wall_step(pc).is_none(), "{name}");
         }
     }
 }

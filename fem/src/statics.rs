@@ -2,20 +2,20 @@
 //! load q (consistent loads ∫q Nᵥ on every DOF of the element, interior ones included) and, when
 //! the scene has gravity, the sag load ρA g⊥.
 
-use data::Scene;
+use data::scene::PlanarChain;
 use faer::prelude::*;
 use faer::{Mat, Side};
 
 use crate::error::FemError;
 use crate::linear::LinearLink;
 
-/// (tip deflection, tip rotation) of the last link under the scene's static loads.
-pub fn solve(scene: &Scene, sys: &LinearLink) -> Result<(f64, f64), FemError> {
-    let link = scene
-        .links()
+/// (tip deflection, tip rotation) of the last link of `pc` under its static loads.
+pub fn solve(pc: &PlanarChain, sys: &LinearLink) -> Result<(f64, f64), FemError> {
+    let link = pc
+        .links
         .last()
         .ok_or_else(|| FemError::unsupported("no links"))?;
-    let statics = scene.statics().cloned().unwrap_or_default();
+    let statics = pc.statics.clone().unwrap_or_default();
     let n = sys.ndof();
     let mut f = Mat::<f64>::zeros(n, 1);
     let tip = sys.n_el;
@@ -23,7 +23,7 @@ pub fn solve(scene: &Scene, sys: &LinearLink) -> Result<(f64, f64), FemError> {
         f[(vt, 0)] += p;
     }
     let mut q = statics.distributed_load.unwrap_or(0.0);
-    if let Some(g) = scene.gravity() {
+    if let Some(g) = &pc.gravity {
         // Frame y axis at the initial joint angle.
         let a = link.joint.initial_angle;
         q += link.mass_per_length * (-a.sin() * g.vector[0] + a.cos() * g.vector[1]);

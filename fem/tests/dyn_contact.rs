@@ -5,7 +5,7 @@
 
 use data::{Backend, Event, RunResult, Scene, Settings, StabilityVerdict};
 use fem::FemBackend;
-use fem::chain::Chain;
+use fem::chain::{Chain, V2};
 
 mod common;
 
@@ -52,7 +52,7 @@ fn check_tip_jacobian(sc: &Scene) {
     let q = bent_state(&chain);
     let mut jac = vec![0.0; 2 * n];
     let r = chain.tip_jacobian(0.0, 1, &q, &mut jac);
-    let mut tips = [[0.0; 2]; 2];
+    let mut tips = [V2::zeros(); 2];
     chain.tip_positions(0.0, &q, &mut tips);
     assert!((r[0] - tips[1][0]).abs() < 1e-15 && (r[1] - tips[1][1]).abs() < 1e-15);
     // Central differences of the tip position (truncation ~ε², round-off ~1e-16/ε).
@@ -63,7 +63,7 @@ fn check_tip_jacobian(sc: &Scene) {
         let (mut qp, mut qm) = (q.clone(), q.clone());
         qp[j] += eps;
         qm[j] -= eps;
-        let (mut tp, mut tm) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
+        let (mut tp, mut tm) = ([V2::zeros(); 2], [V2::zeros(); 2]);
         chain.tip_positions(0.0, &qp, &mut tp);
         chain.tip_positions(0.0, &qm, &mut tm);
         for d in 0..2 {
@@ -90,7 +90,7 @@ fn check_tip_jacobian(sc: &Scene) {
     }
     // The convective term n̂·J̇q̇: d/dt (J q̇) along q(t) = q + t q̇ at fixed q̇ is J̇q̇.
     let dt = 1e-5;
-    let mut jv = [[0.0; 2]; 2];
+    let mut jv = [V2::zeros(); 2];
     for (k, s) in [1.0, -1.0].into_iter().enumerate() {
         let qs: Vec<f64> = (0..n).map(|i| q[i] + s * dt * qd[i]).collect();
         let [_, vs, _] = chain.tip_motion(0.0, 1, &qs, &qd, &zero);
@@ -317,7 +317,7 @@ fn dyn_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     // 141.8697 (0.62 %), |q̇|∞ = 1.5e-3 at 10 s.
     let sc = scene("barhorst-case1-stiff-elbow");
     let st = settings(Some(4), None);
-    let mut p = fem::run::prepare(&sc, &st.fem().unwrap()).unwrap();
+    let mut p = fem::run::prepare(&sc, sc.planar_chain().unwrap(), &st.fem().unwrap()).unwrap();
     let integ = &mut p.driver;
     integ.set_stop(10.0);
     while integ.step().unwrap() != fem::driver::StopReason::ReachedStop {}
@@ -399,9 +399,19 @@ fn sys_contact_refusals_are_precise() {
     }
     // Without contact nothing is allocated and the DOF count is the chain's.
     let free = scene("two-link-free");
-    let p = fem::run::prepare(&free, &settings(Some(4), Some(0.01)).fem().unwrap()).unwrap();
+    let p = fem::run::prepare(
+        &free,
+        free.planar_chain().unwrap(),
+        &settings(Some(4), Some(0.01)).fem().unwrap(),
+    )
+    .unwrap();
     assert!(p.driver.contact.is_none());
-    let pc = fem::run::prepare(&sc, &settings(Some(4), Some(0.01)).fem().unwrap()).unwrap();
+    let pc = fem::run::prepare(
+        &sc,
+        sc.planar_chain().unwrap(),
+        &settings(Some(4), Some(0.01)).fem().unwrap(),
+    )
+    .unwrap();
     assert_eq!(pc.driver.chain.ndof, p.driver.chain.ndof);
 }
 
@@ -442,7 +452,9 @@ fn sys_refined_normal_force_matches_a_fresh_factorization() {
         let n = chain.ndof;
         let q0 = bent_state(&chain);
         let qd: Vec<f64> = (0..n).map(|i| 0.3 * ((i as f64 * 0.9).cos())).collect();
-        let mut held = Contact::from_scene(&sc, &chain).unwrap().unwrap();
+        let mut held = Contact::from_planar_chain(&sc.name, sc.planar_chain().unwrap(), &chain)
+            .unwrap()
+            .unwrap();
         held.state_force(&mut chain, 0.0, &q0, &qd).unwrap();
         // One step's motion (0.5 ms at a few rad/s), then a configuration far away.
         for (k, size) in [(1, 1e-3), (2, 1e-3), (3, 0.2)] {
@@ -452,7 +464,10 @@ fn sys_refined_normal_force_matches_a_fresh_factorization() {
                 .map(|(i, v)| v + size * k as f64 * ((i as f64 * 2.3).sin() + 0.5))
                 .collect();
             let (lam, gmg, _) = held.state_force(&mut chain, 0.0, &q, &qd).unwrap();
-            let mut fresh = Contact::from_scene(&sc, &chain).unwrap().unwrap();
+            let mut fresh =
+                Contact::from_planar_chain(&sc.name, sc.planar_chain().unwrap(), &chain)
+                    .unwrap()
+                    .unwrap();
             let (lam_f, gmg_f, _) = fresh.state_force(&mut chain, 0.0, &q, &qd).unwrap();
             // Force scale: the weight of the two links (ρA = 1.764 slug/ft, 5 ft, g = 32.2).
             let weight = 1.764 * 5.0 * 32.2;

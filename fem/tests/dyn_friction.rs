@@ -105,7 +105,9 @@ fn elem_circle_gap_gradient_matches_finite_differences() {
     // bent, rotated, stretched state of the arm (every DOF non-zero).
     let scene = arm();
     let chain = Chain::new(scene.links(), None, 4).unwrap();
-    let mut c = Contact::from_scene(&scene, &chain).unwrap().unwrap();
+    let mut c = Contact::from_planar_chain(&scene.name, scene.planar_chain().unwrap(), &chain)
+        .unwrap()
+        .unwrap();
     let n = chain.ndof;
     let q: Vec<f64> = (0..n)
         .map(|i| 0.02 * ((i as f64 * 1.3).sin() + 0.2))

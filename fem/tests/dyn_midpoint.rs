@@ -38,7 +38,7 @@ fn dyn_midpoint_is_the_default_for_free_chains_only() {
     for name in ["single-link", "two-link-free", "two-link-free-undamped"] {
         let sc = data::load_scene(name).unwrap();
         assert_eq!(
-            fem::run::default_method(&sc),
+            fem::run::default_method(sc.planar_chain().unwrap()),
             Method::EnergyMidpoint,
             "{name}"
         );
@@ -46,7 +46,7 @@ fn dyn_midpoint_is_the_default_for_free_chains_only() {
     for name in ["spin-up", "spin-up-axial", "cantilever", "rotating-beam"] {
         let sc = data::load_scene(name).unwrap();
         assert_eq!(
-            fem::run::default_method(&sc),
+            fem::run::default_method(sc.planar_chain().unwrap()),
             Method::GeneralizedAlpha,
             "{name}"
         );

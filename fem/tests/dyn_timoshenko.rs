@@ -493,7 +493,7 @@ fn dyn_timoshenko_undamped_massless_hub_defaults_to_generalized_alpha() {
     let mut sc = data::load_scene("two-link-free-undamped").unwrap();
     make_timoshenko(&mut sc, 100.0, 0.0);
     assert_eq!(
-        fem::run::default_method(&sc),
+        fem::run::default_method(sc.planar_chain().unwrap()),
         fem::settings::Method::GeneralizedAlpha
     );
     let r = sim(&sc, &settings(4, None, 0.5, None));
@@ -506,7 +506,7 @@ fn dyn_timoshenko_undamped_massless_hub_defaults_to_generalized_alpha() {
         l.joint.hub_inertia = Some(1e-2);
     }
     assert_eq!(
-        fem::run::default_method(&sc),
+        fem::run::default_method(sc.planar_chain().unwrap()),
         fem::settings::Method::EnergyMidpoint
     );
     let r = sim(&sc, &settings(4, None, 0.5, None));

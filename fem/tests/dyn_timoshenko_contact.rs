@@ -81,7 +81,9 @@ fn elem_massless_directions_carry_no_mass_and_do_not_move_the_tip() {
 fn dyn_consistent_velocity_satisfies_the_massless_balances_and_keeps_energy() {
     let sc = scene();
     let mut chain = Chain::new(sc.links(), sc.gravity(), 4).unwrap();
-    let mut contact = Contact::from_scene(&sc, &chain).unwrap().unwrap();
+    let mut contact = Contact::from_planar_chain(&sc.name, sc.planar_chain().unwrap(), &chain)
+        .unwrap()
+        .unwrap();
     let n = chain.ndof;
     let q = bent(n, 0.02, 0.0);
     let mut qd = bent(n, 1.0, 0.4);
@@ -211,7 +213,9 @@ fn integ_free(n_el: usize, h: f64, unilateral: bool) -> fem::driver::Driver {
         fem::driver::Driver::new(chain, fem::settings::Method::EnergyMidpoint, h, 1.0).unwrap();
     it.h_nominal = h;
     if unilateral {
-        let mut c = Contact::from_scene(&sc, &it.chain).unwrap().unwrap();
+        let mut c = Contact::from_planar_chain(&sc.name, sc.planar_chain().unwrap(), &it.chain)
+            .unwrap()
+            .unwrap();
         c.phase.gap = c.gap_at(&it.chain, it.state.t, &it.state.q);
         it.contact = Some(Box::new(c));
         it.enable_unilateral_contact().unwrap();

@@ -356,7 +356,12 @@ fn sys_analytic_kinetic_gradient_matches_the_finite_difference_identity_at_real_
     };
     for name in ["two-link-free", "barhorst-case1"] {
         let sc = data::load_scene(name).unwrap();
-        let mut p = fem::run::prepare(&sc, &data::FemSettings::default()).unwrap();
+        let mut p = fem::run::prepare(
+            &sc,
+            sc.planar_chain().unwrap(),
+            &data::FemSettings::default(),
+        )
+        .unwrap();
         p.driver.set_stop(0.25);
         while p.driver.state.t < 0.25 - 1e-12 {
             p.driver.step().unwrap();

@@ -188,7 +188,12 @@ fn sys_exact_matrix_is_the_residual_derivative_at_real_states() {
     // (c_a = 1, c_v = h/2, c_q = h²/4).
     for name in ["two-link-free", "barhorst-case1"] {
         let sc = data::load_scene(name).unwrap();
-        let mut p = fem::run::prepare(&sc, &data::FemSettings::default()).unwrap();
+        let mut p = fem::run::prepare(
+            &sc,
+            sc.planar_chain().unwrap(),
+            &data::FemSettings::default(),
+        )
+        .unwrap();
         p.driver.set_stop(0.25);
         while p.driver.state.t < 0.25 - 1e-12 {
             p.driver.step().unwrap();

@@ -148,7 +148,7 @@ impl Chain {
     }
 
     /// Inertial tip position of every link at a state (forward pass with zero rates).
-    pub fn tip_positions(&self, t: f64, q: &[f64], out: &mut [[f64; 2]]) {
+    pub fn tip_positions(&self, t: f64, q: &[f64], out: &mut [V2]) {
         let mut parent: Option<(f64, V2)> = None;
         for (li, l) in self.links.iter().enumerate() {
             let th = match l.joint.prescribed_at(t) {
@@ -169,7 +169,7 @@ impl Chain {
             };
             let p = V2::new(l.length + ax, Self::val(q, l.v_dof[k]));
             let r = r0 + rot(phi, p);
-            out[li] = r.into();
+            out[li] = r;
             parent = Some((phi + Self::val(q, l.r_dof[k]), r));
         }
     }
@@ -219,7 +219,7 @@ impl Chain {
     /// tip rotation of link k about Rₖ₊₁, column ẑ × (r − R) — or moves the tip of link k in
     /// its own frame: v(L) along A(φₖ)ŷ, u(L) along A(φₖ)x̂ and, with foreshortening, every
     /// transverse DOF d along A(φₖ)x̂ with ∂s(L)/∂d = −∫ v′ N′ (the quadrature of s). O(n).
-    pub fn tip_jacobian(&self, t: f64, li: usize, q: &[f64], jac: &mut [f64]) -> [f64; 2] {
+    pub fn tip_jacobian(&self, t: f64, li: usize, q: &[f64], jac: &mut [f64]) -> V2 {
         let n = self.ndof;
         jac[..2 * n].iter_mut().for_each(|x| *x = 0.0);
         let mut origin = [V2::zeros(); MAX_LINKS];
@@ -288,25 +288,18 @@ impl Chain {
                 }
             }
         }
-        r.into()
+        r
     }
 
     /// Tip of link `li`: inertial position, velocity and acceleration at (q, q̇, q̈) from the
     /// forward kinematic pass of the residual (exact for every element the pass handles). With
     /// q̈ = 0 the acceleration is the convective term J̇q̇. Overwrites the point data of the
     /// last residual call (call [`Chain::residual`] again before [`Chain::newton_matrix`]).
-    pub fn tip_motion(
-        &mut self,
-        t: f64,
-        li: usize,
-        q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
-    ) -> [[f64; 2]; 3] {
+    pub fn tip_motion(&mut self, t: f64, li: usize, q: &[f64], qd: &[f64], qdd: &[f64]) -> [V2; 3] {
         self.forward(t, q, qd, qdd, Parts::INERTIA);
         let fr = self.frames[li];
         let r = fr.r + rot(fr.phi, fr.p_tip);
         let v = fr.dr + rot(fr.phi, fr.dphi * perp(fr.p_tip) + fr.dp_tip);
-        [r.into(), v.into(), rot(fr.phi, fr.a_tip).into()]
+        [r, v, rot(fr.phi, fr.a_tip)]
     }
 }

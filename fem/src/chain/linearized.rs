@@ -23,7 +23,7 @@
 //! "axial", every other "bending"; a statically unstable mode (ω² < 0, possible about a
 //! configuration that gravity does not hold) as −√|ω²|.
 
-use data::scene::PrescribedMotion;
+use data::scene::{PlanarChain, PrescribedMotion};
 use data::{FemSettings, ModalResult, ModeShape, Scene};
 use faer::Mat;
 
@@ -195,18 +195,24 @@ impl Chain {
     }
 }
 
-/// Whether a scene is a chain that [`modes`] linearizes: more than one link, or a link on a
+/// Whether a planar chain is one that [`modes`] linearizes: more than one link, or a link on a
 /// free joint (a single link on a fixed or constant-rate hub is the linear link of
 /// [`crate::linear`]).
-pub fn applies(scene: &Scene) -> bool {
-    scene.links().len() > 1 || scene.links().iter().any(|l| l.joint.prescribed.is_none())
+pub fn applies(pc: &PlanarChain) -> bool {
+    pc.links.len() > 1 || pc.links.iter().any(|l| l.joint.prescribed.is_none())
 }
 
-/// `modes` of a chain scene: the lowest `count` linearized frequencies and their shapes.
-pub fn modes(scene: &Scene, settings: &FemSettings, count: usize) -> Result<ModalResult, FemError> {
+/// `modes` of the planar chain `pc` of `scene`: the lowest `count` linearized frequencies and
+/// their shapes.
+pub fn modes(
+    scene: &Scene,
+    pc: &PlanarChain,
+    settings: &FemSettings,
+    count: usize,
+) -> Result<ModalResult, FemError> {
     let start = std::time::Instant::now();
-    let mut chain = Chain::from_scene(scene, settings)?;
-    for (i, l) in scene.links().iter().enumerate() {
+    let mut chain = Chain::from_planar_chain(&scene.name, pc, settings)?;
+    for (i, l) in pc.links.iter().enumerate() {
         match l.joint.prescribed {
             None | Some(PrescribedMotion::Fixed) => {}
             Some(_) => {

@@ -117,7 +117,7 @@ impl Driver {
         b.phase.slip_velocity = fr.vt;
         if b.phase.sticking {
             let (ts, ps) = (b.constraint.stick_tangent, b.constraint.stick_point);
-            let off = ts[0] * (fr.tip[0] - ps[0]) + ts[1] * (fr.tip[1] - ps[1]);
+            let off = ts.dot(&(fr.tip - ps));
             b.record.max_stick_offset = b.record.max_stick_offset.max(off.abs());
             b.record.max_stick_velocity = b.record.max_stick_velocity.max(fr.vt.abs());
             b.phase.e0 = b.constraint.mu * fr.lambda_n.abs() - fr.lambda_t.abs();

@@ -183,10 +183,9 @@
 pub mod friction;
 
 use data::Event;
-use data::Scene;
-use data::scene::Surface;
+use data::scene::{PlanarChain, Surface};
 
-use crate::chain::{Chain, MAX_LINKS, Parts};
+use crate::chain::{Chain, MAX_LINKS, Parts, V2};
 use crate::error::FemError;
 use crate::events::mass_solve::MassSolver;
 use crate::events::massless::Massless;
@@ -251,8 +250,8 @@ pub struct TipConstraint {
     /// Link whose tip touches the line.
     pub link: usize,
     /// Unit normal to the free side and a point of the line.
-    pub normal: [f64; 2],
-    pub point: [f64; 2],
+    pub normal: V2,
+    pub point: V2,
     /// Multiplier of the last constrained step (its mean normal force), the Newton unknown.
     pub step_lambda: f64,
     /// Tip Jacobian J = ∂r_tip/∂q (x rows, then y rows).
@@ -336,27 +335,28 @@ pub(crate) struct ConstrainedSolve {
 }
 
 impl Contact {
-    /// The scene's tip contact on `chain` (None without one; nothing is allocated then).
-    pub fn from_scene(scene: &Scene, chain: &Chain) -> Result<Option<Self>, FemError> {
-        crate::support::check_contact(scene)?;
-        let Some(c) = scene.contacts().first() else {
+    /// The tip contact of the planar chain `pc` (of scene `name`) on its discretization
+    /// `chain` (None without one; nothing is allocated then).
+    pub fn from_planar_chain(
+        name: &str,
+        pc: &PlanarChain,
+        chain: &Chain,
+    ) -> Result<Option<Self>, FemError> {
+        crate::support::check_contact(name, pc)?;
+        let Some(c) = pc.contacts.first() else {
             return Ok(None);
         };
-        let link = scene
-            .links()
-            .iter()
-            .position(|l| l.name == c.link)
-            .unwrap_or(0);
+        let link = pc.links.iter().position(|l| l.name == c.link).unwrap_or(0);
         let bilateral = crate::events::contact::friction::Bilateral::from_scene(c, chain)?;
         let (point, normal) = match c.surface {
-            Surface::Line { point, normal } => (point, normal),
+            Surface::Line { point, normal } => (V2::from(point), V2::from(normal)),
             // The circle's normal depends on the tip position: `bilateral.wall` has it.
-            Surface::Circle { .. } if bilateral.is_some() => ([0.0; 2], [0.0, 1.0]),
+            Surface::Circle { .. } if bilateral.is_some() => (V2::zeros(), V2::new(0.0, 1.0)),
             Surface::Circle { .. } => {
                 return Err(FemError::unsupported("fem: only line contact surfaces"));
             }
         };
-        let len = normal[0].hypot(normal[1]);
+        let len = normal.x.hypot(normal.y);
         if !(len > 0.0 && len.is_finite()) {
             return Err(FemError::InvalidSettings {
                 field: "contact.surface.normal".into(),
@@ -378,7 +378,7 @@ impl Contact {
         Ok(Some(Contact {
             constraint: TipConstraint {
                 link,
-                normal: [normal[0] / len, normal[1] / len],
+                normal: normal / len,
                 point,
                 step_lambda: 0.0,
                 jac: vec![0.0; 2 * n],
@@ -428,17 +428,16 @@ impl Contact {
 
     /// Gap g(q) (tip positions only, no Jacobian).
     pub fn gap_at(&self, chain: &Chain, t: f64, q: &[f64]) -> f64 {
-        let mut tips = [[0.0; 2]; MAX_LINKS];
+        let mut tips = [V2::zeros(); MAX_LINKS];
         chain.tip_positions(t, q, &mut tips[..chain.links.len()]);
         self.gap_of(tips[self.constraint.link])
     }
 
-    fn gap_of(&self, r: [f64; 2]) -> f64 {
+    fn gap_of(&self, r: V2) -> f64 {
         if let Some(b) = self.bilateral.as_deref() {
             return b.constraint.wall.gap(r);
         }
-        self.constraint.normal[0] * (r[0] - self.constraint.point[0])
-            + self.constraint.normal[1] * (r[1] - self.constraint.point[1])
+        self.constraint.normal.dot(&(r - self.constraint.point))
     }
 
     /// Gap and its gradient G = n̂ᵀJ at q, the gradient written to `out`.
@@ -450,8 +449,9 @@ impl Contact {
             Some(b) => b.constraint.wall.frame(r).normal,
             None => self.constraint.normal,
         };
+        let jac = &self.constraint.jac;
         for i in 0..n {
-            out[i] = normal[0] * self.constraint.jac[i] + normal[1] * self.constraint.jac[n + i];
+            out[i] = normal.dot(&V2::new(jac[i], jac[n + i]));
         }
         self.gap_of(r)
     }
@@ -651,7 +651,7 @@ impl Contact {
             let [_, _, a] = chain.tip_motion(t, self.constraint.link, q, qd_c, &self.solve.zero);
             // The normal velocity of the state itself (the drift, before any projection).
             self.phase.normal_velocity = vn;
-            let conv = self.constraint.normal[0] * a[0] + self.constraint.normal[1] * a[1];
+            let conv = self.constraint.normal.dot(&a);
             let sv = &mut self.solve;
             let g_minv_r = if refined {
                 dot(&sv.minv_gt, &sv.tmp)

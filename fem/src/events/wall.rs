@@ -14,23 +14,24 @@
 
 use data::scene::Surface;
 
+use crate::chain::V2;
 use crate::error::FemError;
 
 /// A fixed rigid wall.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Wall {
     /// Unit normal to the free side and a point of the line.
-    Line { normal: [f64; 2], point: [f64; 2] },
+    Line { normal: V2, point: V2 },
     /// Centre and radius; the free side is inside.
-    Circle { center: [f64; 2], radius: f64 },
+    Circle { center: V2, radius: f64 },
 }
 
 /// The wall seen from a tip position: gap, unit normal (to the free side), tangent, curvature.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct WallFrame {
     pub gap: f64,
-    pub normal: [f64; 2],
-    pub tangent: [f64; 2],
+    pub normal: V2,
+    pub tangent: V2,
     pub curvature: f64,
 }
 
@@ -47,8 +48,8 @@ impl Wall {
                     });
                 }
                 Ok(Wall::Line {
-                    normal: [normal[0] / len, normal[1] / len],
-                    point,
+                    normal: V2::from(normal) / len,
+                    point: V2::from(point),
                 })
             }
             Surface::Circle { center, radius } => {
@@ -58,41 +59,46 @@ impl Wall {
                         message: format!("the radius must be positive and finite, got {radius}"),
                     });
                 }
-                Ok(Wall::Circle { center, radius })
+                Ok(Wall::Circle {
+                    center: V2::from(center),
+                    radius,
+                })
             }
         }
     }
 
     /// Gap only.
-    pub fn gap(&self, r: [f64; 2]) -> f64 {
+    pub fn gap(&self, r: V2) -> f64 {
         match *self {
-            Wall::Line { normal, point } => {
-                normal[0] * (r[0] - point[0]) + normal[1] * (r[1] - point[1])
+            // n̂ₓdₓ + n̂ᵧdᵧ in this order: nalgebra's 2-vector dot.
+            Wall::Line { normal, point } => normal.dot(&(r - point)),
+            Wall::Circle { center, radius } => {
+                let d = r - center;
+                radius - d.x.hypot(d.y)
             }
-            Wall::Circle { center, radius } => radius - (r[0] - center[0]).hypot(r[1] - center[1]),
         }
     }
 
     /// Gap, normal, tangent and curvature at the tip position r.
-    pub fn frame(&self, r: [f64; 2]) -> WallFrame {
+    pub fn frame(&self, r: V2) -> WallFrame {
         let (gap, normal, curvature) = match *self {
             Wall::Line { normal, .. } => (self.gap(r), normal, 0.0),
             Wall::Circle { center, radius } => {
-                let d = [r[0] - center[0], r[1] - center[1]];
-                let rho = d[0].hypot(d[1]);
+                let d = r - center;
+                let rho = d.x.hypot(d.y);
                 if rho > 0.0 {
-                    (radius - rho, [-d[0] / rho, -d[1] / rho], 1.0 / rho)
+                    (radius - rho, -d / rho, 1.0 / rho)
                 } else {
                     // The tip at the centre has no normal; it is then a radius away from the
                     // wall, where no constraint or event is evaluated: keep the numbers finite.
-                    (radius, [-1.0, 0.0], 0.0)
+                    (radius, V2::new(-1.0, 0.0), 0.0)
                 }
             }
         };
         WallFrame {
             gap,
             normal,
-            tangent: [normal[1], -normal[0]],
+            tangent: V2::new(normal.y, -normal.x),
             curvature,
         }
     }
@@ -103,17 +109,17 @@ impl Wall {
 pub fn rows(f: &WallFrame, jac: &[f64], g: &mut [f64], t: &mut [f64]) {
     let n = g.len();
     for i in 0..n {
-        let (jx, jy) = (jac[i], jac[n + i]);
-        g[i] = f.normal[0] * jx + f.normal[1] * jy;
-        t[i] = f.tangent[0] * jx + f.tangent[1] * jy;
+        let j = V2::new(jac[i], jac[n + i]);
+        g[i] = f.normal.dot(&j);
+        t[i] = f.tangent.dot(&j);
     }
 }
 
 /// The row a^ᵀJ of a fixed direction a (the tangential stick constraint t̂_sᵀJ).
-pub fn row_along(a: [f64; 2], jac: &[f64], out: &mut [f64]) {
+pub fn row_along(a: V2, jac: &[f64], out: &mut [f64]) {
     let n = out.len();
     for i in 0..n {
-        out[i] = a[0] * jac[i] + a[1] * jac[n + i];
+        out[i] = a.dot(&V2::new(jac[i], jac[n + i]));
     }
 }
 
@@ -124,14 +130,14 @@ mod tests {
     #[test]
     fn elem_circle_gradient_matches_finite_differences() {
         let w = Wall::Circle {
-            center: [0.3, -0.2],
+            center: V2::new(0.3, -0.2),
             radius: 1.1,
         };
-        let r = [0.9, 0.7];
+        let r = V2::new(0.9, 0.7);
         let f = w.frame(r);
         let e = 1e-6;
-        let dgx = (w.gap([r[0] + e, r[1]]) - w.gap([r[0] - e, r[1]])) / (2.0 * e);
-        let dgy = (w.gap([r[0], r[1] + e]) - w.gap([r[0], r[1] - e])) / (2.0 * e);
+        let dgx = (w.gap(V2::new(r[0] + e, r[1])) - w.gap(V2::new(r[0] - e, r[1]))) / (2.0 * e);
+        let dgy = (w.gap(V2::new(r[0], r[1] + e)) - w.gap(V2::new(r[0], r[1] - e))) / (2.0 * e);
         assert!((dgx - f.normal[0]).abs() < 1e-9 && (dgy - f.normal[1]).abs() < 1e-9);
         assert!((f.normal[0].hypot(f.normal[1]) - 1.0).abs() < 1e-15);
         // Counter-clockwise tangent about the centre: z·(ê × t̂) = +1.
@@ -144,19 +150,19 @@ mod tests {
     fn elem_circle_convective_term_is_minus_curvature_times_vt_squared() {
         // g(r(t)) along r(t) = r0 + v t + ½ a t²: g̈(0) = n̂·a − κ v_t² (module docs).
         let w = Wall::Circle {
-            center: [0.0, 0.0],
+            center: V2::zeros(),
             radius: 1.0,
         };
         let (r0, v, a) = ([0.6, 0.75], [-0.4, 1.3], [0.7, -0.2]);
         let at = |t: f64| {
-            [
+            V2::new(
                 r0[0] + v[0] * t + 0.5 * a[0] * t * t,
                 r0[1] + v[1] * t + 0.5 * a[1] * t * t,
-            ]
+            )
         };
         let e = 1e-4;
         let gdd = (w.gap(at(e)) - 2.0 * w.gap(at(0.0)) + w.gap(at(-e))) / (e * e);
-        let f = w.frame(r0);
+        let f = w.frame(V2::from(r0));
         let vt = f.tangent[0] * v[0] + f.tangent[1] * v[1];
         let expect = f.normal[0] * a[0] + f.normal[1] * a[1] - f.curvature * vt * vt;
         assert!((gdd - expect).abs() < 1e-6, "{gdd} vs {expect}");

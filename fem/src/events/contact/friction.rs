@@ -87,10 +87,9 @@
 //! Timoshenko links without rotary inertia are refused here (M is singular in the massless
 //! section rotations, and the index-1 forces need M⁻¹).
 
-use data::Scene;
 use data::scene::{ContactMode, Surface};
 
-use crate::chain::{Chain, MAX_LINKS};
+use crate::chain::{Chain, MAX_LINKS, V2};
 use crate::error::FemError;
 use crate::events::contact::Contact;
 use crate::events::mass_solve::MassSolver;
@@ -106,9 +105,9 @@ pub const STICK_VT_TOL: f64 = 1e-8;
 /// Shortest trial step of the event location, relative to the step being located.
 pub const MIN_TRIAL: f64 = 1e-3;
 
-/// The `describe` line of a bilateral contact (None otherwise).
-pub fn describe(scene: &Scene) -> Option<String> {
-    let c = scene.contacts().first()?;
+/// The `describe` line of a planar chain's bilateral contact (None otherwise).
+pub fn describe(contacts: &[data::scene::Contact]) -> Option<String> {
+    let c = contacts.first()?;
     if c.mode != ContactMode::Bilateral {
         return None;
     }
@@ -151,8 +150,8 @@ pub(crate) struct Forces {
     pub(crate) vt: f64,
     pub(crate) vn: f64,
     pub(crate) gap: f64,
-    pub(crate) tip: [f64; 2],
-    pub(crate) tangent: [f64; 2],
+    pub(crate) tip: V2,
+    pub(crate) tangent: V2,
     /// G M⁻¹Gᵀ ≤ μ|G M⁻¹Tᵀ| (sliding only).
     pub(crate) painleve: bool,
     pub(crate) gmg: f64,
@@ -183,8 +182,8 @@ pub struct WallConstraint {
     pub wall: Wall,
     pub mu: f64,
     /// Stick point p_s and tangent t̂_s of the held tip.
-    pub stick_point: [f64; 2],
-    pub stick_tangent: [f64; 2],
+    pub stick_point: V2,
+    pub stick_tangent: V2,
     /// Tangential multiplier of the last accepted stick step (Newton predictor).
     pub(crate) step_lambda_t: f64,
     /// Tangential multiplier of the current Newton iterate, that of the last residual
@@ -271,8 +270,8 @@ impl Bilateral {
             constraint: WallConstraint {
                 wall,
                 mu: c.friction,
-                stick_point: [0.0; 2],
-                stick_tangent: [0.0; 2],
+                stick_point: V2::zeros(),
+                stick_tangent: V2::zeros(),
                 step_lambda_t: 0.0,
                 lt_iter: 0.0,
                 lt_eval: 0.0,
@@ -353,10 +352,10 @@ impl Bilateral {
         chain.residual(t, q, qd, &self.solve.zero, &mut self.solve.minv_r);
         self.solve.mass.solve_in_place(&mut self.solve.minv_r);
         let [_, v, a] = chain.tip_motion(t, link, q, qd, &self.solve.zero);
-        let vt = f.tangent[0] * v[0] + f.tangent[1] * v[1];
-        let vn = f.normal[0] * v[0] + f.normal[1] * v[1];
-        let conv_n = f.normal[0] * a[0] + f.normal[1] * a[1] - f.curvature * vt * vt;
-        let conv_t = f.tangent[0] * a[0] + f.tangent[1] * a[1];
+        let vt = f.tangent.dot(&v);
+        let vn = f.normal.dot(&v);
+        let conv_n = f.normal.dot(&a) - f.curvature * vt * vt;
+        let conv_t = f.tangent.dot(&a);
         let gmg = dot(&self.constraint.g_row, &self.solve.minv_g);
         let gmt = dot(&self.constraint.g_row, &self.solve.minv_t);
         let tmt = dot(&self.constraint.t_row, &self.solve.minv_t);
@@ -448,11 +447,10 @@ pub(crate) fn midpoint_terms(
     row_along(ts, &b.constraint.jac, &mut b.constraint.h_bar);
     let r1 = chain.tip_jacobian(t1, link, v.q1, &mut b.constraint.jac);
     row_along(ts, &b.constraint.jac, &mut b.constraint.h_end);
-    let mut tips = [[0.0; 2]; MAX_LINKS];
+    let mut tips = [V2::zeros(); MAX_LINKS];
     chain.tip_positions(t0, v.q0, &mut tips[..chain.links.len()]);
-    let r0 = tips[link];
-    let h0 = ts[0] * (r0[0] - ps[0]) + ts[1] * (r0[1] - ps[1]);
-    let h1 = ts[0] * (r1[0] - ps[0]) + ts[1] * (r1[1] - ps[1]);
+    let h0 = ts.dot(&(tips[link] - ps));
+    let h1 = ts.dot(&(r1 - ps));
     let corr = if v.denom > 0.0 {
         (h1 - h0 - dot(&b.constraint.h_bar, v.dq)) / v.denom
     } else {
