@@ -45,12 +45,15 @@ pub enum Error {
         why: String,
     },
     /// No measured discretization meets a requested tolerance.
-    #[error("{}", tolerance_not_met(*tolerance, best.as_ref(), reference_label))]
+    #[error("{}", tolerance_not_met(*tolerance, best.as_ref(), reference_label, capped))]
     ToleranceNotMet {
         tolerance: f64,
         /// The most accurate measured rung: (backend, discretization, error).
         best: Option<(data::BackendKind, String, f64)>,
         reference_label: String,
+        /// The ladders the rung budget stopped, each with its note (finer rungs were not
+        /// measured).
+        capped: Vec<String>,
     },
     /// The backends converge to answers further apart than the requested tolerance: no
     /// discretization can be recommended until the model difference is explained.
@@ -74,12 +77,26 @@ fn tolerance_not_met(
     tol: f64,
     best: Option<&(data::BackendKind, String, f64)>,
     reference_label: &str,
+    capped: &[String],
 ) -> String {
-    match best {
+    let mut s = match best {
         Some((backend, discretization, e)) => format!(
             "no measured discretization meets {tol:.1e}: the best is {backend} {discretization} \
              with error {e:.3e} (against {reference_label})"
         ),
         None => "no discretization could be measured".into(),
+    };
+    s.push_str(&capped_sentence(capped));
+    s
+}
+
+/// "; finer rungs were not measured (…)" for the ladders a rung budget capped (empty if none).
+pub(crate) fn capped_sentence(capped: &[String]) -> String {
+    if capped.is_empty() {
+        return String::new();
     }
+    format!(
+        "; finer rungs were not measured ({}): a larger rung budget measures them",
+        capped.join("; ")
+    )
 }

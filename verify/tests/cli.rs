@@ -237,6 +237,25 @@ fn cli_recommend_names_a_discretization_that_a_rerun_confirms() {
     ]);
     assert_eq!(code, 1);
     assert!(err.contains("no measured discretization meets"), "{err}");
+    assert!(!err.contains("finer rungs were not measured"), "{err}");
+    // A rung budget every run exceeds stops the ladder after its first rung, and says so.
+    let (code, _, err) = flexverify(&[
+        "recommend",
+        "cantilever",
+        "--quantity",
+        "freq1",
+        "--tol",
+        "1e-30",
+        "--backend",
+        "fdm",
+        "--rung-budget",
+        "1e-9",
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("finer rungs were not measured (fdm ladder capped after stations=11"),
+        "{err}"
+    );
 }
 
 #[test]

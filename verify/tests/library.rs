@@ -89,6 +89,7 @@ fn lib_bad_requests_are_typed_errors() {
         1e-30,
         &[BackendKind::Fdm],
         &settings,
+        None,
         &Silent,
     ) {
         Err(Error::ToleranceNotMet {

@@ -110,6 +110,10 @@ pub enum Command {
         /// Relative tolerance the quantity must meet.
         #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
         tol: f64,
+        /// Wall-time budget per rung in seconds: a backend's ladder stops after the first rung
+        /// that took longer (the next would cost several times more), and the answer says so.
+        #[arg(long, value_parser = positive_f64, default_value_t = crate::study::recommend::DEFAULT_RUNG_BUDGET_S)]
+        rung_budget: f64,
         #[command(flatten)]
         opts: CommonOpts,
     },

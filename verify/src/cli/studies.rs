@@ -154,7 +154,13 @@ pub fn merge_converge(
     Ok(())
 }
 
-pub fn recommend(scene: &str, quantity: &str, tol: f64, opts: &CommonOpts) -> Result<(), CliError> {
+pub fn recommend(
+    scene: &str,
+    quantity: &str,
+    tol: f64,
+    rung_budget_s: f64,
+    opts: &CommonOpts,
+) -> Result<(), CliError> {
     let scene = load_scene(scene)?;
     let bar = Bar::new();
     let recommendation = crate::study::recommend::recommend(
@@ -163,6 +169,7 @@ pub fn recommend(scene: &str, quantity: &str, tol: f64, opts: &CommonOpts) -> Re
         tol,
         &opts.kinds(),
         &super::commands::checked_settings(opts, &opts.kinds())?,
+        Some(rung_budget_s),
         &bar,
     );
     bar.clear();

@@ -3,12 +3,16 @@
 //! counter, so the pick inside a ladder never depends on the timer); across backends, the pick
 //! with the smallest minimum wall time, unless the timings cannot separate them (the
 //! runner-up's minimum within the winner's spread), in which case the one with fewer DOFs wins.
+//!
+//! With a rung budget a ladder stops after its first rung dearer than the budget (the
+//! full suite's rule, [`super::run::study_from_rungs`]); when no measured rung meets the
+//! tolerance, the answer names the ladders the budget capped.
 
 use data::{BackendKind, Scene, Settings};
 use serde::Serialize;
 
 use super::ladder::Refine;
-use super::run::run_study;
+use super::run::{CAPPED, run_study};
 use super::summary::Rung;
 use crate::error::Error;
 use crate::output::wrap;
@@ -40,17 +44,41 @@ pub struct Recommendation {
     pub measured: usize,
 }
 
+/// Default wall-time budget per rung of `recommend` (seconds): a ladder's rungs grow 2–8× in
+/// cost, so the rung after a 5 s one would take half a minute or more.
+pub const DEFAULT_RUNG_BUDGET_S: f64 = 5.0;
+
 /// The cheapest backend and space discretization whose measured error on `quantity` is at
-/// most `tol`, from a space-refinement study of `kinds`.
+/// most `tol`, from a space-refinement study of `kinds` (each ladder capped by
+/// `rung_budget_s`, if given).
 pub fn recommend(
     scene: &Scene,
     quantity: &str,
     tol: f64,
     kinds: &[BackendKind],
     base: &Settings,
+    rung_budget_s: Option<f64>,
     progress: &dyn Progress,
 ) -> Result<Recommendation, Error> {
-    let study = run_study(scene, quantity, Refine::Space, kinds, base, None, progress)?;
+    let study = run_study(
+        scene,
+        quantity,
+        Refine::Space,
+        kinds,
+        base,
+        rung_budget_s,
+        progress,
+    )?;
+    let capped: Vec<String> = study
+        .ladders
+        .iter()
+        .filter_map(|l| {
+            l.note
+                .as_ref()
+                .filter(|n| n.starts_with(CAPPED))
+                .map(|n| format!("{} {n}", l.backend))
+        })
+        .collect();
     // Models that converge to answers further apart than the tolerance cannot both meet it,
     // and which one is right is not a question of discretization.
     if let Some(d) = study.disagreement
@@ -67,7 +95,7 @@ pub fn recommend(
         return Err(Error::NoReference {
             quantity: quantity.to_string(),
             scene: scene.name.clone(),
-            why: study.reference_label,
+            why: study.reference_label + &crate::error::capped_sentence(&capped),
         });
     }
     // Each rung with its ladder's reference (the study's, or its own estimate when the
@@ -126,6 +154,7 @@ pub fn recommend(
             tolerance: tol,
             best: best_err.map(|(e, r)| (r.backend, r.discretization.clone(), e)),
             reference_label: study.reference_label,
+            capped,
         });
     };
     let flag = r.discretization.replace('=', " ");

@@ -12,6 +12,9 @@ use crate::error::Error;
 use crate::progress::Progress;
 use crate::suite::run_cache::RunCache;
 
+/// How the note of a ladder stopped by the rung budget begins.
+pub const CAPPED: &str = "ladder capped";
+
 /// Runs the ladders and fills errors against the best available reference, reporting each
 /// rung to `progress`.
 pub fn run_study(
@@ -106,7 +109,7 @@ pub fn study_from_rungs(
             && rungs.len() < rungs_total
         {
             note = Some(format!(
-                "ladder capped after {}: that rung took {:.1} s, above the {budget} s budget per rung",
+                "{CAPPED} after {}: that rung took {:.1} s, above the {budget} s budget per rung",
                 last.discretization, last.wall_time_s
             ));
         }

@@ -52,9 +52,17 @@ pub struct Ladder {
     pub plateau_from: Option<String>,
     /// Why the ladder stopped early, if it did (unsupported, stopped run, …).
     pub note: Option<String>,
-    /// The ladder's own estimate of the converged value (its Richardson extrapolation).
+    /// The ladder's own estimate of the converged value: its Richardson extrapolation, when
+    /// the order it rests on is at least [`MIN_ASYMPTOTIC_ORDER`].
     pub estimate: Option<Estimate>,
 }
+
+/// The smallest observed order at which a ladder's Richardson extrapolation is used as an
+/// estimate or a reference. Below it the rungs are not in their asymptotic range: the
+/// extrapolation divides the last difference by r^p − 1 (0.41 at p = 0.5 for halving, 0.07 at
+/// the floor 0.1 that [`richardson`] applies to differences that do not fall), so it amplifies
+/// noise instead of removing an error.
+pub const MIN_ASYMPTOTIC_ORDER: f64 = 0.5;
 
 /// Where a ladder says the quantity converges to: its Richardson extrapolation, with the
 /// distance of its finest rung from that value as the uncertainty (the finest rung's own error
@@ -119,6 +127,7 @@ pub fn summarize_ladder(kind: BackendKind, rungs: Vec<Rung>, note: Option<String
         values.len() >= 2 && values.windows(2).all(|w| w[1] <= w[0] * (1.0 + 1e-13));
     let extrapolation = richardson(&hs, &values, None);
     let estimate = extrapolation
+        .filter(|&(_, p)| p >= MIN_ASYMPTOTIC_ORDER)
         .zip(rungs.last())
         .map(|((value, _), finest)| Estimate {
             backend: kind,
@@ -153,7 +162,7 @@ pub fn summarize(
 
     // Reference: analytic when the scene/quantity has one; else, unless two ladders converge
     // to different answers, the Richardson value of the ladder whose last two rungs agree best
-    // (its own estimate of its error is smallest).
+    // (its own estimate of its error is smallest), among the ladders with an estimate.
     let analytic = default_analytic_id(scene, q)
         .and_then(|id| analytic_value(&id, scene, q).ok().map(|v| (v, id)));
     let disagreement = if analytic.is_none() {
@@ -171,6 +180,7 @@ pub fn summarize(
             let best = ladders
                 .iter()
                 .filter_map(|l| {
+                    l.estimate?;
                     let (ext, p) = l.richardson?;
                     let last = l.rungs.last()?.value;
                     Some(((last - ext).abs(), ext, p, l.backend))
@@ -181,7 +191,31 @@ pub fn summarize(
                     Some(ext),
                     format!("Richardson of the {b} ladder (p = {p:.2})"),
                 ),
-                None => (None, "none (no ladder reached the asymptotic range)".into()),
+                None => {
+                    let why: Vec<String> = ladders
+                        .iter()
+                        .filter(|l| !l.rungs.is_empty())
+                        .map(|l| match l.richardson {
+                            Some((_, p)) => format!(
+                                "{} Richardson order {p:.2} (below {MIN_ASYMPTOTIC_ORDER})",
+                                l.backend
+                            ),
+                            None if l.rungs.len() >= 3 => {
+                                format!("{}'s last differences change sign", l.backend)
+                            }
+                            None => format!("{} has fewer than 3 rungs", l.backend),
+                        })
+                        .collect();
+                    let why = if why.is_empty() {
+                        String::new()
+                    } else {
+                        format!(": {}", why.join("; "))
+                    };
+                    (
+                        None,
+                        format!("none (no ladder reached the asymptotic range{why})"),
+                    )
+                }
             }
         }
     };
@@ -257,13 +291,18 @@ mod tests {
 
     /// A ladder of `value(h) = limit + c h²` on h = 1/4, 1/8, 1/16.
     fn ladder(backend: BackendKind, limit: f64, c: f64) -> Ladder {
+        ladder_of_order(backend, limit, c, 2.0)
+    }
+
+    /// A ladder of `value(h) = limit + c hᵖ` on h = 1/4, 1/8, 1/16.
+    fn ladder_of_order(backend: BackendKind, limit: f64, c: f64, p: f64) -> Ladder {
         let rungs: Vec<Rung> = [4.0, 8.0, 16.0]
             .iter()
             .map(|n: &f64| Rung {
                 backend,
                 discretization: format!("n={n}"),
                 h: 1.0 / n,
-                value: limit + c / (n * n),
+                value: limit + c * n.powf(-p),
                 error: None,
                 wall_time_s: 1.0,
                 timing: Timing {
@@ -320,6 +359,34 @@ mod tests {
         assert!(worst_disagreement(&ladders, scale).is_none());
         // One ladder alone cannot disagree.
         assert!(worst_disagreement(&ladders[..1], scale).is_none());
+    }
+
+    #[test]
+    fn conv_a_ladder_below_the_asymptotic_order_gives_no_estimate_and_no_reference() {
+        for (p, estimated) in [(2.0, true), (0.6, true), (0.4, false)] {
+            let l = ladder_of_order(BackendKind::Fem, 1.0, 1e-2, p);
+            let (_, order) = l.richardson.expect("an extrapolation");
+            assert!((order - p).abs() < 1e-9, "{order} vs {p}");
+            assert_eq!(l.estimate.is_some(), estimated, "p = {p}");
+        }
+        // Differences that grow (order −1 here): the floor order 0.1, no estimate.
+        let growing = ladder_of_order(BackendKind::Fdm, 1.0, 1e-2, -1.0);
+        assert_eq!(growing.richardson.map(|r| r.1), Some(0.1));
+        assert!(growing.estimate.is_none());
+        // Without an estimate no ladder is scored, and the label says why.
+        let scene = data::load_scene("two-link-free-undamped").unwrap();
+        let quantity = "joint1.angle@10";
+        let q = crate::study::measure::parse_quantity(&scene, quantity).unwrap();
+        let study = summarize(&scene, &q, quantity, Refine::Space, vec![growing]);
+        assert!(study.reference.is_none() && study.disagreement.is_none());
+        assert!(
+            study
+                .reference_label
+                .contains("no ladder reached the asymptotic range: fdm Richardson order 0.10"),
+            "{}",
+            study.reference_label
+        );
+        assert!(study.ladders[0].rungs.iter().all(|r| r.error.is_none()));
     }
 
     #[test]
