@@ -111,8 +111,9 @@ pub fn default_rho_inf(links: &[Link]) -> f64 {
 /// generalized-α (prescribed joints are not supported by the midpoint scheme; extensible links
 /// keep ρ∞ = 0.9 numerical damping of the unresolved axial modes; undamped massless Timoshenko
 /// hubs: see `undamped_massless_hub`). A bilateral contact (seed 001's wall, always
-/// constrained) takes `energy-midpoint` even with extensible links: contact is implemented on
-/// the midpoint schemes only, and energy-midpoint's ledger closure is the friction-work check.
+/// constrained) takes `energy-midpoint` even with extensible links: its held constraint does no
+/// work (generalized-α's trapezoidal force average does O(h²) per step), so its ledger closure
+/// is the friction-work check.
 pub fn default_method(pc: &PlanarChain) -> Method {
     if check_midpoint(&pc.links).is_ok()
         && pc.contacts.iter().any(|c| c.mode == ContactMode::Bilateral)
@@ -256,14 +257,14 @@ pub fn prepare(
     }
     let contact = Contact::from_planar_chain(&scene.name, pc, &chain)?;
     if contact.is_some() {
-        if !matches!(method, Method::EnergyMidpoint | Method::ImplicitMidpoint) {
+        if method == Method::CentralDifference {
             return Err(FemError::unsupported(format!(
-                "fem: contact is implemented for `energy-midpoint` and `implicit-midpoint` only \
-                 (scene `{}`; method {:?})",
+                "fem: contact is implemented for `energy-midpoint`, `implicit-midpoint` and \
+                 `generalized-alpha` (scene `{}`; method {:?})",
                 scene.name, method
             )));
         }
-        if method == Method::ImplicitMidpoint
+        if matches!(method, Method::ImplicitMidpoint | Method::GeneralizedAlpha)
             && let Some(i) = pc.links.iter().position(|l| l.shear && !l.rotary_inertia)
         {
             // Measured on `barhorst-case1-timoshenko` (0.5 s): with the massless rotations
@@ -273,10 +274,11 @@ pub fn prepare(
             // residual −18.1 / +5.9 ft·lbf); without the projection the end rates flip sign
             // every step (615 events against energy-midpoint's 419).
             return Err(FemError::unsupported(format!(
-                "fem implicit-midpoint: contact on link {} (a Timoshenko link without \
-                 `rotary_inertia`) is not implemented: the midpoint rule leaves the end rates of \
-                 its massless section rotations undetermined, which only energy-midpoint \
-                 projects and books consistently; use energy-midpoint",
+                "fem {}: contact on link {} (a Timoshenko link without `rotary_inertia`) is not \
+                 implemented: the method leaves the end rates of its massless section rotations \
+                 undetermined, which only energy-midpoint projects and books consistently; use \
+                 energy-midpoint",
+                method,
                 i + 1
             )));
         }

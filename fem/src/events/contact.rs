@@ -161,7 +161,10 @@
 //! a method only has to step the constrained phase through [`StepConstraint`]. The
 //! `energy-midpoint` and `implicit-midpoint` steps do (both have the mean acceleration ā as
 //! Newton unknown, ∂q₁/∂ā = h²/2, and both apply the discrete-gradient force above, so the
-//! held constraint does no work in either). With `implicit-midpoint` the ledger closes to the
+//! held constraint does no work in either). `generalized-alpha` does too, with that force at t₁
+//! and q̈₁ as unknown; its trapezoidal average of the force over a step does O(h²) work per held
+//! step, so its ledger closes only to first order (`crate::method::generalized_alpha`). With
+//! `implicit-midpoint` the ledger closes to the
 //! rule's own energy error (works by the trapezoidal rule), measured at the default step over
 //! the scenes' spans: `barhorst-case1` 9.2e-6 (energy-midpoint 8.7e-9), `-tipmass` 1.8e-5,
 //! `-stiff-elbow` 1.5e-5, `barhorst-case2` 2.7e-6, `constrained-arm` 1.1e-6. It falls 4× per
@@ -170,15 +173,15 @@
 //! dt = 5e-4 … 3.125e-5): the impacts excite the mesh modes, whose energy error the
 //! non-conserving rule reduces as h² only once h ω resolves them (highest frequency of that
 //! model 2.05 kHz, h ω_max = 6.4 … 0.4 over those steps). Switching times agree with
-//! energy-midpoint's to O(h²) (`tests/dyn_implicit_midpoint_contact.rs`).
+//! energy-midpoint's to O(h²) (`tests/dyn_contact_methods.rs`).
 //!
 //! Refused with `unsupported`: unilateral circle surfaces, friction on a unilateral contact,
 //! more than one contact, contact with prescribed joint motion, contact on Timoshenko links
 //! without rotary inertia and without Kelvin–Voigt damping (above; for a bilateral wall:
-//! without rotary inertia), `implicit-midpoint` contact on Timoshenko links without rotary
-//! inertia at all (the end rates of the massless rotations: `crate::run`), contact with
-//! `generalized-alpha` or `central-difference` (no bordered update: [`crate::method`]), and
-//! contact with adaptive stepping (`time.rtol`).
+//! without rotary inertia), `implicit-midpoint` or `generalized-alpha` contact on Timoshenko
+//! links without rotary inertia at all (the end rates of the massless rotations:
+//! `crate::run`), contact with `central-difference` (no Newton iteration to border:
+//! [`crate::method`]), and contact with adaptive stepping (`time.rtol`).
 
 pub mod friction;
 

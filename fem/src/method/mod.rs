@@ -15,20 +15,14 @@
 //! * [`implicit_midpoint`]: the implicit midpoint rule (one-stage Gauss), fixed or adaptive
 //!   steps.
 //!
-//! A held [`StepConstraint`] is accepted by the two midpoint schemes, whose Newton unknown is
-//! the mean acceleration ā with q₁ = q₀ + h q̇₀ + (h²/2) ā (border factor ∂q₁/∂ā = h²/2, force
-//! the discrete gradient ∇̄g in the metric M(q̄), so it does no work over a step). Generalized-α
-//! refuses one. Its index-3 form (Arnold–Brüls: force ∇g(q₁)λ, λ a Newton unknown,
-//! g(q₁) = 0 at the step end, border factor ∂q₁/∂q̈₁ = βh²(1−α_f)/(1−α_m), which
-//! [`StepConstraint::newton_update`]'s `dq1_da` carries) was tried and is not enabled: it
-//! steps the constrained phases, but its acceleration history (q̈ₙ, aₙ) is that of the
-//! motion before each event, which the driver's resets do not make consistent with the new
-//! phase; on `barhorst-case1` at the default step the first constrained step after the first
-//! impact created 36.6 ft·lbf of strain and damper energy (ledger closure 8.7e-2 over the 3 s,
-//! also 8.1e-2 at ρ∞ = 0.6; energy-midpoint 8.7e-9). Enabling it needs a consistent constrained
-//! acceleration at every event (the index-1 force of [`crate::events::contact`] gives λ, then
-//! M q̈ = Gᵀλ − R(q, q̇, 0)). Explicit central difference refuses a constraint for good: it has
-//! no Newton iteration to border, and a constraint force would need its own projection scheme.
+//! A held [`StepConstraint`] is accepted by the implicit methods. The two midpoint schemes
+//! take the mean acceleration ā as Newton unknown, q₁ = q₀ + h q̇₀ + (h²/2) ā (border factor
+//! ∂q₁/∂ā = h²/2), and the force is the discrete gradient ∇̄g in the metric M(q̄), so it does
+//! no work over a step. Generalized-α takes q̈₁ (border factor βh²(1−α_f)/(1−α_m)) with the same
+//! force at t₁; its trapezoidal average of that force over the step does O(h²) work per held
+//! step, and it recomputes its acceleration history at every event
+//! ([`generalized_alpha`] docs). Explicit central difference refuses a constraint: it has no
+//! Newton iteration to border, and a constraint force would need its own projection scheme.
 //!
 //! Shared machinery: the Newton matrix S = c_a M + c_v C + c_q K and its solver
 //! ([`newton`]) and the consistent acceleration of a (re)start ([`start`]).
@@ -261,7 +255,7 @@ pub trait Stepper: std::fmt::Debug {
 /// The stepper of a method, for `n` DOFs (`rho_inf`: generalized-α spectral radius).
 pub fn stepper(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper> {
     match method {
-        Method::GeneralizedAlpha => Box::new(generalized_alpha::GeneralizedAlpha::new(rho_inf)),
+        Method::GeneralizedAlpha => Box::new(generalized_alpha::GeneralizedAlpha::new(rho_inf, n)),
         Method::CentralDifference => Box::new(central_difference::CentralDifference),
         Method::EnergyMidpoint => Box::new(energy_midpoint::EnergyMidpoint::new(n)),
         Method::ImplicitMidpoint => Box::new(implicit_midpoint::ImplicitMidpoint::new(n)),
@@ -273,8 +267,8 @@ pub fn stepper(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper> {
 pub(crate) fn refuse_constraint(method: &str, held: bool) -> Result<(), FemError> {
     if held {
         return Err(FemError::unsupported(format!(
-            "fem {method}: contact constraints are stepped by energy-midpoint and \
-             implicit-midpoint only"
+            "fem {method}: contact constraints are stepped by the implicit methods only \
+             (energy-midpoint, implicit-midpoint, generalized-alpha)"
         )));
     }
     Ok(())
