@@ -1,6 +1,7 @@
 //! Unilateral, frictionless tip contact with a fixed rigid line (seed 000, Barhorst's work
-//! surface) for the midpoint schemes `energy-midpoint` (the default; the measurements below are
-//! its) and `implicit-midpoint` (same constraint object, see "Methods" at the end).
+//! surface) for the implicit methods: `energy-midpoint` (the default; the measurements below are
+//! its), `implicit-midpoint` and `generalized-alpha` (same constraint object, see "Methods" at
+//! the end).
 //!
 //! **Gap and Jacobian.** g(q) = n̂·(r_tip(q) − p₀) with n̂ the unit normal to the free side,
 //! G = n̂ᵀJ, J = ∂r_tip/∂q from [`Chain::tip_jacobian`] (exact, O(n), checked against finite
