@@ -111,9 +111,8 @@ pub fn default_rho_inf(links: &[Link]) -> f64 {
 /// generalized-α (prescribed joints are not supported by the midpoint scheme; extensible links
 /// keep ρ∞ = 0.9 numerical damping of the unresolved axial modes; undamped massless Timoshenko
 /// hubs: see `undamped_massless_hub`). A bilateral contact (seed 001's wall, always
-/// constrained) takes `energy-midpoint` even with extensible links: its held constraint does no
-/// work (generalized-α's trapezoidal force average does O(h²) per step), so its ledger closure
-/// is the friction-work check.
+/// constrained) takes `energy-midpoint` even with extensible links: its ledger closes to the
+/// Newton tolerance, so the closure is the friction-work check.
 pub fn default_method(pc: &PlanarChain) -> Method {
     if check_midpoint(&pc.links).is_ok()
         && pc.contacts.iter().any(|c| c.mode == ContactMode::Bilateral)

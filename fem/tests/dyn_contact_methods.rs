@@ -4,8 +4,8 @@
 //! at the same step to second order (both methods are second order: the difference falls 4×
 //! per halving of the step), and the impact map keeps its momentum and energy relations.
 //! `generalized-alpha`: the free flight to the first impact agrees to second order, the impact
-//! map holds, and the ledger closes to first order (its trapezoidal average of the constraint
-//! force does O(h²) work per constrained step: `crate::method::generalized_alpha` docs).
+//! map holds, and the ledger closes to a tenth of the warning level (the work balance of its
+//! end force: `crate::method::generalized_alpha` docs).
 //! Explicit central difference is still refused.
 
 use data::{Backend, BackendError, Event, RunResult, Scene, Settings, StabilityVerdict};
@@ -219,7 +219,7 @@ fn assert_plastic_impacts(r: &RunResult) {
 }
 
 #[test]
-fn dyn_generalized_alpha_steps_contact_with_a_first_order_ledger() {
+fn dyn_generalized_alpha_steps_contact_and_balances_the_constraint_work() {
     let case1 = scene("barhorst-case1");
     let arm = scene("constrained-arm");
     let steps = [2.5e-4, 1.25e-4, 6.25e-5];
@@ -243,20 +243,24 @@ fn dyn_generalized_alpha_steps_contact_with_a_first_order_ledger() {
     }
     // The free fall to the first impact: O(h²) difference of two second-order methods.
     assert_second_order("first impact time", &first_impact);
-    // The constraint's trapezoidal force average does O(h²) work per constrained step: O(h)
-    // over a held phase. The wall is held throughout, so its closure halves with the step;
-    // the Barhorst run mixes free flight (O(h²)) with short held phases, and its closure falls
-    // at least as fast.
-    for (what, c, first_order) in [
-        ("barhorst-case1", &closure_case1, false),
-        ("constrained-arm", &closure_arm, true),
-    ] {
-        for k in 0..c.len() - 1 {
-            let ratio = c[k] / c[k + 1];
-            assert!(
-                ratio >= 1.6 && (!first_order || ratio <= 2.5),
-                "{what}: closures {c:?} fall by {ratio:.2} at a halved step"
-            );
+    // Without the work balance of the end force (crate::method::generalized_alpha) the
+    // trapezoidal average of the constraint force did O(h²) work per held step, O(h) over a
+    // held phase: the wall, held throughout, closed to 2.19e-3, 1.10e-3, 5.50e-4 at these
+    // steps. With it the wall closes to the rule's own energy error, a tenth of the warning
+    // level; the Barhorst run, whose impacts excite the unresolved mesh modes (as for
+    // implicit-midpoint, module docs of crate::events::contact), closes below the warning
+    // level and falls with the step.
+    for (&dt, &closure) in steps.iter().zip(&closure_arm) {
+        assert!(
+            closure <= 0.1 * LEDGER_WARNING,
+            "constrained-arm, dt = {dt}: closure {closure:.3e}"
+        );
+    }
+    for k in 0..closure_case1.len() {
+        assert!(closure_case1[k] <= LEDGER_WARNING, "{closure_case1:?}");
+        if k > 0 {
+            let ratio = closure_case1[k - 1] / closure_case1[k];
+            assert!(ratio >= 1.6, "barhorst-case1 closures {closure_case1:?}");
         }
     }
 }

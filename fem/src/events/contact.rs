@@ -163,8 +163,8 @@
 //! `energy-midpoint` and `implicit-midpoint` steps do (both have the mean acceleration ā as
 //! Newton unknown, ∂q₁/∂ā = h²/2, and both apply the discrete-gradient force above, so the
 //! held constraint does no work in either). `generalized-alpha` does too, with that force at t₁
-//! and q̈₁ as unknown; its trapezoidal average of the force over a step does O(h²) work per held
-//! step, so its ledger closes only to first order (`crate::method::generalized_alpha`). With
+//! and q̈₁ as unknown, balanced so that the rule's average of the start and end forces does the
+//! end force's work (`crate::method::generalized_alpha`). With
 //! `implicit-midpoint` the ledger closes to the
 //! rule's own energy error (works by the trapezoidal rule), measured at the default step over
 //! the scenes' spans: `barhorst-case1` 9.2e-6 (energy-midpoint 8.7e-9), `-tipmass` 1.8e-5,

@@ -19,9 +19,8 @@
 //! take the mean acceleration ā as Newton unknown, q₁ = q₀ + h q̇₀ + (h²/2) ā (border factor
 //! ∂q₁/∂ā = h²/2), and the force is the discrete gradient ∇̄g in the metric M(q̄), so it does
 //! no work over a step. Generalized-α takes q̈₁ (border factor βh²(1−α_f)/(1−α_m)) with the same
-//! force at t₁; its trapezoidal average of that force over the step does O(h²) work per held
-//! step, and it recomputes its acceleration history at every event
-//! ([`generalized_alpha`] docs). Explicit central difference refuses a constraint: it has no
+//! force at t₁, balanced so that its average over the step does the end force's work, and it
+//! recomputes its acceleration history at every event ([`generalized_alpha`] docs). Explicit central difference refuses a constraint: it has no
 //! Newton iteration to border, and a constraint force would need its own projection scheme.
 //!
 //! Shared machinery: the Newton matrix S = c_a M + c_v C + c_q K and its solver
