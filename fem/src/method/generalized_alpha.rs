@@ -40,10 +40,10 @@
 //! force the driver computes at each contact event; the friction force or stick multiplier of
 //! the current friction phase), by Newton with S = M.
 
-use crate::chain::{NewtonCoefficients, Parts};
+use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
-use crate::method::{ConstraintView, StepConstraint, StepContext, Stepper};
+use crate::method::{ConstraintView, HeldConstraint, StepConstraint, StepContext, Stepper, start};
 
 #[derive(Debug, Clone, Copy)]
 struct AlphaParams {
@@ -81,13 +81,9 @@ pub struct GeneralizedAlpha {
     /// A constraint was held in an earlier step (or is held now): restarts then recompute the
     /// history.
     constrained_before: bool,
-    /// q̄ = (q₀ + q₁)/2, Δq = q₁ − q₀ and W Δq = M(q̄)Δq of the iterate.
+    /// q̄ = (q₀ + q₁)/2 of the iterate.
     q_mid: Vec<f64>,
-    dq: Vec<f64>,
-    w_dq: Vec<f64>,
-    /// Momentum residual with the constraint force.
-    res: Vec<f64>,
-    zero: Vec<f64>,
+    held: HeldConstraint,
     /// The constraint (and friction) force the method applied at the step start: the last
     /// accepted step's end force, or the restart's (module docs, work balance).
     force_start: Vec<f64>,
@@ -103,82 +99,53 @@ impl GeneralizedAlpha {
             restart_pending: true,
             constrained_before: false,
             q_mid: vec![0.0; n],
-            dq: vec![0.0; n],
-            w_dq: vec![0.0; n],
-            res: vec![0.0; n],
-            zero: vec![0.0; n],
+            held: HeldConstraint::new(n),
             force_start: vec![0.0; n],
             force_end: vec![0.0; n],
         }
     }
 
     /// q̈ₙ = aₙ consistent with the held constraint at the step start (module docs), by Newton
-    /// with S = M; R is affine in q̈, so this converges in one or two passes.
+    /// with S = M; R is affine in q̈, so this converges in one or two passes. Keeps the
+    /// constraint force applied as the next step's start force.
     fn constrained_start(
         &mut self,
         cx: &mut StepContext<'_>,
         k: &mut dyn StepConstraint,
         t_law: f64,
     ) -> Result<(), FemError> {
-        let st = &mut *cx.state;
-        let n = st.q.len();
-        let c = NewtonCoefficients {
-            c_a: 1.0,
-            c_v: 0.0,
-            c_q: 0.0,
-        };
-        let g0 = k.value(cx.chain, st.t, &st.q);
+        let t0 = cx.state.t;
+        let g0 = k.value(cx.chain, t0, &cx.state.q);
         let lambda = k.multiplier();
-        for it in 0..10 {
-            cx.chain
-                .residual(t_law, &st.q, &st.qd, &st.qdd, &mut cx.newton.res);
-            cx.counters.rhs += 1;
-            if it == 0 {
-                st.q1.copy_from_slice(&st.q);
-                st.qd1.copy_from_slice(&st.qd);
-                st.qdd1.copy_from_slice(&st.qdd);
-                cx.newton.form(cx.chain, st, cx.counters, c, st.t)?;
-                cx.newton.matrix_h = f64::NAN;
-            }
+        let (zero, before, force) = (&self.held.zero, &mut self.held.res, &mut self.force_start);
+        start::accelerate_with(cx, t_law, |chain, q, res| {
             // The force at q₀ itself: a view of zero length (∇̄g = ∇g(q₀)).
             let view = ConstraintView {
                 it: 0,
-                t: [st.t; 3],
-                q0: &st.q,
-                q1: &st.q,
-                qbar: &st.q,
-                dq: &self.zero,
-                w_dq: &self.zero,
+                t: [t0; 3],
+                q0: q,
+                q1: q,
+                qbar: q,
+                dq: zero,
+                w_dq: zero,
                 denom: 0.0,
                 g0,
                 lambda,
             };
-            self.res.copy_from_slice(&cx.newton.res);
-            k.add_force(cx.chain, &view, &mut self.res);
-            for i in 0..n {
-                self.force_start[i] = cx.newton.res[i] - self.res[i];
+            before.copy_from_slice(res);
+            k.add_force(chain, &view, res);
+            for i in 0..res.len() {
+                force[i] = before[i] - res[i];
             }
-            cx.newton.delta.copy_from_slice(&self.res);
-            cx.newton.solve();
-            let (mut big, mut amax) = (0.0f64, 0.0f64);
-            for i in 0..n {
-                st.qdd[i] -= cx.newton.delta[i];
-                big = big.max(cx.newton.delta[i].abs());
-                amax = amax.max(st.qdd[i].abs());
-            }
-            if !big.is_finite() {
-                break;
-            }
-            if big <= 1e-10 * amax.max(1e-12) {
-                st.a.copy_from_slice(&st.qdd);
-                return Ok(());
-            }
-        }
-        Err(FemError::Numerical {
-            t: st.t,
-            message: "generalized-alpha: could not compute the constrained acceleration at a \
-                      restart"
-                .into(),
+        })
+        .map_err(|e| match e {
+            FemError::Numerical { t, .. } => FemError::Numerical {
+                t,
+                message: "generalized-alpha: could not compute the constrained acceleration at \
+                          a restart"
+                    .into(),
+            },
+            other => other,
         })
     }
 }
@@ -200,7 +167,7 @@ impl Stepper for GeneralizedAlpha {
             let t0 = cx.state.t;
             match constraint.as_deref_mut() {
                 Some(k) => self.constrained_start(cx, k, t0)?,
-                None => crate::method::start::consistent_acceleration(cx, h, t0)?,
+                None => start::consistent_acceleration(cx, h, t0)?,
             }
         }
         let st = &mut *cx.state;
@@ -255,53 +222,39 @@ impl Stepper for GeneralizedAlpha {
             cx.newton
                 .form_if_due(it, h, cx.chain, st, cx.counters, c, t1)?;
             if let Some(k) = constraint.as_deref_mut() {
+                let held = &mut self.held;
                 for i in 0..n {
-                    self.dq[i] = st.q1[i] - st.q[i];
-                    self.q_mid[i] = st.q[i] + 0.5 * self.dq[i];
+                    held.dq[i] = st.q1[i] - st.q[i];
+                    self.q_mid[i] = st.q[i] + 0.5 * held.dq[i];
                 }
-                // Metric of the discrete gradient, W Δq = M(q̄)Δq (after the matrix was
-                // formed: it reads the point data of the full residual pass).
-                cx.chain.residual_parts(
-                    t_mid,
-                    &self.q_mid,
-                    &self.zero,
-                    &self.dq,
-                    Parts::INERTIA,
-                    &mut self.w_dq,
-                );
-                cx.counters.rhs += 1;
-                let view = ConstraintView {
+                let gap1 = held.force(
+                    cx.chain,
+                    cx.counters,
+                    k,
                     it,
-                    t: [t0, t_mid, t1],
-                    q0: &st.q,
-                    q1: &st.q1,
-                    qbar: &self.q_mid,
-                    dq: &self.dq,
-                    w_dq: &self.w_dq,
-                    denom: dot(&self.dq, &self.w_dq),
-                    g0,
-                    lambda,
-                };
-                self.res.copy_from_slice(&cx.newton.res);
-                let gap1 = k.add_force(cx.chain, &view, &mut self.res);
+                    [t0, t_mid, t1],
+                    (&st.q, &st.q1, &self.q_mid),
+                    (g0, lambda),
+                    &cx.newton.res,
+                );
                 // Work balance (module docs): the end force gains c·WΔq so that the step's
                 // average of the start and end forces does the work of the end force alone.
                 let (mut work_end, mut work_start) = (0.0, 0.0);
                 for i in 0..n {
-                    work_end += self.dq[i] * (cx.newton.res[i] - self.res[i]);
-                    work_start += self.dq[i] * self.force_start[i];
+                    work_end += held.dq[i] * (cx.newton.res[i] - held.res[i]);
+                    work_start += held.dq[i] * self.force_start[i];
                 }
-                let denom = dot(&self.dq, &self.w_dq);
+                let denom = dot(&held.dq, &held.w_dq);
                 let c_balance = if denom > 0.0 {
                     (work_end - work_start) / denom
                 } else {
                     0.0
                 };
                 for i in 0..n {
-                    self.res[i] -= c_balance * self.w_dq[i];
+                    held.res[i] -= c_balance * held.w_dq[i];
                 }
                 let on_surface = (gap1 - gap_target).abs() <= cx.newton.tol;
-                let dlambda = k.newton_update(cx.newton, &self.res, c.c_q, gap1, gap_target);
+                let dlambda = k.newton_update(cx.newton, &held.res, c.c_q, gap1, gap_target);
                 let dq = max_abs(&cx.newton.delta) * c.c_q;
                 if !dq.is_finite() || (it > 2 && dq > 10.0 * last) {
                     break;
@@ -314,7 +267,7 @@ impl Stepper for GeneralizedAlpha {
                 // docs): its multipliers and friction work are the constraint's current ones.
                 if dq <= tol && on_surface {
                     for i in 0..n {
-                        self.force_end[i] = cx.newton.res[i] - self.res[i];
+                        self.force_end[i] = cx.newton.res[i] - held.res[i];
                     }
                     converged = true;
                     break;

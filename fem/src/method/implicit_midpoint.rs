@@ -34,10 +34,10 @@
 //! The constraint force enters through λ only (its dependence on ā through ∇̄g(q̄) is not in
 //! S), so a constrained step converges linearly at the rate λh²|∇²g|/|M|.
 
-use crate::chain::{NewtonCoefficients, Parts};
+use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
-use crate::linalg::{dot, max_abs};
-use crate::method::{ConstraintView, StepConstraint, StepContext, Stepper};
+use crate::linalg::max_abs;
+use crate::method::{HeldConstraint, StepConstraint, StepContext, Stepper};
 
 /// Newton iterations at most before the step is retried shorter.
 const MAX_ITERATIONS: usize = 30;
@@ -48,12 +48,7 @@ const MAX_ITERATIONS: usize = 30;
 pub struct ImplicitMidpoint {
     /// Step end q₁ = 2q̄ − q₀ of the iterate (q̄ lives in the state's trial-end slot).
     q_end: Vec<f64>,
-    /// Δq = q₁ − q₀ and W Δq = M(q̄)Δq.
-    dq: Vec<f64>,
-    w_dq: Vec<f64>,
-    /// Momentum residual with the constraint force.
-    res: Vec<f64>,
-    zero: Vec<f64>,
+    held: HeldConstraint,
 }
 
 impl ImplicitMidpoint {
@@ -61,10 +56,7 @@ impl ImplicitMidpoint {
     pub fn new(n: usize) -> Self {
         ImplicitMidpoint {
             q_end: vec![0.0; n],
-            dq: vec![0.0; n],
-            w_dq: vec![0.0; n],
-            res: vec![0.0; n],
-            zero: vec![0.0; n],
+            held: HeldConstraint::new(n),
         }
     }
 }
@@ -115,37 +107,23 @@ impl Stepper for ImplicitMidpoint {
             let mut dlambda = 0.0;
             let mut on_surface = true;
             if let Some(k) = constraint.as_deref_mut() {
+                let held = &mut self.held;
                 for i in 0..n {
-                    self.dq[i] = 2.0 * (st.q1[i] - st.q[i]);
-                    self.q_end[i] = st.q[i] + self.dq[i];
+                    held.dq[i] = 2.0 * (st.q1[i] - st.q[i]);
+                    self.q_end[i] = st.q[i] + held.dq[i];
                 }
-                // Metric of the discrete gradient, W Δq = M(q̄)Δq (after the matrix was formed:
-                // it reads the point data of the full residual pass).
-                cx.chain.residual_parts(
-                    t_mid,
-                    &st.q1,
-                    &self.zero,
-                    &self.dq,
-                    Parts::INERTIA,
-                    &mut self.w_dq,
-                );
-                cx.counters.rhs += 1;
-                let view = ConstraintView {
+                let gap1 = held.force(
+                    cx.chain,
+                    cx.counters,
+                    k,
                     it,
-                    t: [t0, t_mid, t1],
-                    q0: &st.q,
-                    q1: &self.q_end,
-                    qbar: &st.q1,
-                    dq: &self.dq,
-                    w_dq: &self.w_dq,
-                    denom: dot(&self.dq, &self.w_dq),
-                    g0,
-                    lambda,
-                };
-                self.res.copy_from_slice(&cx.newton.res);
-                let gap1 = k.add_force(cx.chain, &view, &mut self.res);
+                    [t0, t_mid, t1],
+                    (&st.q, &self.q_end, &st.q1),
+                    (g0, lambda),
+                    &cx.newton.res,
+                );
                 on_surface = (gap1 - gap_target).abs() <= cx.newton.tol;
-                dlambda = k.newton_update(cx.newton, &self.res, 0.5 * h * h, gap1, gap_target);
+                dlambda = k.newton_update(cx.newton, &held.res, 0.5 * h * h, gap1, gap_target);
             } else {
                 cx.newton.delta.copy_from_slice(&cx.newton.res);
                 cx.newton.solve();

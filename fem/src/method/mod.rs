@@ -42,8 +42,9 @@ use std::time::Instant;
 
 use data::Cost;
 
-use crate::chain::Chain;
+use crate::chain::{Chain, Parts};
 use crate::error::FemError;
+use crate::linalg::dot;
 use crate::settings::Method;
 
 /// Work counters.
@@ -192,6 +193,72 @@ pub struct ConstraintView<'a> {
     pub g0: f64,
     /// Normal multiplier of this iterate.
     pub lambda: f64,
+}
+
+/// Work buffers of a held constraint in a method's Newton iteration, and the one operation
+/// the implicit methods share: the constraint force of an iterate on the momentum residual.
+#[derive(Debug, Clone)]
+pub(crate) struct HeldConstraint {
+    /// Δq = q₁ − q₀ of the iterate (filled by the method) and W Δq = M(q̄)Δq.
+    pub dq: Vec<f64>,
+    pub w_dq: Vec<f64>,
+    /// The momentum residual with the constraint force.
+    pub res: Vec<f64>,
+    /// Zeros (the rates of the metric pass; a zero-length step's Δq).
+    pub zero: Vec<f64>,
+}
+
+impl HeldConstraint {
+    /// Buffers for `n` DOFs.
+    pub fn new(n: usize) -> Self {
+        HeldConstraint {
+            dq: vec![0.0; n],
+            w_dq: vec![0.0; n],
+            res: vec![0.0; n],
+            zero: vec![0.0; n],
+        }
+    }
+
+    /// With [`Self::dq`] filled: W Δq at q̄ (after the Newton matrix was formed: it reads the
+    /// point data of the full residual pass), then [`Self::res`] = `residual` minus the
+    /// constraint force of the iterate (times t₀, t_mid, t₁). Returns the constraint value
+    /// Newton must drive to its target ([`StepConstraint::add_force`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn force(
+        &mut self,
+        chain: &mut Chain,
+        counters: &mut Counters,
+        k: &mut dyn StepConstraint,
+        it: usize,
+        t: [f64; 3],
+        (q0, q1, qbar): (&[f64], &[f64], &[f64]),
+        (g0, lambda): (f64, f64),
+        residual: &[f64],
+    ) -> f64 {
+        chain.residual_parts(
+            t[1],
+            qbar,
+            &self.zero,
+            &self.dq,
+            Parts::INERTIA,
+            &mut self.w_dq,
+        );
+        counters.rhs += 1;
+        let view = ConstraintView {
+            it,
+            t,
+            q0,
+            q1,
+            qbar,
+            dq: &self.dq,
+            w_dq: &self.w_dq,
+            denom: dot(&self.dq, &self.w_dq),
+            g0,
+            lambda,
+        };
+        self.res.copy_from_slice(residual);
+        k.add_force(chain, &view, &mut self.res)
+    }
 }
 
 /// A bilateral constraint held during a step (a tip on a surface, optionally with friction),

@@ -2,7 +2,7 @@
 //! t = 0 and after a torque-law discontinuity), with the Newton machinery of
 //! [`crate::method::newton`].
 
-use crate::chain::NewtonCoefficients;
+use crate::chain::{Chain, NewtonCoefficients};
 use crate::error::FemError;
 use crate::linalg::max_abs;
 use crate::method::StepContext;
@@ -18,6 +18,17 @@ pub fn consistent_acceleration(
     if cx.chain.has_massless_dofs() {
         return regularized_acceleration(cx, h, t_law);
     }
+    accelerate_with(cx, t_law, |_, _, _| {})
+}
+
+/// Consistent q̈ under extra forces: solves R(q, q̇, q̈) − F = 0 for q̈, where
+/// `subtract_forces(chain, q, res)` subtracts F(q) from the residual (a held constraint's
+/// force, for a method's restart; chains without massless directions).
+pub fn accelerate_with(
+    cx: &mut StepContext<'_>,
+    t_law: f64,
+    mut subtract_forces: impl FnMut(&Chain, &[f64], &mut [f64]),
+) -> Result<(), FemError> {
     let st = &mut *cx.state;
     let c = NewtonCoefficients {
         c_a: 1.0,
@@ -35,6 +46,7 @@ pub fn consistent_acceleration(
             cx.newton.form(cx.chain, st, cx.counters, c, st.t)?;
             cx.newton.matrix_h = f64::NAN;
         }
+        subtract_forces(cx.chain, &st.q, &mut cx.newton.res);
         cx.newton.delta.copy_from_slice(&cx.newton.res);
         cx.newton.solve();
         let mut big = 0.0f64;
