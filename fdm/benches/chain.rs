@@ -27,7 +27,8 @@ fn bench(c: &mut Criterion) {
         let s = settings(n, 1.0);
         group.bench_function(format!("1s_{n}_stations_implicit_damping"), |b| {
             b.iter(|| {
-                let out = fdm::runs::two_link_chain(&scene, &s).expect("run");
+                let out = fdm::runs::two_link_chain(&scene, scene.planar_chain().unwrap(), &s)
+                    .expect("run");
                 std::hint::black_box(out.cost.steps)
             })
         });
@@ -35,7 +36,9 @@ fn bench(c: &mut Criterion) {
     let s = settings(21, 0.1);
     group.bench_function("0.1s_21_stations_explicit_damping", |b| {
         b.iter(|| {
-            let mut sys = TwoLinkChain::from_scene(&scene, s.stations).expect("chain");
+            let mut sys =
+                TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), s.stations)
+                    .expect("chain");
             let (q0, v0) = sys.initial_state();
             let ctl = StepControl {
                 method: fdm::Method::VelocityForm,

@@ -14,7 +14,8 @@ fn bench(c: &mut Criterion) {
             .expect("valid settings");
         c.bench_function(&format!("rocket_0.1s_76_stations_{label}"), |b| {
             b.iter(|| {
-                let (_, out) = fdm::runs::rocket_with(&scene, &s, true).expect("run");
+                let (_, out) =
+                    fdm::runs::rocket_with(&scene, scene.rocket().unwrap(), &s, true).expect("run");
                 std::hint::black_box(out.cost.steps)
             })
         });
@@ -28,7 +29,8 @@ fn bench(c: &mut Criterion) {
             .expect("valid settings");
         c.bench_function(&format!("rocket_0.01s_{n}_stations_velocity-form"), |b| {
             b.iter(|| {
-                let (_, out) = fdm::runs::rocket_with(&scene, &s, true).expect("run");
+                let (_, out) =
+                    fdm::runs::rocket_with(&scene, scene.rocket().unwrap(), &s, true).expect("run");
                 std::hint::black_box(out.cost.steps)
             })
         });

@@ -21,7 +21,10 @@ fn main() {
     let (stations, count) = (parse(2, 21), parse(3, 6));
     let result = load_scene(name)
         .map_err(|e| e.to_string())
-        .and_then(|s| PayloadLinkModel::from_scene(&s, Some(stations)).map_err(|e| e.to_string()))
+        .and_then(|s| {
+            PayloadLinkModel::from_payload_link(&s, s.payload_link().unwrap(), Some(stations))
+                .map_err(|e| e.to_string())
+        })
         .and_then(|m| m.spectrum().map_err(|e| e.to_string()));
     match result {
         Ok(sp) => {

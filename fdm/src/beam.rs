@@ -10,7 +10,7 @@
 
 use data::{
     BackendKind, Cost, DofPlan, ModalResult, ModeShape, Scene, StaticResult,
-    scene::PrescribedMotion,
+    scene::{PlanarChain, PrescribedMotion},
 };
 use faer::prelude::Solve;
 use faer::{Mat, Side};
@@ -36,16 +36,21 @@ pub struct Cantilever {
 }
 
 impl Cantilever {
-    /// Accepts single clamped links whose switched-on physics this module builds.
-    pub fn from_scene(scene: &Scene, stations: Option<usize>) -> Result<Self, FdmError> {
-        if scene.links().len() != 1 {
+    /// Accepts single clamped links of `pc`, the chain of `scene`, whose switched-on physics
+    /// this module builds.
+    pub fn from_planar_chain(
+        scene: &Scene,
+        pc: &PlanarChain,
+        stations: Option<usize>,
+    ) -> Result<Self, FdmError> {
+        if pc.links.len() != 1 {
             return Err(FdmError::Unsupported(format!(
                 "fdm: `{}` has {} links; only the single clamped link (cantilever family) is implemented for beams",
                 scene.name,
-                scene.links().len()
+                pc.links.len()
             )));
         }
-        let l = &scene.links()[0];
+        let l = &pc.links[0];
         let spin = match l.joint.prescribed {
             Some(PrescribedMotion::Fixed) => 0.0,
             Some(PrescribedMotion::ConstantRate { rate }) => l.joint.initial_rate + rate,
@@ -65,8 +70,8 @@ impl Cantilever {
                 ("rotary_inertia", l.rotary_inertia),
                 ("kelvin_voigt", l.kelvin_voigt.is_some()),
                 ("tip_inertia", l.tip_inertia.is_some()),
-                ("gravity", scene.gravity().is_some()),
-                ("contact", !scene.contacts().is_empty()),
+                ("gravity", pc.gravity.as_ref().is_some()),
+                ("contact", !pc.contacts.is_empty()),
             ],
         )?;
         let n = stations.unwrap_or(DEFAULT_STATIONS);
@@ -202,8 +207,12 @@ impl Cantilever {
     }
 }
 
-pub fn dof_plan(scene: &Scene, stations: Option<usize>) -> Result<DofPlan, FdmError> {
-    let c = Cantilever::from_scene(scene, stations)?;
+pub fn dof_plan(
+    scene: &Scene,
+    pc: &PlanarChain,
+    stations: Option<usize>,
+) -> Result<DofPlan, FdmError> {
+    let c = Cantilever::from_planar_chain(scene, pc, stations)?;
     let mut plan = DofPlan::default();
     plan.add("transverse w at stations (clamp excluded)", c.dofs());
     if c.spin != 0.0 && c.foreshortening {
@@ -217,9 +226,14 @@ pub fn dof_plan(scene: &Scene, stations: Option<usize>) -> Result<DofPlan, FdmEr
     Ok(plan)
 }
 
-pub fn modes(scene: &Scene, s: &ValidatedSettings, count: usize) -> Result<ModalResult, FdmError> {
+pub fn modes(
+    scene: &Scene,
+    pc: &PlanarChain,
+    s: &ValidatedSettings,
+    count: usize,
+) -> Result<ModalResult, FdmError> {
     let clock = std::time::Instant::now();
-    let c = Cantilever::from_scene(scene, s.stations)?;
+    let c = Cantilever::from_planar_chain(scene, pc, s.stations)?;
     let (omega, shapes) = c.eigen()?;
     let count = count.min(c.dofs());
     let x: Vec<f64> = (0..c.stations).map(|i| i as f64 * c.h).collect();
@@ -258,14 +272,19 @@ pub fn modes(scene: &Scene, s: &ValidatedSettings, count: usize) -> Result<Modal
     })
 }
 
-pub fn statics(scene: &Scene, s: &ValidatedSettings) -> Result<StaticResult, FdmError> {
-    if scene.links().len() == 1 && scene.links()[0].shear {
-        return timoshenko_statics(scene, s);
+pub fn statics(
+    scene: &Scene,
+    pc: &PlanarChain,
+    s: &ValidatedSettings,
+) -> Result<StaticResult, FdmError> {
+    if pc.links.len() == 1 && pc.links[0].shear {
+        return timoshenko_statics(scene, pc, s);
     }
     let clock = std::time::Instant::now();
-    let c = Cantilever::from_scene(scene, s.stations)?;
-    let st = scene
-        .statics()
+    let c = Cantilever::from_planar_chain(scene, pc, s.stations)?;
+    let st = pc
+        .statics
+        .as_ref()
         .ok_or_else(|| FdmError::Unsupported(format!("`{}` has no [statics] loads", scene.name)))?;
     let w = c.static_deflection(
         st.tip_force.unwrap_or(0.0),
@@ -294,9 +313,13 @@ pub fn statics(scene: &Scene, s: &ValidatedSettings) -> Result<StaticResult, Fdm
 /// v₀ = ψ₀ = 0, tip force and lumped distributed load. Reported rotation: ψ(L) (the convention's
 /// "slope"). Section rotary inertia does not enter statics (accepted); axial fields, tip
 /// inertia, gravity and contact are refused as for the Euler beam.
-fn timoshenko_statics(scene: &Scene, s: &ValidatedSettings) -> Result<StaticResult, FdmError> {
+fn timoshenko_statics(
+    scene: &Scene,
+    pc: &PlanarChain,
+    s: &ValidatedSettings,
+) -> Result<StaticResult, FdmError> {
     let clock = std::time::Instant::now();
-    let l = &scene.links()[0];
+    let l = &pc.links[0];
     if !matches!(l.joint.prescribed, Some(PrescribedMotion::Fixed)) {
         return Err(FdmError::Unsupported(format!(
             "fdm: statics of the Timoshenko link `{}` need a fixed clamp",
@@ -309,13 +332,14 @@ fn timoshenko_statics(scene: &Scene, s: &ValidatedSettings) -> Result<StaticResu
         &[
             ("axial", l.axial),
             ("tip_inertia", l.tip_inertia.is_some()),
-            ("gravity", scene.gravity().is_some()),
-            ("contact", !scene.contacts().is_empty()),
+            ("gravity", pc.gravity.as_ref().is_some()),
+            ("contact", !pc.contacts.is_empty()),
         ],
     )?;
     let kga = crate::chain::timoshenko::shear_stiffness(&scene.name, l)?;
-    let st = scene
-        .statics()
+    let st = pc
+        .statics
+        .as_ref()
         .ok_or_else(|| FdmError::Unsupported(format!("`{}` has no [statics] loads", scene.name)))?;
     let n = s.stations.unwrap_or(DEFAULT_STATIONS);
     let (v, psi) = crate::chain::timoshenko::TimoFields::cantilever_statics(

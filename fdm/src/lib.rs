@@ -5,7 +5,8 @@
 //!   powers, stored energies, step bound, constraint projections). Implementations:
 //!   [`rocket::system`], [`link`], [`chain`]; [`beam`] for modes and statics; [`payload_link`]
 //!   (the 3-D link) carries its own model, stepping and outputs.
-//!   [`ModelChoice`] classifies a scene once.
+//!   The backend's entries match the scene's family once; [`ChainModel`] classifies a planar
+//!   chain.
 //! * **Method** — [`method::Stepper`], one type per method ([`method::two_step`],
 //!   [`method::velocity_form`]); [`method::stepper`] maps `time.method` to its type.
 //! * **Events** — [`events::Events`]: located inside a step, applied as resets and constraint
@@ -199,9 +200,10 @@ pub mod runs;
 pub mod settings;
 pub mod system;
 
+use data::scene::{Model, PlanarChain, PrescribedMotion};
 use data::{
-    Backend, BackendError, BackendKind, Discretization, DofPlan, Family, ModalResult, RunResult,
-    Scene, Settings, StaticResult,
+    Backend, BackendError, BackendKind, Discretization, DofPlan, ModalResult, RunResult, Scene,
+    Settings, StaticResult,
 };
 
 pub use error::FdmError;
@@ -211,48 +213,42 @@ pub use settings::{Method, ValidatedSettings};
 #[derive(Debug, Clone, Copy, Default)]
 pub struct FdmBackend;
 
-/// The model a scene becomes in this backend (the one place a scene is classified).
+/// The model a planar chain becomes in this backend (the one place a chain is classified; the
+/// other families have one model each).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ModelChoice {
-    /// The two-stage variable-mass rocket ([`rocket`]).
-    Rocket,
+pub enum ChainModel {
     /// One link clamped to the ground: modes and statics ([`beam`]).
     Cantilever,
     /// One link on a hub, prescribed or torque driven ([`link`]).
     SingleLink,
     /// Two links in series, with its tip contact if any ([`chain`]).
     TwoLinkChain,
-    /// The 3-D link with an offset payload ([`payload_link`]).
-    PayloadLink,
 }
 
-impl ModelChoice {
-    /// The model of `scene`; `Unsupported` for families and chains this backend does not carry.
-    pub fn of(scene: &Scene) -> Result<Self, FdmError> {
-        match scene.family() {
-            Family::Rocket => Ok(ModelChoice::Rocket),
-            Family::PayloadLink => Ok(ModelChoice::PayloadLink),
-            Family::PlanarChain => Ok(match scene.links().len() {
-                1 if matches!(
-                    scene.links()[0].joint.prescribed,
-                    Some(data::scene::PrescribedMotion::Fixed)
-                ) =>
-                {
-                    ModelChoice::Cantilever
-                }
-                2 => ModelChoice::TwoLinkChain,
-                // more than two links: refused with the link model's precise message
-                _ => ModelChoice::SingleLink,
-            }),
-            _ => Err(FdmError::Unsupported(format!(
-                "fdm backend: {} scenes (`{}`) are not implemented",
-                scene.family(),
-                scene.name
-            ))),
+impl ChainModel {
+    /// The model of `pc`, by its number of links.
+    pub fn of(pc: &PlanarChain) -> Self {
+        match pc.links.as_slice() {
+            [l] if matches!(l.joint.prescribed, Some(PrescribedMotion::Fixed)) => {
+                ChainModel::Cantilever
+            }
+            [_, _] => ChainModel::TwoLinkChain,
+            // more than two links: refused with the link model's precise message
+            _ => ChainModel::SingleLink,
         }
     }
 }
 
+/// The refusal of a family this backend does not solve.
+fn unsupported_family(scene: &Scene) -> FdmError {
+    FdmError::Unsupported(format!(
+        "fdm backend: {} scenes (`{}`) are not implemented",
+        scene.family(),
+        scene.name
+    ))
+}
+
+// Each entry dispatches on the scene's model family once and hands the family on.
 impl Backend for FdmBackend {
     fn kind(&self) -> BackendKind {
         BackendKind::Fdm
@@ -260,18 +256,21 @@ impl Backend for FdmBackend {
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
         let s = ValidatedSettings::from_settings(&disc.fdm()?)?;
-        Ok(match ModelChoice::of(scene)? {
-            ModelChoice::Rocket => rocket::dof_plan(scene, s.stations)?,
-            ModelChoice::Cantilever => beam::dof_plan(scene, s.stations)?,
-            ModelChoice::TwoLinkChain => {
-                chain::TwoLinkChain::from_scene(scene, s.stations)?.dof_plan()
+        Ok(match &scene.model {
+            Model::PlanarChain(pc) => match ChainModel::of(pc) {
+                ChainModel::Cantilever => beam::dof_plan(scene, pc, s.stations)?,
+                ChainModel::TwoLinkChain => {
+                    chain::TwoLinkChain::from_planar_chain(scene, pc, s.stations)?.dof_plan()
+                }
+                ChainModel::SingleLink => {
+                    link::FloatingLink::from_planar_chain(scene, pc, s.stations)?.dof_plan()
+                }
+            },
+            Model::Rocket(r) => rocket::dof_plan(r, s.stations)?,
+            Model::PayloadLink(p) => {
+                payload_link::PayloadLinkModel::from_payload_link(scene, p, s.stations)?.dof_plan()
             }
-            ModelChoice::SingleLink => {
-                link::FloatingLink::from_scene(scene, s.stations)?.dof_plan()
-            }
-            ModelChoice::PayloadLink => {
-                payload_link::PayloadLinkModel::from_scene(scene, s.stations)?.dof_plan()
-            }
+            Model::MobileManipulator(_) => return Err(unsupported_family(scene).into()),
         })
     }
 
@@ -282,39 +281,44 @@ impl Backend for FdmBackend {
         count: usize,
     ) -> Result<ModalResult, BackendError> {
         let s = ValidatedSettings::from_settings(&settings.fdm()?)?;
-        match ModelChoice::of(scene)? {
-            ModelChoice::Rocket => Err(BackendError::Unsupported(
+        match &scene.model {
+            Model::PlanarChain(pc) => match ChainModel::of(pc) {
+                ChainModel::TwoLinkChain => Ok(chain::modes::modes(scene, pc, &s, count)?),
+                ChainModel::Cantilever | ChainModel::SingleLink => {
+                    Ok(beam::modes(scene, pc, &s, count)?)
+                }
+            },
+            Model::Rocket(_) => Err(BackendError::Unsupported(
                 "fdm modes of the rocket: the variable-mass body has no fixed modes; use `run`"
                     .into(),
             )),
-            ModelChoice::TwoLinkChain => Ok(chain::modes::modes(scene, &s, count)?),
-            ModelChoice::PayloadLink => Ok(payload_link::analysis::modes(scene, &s, count)?),
-            _ => Ok(beam::modes(scene, &s, count)?),
+            Model::PayloadLink(p) => Ok(payload_link::analysis::modes(scene, p, &s, count)?),
+            Model::MobileManipulator(_) => Err(unsupported_family(scene).into()),
         }
     }
 
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
         let s = ValidatedSettings::from_settings(&settings.fdm()?)?;
-        if scene.family() == Family::PlanarChain {
-            return Ok(beam::statics(scene, &s)?);
+        match &scene.model {
+            Model::PlanarChain(pc) => Ok(beam::statics(scene, pc, &s)?),
+            Model::PayloadLink(p) => Ok(payload_link::analysis::statics(scene, p, &s)?),
+            Model::Rocket(_) | Model::MobileManipulator(_) => Err(BackendError::Unsupported(
+                format!("fdm statics for {} scenes", scene.family()),
+            )),
         }
-        if scene.family() == Family::PayloadLink {
-            return Ok(payload_link::analysis::statics(scene, &s)?);
-        }
-        Err(BackendError::Unsupported(format!(
-            "fdm statics for {} scenes",
-            scene.family()
-        )))
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
         let s = ValidatedSettings::from_settings(&settings.fdm()?)?;
-        Ok(match ModelChoice::of(scene)? {
-            ModelChoice::Rocket => runs::rocket(scene, &s)?,
-            ModelChoice::Cantilever => return Err(beam::simulate_unsupported(scene).into()),
-            ModelChoice::TwoLinkChain => runs::two_link_chain(scene, &s)?,
-            ModelChoice::SingleLink => runs::single_link(scene, &s)?,
-            ModelChoice::PayloadLink => payload_link::run::simulate(scene, &s)?,
+        Ok(match &scene.model {
+            Model::PlanarChain(pc) => match ChainModel::of(pc) {
+                ChainModel::Cantilever => return Err(beam::simulate_unsupported(scene).into()),
+                ChainModel::TwoLinkChain => runs::two_link_chain(scene, pc, &s)?,
+                ChainModel::SingleLink => runs::single_link(scene, pc, &s)?,
+            },
+            Model::Rocket(r) => runs::rocket(scene, r, &s)?,
+            Model::PayloadLink(p) => payload_link::run::simulate(scene, p, &s)?,
+            Model::MobileManipulator(_) => return Err(unsupported_family(scene).into()),
         })
     }
 }

@@ -1,6 +1,7 @@
 //! Each model's run, built from the scene: the model, its method (the scene's `time.method` or
 //! the model's default), its events, the step control, then [`crate::driver::run`].
 
+use data::scene::{PlanarChain, Rocket};
 use data::{RunResult, Scene};
 
 use crate::chain::TwoLinkChain;
@@ -25,21 +26,20 @@ pub const TIMOSHENKO_CONTACT_SAFETY: f64 = 0.1;
 /// false` to show what happens above the bound).
 pub fn rocket_with(
     scene: &Scene,
+    r: &Rocket,
     s: &ValidatedSettings,
     enforce_bound: bool,
 ) -> Result<(RocketSystem, Outcome), FdmError> {
-    let r = scene
-        .rocket()
-        .ok_or_else(|| FdmError::Unsupported("scene has no [rocket]".into()))?;
-    let mut sys = crate::rocket::build(scene, s)?;
+    let mut sys = crate::rocket::build(scene, r, s)?;
     let (q0, v0) = sys.initial_state(&r.initial_shape);
     let ctl = StepControl::for_scene(scene, s, s.method, true, enforce_bound);
     let out = integrate(&mut sys, &q0, &v0, &ctl)?;
     Ok((sys, out))
 }
 
-pub fn rocket(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult, FdmError> {
-    let (_, out) = rocket_with(scene, s, true)?;
+/// Runs `r`, the rocket of `scene`.
+pub fn rocket(scene: &Scene, r: &Rocket, s: &ValidatedSettings) -> Result<RunResult, FdmError> {
+    let (_, out) = rocket_with(scene, r, s, true)?;
     Ok(out.into_run_result(scene, s))
 }
 
@@ -57,8 +57,12 @@ pub fn default_method(s: &ValidatedSettings, sys: &dyn System) -> Method {
 
 /// Runs one link on its hub (method: [`default_method`] — the velocity form for a torque-driven
 /// hub or Kelvin–Voigt damping, the report's two-step scheme for a prescribed undamped hub).
-pub fn single_link(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult, FdmError> {
-    let mut sys = FloatingLink::from_scene(scene, s.stations)?;
+pub fn single_link(
+    scene: &Scene,
+    pc: &PlanarChain,
+    s: &ValidatedSettings,
+) -> Result<RunResult, FdmError> {
+    let mut sys = FloatingLink::from_planar_chain(scene, pc, s.stations)?;
     let (q0, v0) = sys.initial_state();
     let method = default_method(s, &sys);
     let ctl = StepControl::for_scene(scene, s, method, false, true);
@@ -68,11 +72,15 @@ pub fn single_link(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult, Fd
 /// Runs a two-link chain. Default method (no `time.method`): the one-step velocity form — the
 /// free joints make the inertia forces velocity dependent and damping is on in the damped scene,
 /// both of which grow the two-step scheme's computational mode.
-pub fn two_link_chain(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult, FdmError> {
-    if !scene.contacts().is_empty() {
-        return Ok(two_link_chain_with_contact(scene, s)?.0);
+pub fn two_link_chain(
+    scene: &Scene,
+    pc: &PlanarChain,
+    s: &ValidatedSettings,
+) -> Result<RunResult, FdmError> {
+    if !pc.contacts.is_empty() {
+        return Ok(two_link_chain_with_contact(scene, pc, s)?.0);
     }
-    let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
+    let mut sys = TwoLinkChain::from_planar_chain(scene, pc, s.stations)?;
     let method = if s.requested.method.is_none() {
         Method::VelocityForm
     } else {
@@ -92,6 +100,7 @@ pub fn two_link_chain(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult,
 /// ([`TipContactEvents`]). Returns the run and the contact diagnostics.
 pub fn two_link_chain_with_contact(
     scene: &Scene,
+    pc: &PlanarChain,
     s: &ValidatedSettings,
 ) -> Result<(RunResult, ContactReport), FdmError> {
     if s.requested.method.is_some() && s.method != Method::VelocityForm {
@@ -101,7 +110,7 @@ pub fn two_link_chain_with_contact(
             s.method.name()
         )));
     }
-    let mut sys = TwoLinkChain::from_scene(scene, s.stations)?;
+    let mut sys = TwoLinkChain::from_planar_chain(scene, pc, s.stations)?;
     let (q0, v0) = sys.initial_state();
     let mut ctl = StepControl::for_scene(scene, s, Method::VelocityForm, false, true);
     if sys.timoshenko().is_some() && s.requested.safety_factor.is_none() {

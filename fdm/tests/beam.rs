@@ -73,7 +73,7 @@ fn sys_cantilever_dof_plan_counts() {
 #[test]
 fn elem_cantilever_rows_equal_ghost_node_stencils() {
     let scene = load_scene("cantilever").unwrap();
-    let c = Cantilever::from_scene(&scene, Some(12)).unwrap();
+    let c = Cantilever::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(12)).unwrap();
     let k = c.stiffness();
     let m = c.masses();
     let n = c.dofs();

@@ -14,7 +14,8 @@ mod common;
 #[test]
 fn elem_chain_momenta_and_gradient_are_derivatives_of_the_kinetic_energy() {
     let scene = load_scene("two-link-free").unwrap();
-    let sys = TwoLinkChain::from_scene(&scene, Some(9)).unwrap();
+    let sys =
+        TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9)).unwrap();
     let ine = &sys.inertia;
     let n = sys.dofs();
     let (q, v) = common::moving_chain_state(sys.dofs());
@@ -76,7 +77,8 @@ fn elem_chain_momenta_and_gradient_are_derivatives_of_the_kinetic_energy() {
 #[test]
 fn elem_chain_momentum_values_are_the_dual_values_bit_for_bit() {
     let scene = load_scene("two-link-free").unwrap();
-    let sys = TwoLinkChain::from_scene(&scene, Some(9)).unwrap();
+    let sys =
+        TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9)).unwrap();
     let ine = &sys.inertia;
     let n = ine.dofs();
     let (q, v) = common::moving_chain_state(sys.dofs());
@@ -94,7 +96,8 @@ fn elem_chain_forces_are_minus_potential_gradients() {
     // accelerations with q̇ = 0 and no dampers: M a = −∂V/∂q; check M a against FD of V.
     let mut scene = load_scene("two-link-free-undamped").unwrap();
     scene.planar_chain_mut().unwrap().links[1].joint.set_point = Some(0.3);
-    let mut sys = TwoLinkChain::from_scene(&scene, Some(9)).unwrap();
+    let mut sys =
+        TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9)).unwrap();
     let n = sys.dofs();
     let (q, _) = common::moving_chain_state(sys.dofs());
     let v = vec![0.0; n];
@@ -589,7 +592,9 @@ fn sys_chain_overextension_is_the_clamp_frame_tip_deflection_past_the_length() {
     for (name, per_h) in [("two-link-free", 0.5), ("barhorst-case1-timoshenko", 1.0)] {
         let scene = load_scene(name).unwrap();
         let stations = 11;
-        let sys = TwoLinkChain::from_scene(&scene, Some(stations)).unwrap();
+        let sys =
+            TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(stations))
+                .unwrap();
         let l1 = scene.links()[0].length;
         let h = l1 / (stations - 1) as f64;
         let (q0, _) = sys.initial_state();

@@ -24,6 +24,7 @@ fn run(scene: &str, stations: usize, t_end: f64) -> (RunResult, ContactReport) {
     let s = settings(stations, t_end);
     let (r, rep) = simulate(
         &scene,
+        scene.planar_chain().unwrap(),
         &ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap(),
     )
     .unwrap();
@@ -184,7 +185,9 @@ fn dyn_contact_stiff_elbow_rests_on_the_tip_at_the_static_force() {
     assert!(hi - lo < 1e-2 * resting);
     // the static equilibrium of the same discrete model, from the final state as a guess
     let scene = load_scene("barhorst-case1-stiff-elbow").unwrap();
-    let mut sys = TwoLinkChain::from_scene(&scene, Some(stations)).unwrap();
+    let mut sys =
+        TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(stations))
+            .unwrap();
     let (q0, _) = sys.initial_state();
     let (q, stat) = sys.rest_on_surface(&q0).unwrap();
     assert!(sys.gap(&q).abs() < 1e-12);
@@ -275,6 +278,7 @@ fn elem_contact_gravity_force_is_minus_the_potential_gradient() {
         .unwrap();
     // the arm falls: gravity potential drops by more than the initial kinetic energy
     assert!(grav.values.last().unwrap() < &(grav.values[0] - 1.0));
-    let sys = TwoLinkChain::from_scene(&scene, Some(11)).unwrap();
+    let sys =
+        TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(11)).unwrap();
     assert!(sys.ledger_names().0.contains(&"gravity"));
 }

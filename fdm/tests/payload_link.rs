@@ -67,7 +67,7 @@ fn sys_payload_link_dof_counts_per_scene() {
         p.fields = vec![LinkField::Vertical, LinkField::Torsion]
     });
     assert_eq!(total(&two), 2 * 20 + 1);
-    let m = PayloadLinkModel::from_scene(&two, None).unwrap();
+    let m = PayloadLinkModel::from_payload_link(&two, two.payload_link().unwrap(), None).unwrap();
     let (stored, inputs, diss) = m.ledger_names();
     assert_eq!(stored, ["kinetic", "strain", "gravity"]);
     assert_eq!(inputs, ["applied_torque"]);
@@ -93,28 +93,36 @@ fn sys_payload_link_dof_counts_per_scene() {
             .iter()
             .any(|b| b.contains("gravity") || b.contains("Kelvin"))
     );
-    let (stored, _, diss) = PayloadLinkModel::from_scene(&flat, None)
-        .unwrap()
-        .ledger_names();
+    let (stored, _, diss) =
+        PayloadLinkModel::from_payload_link(&flat, flat.payload_link().unwrap(), None)
+            .unwrap()
+            .ledger_names();
     assert_eq!(stored, ["kinetic", "strain"]);
     assert!(diss.is_empty());
     // soft sag: clamped base, KV on the two bending fields only
-    let soft = PayloadLinkModel::from_scene(&load_scene("single-link-3d-soft-sag").unwrap(), None)
-        .unwrap();
+    let soft_sag = load_scene("single-link-3d-soft-sag").unwrap();
+    let soft =
+        PayloadLinkModel::from_payload_link(&soft_sag, soft_sag.payload_link().unwrap(), None)
+            .unwrap();
     let (stored, inputs, diss) = soft.ledger_names();
     assert_eq!(stored, ["kinetic", "strain", "gravity"]);
     assert_eq!(inputs, ["prescribed_motion"]);
     assert_eq!(diss, ["kelvin_voigt_horizontal", "kelvin_voigt_vertical"]);
     // stiff: no gravity
-    let stiff =
-        PayloadLinkModel::from_scene(&load_scene("single-link-3d-stiff").unwrap(), None).unwrap();
+    let stiff_scene = load_scene("single-link-3d-stiff").unwrap();
+    let stiff = PayloadLinkModel::from_payload_link(
+        &stiff_scene,
+        stiff_scene.payload_link().unwrap(),
+        None,
+    )
+    .unwrap();
     assert_eq!(stiff.ledger_names().0, ["kinetic", "strain"]);
 }
 
 #[test]
 fn dyn_payload_link_refuses_a_step_above_the_bound_naming_the_field() {
     let s = load_scene("single-link-3d").unwrap();
-    let m = PayloadLinkModel::from_scene(&s, None).unwrap();
+    let m = PayloadLinkModel::from_payload_link(&s, s.payload_link().unwrap(), None).unwrap();
     let bounds = m.field_bounds();
     let axial = bounds.iter().find(|b| b.0 == LinkField::Axial).unwrap().1;
     match FdmBackend.simulate(&s, &settings(None, Some(1e-3), Some(1.01 * axial))) {
@@ -130,7 +138,7 @@ fn dyn_payload_link_refuses_a_step_above_the_bound_naming_the_field() {
     let s2 = scene("single-link-3d", |p| {
         p.fields = vec![LinkField::Vertical, LinkField::Torsion]
     });
-    let m2 = PayloadLinkModel::from_scene(&s2, None).unwrap();
+    let m2 = PayloadLinkModel::from_payload_link(&s2, s2.payload_link().unwrap(), None).unwrap();
     let torsion = m2
         .field_bounds()
         .iter()
@@ -230,7 +238,7 @@ fn conv_payload_link_static_sag_against_the_closed_form() {
 
 /// Frequencies (Hz) and kinds at `n` stations.
 fn spectrum(s: &Scene, n: usize) -> (Vec<f64>, Vec<String>) {
-    let sp = PayloadLinkModel::from_scene(s, Some(n))
+    let sp = PayloadLinkModel::from_payload_link(s, s.payload_link().unwrap(), Some(n))
         .unwrap()
         .spectrum()
         .unwrap();

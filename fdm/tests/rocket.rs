@@ -25,7 +25,9 @@ fn settings(method: &str) -> (Settings, ValidatedSettings) {
 
 fn run(scene: &Scene, method: &str) -> fdm::output::Outcome {
     let (_, f) = settings(method);
-    fdm::runs::rocket_with(scene, &f, true).expect("run").1
+    fdm::runs::rocket_with(scene, scene.rocket().unwrap(), &f, true)
+        .expect("run")
+        .1
 }
 
 fn ch<'a>(o: &'a Observables, name: &str) -> &'a [f64] {
@@ -354,6 +356,7 @@ fn dyn_rocket_report_two_step_at_the_reports_own_sigma_blows_up() {
     let (mut s, _) = settings("report");
     let sys = fdm::rocket::build(
         &scene,
+        scene.rocket().unwrap(),
         &ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap(),
     )
     .unwrap();
@@ -361,7 +364,7 @@ fn dyn_rocket_report_two_step_at_the_reports_own_sigma_blows_up() {
     s.time.dt = Some(0.999 * sigma);
     s.time.t_end = Some(0.005);
     let f = ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
-    let (_, out) = fdm::runs::rocket_with(&scene, &f, false).unwrap();
+    let (_, out) = fdm::runs::rocket_with(&scene, scene.rocket().unwrap(), &f, false).unwrap();
     match &out.verdict {
         StabilityVerdict::Stopped { diagnostic } => {
             eprintln!("report at σ: {diagnostic}");
@@ -372,7 +375,7 @@ fn dyn_rocket_report_two_step_at_the_reports_own_sigma_blows_up() {
     }
     s.time.method = Some("velocity-form".parse().expect("a method name"));
     let f = ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
-    let (_, out) = fdm::runs::rocket_with(&scene, &f, true).unwrap();
+    let (_, out) = fdm::runs::rocket_with(&scene, scene.rocket().unwrap(), &f, true).unwrap();
     assert!(matches!(out.verdict, StabilityVerdict::Completed));
 }
 
@@ -494,7 +497,7 @@ fn prop_rocket_split_satisfies_5_37_exactly() {
         let mut s = Settings::default();
         s.discretization.stations = Some(n);
         let f = ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
-        let mut sys = fdm::rocket::build(&scene, &f).unwrap();
+        let mut sys = fdm::rocket::build(&scene, scene.rocket().unwrap(), &f).unwrap();
         let dofs = sys.dofs();
         let mut q: Vec<f64> = (0..dofs).map(|_| 1e-2 * rng.next()).collect();
         let v: Vec<f64> = (0..dofs).map(|_| rng.next()).collect();
@@ -568,7 +571,7 @@ fn sys_rocket_initial_shape_is_elastic_with_respect_to_ignition_mass() {
     let scene = load_scene("rocket").unwrap();
     let r = scene.rocket().unwrap();
     let (_, f) = settings("report");
-    let sys = fdm::rocket::build(&scene, &f).unwrap();
+    let sys = fdm::rocket::build(&scene, scene.rocket().unwrap(), &f).unwrap();
     let (q, _) = sys.initial_state(&r.initial_shape);
     let m = &sys.model;
     let w = &q[sys.w_range()];

@@ -11,7 +11,7 @@ fn field(stations: usize, prefix: &str, t_end: f64, method: &str) -> Vec<f64> {
     s.time.t_end = Some(t_end);
     s.time.method = Some(method.parse().expect("a method name"));
     let f = ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
-    let (_, out) = fdm::runs::rocket_with(&scene, &f, true).unwrap();
+    let (_, out) = fdm::runs::rocket_with(&scene, scene.rocket().unwrap(), &f, true).unwrap();
     let o = &out.observables;
     (0..scene.simulation.field_stations)
         .map(|k| {

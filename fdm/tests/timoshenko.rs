@@ -41,7 +41,7 @@ fn chain_with_springs() -> TwoLinkChain {
     sc.planar_chain_mut().unwrap().links[0].joint.stiffness = Some(35.0);
     sc.planar_chain_mut().unwrap().links[0].joint.set_point = Some(0.3);
     sc.planar_chain_mut().unwrap().links[1].joint.set_point = Some(-0.2);
-    TwoLinkChain::from_scene(&sc, Some(9)).unwrap()
+    TwoLinkChain::from_planar_chain(&sc, sc.planar_chain().unwrap(), Some(9)).unwrap()
 }
 
 #[test]
@@ -281,6 +281,7 @@ fn dyn_timoshenko_case1_impacts_and_ledger() {
     s.time.safety_factor = Some(0.1);
     let (r, rep) = simulate(
         &scene,
+        scene.planar_chain().unwrap(),
         &ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap(),
     )
     .unwrap();
@@ -321,6 +322,7 @@ fn first_events(scene: &Scene, stations: usize, t_end: f64) -> (f64, f64) {
     s.time.safety_factor = Some(1.0);
     let (r, _) = simulate(
         scene,
+        scene.planar_chain().unwrap(),
         &ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap(),
     )
     .unwrap();
@@ -409,7 +411,8 @@ fn elem_timoshenko_top_frequency_is_the_shear_sawtooth() {
     // h = 0.1) must match that value and stay below the bound, for soft and stiff shear.
     for kga in [1.0e6, 1.0e8] {
         let sc = sheared("barhorst-case1", kga);
-        let sys = TwoLinkChain::from_scene(&sc, Some(21)).unwrap();
+        let sys =
+            TwoLinkChain::from_planar_chain(&sc, sc.planar_chain().unwrap(), Some(21)).unwrap();
         let (l2, r) = (&sc.links()[1], 20.0);
         let h = l2.length / r;
         let (ei, rho_a) = (l2.bending_stiffness, l2.mass_per_length);

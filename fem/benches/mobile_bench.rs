@@ -17,7 +17,12 @@ fn one_step(c: &mut Criterion) {
         let mut s = Settings::default();
         s.discretization.elements = Some(n);
         s.time.dt = Some(3.2e-4);
-        let mut p = prepare(&sc, &s.fem().expect("fem settings")).unwrap();
+        let mut p = prepare(
+            &sc,
+            sc.mobile_manipulator().unwrap(),
+            &s.fem().expect("fem settings"),
+        )
+        .unwrap();
         let h = p.h;
         g.bench_with_input(BenchmarkId::new("implicit_midpoint", n), &n, |b, _| {
             b.iter(|| p.stepper.step(black_box(h)).unwrap())

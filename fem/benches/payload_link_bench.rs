@@ -16,7 +16,12 @@ fn one_step(c: &mut Criterion) {
     for n in [8, 16, 32] {
         let mut s = Settings::default();
         s.discretization.elements = Some(n);
-        let mut p = prepare(&sc, &s.fem().expect("fem settings")).unwrap();
+        let mut p = prepare(
+            &sc,
+            sc.payload_link().unwrap(),
+            &s.fem().expect("fem settings"),
+        )
+        .unwrap();
         let h = p.h;
         g.bench_with_input(BenchmarkId::new("implicit_midpoint", n), &n, |b, _| {
             b.iter(|| p.stepper.step(black_box(h)).unwrap())

@@ -291,12 +291,12 @@ impl Backend for FemBackend {
                 let n_el = settings::elements(settings)?;
                 Ok(plan::dof_plan(&scene.name, pc, n_el, settings.element)?)
             }
-            Model::PayloadLink(_) => {
+            Model::PayloadLink(l) => {
                 let n_el = settings::elements(settings)?;
-                Ok(payload_link::dof_plan(scene, n_el)?)
+                Ok(payload_link::dof_plan(l, n_el)?)
             }
-            Model::Rocket(_) => Ok(rocket::dof_plan(scene, settings)?),
-            Model::MobileManipulator(_) => Ok(mobile::dof_plan(scene, settings)?),
+            Model::Rocket(r) => Ok(rocket::dof_plan(r, settings)?),
+            Model::MobileManipulator(mm) => Ok(mobile::dof_plan(mm, settings)?),
         }
     }
 
@@ -312,8 +312,8 @@ impl Backend for FemBackend {
                 Ok(chain::linearized::modes(scene, pc, settings, count)?)
             }
             Model::PlanarChain(pc) => Ok(self.modes_impl(scene, pc, settings, count)?),
-            Model::PayloadLink(_) => Ok(payload_link::modes(scene, settings, count)?),
-            Model::Rocket(_) => Ok(rocket::modes(scene, settings, count)?),
+            Model::PayloadLink(l) => Ok(payload_link::modes(scene, l, settings, count)?),
+            Model::Rocket(r) => Ok(rocket::modes(scene, r, settings, count)?),
             Model::MobileManipulator(_) => Err(support::unsupported_family(scene).into()),
         }
     }
@@ -322,7 +322,7 @@ impl Backend for FemBackend {
         let settings = &settings.fem()?;
         match &scene.model {
             Model::PlanarChain(pc) => Ok(self.statics_impl(scene, pc, settings)?),
-            Model::PayloadLink(_) => Ok(payload_link::statics(scene, settings)?),
+            Model::PayloadLink(l) => Ok(payload_link::statics(scene, l, settings)?),
             Model::Rocket(_) | Model::MobileManipulator(_) => {
                 Err(support::unsupported_family(scene).into())
             }
@@ -333,9 +333,9 @@ impl Backend for FemBackend {
         let settings = &settings.fem()?;
         match &scene.model {
             Model::PlanarChain(pc) => Ok(run::simulate(scene, pc, settings)?),
-            Model::PayloadLink(_) => Ok(payload_link::simulate(scene, settings)?),
-            Model::Rocket(_) => Ok(rocket::simulate(scene, settings)?),
-            Model::MobileManipulator(_) => Ok(mobile::simulate(scene, settings)?),
+            Model::PayloadLink(l) => Ok(payload_link::simulate(scene, l, settings)?),
+            Model::Rocket(r) => Ok(rocket::simulate(scene, r, settings)?),
+            Model::MobileManipulator(mm) => Ok(mobile::simulate(scene, mm, settings)?),
         }
     }
 }

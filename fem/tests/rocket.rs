@@ -35,7 +35,11 @@ fn elem_rocket_kinetic_energy_matches_direct_quadrature() {
     // (stage by stage; error ~1e-15 relative at 20 000 intervals for these polynomials).
     let sc = scene();
     let r = sc.rocket().unwrap();
-    let model = rocket::build(&sc, &settings(Some(7), None).fem().unwrap()).unwrap();
+    let model = rocket::build(
+        sc.rocket().unwrap(),
+        &settings(Some(7), None).fem().unwrap(),
+    )
+    .unwrap();
     let ud = |x: f64| 3.0 - 0.02 * x;
     let wd = |x: f64| 0.5 + 0.01 * x - 3e-4 * x * x + 2e-6 * x * x * x;
     let wd1 = |x: f64| 0.01 - 6e-4 * x + 6e-6 * x * x;
@@ -87,7 +91,11 @@ fn elem_rocket_forces_are_minus_energy_gradient() {
     // Beam (linear + cubic ½EA u′w′²) and discrete springs at a fixed axis angle: the force
     // vector is −∂V/∂q, checked by central differences of the energies.
     let sc = scene();
-    let model = rocket::build(&sc, &settings(Some(9), None).fem().unwrap()).unwrap();
+    let model = rocket::build(
+        sc.rocket().unwrap(),
+        &settings(Some(9), None).fem().unwrap(),
+    )
+    .unwrap();
     let n = model.n;
     let q: Vec<f64> = (0..n)
         .map(|i| 1e-2 * ((i as f64) * 0.73).sin() + 2e-3 * ((i as f64) * 0.21).cos())
@@ -128,7 +136,11 @@ fn sys_rocket_dof_counts() {
             .dof_plan(&sc, &settings(elements, None).discretization)
             .unwrap();
         assert_eq!(plan.total(), expect);
-        let model = rocket::build(&sc, &settings(elements, None).fem().unwrap()).unwrap();
+        let model = rocket::build(
+            sc.rocket().unwrap(),
+            &settings(elements, None).fem().unwrap(),
+        )
+        .unwrap();
         assert_eq!(model.n, expect);
     }
     let run = FemBackend
@@ -240,7 +252,11 @@ fn elem_rocket_springs_between_masses_ride_with_the_body() {
     // rigidly by a finite angle and moved, the whole body (case and masses) stores no energy in
     // them and they exert no force; in launch axes they would be stretched by α(x_a − x_b).
     let sc = scene();
-    let model = rocket::build(&sc, &settings(Some(12), None).fem().unwrap()).unwrap();
+    let model = rocket::build(
+        sc.rocket().unwrap(),
+        &settings(Some(12), None).fem().unwrap(),
+    )
+    .unwrap();
     let n = model.n;
     let (alpha, shift) = (0.2_f64, (0.7, -1.3));
     let mut q = vec![0.0; n];

@@ -22,7 +22,7 @@ fn mass_matrices(c: &mut Criterion) {
             modes: Some(modes),
             ..Default::default()
         };
-        let mut chain = build_chain(&scene, &disc.modal().unwrap()).unwrap();
+        let mut chain = build_chain(scene.planar_chain().unwrap(), &disc.modal().unwrap()).unwrap();
         let n = chain.n;
         let q: Vec<f64> = (0..n).map(|k| 1e-2 * (k as f64 + 1.0).sin()).collect();
         let qd: Vec<f64> = (0..n).map(|k| 1e-1 * (k as f64 + 2.0).cos()).collect();

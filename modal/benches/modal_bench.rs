@@ -17,7 +17,7 @@ fn rhs(c: &mut Criterion) {
             modes: Some(n),
             ..Default::default()
         };
-        let mut chain = build_chain(&scene, &disc.modal().unwrap()).unwrap();
+        let mut chain = build_chain(scene.planar_chain().unwrap(), &disc.modal().unwrap()).unwrap();
         let q: Vec<f64> = (0..chain.n)
             .map(|k| 1e-2 * (k as f64 + 1.0).sin())
             .collect();

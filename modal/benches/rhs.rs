@@ -16,7 +16,7 @@ use modal::setup::build_chain;
 
 fn one_rhs(c: &mut Criterion) {
     let scene = load_scene("two-link-free-undamped").unwrap();
-    let chain = build_chain(&scene, &ModalSettings::default()).unwrap();
+    let chain = build_chain(scene.planar_chain().unwrap(), &ModalSettings::default()).unwrap();
     let mut rhs = ChainRhs::new(chain);
     let mut y = rhs.initial_state();
     // A deflected, moving state: every coordinate and rate nonzero (no zero-skipping shortcut).

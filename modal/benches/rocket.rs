@@ -29,10 +29,25 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     for n in [4, 6, 12] {
         g.bench_function(format!("modes_n{n}"), |b| {
-            b.iter(|| modal::rocket::modes(&scene, &settings(n).modal().unwrap(), 6).unwrap())
+            b.iter(|| {
+                modal::rocket::modes(
+                    &scene,
+                    scene.rocket().unwrap(),
+                    &settings(n).modal().unwrap(),
+                    6,
+                )
+                .unwrap()
+            })
         });
         g.bench_function(format!("simulate_10ms_n{n}"), |b| {
-            b.iter(|| modal::rocket::simulate(&short, &settings(n).modal().unwrap()).unwrap())
+            b.iter(|| {
+                modal::rocket::simulate(
+                    &short,
+                    short.rocket().unwrap(),
+                    &settings(n).modal().unwrap(),
+                )
+                .unwrap()
+            })
         });
     }
     g.finish();

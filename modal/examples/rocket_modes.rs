@@ -18,7 +18,8 @@ fn main() {
             },
             ..Default::default()
         };
-        let r = modal::rocket::simulate(&scene, &s.modal().unwrap()).expect("rocket run");
+        let r = modal::rocket::simulate(&scene, scene.rocket().unwrap(), &s.modal().unwrap())
+            .expect("rocket run");
         let vals: Vec<f64> = channels
             .iter()
             .map(|c| r.observables.value_at(c, 0.05).unwrap_or(f64::NAN))

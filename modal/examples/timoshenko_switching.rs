@@ -50,7 +50,12 @@ fn main() {
                     ..Default::default()
                 },
             };
-            let (r, _) = simulate_detailed(&scene, &settings.modal().unwrap()).expect("run");
+            let (r, _) = simulate_detailed(
+                &scene,
+                scene.planar_chain().unwrap(),
+                &settings.modal().unwrap(),
+            )
+            .expect("run");
             let sw: Vec<String> = switching(&r)
                 .iter()
                 .map(|(t, k)| format!("{k}{t:.6}"))

@@ -1,9 +1,10 @@
 //! The `data::Backend` implementation: planar chains here, the rocket in [`crate::rocket`], the
 //! 3-D payload link in [`crate::payload_link`], the mobile manipulator in [`crate::mobile`].
 
+use data::scene::Model;
 use data::{
-    Backend, BackendError, BackendKind, Discretization, DofPlan, Family, ModalResult, RunResult,
-    Scene, Settings, StaticResult,
+    Backend, BackendError, BackendKind, Discretization, DofPlan, ModalResult, RunResult, Scene,
+    Settings, StaticResult,
 };
 
 use crate::{mobile, modes, payload_link, rocket, setup, simulate, statics};
@@ -12,6 +13,7 @@ use crate::{mobile, modes, payload_link, rocket, setup, simulate, statics};
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ModalBackend;
 
+// Each entry dispatches on the scene's model family once and hands the family on.
 impl Backend for ModalBackend {
     fn kind(&self) -> BackendKind {
         BackendKind::Modal
@@ -19,11 +21,11 @@ impl Backend for ModalBackend {
 
     fn dof_plan(&self, scene: &Scene, disc: &Discretization) -> Result<DofPlan, BackendError> {
         let settings = &disc.modal()?;
-        match scene.family() {
-            Family::Rocket => rocket::dof_plan(scene, settings),
-            Family::PayloadLink => Ok(payload_link::dof_plan(scene, settings)?),
-            Family::MobileManipulator => Ok(mobile::dof_plan(scene, settings)?),
-            _ => Ok(setup::dof_plan(scene, settings)?),
+        match &scene.model {
+            Model::PlanarChain(pc) => Ok(setup::dof_plan(pc, settings)?),
+            Model::Rocket(r) => rocket::dof_plan(r, settings),
+            Model::PayloadLink(link) => Ok(payload_link::dof_plan(link, settings)?),
+            Model::MobileManipulator(mm) => Ok(mobile::dof_plan(mm, settings)?),
         }
     }
 
@@ -34,33 +36,33 @@ impl Backend for ModalBackend {
         count: usize,
     ) -> Result<ModalResult, BackendError> {
         let settings = &settings.modal()?;
-        match scene.family() {
-            Family::Rocket => rocket::modes(scene, settings, count),
-            Family::PayloadLink => Ok(payload_link::modes(scene, settings, count)?),
-            Family::MobileManipulator => Ok(mobile::modes(scene, settings, count)?),
-            _ => Ok(modes::modes(scene, settings, count)?),
+        match &scene.model {
+            Model::PlanarChain(pc) => Ok(modes::modes(scene, pc, settings, count)?),
+            Model::Rocket(r) => rocket::modes(scene, r, settings, count),
+            Model::PayloadLink(link) => Ok(payload_link::modes(scene, link, settings, count)?),
+            Model::MobileManipulator(mm) => Ok(mobile::modes(scene, mm, settings, count)?),
         }
     }
 
     fn statics(&self, scene: &Scene, settings: &Settings) -> Result<StaticResult, BackendError> {
         let settings = &settings.modal()?;
-        match scene.family() {
-            Family::Rocket => Err(BackendError::unsupported("modal: statics of the rocket")),
-            Family::PayloadLink => Ok(payload_link::statics(scene, settings)?),
-            Family::MobileManipulator => Err(BackendError::unsupported(
+        match &scene.model {
+            Model::PlanarChain(pc) => Ok(statics::statics(scene, pc, settings)?),
+            Model::Rocket(_) => Err(BackendError::unsupported("modal: statics of the rocket")),
+            Model::PayloadLink(link) => Ok(payload_link::statics(scene, link, settings)?),
+            Model::MobileManipulator(_) => Err(BackendError::unsupported(
                 "modal: statics of the mobile manipulator (it has no [statics] loads)",
             )),
-            _ => Ok(statics::statics(scene, settings)?),
         }
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
         let settings = &settings.modal()?;
-        match scene.family() {
-            Family::Rocket => rocket::simulate(scene, settings),
-            Family::PayloadLink => Ok(payload_link::simulate(scene, settings)?),
-            Family::MobileManipulator => Ok(mobile::simulate(scene, settings)?),
-            _ => Ok(simulate::simulate(scene, settings)?),
+        match &scene.model {
+            Model::PlanarChain(pc) => Ok(simulate::simulate(scene, pc, settings)?),
+            Model::Rocket(r) => rocket::simulate(scene, r, settings),
+            Model::PayloadLink(link) => Ok(payload_link::simulate(scene, link, settings)?),
+            Model::MobileManipulator(mm) => Ok(mobile::simulate(scene, mm, settings)?),
         }
     }
 }

@@ -40,8 +40,7 @@
 //! A run that starts at rest makes the same test at t = 0. Events are located on the dense
 //! output, never stepped through, so there is no chattering between phases.
 
-use data::Scene;
-use data::scene::{ContactMode, Surface};
+use data::scene::{ContactMode, PlanarChain, Surface};
 
 use crate::error::ModalError;
 
@@ -104,14 +103,18 @@ pub struct ContactState {
 }
 
 impl ContactState {
-    /// The single tip contact of a planar chain scene.
-    pub fn from_scene(scene: &Scene, n: usize, nf: usize) -> Result<Option<Self>, ModalError> {
-        let Some(c) = scene.contacts().first() else {
+    /// The single tip contact of the planar chain `pc`.
+    pub fn from_planar_chain(
+        pc: &PlanarChain,
+        n: usize,
+        nf: usize,
+    ) -> Result<Option<Self>, ModalError> {
+        let Some(c) = pc.contacts.first() else {
             return Ok(None);
         };
-        check(scene)?;
-        let link = scene
-            .links()
+        check(pc)?;
+        let link = pc
+            .links
             .iter()
             .position(|l| l.name == c.link)
             .ok_or_else(|| {
@@ -203,14 +206,14 @@ impl ContactState {
 }
 
 /// Rejects the contact features this backend does not model, with a precise message.
-pub fn check(scene: &Scene) -> Result<(), ModalError> {
-    if scene.contacts().len() > 1 {
+pub fn check(pc: &PlanarChain) -> Result<(), ModalError> {
+    if pc.contacts.len() > 1 {
         return Err(ModalError::Unsupported(format!(
             "modal: {} contacts; only one tip contact is implemented",
-            scene.contacts().len()
+            pc.contacts.len()
         )));
     }
-    let Some(c) = scene.contacts().first() else {
+    let Some(c) = pc.contacts.first() else {
         return Ok(());
     };
     let unilateral = c.mode == ContactMode::Unilateral;
@@ -221,13 +224,13 @@ pub fn check(scene: &Scene) -> Result<(), ModalError> {
             c.friction, c.link
         )));
     }
-    if scene.links().iter().any(|l| l.joint.prescribed.is_some()) {
+    if pc.links.iter().any(|l| l.joint.prescribed.is_some()) {
         return Err(ModalError::Unsupported(
             "modal: contact together with a prescribed joint motion".into(),
         ));
     }
     if let (false, [l], Surface::Circle { center, radius }) =
-        (unilateral, scene.links(), &c.surface)
+        (unilateral, pc.links.as_slice(), &c.surface)
     {
         // An inextensible link (linear or foreshortening kinematics) has |r_tip − hub| ≤ L with
         // equality only when it is straight (∫v'² ≥ v(L)²/L), so on the circle of radius L
@@ -241,7 +244,7 @@ pub fn check(scene: &Scene) -> Result<(), ModalError> {
             )));
         }
     }
-    if unilateral && scene.links().iter().any(|l| l.axial) {
+    if unilateral && pc.links.iter().any(|l| l.axial) {
         return Err(ModalError::Unsupported(
             "modal: unilateral contact of a chain with axial fields (impacts are implemented for \
              inextensible links only; bilateral contacts accept axial links)"

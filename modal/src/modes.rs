@@ -10,21 +10,23 @@
 
 use std::time::Instant;
 
+use data::scene::PlanarChain;
 use data::{Cost, ModalResult, ModalSettings, ModeShape, Scene};
 use faer::{Mat, Side};
 
 use crate::error::ModalError;
 use crate::setup::{Purpose, build_chain_for};
 
-/// Natural frequencies \[Hz\], ascending. A statically unstable (divergent) mode is reported as
-/// −sqrt(−λ)/2π.
+/// Natural frequencies \[Hz\] of `pc`, the chain of `scene`, ascending. A statically unstable
+/// (divergent) mode is reported as −sqrt(−λ)/2π.
 pub fn modes(
     scene: &Scene,
+    pc: &PlanarChain,
     settings: &ModalSettings,
     count: usize,
 ) -> Result<ModalResult, ModalError> {
     let wall = Instant::now();
-    let mut chain = build_chain_for(scene, settings, Purpose::Modes)?;
+    let mut chain = build_chain_for(pc, settings, Purpose::Modes)?;
     let n = chain.n;
     let mut q = vec![0.0; n];
     let mut qd = vec![0.0; n];
@@ -157,15 +159,16 @@ pub fn modes(
 /// hub law): rotating-beam frequencies \[Hz\] for the λ studies.
 pub fn rotating_modes(
     scene: &Scene,
+    pc: &PlanarChain,
     settings: &ModalSettings,
     hub_rate: f64,
     count: usize,
 ) -> Result<ModalResult, ModalError> {
-    let mut s = scene.clone();
-    if let Some(l) = s.planar_chain_mut().and_then(|c| c.links.first_mut()) {
+    let mut spinning = pc.clone();
+    if let Some(l) = spinning.links.first_mut() {
         l.joint.prescribed = Some(data::scene::PrescribedMotion::ConstantRate { rate: hub_rate });
     }
-    modes(&s, settings, count)
+    modes(scene, &spinning, settings, count)
 }
 
 /// K x = λ M x by Cholesky reduction: ascending λ and M-orthonormal x (columns).

@@ -1,7 +1,9 @@
-//! Scene + settings → assumed-mode chain model (bases, integrals, joints), and the DOF plan.
+//! Planar chain + settings → assumed-mode chain model (bases, integrals, joints), and the DOF
+//! plan. Every function here takes the scene's [`PlanarChain`] (the backend's entry matches the
+//! family once).
 
-use data::scene::Link;
-use data::{Basis, DofPlan, Family, ModalSettings, Scene};
+use data::scene::{Link, PlanarChain};
+use data::{Basis, DofPlan, ModalSettings, Scene};
 
 use crate::basis::ShapeSet;
 use crate::error::ModalError;
@@ -21,18 +23,12 @@ pub enum Purpose {
 }
 
 /// Rejects what this backend does not build for planar chains, with a precise message.
-pub fn check_supported(scene: &Scene, purpose: Purpose) -> Result<(), ModalError> {
-    if scene.family() != Family::PlanarChain {
-        return Err(ModalError::Unsupported(format!(
-            "modal: the {} family is not a planar chain",
-            scene.family()
-        )));
-    }
-    if scene.links().is_empty() {
+pub fn check_supported(pc: &PlanarChain, purpose: Purpose) -> Result<(), ModalError> {
+    if pc.links.is_empty() {
         return Err(ModalError::Unsupported("modal: scene has no links".into()));
     }
-    crate::contact::check(scene)?;
-    for (i, l) in scene.links().iter().enumerate() {
+    crate::contact::check(pc)?;
+    for (i, l) in pc.links.iter().enumerate() {
         if l.shear && l.shear_stiffness.is_none() {
             return Err(ModalError::Unsupported(format!(
                 "modal: link {} has `shear` on but no `shear_stiffness`",
@@ -114,11 +110,11 @@ pub fn modes_per_link(settings: &ModalSettings) -> Result<usize, ModalError> {
 /// 3 / 6 modes 2.21 / 4.50e-2 rad, with poly 3 / 4 / 6 / 8 modes 1.43e-2 / 1.014e-2 /
 /// 9.447e-3 / 9.460e-3 (fem: 9.39e-3); the `barhorst-case1` first impact at 6 modes is 2e-4
 /// early with clamped-free, 1e-7 off fem with poly.
-pub fn default_basis(scene: &Scene) -> Basis {
-    let tip_loaded = scene.links().len() > 1
-        || !scene.contacts().is_empty()
-        || scene
-            .links()
+pub fn default_basis(pc: &PlanarChain) -> Basis {
+    let tip_loaded = pc.links.len() > 1
+        || !pc.contacts.is_empty()
+        || pc
+            .links
             .iter()
             .any(|l| l.tip_mass.is_some_and(|m| m > 0.0) || l.tip_inertia.is_some_and(|j| j > 0.0));
     if !tip_loaded {
@@ -128,8 +124,8 @@ pub fn default_basis(scene: &Scene) -> Basis {
     }
 }
 
-pub fn basis_choice(scene: &Scene, settings: &ModalSettings) -> Result<Basis, ModalError> {
-    let basis = settings.basis.unwrap_or_else(|| default_basis(scene));
+pub fn basis_choice(pc: &PlanarChain, settings: &ModalSettings) -> Result<Basis, ModalError> {
+    let basis = settings.basis.unwrap_or_else(|| default_basis(pc));
     match basis {
         Basis::FreeFree => Err(ModalError::invalid(
             "discretization.basis",
@@ -137,8 +133,8 @@ pub fn basis_choice(scene: &Scene, settings: &ModalSettings) -> Result<Basis, Mo
              `clamped-free`, `tip-mass` or `poly`",
         )),
         Basis::TipMass => {
-            if let Some(l) = scene
-                .links()
+            if let Some(l) = pc
+                .links
                 .iter()
                 .find(|l| l.tip_mass.is_none() && l.tip_inertia.is_none())
             {
@@ -181,8 +177,8 @@ fn shapes(link: &Link, index: usize, basis: Basis, n: usize) -> Result<ShapeSet,
 /// Builds the chain model. Everything the scene leaves off is not allocated: no foreshortening
 /// integrals without `foreshortening`, no tip terms without a tip mass, no gravity force without
 /// `[gravity]`.
-pub fn build_chain(scene: &Scene, settings: &ModalSettings) -> Result<Chain, ModalError> {
-    build_chain_for(scene, settings, Purpose::Dynamics)
+pub fn build_chain(pc: &PlanarChain, settings: &ModalSettings) -> Result<Chain, ModalError> {
+    build_chain_for(pc, settings, Purpose::Dynamics)
 }
 
 /// Whether a Timoshenko link's v basis carries the root shear strain v'(0) (see
@@ -233,17 +229,17 @@ fn axial_shapes(link: &Link, basis: Basis, n: usize) -> ShapeSet {
 }
 
 pub fn build_chain_for(
-    scene: &Scene,
+    pc: &PlanarChain,
     settings: &ModalSettings,
     purpose: Purpose,
 ) -> Result<Chain, ModalError> {
-    check_supported(scene, purpose)?;
+    check_supported(pc, purpose)?;
     let n = modes_per_link(settings)?;
-    let basis = basis_choice(scene, settings)?;
+    let basis = basis_choice(pc, settings)?;
     let mut links = Vec::new();
     let mut joints = Vec::new();
     let mut offset = 0;
-    for (i, l) in scene.links().iter().enumerate() {
+    for (i, l) in pc.links.iter().enumerate() {
         let (transverse, rotation) = if l.shear {
             let (v, psi) = timoshenko_shapes(l, i, basis, n)?;
             (v, Some(psi))
@@ -307,10 +303,10 @@ pub fn build_chain_for(
             prescribed: j.prescribed.clone(),
         });
     }
-    let gravity = scene.gravity().map(|g| g.vector);
+    let gravity = pc.gravity.as_ref().map(|g| g.vector);
     let mut chain = Chain::new(links, joints, gravity);
     if purpose == Purpose::Dynamics {
-        chain.step_load = step_load(scene, &chain)?;
+        chain.step_load = step_load(pc, &chain)?;
     }
     Ok(chain)
 }
@@ -319,8 +315,8 @@ pub fn build_chain_for(
 /// applies them in dynamics): tip force P along the link frame's y and uniform load q per unit
 /// length, on the transverse coordinates b of a single clamped link,
 /// f_b = P φ(L) + q ∫₀ᴸ φ dx.
-fn step_load(scene: &Scene, chain: &Chain) -> Result<Option<Vec<f64>>, ModalError> {
-    let Some(st) = scene.statics() else {
+fn step_load(pc: &PlanarChain, chain: &Chain) -> Result<Option<Vec<f64>>, ModalError> {
+    let Some(st) = &pc.statics else {
         return Ok(None);
     };
     let (p, q) = (
@@ -330,27 +326,32 @@ fn step_load(scene: &Scene, chain: &Chain) -> Result<Option<Vec<f64>>, ModalErro
     if p == 0.0 && q == 0.0 {
         return Ok(None);
     }
-    let clamped_single = scene.links().len() == 1
-        && matches!(
-            scene.links()[0].joint.prescribed,
-            Some(data::scene::PrescribedMotion::Fixed)
-        );
-    if !clamped_single {
-        return Err(ModalError::Unsupported(
-            "modal: the [statics] loads act in dynamics only on a single clamped link".into(),
-        ));
-    }
+    let link = match pc.links.as_slice() {
+        [link]
+            if matches!(
+                link.joint.prescribed,
+                Some(data::scene::PrescribedMotion::Fixed)
+            ) =>
+        {
+            link
+        }
+        _ => {
+            return Err(ModalError::Unsupported(
+                "modal: the [statics] loads act in dynamics only on a single clamped link".into(),
+            ));
+        }
+    };
     let l = &chain.links[0];
     let mut f = vec![0.0; chain.n];
-    f[l.b0..l.b0 + l.nb()].copy_from_slice(&transverse_load(scene, l, p, q));
+    f[l.b0..l.b0 + l.nb()].copy_from_slice(&transverse_load(link, l, p, q));
     Ok(Some(f))
 }
 
 /// Generalized force of a tip force P and a uniform load q (per unit length) on the transverse
-/// coordinates of link `l` of a single-link scene: P φ(L) + q ∫₀ᴸ φ dx.
-pub(crate) fn transverse_load(scene: &Scene, l: &LinkModel, p: f64, q: f64) -> Vec<f64> {
+/// coordinates of `l`, the model of the scene's `link`: P φ(L) + q ∫₀ᴸ φ dx.
+pub(crate) fn transverse_load(link: &Link, l: &LinkModel, p: f64, q: f64) -> Vec<f64> {
     // `phi1` is the mass-weighted ∫ρA φ.
-    let q_per_mass = q / scene.links()[0].mass_per_length;
+    let q_per_mass = q / link.mass_per_length;
     (0..l.nb())
         .map(|i| p * l.ints.phi_l[i] + q_per_mass * l.ints.phi1[i])
         .collect()
@@ -358,12 +359,12 @@ pub(crate) fn transverse_load(scene: &Scene, l: &LinkModel, p: f64, q: f64) -> V
 
 /// The DOFs of the model a run integrates (`modes` may refuse a scene a run accepts: the
 /// spinning extensible link, [`check_supported`]).
-pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
-    check_supported(scene, Purpose::Dynamics)?;
+pub fn dof_plan(pc: &PlanarChain, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
+    check_supported(pc, Purpose::Dynamics)?;
     let n = modes_per_link(settings)?;
-    let basis = basis_choice(scene, settings)?;
+    let basis = basis_choice(pc, settings)?;
     let mut plan = DofPlan::default();
-    for (i, l) in scene.links().iter().enumerate() {
+    for (i, l) in pc.links.iter().enumerate() {
         let k = i + 1;
         if l.joint.prescribed.is_none() {
             plan.add(format!("joint{k} angle"), 1);
@@ -428,10 +429,10 @@ pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, Moda
                 .push(format!("joint{k}: prescribed motion (torque reported)"));
         }
     }
-    if scene.gravity().is_some() {
+    if pc.gravity.is_some() {
         plan.builds.push("gravity".into());
     }
-    for (c, ct) in scene.contacts().iter().enumerate() {
+    for (c, ct) in pc.contacts.iter().enumerate() {
         if ct.mode == data::scene::ContactMode::Bilateral {
             plan.builds.push(format!(
                 "contact{}: bilateral tip contact of `{}` (constraint g = 0 for all time, \

@@ -6,6 +6,7 @@
 
 use std::time::Instant;
 
+use data::scene::PlanarChain;
 use data::{ModalSettings, RunResult, Scene, StabilityVerdict};
 
 use crate::contact::ContactState;
@@ -38,10 +39,10 @@ pub const KELVIN_VOIGT_DEFAULT_TOL: (f64, f64) = (1e-6, 1e-8);
 pub type Method = &'static MethodInfo;
 
 /// The method of a run: the one named in the settings, else the default ([`default_method`]).
-pub fn method_choice(scene: &Scene, settings: &ModalSettings) -> Method {
+pub fn method_choice(pc: &PlanarChain, settings: &ModalSettings) -> Method {
     settings
         .method
-        .map_or_else(|| default_method(scene, settings), method_for)
+        .map_or_else(|| default_method(pc, settings), method_for)
 }
 
 /// The default method: adaptive TR-BDF2 ([`TRBDF2`], tolerances
@@ -71,13 +72,13 @@ pub fn method_choice(scene: &Scene, settings: &ModalSettings) -> Method {
 /// is 8.5e-5 rad off. A tolerance given
 /// (`rtol`/`atol`) without a method asks for Dormand–Prince; a contact scene keeps
 /// Dormand–Prince, whose switching times are located on the tolerance-controlled dense output.
-pub fn default_method(scene: &Scene, settings: &ModalSettings) -> Method {
+pub fn default_method(pc: &PlanarChain, settings: &ModalSettings) -> Method {
     let tolerance_given = settings.rtol.is_some() || settings.atol.is_some();
-    let all_damped = scene
-        .links()
+    let all_damped = pc
+        .links
         .iter()
         .all(|l| l.kelvin_voigt.is_some_and(|g| g > 0.0));
-    if tolerance_given || !scene.contacts().is_empty() || !all_damped {
+    if tolerance_given || !pc.contacts.is_empty() || !all_damped {
         &DOPRI5
     } else {
         &TRBDF2
@@ -91,10 +92,9 @@ pub const STEPS_PER_PERIOD: f64 = 128.0;
 /// shortest first-mode period among the links, ω₁ = β₁²√(EI/(ρA L⁴)), β₁ = 1.8751 (the
 /// clamped–free cantilever; a tip mass or a child link only lowers it, so the step is
 /// conservative). `two-link-free`: T₁ = 0.134 s (link 2), h = 1.05e-3.
-pub fn default_step(scene: &Scene) -> f64 {
+pub fn default_step(pc: &PlanarChain) -> f64 {
     const BETA1: f64 = 1.875_104_068_711_961;
-    scene
-        .links()
+    pc.links
         .iter()
         .map(|l| {
             let omega1 = BETA1
@@ -105,18 +105,24 @@ pub fn default_step(scene: &Scene) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-pub fn simulate(scene: &Scene, settings: &ModalSettings) -> Result<RunResult, ModalError> {
-    simulate_detailed(scene, settings).map(|(r, _)| r)
+/// A run of `pc`, the chain of `scene` (whose name and simulation settings it reports).
+pub fn simulate(
+    scene: &Scene,
+    pc: &PlanarChain,
+    settings: &ModalSettings,
+) -> Result<RunResult, ModalError> {
+    simulate_detailed(scene, pc, settings).map(|(r, _)| r)
 }
 
 /// [`simulate`] that also returns the final state and the contact diagnostics.
 pub fn simulate_detailed(
     scene: &Scene,
+    pc: &PlanarChain,
     settings: &ModalSettings,
 ) -> Result<(RunResult, FinalState), ModalError> {
     let wall = Instant::now();
-    let chain = build_chain(scene, settings)?;
-    let method = method_choice(scene, settings);
+    let chain = build_chain(pc, settings)?;
+    let method = method_choice(pc, settings);
     let fixed_step = method.is_fixed_step();
     let default_kelvin_voigt_method = settings.method.is_none() && std::ptr::eq(method, &TRBDF2);
     let (rtol_default, atol_default) = if default_kelvin_voigt_method {
@@ -137,13 +143,13 @@ pub fn simulate_detailed(
     let t_end = crate::setup::checked_span(scene, settings)?;
     let (n_all, n_free) = (chain.n, chain.free.len());
     let mut rhs = ChainRhs::new(chain);
-    rhs.attach_contact(ContactState::from_scene(scene, n_all, n_free)?);
+    rhs.attach_contact(ContactState::from_planar_chain(pc, n_all, n_free)?);
     let mut y = rhs.initial_state();
     let dim = y.len();
     let tol = Tolerances { rtol, atol };
     let mut stepper = match method.build {
         Build::Adaptive(build) => build(dim, tol, settings.dt),
-        Build::Fixed(build) => build(dim, tol, settings.dt.unwrap_or_else(|| default_step(scene))),
+        Build::Fixed(build) => build(dim, tol, settings.dt.unwrap_or_else(|| default_step(pc))),
     };
     let mut out = Output::new(&rhs, scene, t_end, dim);
 

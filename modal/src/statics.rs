@@ -2,30 +2,41 @@
 //! PL³/3EI is reached as the basis is refined, and the polynomial basis with n ≥ 3 contains the
 //! exact cubic tip-load solution).
 
+use data::scene::PlanarChain;
 use data::{Cost, ModalSettings, Scene, StaticResult};
 
 use crate::error::ModalError;
 use crate::linalg::{cholesky_solve, dot};
 use crate::setup::{build_chain, transverse_load};
 
-pub fn statics(scene: &Scene, settings: &ModalSettings) -> Result<StaticResult, ModalError> {
+/// The static tip deflection and rotation of `pc`, the chain of `scene`.
+pub fn statics(
+    scene: &Scene,
+    pc: &PlanarChain,
+    settings: &ModalSettings,
+) -> Result<StaticResult, ModalError> {
     let wall = std::time::Instant::now();
-    let Some(loads) = scene.statics() else {
+    let Some(loads) = &pc.statics else {
         return Err(ModalError::Unsupported(
             "modal: the scene has no [statics] loads".into(),
         ));
     };
-    if scene.links().len() != 1
-        || !matches!(
-            scene.links()[0].joint.prescribed,
-            Some(data::scene::PrescribedMotion::Fixed)
-        )
-    {
-        return Err(ModalError::Unsupported(
-            "modal: statics only for a single link clamped to the ground".into(),
-        ));
-    }
-    let chain = build_chain(scene, settings)?;
+    let link = match pc.links.as_slice() {
+        [link]
+            if matches!(
+                link.joint.prescribed,
+                Some(data::scene::PrescribedMotion::Fixed)
+            ) =>
+        {
+            link
+        }
+        _ => {
+            return Err(ModalError::Unsupported(
+                "modal: statics only for a single link clamped to the ground".into(),
+            ));
+        }
+    };
+    let chain = build_chain(pc, settings)?;
     let l = &chain.links[0];
     let nb = l.nb();
     let nbc = l.nbc();
@@ -33,7 +44,7 @@ pub fn statics(scene: &Scene, settings: &ModalSettings) -> Result<StaticResult, 
     let mut k = l.section.kbc.clone();
     let p = loads.tip_force.unwrap_or(0.0);
     let q = loads.distributed_load.unwrap_or(0.0);
-    let mut b = transverse_load(scene, l, p, q);
+    let mut b = transverse_load(link, l, p, q);
     b.resize(nbc, 0.0);
     cholesky_solve(&mut k, nbc, &mut b).map_err(|_| ModalError::Numerical {
         t: 0.0,

@@ -104,7 +104,7 @@ fn check_lagrange_scene(
     amp_q: f64,
     amp_qd: f64,
 ) {
-    let mut chain = build_chain(scene, &disc.modal().unwrap()).unwrap();
+    let mut chain = build_chain(scene.planar_chain().unwrap(), &disc.modal().unwrap()).unwrap();
     let (q, qd) = state(chain.n, seed, amp_q, amp_qd);
     check_lagrange(&mut chain, &q, &qd);
 }
@@ -180,7 +180,11 @@ fn sys_extensible_link_kinetic_energy_is_the_continuum_integral() {
     // (free hub joint at the origin: V = 0, ω = θ̇).
     let mut scene = load_scene("spin-up-axial").unwrap();
     scene.planar_chain_mut().unwrap().links[0].joint.prescribed = None;
-    let mut chain = build_chain(&scene, &with_modes(3).modal().unwrap()).unwrap();
+    let mut chain = build_chain(
+        scene.planar_chain().unwrap(),
+        &with_modes(3).modal().unwrap(),
+    )
+    .unwrap();
     let n = chain.n;
     let link = chain.links[0].clone();
     let (na, nb) = (link.na(), link.nb());
@@ -478,15 +482,18 @@ fn sys_default_method_is_adaptive_trbdf2_for_damped_chains_without_contact() {
         ..Default::default()
     };
     let damped = load_scene("two-link-free").unwrap();
-    assert_eq!(default_method(&damped, &plain.modal().unwrap()), &TRBDF2);
     assert_eq!(
-        default_method(&damped, &with_rtol.modal().unwrap()),
+        default_method(damped.planar_chain().unwrap(), &plain.modal().unwrap()),
+        &TRBDF2
+    );
+    assert_eq!(
+        default_method(damped.planar_chain().unwrap(), &with_rtol.modal().unwrap()),
         &DOPRI5
     );
     for name in ["two-link-free-undamped", "single-link", "barhorst-case1"] {
         let scene = load_scene(name).unwrap();
         assert_eq!(
-            default_method(&scene, &plain.modal().unwrap()),
+            default_method(scene.planar_chain().unwrap(), &plain.modal().unwrap()),
             &DOPRI5,
             "{name}"
         );
@@ -497,7 +504,7 @@ fn sys_default_method_is_adaptive_trbdf2_for_damped_chains_without_contact() {
     let omega1 = 1.875_104_068_711_961f64.powi(2)
         * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt();
     let h = std::f64::consts::TAU / omega1 / STEPS_PER_PERIOD;
-    assert!((default_step(&damped) - h).abs() <= 1e-15 * h);
+    assert!((default_step(damped.planar_chain().unwrap()) - h).abs() <= 1e-15 * h);
 }
 
 /// The Kelvin–Voigt work of the default method through the step release at t = 0 of

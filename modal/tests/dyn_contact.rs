@@ -26,7 +26,12 @@ fn settings(modes: usize, rtol: f64, t_end: Option<f64>) -> Settings {
 
 fn run(name: &str, modes: usize, rtol: f64, t_end: Option<f64>) -> (RunResult, FinalState) {
     let scene = load_scene(name).unwrap();
-    simulate_detailed(&scene, &settings(modes, rtol, t_end).modal().unwrap()).unwrap()
+    simulate_detailed(
+        &scene,
+        scene.planar_chain().unwrap(),
+        &settings(modes, rtol, t_end).modal().unwrap(),
+    )
+    .unwrap()
 }
 
 fn summary(r: &RunResult) {
@@ -229,7 +234,7 @@ fn dyn_contact_stiff_elbow_rests_on_its_tip_with_the_static_normal_force() {
     // N·x_tip = Σ Wᵢ x_cg,i. Σ mᵢ x_cg,i from the model's own mass integrals: with a unit
     // gravity along −x the gravity potential is +Σ mᵢ x_cg,i.
     let mut chain = modal::setup::build_chain(
-        &scene,
+        scene.planar_chain().unwrap(),
         &settings(2, 1e-9, None).discretization.modal().unwrap(),
     )
     .unwrap();
@@ -357,7 +362,7 @@ fn dyn_contact_convective_tip_acceleration_matches_finite_differences() {
     // along q̇, for a deformed, moving two-link arm with foreshortening (exact tip kinematics).
     let scene = load_scene("barhorst-case1-tipmass").unwrap();
     let mut chain = modal::setup::build_chain(
-        &scene,
+        scene.planar_chain().unwrap(),
         &settings(3, 1e-8, None).discretization.modal().unwrap(),
     )
     .unwrap();
@@ -408,7 +413,7 @@ fn sys_default_basis_is_poly_for_tip_loaded_links() {
     ] {
         let scene = load_scene(name).unwrap();
         assert_eq!(
-            modal::setup::default_basis(&scene),
+            modal::setup::default_basis(scene.planar_chain().unwrap()),
             data::Basis::Poly,
             "{name}"
         );
@@ -416,7 +421,7 @@ fn sys_default_basis_is_poly_for_tip_loaded_links() {
     for name in ["cantilever", "spin-up", "rotating-beam"] {
         let scene = load_scene(name).unwrap();
         assert_eq!(
-            modal::setup::default_basis(&scene),
+            modal::setup::default_basis(scene.planar_chain().unwrap()),
             data::Basis::ClampedFree,
             "{name}"
         );

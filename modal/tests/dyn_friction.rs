@@ -143,7 +143,12 @@ fn dyn_friction_arm_constraint_ledger_and_friction_work() {
     // 1e-8 the steep rise of the normal force just before the first stick (t = 0.0243 s)
     // leaves 5e-9 J of integration error in the ledger (1.4e-7 relative; 1.3e-10 J at 1e-9).
     let scene = arm();
-    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-9, None).modal().unwrap()).unwrap();
+    let (r, f) = simulate_detailed(
+        &scene,
+        scene.planar_chain().unwrap(),
+        &settings(3, 1e-9, None).modal().unwrap(),
+    )
+    .unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     let len = scene.links()[0].length;
     // Drift control: |g| and |G q̇| before each projection stay at round-off (stated: 1e-12 L,
@@ -204,8 +209,12 @@ fn dyn_friction_work_equals_integral_of_mu_n_vt() {
     scene.planar_chain_mut().unwrap().links[0].kelvin_voigt = Some(0.5);
     scene.simulation.output_interval = 2.5e-5;
     let t_end = 0.8;
-    let (r, _) =
-        simulate_detailed(&scene, &settings(3, 1e-9, Some(t_end)).modal().unwrap()).unwrap();
+    let (r, _) = simulate_detailed(
+        &scene,
+        scene.planar_chain().unwrap(),
+        &settings(3, 1e-9, Some(t_end)).modal().unwrap(),
+    )
+    .unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     let mu = scene.contacts()[0].friction;
     let (n, vt) = (
@@ -240,7 +249,12 @@ fn dyn_friction_stick_slip_pendulum_sticks_and_stays() {
     let mut scene = arm();
     pendulum(&mut scene);
     scene.planar_chain_mut().unwrap().links[0].kelvin_voigt = Some(0.5);
-    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, Some(1.5)).modal().unwrap()).unwrap();
+    let (r, f) = simulate_detailed(
+        &scene,
+        scene.planar_chain().unwrap(),
+        &settings(3, 1e-8, Some(1.5)).modal().unwrap(),
+    )
+    .unwrap();
     print_summary(&r, &f);
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     let ev = stick_slips(&r);
@@ -318,7 +332,8 @@ fn assert_rigid_limit(label: &str, stiffen: impl Fn(f64) -> Scene) {
         let scene = stiffen(scale);
         let mut st = settings(3, 1e-6, Some(0.5));
         st.discretization.basis = Some(data::Basis::Poly);
-        let (r, _) = simulate_detailed(&scene, &st.modal().unwrap()).unwrap();
+        let (r, _) =
+            simulate_detailed(&scene, scene.planar_chain().unwrap(), &st.modal().unwrap()).unwrap();
         assert_eq!(r.verdict, StabilityVerdict::Completed);
         assert!(r.ledger.relative_closure() < 1e-5);
         let (e_theta, e_force) = rigid_errors(&scene, &r);
@@ -409,7 +424,12 @@ fn dyn_friction_inclined_line_bilateral_ledger_closes() {
         normal: [-h, -h],
     };
     scene.planar_chain_mut().unwrap().contacts[0].friction = 0.3;
-    let (r, f) = simulate_detailed(&scene, &settings(3, 1e-8, Some(0.2)).modal().unwrap()).unwrap();
+    let (r, f) = simulate_detailed(
+        &scene,
+        scene.planar_chain().unwrap(),
+        &settings(3, 1e-8, Some(0.2)).modal().unwrap(),
+    )
+    .unwrap();
     assert_eq!(r.verdict, StabilityVerdict::Completed);
     assert!(f.contact.max_gap_violation <= 1e-12, "{:?}", f.contact);
     assert!(f.contact.max_stick_velocity <= 1e-9, "{:?}", f.contact);

@@ -140,7 +140,11 @@ fn elem_timoshenko_strain_energy_from_fields_and_spd_matrices() {
     ];
     for (name, basis, kind) in cases {
         let scene = load_scene(name).unwrap();
-        let mut chain = build_chain(&scene, &disc(5, basis).modal().unwrap()).unwrap();
+        let mut chain = build_chain(
+            scene.planar_chain().unwrap(),
+            &disc(5, basis).modal().unwrap(),
+        )
+        .unwrap();
         let q = random_state(&chain, 1e-3 * scene.links()[0].length, 7);
         let qd = random_state(&chain, 1e-1, 11);
         chain.evaluate(0.0, &q, &qd);
@@ -186,7 +190,11 @@ fn elem_timoshenko_force_is_minus_energy_gradient() {
     // kinematics and the joint chaining through ψ₁(L) (link 2's gravity potential depends on it).
     for basis in [Basis::Poly, Basis::ClampedFree] {
         let scene = load_scene("barhorst-case1-timoshenko").unwrap();
-        let mut chain = build_chain(&scene, &disc(4, basis).modal().unwrap()).unwrap();
+        let mut chain = build_chain(
+            scene.planar_chain().unwrap(),
+            &disc(4, basis).modal().unwrap(),
+        )
+        .unwrap();
         let mut q = random_state(&chain, 2e-2, 3);
         let qd = vec![0.0; chain.n];
         chain.evaluate(0.0, &q, &qd);
@@ -331,6 +339,7 @@ fn dyn_timoshenko_barhorst_impacts_and_ledger() {
     let scene = load_scene("barhorst-case1-timoshenko").unwrap();
     let (r, _) = simulate_detailed(
         &scene,
+        scene.planar_chain().unwrap(),
         &run_settings(3, None, 1e-8, Some(0.3)).modal().unwrap(),
     )
     .unwrap();
@@ -392,14 +401,17 @@ fn dyn_timoshenko_arm_approaches_euler_as_slenderness_grows() {
         s
     };
     let euler = load_scene("constrained-arm").unwrap();
-    let (re, _) = simulate_detailed(&euler, &st.modal().unwrap()).unwrap();
+    let (re, _) =
+        simulate_detailed(&euler, euler.planar_chain().unwrap(), &st.modal().unwrap()).unwrap();
     assert_eq!(re.verdict, StabilityVerdict::Completed);
     let th_e = channel(&re, "joint1.angle").to_vec();
     let mut diffs = Vec::new();
     // Measured (3 poly modes, 0.5 s): λ = 5, 10, 20, 40 → 2.8e-2, 1.8e-2, 9.2e-3, 4.6e-3 rad
     // (stick–slip phases shift at small λ); at λ ≥ 40 the gap falls ~ 1/λ² (shear compliance).
     for lambda in [10.0, 40.0, 160.0] {
-        let (r, _) = simulate_detailed(&timoshenko_arm(lambda), &st.modal().unwrap()).unwrap();
+        let arm = timoshenko_arm(lambda);
+        let (r, _) =
+            simulate_detailed(&arm, arm.planar_chain().unwrap(), &st.modal().unwrap()).unwrap();
         assert_eq!(r.verdict, StabilityVerdict::Completed);
         assert!(r.ledger.relative_closure() < 1e-6);
         let th = channel(&r, "joint1.angle");
@@ -439,6 +451,7 @@ fn dyn_timoshenko_rotary_inertia_chain_impact_and_ledger() {
     assert_eq!(plan.total(), 2 + 2 * (3 + 3));
     let (r, _) = simulate_detailed(
         &scene,
+        scene.planar_chain().unwrap(),
         &run_settings(3, None, 1e-8, Some(0.3)).modal().unwrap(),
     )
     .unwrap();

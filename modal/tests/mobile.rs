@@ -248,7 +248,11 @@ fn sys_mobile_dof_counts() {
         let scene = load_scene(name).unwrap();
         let plan = backend.dof_plan(&scene, &disc(modes)).unwrap();
         assert_eq!(plan.total(), want, "{name} at {modes} modes: {plan:?}");
-        let (model, _) = set_up(&scene, &disc(modes).modal().unwrap()).unwrap();
+        let (model, _) = set_up(
+            scene.mobile_manipulator().unwrap(),
+            &disc(modes).modal().unwrap(),
+        )
+        .unwrap();
         assert_eq!(model.layout.m, want, "{name}");
         let elastic = model.layout.elastic.is_some();
         assert_eq!(elastic, name.ends_with("flexible"), "{name}");

@@ -8,12 +8,20 @@
 
 use std::sync::OnceLock;
 
-use data::{BackendError, Basis, Discretization, Event, Settings, StabilityVerdict, load_scene};
+use data::{
+    Backend, BackendError, Basis, Discretization, Event, Settings, StabilityVerdict, load_scene,
+};
+use modal::ModalBackend;
 use modal::rocket::{self, DetailedRun};
 
 fn run(name: &str) -> DetailedRun {
     let scene = load_scene(name).unwrap();
-    rocket::simulate_detailed(&scene, &Settings::default().modal().unwrap()).unwrap()
+    rocket::simulate_detailed(
+        &scene,
+        scene.rocket().unwrap(),
+        &Settings::default().modal().unwrap(),
+    )
+    .unwrap()
 }
 
 /// The default `rocket` run (0.1 s, 6 + 6 modes, dopri5 at rtol 1e-8), shared by the tests.
@@ -275,7 +283,7 @@ fn sys_dof_counts_per_scene() {
         "rocket-launch-75",
     ] {
         let scene = load_scene(name).unwrap();
-        let plan = rocket::dof_plan(&scene, &disc.modal().unwrap()).unwrap();
+        let plan = rocket::dof_plan(scene.rocket().unwrap(), &disc.modal().unwrap()).unwrap();
         let counts: Vec<(String, usize)> = plan
             .groups
             .iter()
@@ -302,7 +310,7 @@ fn sys_dof_counts_per_scene() {
     rk.springs.clear();
     rk.stages[0].burn_rate = 0.0;
     let plan = rocket::dof_plan(
-        &scene,
+        scene.rocket().unwrap(),
         &Discretization {
             modes: Some(4),
             ..Default::default()
@@ -323,7 +331,13 @@ fn sys_dof_counts_per_scene() {
 #[test]
 fn sys_modes_at_ignition() {
     let scene = load_scene("rocket").unwrap();
-    let m = rocket::modes(&scene, &Settings::default().modal().unwrap(), 10).unwrap();
+    let m = rocket::modes(
+        &scene,
+        scene.rocket().unwrap(),
+        &Settings::default().modal().unwrap(),
+        10,
+    )
+    .unwrap();
     assert_eq!(m.frequencies_hz.len(), 10);
     assert!(m.frequencies_hz.windows(2).all(|w| w[0] <= w[1]));
     assert!(m.kinds.iter().all(|k| k == "axial" || k == "bending"));
@@ -338,7 +352,7 @@ fn sys_modes_at_ignition() {
             },
             ..Default::default()
         };
-        rocket::modes(&scene, &s.modal().unwrap(), 6)
+        rocket::modes(&scene, scene.rocket().unwrap(), &s.modal().unwrap(), 6)
             .unwrap()
             .frequencies_hz
     };
@@ -378,7 +392,8 @@ fn dyn_burnout_ends_thrust_and_restarts_integrator() {
         },
         ..Default::default()
     };
-    let r = rocket::simulate_detailed(&scene, &settings.modal().unwrap()).unwrap();
+    let r = rocket::simulate_detailed(&scene, scene.rocket().unwrap(), &settings.modal().unwrap())
+        .unwrap();
     assert_eq!(r.run.verdict, StabilityVerdict::Completed);
     let ev: Vec<&Event> = r
         .run
@@ -423,8 +438,18 @@ fn dyn_implicit_method_agrees_with_dopri5() {
             ..Default::default()
         },
     };
-    let a = rocket::simulate_detailed(&scene, &mk("dopri5").modal().unwrap()).unwrap();
-    let b = rocket::simulate_detailed(&scene, &mk("tr-bdf2").modal().unwrap()).unwrap();
+    let a = rocket::simulate_detailed(
+        &scene,
+        scene.rocket().unwrap(),
+        &mk("dopri5").modal().unwrap(),
+    )
+    .unwrap();
+    let b = rocket::simulate_detailed(
+        &scene,
+        scene.rocket().unwrap(),
+        &mk("tr-bdf2").modal().unwrap(),
+    )
+    .unwrap();
     assert!(b.run.cost.factorizations > 0 && b.run.cost.jacobian_evaluations > 0);
     let (va, vb) = (values(&a, "rocket.vY"), values(&b, "rocket.vY"));
     let (ua, ub) = (values(&a, "rocket.u@10"), values(&b, "rocket.u@10"));
@@ -451,6 +476,7 @@ fn sys_settings_and_scenes_are_checked() {
     for modes in [0, 41] {
         let e = rocket::simulate(
             &scene,
+            scene.rocket().unwrap(),
             &with_disc(Discretization {
                 modes: Some(modes),
                 ..Default::default()
@@ -465,6 +491,7 @@ fn sys_settings_and_scenes_are_checked() {
     }
     let e = rocket::modes(
         &scene,
+        scene.rocket().unwrap(),
         &with_disc(Discretization {
             basis: Some(Basis::ClampedFree),
             ..Default::default()
@@ -479,6 +506,7 @@ fn sys_settings_and_scenes_are_checked() {
     );
     let e = rocket::simulate(
         &scene,
+        scene.rocket().unwrap(),
         &Settings {
             time: data::TimeStepping {
                 // a modal method the rocket does not offer
@@ -492,19 +520,28 @@ fn sys_settings_and_scenes_are_checked() {
     )
     .unwrap_err();
     assert!(matches!(e, BackendError::InvalidSettings { ref field, .. } if field == "time.method"));
-    let e = rocket::modes(&scene, &Settings::default().modal().unwrap(), 100).unwrap_err();
-    assert!(matches!(e, BackendError::InvalidSettings { .. }));
-    // non-rocket scene and unsupported physics
-    let e = rocket::dof_plan(
-        &load_scene("cantilever").unwrap(),
-        &Discretization::default().modal().unwrap(),
+    let e = rocket::modes(
+        &scene,
+        scene.rocket().unwrap(),
+        &Settings::default().modal().unwrap(),
+        100,
     )
     .unwrap_err();
-    assert!(matches!(e, BackendError::Unsupported(_)));
+    assert!(matches!(e, BackendError::InvalidSettings { .. }));
+    // A non-rocket scene cannot reach the rocket model (it takes a `Rocket`): the backend
+    // builds its own family's model.
+    let plan = ModalBackend
+        .dof_plan(
+            &load_scene("cantilever").unwrap(),
+            &Discretization::default(),
+        )
+        .unwrap();
+    assert!(plan.groups.iter().all(|g| !g.what.contains("rigid body")));
+    // unsupported physics
     let mut s = scene.clone();
     s.rocket_mut().unwrap().exit_pressure = 10.0;
     assert!(matches!(
-        rocket::simulate(&s, &Settings::default().modal().unwrap()).unwrap_err(),
+        rocket::simulate(&s, s.rocket().unwrap(), &Settings::default().modal().unwrap()).unwrap_err(),
         BackendError::Unsupported(m) if m.contains("exit_pressure")
     ));
 }
@@ -529,7 +566,12 @@ fn dyn_dampers_dissipate_and_ledger_still_closes() {
         m.transverse_damping = 5.0;
     }
     rk.springs[0].axial_damping = 2.0;
-    let r = rocket::simulate_detailed(&scene, &short_settings(3).modal().unwrap()).unwrap();
+    let r = rocket::simulate_detailed(
+        &scene,
+        scene.rocket().unwrap(),
+        &short_settings(3).modal().unwrap(),
+    )
+    .unwrap();
     let l = &r.run.ledger;
     assert_eq!(l.dissipation.len(), 1);
     assert_eq!(l.dissipation[0].name, "discrete_damper");
@@ -546,7 +588,11 @@ fn dyn_dampers_dissipate_and_ledger_still_closes() {
         "closure {:e}",
         l.relative_closure()
     );
-    let plan = rocket::dof_plan(&scene, &Discretization::default().modal().unwrap()).unwrap();
+    let plan = rocket::dof_plan(
+        scene.rocket().unwrap(),
+        &Discretization::default().modal().unwrap(),
+    )
+    .unwrap();
     assert!(plan.builds.iter().any(|b| b.contains("damper")));
 }
 
@@ -557,7 +603,12 @@ fn dyn_runaway_is_stopped_with_diagnostic() {
     let mut scene = load_scene("rocket").unwrap();
     scene.rocket_mut().unwrap().initial_shape =
         data::scene::InitialShape::Report { a1: 10.0, a2: 0.0 };
-    let r = rocket::simulate(&scene, &short_settings(3).modal().unwrap()).unwrap();
+    let r = rocket::simulate(
+        &scene,
+        scene.rocket().unwrap(),
+        &short_settings(3).modal().unwrap(),
+    )
+    .unwrap();
     match &r.verdict {
         StabilityVerdict::Stopped { diagnostic } => {
             assert!(
@@ -582,12 +633,22 @@ fn sys_largest_basis_sets_up() {
     // eigen-solution must still separate the rigid modes and agree with a small basis on the
     // lowest frequencies (Rayleigh–Ritz: from above, converged to 1e-4 at 12 modes).
     let scene = load_scene("rocket").unwrap();
-    let f40 = rocket::modes(&scene, &short_settings(40).modal().unwrap(), 4)
-        .unwrap()
-        .frequencies_hz;
-    let f12 = rocket::modes(&scene, &short_settings(12).modal().unwrap(), 4)
-        .unwrap()
-        .frequencies_hz;
+    let f40 = rocket::modes(
+        &scene,
+        scene.rocket().unwrap(),
+        &short_settings(40).modal().unwrap(),
+        4,
+    )
+    .unwrap()
+    .frequencies_hz;
+    let f12 = rocket::modes(
+        &scene,
+        scene.rocket().unwrap(),
+        &short_settings(12).modal().unwrap(),
+        4,
+    )
+    .unwrap()
+    .frequencies_hz;
     for k in 0..4 {
         assert!(f40[k] <= f12[k] * (1.0 + 1e-10));
         assert!(

@@ -14,7 +14,11 @@ use counting_alloc::ALLOCATIONS;
 #[test]
 fn dyn_rocket_rhs_and_steps_do_not_allocate() {
     let scene = load_scene("rocket").unwrap();
-    let mut ode = RocketOde::new(&scene, &Settings::default().modal().unwrap()).unwrap();
+    let mut ode = RocketOde::new(
+        scene.rocket().unwrap(),
+        &Settings::default().modal().unwrap(),
+    )
+    .unwrap();
     let mut y = ode.initial_state();
     let mut dydt = vec![0.0; ode.dim()];
     let mut s = Dopri5::new(

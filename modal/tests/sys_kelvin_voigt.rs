@@ -53,7 +53,7 @@ fn sys_kelvin_voigt_power_of_a_velocity_field_matches_quadrature_in_6_and_12_pol
             basis: Some(Basis::Poly),
             ..Default::default()
         };
-        let chain = build_chain(&scene, &disc.modal().unwrap()).unwrap();
+        let chain = build_chain(scene.planar_chain().unwrap(), &disc.modal().unwrap()).unwrap();
         for (link, spec) in chain.links.iter().zip(scene.links()) {
             let (n, l) = (link.nbc(), spec.length);
             assert_eq!(n, modes);

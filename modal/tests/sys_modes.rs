@@ -147,9 +147,15 @@ fn sys_rotating_beam_in_plane_identity_and_convergence() {
     for lam in [0.0, 1.0, 4.0, 12.0] {
         let omega = lam / lam_scale;
         let at = |b: Basis, n: usize| {
-            rotating_modes(&scene, &settings(b, n).modal().unwrap(), omega, 3)
-                .unwrap()
-                .frequencies_hz
+            rotating_modes(
+                &scene,
+                scene.planar_chain().unwrap(),
+                &settings(b, n).modal().unwrap(),
+                omega,
+                3,
+            )
+            .unwrap()
+            .frequencies_hz
         };
         let (p14, p16) = (at(Basis::Poly, 14), at(Basis::Poly, 16));
         let (f6, f12, f20) = (

@@ -20,10 +20,12 @@ fn rest_rhs(modes: usize, constrained: bool) -> (ChainRhs, Vec<f64>) {
         modes: Some(modes),
         ..Default::default()
     };
-    let chain = build_chain(&scene, &disc.modal().unwrap()).unwrap();
+    let chain = build_chain(scene.planar_chain().unwrap(), &disc.modal().unwrap()).unwrap();
     let (n, nf) = (chain.n, chain.free.len());
     let mut rhs = ChainRhs::new(chain);
-    let mut contact = ContactState::from_scene(&scene, n, nf).unwrap().unwrap();
+    let mut contact = ContactState::from_planar_chain(scene.planar_chain().unwrap(), n, nf)
+        .unwrap()
+        .unwrap();
     contact.constrained = constrained;
     rhs.attach_contact(Some(contact));
     let y = vec![0.0; rhs.dim()];
@@ -161,7 +163,12 @@ fn sys_trbdf2_contact_run_cost_and_first_impulse() {
             ..Default::default()
         },
     };
-    let r = simulate(&scene, &settings.modal().unwrap()).unwrap();
+    let r = simulate(
+        &scene,
+        scene.planar_chain().unwrap(),
+        &settings.modal().unwrap(),
+    )
+    .unwrap();
     let c = &r.cost;
     println!("{c:?}");
     assert!(c.jacobian_evaluations <= 40, "{c:?}");

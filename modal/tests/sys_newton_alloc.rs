@@ -19,7 +19,8 @@ fn sys_implicit_chain_steps_do_not_allocate() {
         modes: Some(4),
         ..Default::default()
     };
-    let chain = modal::setup::build_chain(&scene, &disc.modal().unwrap()).unwrap();
+    let chain =
+        modal::setup::build_chain(scene.planar_chain().unwrap(), &disc.modal().unwrap()).unwrap();
     let mut f = modal::simulate::ChainRhs::new(chain);
     let mut y = f.initial_state();
     let dim = y.len();

@@ -583,7 +583,12 @@ fn freqs(scene: &Scene, modes: usize, basis: Basis, count: usize) -> Vec<f64> {
 /// gyroscopic terms, which are not variational bounds).
 fn pencil_freqs(scene: &Scene, modes: usize, count: usize) -> Vec<f64> {
     let s = settings(modes, Basis::Poly);
-    let set = modal::payload_link::set_up(scene, &s.discretization.modal().unwrap()).unwrap();
+    let set = modal::payload_link::set_up(
+        scene,
+        scene.payload_link().unwrap(),
+        &s.discretization.modal().unwrap(),
+    )
+    .unwrap();
     let (k, m, _) = modal::payload_link::analysis::linear_pencil(&set.model);
     let (lambda, _) = modal::modes::generalized_eigen(&k, &m).unwrap();
     lambda
@@ -815,13 +820,23 @@ fn sys_payload_link_gyroscopic_frequencies_reduce_to_the_pencil_at_rest() {
     at_rest.payload_link_mut().unwrap().base.prescribed =
         Some(data::scene::PrescribedMotion::ConstantRate { rate: 0.0 });
     let plain = ModalBackend.modes(&at_rest, &s, 10).unwrap().frequencies_hz;
-    let gyro =
-        modal::payload_link::gyroscopic_frequencies(&at_rest, &s.modal().unwrap(), 10).unwrap();
+    let gyro = modal::payload_link::gyroscopic_frequencies(
+        &at_rest,
+        at_rest.payload_link().unwrap(),
+        &s.modal().unwrap(),
+        10,
+    )
+    .unwrap();
     for (p, g) in plain.iter().zip(&gyro) {
         assert!((p - g).abs() < 1e-9 * p, "{p} {g}");
     }
     // At the scene's rate `modes` keeps the coupling; the symmetric pencil drops it.
-    let set = modal::payload_link::set_up(&scene, &s.discretization.modal().unwrap()).unwrap();
+    let set = modal::payload_link::set_up(
+        &scene,
+        scene.payload_link().unwrap(),
+        &s.discretization.modal().unwrap(),
+    )
+    .unwrap();
     let (k, m, _) = modal::payload_link::analysis::linear_pencil(&set.model);
     let (lambda, _) = modal::modes::generalized_eigen(&k, &m).unwrap();
     let plain: Vec<f64> = lambda
@@ -829,8 +844,13 @@ fn sys_payload_link_gyroscopic_frequencies_reduce_to_the_pencil_at_rest() {
         .take(10)
         .map(|l| l.sqrt() / std::f64::consts::TAU)
         .collect();
-    let gyro =
-        modal::payload_link::gyroscopic_frequencies(&scene, &s.modal().unwrap(), 10).unwrap();
+    let gyro = modal::payload_link::gyroscopic_frequencies(
+        &scene,
+        scene.payload_link().unwrap(),
+        &s.modal().unwrap(),
+        10,
+    )
+    .unwrap();
     let reported = ModalBackend.modes(&scene, &s, 10).unwrap().frequencies_hz;
     let mut moved = 0.0f64;
     for ((p, g), r) in plain.iter().zip(&gyro).zip(&reported) {

@@ -40,8 +40,8 @@
 // Index loops over parallel buffers (q, v, a, G, M⁻¹Gᵀ) read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use data::scene::{ContactMode, Surface};
-use data::{Event, Scene};
+use data::Event;
+use data::scene::{ContactMode, PlanarChain, Surface};
 use faer::Mat;
 use faer::prelude::Solve;
 
@@ -65,22 +65,22 @@ pub struct TipContact {
 }
 
 impl TipContact {
-    /// The scene's contact, if any; `unsupported: …` for what this model does not carry.
-    pub fn from_scene(scene: &Scene) -> Result<Option<Self>, FdmError> {
-        let Some(c) = scene.contacts().first() else {
+    /// The contact of `pc` (the chain of scene `name`), if any; `unsupported: …` for what this
+    /// model does not carry.
+    pub fn from_planar_chain(name: &str, pc: &PlanarChain) -> Result<Option<Self>, FdmError> {
+        let Some(c) = pc.contacts.first() else {
             return Ok(None);
         };
         let unsupported = |what: String| {
             Err(FdmError::Unsupported(format!(
-                "fdm: `{}`: {what} (the finite-difference chain carries one frictionless \
-                 unilateral contact of link 2's tip with a line)",
-                scene.name
+                "fdm: `{name}`: {what} (the finite-difference chain carries one frictionless \
+                 unilateral contact of link 2's tip with a line)"
             )))
         };
-        if scene.contacts().len() > 1 {
-            return unsupported(format!("{} contacts", scene.contacts().len()));
+        if pc.contacts.len() > 1 {
+            return unsupported(format!("{} contacts", pc.contacts.len()));
         }
-        if scene.link_index(&c.link) != Some(1) {
+        if pc.link_index(&c.link) != Some(1) {
             return unsupported(format!("contact of link `{}`", c.link));
         }
         if c.friction != 0.0 {

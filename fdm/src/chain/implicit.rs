@@ -294,7 +294,9 @@ mod tests {
         // (M + ½τC) x = r checked by M x (the chain's own product) and C x (the damping forces
         // themselves), at a deformed, moving state and a step far above the damped bound
         let scene = data::load_scene("two-link-free").unwrap();
-        let mut sys = TwoLinkChain::from_scene(&scene, Some(9)).unwrap();
+        let mut sys =
+            TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9))
+                .unwrap();
         assert!(sys.enable_implicit_damping());
         let n = sys.dofs();
         let q: Vec<f64> = (0..n)

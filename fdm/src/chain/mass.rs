@@ -14,7 +14,7 @@ pub(super) const MAX_FULL: usize = 5;
 
 impl TwoLinkChain {
     /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`; the ghost
-    /// columns are constant (built in `from_scene`).
+    /// columns are constant (built in `from_planar_chain`).
     pub(super) fn build_columns(&mut self) {
         let n = self.dofs();
         let full = [TH, BE];

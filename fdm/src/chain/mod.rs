@@ -66,7 +66,7 @@ pub mod modes;
 mod outputs;
 pub mod timoshenko;
 
-use data::scene::{Link, TorqueLaw};
+use data::scene::{Link, PlanarChain, TorqueLaw};
 use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
@@ -173,9 +173,9 @@ pub struct TwoLinkChain {
     timo: Option<TimoFields>,
 }
 
-fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
+fn check_link(name: &str, l: &Link) -> Result<(), FdmError> {
     FdmError::check_switches(
-        &format!("`{}` (link `{}`)", scene.name, l.name),
+        &format!("`{name}` (link `{}`)", l.name),
         "chain",
         &[
             ("axial", l.axial),
@@ -190,37 +190,42 @@ fn check_link(scene: &Scene, l: &Link) -> Result<(), FdmError> {
         // would not be the scene's clamped-frame linear beam (measured on `two-link-free` with
         // both links linear: 8.5e-4 of the peak hub angle from fem and modal, which agree).
         return Err(FdmError::Unsupported(format!(
-            "fdm: `{}` (link `{}`) is a linear beam (no `foreshortening`): the \
+            "fdm: `{name}` (link `{}`) is a linear beam (no `foreshortening`): the \
              finite-difference chain measures deflections from the link's tip chord, which \
              matches the clamped frame of the scene only with foreshortening; switch it on, \
              or use the fem or modal backend",
-            scene.name, l.name
+            l.name
         )));
     }
     Ok(())
 }
 
 impl TwoLinkChain {
-    pub fn from_scene(scene: &Scene, stations: Option<usize>) -> Result<Self, FdmError> {
-        if scene.links().len() != 2 {
+    /// The chain model of `pc`, the planar chain of `scene`.
+    pub fn from_planar_chain(
+        scene: &Scene,
+        pc: &PlanarChain,
+        stations: Option<usize>,
+    ) -> Result<Self, FdmError> {
+        if pc.links.len() != 2 {
             return Err(FdmError::Unsupported(format!(
                 "fdm: `{}` has {} links; the finite-difference chain handles exactly two",
                 scene.name,
-                scene.links().len()
+                pc.links.len()
             )));
         }
-        for l in scene.links() {
-            check_link(scene, l)?;
+        for l in &pc.links {
+            check_link(&scene.name, l)?;
         }
-        let shear = scene.links()[0].shear;
-        if scene.links()[1].shear != shear {
+        let shear = pc.links[0].shear;
+        if pc.links[1].shear != shear {
             return Err(FdmError::Unsupported(format!(
                 "fdm: `{}` mixes a Timoshenko (`shear`) and an Euler link; the finite-difference \
                  chain needs both links of one model",
                 scene.name
             )));
         }
-        for l in scene.links() {
+        for l in &pc.links {
             if l.rotary_inertia {
                 return Err(FdmError::Unsupported(format!(
                     "fdm: `{}` (link `{}`) switches on rotary_inertia — the finite-difference \
@@ -242,7 +247,7 @@ impl TwoLinkChain {
                 )));
             }
         }
-        if scene.links()[1].joint.hub_inertia.unwrap_or(0.0) != 0.0 {
+        if pc.links[1].joint.hub_inertia.unwrap_or(0.0) != 0.0 {
             return Err(FdmError::Unsupported(format!(
                 "fdm: `{}`: a rotor inertia at the elbow is not implemented",
                 scene.name
@@ -256,8 +261,8 @@ impl TwoLinkChain {
             m[r - 1] = 0.5 * l.mass_per_length * h + l.tip_mass.unwrap_or(0.0);
             (r, h, m)
         };
-        let (r1, h1, m1) = lump(&scene.links()[0]);
-        let (r2, h2, m2) = lump(&scene.links()[1]);
+        let (r1, h1, m1) = lump(&pc.links[0]);
+        let (r2, h2, m2) = lump(&pc.links[1]);
         // outboard sums per segment: Σ_{i > seg} mᵢ xᵢ and Σ_{i > seg} mᵢ
         let outboard = |m: &[f64], h: f64, moment: bool| -> Vec<f64> {
             let mut out = vec![0.0; m.len()];
@@ -275,11 +280,11 @@ impl TwoLinkChain {
         let jc = if shear {
             [0.0; 2]
         } else {
-            [clamp(&scene.links()[0], h1), clamp(&scene.links()[1], h2)]
+            [clamp(&pc.links[0], h1), clamp(&pc.links[1], h2)]
         };
         let timo = if shear {
             let mut lk = [(0, 0.0, 0.0, 0.0, 0.0); 2];
-            for (k, (l, (r, h))) in scene.links().iter().zip([(r1, h1), (r2, h2)]).enumerate() {
+            for (k, (l, (r, h))) in pc.links.iter().zip([(r1, h1), (r2, h2)]).enumerate() {
                 lk[k] = (
                     r,
                     h,
@@ -295,28 +300,25 @@ impl TwoLinkChain {
                     l.joint.set_point.unwrap_or(0.0),
                 )
             };
-            Some(TimoFields::new(
-                lk,
-                [jt(&scene.links()[0]), jt(&scene.links()[1])],
-            )?)
+            Some(TimoFields::new(lk, [jt(&pc.links[0]), jt(&pc.links[1])])?)
         } else {
             None
         };
         let inertia = ChainInertia {
-            hub: scene.links()[0].joint.hub_inertia.unwrap_or(0.0),
-            l1: scene.links()[0].length,
+            hub: pc.links[0].joint.hub_inertia.unwrap_or(0.0),
+            l1: pc.links[0].length,
             h1,
             h2,
             r1,
             r2,
-            fs1: scene.links()[0].foreshortening,
-            fs2: scene.links()[1].foreshortening,
+            fs1: pc.links[0].foreshortening,
+            fs2: pc.links[1].foreshortening,
             w1: outboard(&m1, h1, true),
             w2: outboard(&m2, h2, true),
             mu2: outboard(&m2, h2, false),
             sum_mx2_1: (0..r1).map(|k| m1[k] * ((k + 1) as f64 * h1).powi(2)).sum(),
             // link 2's clamp half cell (mass ρA₂h₂/2 at ξ = 0) rides on the elbow
-            mass2: m2.iter().sum::<f64>() + 0.5 * scene.links()[1].mass_per_length * h2,
+            mass2: m2.iter().sum::<f64>() + 0.5 * pc.links[1].mass_per_length * h2,
             q2: (0..r2).map(|j| m2[j] * (j + 1) as f64 * h2).sum(),
             i2: (0..r2).map(|j| m2[j] * ((j + 1) as f64 * h2).powi(2)).sum(),
             m1,
@@ -336,13 +338,9 @@ impl TwoLinkChain {
         };
         // Euler links: link 1's tip ghost y after the inertia's coordinates
         let tip_ghost = (!shear).then(|| inertia.dofs());
-        let jt = if shear {
-            0.0
-        } else {
-            clamp(&scene.links()[0], h1)
-        };
+        let jt = if shear { 0.0 } else { clamp(&pc.links[0], h1) };
         let nd = inertia.dofs() + usize::from(tip_ghost.is_some());
-        let contact = TipContact::from_scene(scene)?;
+        let contact = TipContact::from_planar_chain(&scene.name, pc)?;
         let mu1g = {
             let mut acc = inertia.mass2;
             let mut out = vec![0.0; r1];
@@ -352,10 +350,10 @@ impl TwoLinkChain {
             }
             out
         };
-        let (j1, j2) = (&scene.links()[0].joint, &scene.links()[1].joint);
+        let (j1, j2) = (&pc.links[0].joint, &pc.links[1].joint);
         let mut chain = TwoLinkChain {
-            links: [props(&scene.links()[0]), props(&scene.links()[1])],
-            joints: [joint(&scene.links()[0]), joint(&scene.links()[1])],
+            links: [props(&pc.links[0]), props(&pc.links[1])],
+            joints: [joint(&pc.links[0]), joint(&pc.links[1])],
             init: [
                 (j1.initial_angle, j1.initial_rate),
                 (j2.initial_angle, j2.initial_rate),
@@ -381,7 +379,7 @@ impl TwoLinkChain {
             obs_scratch: std::cell::RefCell::new(vec![0.0; nd]),
             obs_scratch_v: std::cell::RefCell::new(vec![0.0; nd]),
             inertia,
-            gravity: scene.gravity().map(|g| g.vector),
+            gravity: pc.gravity.as_ref().map(|g| g.vector),
             mu1g,
             contact,
             constrained: false,

@@ -14,6 +14,7 @@
 //! gravity) gives a zero frequency (a rigid mode), reported as 0 with kind "rigid" (any mode
 //! below 1 % of the slowest link's √(EI/ρAL⁴)).
 
+use data::scene::PlanarChain;
 use data::{BackendKind, Cost, ModalResult, ModeShape, Scene};
 use faer::{Mat, Side};
 
@@ -167,10 +168,15 @@ fn generalized_eigen(k: &Mat<f64>, m: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>),
     Ok((lambda, x))
 }
 
-/// `modes` of a two-link chain scene: the lowest `count` linearized frequencies.
-pub fn modes(scene: &Scene, s: &ValidatedSettings, count: usize) -> Result<ModalResult, FdmError> {
+/// `modes` of a two-link chain `pc` (of `scene`): the lowest `count` linearized frequencies.
+pub fn modes(
+    scene: &Scene,
+    pc: &PlanarChain,
+    s: &ValidatedSettings,
+    count: usize,
+) -> Result<ModalResult, FdmError> {
     let clock = std::time::Instant::now();
-    let mut chain = TwoLinkChain::from_scene(scene, s.stations)?;
+    let mut chain = TwoLinkChain::from_planar_chain(scene, pc, s.stations)?;
     let m = chain.linearized_modes()?;
     let n = m.omega.len();
     let count = count.min(n);

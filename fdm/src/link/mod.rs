@@ -37,7 +37,7 @@
 
 use std::ops::Range;
 
-use data::scene::{PrescribedMotion, TorqueLaw};
+use data::scene::{PlanarChain, PrescribedMotion, TorqueLaw};
 use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
@@ -101,16 +101,21 @@ pub struct FloatingLink {
 }
 
 impl FloatingLink {
-    pub fn from_scene(scene: &Scene, stations: Option<usize>) -> Result<Self, FdmError> {
-        if scene.links().len() != 1 {
+    /// The link model of `pc`, the planar chain of `scene`.
+    pub fn from_planar_chain(
+        scene: &Scene,
+        pc: &PlanarChain,
+        stations: Option<usize>,
+    ) -> Result<Self, FdmError> {
+        if pc.links.len() != 1 {
             return Err(FdmError::Unsupported(format!(
                 "fdm: `{}` has {} links; chains of floating-frame links (joint coupling through the \
                  tip slope) are not implemented in fdm",
                 scene.name,
-                scene.links().len()
+                pc.links.len()
             )));
         }
-        let l = &scene.links()[0];
+        let l = &pc.links[0];
         FdmError::check_switches(
             &format!("`{}`", scene.name),
             "floating link",
@@ -119,8 +124,8 @@ impl FloatingLink {
                 ("shear", l.shear),
                 ("rotary_inertia", l.rotary_inertia),
                 ("tip_inertia", l.tip_inertia.is_some()),
-                ("gravity", scene.gravity().is_some()),
-                ("contact", !scene.contacts().is_empty()),
+                ("gravity", pc.gravity.as_ref().is_some()),
+                ("contact", !pc.contacts.is_empty()),
             ],
         )?;
         let j = &l.joint;

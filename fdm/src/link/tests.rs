@@ -6,7 +6,8 @@ use data::Settings;
 #[test]
 fn elem_link_forces_are_minus_energy_gradients() {
     let scene = data::load_scene("spin-up").unwrap();
-    let link = FloatingLink::from_scene(&scene, Some(9)).unwrap();
+    let link =
+        FloatingLink::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9)).unwrap();
     let h = link.h;
     let vs: Vec<f64> = (1..=8)
         .map(|i| 0.01 * (0.7 * i as f64).sin() + 0.002 * i as f64)
@@ -40,8 +41,13 @@ fn elem_link_forces_are_minus_energy_gradients() {
         );
     }
     // and the bending energy equals the cantilever's ½ vᵀKv
-    let c = crate::beam::Cantilever::from_scene(&data::load_scene("cantilever").unwrap(), Some(9))
-        .unwrap();
+    let cantilever = data::load_scene("cantilever").unwrap();
+    let c = crate::beam::Cantilever::from_planar_chain(
+        &cantilever,
+        cantilever.planar_chain().unwrap(),
+        Some(9),
+    )
+    .unwrap();
     let k = c.stiffness();
     let quad: f64 = (0..8)
         .map(|i| (0..8).map(|j| 0.5 * vs[i] * k[(i, j)] * vs[j]).sum::<f64>())
@@ -73,7 +79,9 @@ fn spinning(omega: f64, stations: usize) -> (FloatingLink, Scene) {
     scene.planar_chain_mut().unwrap().links[0]
         .joint
         .initial_rate = omega - RAMP_GAIN;
-    let link = FloatingLink::from_scene(&scene, Some(stations)).unwrap();
+    let link =
+        FloatingLink::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(stations))
+            .unwrap();
     (link, scene)
 }
 
@@ -212,7 +220,7 @@ fn dyn_link_tension_bound_is_sharp() {
     s.time.dt = Some(1.05 * 0.5 * link.bound(RAMP + 0.1).sigma);
     s.time.t_end = Some(RAMP + 0.2);
     let fs = crate::settings::ValidatedSettings::from_settings(&s.fdm().unwrap()).unwrap();
-    match simulate(&scene, &fs) {
+    match simulate(&scene, scene.planar_chain().unwrap(), &fs) {
         Err(FdmError::StabilityBound {
             t, kind, location, ..
         }) => {
@@ -267,7 +275,8 @@ fn point_positions(link: &FloatingLink, th: f64, vs: &[f64]) -> Vec<[f64; 2]> {
 #[test]
 fn elem_link_kinetic_energy_is_the_exact_one_of_the_points() {
     let scene = data::load_scene("spin-up").unwrap();
-    let link = FloatingLink::from_scene(&scene, Some(21)).unwrap();
+    let link =
+        FloatingLink::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(21)).unwrap();
     let t = 12.0;
     let n = link.dofs();
     let (q0, v0) = (vec![0.0; n], vec![0.0; n]);
@@ -326,7 +335,8 @@ fn sys_link_bordered_mass_solve_matches_dense() {
     scene.planar_chain_mut().unwrap().links[0].joint.stiffness = Some(stiffness);
     scene.planar_chain_mut().unwrap().links[0].joint.torque = None;
     scene.planar_chain_mut().unwrap().links[0].joint.damping = None;
-    let mut link = FloatingLink::from_scene(&scene, Some(21)).unwrap();
+    let mut link =
+        FloatingLink::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(21)).unwrap();
     assert!(!link.prescribed());
     let (vs, vd) = lagging_state(&link);
     let n = link.dofs();

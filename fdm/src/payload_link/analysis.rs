@@ -12,7 +12,7 @@
 //! **Statics**: K q = f_g, the discrete static equations under gravity at rest (the static-sag
 //! start of the dynamics).
 
-use data::scene::{LinkField, PrescribedMotion};
+use data::scene::{LinkField, PayloadLink, PrescribedMotion};
 use data::{BackendKind, Cost, ModalResult, ModeShape, Scene, StaticResult};
 use faer::{Mat, Side};
 
@@ -159,9 +159,14 @@ pub fn kind_name(f: LinkField) -> &'static str {
 
 /// `modes` of a payload-link scene: the lowest `count` frequencies with their kinds; each
 /// shape is the dominant field at the stations (root included), unit peak.
-pub fn modes(scene: &Scene, s: &ValidatedSettings, count: usize) -> Result<ModalResult, FdmError> {
+pub fn modes(
+    scene: &Scene,
+    p: &PayloadLink,
+    s: &ValidatedSettings,
+    count: usize,
+) -> Result<ModalResult, FdmError> {
     let clock = std::time::Instant::now();
-    let model = PayloadLinkModel::from_scene(scene, s.stations)?;
+    let model = PayloadLinkModel::from_payload_link(scene, p, s.stations)?;
     let sp = model.spectrum()?;
     let off = usize::from(model.free_base());
     let count = count.min(sp.omega.len());
@@ -213,9 +218,13 @@ pub fn modes(scene: &Scene, s: &ValidatedSettings, count: usize) -> Result<Modal
 }
 
 /// `statics`: the gravity sag, w_L and w′_L.
-pub fn statics(scene: &Scene, s: &ValidatedSettings) -> Result<StaticResult, FdmError> {
+pub fn statics(
+    scene: &Scene,
+    p: &PayloadLink,
+    s: &ValidatedSettings,
+) -> Result<StaticResult, FdmError> {
     let clock = std::time::Instant::now();
-    let model = PayloadLinkModel::from_scene(scene, s.stations)?;
+    let model = PayloadLinkModel::from_payload_link(scene, p, s.stations)?;
     if model.f_gravity.is_none() {
         return Err(FdmError::Unsupported(format!(
             "fdm statics of `{}`: the payload link's static load is gravity, and the scene has \

@@ -121,10 +121,12 @@ pub struct PayloadLinkModel {
 }
 
 impl PayloadLinkModel {
-    pub fn from_scene(scene: &Scene, stations: Option<usize>) -> Result<Self, FdmError> {
-        let p = scene.payload_link().ok_or_else(|| {
-            FdmError::Unsupported(format!("fdm: `{}` has no [payload_link]", scene.name))
-        })?;
+    /// The model of `p`, the payload link of `scene` (whose field stations it samples).
+    pub fn from_payload_link(
+        scene: &Scene,
+        p: &PayloadLink,
+        stations: Option<usize>,
+    ) -> Result<Self, FdmError> {
         Self::build(
             p,
             stations,

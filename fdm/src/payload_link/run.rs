@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use data::scene::LinkField;
+use data::scene::{LinkField, PayloadLink};
 use data::{
     Cost, Diagnostic, EnergyLedger, Observables, RunResult, Scene, StabilityVerdict, channel,
     ledger_term,
@@ -302,12 +302,13 @@ impl PayloadLinkModel {
 }
 
 /// Runs the scene.
-pub fn simulate(scene: &Scene, s: &ValidatedSettings) -> Result<RunResult, FdmError> {
+pub fn simulate(
+    scene: &Scene,
+    p: &PayloadLink,
+    s: &ValidatedSettings,
+) -> Result<RunResult, FdmError> {
     let clock = Instant::now();
-    let model = PayloadLinkModel::from_scene(scene, s.stations)?;
-    let p = scene.payload_link().ok_or_else(|| {
-        FdmError::Unsupported(format!("fdm: `{}` has no [payload_link]", scene.name))
-    })?;
+    let model = PayloadLinkModel::from_payload_link(scene, p, s.stations)?;
     let sag = p.initial_shape == data::scene::LinkInitialShape::StaticSag;
     let t_end = s.t_end.unwrap_or(scene.simulation.t_end);
     let interval = scene.simulation.output_interval;

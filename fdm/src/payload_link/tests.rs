@@ -17,7 +17,7 @@ fn model(name: &str, payload: bool) -> PayloadLinkModel {
         p.offset = 0.0;
         p.inertia = [[0.0; 3]; 3];
     }
-    PayloadLinkModel::from_scene(&scene, Some(11)).unwrap()
+    PayloadLinkModel::from_payload_link(&scene, scene.payload_link().unwrap(), Some(11)).unwrap()
 }
 
 /// A smooth field state: each field a different mix of shapes, scaled by `amp`.
@@ -177,7 +177,8 @@ fn elem_payload_kinetic_energy_second_order_part_is_exact_without_payload_rotati
         pl.inertia = [[0.0; 3]; 3];
     }
     let p = scene.payload_link().cloned().unwrap();
-    let m = PayloadLinkModel::from_scene(&scene, Some(11)).unwrap();
+    let m = PayloadLinkModel::from_payload_link(&scene, scene.payload_link().unwrap(), Some(11))
+        .unwrap();
     let zero = vec![0.0; m.n];
     let (a, b) = (
         kinetic(&m, &zero, &zero, 2.0),
@@ -287,7 +288,8 @@ fn elem_payload_elastic_and_gravity_forces_are_the_potential_gradient() {
 fn elem_payload_step_bounds_are_the_reports_per_field() {
     let scene = load_scene("single-link-3d").unwrap();
     let p = scene.payload_link().cloned().unwrap();
-    let m = PayloadLinkModel::from_scene(&scene, Some(21)).unwrap();
+    let m = PayloadLinkModel::from_payload_link(&scene, scene.payload_link().unwrap(), Some(21))
+        .unwrap();
     let h = m.h;
     for (f, sigma, station) in m.field_bounds() {
         let report = match f {

@@ -4,6 +4,7 @@ pub mod model;
 pub mod operators;
 pub mod system;
 
+use data::scene::Rocket;
 use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
@@ -14,19 +15,14 @@ use system::RocketSystem;
 /// Default stations: h = 2 in over 150 in, as in the report.
 pub const DEFAULT_STATIONS: usize = 76;
 
-pub fn build(scene: &Scene, s: &ValidatedSettings) -> Result<RocketSystem, FdmError> {
-    let r = scene
-        .rocket()
-        .ok_or_else(|| FdmError::Unsupported("scene has no [rocket]".into()))?;
+/// The system of `r`, the rocket of `scene` (whose field stations it samples).
+pub fn build(scene: &Scene, r: &Rocket, s: &ValidatedSettings) -> Result<RocketSystem, FdmError> {
     let n = s.stations.unwrap_or(DEFAULT_STATIONS);
     let model = RocketModel::new(r, n)?;
     Ok(RocketSystem::new(model, scene.simulation.field_stations))
 }
 
-pub fn dof_plan(scene: &Scene, stations: Option<usize>) -> Result<DofPlan, FdmError> {
-    let r = scene
-        .rocket()
-        .ok_or_else(|| FdmError::Unsupported("scene has no [rocket]".into()))?;
+pub fn dof_plan(r: &Rocket, stations: Option<usize>) -> Result<DofPlan, FdmError> {
     let n = stations.unwrap_or(DEFAULT_STATIONS);
     let mut plan = DofPlan::default();
     plan.add("rigid body (X, Y, θ)", 3);

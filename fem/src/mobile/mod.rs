@@ -71,21 +71,15 @@ pub const DEFAULT_ELEMENTS: usize = 4;
 /// Midpoint steps per first flexible period for the default step.
 pub const STEPS_PER_PERIOD: f64 = 40.0;
 
-/// The scene's mobile manipulator (None for other families).
-pub fn scene_model(scene: &Scene) -> Option<&MobileManipulator> {
-    scene.mobile_manipulator()
-}
-
-fn the_scene(scene: &Scene) -> Result<&MobileManipulator, FemError> {
-    let mm = scene_model(scene)
-        .ok_or_else(|| FemError::unsupported("fem: not a mobile-manipulator scene"))?;
+/// Refuses the rigid manipulator (verify's reference solves it).
+fn check_flexible(mm: &MobileManipulator) -> Result<(), FemError> {
     if mm.flexible_link.is_none() {
         return Err(FemError::unsupported(
             "fem mobile manipulator: rigid scenes are verify's reference (`--backend \
              reference`); fem runs the flexible variant (`[mobile_manipulator.flexible_link]`)",
         ));
     }
-    Ok(mm)
+    Ok(())
 }
 
 fn elements(settings: &data::FemSettings) -> Result<usize, FemError> {
@@ -99,8 +93,8 @@ fn elements(settings: &data::FemSettings) -> Result<usize, FemError> {
 }
 
 /// DOFs and physics built for the scene.
-pub fn dof_plan(scene: &Scene, settings: &data::FemSettings) -> Result<DofPlan, FemError> {
-    let mm = the_scene(scene)?;
+pub fn dof_plan(mm: &MobileManipulator, settings: &data::FemSettings) -> Result<DofPlan, FemError> {
+    check_flexible(mm)?;
     let n_el = elements(settings)?;
     let md = Model::from_scene(mm, n_el)?;
     let mut plan = DofPlan::default();
@@ -234,8 +228,13 @@ pub struct Prepared {
     pub output_interval: f64,
 }
 
-pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemError> {
-    let mm = the_scene(scene)?;
+/// The stepper, step and output settings of a run of `mm`, the manipulator of `scene`.
+pub fn prepare(
+    scene: &Scene,
+    mm: &MobileManipulator,
+    settings: &FemSettings,
+) -> Result<Prepared, FemError> {
+    check_flexible(mm)?;
     let n_el = elements(settings)?;
     match settings.method {
         None | Some(data::FemMethod::ImplicitMidpoint) => {}
@@ -397,14 +396,19 @@ pub fn advance(st: &mut Stepper, h: f64, t_stop: f64, breakpoints: &[f64]) -> Re
     Ok(())
 }
 
-pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemError> {
+/// A run of `mm`, the manipulator of `scene`.
+pub fn simulate(
+    scene: &Scene,
+    mm: &MobileManipulator,
+    settings: &FemSettings,
+) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
         mut stepper,
         h,
         t_end,
         output_interval,
-    } = prepare(scene, settings)?;
+    } = prepare(scene, mm, settings)?;
     let specs = channel_specs(&stepper.model);
     let mut obs = Observables::with_channels(&specs);
     let (s, i, d) = ledger_names(&stepper.model);

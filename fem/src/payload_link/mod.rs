@@ -86,15 +86,6 @@ use step::{State, Stepper};
 /// below this fraction of each observable's scale ([`default_step`]).
 pub const PHASE_ERROR_TOLERANCE: f64 = 1e-4;
 
-/// The scene's payload link (None for other families).
-pub fn link(scene: &Scene) -> Option<&PayloadLink> {
-    scene.payload_link()
-}
-
-fn the_link(scene: &Scene) -> Result<&PayloadLink, FemError> {
-    link(scene).ok_or_else(|| FemError::unsupported("fem: not a payload-link scene"))
-}
-
 fn field_dofs(f: LinkField) -> (&'static str, usize) {
     match f {
         LinkField::Axial => ("axial u", 1),
@@ -104,9 +95,8 @@ fn field_dofs(f: LinkField) -> (&'static str, usize) {
     }
 }
 
-/// DOFs and physics built for the scene with `n_el` elements.
-pub fn dof_plan(scene: &Scene, n_el: usize) -> Result<DofPlan, FemError> {
-    let l = the_link(scene)?;
+/// DOFs and physics built for the payload link `l` with `n_el` elements.
+pub fn dof_plan(l: &PayloadLink, n_el: usize) -> Result<DofPlan, FemError> {
     let md = Model::assemble(l, n_el)?;
     let mut plan = DofPlan::default();
     if md.free_base() {
@@ -372,9 +362,14 @@ fn slot_of(md: &Model, i: usize) -> usize {
         .unwrap_or(U)
 }
 
-pub fn modes(scene: &Scene, settings: &FemSettings, count: usize) -> Result<ModalResult, FemError> {
+/// The modes of `l`, the payload link of `scene`.
+pub fn modes(
+    scene: &Scene,
+    l: &PayloadLink,
+    settings: &FemSettings,
+    count: usize,
+) -> Result<ModalResult, FemError> {
     let start = Instant::now();
-    let l = the_link(scene)?;
     let n_el = settings::elements(settings)?;
     let md = build(l, n_el)?;
     // A free base without spring turns rigidly (ω = 0, kind `rigid`), listed first as by the
@@ -448,9 +443,13 @@ pub fn static_sag(md: &Model) -> Result<Vec<f64>, FemError> {
     Ok((0..n).map(|i| d[(i, 0)]).collect())
 }
 
-pub fn statics(scene: &Scene, settings: &FemSettings) -> Result<StaticResult, FemError> {
+/// The gravity sag of `l`, the payload link of `scene`.
+pub fn statics(
+    scene: &Scene,
+    l: &PayloadLink,
+    settings: &FemSettings,
+) -> Result<StaticResult, FemError> {
     let start = Instant::now();
-    let l = the_link(scene)?;
     let n_el = settings::elements(settings)?;
     let md = build(l, n_el)?;
     let d = static_sag(&md)?;
@@ -663,8 +662,12 @@ pub fn default_step(md: &Model, d0: &[f64], t_end: f64, out: f64) -> Result<f64,
     Ok(lo)
 }
 
-pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemError> {
-    let l = the_link(scene)?;
+/// The stepper, step and output settings of a run of `l`, the payload link of `scene`.
+pub fn prepare(
+    scene: &Scene,
+    l: &PayloadLink,
+    settings: &FemSettings,
+) -> Result<Prepared, FemError> {
     let n_el = settings::elements(settings)?;
     match settings.method {
         None | Some(data::FemMethod::ImplicitMidpoint) => {}
@@ -810,7 +813,12 @@ fn push_ledger(st: &Stepper, ledger: &mut EnergyLedger) {
     ledger.push(s.t, &stored[..k], &input, &diss[..nd]);
 }
 
-pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemError> {
+/// A run of `l`, the payload link of `scene`.
+pub fn simulate(
+    scene: &Scene,
+    l: &PayloadLink,
+    settings: &FemSettings,
+) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
         mut stepper,
@@ -818,7 +826,7 @@ pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemE
         t_end,
         output_interval,
         stations,
-    } = prepare(scene, settings)?;
+    } = prepare(scene, l, settings)?;
     let specs = channel::payload_link(&stepper.model.fields, stations);
     let mut obs = Observables::with_channels(&specs);
     let (s, i, d) = ledger_names(&stepper.model);

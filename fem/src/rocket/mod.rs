@@ -59,6 +59,7 @@ use std::time::Instant;
 
 use data::channel::spec;
 use data::results::ledger_term;
+use data::scene::Rocket;
 use data::{
     DofPlan, EnergyLedger, FemSettings, ModalResult, ModeShape, Observables, RunResult, Scene,
     StabilityVerdict,
@@ -82,23 +83,12 @@ const NEWTON_TOL: f64 = 1e-13;
 const NEWTON_ACCEPT: f64 = 1e-10;
 const NEWTON_MAX: usize = 12;
 
-pub fn the_rocket(scene: &Scene) -> Option<&data::scene::Rocket> {
-    scene.rocket()
+/// The discretized model of the rocket `r`.
+pub fn build(r: &Rocket, settings: &FemSettings) -> Result<Model, FemError> {
+    Model::new(r, crate::settings::elements_or(settings, DEFAULT_ELEMENTS)?)
 }
 
-fn rocket_of(scene: &Scene) -> Result<&data::scene::Rocket, FemError> {
-    the_rocket(scene).ok_or_else(|| FemError::unsupported("scene has no [rocket]"))
-}
-
-pub fn build(scene: &Scene, settings: &FemSettings) -> Result<Model, FemError> {
-    Model::new(
-        rocket_of(scene)?,
-        crate::settings::elements_or(settings, DEFAULT_ELEMENTS)?,
-    )
-}
-
-pub fn dof_plan(scene: &Scene, settings: &data::FemSettings) -> Result<DofPlan, FemError> {
-    let r = rocket_of(scene)?;
+pub fn dof_plan(r: &Rocket, settings: &data::FemSettings) -> Result<DofPlan, FemError> {
     let n_el = crate::settings::elements_or(settings, DEFAULT_ELEMENTS)?;
     let nm = r.discrete_masses.len();
     let mut plan = DofPlan::default();
@@ -428,8 +418,8 @@ pub struct Prepared {
     pub stations: usize,
 }
 
-pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemError> {
-    let r = rocket_of(scene)?;
+/// The stepper, step and output settings of a run of `r`, the rocket of `scene`.
+pub fn prepare(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Prepared, FemError> {
     match settings.method {
         None | Some(data::FemMethod::ImplicitMidpoint) => {}
         Some(other) => {
@@ -447,7 +437,7 @@ pub fn prepare(scene: &Scene, settings: &FemSettings) -> Result<Prepared, FemErr
     let h = crate::settings::positive("time.dt", settings.dt)?.unwrap_or(DEFAULT_STEP);
     let t_end =
         crate::settings::positive("time.t_end", settings.t_end)?.unwrap_or(scene.simulation.t_end);
-    let model = build(scene, settings)?;
+    let model = build(r, settings)?;
     let q = model.initial_shape(&r.initial_shape);
     let v = vec![0.0; model.n];
     Ok(Prepared {
@@ -469,7 +459,8 @@ fn push_ledger(st: &Stepper, ledger: &mut EnergyLedger) {
     );
 }
 
-pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemError> {
+/// A run of `r`, the rocket of `scene`.
+pub fn simulate(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
         mut stepper,
@@ -477,7 +468,7 @@ pub fn simulate(scene: &Scene, settings: &FemSettings) -> Result<RunResult, FemE
         t_end,
         output_interval,
         stations,
-    } = prepare(scene, settings)?;
+    } = prepare(scene, r, settings)?;
     let specs = channel_specs(&stepper.model, stations);
     let mut obs = Observables::with_channels(&specs);
     let mut ledger = EnergyLedger::new(
@@ -642,9 +633,15 @@ pub fn rocket_modes(model: &Model, count: usize) -> Result<Vec<RocketMode>, FemE
     Ok(out)
 }
 
-pub fn modes(scene: &Scene, settings: &FemSettings, count: usize) -> Result<ModalResult, FemError> {
+/// The free-free modes of `r`, the rocket of `scene`, at ignition mass.
+pub fn modes(
+    scene: &Scene,
+    r: &Rocket,
+    settings: &FemSettings,
+    count: usize,
+) -> Result<ModalResult, FemError> {
     let start = Instant::now();
-    let model = build(scene, settings)?;
+    let model = build(r, settings)?;
     let modes = rocket_modes(&model, count)?;
     let stations = scene.simulation.field_stations.max(2);
     let shapes = modes

@@ -30,7 +30,7 @@
 pub mod model;
 pub mod run;
 
-use data::scene::TorqueSchedule;
+use data::scene::{MobileManipulator, TorqueSchedule};
 use data::{Basis, DofPlan, ModalResult, ModalSettings, ModeShape, Scene};
 use faer::Mat;
 
@@ -107,14 +107,11 @@ pub fn shape_choice(settings: &ModalSettings) -> Result<(usize, ShapeChoice), Mo
     Ok((n, choice))
 }
 
-/// The scene's model and inputs.
+/// The model and inputs of the mobile manipulator `mm`.
 pub fn set_up(
-    scene: &Scene,
+    mm: &MobileManipulator,
     settings: &ModalSettings,
 ) -> Result<(MobileModel, Inputs), ModalError> {
-    let mm = scene
-        .mobile_manipulator()
-        .ok_or_else(|| ModalError::Unsupported("not a mobile-manipulator scene".into()))?;
     let (n, choice) = shape_choice(settings)?;
     let model = MobileModel::from_scene(mm, n, choice)?;
     let inputs = Inputs {
@@ -125,8 +122,8 @@ pub fn set_up(
 }
 
 /// Degrees of freedom and physics built for the scene.
-pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
-    let (model, _) = set_up(scene, settings)?;
+pub fn dof_plan(mm: &MobileManipulator, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
+    let (model, _) = set_up(mm, settings)?;
     let l = model.layout;
     let mut plan = DofPlan::default();
     if l.platform.is_some() {
@@ -160,17 +157,16 @@ pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, Moda
     Ok(plan)
 }
 
-/// Elastic modes about the initial pose with the platform and all joints held.
+/// Elastic modes of `mm`, the manipulator of `scene`, about the initial pose with the platform
+/// and all joints held.
 pub fn modes(
     scene: &Scene,
+    mm: &MobileManipulator,
     settings: &ModalSettings,
     count: usize,
 ) -> Result<ModalResult, ModalError> {
     let start = std::time::Instant::now();
-    let (model, inputs) = set_up(scene, settings)?;
-    let mm = scene
-        .mobile_manipulator()
-        .ok_or_else(|| ModalError::Unsupported("not a mobile-manipulator scene".into()))?;
+    let (model, inputs) = set_up(mm, settings)?;
     let (Some(fl), Some(e0)) = (&model.flex, model.layout.elastic) else {
         return Err(ModalError::Unsupported(
             "modes of the mobile manipulator: the scene has no flexible link (the rigid \

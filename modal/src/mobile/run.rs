@@ -12,6 +12,7 @@
 use std::time::Instant;
 
 use data::channel::spec;
+use data::scene::MobileManipulator;
 use data::{
     Diagnostic, EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict,
     ledger_term,
@@ -178,9 +179,14 @@ fn method(settings: &ModalSettings) -> &'static crate::integrate::MethodInfo {
         .map_or(&crate::integrate::DOPRI5, method_for)
 }
 
-pub fn simulate(scene: &Scene, settings: &ModalSettings) -> Result<RunResult, ModalError> {
+/// A run of `mm`, the manipulator of `scene`.
+pub fn simulate(
+    scene: &Scene,
+    mm: &MobileManipulator,
+    settings: &ModalSettings,
+) -> Result<RunResult, ModalError> {
     let wall = Instant::now();
-    let (model, inputs) = set_up(scene, settings)?;
+    let (model, inputs) = set_up(mm, settings)?;
     let method = method(settings);
     let rtol = settings.rtol.unwrap_or(DEFAULT_TOL.0);
     let atol = settings.atol.unwrap_or(DEFAULT_TOL.1);
@@ -191,9 +197,6 @@ pub fn simulate(scene: &Scene, settings: &ModalSettings) -> Result<RunResult, Mo
         ));
     }
     let t_end = crate::setup::checked_span(scene, settings)?;
-    let mm = scene
-        .mobile_manipulator()
-        .ok_or_else(|| ModalError::Unsupported("not a mobile-manipulator scene".into()))?;
     let mut rhs = MobileRhs::new(model, inputs);
     let (n, m) = (rhs.n(), rhs.m());
     let dim = n + m + N_WORK;
@@ -264,7 +267,7 @@ pub fn simulate(scene: &Scene, settings: &ModalSettings) -> Result<RunResult, Mo
 }
 
 /// y(0): the scene's pose and rates, undeformed link at rest relative to its frame, no work.
-pub fn initial_state(model: &MobileModel, mm: &data::scene::MobileManipulator, y: &mut [f64]) {
+pub fn initial_state(model: &MobileModel, mm: &MobileManipulator, y: &mut [f64]) {
     let l = model.layout;
     y.fill(0.0);
     let n = l.n;

@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use data::scene::LinkField;
+use data::scene::{LinkField, PayloadLink};
 use data::{Cost, ModalResult, ModalSettings, ModeShape, Scene, StaticResult};
 use faer::Mat;
 
@@ -55,11 +55,12 @@ pub fn linear_pencil(model: &LinkModel) -> (Mat<f64>, Mat<f64>, f64) {
 
 pub fn modes(
     scene: &Scene,
+    link: &PayloadLink,
     settings: &ModalSettings,
     count: usize,
 ) -> Result<ModalResult, ModalError> {
     let wall = Instant::now();
-    let s = set_up(scene, settings)?;
+    let s = set_up(scene, link, settings)?;
     let model = &s.model;
     let (k, m, rate) = linear_pencil(model);
     // At a prescribed constant rate the gyroscopic coupling stays in (its modes' velocity
@@ -151,9 +152,13 @@ pub fn modes(
 }
 
 /// The linear gravity sag: `tip_deflection` = w(L), `tip_rotation` = w′(L).
-pub fn statics(scene: &Scene, settings: &ModalSettings) -> Result<StaticResult, ModalError> {
+pub fn statics(
+    scene: &Scene,
+    link: &PayloadLink,
+    settings: &ModalSettings,
+) -> Result<StaticResult, ModalError> {
     let wall = Instant::now();
-    let s = set_up(scene, settings)?;
+    let s = set_up(scene, link, settings)?;
     let q = static_sag(&s.model)?;
     let dot = |r: &[f64]| r.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>();
     Ok(StaticResult {
@@ -174,10 +179,11 @@ pub fn statics(scene: &Scene, settings: &ModalSettings) -> Result<StaticResult, 
 /// base), ascending, `count` of them ([`gyroscopic_modes`]).
 pub fn gyroscopic_frequencies(
     scene: &Scene,
+    link: &PayloadLink,
     settings: &ModalSettings,
     count: usize,
 ) -> Result<Vec<f64>, ModalError> {
-    let s = set_up(scene, settings)?;
+    let s = set_up(scene, link, settings)?;
     let (w2, _) = gyroscopic_modes(&s.model)?;
     Ok(w2
         .iter()

@@ -78,10 +78,12 @@ pub fn basis_choice(settings: &ModalSettings) -> Result<(usize, BasisChoice), Mo
     Ok((n, choice))
 }
 
-pub fn set_up<'a>(scene: &'a Scene, settings: &ModalSettings) -> Result<SetUp<'a>, ModalError> {
-    let link = scene
-        .payload_link()
-        .ok_or_else(|| ModalError::Unsupported("not a payload-link scene".into()))?;
+/// The model of `link`, the payload link of `scene` (whose field stations it samples).
+pub fn set_up<'a>(
+    scene: &Scene,
+    link: &'a PayloadLink,
+    settings: &ModalSettings,
+) -> Result<SetUp<'a>, ModalError> {
     let (n, choice) = basis_choice(settings)?;
     let model = LinkModel::build(link, n, choice, scene.simulation.field_stations)?;
     Ok(SetUp { link, model })
@@ -103,10 +105,7 @@ pub fn static_sag(model: &LinkModel) -> Result<Vec<f64>, ModalError> {
 }
 
 /// Degrees of freedom and physics built for the scene.
-pub fn dof_plan(scene: &Scene, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
-    let link = scene
-        .payload_link()
-        .ok_or_else(|| ModalError::Unsupported("not a payload-link scene".into()))?;
+pub fn dof_plan(link: &PayloadLink, settings: &ModalSettings) -> Result<DofPlan, ModalError> {
     let (n, choice) = basis_choice(settings)?;
     let mut plan = DofPlan::default();
     if link.base.prescribed.is_none() {

@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use data::scene::{LinkField, LinkInitialShape, PrescribedMotion};
+use data::scene::{LinkField, LinkInitialShape, PayloadLink, PrescribedMotion};
 use data::{
     Diagnostic, EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict,
     channel, ledger_term,
@@ -56,9 +56,14 @@ pub fn default_step(model: &LinkModel) -> Result<f64, ModalError> {
     Ok(std::f64::consts::TAU / omega1 / STEPS_PER_PERIOD)
 }
 
-pub fn simulate(scene: &Scene, settings: &ModalSettings) -> Result<RunResult, ModalError> {
+/// A run of `link`, the payload link of `scene`.
+pub fn simulate(
+    scene: &Scene,
+    link: &PayloadLink,
+    settings: &ModalSettings,
+) -> Result<RunResult, ModalError> {
     let wall = Instant::now();
-    let SetUp { link, model } = set_up(scene, settings)?;
+    let SetUp { link, model } = set_up(scene, link, settings)?;
     let method = settings
         .method
         .map_or_else(|| default_method(&model), method_for);

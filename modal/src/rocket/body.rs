@@ -95,14 +95,7 @@ pub struct Body {
 }
 
 impl Body {
-    pub fn from_scene(scene: &data::Scene) -> Result<Body, RocketError> {
-        let r: &Rocket = scene.rocket().ok_or_else(|| {
-            RocketError::Unsupported(format!(
-                "the modal rocket model needs a [rocket] scene; `{}` is a {}",
-                scene.name,
-                scene.family()
-            ))
-        })?;
+    pub fn from_rocket(r: &Rocket) -> Result<Body, RocketError> {
         let g = r.gravity;
         if r.exit_pressure != 0.0 {
             return Err(RocketError::Unsupported(

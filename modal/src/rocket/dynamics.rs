@@ -806,7 +806,7 @@ mod tests {
     use crate::rocket::integrals::QuadTable;
 
     fn rocket_body() -> Body {
-        Body::from_scene(&data::load_scene("rocket").unwrap()).unwrap()
+        Body::from_rocket(data::load_scene("rocket").unwrap().rocket().unwrap()).unwrap()
     }
 
     /// Deterministic pseudo-random numbers in [-1, 1].

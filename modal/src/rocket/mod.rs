@@ -99,16 +99,18 @@ mod integrals;
 mod modes;
 mod run;
 
+use data::scene::Rocket;
+
 pub use config::{DEFAULT_ATOL, DEFAULT_MODES, DEFAULT_RTOL, MAX_MODES};
 pub use error::RocketError;
 pub use run::{DetailedRun, MomentumBalance, RocketOde};
 
 /// DOF table of the rocket model for this scene and discretization.
 pub fn dof_plan(
-    scene: &data::Scene,
+    r: &Rocket,
     settings: &data::ModalSettings,
 ) -> Result<data::DofPlan, data::BackendError> {
-    let body = body::Body::from_scene(scene)?;
+    let body = body::Body::from_rocket(r)?;
     let n = config::modes(settings)?;
     let mut plan = data::DofPlan::default();
     plan.add("rigid body X, Y, θ", 3);
@@ -146,28 +148,32 @@ pub fn dof_plan(
     Ok(plan)
 }
 
-/// Free-free elastic frequencies (Hz, ascending) at ignition mass, kinds "axial"/"bending".
+/// Free-free elastic frequencies (Hz, ascending) of `r`, the rocket of `scene`, at ignition
+/// mass, kinds "axial"/"bending".
 pub fn modes(
     scene: &data::Scene,
+    r: &Rocket,
     settings: &data::ModalSettings,
     count: usize,
 ) -> Result<data::ModalResult, data::BackendError> {
-    Ok(modes::modes(scene, settings, count)?)
+    Ok(modes::modes(scene, r, settings, count)?)
 }
 
-/// Dynamic response over [0, t_end].
+/// Dynamic response of `r`, the rocket of `scene`, over [0, t_end].
 pub fn simulate(
     scene: &data::Scene,
+    r: &Rocket,
     settings: &data::ModalSettings,
 ) -> Result<data::RunResult, data::BackendError> {
-    Ok(run::simulate_detailed(scene, settings)?.run)
+    Ok(run::simulate_detailed(scene, r, settings)?.run)
 }
 
 /// [`simulate`] plus the momentum balance, the initial-shape projection residual and the basis
 /// frequencies.
 pub fn simulate_detailed(
     scene: &data::Scene,
+    r: &Rocket,
     settings: &data::ModalSettings,
 ) -> Result<DetailedRun, data::BackendError> {
-    Ok(run::simulate_detailed(scene, settings)?)
+    Ok(run::simulate_detailed(scene, r, settings)?)
 }

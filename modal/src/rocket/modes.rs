@@ -7,6 +7,7 @@
 //! each mode is classified by where its kinetic energy lives. Being a Rayleigh–Ritz reduction,
 //! the frequencies converge from above as `discretization.modes` grows.
 
+use data::scene::Rocket;
 use data::{BackendKind, Cost, ModalResult, ModalSettings, ModeShape};
 
 use super::basis::Basis;
@@ -67,11 +68,12 @@ fn is_axial(l: Layout, i: usize) -> bool {
 
 pub fn modes(
     scene: &data::Scene,
+    r: &Rocket,
     settings: &ModalSettings,
     count: usize,
 ) -> Result<ModalResult, RocketError> {
     let wall = std::time::Instant::now();
-    let body = Body::from_scene(scene)?;
+    let body = Body::from_rocket(r)?;
     let n = config::modes(settings)?;
     let basis = Basis::new(&body, n)?;
     let model = Model::new(body, &basis);

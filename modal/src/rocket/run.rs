@@ -2,6 +2,8 @@
 
 use std::time::Instant;
 
+use data::scene::Rocket;
+
 use data::{
     BackendKind, Diagnostic, EnergyLedger, Event, ModalSettings, Observables, RunResult,
     StabilityVerdict, channel, ledger_term,
@@ -38,8 +40,8 @@ pub struct RocketOde {
 }
 
 impl RocketOde {
-    pub fn new(scene: &data::Scene, settings: &ModalSettings) -> Result<RocketOde, RocketError> {
-        let body = Body::from_scene(scene)?;
+    pub fn new(r: &Rocket, settings: &ModalSettings) -> Result<RocketOde, RocketError> {
+        let body = Body::from_rocket(r)?;
         let n = config::modes(settings)?;
         let basis = Basis::new(&body, n)?;
         let model = Model::new(body, &basis);
@@ -320,10 +322,11 @@ fn runaway(model: &Model, y: &[f64]) -> Option<(String, f64)> {
 
 pub fn simulate_detailed(
     scene: &data::Scene,
+    r: &Rocket,
     settings: &ModalSettings,
 ) -> Result<DetailedRun, RocketError> {
     let wall = Instant::now();
-    let body = Body::from_scene(scene)?;
+    let body = Body::from_rocket(r)?;
     let n = config::modes(settings)?;
     let tc: TimeConfig = config::time(scene, settings)?;
     let basis = Basis::new(&body, n)?;
