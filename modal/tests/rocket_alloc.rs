@@ -1,15 +1,13 @@
 //! The rocket's right-hand side and integration steps perform no heap allocation (counting
 //! global allocator; this binary holds only this test so nothing else allocates meanwhile).
 
-use std::sync::atomic::Ordering;
-
 use data::{Settings, load_scene};
 use modal::integrate::{Dopri5, OdeRhs, Tolerances};
 use modal::rocket::RocketOde;
 
 #[path = "support/counting_alloc.rs"]
 mod counting_alloc;
-use counting_alloc::ALLOCATIONS;
+use counting_alloc::allocations;
 
 #[test]
 fn dyn_rocket_rhs_and_steps_do_not_allocate() {
@@ -32,14 +30,14 @@ fn dyn_rocket_rhs_and_steps_do_not_allocate() {
     );
     let mut t = 0.0;
     s.step(&mut ode, &mut t, &mut y, 0.01).unwrap(); // warm-up
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     for k in 0..50 {
         ode.eval(1e-3 * k as f64, &y, &mut dydt);
     }
     for _ in 0..50 {
         s.step(&mut ode, &mut t, &mut y, 0.01).unwrap();
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = allocations();
     assert_eq!(after - before, 0, "allocations in the step loop");
     assert!(t > 0.0 && dydt.iter().all(|v| v.is_finite()));
 }
