@@ -1,8 +1,9 @@
 //! A counting global allocator for the allocation tests: each test binary that includes this
 //! module counts the heap allocations of each thread ([`allocations`] reads the calling
-//! thread's count). Counting per thread keeps the test harness's own threads (and any pool
-//! started before the measurement) out of the count: a process-wide counter saw a few of their
-//! allocations on a loaded machine (`ode_alloc`, 4 during a CI run).
+//! thread's count). Counting per thread keeps other threads (the test harness's, a pool's) out
+//! of the count: a process-wide counter once saw 4 allocations in `ode_alloc` during a CI run
+//! on a loaded machine that no rerun reproduced, which a deterministic step loop on the test's
+//! own thread cannot produce.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
