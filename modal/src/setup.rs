@@ -2,7 +2,7 @@
 //! plan. Every function here takes the scene's [`PlanarChain`] (the backend's entry matches the
 //! family once).
 
-use data::scene::{Link, PlanarChain};
+use data::scene::{Link, PlanarChain, PrescribedMotion};
 use data::{Basis, DofPlan, ModalSettings, Scene};
 
 use crate::basis::ShapeSet;
@@ -326,20 +326,10 @@ fn step_load(pc: &PlanarChain, chain: &Chain) -> Result<Option<Vec<f64>>, ModalE
     if p == 0.0 && q == 0.0 {
         return Ok(None);
     }
-    let link = match pc.links.as_slice() {
-        [link]
-            if matches!(
-                link.joint.prescribed,
-                Some(data::scene::PrescribedMotion::Fixed)
-            ) =>
-        {
-            link
-        }
-        _ => {
-            return Err(ModalError::Unsupported(
-                "modal: the [statics] loads act in dynamics only on a single clamped link".into(),
-            ));
-        }
+    let Some(link) = single_clamped_link(pc) else {
+        return Err(ModalError::Unsupported(
+            "modal: the [statics] loads act in dynamics only on a single clamped link".into(),
+        ));
     };
     let l = &chain.links[0];
     let mut f = vec![0.0; chain.n];
@@ -349,6 +339,14 @@ fn step_load(pc: &PlanarChain, chain: &Chain) -> Result<Option<Vec<f64>>, ModalE
 
 /// Generalized force of a tip force P and a uniform load q (per unit length) on the transverse
 /// coordinates of `l`, the model of the scene's `link`: P φ(L) + q ∫₀ᴸ φ dx.
+/// The link of a chain that is one link clamped to the ground (the statics loads' model).
+pub(crate) fn single_clamped_link(pc: &PlanarChain) -> Option<&Link> {
+    match pc.links.as_slice() {
+        [link] if matches!(link.joint.prescribed, Some(PrescribedMotion::Fixed)) => Some(link),
+        _ => None,
+    }
+}
+
 pub(crate) fn transverse_load(link: &Link, l: &LinkModel, p: f64, q: f64) -> Vec<f64> {
     // `phi1` is the mass-weighted ∫ρA φ.
     let q_per_mass = q / link.mass_per_length;

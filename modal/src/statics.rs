@@ -7,7 +7,7 @@ use data::{Cost, ModalSettings, Scene, StaticResult};
 
 use crate::error::ModalError;
 use crate::linalg::{cholesky_solve, dot};
-use crate::setup::{build_chain, transverse_load};
+use crate::setup::{build_chain, single_clamped_link, transverse_load};
 
 /// The static tip deflection and rotation of `pc`, the chain of `scene`.
 pub fn statics(
@@ -21,20 +21,10 @@ pub fn statics(
             "modal: the scene has no [statics] loads".into(),
         ));
     };
-    let link = match pc.links.as_slice() {
-        [link]
-            if matches!(
-                link.joint.prescribed,
-                Some(data::scene::PrescribedMotion::Fixed)
-            ) =>
-        {
-            link
-        }
-        _ => {
-            return Err(ModalError::Unsupported(
-                "modal: statics only for a single link clamped to the ground".into(),
-            ));
-        }
+    let Some(link) = single_clamped_link(pc) else {
+        return Err(ModalError::Unsupported(
+            "modal: statics only for a single link clamped to the ground".into(),
+        ));
     };
     let chain = build_chain(pc, settings)?;
     let l = &chain.links[0];
