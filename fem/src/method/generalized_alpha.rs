@@ -28,14 +28,16 @@
 //! Δq·F₀ is of the previous step's direction: O(h²) per held step, O(h) over a held phase.
 //! So the end force gains c·WΔq, W = M(q̄), with c·ΔqᵀWΔq = Δq·F₁ − Δq·F₀: the average then
 //! does the work Δq·F₁ of the end force, and the ledger closes to the rule's own energy error
-//! (a consistent O(h) correction along the step's own motion, not in the Newton matrix).
+//! (a consistent O(h) correction along the step's own motion, not in the Newton matrix). For
+//! ρ∞ < 1 the same correction is applied; the method's weights of F₀ and F₁ then differ from ½
+//! by O(1 − ρ∞), and the balance holds to that order.
 //!
 //! **Restarts.** The method carries the acceleration history (q̈ₙ, aₙ) from step to step. An
 //! impact changes q̇, a contact start or release changes the force law, and a history from
-//! before the event is not that of the motion after it (measured with the plain history on
-//! `barhorst-case1`: 36.6 ft·lbf of strain and damper energy appeared at the first
-//! constrained step after the first impact). So after every event ([`Stepper::restart`]) and
-//! at the first step, q̈ₙ = aₙ is recomputed consistent with the current phase:
+//! before the event is not that of the motion after it: the first step after the event would
+//! create energy (docs/contact.md). So once a run has held a constraint, after every event
+//! ([`Stepper::restart`]) and at the first held step, q̈ₙ = aₙ is recomputed consistent with
+//! the current phase:
 //! R(qₙ, q̇ₙ, q̈ₙ) − ∇g(qₙ) λₙ = 0 with the constraint's multiplier λₙ (the index-1 normal
 //! force the driver computes at each contact event; the friction force or stick multiplier of
 //! the current friction phase), by Newton with S = M.
