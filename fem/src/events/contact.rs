@@ -14,9 +14,8 @@
 //! Schur complement, see [`crate::method::energy_midpoint`]); ∇̄g is the Gonzalez discrete gradient of g in
 //! the same metric M(q̄) as the potential, so Δqᵀ∇̄g = g(q₁) − g(q₀) = 0 and the constraint
 //! does no work: the ledger closes to the Newton tolerance in every phase. |g| at the step
-//! ends is at the Newton tolerance (1e-11·L; measured ≤ 1.4e-14 ft). G q̇ at the step ends is
-//! not enforced by the scheme and drifts O(h²) (measured ≤ 1e-2 ft/s right after impacts on
-//! `barhorst-case1`, against tip speeds of several ft/s), reported as the running max
+//! ends is at the Newton tolerance (1e-11·L). G q̇ at the step ends is not enforced by the
+//! scheme and drifts O(h²), reported as the running max
 //! `contact1.max_normal_velocity` (|g|: `contact1.max_gap`). Drift control: after every
 //! accepted constrained step the velocity is projected onto G q̇ = 0 by the plastic projection
 //! q̇ ← q̇ − M⁻¹Gᵀ(G q̇)/(G M⁻¹Gᵀ) (at a release only an inward drift G q̇ < 0, so that free
@@ -37,21 +36,16 @@
 //! pushes the tip to the free side. It is evaluated at the velocity the constrained
 //! dynamics allows: q̇ projected onto G q̇ = 0 (the plastic projection that ends every
 //! constrained step) and made consistent along the massless directions. At a step end the
-//! drift G q̇ = O(h²) otherwise entered λ through the velocity terms, and λ of the projected
-//! state — the next step's λ(h → 0⁺) — differed from the event value by up to 9.6 lbf
-//! (`barhorst-case1-tipmass`): releases were then located at brackets of 4e-14 s with that
-//! force (|λ| up to 1.5e-5·W over 3 s on `barhorst-case1`; 9.2e-5 lbf = 3.2e-7·W now).
+//! drift G q̇ = O(h²) would otherwise enter λ through the velocity terms, and λ of the projected
+//! state — the next step's λ(h → 0⁺) — would differ from the event value, a jump that the
+//! release location cannot bracket (docs/contact.md).
 //!
 //! **Step multiplier** λ̄: the Newton multiplier of a constrained step, its mean normal force
 //! (impulse/h), the constraint force the scheme applies; it predicts the next step's λ̄. It is
 //! not the release event function: after an impact the state force contains the highest mesh
 //! frequencies of the constrained chain (the point impact excites them; the symmetric midpoint
-//! scheme does not damp them), with amplitudes comparable to its mean. Measured on
-//! `barhorst-case1-timoshenko` (8 elements): at the default step (0.5 ms) λ at consecutive step
-//! ends went +2723, +685, +2085, …, −33 lbf while the step multipliers were all positive
-//! (+2437, +1704, +1385, …, +779); at h = 20 µs the same λ(t) is a smooth oscillation of period
-//! ≈ 0.35 ms = the shear-wave transit time of one element (h_el/√(κGA/ρA) = 0.25/753 s), a mesh
-//! mode aliased by the 0.5 ms step. Where that oscillation takes λ through zero the
+//! scheme does not damp them), with amplitudes comparable to its mean: a mesh mode aliased by
+//! the step (docs/contact.md). Where that oscillation takes λ through zero the
 //! semi-discrete model does leave the surface: the release is located there (below) and the tip
 //! comes back after a short flight — micro-bounces of the discretized model, whose number grows
 //! with refinement (as in `modal`), not converged quantities. The converged quantities are the
@@ -80,21 +74,19 @@
 //! massive subspace since Gᵀ, R ⊥ N: the solution has no N-component, Λ, λ and the kinetic
 //! energy are those of the massive block. The frame directions of a free joint without hub
 //! inertia (turn the frame by α with v = −αx; [`Chain::massless_directions`]) move the points
-//! by α·s(x) only, mass ∫ρA s² ~ 1e-8 of the link's: kept massive in M they took velocity
-//! jumps of 1.5e5 (rad/s) at the first impact of `barhorst-case1-timoshenko` and stalled the
-//! next step. They are regularized the same way (μ added along them): their velocity does
+//! by α·s(x) only, with a mass ∫ρA s² orders of magnitude below the link's: kept massive in M
+//! they would take huge velocity jumps at an impact (docs/contact.md). They are regularized
+//! the same way (μ added along them): their velocity does
 //! not jump at an impact (the modal backend removes this direction from its basis: it keeps
 //! v′(0) = 0): the impact map is M Δq̇ = GᵀΛ + R_f with R_f = −μN_f N_fᵀΔq̇ the reaction that
 //! holds the frame directions' velocity. The momentum residual reported is that of this
 //! balance, ‖M Δq̇ − R_f − GᵀΛ‖/‖M Δq̇‖ (round-off; the μ-term vanishes on the exact
-//! directions). The reaction itself, ‖R_f‖/‖M Δq̇‖, is
-//! not at round-off once the links are deflected: 5.4e-12 at the first impact, up to 5.6e-6 at
-//! later ones (4 elements, 0.3 s); it does work where the frame directions move, so the impact
-//! loss is booked as the evaluated kinetic energy difference (below). The same directions are
-//! left out of the normal force (M + μN_fN_fᵀ): measured against λ with them (M regularized
-//! only along the exact N), λ differed by up to ±1e5 lbf at 4 elements — their O(s) inertial
-//! coupling to the tip through a mass O(s²) is a stiff, unresolved mode of the discretization
-//! (see "Grazing" for where this shows).
+//! directions). The reaction itself, ‖R_f‖/‖M Δq̇‖, is not at round-off once the links are
+//! deflected; it does work where the frame directions move, so the impact loss is booked as the
+//! evaluated kinetic energy difference (below). The same directions are left out of the normal
+//! force (M + μN_fN_fᵀ): with them, their O(s) inertial coupling to the tip through a mass
+//! O(s²) is a stiff, unresolved mode of the discretization that λ would carry (see "Grazing"
+//! for where this shows).
 //!
 //! **Events**, located INSIDE the step by re-solving it with a shortened step h* (Illinois
 //! secant on the step length, other bracket points where Newton fails): contact start when
@@ -106,14 +98,10 @@
 //! keep λ(h) continuous in h so that the secant converges: the velocity is projected onto
 //! G q̇ = 0 after every constrained step (drift control; kinetic energy removed booked as
 //! `contact_projection`), and a shortened step removes only the share (h/h_nominal)² of the
-//! start gap (see [`crate::method::energy_midpoint`]) instead of carrying g(q₀)/h² into the multiplier.
-//! Measured (`flexverify run … --backend fem`, 3 s, default step): `barhorst-case1`
-//! (8 elements) 31 releases, largest |λ| 9.2e-5 lbf = 3.2e-7·W (before the projected
-//! velocity: 81 releases, 4.3e-3 lbf = 1.5e-5·W at brackets of 1e-13·t);
-//! `barhorst-case1-timoshenko`: table under "Robustness". (A rule on the step
-//! multiplier λ̄ instead — the force the scheme applies over a step — was tried: it releases
-//! fewer times, but where λ̄ is positive over a step whose end force is negative it can only
-//! place the release at the next step start, with λ far from zero; not used.)
+//! start gap (see [`crate::method::energy_midpoint`]) instead of carrying g(q₀)/h² into the
+//! multiplier. The release rule is on the state force, not on the step multiplier λ̄: where λ̄
+//! is positive over a step whose end force is negative, a rule on λ̄ could only place the
+//! release at the next step start, with λ far from zero.
 //!
 //! **Impact** (perfectly plastic, positions unchanged): M(q̇⁺ − q̇⁻) = GᵀΛ, G q̇⁺ = 0, so
 //! Λ = −G q̇⁻ / (G M⁻¹Gᵀ), q̇⁺ = q̇⁻ + M⁻¹GᵀΛ. The momentum residual
@@ -121,10 +109,9 @@
 //! (not the factorized matrix). The kinetic energy lost is booked as the ledger dissipation
 //! `impact` as the difference of the evaluated kinetic energies before and after: for the
 //! massive block alone it is ½Λ²(G M⁻¹Gᵀ) ≥ 0, but the frame reaction R_f (above) does work
-//! where the frame directions move — booking the formula left the ledger open by 3e-3 ft·lbf
-//! at one impact (closure 4.7e-5 at 4 elements, 0.3 s; 1e-9 now); the evaluated loss can be
-//! slightly negative at micro-impacts (−6.7e-7 ft·lbf measured). A normal velocity at the
-//! round-off level of G q̇ is no impact.
+//! where the frame directions move, so the evaluated difference, not the formula, closes the
+//! ledger; it can be slightly negative at micro-impacts. A normal velocity at the round-off
+//! level of G q̇ is no impact.
 //!
 //! **Grazing** (stated rules). After an impact the phase is constrained only if the normal
 //! force at (q, q̇⁺) is positive, else the tip stays free (an impact immediately followed by
@@ -145,10 +132,6 @@
 //! its end; the event reports that force and the step as `time_tolerance`. Beyond
 //! [`GRAZING_FORCE_LIMIT`]·W the run stops with a diagnostic instead. A release is reported
 //! once the free motion after it has been stepped, so that a withdrawn one never appears.
-//! (Before, such a constrained phase lasted one full step and was released at its end
-//! whatever the force: −19 to −227 lbf on `barhorst-case1-timoshenko`, 16 elements, with
-//! `time_tolerance` 0; and a release and a contact start at the same instant split the
-//! contact episodes of `data::results::contact_episodes`, whose sort puts the start first.)
 //! Every event advances time; [`MAX_EVENTS`] bounds a Zeno-like accumulation. The normal force
 //! after an impact oscillates at the unresolved mesh frequencies, and the tip makes
 //! micro-bounces: the point impact on an Euler–Bernoulli beam is singular (Szalai 2014) and
@@ -164,17 +147,13 @@
 //! Newton unknown, ∂q₁/∂ā = h²/2, and both apply the discrete-gradient force above, so the
 //! held constraint does no work in either). `generalized-alpha` does too, with that force at t₁
 //! and q̈₁ as unknown, balanced so that the rule's average of the start and end forces does the
-//! end force's work (`crate::method::generalized_alpha`). With
-//! `implicit-midpoint` the ledger closes to the
-//! rule's own energy error (works by the trapezoidal rule), measured at the default step over
-//! the scenes' spans: `barhorst-case1` 9.2e-6 (energy-midpoint 8.7e-9), `-tipmass` 1.8e-5,
-//! `-stiff-elbow` 1.5e-5, `barhorst-case2` 2.7e-6, `constrained-arm` 1.1e-6. It falls 4× per
-//! halved step in free flight and on the friction wall, but only about 2× through the impacts
-//! of `barhorst-case1` (4 elements, 0.45 s: 6.7e-5, 2.4e-5, 1.3e-5, 6.2e-6, 2.9e-6 at
-//! dt = 5e-4 … 3.125e-5): the impacts excite the mesh modes, whose energy error the
-//! non-conserving rule reduces as h² only once h ω resolves them (highest frequency of that
-//! model 2.05 kHz, h ω_max = 6.4 … 0.4 over those steps). Switching times agree with
-//! energy-midpoint's to O(h²) (`tests/dyn_contact_methods.rs`).
+//! end force's work (`crate::method::generalized_alpha`). With `implicit-midpoint` and
+//! `generalized-alpha` the ledger closes to the rule's own energy error (works by the
+//! trapezoidal rule): it falls 4× per halved step in free flight and on the friction wall, but
+//! more slowly through impacts, which excite mesh modes whose energy error the non-conserving
+//! rule reduces as h² only once h ω resolves them. Switching times agree with
+//! energy-midpoint's to O(h²) (`tests/dyn_contact_methods.rs`; measurements in
+//! docs/contact.md).
 //!
 //! Refused with `unsupported`: unilateral circle surfaces, friction on a unilateral contact,
 //! more than one contact, contact with prescribed joint motion, contact on Timoshenko links
