@@ -94,7 +94,9 @@
 use crate::chain::{Chain, NONE, NewtonCoefficients, Parts};
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
-use crate::method::{ConstraintView, StepConstraint, StepContext, Stepper, Works};
+use crate::method::{
+    ConstraintView, StepConstraint, StepContext, Stepper, Works, unconverged, update_tolerance,
+};
 
 /// Relative size of the finite-difference perturbation of q for Ṁ(x)x in the oracle
 /// [`kinetic_gradient_fd`].
@@ -635,9 +637,7 @@ impl Stepper for EnergyMidpoint {
             iterations = it + 1;
             // Absolute tolerance, floored at the round-off level of the update itself. The
             // state where the residual was evaluated is kept (the update is below tolerance).
-            let amax = max_abs(&st.qdd1);
-            let vmax = max_abs(&st.qd1);
-            let tol = cx.newton.tol + 1e-13 * (c.c_q * amax + h * vmax);
+            let tol = update_tolerance(cx.newton.tol, c.c_q, h, &st.qdd1, &st.qd1);
             // The energy balance of the step is off by exactly h v̄ᵀ(residual): demand it
             // small too, unless it has reached its round-off floor (no longer falls) or the
             // update is far below tolerance.
@@ -736,16 +736,7 @@ impl Stepper for EnergyMidpoint {
         // See the module docs: the linear contraction makes > 3 iterations normal here.
         cx.newton.slow_convergence = !converged || iterations > 8;
         if !converged {
-            if cx.adaptive.is_some() || h > 1e-6 * cx.h_nominal {
-                return Ok(Some(f64::INFINITY));
-            }
-            return Err(FemError::Runaway {
-                t: st.t,
-                what: format!("Newton iteration did not converge (last update {last:.3e})"),
-                location: None,
-                why: "the step is too large for the nonlinearity or the solution diverged".into(),
-                remedy: "reduce --dt or give --rtol for adaptive stepping".into(),
-            });
+            return unconverged(cx.adaptive.is_some(), cx.h_nominal, st.t, h, last);
         }
         if robust {
             w.resolve = Some((t0, h));

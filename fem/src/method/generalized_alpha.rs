@@ -45,7 +45,10 @@
 use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
-use crate::method::{ConstraintView, HeldConstraint, StepConstraint, StepContext, Stepper, start};
+use crate::method::{
+    ConstraintView, HeldConstraint, StepConstraint, StepContext, Stepper, start, unconverged,
+    update_tolerance,
+};
 
 #[derive(Debug, Clone, Copy)]
 struct AlphaParams {
@@ -263,8 +266,7 @@ impl Stepper for GeneralizedAlpha {
                 }
                 last = dq;
                 iterations = it + 1;
-                let tol =
-                    cx.newton.tol + 1e-13 * (c.c_q * max_abs(&st.qdd1) + h * max_abs(&st.qd1));
+                let tol = update_tolerance(cx.newton.tol, c.c_q, h, &st.qdd1, &st.qd1);
                 // Accept the iterate where the residual and the gap were evaluated (module
                 // docs): its multipliers and friction work are the constraint's current ones.
                 if dq <= tol && on_surface {
@@ -297,10 +299,8 @@ impl Stepper for GeneralizedAlpha {
             }
             last = dq;
             // Absolute tolerance, floored at the round-off level of the update itself.
-            let amax = max_abs(&st.qdd1);
-            let vmax = max_abs(&st.qd1);
             iterations = it + 1;
-            if dq <= cx.newton.tol + 1e-13 * (c.c_q * amax + h * vmax) {
+            if dq <= update_tolerance(cx.newton.tol, c.c_q, h, &st.qdd1, &st.qd1) {
                 converged = true;
             }
         }
@@ -309,16 +309,7 @@ impl Stepper for GeneralizedAlpha {
         }
         cx.newton.slow_convergence = !converged || iterations > 3;
         if !converged {
-            if cx.adaptive.is_some() || h > 1e-6 * cx.h_nominal {
-                return Ok(Some(f64::INFINITY));
-            }
-            return Err(FemError::Runaway {
-                t: st.t,
-                what: format!("Newton iteration did not converge (last update {last:.3e})"),
-                location: None,
-                why: "the step is too large for the nonlinearity or the solution diverged".into(),
-                remedy: "reduce --dt or give --rtol for adaptive stepping".into(),
-            });
+            return unconverged(cx.adaptive.is_some(), cx.h_nominal, st.t, h, last);
         }
         Ok(cx.adaptive.map(|ad| {
             let mut err = 0.0f64;

@@ -37,7 +37,9 @@
 use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
 use crate::linalg::max_abs;
-use crate::method::{HeldConstraint, StepConstraint, StepContext, Stepper};
+use crate::method::{
+    HeldConstraint, StepConstraint, StepContext, Stepper, unconverged, update_tolerance,
+};
 
 /// Newton iterations at most before the step is retried shorter.
 const MAX_ITERATIONS: usize = 30;
@@ -135,8 +137,7 @@ impl Stepper for ImplicitMidpoint {
                 }
                 last = dq;
                 iterations = it + 1;
-                let tol =
-                    cx.newton.tol + 1e-13 * (c.c_q * max_abs(&st.qdd1) + h * max_abs(&st.qd1));
+                let tol = update_tolerance(cx.newton.tol, c.c_q, h, &st.qdd1, &st.qd1);
                 // Accept the iterate where the residual and the gap were evaluated (module
                 // docs): its multipliers and friction work are the constraint's current ones.
                 if dq <= tol && on_surface {
@@ -159,9 +160,7 @@ impl Stepper for ImplicitMidpoint {
             last = dq;
             iterations = it + 1;
             // Absolute tolerance on the position update, floored at its round-off level.
-            let amax = max_abs(&st.qdd1);
-            let vmax = max_abs(&st.qd1);
-            if dq <= cx.newton.tol + 1e-13 * (c.c_q * amax + h * vmax) {
+            if dq <= update_tolerance(cx.newton.tol, c.c_q, h, &st.qdd1, &st.qd1) {
                 converged = true;
                 break;
             }
@@ -171,16 +170,7 @@ impl Stepper for ImplicitMidpoint {
         }
         cx.newton.slow_convergence = !converged || iterations > 3;
         if !converged {
-            if cx.adaptive.is_some() || h > 1e-6 * cx.h_nominal {
-                return Ok(Some(f64::INFINITY));
-            }
-            return Err(FemError::Runaway {
-                t: st.t,
-                what: format!("Newton iteration did not converge (last update {last:.3e})"),
-                location: None,
-                why: "the step is too large for the nonlinearity or the solution diverged".into(),
-                remedy: "reduce --dt or give --rtol for adaptive stepping".into(),
-            });
+            return unconverged(cx.adaptive.is_some(), cx.h_nominal, st.t, h, last);
         }
         for i in 0..n {
             let v_bar = st.qd[i] + 0.5 * h * st.qdd1[i];

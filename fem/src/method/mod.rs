@@ -44,7 +44,7 @@ use data::Cost;
 
 use crate::chain::{Chain, Parts};
 use crate::error::FemError;
-use crate::linalg::dot;
+use crate::linalg::{dot, max_abs};
 use crate::settings::Method;
 
 /// Work counters.
@@ -193,6 +193,34 @@ pub struct ConstraintView<'a> {
     pub g0: f64,
     /// Normal multiplier of this iterate.
     pub lambda: f64,
+}
+
+/// The Newton tolerance of a position update: the system's absolute tolerance, floored at the
+/// round-off level of the update itself (`c_q`|q̈| + h|q̇|).
+pub(crate) fn update_tolerance(newton_tol: f64, c_q: f64, h: f64, qdd: &[f64], qd: &[f64]) -> f64 {
+    newton_tol + 1e-13 * (c_q * max_abs(qdd) + h * max_abs(qd))
+}
+
+/// A step of length `h` from `t` whose Newton iteration did not converge (`last`: its last
+/// update): retried shorter when it can be (adaptive, or longer than 1e-6 of the nominal
+/// step: `Some(∞)`), else the run stops.
+pub(crate) fn unconverged(
+    adaptive: bool,
+    h_nominal: f64,
+    t: f64,
+    h: f64,
+    last: f64,
+) -> Result<Option<f64>, FemError> {
+    if adaptive || h > 1e-6 * h_nominal {
+        return Ok(Some(f64::INFINITY));
+    }
+    Err(FemError::Runaway {
+        t,
+        what: format!("Newton iteration did not converge (last update {last:.3e})"),
+        location: None,
+        why: "the step is too large for the nonlinearity or the solution diverged".into(),
+        remedy: "reduce --dt or give --rtol for adaptive stepping".into(),
+    })
 }
 
 /// Work buffers of a held constraint in a method's Newton iteration, and the one operation
