@@ -12,7 +12,7 @@ use data::{BackendKind, Scene, Settings};
 use serde::Serialize;
 
 use super::ladder::Refine;
-use super::run::{CAPPED, run_study};
+use super::run::run_study;
 use super::summary::Rung;
 use crate::error::Error;
 use crate::output::wrap;
@@ -72,12 +72,8 @@ pub fn recommend(
     let capped: Vec<String> = study
         .ladders
         .iter()
-        .filter_map(|l| {
-            l.note
-                .as_ref()
-                .filter(|n| n.starts_with(CAPPED))
-                .map(|n| format!("{} {n}", l.backend))
-        })
+        .filter(|l| l.capped_by_budget())
+        .filter_map(|l| Some(format!("{} {}", l.backend, l.note.as_ref()?)))
         .collect();
     // Models that converge to answers further apart than the tolerance cannot both meet it,
     // and which one is right is not a question of discretization.

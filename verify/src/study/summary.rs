@@ -57,6 +57,15 @@ pub struct Ladder {
     pub estimate: Option<Estimate>,
 }
 
+impl Ladder {
+    /// Whether the rung budget stopped this ladder before its last rung.
+    pub fn capped_by_budget(&self) -> bool {
+        self.note
+            .as_deref()
+            .is_some_and(|n| n.starts_with(super::run::CAPPED))
+    }
+}
+
 /// The smallest observed order at which a ladder's Richardson extrapolation is used as an
 /// estimate or a reference. Below it the rungs are not in their asymptotic range: the
 /// extrapolation divides the last difference by r^p − 1 (0.41 at p = 0.5 for halving, 0.07 at
