@@ -59,7 +59,7 @@ impl Quantity {
     pub fn parse(text: &str, scene: &Scene) -> Result<Quantity, String> {
         let t = text.trim();
         let chain = scene.planar_chain();
-        // The other families have one link: the aliases name link 1.
+        // Outside a planar chain the aliases name link 1 (the payload link is one link).
         let last = chain.map_or(1, |c| c.links.len().max(1));
         let alias = |c: &str| -> String {
             match c {
