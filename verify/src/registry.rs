@@ -1,9 +1,12 @@
 //! The three backends and verify's rigid reference, behind the common [`Backend`] trait.
 
+use data::scene::Model;
 use data::{
     Backend, BackendError, BackendKind, Discretization, DofPlan, ModalResult, RunResult, Scene,
     Settings, StaticResult,
 };
+
+use crate::analytic::rigid::mobile;
 
 /// The backend implementation of a kind.
 pub fn backend(kind: BackendKind) -> Box<dyn Backend> {
@@ -19,13 +22,22 @@ pub fn backend(kind: BackendKind) -> Box<dyn Backend> {
 /// reference run it; every other request is `unsupported`.
 pub struct ReferenceBackend;
 
+// Each entry dispatches on the scene's model family once and hands the family on.
 impl Backend for ReferenceBackend {
     fn kind(&self) -> BackendKind {
         BackendKind::Reference
     }
 
     fn dof_plan(&self, scene: &Scene, _disc: &Discretization) -> Result<DofPlan, BackendError> {
-        crate::analytic::rigid::mobile::dof_plan(scene)
+        match &scene.model {
+            Model::MobileManipulator(mm) => mobile::dof_plan(mm),
+            Model::PlanarChain(_) | Model::Rocket(_) | Model::PayloadLink(_) => {
+                Err(BackendError::unsupported(format!(
+                    "reference: no verify reference for the {} family",
+                    scene.family()
+                )))
+            }
+        }
     }
 
     fn modes(&self, _: &Scene, _: &Settings, _: usize) -> Result<ModalResult, BackendError> {
@@ -41,6 +53,15 @@ impl Backend for ReferenceBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
-        crate::analytic::rigid::mobile::simulate(scene, settings)
+        match &scene.model {
+            Model::MobileManipulator(mm) => mobile::simulate(scene, mm, settings),
+            Model::PlanarChain(_) | Model::Rocket(_) | Model::PayloadLink(_) => {
+                Err(BackendError::unsupported(format!(
+                    "reference: no verify reference for the {} family (only the mobile \
+                     manipulator)",
+                    scene.family()
+                )))
+            }
+        }
     }
 }

@@ -93,12 +93,12 @@ fn ana_catalog_rotating_beam_speeds() {
 #[test]
 fn ana_catalog_rigid_limits() {
     let s = data::load_scene("single-link").unwrap();
-    let r = ana::RigidLink::from_scene(&s).unwrap();
+    let r = ana::RigidLink::from_chain(s.planar_chain().unwrap()).unwrap();
     let end = r.state(s.simulation.t_end).unwrap();
     println!("single-link rigid: theta(t_end) = {:.12}", end.angle);
 
     let s = data::load_scene("constrained-arm").unwrap();
-    let c = ana::ConstrainedRigidLink::from_scene(&s).unwrap();
+    let c = ana::ConstrainedRigidLink::from_chain(s.planar_chain().unwrap()).unwrap();
     let end = c.state(s.simulation.t_end).unwrap();
     println!(
         "constrained-arm rigid: theta = {:.12}, rate = {:.12} (terminal {:.12}), N = {:.10}, W_f = {:.10}",
@@ -111,7 +111,7 @@ fn ana_catalog_rigid_limits() {
     assert!(end.friction_work > 0.0 && end.friction_work < end.input_work);
 
     let s = data::load_scene("two-link-free").unwrap();
-    let arm = ana::RigidTwoLink::from_scene(&s).unwrap();
+    let arm = ana::RigidTwoLink::from_chain(s.planar_chain().unwrap()).unwrap();
     let t0 = std::time::Instant::now();
     let h = arm
         .simulate(&ana::output_times(
@@ -128,7 +128,7 @@ fn ana_catalog_rigid_limits() {
     );
 
     let s = data::load_scene("barhorst-case1-stiff-elbow").unwrap();
-    let rest = ana::resting_from_scene(&s).unwrap();
+    let rest = ana::resting_from_chain(s.planar_chain().unwrap()).unwrap();
     println!(
         "stiff-elbow at rest: straight N = {:.10}, with elbow spring N = {:.10} (q5 = {:.3e})",
         rest.straight.normal_force,
@@ -146,7 +146,7 @@ fn ana_catalog_rocket_translation() {
         "rocket-launch-75",
     ] {
         let s = data::load_scene(name).unwrap();
-        let r = ana::RocketTranslation::from_scene(&s).unwrap();
+        let r = ana::RocketTranslation::from_rocket(s.rocket().unwrap()).unwrap();
         let st = r.state(s.simulation.t_end).unwrap();
         println!(
             "{name}: t = {}, m = {:.10}, v_axis = {:.10}, s_axis = {:.10}, cg = ({:.10}, {:.10})",

@@ -140,7 +140,8 @@ fn ana_free_vibration_of_the_catalog_rocket_is_converged_in_modes() {
     r.chamber_pressure = 0.0;
     let times: Vec<f64> = (0..=1000).map(|k| 1e-4 * k as f64).collect();
     let history = |modes: usize| {
-        let fv = FreeVibration::from_scene(&scene, modes).expect("free vibration");
+        let fv = FreeVibration::from_rocket(scene.rocket().expect("rocket"), modes)
+            .expect("free vibration");
         let h: Vec<(f64, f64)> = times
             .iter()
             .map(|&t| {

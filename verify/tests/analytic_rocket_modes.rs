@@ -232,7 +232,7 @@ fn ana_rocket_modes_coupled_masses_on_a_rigid_body() {
 fn ana_rocket_modes_catalog() {
     for name in ["rocket", "rocket-case2"] {
         let s = data::load_scene(name).unwrap();
-        let body = FreeFreeRocket::from_scene(&s).unwrap();
+        let body = FreeFreeRocket::from_rocket(s.rocket().unwrap()).unwrap();
         let bend = body.frequencies_hz(Motion::Transverse, 6).unwrap();
         let axial = body.frequencies_hz(Motion::Axial, 6).unwrap();
         println!("{name}: bending {bend:.6?} Hz");

@@ -1,9 +1,15 @@
 //! The rigid reference of the mobile manipulator (seed 004): equations against the energies,
 //! the two formulations, inverse dynamics, the ledger, and the scene family's DOF counts.
 
-use data::{Settings, TimeStepping, load_scene};
+use data::{Backend, BackendError, RunResult, Scene, Settings, TimeStepping, load_scene};
 use verify::analytic::rigid::mobile::model::MAX_Q;
-use verify::analytic::rigid::mobile::{Reference, Tolerances, simulate};
+use verify::analytic::rigid::mobile::{Reference, Tolerances};
+use verify::registry::ReferenceBackend;
+
+/// A reference run through the backend entry (which picks the family).
+fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+    ReferenceBackend.simulate(scene, settings)
+}
 
 fn reference(name: &str) -> Reference {
     let scene = load_scene(name).expect("catalog scene");

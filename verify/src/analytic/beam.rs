@@ -298,7 +298,7 @@ mod tests {
     #[test]
     fn ana_bending_frequency_of_scene_cantilever() {
         let scene = data::load_scene("cantilever").unwrap();
-        let link = &scene.links()[0];
+        let link = &scene.planar_chain().unwrap().links[0];
         let f = bending_frequencies_hz(
             BeamSupport::ClampedFree,
             link.bending_stiffness,
@@ -378,7 +378,7 @@ mod tests {
     #[test]
     fn ana_tip_mass_scene_frequency() {
         let scene = data::load_scene("cantilever-tip-mass").unwrap();
-        let link = &scene.links()[0];
+        let link = &scene.planar_chain().unwrap().links[0];
         let f = cantilever_tip_mass_frequencies_hz(
             link.bending_stiffness,
             link.mass_per_length,

@@ -41,8 +41,7 @@
 
 use std::f64::consts::PI;
 
-use data::Scene;
-use data::scene::PrescribedMotion;
+use data::scene::{PlanarChain, PrescribedMotion};
 
 use super::beam::{BeamSupport, bending_frequencies_hz};
 use super::error::{AnalyticError, Result};
@@ -82,18 +81,13 @@ struct DofMap {
 }
 
 impl SpringJointedChain {
-    /// The chain of a scene, linearized about its set points. Refuses what the model does not
+    /// A scene's planar chain, linearized about its set points. Refuses what the model does not
     /// contain: gravity, extensible, Timoshenko or rotary-inertia links, prescribed joint
     /// motion other than `fixed`, and a reference configuration that is not straight.
-    pub fn from_scene(scene: &Scene) -> Result<Self> {
-        if scene.links().is_empty() {
-            return Err(AnalyticError::Unsupported(format!(
-                "the spring-jointed chain needs a planar link chain; `{}` has no [[link]]",
-                scene.name
-            )));
-        }
-        if scene
-            .gravity()
+    pub fn from_chain(chain: &PlanarChain) -> Result<Self> {
+        if chain
+            .gravity
+            .as_ref()
             .is_some_and(|g| g.vector.iter().any(|&x| x != 0.0))
         {
             return Err(AnalyticError::Unsupported(
@@ -102,9 +96,9 @@ impl SpringJointedChain {
                     .into(),
             ));
         }
-        let mut links = Vec::with_capacity(scene.links().len());
-        let mut joints = Vec::with_capacity(scene.links().len());
-        for (i, l) in scene.links().iter().enumerate() {
+        let mut links = Vec::with_capacity(chain.links.len());
+        let mut joints = Vec::with_capacity(chain.links.len());
+        for (i, l) in chain.links.iter().enumerate() {
             if l.axial || l.shear || l.rotary_inertia {
                 return Err(AnalyticError::Unsupported(format!(
                     "link {}: the spring-jointed chain is of inextensible Euler–Bernoulli links \

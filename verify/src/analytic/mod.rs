@@ -45,7 +45,7 @@ pub use beam::{
 pub use chain_modes::{ChainJoint, ChainLink, SpringJointedChain};
 pub use error::{AnalyticError, Result};
 pub use rigid::constrained::{ConstrainedRigidLink, ConstrainedState, evolve_quadratic_friction};
-pub use rigid::resting::{RestingArm, RestingState, resting_from_scene, resting_on_tip};
+pub use rigid::resting::{RestingArm, RestingState, resting_from_chain, resting_on_tip};
 pub use rigid::single::{RigidLink, RigidLinkState};
 pub use rigid::two_link::{RigidTwoLink, TwoLinkHistory, output_times};
 pub use rocket::{RocketState, RocketTranslation};

@@ -32,7 +32,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use data::Scene;
+use data::scene::Rocket;
 
 use crate::analytic::error::{AnalyticError, Result, finite, non_negative, positive};
 
@@ -88,11 +88,8 @@ pub struct RocketState {
 }
 
 impl RocketTranslation {
-    /// From a scene with a `[rocket]` table.
-    pub fn from_scene(scene: &Scene) -> Result<Self> {
-        let r = scene.rocket().ok_or_else(|| {
-            AnalyticError::Unsupported("rocket translation: the scene has no [rocket]".into())
-        })?;
+    /// From a scene's `[rocket]` table.
+    pub fn from_rocket(r: &Rocket) -> Result<Self> {
         let g = positive("gravity", r.gravity)?;
         let ve = positive("exhaust velocity", r.exhaust_velocity)?;
         finite("launch angle", r.launch_angle_deg)?;
@@ -264,7 +261,7 @@ mod tests {
     #[test]
     fn ana_rocket_mass_law_of_scene() {
         let scene = data::load_scene("rocket").unwrap();
-        let r = RocketTranslation::from_scene(&scene).unwrap();
+        let r = RocketTranslation::from_rocket(scene.rocket().unwrap()).unwrap();
         let g = 386.09;
         let m0 = (4.25 * 100.0 + 3.0 * 50.0 + 18.0) / g;
         assert!(rel(r.initial_mass, m0) < 1e-15);
@@ -283,7 +280,7 @@ mod tests {
         // velocity, displacement and the mass-centre motion (RK rtol 1e-13 ⇒ ≤ 1e-10 relative).
         for name in ["rocket", "rocket-launch-60"] {
             let scene = data::load_scene(name).unwrap();
-            let r = RocketTranslation::from_scene(&scene).unwrap();
+            let r = RocketTranslation::from_rocket(scene.rocket().unwrap()).unwrap();
             let (sin0, _) = r.launch_angle_rad.sin_cos();
             let t_end = 2.5; // past burn-out at 1.91 s
             let tb = r.burnout_time;
@@ -333,7 +330,7 @@ mod tests {
         // checked by central differences of P (h = 1e-5, O(h²) ≈ 1e-10 relative, round-off
         // ~1e-16·P/h ≈ 1e-9 relative to dP/dt). θ₀ = 90°: axis = +y.
         let scene = data::load_scene("rocket").unwrap();
-        let r = RocketTranslation::from_scene(&scene).unwrap();
+        let r = RocketTranslation::from_rocket(scene.rocket().unwrap()).unwrap();
         let h = 1e-5;
         for &t in &[0.02, 0.5, 1.5, 2.5] {
             let p = |t: f64| {
@@ -347,11 +344,5 @@ mod tests {
             // Across the axis only gravity acts (θ₀ = 90°: nothing across).
             assert!(s.body_vx.abs() < 1e-9 * s.body_vy.abs().max(1.0));
         }
-    }
-
-    #[test]
-    fn ana_rocket_rejects_non_rocket_scene() {
-        let scene = data::load_scene("cantilever").unwrap();
-        assert!(RocketTranslation::from_scene(&scene).is_err());
     }
 }

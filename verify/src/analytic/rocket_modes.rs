@@ -53,7 +53,7 @@
 
 use std::f64::consts::PI;
 
-use data::Scene;
+use data::scene::Rocket;
 
 use super::error::{AnalyticError, Result, non_negative, positive};
 
@@ -233,10 +233,7 @@ impl FreeFreeRocket {
     }
 
     /// The rocket scene at ignition (stage-1 weight per length before any burn).
-    pub fn from_scene(scene: &Scene) -> Result<Self> {
-        let r = scene.rocket().ok_or_else(|| {
-            AnalyticError::Unsupported(format!("`{}` is not a rocket scene", scene.name))
-        })?;
+    pub fn from_rocket(r: &Rocket) -> Result<Self> {
         let g = positive("gravity", r.gravity)?;
         let e = positive("Young's modulus", r.youngs_modulus)?;
         let segments: Vec<Segment> = r

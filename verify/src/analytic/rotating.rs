@@ -328,7 +328,7 @@ mod tests {
     #[test]
     fn ana_rotating_hz_scales() {
         let scene = data::load_scene("spin-up").unwrap();
-        let l = &scene.links()[0];
+        let l = &scene.planar_chain().unwrap().links[0];
         let f = rotating_frequencies_hz(
             RotatingPlane::InPlane,
             l.bending_stiffness,

@@ -275,7 +275,7 @@ mod tests {
 
     fn scene_beam() -> TimoshenkoBeam {
         let scene = data::load_scene("cantilever-timoshenko").unwrap();
-        TimoshenkoBeam::from_link(&scene.links()[0]).unwrap()
+        TimoshenkoBeam::from_link(&scene.planar_chain().unwrap().links[0]).unwrap()
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! One function per subcommand.
 
-use data::{BackendError, BackendKind, Scene, Settings, StabilityVerdict, load_scene};
+use data::{BackendError, BackendKind, Model, Scene, Settings, StabilityVerdict, load_scene};
 
 use super::CliError;
 use super::args::{Cli, Command, CommonOpts};
@@ -210,46 +210,51 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
             for (k, v) in &flags {
                 say!("  {:<width$} {}", k, if *v { "on" } else { "off" });
             }
-            if let Some(p) = scene.payload_link() {
-                say!(
-                    "rod: L = {}, R = {}, E = {:e}, G = {:e}, ρ = {}; fields {}; payload m = {}, c = {}",
-                    p.length,
-                    p.radius,
-                    p.youngs_modulus,
-                    p.shear_modulus,
-                    p.density,
-                    p.fields
-                        .iter()
-                        .map(|f| f.symbol())
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                    p.payload.mass,
-                    p.payload.offset
-                );
-            }
-            for (i, l) in scene.links().iter().enumerate() {
-                say!(
-                    "link {} `{}`: L = {}, ρA = {}, EI = {}{}{}",
-                    i + 1,
-                    l.name,
-                    l.length,
-                    l.mass_per_length,
-                    l.bending_stiffness,
-                    l.axial_stiffness
-                        .map_or(String::new(), |v| format!(", EA = {v}")),
-                    l.tip_mass
-                        .map_or(String::new(), |v| format!(", tip mass {v}")),
-                );
-            }
-            for (i, c) in scene.contacts().iter().enumerate() {
-                say!(
-                    "contact {}: tip of `{}` against {:?} ({:?}, μ = {})",
-                    i + 1,
-                    c.link,
-                    c.surface,
-                    c.mode,
-                    c.friction
-                );
+            match &scene.model {
+                Model::PayloadLink(p) => {
+                    say!(
+                        "rod: L = {}, R = {}, E = {:e}, G = {:e}, ρ = {}; fields {}; payload m = {}, c = {}",
+                        p.length,
+                        p.radius,
+                        p.youngs_modulus,
+                        p.shear_modulus,
+                        p.density,
+                        p.fields
+                            .iter()
+                            .map(|f| f.symbol())
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                        p.payload.mass,
+                        p.payload.offset
+                    );
+                }
+                Model::PlanarChain(chain) => {
+                    for (i, l) in chain.links.iter().enumerate() {
+                        say!(
+                            "link {} `{}`: L = {}, ρA = {}, EI = {}{}{}",
+                            i + 1,
+                            l.name,
+                            l.length,
+                            l.mass_per_length,
+                            l.bending_stiffness,
+                            l.axial_stiffness
+                                .map_or(String::new(), |v| format!(", EA = {v}")),
+                            l.tip_mass
+                                .map_or(String::new(), |v| format!(", tip mass {v}")),
+                        );
+                    }
+                    for (i, contact) in chain.contacts.iter().enumerate() {
+                        say!(
+                            "contact {}: tip of `{}` against {:?} ({:?}, μ = {})",
+                            i + 1,
+                            contact.link,
+                            contact.surface,
+                            contact.mode,
+                            contact.friction
+                        );
+                    }
+                }
+                Model::Rocket(_) | Model::MobileManipulator(_) => {}
             }
             say!("degrees of freedom");
             for p in &plans {
@@ -387,6 +392,11 @@ fn statics(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
 
 fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
     let scene = load_scene(name)?;
+    // Contacts (and so switching events) exist only in planar chains.
+    let has_contacts = match &scene.model {
+        Model::PlanarChain(chain) => !chain.contacts.is_empty(),
+        Model::Rocket(_) | Model::PayloadLink(_) | Model::MobileManipulator(_) => false,
+    };
     let results = for_backends(&scene, opts, |b, settings| b.simulate(&scene, settings))?;
     if let Some(dir) = &opts.out {
         for (kind, r) in &results {
@@ -411,7 +421,7 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 &format!("{stem}-events.json"),
                 &serde_json::to_vec_pretty(&r.events).expect("serializable"),
             )?;
-            if !scene.contacts().is_empty() {
+            if has_contacts {
                 write_atomic(
                     dir,
                     &format!("{stem}-switching.csv"),
@@ -502,7 +512,7 @@ fn run(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
                 columns[0] = Column::left(header[0]).elastic();
                 out!("{}", fitted_table(&columns, &rows, TERMINAL_WIDTH));
             }
-            if !scene.contacts().is_empty() {
+            if has_contacts {
                 // The terminal table names the columns briefly; `--format wide` and the
                 // switching CSV spell them out.
                 let short = [

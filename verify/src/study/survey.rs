@@ -17,18 +17,16 @@ use crate::progress::Progress;
 /// Per-rung wall-time budget of the full suite's ladders.
 pub const FULL_RUNG_BUDGET_S: f64 = 10.0;
 
-/// The quantity a scene's refinement ladder follows in the full suite.
+/// The quantity a scene's refinement ladder follows in the full suite (the payload link and
+/// the mobile manipulator have none).
 pub fn ladder_quantity(scene: &Scene) -> Option<String> {
-    use data::scene::PrescribedMotion;
-    if let Some(_r) = scene.rocket() {
-        return Some(format!(
-            "{}@{}",
-            data::channel::ROCKET_VY,
-            scene.simulation.t_end
-        ));
-    }
-    let first = scene.links().first()?;
+    use data::scene::{Model, PrescribedMotion};
     let t = scene.simulation.t_end;
+    let first = match &scene.model {
+        Model::Rocket(_) => return Some(format!("{}@{t}", data::channel::ROCKET_VY)),
+        Model::PlanarChain(chain) => chain.links.first()?,
+        Model::PayloadLink(_) | Model::MobileManipulator(_) => return None,
+    };
     Some(match first.joint.prescribed {
         Some(PrescribedMotion::Fixed) | Some(PrescribedMotion::ConstantRate { .. }) => {
             "freq1".into()

@@ -58,7 +58,9 @@ impl Quantity {
     /// Parses the grammar of `data::cases` against a scene (aliases resolve to its last link).
     pub fn parse(text: &str, scene: &Scene) -> Result<Quantity, String> {
         let t = text.trim();
-        let last = scene.links().len().max(1);
+        let chain = scene.planar_chain();
+        // Outside a planar chain the aliases name link 1 (the payload link is one link).
+        let last = chain.map_or(1, |c| c.links.len().max(1));
         let alias = |c: &str| -> String {
             match c {
                 "tip_deflection" => channel::tip_deflection(last),
@@ -124,12 +126,12 @@ impl Quantity {
             });
         }
         if let Some(rest) = t.strip_prefix("impulse_excess") {
-            let contact_link = scene
-                .contacts()
-                .first()
-                .and_then(|c| scene.link_index(&c.link))
+            let link = chain
+                .and_then(|c| {
+                    let contact = c.contacts.first()?;
+                    c.links.get(c.link_index(&contact.link)?)
+                })
                 .ok_or_else(|| format!("`{text}` needs a scene with a contact"))?;
-            let link = &scene.links()[contact_link];
             let tip_mass = link.tip_mass.filter(|m| *m > 0.0).ok_or_else(|| {
                 format!(
                     "`{text}` needs a tip mass on the contact link `{}`",

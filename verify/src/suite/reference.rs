@@ -1,6 +1,10 @@
 //! Analytic reference values by id, computed from the scene's own parameters by
 //! [`crate::analytic`] (root finding, series, shooting — never typed-in numbers).
 //!
+//! Each reference is built from its family's type (`PlanarChain`, `Rocket`, `PayloadLink`);
+//! the match on `scene.model` happens here, and a scene of another family gets the reference's
+//! own refusal.
+//!
 //! | id | quantity | reference |
 //! |---|---|---|
 //! | `clamped-free` | `freqN`, `bending_freqN` | uniform Euler–Bernoulli cantilever, 1 + cos βL cosh βL = 0 |
@@ -25,31 +29,58 @@
 //! | `rocket-free-vibration` | `history:rocket.w@K`, `history:rocket.massJ.w` (and low-passed) | the rocket without mass flow, pressure or dampers, released from its initial shape: superposition of the first 64 exact free-free modes, relative to the mean axis |
 
 use data::Scene;
-use data::scene::Link;
-use data::scene::PayloadLink;
-use data::scene::PrescribedMotion;
+use data::scene::{Link, Model, PayloadLink, PlanarChain, PrescribedMotion, Rocket};
 
 use super::quantity::Quantity;
 use crate::analytic as ana;
 
-fn single_link(scene: &Scene) -> Result<&Link, String> {
-    match scene.links() {
-        [l] => Ok(l),
-        _ => Err(format!(
-            "this analytic reference needs a single-link scene; `{}` has {} links",
-            scene.name,
-            scene.links().len()
-        )),
+/// The planar chain of a scene; for the other families the reference's own refusal `why`.
+fn planar_chain(scene: &Scene, why: impl FnOnce() -> String) -> Result<&PlanarChain, String> {
+    match &scene.model {
+        Model::PlanarChain(c) => Ok(c),
+        Model::Rocket(_) | Model::PayloadLink(_) | Model::MobileManipulator(_) => {
+            Err(ana::AnalyticError::Unsupported(why()).to_string())
+        }
     }
 }
 
+/// The rocket of a scene; for the other families the reference's own refusal `why`.
+fn rocket(scene: &Scene, why: impl FnOnce() -> String) -> Result<&Rocket, String> {
+    match &scene.model {
+        Model::Rocket(r) => Ok(r),
+        Model::PlanarChain(_) | Model::PayloadLink(_) | Model::MobileManipulator(_) => {
+            Err(ana::AnalyticError::Unsupported(why()).to_string())
+        }
+    }
+}
+
+fn not_a_rocket(scene: &Scene) -> String {
+    format!("`{}` is not a rocket scene", scene.name)
+}
+
+/// The planar chain of a single-link scene and its link.
+fn single_link(scene: &Scene) -> Result<(&PlanarChain, &Link), String> {
+    let links = match &scene.model {
+        Model::PlanarChain(c) => match c.links.as_slice() {
+            [l] => return Ok((c, l)),
+            links => links.len(),
+        },
+        Model::Rocket(_) | Model::PayloadLink(_) | Model::MobileManipulator(_) => 0,
+    };
+    Err(format!(
+        "this analytic reference needs a single-link scene; `{}` has {links} links",
+        scene.name
+    ))
+}
+
 fn payload_link(scene: &Scene) -> Result<&PayloadLink, String> {
-    scene.payload_link().ok_or_else(|| {
-        format!(
+    match &scene.model {
+        Model::PayloadLink(p) => Ok(p),
+        Model::PlanarChain(_) | Model::Rocket(_) | Model::MobileManipulator(_) => Err(format!(
             "this analytic reference needs a [payload_link] scene; `{}` is not one",
             scene.name
-        )
-    })
+        )),
+    }
 }
 
 fn mode_number(q: &Quantity, want_kind: Option<&str>) -> Result<usize, String> {
@@ -79,7 +110,7 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             _ => Err("`tip-mass-momentum-limit` is the limit of `impulse_excessN` only".into()),
         },
         "clamped-free" => {
-            let l = single_link(scene)?;
+            let (_, l) = single_link(scene)?;
             let n = mode_number(q, Some("bending"))?;
             nth(
                 ana::bending_frequencies_hz(
@@ -93,7 +124,7 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             )
         }
         "tip-mass" => {
-            let l = single_link(scene)?;
+            let (_, l) = single_link(scene)?;
             let n = mode_number(q, Some("bending"))?;
             nth(
                 ana::cantilever_tip_mass_frequencies_hz(
@@ -108,7 +139,7 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             )
         }
         "timoshenko" => {
-            let l = single_link(scene)?;
+            let (_, l) = single_link(scene)?;
             let n = mode_number(q, Some("bending"))?;
             let beam = ana::TimoshenkoBeam {
                 kappa_ga: l
@@ -126,7 +157,7 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             nth(ana::timoshenko_clamped_free_hz(&beam, n), n)
         }
         "axial-clamped-free" => {
-            let l = single_link(scene)?;
+            let (_, l) = single_link(scene)?;
             let n = mode_number(q, Some("axial"))?;
             let ea = l
                 .axial_stiffness
@@ -143,7 +174,7 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             }
         }
         "rotating-in-plane" => {
-            let l = single_link(scene)?;
+            let (_, l) = single_link(scene)?;
             let n = mode_number(q, Some("bending"))?;
             let omega = match l.joint.prescribed {
                 Some(PrescribedMotion::ConstantRate { rate }) => rate,
@@ -172,7 +203,13 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             )
         }
         "spring-jointed-chain" | "chain-clamped-limit" | "chain-pinned-limit" => {
-            let chain = ana::SpringJointedChain::from_scene(scene).map_err(|e| e.to_string())?;
+            let chain = planar_chain(scene, || {
+                format!(
+                    "the spring-jointed chain needs a planar link chain; `{}` has no [[link]]",
+                    scene.name
+                )
+            })?;
+            let chain = ana::SpringJointedChain::from_chain(chain).map_err(|e| e.to_string())?;
             let (n, bending_only) = match q {
                 Quantity::Frequency { n, kind: None } => (*n, false),
                 Quantity::Frequency { n, kind: Some(k) } if k == "bending" => (*n, true),
@@ -195,8 +232,11 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             if !matches!(q, Quantity::StaticTip) {
                 return Err("`static-linear` applies to `tip_static`".into());
             }
-            let l = single_link(scene)?;
-            let st = scene.statics().ok_or("the scene has no [statics] loads")?;
+            let (chain, l) = single_link(scene)?;
+            let st = chain
+                .statics
+                .as_ref()
+                .ok_or("the scene has no [statics] loads")?;
             let mut w = 0.0;
             if let Some(p) = st.tip_force {
                 w += ana::cantilever_tip_load(p, l.bending_stiffness, l.length)
@@ -214,7 +254,10 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             let Quantity::At { channel, t } = q else {
                 return Err("`rigid-single-link` applies to CHANNEL@T".into());
             };
-            let st = ana::RigidLink::from_scene(scene)
+            let chain = planar_chain(scene, || {
+                "rigid single-link reference: the scene must have exactly one link".into()
+            })?;
+            let st = ana::RigidLink::from_chain(chain)
                 .and_then(|r| r.state(*t))
                 .map_err(|e| e.to_string())?;
             offered_channel(
@@ -230,7 +273,10 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             let Quantity::At { channel, t } = q else {
                 return Err("`rigid-two-link` applies to CHANNEL@T".into());
             };
-            let h = ana::RigidTwoLink::from_scene(scene)
+            let chain = planar_chain(scene, || {
+                "rigid two-link reference: the scene must have exactly two links".into()
+            })?;
+            let h = ana::RigidTwoLink::from_chain(chain)
                 .and_then(|r| r.simulate(&[0.0, *t]))
                 .map_err(|e| e.to_string())?;
             let last = |v: &Vec<f64>| v.last().copied().ok_or("empty rigid history".to_string());
@@ -247,7 +293,10 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             let Quantity::At { channel, t } = q else {
                 return Err("`constrained-rigid-link` applies to CHANNEL@T".into());
             };
-            let st = ana::ConstrainedRigidLink::from_scene(scene)
+            let chain = planar_chain(scene, || {
+                "constrained rigid link: the scene must have exactly one link".into()
+            })?;
+            let st = ana::ConstrainedRigidLink::from_chain(chain)
                 .and_then(|r| r.state(*t))
                 .map_err(|e| e.to_string())?;
             offered_channel(
@@ -265,7 +314,10 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
             let Quantity::At { channel, t } = q else {
                 return Err("`rocket-translation` applies to CHANNEL@T".into());
             };
-            let st = ana::RocketTranslation::from_scene(scene)
+            let r = rocket(scene, || {
+                "rocket translation: the scene has no [rocket]".into()
+            })?;
+            let st = ana::RocketTranslation::from_rocket(r)
                 .and_then(|r| r.state(*t))
                 .map_err(|e| e.to_string())?;
             offered_channel(
@@ -286,7 +338,8 @@ pub fn analytic_value(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Stri
                         .into(),
                 );
             };
-            let body = FreeFreeRocket::from_scene(scene).map_err(|e| e.to_string())?;
+            let r = rocket(scene, || not_a_rocket(scene))?;
+            let body = FreeFreeRocket::from_rocket(r).map_err(|e| e.to_string())?;
             let of = |m: Motion| body.frequencies_hz(m, *n);
             match kind.as_deref() {
                 Some("axial") => nth(of(Motion::Axial), *n),
@@ -379,9 +432,9 @@ pub fn analytic_history(
 ) -> Result<Vec<f64>, String> {
     match id {
         "rocket-free-vibration" => {
-            let fv = ana::rocket_modes::FreeVibration::from_scene(scene, FREE_VIBRATION_MODES)
+            let r = rocket(scene, || not_a_rocket(scene))?;
+            let fv = ana::rocket_modes::FreeVibration::from_rocket(r, FREE_VIBRATION_MODES)
                 .map_err(|e| e.to_string())?;
-            let r = scene.rocket().ok_or("not a rocket scene")?;
             let stations = scene.simulation.field_stations;
             let mass = (1..=r.discrete_masses.len())
                 .find(|&j| data::channel::rocket_mass_transverse(j) == channel);
@@ -414,33 +467,13 @@ pub fn analytic_history(
 
 /// The analytic reference that naturally applies to a quantity on a scene, if any.
 pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
-    if scene.rocket().is_some() {
-        return match q {
-            Quantity::Frequency { kind, .. }
-                if kind
-                    .as_deref()
-                    .is_none_or(|k| k == "bending" || k == "axial") =>
-            {
-                Some("rocket-free-free".to_string())
-            }
-            _ => None,
-        };
-    }
-    if scene.payload_link().is_some() {
-        let id = match q {
-            Quantity::Frequency {
-                kind: Some(kind), ..
-            } if ["bending-horizontal", "bending-vertical", "torsion", "axial"]
-                .contains(&kind.as_str()) =>
-            {
-                format!("payload-{}", kind.trim_start_matches("bending-"))
-            }
-            Quantity::StaticTip => "payload-static-sag".to_string(),
-            _ => return None,
-        };
-        return Some(id);
-    }
-    let [l] = scene.links() else {
+    let chain = match &scene.model {
+        Model::PlanarChain(c) => c,
+        Model::Rocket(_) => return rocket_default_id(q),
+        Model::PayloadLink(_) => return payload_link_default_id(q),
+        Model::MobileManipulator(_) => return None,
+    };
+    let [l] = chain.links.as_slice() else {
         return None;
     };
     let clamped = matches!(l.joint.prescribed, Some(PrescribedMotion::Fixed));
@@ -469,6 +502,35 @@ pub fn default_analytic_id(scene: &Scene, q: &Quantity) -> Option<String> {
         _ => return None,
     };
     Some(id.to_string())
+}
+
+/// The default reference of a rocket quantity: its free-free spectrum.
+fn rocket_default_id(q: &Quantity) -> Option<String> {
+    match q {
+        Quantity::Frequency { kind, .. }
+            if kind
+                .as_deref()
+                .is_none_or(|k| k == "bending" || k == "axial") =>
+        {
+            Some("rocket-free-free".to_string())
+        }
+        _ => None,
+    }
+}
+
+/// The default reference of a payload-link quantity: the matching 3-D link spectrum or sag.
+fn payload_link_default_id(q: &Quantity) -> Option<String> {
+    match q {
+        Quantity::Frequency {
+            kind: Some(kind), ..
+        } if ["bending-horizontal", "bending-vertical", "torsion", "axial"]
+            .contains(&kind.as_str()) =>
+        {
+            Some(format!("payload-{}", kind.trim_start_matches("bending-")))
+        }
+        Quantity::StaticTip => Some("payload-static-sag".to_string()),
+        _ => None,
+    }
 }
 
 /// The value of `channel` among the channels a reference offers, or an error naming them.

@@ -40,8 +40,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use data::Scene;
-use data::scene::{ContactMode, Surface, TorqueLaw};
+use data::scene::{ContactMode, PlanarChain, Surface, TorqueLaw};
 
 use super::{law_breakpoints, link_inertia_about_root, reject};
 use crate::analytic::error::{AnalyticError, Result, finite, non_negative, positive};
@@ -138,10 +137,10 @@ pub fn evolve_quadratic_friction(a: f64, b: f64, theta0: f64, rate0: f64, h: f64
 
 impl ConstrainedRigidLink {
     /// Rigid limit of a one-link scene whose tip is held on a circle of radius L about the hub.
-    pub fn from_scene(scene: &Scene) -> Result<Self> {
-        let link = super::torque_driven_single_link(scene, "constrained rigid link")?;
+    pub fn from_chain(chain: &PlanarChain) -> Result<Self> {
+        let link = super::torque_driven_single_link(chain, "constrained rigid link")?;
         let j = &link.joint;
-        let [contact] = scene.contacts() else {
+        let [contact] = chain.contacts.as_slice() else {
             return Err(AnalyticError::Unsupported(
                 "constrained rigid link: exactly one contact is required".into(),
             ));
@@ -307,7 +306,7 @@ mod tests {
     #[test]
     fn ana_constrained_scene_terminal_speed_and_ledger() {
         let scene = data::load_scene("constrained-arm").unwrap();
-        let r = ConstrainedRigidLink::from_scene(&scene).unwrap();
+        let r = ConstrainedRigidLink::from_chain(scene.planar_chain().unwrap()).unwrap();
         // J = 0.01 + 1/3 + 0.5; wall factor (0.5 + 1/3)·1.
         assert!((r.inertia - (0.01 + 1.0 / 3.0 + 0.5)).abs() < 1e-15);
         assert!((r.wall_load_factor() - (0.5 + 1.0 / 3.0)).abs() < 1e-15);
@@ -336,8 +335,13 @@ mod tests {
     #[test]
     fn ana_constrained_piecewise_torque() {
         // Torque switched off at 1 s: afterwards θ̇ decays as 1/(1 + b θ̇₁ t).
-        let mut r = ConstrainedRigidLink::from_scene(&data::load_scene("constrained-arm").unwrap())
-            .unwrap();
+        let mut r = ConstrainedRigidLink::from_chain(
+            data::load_scene("constrained-arm")
+                .unwrap()
+                .planar_chain()
+                .unwrap(),
+        )
+        .unwrap();
         r.torque = Some(TorqueLaw::Constant {
             value: 2.0,
             until: Some(1.0),

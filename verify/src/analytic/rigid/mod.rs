@@ -18,8 +18,7 @@ pub mod resting;
 pub mod single;
 pub mod two_link;
 
-use data::Scene;
-use data::scene::{Link, TorqueLaw};
+use data::scene::{Link, PlanarChain, TorqueLaw};
 
 use crate::analytic::error::{AnalyticError, Result};
 
@@ -56,15 +55,15 @@ pub(crate) fn reject(cond: bool, what: &str) -> Result<()> {
 
 /// The one link of a horizontal-plane scene driven only by a torque law at its hub (no gravity,
 /// joint spring/damper or prescribed motion): what the single-link rigid limits require.
-pub(crate) fn torque_driven_single_link<'a>(scene: &'a Scene, who: &str) -> Result<&'a Link> {
-    reject(
-        scene.links().len() != 1,
-        &format!("{who}: the scene must have exactly one link"),
-    )?;
-    let link = &scene.links()[0];
+pub(crate) fn torque_driven_single_link<'a>(chain: &'a PlanarChain, who: &str) -> Result<&'a Link> {
+    let [link] = chain.links.as_slice() else {
+        return Err(AnalyticError::Unsupported(format!(
+            "{who}: the scene must have exactly one link"
+        )));
+    };
     let j = &link.joint;
     reject(
-        scene.gravity().is_some(),
+        chain.gravity.is_some(),
         &format!("{who}: gravity (only the horizontal plane is modelled)"),
     )?;
     reject(

@@ -27,8 +27,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use data::Scene;
-use data::scene::Surface;
+use data::scene::{PlanarChain, Surface};
 
 use super::reject;
 use super::two_link::RigidTwoLink;
@@ -155,9 +154,8 @@ pub fn resting_on_tip(arm: &RigidTwoLink, h: f64) -> Result<RestingArm> {
 }
 
 /// Rest states for a two-link scene with one unilateral horizontal line contact on link 2.
-pub fn resting_from_scene(scene: &Scene) -> Result<RestingArm> {
-    let mut no_contact = scene.clone();
-    let [contact] = scene.contacts() else {
+pub fn resting_from_chain(chain: &PlanarChain) -> Result<RestingArm> {
+    let [contact] = chain.contacts.as_slice() else {
         return Err(AnalyticError::Unsupported(
             "resting arm: exactly one contact is required".into(),
         ));
@@ -171,13 +169,14 @@ pub fn resting_from_scene(scene: &Scene) -> Result<RestingArm> {
         }
     };
     reject(
-        scene.link_index(&contact.link) != Some(1),
+        chain.link_index(&contact.link) != Some(1),
         "resting arm: the contact must be on the tip of link 2",
     )?;
-    if let Some(chain) = no_contact.planar_chain_mut() {
-        chain.contacts.clear();
-    }
-    let arm = RigidTwoLink::from_scene(&no_contact)?;
+    let no_contact = PlanarChain {
+        contacts: Vec::new(),
+        ..chain.clone()
+    };
+    let arm = RigidTwoLink::from_chain(&no_contact)?;
     resting_on_tip(&arm, h)
 }
 
@@ -188,7 +187,7 @@ mod tests {
     #[test]
     fn ana_resting_stiff_elbow_normal_force() {
         let scene = data::load_scene("barhorst-case1-stiff-elbow").unwrap();
-        let r = resting_from_scene(&scene).unwrap();
+        let r = resting_from_chain(scene.planar_chain().unwrap()).unwrap();
         let s = r.straight;
         // Straight arm: N = (W₁ L₁/2 + W₂ (L₁ + L₂/2)) / (L₁ + L₂), the cos q₁ cancels.
         let g = 32.17;
@@ -214,9 +213,9 @@ mod tests {
         // Case 1 (K₂ = 20): the spring-held equilibrium, if any, is far from straight; the
         // straight reference still exists.
         let scene = data::load_scene("barhorst-case1").unwrap();
-        let r = resting_from_scene(&scene).unwrap();
+        let r = resting_from_chain(scene.planar_chain().unwrap()).unwrap();
         assert!(r.straight.normal_force > 0.0);
         let scene = data::load_scene("two-link-free").unwrap();
-        assert!(resting_from_scene(&scene).is_err());
+        assert!(resting_from_chain(scene.planar_chain().unwrap()).is_err());
     }
 }

@@ -12,8 +12,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use data::Scene;
-use data::scene::TorqueLaw;
+use data::scene::{PlanarChain, TorqueLaw};
 
 use super::{law_breakpoints, link_inertia_about_root, reject};
 use crate::analytic::error::{AnalyticError, Result, finite, positive};
@@ -45,11 +44,11 @@ pub struct RigidLinkState {
 
 impl RigidLink {
     /// The rigid limit of a single-link planar scene (horizontal plane, torque-driven hub).
-    pub fn from_scene(scene: &Scene) -> Result<Self> {
-        let link = super::torque_driven_single_link(scene, "rigid single-link reference")?;
+    pub fn from_chain(chain: &PlanarChain) -> Result<Self> {
+        let link = super::torque_driven_single_link(chain, "rigid single-link reference")?;
         let j = &link.joint;
         reject(
-            !scene.contacts().is_empty(),
+            !chain.contacts.is_empty(),
             "rigid single-link reference: contact (see rigid::constrained for the circular wall)",
         )?;
         let r = RigidLink {
@@ -110,7 +109,7 @@ mod tests {
     #[test]
     fn ana_rigid_single_link_bang_bang() {
         let scene = data::load_scene("single-link").unwrap();
-        let r = RigidLink::from_scene(&scene).unwrap();
+        let r = RigidLink::from_chain(scene.planar_chain().unwrap()).unwrap();
         // J = 0.01 + 1·1³/3 + 0.5·1² = 0.843333…
         let j = 0.01 + 1.0 / 3.0 + 0.5;
         assert!((r.inertia - j).abs() < 1e-15);
@@ -141,10 +140,10 @@ mod tests {
     fn ana_rigid_single_link_rejects_unmodelled_physics() {
         let scene = data::load_scene("two-link-free").unwrap();
         assert!(matches!(
-            RigidLink::from_scene(&scene),
+            RigidLink::from_chain(scene.planar_chain().unwrap()),
             Err(AnalyticError::Unsupported(_))
         ));
         let scene = data::load_scene("constrained-arm").unwrap();
-        assert!(RigidLink::from_scene(&scene).is_err());
+        assert!(RigidLink::from_chain(scene.planar_chain().unwrap()).is_err());
     }
 }

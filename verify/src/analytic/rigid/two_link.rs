@@ -32,8 +32,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use data::Scene;
-use data::scene::{Link, TorqueLaw};
+use data::scene::{Link, PlanarChain, TorqueLaw};
 
 use super::{law_breakpoints, reject};
 use crate::analytic::error::{AnalyticError, Result, finite, non_negative, positive};
@@ -123,29 +122,24 @@ fn joint_from_link(link: &Link) -> JointModel {
 impl RigidTwoLink {
     /// Rigid limit of a two-link planar scene without contact (elastic fields, Kelvin–Voigt
     /// damping, foreshortening and shear vanish in the rigid limit and are ignored).
-    pub fn from_scene(scene: &Scene) -> Result<Self> {
+    pub fn from_chain(chain: &PlanarChain) -> Result<Self> {
+        let [l1, l2] = chain.links.as_slice() else {
+            return Err(AnalyticError::Unsupported(
+                "rigid two-link reference: the scene must have exactly two links".into(),
+            ));
+        };
         reject(
-            scene.links().len() != 2,
-            "rigid two-link reference: the scene must have exactly two links",
-        )?;
-        reject(
-            !scene.contacts().is_empty(),
+            !chain.contacts.is_empty(),
             "rigid two-link reference: contact (use rigid::resting for the static limit)",
         )?;
         reject(
-            scene.links().iter().any(|l| l.joint.prescribed.is_some()),
+            chain.links.iter().any(|l| l.joint.prescribed.is_some()),
             "rigid two-link reference: prescribed joint motion",
         )?;
         let r = RigidTwoLink {
-            links: [
-                body_from_link(&scene.links()[0]),
-                body_from_link(&scene.links()[1]),
-            ],
-            joints: [
-                joint_from_link(&scene.links()[0]),
-                joint_from_link(&scene.links()[1]),
-            ],
-            gravity: scene.gravity().map_or([0.0, 0.0], |g| g.vector),
+            links: [body_from_link(l1), body_from_link(l2)],
+            joints: [joint_from_link(l1), joint_from_link(l2)],
+            gravity: chain.gravity.as_ref().map_or([0.0, 0.0], |g| g.vector),
         };
         r.validate()?;
         Ok(r)
@@ -352,9 +346,12 @@ mod tests {
 
     /// The rigid arm of a scene, with any contact removed (the free-flight dynamics).
     fn arm(name: &str) -> RigidTwoLink {
-        let mut scene = data::load_scene(name).unwrap();
-        scene.planar_chain_mut().unwrap().contacts.clear();
-        RigidTwoLink::from_scene(&scene).unwrap()
+        let scene = data::load_scene(name).unwrap();
+        let chain = PlanarChain {
+            contacts: Vec::new(),
+            ..scene.planar_chain().unwrap().clone()
+        };
+        RigidTwoLink::from_chain(&chain).unwrap()
     }
 
     #[test]
@@ -539,6 +536,14 @@ mod tests {
         let closure = e(last) - e(0) - h.input_work[last] + h.dissipated[last];
         assert!(closure.abs() < 1e-9 * e(0).abs());
         assert!(h.input_work[last] != 0.0);
-        assert!(RigidTwoLink::from_scene(&data::load_scene("barhorst-case1").unwrap()).is_err());
+        assert!(
+            RigidTwoLink::from_chain(
+                data::load_scene("barhorst-case1")
+                    .unwrap()
+                    .planar_chain()
+                    .unwrap()
+            )
+            .is_err()
+        );
     }
 }

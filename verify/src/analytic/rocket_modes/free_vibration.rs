@@ -31,7 +31,7 @@
 use super::{FreeFreeRocket, Motion, basis_end_values, solve4};
 use crate::analytic::error::{AnalyticError, Result};
 use crate::analytic::numerics::quadrature::gauss_legendre_nodes;
-use data::Scene;
+use data::scene::Rocket;
 
 /// Gauss points per sub-interval of a member.
 const GAUSS_POINTS: usize = 12;
@@ -73,12 +73,10 @@ pub struct TransverseState {
 }
 
 impl FreeVibration {
-    /// The scene's free vibration on its first `modes` elastic transverse modes. The scene must
-    /// have no mass flow, chamber pressure or dampers (the rows switch them off by overrides).
-    pub fn from_scene(scene: &Scene, modes: usize) -> Result<Self> {
-        let r = scene.rocket().ok_or_else(|| {
-            AnalyticError::Unsupported(format!("`{}` is not a rocket scene", scene.name))
-        })?;
+    /// The rocket's free vibration on its first `modes` elastic transverse modes. The rocket
+    /// must have no mass flow, chamber pressure or dampers (the rows switch them off by
+    /// overrides).
+    pub fn from_rocket(r: &Rocket, modes: usize) -> Result<Self> {
         if r.stages.iter().any(|s| s.burn_rate != 0.0) || r.chamber_pressure != 0.0 {
             return Err(AnalyticError::Unsupported(
                 "free vibration needs burn_rate = 0 and chamber_pressure = 0 (override them)"
@@ -97,7 +95,7 @@ impl FreeVibration {
                 "free vibration of the undamped body: the scene has dampers".into(),
             ));
         }
-        let body = FreeFreeRocket::from_scene(scene)?;
+        let body = FreeFreeRocket::from_rocket(r)?;
         let length = r.length();
         let shape = |x: f64| r.initial_shape.deflection(x, length);
         Self::new(body, &shape, modes)

@@ -28,6 +28,7 @@ use std::time::Instant;
 
 use data::channel::spec;
 use data::ledger_term;
+use data::scene::MobileManipulator;
 use data::{
     BackendError, BackendKind, Cost, EnergyLedger, Observables, RunResult, Scene, Settings,
     StabilityVerdict,
@@ -48,15 +49,14 @@ fn to_backend_error(e: AnalyticError) -> BackendError {
     }
 }
 
-/// The rigid reference of a `[mobile_manipulator]` scene as a run result (backend `reference`).
-pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+/// The rigid reference of a `[mobile_manipulator]` scene (`mm` is its model) as a run result
+/// (backend `reference`).
+pub fn simulate(
+    scene: &Scene,
+    mm: &MobileManipulator,
+    settings: &Settings,
+) -> Result<RunResult, BackendError> {
     let start = Instant::now();
-    let mm = scene.mobile_manipulator().ok_or_else(|| {
-        BackendError::unsupported(format!(
-            "reference: no verify reference for the {} family (only the mobile manipulator)",
-            scene.family()
-        ))
-    })?;
     let settings = settings.reference()?;
     let mut tol = Tolerances::default();
     for (field, v, slot) in [
@@ -178,13 +178,7 @@ pub fn simulate(scene: &Scene, settings: &Settings) -> Result<RunResult, Backend
 }
 
 /// DOF plan of the reference for `describe`.
-pub fn dof_plan(scene: &Scene) -> Result<data::DofPlan, BackendError> {
-    let mm = scene.mobile_manipulator().ok_or_else(|| {
-        BackendError::unsupported(format!(
-            "reference: no verify reference for the {} family",
-            scene.family()
-        ))
-    })?;
+pub fn dof_plan(mm: &MobileManipulator) -> Result<data::DofPlan, BackendError> {
     let model = Model::from_scene(mm).map_err(to_backend_error)?;
     let mut plan = data::DofPlan::default();
     if model.layout.platform.is_some() {
