@@ -31,7 +31,7 @@
 //! for the exact inextensible kinetic terms) plus a dense N³/3 Cholesky of the small reduced
 //! mass matrix. Prescribed hub motion is
 //! imposed exactly and the torque it needs is reported. Time integration: [`integrate`]
-//! (by default adaptive TR-BDF2 for Kelvin–Voigt-damped chains without contact,
+//! (by default adaptive TR-BDF2 for Kelvin–Voigt-damped chains, with or without contact,
 //! Dormand–Prince 5(4) otherwise, see [`simulate::default_method`]; adaptive TR-BDF2 is also
 //! the method for other stiff cases: many `poly` modes, whose
 //! overdamped Kelvin–Voigt eigenvalues reach −1.4e7 / −4.8e7 / −1.4e8 s⁻¹ at 16 / 20 / 24 modes

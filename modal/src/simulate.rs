@@ -34,6 +34,12 @@ pub const FIXED_STEP_NEWTON_TOL: (f64, f64) = (1e-6, 1e-8);
 /// `two-link-free` (6 poly modes, 10 s) the Kelvin–Voigt work is 5.75445e-2 against 5.75434e-2
 /// at 1e-8 / 1e-10 (2e-5 relative) in 7 553 steps instead of 35 852.
 pub const KELVIN_VOIGT_DEFAULT_TOL: (f64, f64) = (1e-6, 1e-8);
+/// (rtol, atol) of the default method of Kelvin–Voigt chains with a tip contact: tight enough
+/// that the longest contact scene closes its energy ledger well inside 1e-5 (`barhorst-case2`,
+/// 30 s: 3.1e-6 at the default 6 modes, 5.1e-6 at 2 modes, against 6.9e-6 and 1.2e-5 at
+/// [`KELVIN_VOIGT_DEFAULT_TOL`]); the located switching times move by less than 1e-6 s against
+/// Dormand–Prince at rtol 1e-8 (docs/backends.md).
+pub const KELVIN_VOIGT_CONTACT_TOL: (f64, f64) = (3e-7, 3e-9);
 
 /// An integration method of the registry ([`crate::integrate::METHODS`]).
 pub type Method = &'static MethodInfo;
@@ -45,40 +51,33 @@ pub fn method_choice(pc: &PlanarChain, settings: &ModalSettings) -> Method {
         .map_or_else(|| default_method(pc, settings), method_for)
 }
 
-/// The default method: adaptive TR-BDF2 ([`TRBDF2`], tolerances
-/// [`KELVIN_VOIGT_DEFAULT_TOL`]) for a chain without contact whose every link carries Kelvin–Voigt damping,
-/// when no tolerance is given; otherwise Dormand–Prince.
+/// The default method: adaptive TR-BDF2 ([`TRBDF2`], tolerances [`KELVIN_VOIGT_DEFAULT_TOL`],
+/// with a tip contact [`KELVIN_VOIGT_CONTACT_TOL`]) for a chain whose every link carries
+/// Kelvin–Voigt damping, when no tolerance is given; otherwise Dormand–Prince.
 ///
 /// Why: an explicit method is bound by the highest Ritz frequency (ω ~ β²√(EI/ρAL⁴) grows
-/// like the square of the mode number) and, at a tight tolerance, resolves every such mode:
-/// `two-link-free` (6 clamped-free modes per link) took 48 931 Dormand–Prince steps for 10 s.
+/// like the square of the mode number) and, at a tight tolerance, resolves every such mode.
 /// The implicit method follows the stiff, Kelvin–Voigt-damped high modes with steps set by the
 /// error test: short while the step release at t = 0 (joint springs away from their set points)
-/// rings through every mode, long afterwards. A fixed step ([`TRBDF2_FIXED`](crate::integrate::TRBDF2_FIXED) at
-/// [`default_step`], still available by name) cannot resolve that initial transient: on
-/// `two-link-free` (6 `poly` modes, h = T₁/128 = 1.05e-3) it books 7.5e-3 too much
-/// Kelvin–Voigt work and loses 3.5e-2 of energy closure within the first 0.01 s (ledger
-/// residual; 2.5e-6 adaptive), i.e. the term `dissipated:kelvin_voigt` is 14 % high at 6 modes
-/// and 12 % high at 8 modes, and the error grows with the mode count (measured against
-/// Dormand–Prince at rtol 1e-8: 5.740e-2 both at 6 modes, t = 2 s). Undamped links keep their
+/// or an impact rings through every mode, long afterwards. Its dense output locates the
+/// contact switches (gap, normal force) as Dormand–Prince's does. A fixed step
+/// ([`TRBDF2_FIXED`](crate::integrate::TRBDF2_FIXED) at [`default_step`], still available by
+/// name) cannot resolve the initial transient: on `two-link-free` (6 `poly` modes,
+/// h = T₁/128 = 1.05e-3) the term `dissipated:kelvin_voigt` comes out 14 % high at 6 modes
+/// and 12 % high at 8, and the error grows with the mode count. Undamped links keep their
 /// high modes ringing for all time; they keep the explicit method. There the high modes are not
 /// stiff in the sense an implicit method exploits: they oscillate about their quasi-static
 /// state with an amplitude the joint angles feel (the nonlinear coupling keeps re-exciting
 /// them), so an error-controlled step resolves them whatever the method, and a method that
-/// damps or aliases them moves the answer. `two-link-free-undamped` (6 poly modes, first 1 s,
-/// 20 Hz low-passed joint angles against Dormand–Prince at rtol 1e-8, 1.7e5 steps): adaptive
-/// TR-BDF2 at rtol 1e-3 takes 3.2e4 steps (30 % rejected, ~5 Newton iterations a step) and is
-/// 2.3e-3 rad off; Dormand–Prince at rtol 1e-3 takes 1.7e4 steps (near its stability bound) and
-/// is 8.5e-5 rad off. A tolerance given
-/// (`rtol`/`atol`) without a method asks for Dormand–Prince; a contact scene keeps
-/// Dormand–Prince, whose switching times are located on the tolerance-controlled dense output.
+/// damps or aliases them moves the answer (docs/backends.md has the measurements). A tolerance
+/// given (`rtol`/`atol`) without a method asks for Dormand–Prince.
 pub fn default_method(pc: &PlanarChain, settings: &ModalSettings) -> Method {
     let tolerance_given = settings.rtol.is_some() || settings.atol.is_some();
     let all_damped = pc
         .links
         .iter()
         .all(|l| l.kelvin_voigt.is_some_and(|g| g > 0.0));
-    if tolerance_given || !pc.contacts.is_empty() || !all_damped {
+    if tolerance_given || !all_damped {
         &DOPRI5
     } else {
         &TRBDF2
@@ -126,7 +125,11 @@ pub fn simulate_detailed(
     let fixed_step = method.is_fixed_step();
     let default_kelvin_voigt_method = settings.method.is_none() && std::ptr::eq(method, &TRBDF2);
     let (rtol_default, atol_default) = if default_kelvin_voigt_method {
-        KELVIN_VOIGT_DEFAULT_TOL
+        if pc.contacts.is_empty() {
+            KELVIN_VOIGT_DEFAULT_TOL
+        } else {
+            KELVIN_VOIGT_CONTACT_TOL
+        }
     } else if fixed_step {
         FIXED_STEP_NEWTON_TOL
     } else {

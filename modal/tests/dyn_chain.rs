@@ -470,7 +470,7 @@ fn dyn_spin_up_axial_converges_to_the_inextensible_model() {
 }
 
 #[test]
-fn sys_default_method_is_adaptive_trbdf2_for_damped_chains_without_contact() {
+fn sys_default_method_is_adaptive_trbdf2_for_kelvin_voigt_chains_with_or_without_contact() {
     use modal::integrate::{DOPRI5, TRBDF2};
     use modal::simulate::{STEPS_PER_PERIOD, default_method, default_step};
     let plain = Settings::default();
@@ -482,15 +482,25 @@ fn sys_default_method_is_adaptive_trbdf2_for_damped_chains_without_contact() {
         ..Default::default()
     };
     let damped = load_scene("two-link-free").unwrap();
-    assert_eq!(
-        default_method(damped.planar_chain().unwrap(), &plain.modal().unwrap()),
-        &TRBDF2
-    );
-    assert_eq!(
-        default_method(damped.planar_chain().unwrap(), &with_rtol.modal().unwrap()),
-        &DOPRI5
-    );
-    for name in ["two-link-free-undamped", "single-link", "barhorst-case1"] {
+    for name in [
+        "two-link-free",
+        "barhorst-case1",
+        "barhorst-case1-timoshenko",
+    ] {
+        let scene = load_scene(name).unwrap();
+        assert_eq!(
+            default_method(scene.planar_chain().unwrap(), &plain.modal().unwrap()),
+            &TRBDF2,
+            "{name}"
+        );
+        assert_eq!(
+            default_method(scene.planar_chain().unwrap(), &with_rtol.modal().unwrap()),
+            &DOPRI5,
+            "{name}"
+        );
+    }
+    // Undamped links (and a contact scene without Kelvin–Voigt) keep the explicit method.
+    for name in ["two-link-free-undamped", "single-link", "constrained-arm"] {
         let scene = load_scene(name).unwrap();
         assert_eq!(
             default_method(scene.planar_chain().unwrap(), &plain.modal().unwrap()),
