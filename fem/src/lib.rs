@@ -292,7 +292,7 @@ impl Backend for FemBackend {
                 Ok(plan::dof_plan(&scene.name, pc, n_el, settings.element)?)
             }
             Model::PayloadLink(l) => {
-                let n_el = settings::elements(settings)?;
+                let n_el = payload_link::elements(settings)?;
                 Ok(payload_link::dof_plan(l, n_el)?)
             }
             Model::Rocket(r) => Ok(rocket::dof_plan(r, settings)?),

@@ -15,6 +15,23 @@ pub fn elements(settings: &data::FemSettings) -> Result<usize, FemError> {
     elements_or(settings, DEFAULT_ELEMENTS)
 }
 
+/// Elements per link of a family whose beams are Hermite cubics only (`family` and `beam` name
+/// them in the message): as [`elements_or`], but `discretization.element = "hermite-quintic"` is
+/// refused rather than run as cubics under that name.
+pub fn cubic_elements_or(
+    settings: &data::FemSettings,
+    default: usize,
+    family: &str,
+    beam: &str,
+) -> Result<usize, FemError> {
+    if settings.element == Some(data::FemElement::HermiteQuintic) {
+        return Err(FemError::unsupported(format!(
+            "fem {family}: the hermite-quintic element ({beam} uses Hermite cubics)"
+        )));
+    }
+    elements_or(settings, default)
+}
+
 /// Elements per link: `elements`, `default` (a family's own default) when unset, checked
 /// against 1..=[`MAX_ELEMENTS`].
 pub fn elements_or(settings: &data::FemSettings, default: usize) -> Result<usize, FemError> {

@@ -209,6 +209,41 @@ fn sys_quintic_dof_count_in_modes_and_dynamics_and_shear_refusal() {
     }
 }
 
+#[test]
+fn sys_quintic_is_refused_by_the_families_built_from_cubics() {
+    // The rocket, the 3-D payload link and the mobile manipulator's flexible link are Hermite
+    // cubics only: asking for the quintic there is refused, in the DOF plan and in a run,
+    // instead of running cubics under the quintic's name.
+    for (scene, family) in [
+        ("rocket", "fem rocket"),
+        ("single-link-3d", "fem 3-D payload link"),
+        ("mobile-manipulator-flexible", "fem mobile manipulator"),
+    ] {
+        let sc = data::load_scene(scene).unwrap();
+        let quintic = settings(4, QUINTIC);
+        for result in [
+            FemBackend
+                .dof_plan(&sc, &quintic.discretization)
+                .map(|_| ()),
+            FemBackend.simulate(&sc, &quintic).map(|_| ()),
+        ] {
+            match result {
+                Err(BackendError::Unsupported(message)) => {
+                    assert!(message.starts_with(family), "{scene}: {message}");
+                    assert!(message.contains("hermite-quintic"), "{scene}: {message}");
+                }
+                other => panic!("{scene}: {other:?}"),
+            }
+        }
+        // The cubic (named or by default) still builds.
+        let cubic = settings(4, Some(FemElement::HermiteCubic));
+        assert!(
+            FemBackend.dof_plan(&sc, &cubic.discretization).is_ok(),
+            "{scene}"
+        );
+    }
+}
+
 /// Hub angle history θ(tᵢ) of `single-link` with `n` elements of `element`, all runs at the same
 /// fixed step so that they share one time discretization and differ only in space.
 fn hub_angle_history(n: usize, element: Option<FemElement>, dt: f64) -> Vec<f64> {

@@ -83,13 +83,12 @@ fn check_flexible(mm: &MobileManipulator) -> Result<(), FemError> {
 }
 
 fn elements(settings: &data::FemSettings) -> Result<usize, FemError> {
-    if settings.element == Some(data::FemElement::HermiteQuintic) {
-        return Err(FemError::unsupported(
-            "fem mobile manipulator: the hermite-quintic element (the flexible link uses \
-             Hermite cubics)",
-        ));
-    }
-    settings::elements_or(settings, DEFAULT_ELEMENTS)
+    settings::cubic_elements_or(
+        settings,
+        DEFAULT_ELEMENTS,
+        "mobile manipulator",
+        "the flexible link",
+    )
 }
 
 /// DOFs and physics built for the scene.

@@ -96,6 +96,16 @@ fn field_dofs(f: LinkField) -> (&'static str, usize) {
 }
 
 /// DOFs and physics built for the payload link `l` with `n_el` elements.
+/// Elements of the 3-D link (Hermite cubics only).
+pub fn elements(settings: &data::FemSettings) -> Result<usize, FemError> {
+    settings::cubic_elements_or(
+        settings,
+        settings::DEFAULT_ELEMENTS,
+        "3-D payload link",
+        "the link",
+    )
+}
+
 pub fn dof_plan(l: &PayloadLink, n_el: usize) -> Result<DofPlan, FemError> {
     let md = Model::assemble(l, n_el)?;
     let mut plan = DofPlan::default();
@@ -370,7 +380,7 @@ pub fn modes(
     count: usize,
 ) -> Result<ModalResult, FemError> {
     let start = Instant::now();
-    let n_el = settings::elements(settings)?;
+    let n_el = elements(settings)?;
     let md = build(l, n_el)?;
     // A free base without spring turns rigidly (ω = 0, kind `rigid`), listed first as by the
     // other backends; a base at a prescribed constant rate keeps the gyroscopic coupling.
@@ -450,7 +460,7 @@ pub fn statics(
     settings: &FemSettings,
 ) -> Result<StaticResult, FemError> {
     let start = Instant::now();
-    let n_el = settings::elements(settings)?;
+    let n_el = elements(settings)?;
     let md = build(l, n_el)?;
     let d = static_sag(&md)?;
     Ok(StaticResult {
@@ -668,7 +678,7 @@ pub fn prepare(
     l: &PayloadLink,
     settings: &FemSettings,
 ) -> Result<Prepared, FemError> {
-    let n_el = settings::elements(settings)?;
+    let n_el = elements(settings)?;
     match settings.method {
         None | Some(data::FemMethod::ImplicitMidpoint) => {}
         Some(other) => {

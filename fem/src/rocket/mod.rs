@@ -84,12 +84,17 @@ const NEWTON_ACCEPT: f64 = 1e-10;
 const NEWTON_MAX: usize = 12;
 
 /// The discretized model of the rocket `r`.
+/// Elements of the rocket's beam (Hermite cubics only).
+fn elements(settings: &FemSettings) -> Result<usize, FemError> {
+    crate::settings::cubic_elements_or(settings, DEFAULT_ELEMENTS, "rocket", "the beam")
+}
+
 pub fn build(r: &Rocket, settings: &FemSettings) -> Result<Model, FemError> {
-    Model::new(r, crate::settings::elements_or(settings, DEFAULT_ELEMENTS)?)
+    Model::new(r, elements(settings)?)
 }
 
 pub fn dof_plan(r: &Rocket, settings: &data::FemSettings) -> Result<DofPlan, FemError> {
-    let n_el = crate::settings::elements_or(settings, DEFAULT_ELEMENTS)?;
+    let n_el = elements(settings)?;
     let nm = r.discrete_masses.len();
     let mut plan = DofPlan::default();
     plan.add(
