@@ -8,6 +8,8 @@
 
 use data::scene::{InitialShape, Rocket};
 
+use crate::element::hermite::{HermiteAt, hermite};
+use crate::element::quadrature::gauss01;
 use crate::error::FemError;
 
 /// Nodal DOFs: axial u, transverse w, slope w′.
@@ -168,40 +170,9 @@ impl MeanAxis {
     }
 }
 
-const GAUSS4: [(f64, f64); 4] = [
-    (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-    (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-    (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
-    (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
-];
-
 /// Linear shape functions and derivatives on an element of length h at s ∈ [0, 1].
 fn linear(s: f64, h: f64) -> ([f64; 2], [f64; 2]) {
     ([1.0 - s, s], [-1.0 / h, 1.0 / h])
-}
-
-/// Hermite cubic shape functions (w₁, w′₁, w₂, w′₂) and their first and second x-derivatives.
-pub fn hermite(s: f64, h: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
-    let (s2, s3) = (s * s, s * s * s);
-    let n = [
-        1.0 - 3.0 * s2 + 2.0 * s3,
-        h * (s - 2.0 * s2 + s3),
-        3.0 * s2 - 2.0 * s3,
-        h * (-s2 + s3),
-    ];
-    let d = [
-        (-6.0 * s + 6.0 * s2) / h,
-        1.0 - 4.0 * s + 3.0 * s2,
-        (6.0 * s - 6.0 * s2) / h,
-        -2.0 * s + 3.0 * s2,
-    ];
-    let dd = [
-        (-6.0 + 12.0 * s) / (h * h),
-        (-4.0 + 6.0 * s) / h,
-        (6.0 - 12.0 * s) / (h * h),
-        (-2.0 + 6.0 * s) / h,
-    ];
-    (n, d, dd)
 }
 
 fn dofs_of(e: usize) -> ([usize; 2], [usize; 4]) {
@@ -247,12 +218,13 @@ impl Model {
                 if hi - lo <= 1e-12 * h {
                     continue;
                 }
-                for &(z, wg) in &GAUSS4 {
-                    let x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * z;
+                let (nodes, weights) = gauss01(4);
+                for (&z, &wg) in nodes.iter().zip(weights) {
+                    let x = lo + (hi - lo) * z;
                     quad.push(Quad {
                         element: el,
                         s: (x - xa) / h,
-                        weight: 0.5 * (hi - lo) * wg,
+                        weight: (hi - lo) * wg,
                         ea: e_mod * st.area,
                         ei: e_mod * st.inertia,
                         fixed_mass: if k == 0 {
@@ -272,7 +244,9 @@ impl Model {
         let mut cor_w = vec![0.0; n];
         for q in &quad {
             let (nu, du) = linear(q.s, h);
-            let (hw, _, hdd) = hermite(q.s, h);
+            let HermiteAt {
+                n: hw, ddn: hdd, ..
+            } = hermite(q.s, h);
             let (iu, iw) = dofs_of(q.element);
             let (mass_b, mass_f) = (
                 if q.burning { q.weight } else { 0.0 },
@@ -309,7 +283,7 @@ impl Model {
             let el = ((x / h).floor() as usize).min(elements - 1);
             let s = x / h - el as f64;
             let (nu, _) = linear(s, h);
-            let (hw, _, _) = hermite(s, h);
+            let hw = hermite(s, h).n;
             let (iu, iw) = dofs_of(el);
             Point { x, iu, nu, iw, hw }
         };
@@ -569,7 +543,7 @@ impl Model {
         let el = ((x / self.h).floor() as usize).min(self.elements - 1);
         let s = x / self.h - el as f64;
         let (nu, _) = linear(s, self.h);
-        let (hw, _, _) = hermite(s, self.h);
+        let hw = hermite(s, self.h).n;
         let (iu, iw) = dofs_of(el);
         Point { x, iu, nu, iw, hw }
     }
@@ -587,7 +561,7 @@ impl Model {
     fn slopes(&self, qp: &Quad, q: &[f64]) -> (f64, f64) {
         let (iu, iw) = dofs_of(qp.element);
         let (_, du) = linear(qp.s, self.h);
-        let (_, hd, _) = hermite(qp.s, self.h);
+        let hd = hermite(qp.s, self.h).dn;
         let up = du[0] * q[iu[0]] + du[1] * q[iu[1]];
         let wp = (0..4).map(|a| hd[a] * q[iw[a]]).sum::<f64>();
         (up, wp)
@@ -600,7 +574,7 @@ impl Model {
             let (up, wp) = self.slopes(qp, q);
             let (iu, iw) = dofs_of(qp.element);
             let (_, du) = linear(qp.s, self.h);
-            let (_, hd, _) = hermite(qp.s, self.h);
+            let hd = hermite(qp.s, self.h).dn;
             let fu = qp.weight * 0.5 * qp.ea * wp * wp;
             let fw = qp.weight * qp.ea * up * wp;
             for a in 0..2 {
