@@ -8,7 +8,8 @@
 //! per constrained step, refined against the last sparse factorization where it can be); `barhorst-case1-timoshenko` over t ∈ [0, 0.35] s
 //! (`contact-timoshenko-0.35s`: its first impact and micro-bounces, bound by event location);
 //! the forces of one energy-midpoint iteration at q̄ with and without the shared kinematic pass
-//! (`midpoint-forces-at-qbar`).
+//! (`midpoint-forces-at-qbar`); the band LU of the exact augmented matrix against faer's sparse
+//! LU of the same matrix (`augmented-solver`).
 //! Run: `cargo bench -p fem --bench fem_bench -- --quick` (one group: append its name, e.g. `arms`).
 
 use std::hint::black_box;
@@ -16,6 +17,7 @@ use std::hint::black_box;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use data::{Backend, Settings};
 use fem::FemBackend;
+use fem::band::BorderedBand;
 use fem::chain::{Chain, NewtonCoefficients};
 use fem::run::prepare;
 
@@ -194,6 +196,50 @@ fn assembly_foreshortening(c: &mut Criterion) {
     g.finish();
 }
 
+/// The hand-written band LU with a dense border Schur complement against faer's sparse LU
+/// (COLAMD ordering, symbolic factorization reused) on the same exact augmented Newton matrix of
+/// the free two-link arm, factorization and one solve, 4–64 elements per link: the band solver
+/// stays only while it wins here.
+fn augmented_solver(c: &mut Criterion) {
+    let sc = data::load_scene("two-link-free-undamped").unwrap();
+    let mut g = c.benchmark_group("augmented-solver");
+    for n in MESHES {
+        let mut ch = Chain::new(sc.links(), None, n).unwrap();
+        let nd = ch.ndof;
+        let q: Vec<f64> = (0..nd).map(|i| 1e-3 * (i as f64).sin()).collect();
+        let qd = vec![0.1; nd];
+        let qdd = vec![0.2; nd];
+        let mut r = vec![0.0; nd];
+        ch.residual(3.0, &q, &qd, &qdd, &mut r);
+        let layout = ch.augmented_layout();
+        let coef = NewtonCoefficients {
+            c_a: 1.0,
+            c_v: 3.6e-4,
+            c_q: 1.3e-7,
+        };
+        let mut band = ch.new_augmented_matrix(&layout);
+        ch.exact_newton_matrix(&q, &qd, &qdd, coef, &layout, &mut band);
+        let mut sparse = BorderedBand::new(
+            layout.n_interior,
+            layout.n - layout.n_interior,
+            layout.half_bandwidth,
+        );
+        ch.exact_newton_matrix(&q, &qd, &qdd, coef, &layout, &mut sparse);
+        let mut x = vec![0.0; layout.n];
+        for (label, m) in [("band-lu", &mut band), ("faer-sparse-lu", &mut sparse)] {
+            g.bench_with_input(BenchmarkId::new(label, n), &n, |b, _| {
+                b.iter(|| {
+                    m.factorize().unwrap();
+                    x.iter_mut().for_each(|v| *v = 1.0);
+                    m.solve_in_place(&mut x);
+                    black_box(&x);
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
 /// The forces of one energy-midpoint iteration at q̄ (metric product M(q̄)Δq, ∇V, −Q) on the
 /// arms at their default meshes: three full passes (kinematic and force pass each) against one
 /// full pass and two force passes on its kinematics ([`Chain::residual_parts_at_last_q`], what
@@ -238,6 +284,7 @@ criterion_group!(
     benches,
     assembly,
     assembly_foreshortening,
+    augmented_solver,
     one_step,
     spin_up,
     single_link,
