@@ -27,6 +27,8 @@
 // Index loops run over the slopes, the masses and the right-hand side together.
 #![allow(clippy::needless_range_loop)]
 
+use crate::tridiagonal::TridiagonalLdl;
+
 /// The foreshortening kinematics of one link at one state, and the factorized mass operator A.
 #[derive(Debug, Clone)]
 pub struct Foreshortening {
@@ -43,9 +45,8 @@ pub struct Foreshortening {
     pub sd: Vec<f64>,
     /// cᵢ = h Σ_{seg<i} ġ² (the velocity part of s̈)
     pub c: Vec<f64>,
-    /// LDLᵀ of K: pivots and the sub-diagonal multipliers
-    piv: Vec<f64>,
-    mult: Vec<f64>,
+    /// LDLᵀ of K
+    ldl: TridiagonalLdl,
     /// scratch of a solve
     lam: Vec<f64>,
 }
@@ -62,8 +63,7 @@ impl Foreshortening {
             s: vec![0.0; r],
             sd: vec![0.0; r],
             c: vec![0.0; r],
-            piv: vec![0.0; r],
-            mult: vec![0.0; r],
+            ldl: TridiagonalLdl::new(r),
             lam: vec![0.0; r],
         }
     }
@@ -119,48 +119,32 @@ impl Foreshortening {
 
     /// Factorizes K = T + G T G at the slopes of the last [`Self::set_state`].
     pub fn factor(&mut self) {
-        let r = self.m.len();
+        let (m, g) = (&self.m, &self.g);
         // T_kk = 1/m_k + 1/m_{k−1} (k ≥ 1), T_00 = 1/m_0; T_{k−1,k} = −1/m_{k−1}
-        for k in 0..r {
-            let mut t_kk = 1.0 / self.m[k];
+        let diag = |k: usize| {
+            let mut t_kk = 1.0 / m[k];
             if k > 0 {
-                t_kk += 1.0 / self.m[k - 1];
+                t_kk += 1.0 / m[k - 1];
             }
-            let k_kk = t_kk * (1.0 + self.g[k] * self.g[k]);
-            if k == 0 {
-                self.piv[0] = k_kk;
-                self.mult[0] = 0.0;
-            } else {
-                let k_off = -(1.0 + self.g[k - 1] * self.g[k]) / self.m[k - 1];
-                let l = k_off / self.piv[k - 1];
-                self.mult[k] = l;
-                self.piv[k] = k_kk - l * k_off;
-            }
-        }
+            t_kk * (1.0 + g[k] * g[k])
+        };
+        let off = |k: usize| -(1.0 + g[k] * g[k + 1]) / m[k];
+        // T is positive definite for positive masses and G T G semi-definite: a pivot fails
+        // only on non-finite slopes, which the run's finiteness checks report.
+        let _ = self.ldl.factor(diag, off);
     }
 
     /// out = A⁻¹ f with the factor of the last [`Self::factor`].
     pub fn solve(&mut self, f: &[f64], out: &mut [f64]) {
         let r = self.m.len();
-        // b = G E diag(m)⁻¹ f, forward elimination on the fly
+        // b = G E diag(m)⁻¹ f
         let mut w_prev = 0.0;
         for k in 0..r {
             let w = f[k] / self.m[k];
-            let b = self.g[k] * (w - w_prev);
+            self.lam[k] = self.g[k] * (w - w_prev);
             w_prev = w;
-            self.lam[k] = if k == 0 {
-                b
-            } else {
-                b - self.mult[k] * self.lam[k - 1]
-            };
         }
-        for k in (0..r).rev() {
-            let mut x = self.lam[k] / self.piv[k];
-            if k + 1 < r {
-                x -= self.mult[k + 1] * self.lam[k + 1];
-            }
-            self.lam[k] = x;
-        }
+        self.ldl.solve_in_place(&mut self.lam);
         // u = diag(m)⁻¹ (f − Eᵀ G λ),  (Eᵀ G λ)_k = g_k λ_k − g_{k+1} λ_{k+1}
         for k in 0..r {
             let mut egl = self.g[k] * self.lam[k];

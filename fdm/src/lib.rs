@@ -199,6 +199,7 @@ pub mod rocket;
 pub mod runs;
 pub mod settings;
 pub mod system;
+pub mod tridiagonal;
 
 use data::scene::{Model, PlanarChain, PrescribedMotion};
 use data::{

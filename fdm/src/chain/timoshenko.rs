@@ -84,6 +84,7 @@
 use data::scene::Link;
 
 use crate::error::FdmError;
+use crate::tridiagonal::TridiagonalLdl;
 
 use super::kinetic::{BE, TH};
 
@@ -133,9 +134,8 @@ pub struct TimoFields {
     first: [usize; 2],
     elastic: Coef,
     damping: Coef,
-    /// LDLᵀ of the tridiagonal K_zz: pivots d and multipliers l
-    piv: Vec<f64>,
-    mult: Vec<f64>,
+    /// LDLᵀ of the tridiagonal K_zz
+    ldl: TridiagonalLdl,
     /// whether D has any term (γ or joint dampers)
     damped: bool,
     scratch: std::cell::RefCell<Scratch>,
@@ -196,26 +196,12 @@ impl TimoFields {
         a[r[0]] += elastic.joint[1];
         a[r[0] + 1] += elastic.joint[1];
         b[r[0]] -= elastic.joint[1];
-        // LDLᵀ (SPD: no pivoting)
-        let mut piv = vec![0.0; nz];
-        let mut mult = vec![0.0; nz - 1];
-        piv[0] = a[0];
-        for i in 0..nz - 1 {
-            if piv[i].is_nan() || piv[i] <= 0.0 {
-                return Err(FdmError::Numerical {
-                    t: 0.0,
-                    message: format!("Timoshenko ψ stiffness not positive definite (pivot {i})"),
-                });
-            }
-            mult[i] = b[i] / piv[i];
-            piv[i + 1] = a[i + 1] - mult[i] * b[i];
-        }
-        if piv[nz - 1].is_nan() || piv[nz - 1] <= 0.0 {
-            return Err(FdmError::Numerical {
+        let mut ldl = TridiagonalLdl::new(nz);
+        ldl.factor(|i| a[i], |i| b[i])
+            .map_err(|i| FdmError::Numerical {
                 t: 0.0,
-                message: "Timoshenko ψ stiffness not positive definite (last pivot)".into(),
-            });
-        }
+                message: format!("Timoshenko ψ stiffness not positive definite (pivot {i})"),
+            })?;
         let damped = damping.bend.iter().chain(&damping.joint).any(|&c| c != 0.0);
         let zeros = vec![0.0; nz];
         Ok(TimoFields {
@@ -224,8 +210,7 @@ impl TimoFields {
             first: [2, 2 + r[0]],
             elastic,
             damping,
-            piv,
-            mult,
+            ldl,
             damped,
             scratch: std::cell::RefCell::new(Scratch {
                 z: zeros.clone(),
@@ -248,16 +233,7 @@ impl TimoFields {
 
     /// x ← K_zz⁻¹ x.
     fn solve(&self, x: &mut [f64]) {
-        let n = x.len();
-        for i in 0..n - 1 {
-            x[i + 1] -= self.mult[i] * x[i];
-        }
-        for i in 0..n {
-            x[i] /= self.piv[i];
-        }
-        for i in (0..n - 1).rev() {
-            x[i] -= self.mult[i] * x[i + 1];
-        }
+        self.ldl.solve_in_place(x);
     }
 
     /// Deflection of link ℓ at station i of the chord-frame q (v₀ = v_r = 0).
