@@ -8,10 +8,10 @@
 //! reuses both and only refactorizes numerically (sparse LU with partial pivoting), into storage
 //! and a workspace allocated once: factorize/solve allocate nothing.
 //!
-//! [`DenseLu`]: dense LU with partial pivoting (faer `lu_in_place`) for the small dense systems:
-//! the exact finite-difference Jacobian of chains whose foreshortening couples whole links to
-//! the joint angles, mass matrices of the contact and friction maps, the massless-direction
-//! balance.
+//! [`DenseLu`]: dense LU with partial pivoting (faer `lu_in_place`) for the small dense systems
+//! of the massless-direction balance of Timoshenko links without rotary inertia: its Newton
+//! matrix at the start of a run ([`crate::chain::Chain::settle_massless`]) and the stiffness and
+//! damping blocks of its projection ([`crate::events::massless`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::lu_in_place;
