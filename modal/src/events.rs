@@ -54,6 +54,8 @@ pub(crate) struct ContactEvents {
     pub(crate) events: Vec<data::Event>,
     pub(crate) report: ContactReport,
     scratch: Vec<f64>,
+    /// Start of the current free phase when an impact began it (its would-be normal force ≤ 0).
+    free_from_impact: Option<f64>,
 }
 
 /// Why the event machinery stopped the run.
@@ -63,6 +65,10 @@ pub(crate) enum Halt {
     Singular,
     /// [`MAX_CONTACT_EVENTS`] events were reached.
     TooManyEvents(usize),
+    /// The step [t, t + h] after a plastic impact at t that left the tip free (normal force
+    /// ≤ 0) went `depth` below the surface: taking the contact again at t would repeat the same
+    /// decision at the same instant.
+    UnresolvedGrazing { t: f64, h: f64, depth: f64 },
 }
 
 impl ContactEvents {
@@ -75,6 +81,7 @@ impl ContactEvents {
                 ..Default::default()
             },
             scratch: vec![0.0; dim],
+            free_from_impact: None,
         }
     }
 
@@ -146,6 +153,13 @@ impl ContactEvents {
                     .ints
                     .length;
             if now < -tol_gap {
+                if self.free_from_impact == Some(t_old) {
+                    return Err(Halt::UnresolvedGrazing {
+                        t: t_old,
+                        h: t - t_old,
+                        depth: -now,
+                    });
+                }
                 return Ok(Some((t_old, t - t_old)));
             }
         }
@@ -175,6 +189,9 @@ impl ContactEvents {
             if !switch_phase(rhs, *t, y, tol_t, &mut self.events, &mut self.report) {
                 return Err(Halt::Singular);
             }
+            let impact_left_free = matches!(self.events.last(), Some(data::Event::Impact { .. }))
+                && rhs.contact.as_ref().is_some_and(|c| !c.constrained);
+            self.free_from_impact = impact_left_free.then_some(*t);
             stepper.reset();
         } else if rhs.contact.as_ref().is_some_and(|c| c.constrained) {
             if !project(rhs, *t, y, &mut self.report) {

@@ -349,6 +349,33 @@ pub(crate) fn stopped(
 }
 
 /// The stop of a run whose contact events accumulate (Zeno-like chattering).
+/// The stop of a run whose step after a plastic impact at `t` (normal force ≤ 0, so the tip
+/// was left free) went `depth` below the surface: the contact would be taken again at `t` with
+/// zero impulse and the same decision, without end.
+pub(crate) fn unresolved_grazing(t: f64, h: f64, depth: f64, fixed_step: bool) -> StabilityVerdict {
+    StabilityVerdict::Stopped {
+        diagnostic: Diagnostic {
+            t,
+            what: format!(
+                "grazing contact: after the impact at t = {t:.9e} left the tip free (normal \
+                 force ≤ 0), the step of {h:.3e} s went {depth:.3e} below the surface"
+            ),
+            location: Some("contact1".into()),
+            why: "the step's own error near a grazing state exceeds the tip's departure from \
+                  the surface, so the contact would be taken again at the same instant with \
+                  zero impulse"
+                .into(),
+            remedy: if fixed_step {
+                "a smaller --dt, or an adaptive method (trbdf2, dopri5), which shortens the \
+                 step there"
+                    .into()
+            } else {
+                "a tighter --rtol/--atol".into()
+            },
+        },
+    }
+}
+
 pub(crate) fn too_many_events(t: f64, count: usize) -> StabilityVerdict {
     StabilityVerdict::Stopped {
         diagnostic: Diagnostic {

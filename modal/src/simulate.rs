@@ -13,7 +13,7 @@ use crate::contact::ContactState;
 use crate::error::ModalError;
 use crate::events::{ContactEvents, Halt};
 use crate::integrate::{Build, DOPRI5, MethodInfo, TRBDF2, Tolerances, method_for};
-use crate::output::{Output, runaway, stopped, too_many_events};
+use crate::output::{Output, runaway, stopped, too_many_events, unresolved_grazing};
 use crate::setup::build_chain;
 
 pub use crate::events::{ContactReport, EVENT_TIME_TOLERANCE, MAX_CONTACT_EVENTS};
@@ -81,6 +81,18 @@ pub fn default_method(pc: &PlanarChain, settings: &ModalSettings) -> Method {
         &DOPRI5
     } else {
         &TRBDF2
+    }
+}
+
+/// What a run that stops on a mass matrix no longer positive definite reports.
+const SINGULAR: &str = "mass matrix lost positive definiteness";
+
+/// The stop verdict of a contact run halted at `t`.
+fn halt_verdict(halt: Halt, rhs: &ChainRhs, t: f64, fixed_step: bool) -> StabilityVerdict {
+    match halt {
+        Halt::Singular => stopped(rhs, t, SINGULAR, None),
+        Halt::TooManyEvents(count) => too_many_events(t, count),
+        Halt::UnresolvedGrazing { t, h, depth } => unresolved_grazing(t, h, depth, fixed_step),
     }
 }
 
@@ -182,7 +194,6 @@ pub fn simulate_detailed(
         });
     }
     contact.arm(&rhs)?;
-    let singular = "mass matrix lost positive definiteness";
     'outer: for &target in &breaks {
         while t < target {
             let t_old = t;
@@ -192,26 +203,24 @@ pub fn simulate_detailed(
             }
             let located = match contact.detect(&mut rhs, stepper.as_ref(), t_old, t, &y) {
                 Ok(located) => located,
-                Err(_) => {
-                    verdict = stopped(&rhs, t, singular, None);
+                Err(halt) => {
+                    if let Halt::UnresolvedGrazing { .. } = halt {
+                        // Keep the state of the impact, the last one the run can vouch for.
+                        stepper.dense(t_old, &mut y);
+                        t = t_old;
+                    }
+                    verdict = halt_verdict(halt, &rhs, t, fixed_step);
                     break 'outer;
                 }
             };
             let t_limit = located.map_or(t, |(te, _)| te);
             if let Err(to) = out.sample_through(&mut rhs, stepper.as_ref(), t, &y, t_limit) {
-                verdict = stopped(&rhs, to, singular, None);
+                verdict = stopped(&rhs, to, SINGULAR, None);
                 break 'outer;
             }
-            match contact.settle(&mut rhs, stepper.as_mut(), &mut t, &mut y, located) {
-                Ok(()) => {}
-                Err(Halt::Singular) => {
-                    verdict = stopped(&rhs, t, singular, None);
-                    break 'outer;
-                }
-                Err(Halt::TooManyEvents(count)) => {
-                    verdict = too_many_events(t, count);
-                    break 'outer;
-                }
+            if let Err(halt) = contact.settle(&mut rhs, stepper.as_mut(), &mut t, &mut y, located) {
+                verdict = halt_verdict(halt, &rhs, t, fixed_step);
+                break 'outer;
             }
             if let Some((i, v)) = runaway(&rhs, &y) {
                 verdict = stopped(&rhs, t, "", Some((i, v)));

@@ -427,3 +427,50 @@ fn sys_default_basis_is_poly_for_tip_loaded_links() {
         );
     }
 }
+
+#[test]
+fn dyn_fixed_step_grazing_contact_stops_at_once_with_its_diagnostic() {
+    // At their default step the fixed-step methods meet a grazing state on `barhorst-case1`: a
+    // plastic impact leaves the tip free (normal force ≤ 0) and the next step goes below the
+    // surface. The run stops there with a diagnostic naming the remedy instead of retaking the
+    // contact at the same instant until the event limit.
+    let scene = load_scene("barhorst-case1").unwrap();
+    for method in ["trapezoid", "trbdf2-fixed"] {
+        let mut s = Settings::default();
+        s.time.method = Some(method.parse().unwrap());
+        s.time.t_end = Some(0.5);
+        let r = ModalBackend.simulate(&scene, &s).unwrap();
+        let StabilityVerdict::Stopped { diagnostic } = &r.verdict else {
+            panic!("{method}: {:?}", r.verdict);
+        };
+        assert!(
+            diagnostic.what.starts_with("grazing contact"),
+            "{method}: {diagnostic:?}"
+        );
+        assert!(
+            diagnostic.remedy.contains("smaller --dt"),
+            "{method}: {diagnostic:?}"
+        );
+        // The stop is at the impact that began the free phase, before any chattering.
+        let last_impact = r
+            .events
+            .iter()
+            .rev()
+            .find_map(|e| match e {
+                Event::Impact { t, .. } => Some(*t),
+                _ => None,
+            })
+            .unwrap();
+        assert_eq!(diagnostic.t, last_impact, "{method}");
+        assert!(r.events.len() < 50, "{method}: {} events", r.events.len());
+        // A smaller step resolves the same grazing contact.
+        s.time.dt = Some(1e-4);
+        s.time.t_end = Some(0.45);
+        let fine = ModalBackend.simulate(&scene, &s).unwrap();
+        assert_eq!(
+            fine.verdict,
+            StabilityVerdict::Completed,
+            "{method} at dt 1e-4"
+        );
+    }
+}
