@@ -110,7 +110,7 @@ mod tests {
 
     #[test]
     fn method_spellings_round_trip_and_unknown_names_list_the_accepted_ones() {
-        for name in crate::settings::METHOD_SPELLINGS {
+        for name in crate::settings::method_spellings() {
             let m: Method = name.parse().unwrap();
             assert_eq!(m.name(), name);
         }

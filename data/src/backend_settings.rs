@@ -475,7 +475,7 @@ mod tests {
 
     #[test]
     fn each_method_reaches_exactly_the_backends_that_implement_it() {
-        for name in crate::settings::METHOD_SPELLINGS {
+        for name in crate::settings::method_spellings() {
             let m: Method = name.parse().unwrap();
             assert!(!m.backends().is_empty(), "{name} reaches no backend");
             let s = Settings {

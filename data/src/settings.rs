@@ -151,23 +151,33 @@ impl Method {
 
     /// The canonical spelling (`robert-asselin=ν` with its coefficient when one is given).
     pub fn name(self) -> String {
-        let fixed = match self {
-            Method::EnergyMidpoint => "energy-midpoint",
-            Method::GeneralizedAlpha => "generalized-alpha",
-            Method::CentralDifference => "central-difference",
-            Method::ImplicitMidpoint => "implicit-midpoint",
-            Method::Report => "report",
-            Method::RobertAsselin { nu: Some(nu) } => return format!("robert-asselin={nu}"),
-            Method::RobertAsselin { nu: None } => "robert-asselin",
-            Method::VelocityForm => "velocity-form",
-            Method::Dopri5 => "dopri5",
-            Method::TrBdf2 => "trbdf2",
-            Method::TrBdf2Fixed => "trbdf2-fixed",
-            Method::Trapezoid => "trapezoid",
-        };
-        fixed.to_string()
+        if let Method::RobertAsselin { nu: Some(nu) } = self {
+            return format!("robert-asselin={nu}");
+        }
+        let kind = std::mem::discriminant(&self);
+        SPELLINGS
+            .iter()
+            .find(|(m, _, _)| std::mem::discriminant(m) == kind)
+            .map_or_else(String::new, |(_, name, _)| (*name).to_string())
     }
 }
+
+/// Every method with its canonical spelling and its aliases, in the order the messages list
+/// them ([`Method::names_for`]). The spellings are read ([`std::str::FromStr`]) and written
+/// ([`Method::name`]) from this table alone: a new method is its variant and one line here.
+const SPELLINGS: [(Method, &str, &[&str]); 11] = [
+    (Method::EnergyMidpoint, "energy-midpoint", &[]),
+    (Method::GeneralizedAlpha, "generalized-alpha", &[]),
+    (Method::Report, "report", &[]),
+    (Method::CentralDifference, "central-difference", &[]),
+    (Method::ImplicitMidpoint, "implicit-midpoint", &[]),
+    (Method::RobertAsselin { nu: None }, "robert-asselin", &[]),
+    (Method::VelocityForm, "velocity-form", &[]),
+    (Method::Dopri5, "dopri5", &[]),
+    (Method::TrBdf2, "trbdf2", &["tr-bdf2", "sdirk"]),
+    (Method::TrBdf2Fixed, "trbdf2-fixed", &[]),
+    (Method::Trapezoid, "trapezoid", &[]),
+];
 
 impl Method {
     /// Whether `backend` implements this method (a family may still refuse it, e.g. a method
@@ -191,15 +201,25 @@ impl Method {
     }
 
     /// The spellings `backend` implements, for error messages.
-    pub fn names_for(backend: BackendKind) -> &'static str {
-        match backend {
-            BackendKind::Fem => {
-                "energy-midpoint, generalized-alpha, central-difference, implicit-midpoint"
-            }
-            BackendKind::Fdm => "report, central-difference, robert-asselin[=nu], velocity-form",
-            BackendKind::Modal => "dopri5, trbdf2 (also tr-bdf2, sdirk), trbdf2-fixed, trapezoid",
-            BackendKind::Reference => "none (always adaptive Dormand–Prince 5(4))",
+    pub fn names_for(backend: BackendKind) -> String {
+        if backend == BackendKind::Reference {
+            return "none (always adaptive Dormand–Prince 5(4))".into();
         }
+        SPELLINGS
+            .iter()
+            .filter(|(m, _, _)| m.implemented_by(backend))
+            .map(|(m, name, aliases)| {
+                let mut text = (*name).to_string();
+                if matches!(m, Method::RobertAsselin { .. }) {
+                    text += "[=nu]";
+                }
+                if !aliases.is_empty() {
+                    text += &format!(" (also {})", aliases.join(", "));
+                }
+                text
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 }
 
@@ -212,52 +232,36 @@ impl std::fmt::Display for Method {
 /// One spelling of every method (and of fdm's filter with its coefficient), for tests that
 /// walk all of them.
 #[cfg(test)]
-pub(crate) const METHOD_SPELLINGS: [&str; 12] = [
-    "energy-midpoint",
-    "generalized-alpha",
-    "central-difference",
-    "implicit-midpoint",
-    "report",
-    "robert-asselin",
-    "robert-asselin=0.05",
-    "velocity-form",
-    "dopri5",
-    "trbdf2",
-    "trbdf2-fixed",
-    "trapezoid",
-];
+pub(crate) fn method_spellings() -> Vec<String> {
+    SPELLINGS
+        .iter()
+        .map(|(_, name, _)| (*name).to_string())
+        .chain(["robert-asselin=0.05".to_string()])
+        .collect()
+}
 
 impl std::str::FromStr for Method {
     type Err = String;
 
     fn from_str(text: &str) -> Result<Self, String> {
         let name = text.trim();
-        Ok(match name {
-            "energy-midpoint" => Method::EnergyMidpoint,
-            "generalized-alpha" => Method::GeneralizedAlpha,
-            "central-difference" => Method::CentralDifference,
-            "implicit-midpoint" => Method::ImplicitMidpoint,
-            "report" => Method::Report,
-            "robert-asselin" => Method::RobertAsselin { nu: None },
-            "velocity-form" => Method::VelocityForm,
-            "dopri5" => Method::Dopri5,
-            "trbdf2" | "tr-bdf2" | "sdirk" => Method::TrBdf2,
-            "trbdf2-fixed" => Method::TrBdf2Fixed,
-            "trapezoid" => Method::Trapezoid,
-            _ => {
-                if let Some(value) = name.strip_prefix("robert-asselin=") {
-                    let nu = value
-                        .trim()
-                        .parse::<f64>()
-                        .map_err(|_| format!("cannot read the Robert–Asselin ν in `{name}`"))?;
-                    return Ok(Method::RobertAsselin { nu: Some(nu) });
-                }
-                return Err(format!(
-                    "unknown time-integration method `{name}`; accepted: {}",
-                    Method::names()
-                ));
-            }
-        })
+        if let Some((method, _, _)) = SPELLINGS
+            .iter()
+            .find(|(_, spelling, aliases)| *spelling == name || aliases.contains(&name))
+        {
+            return Ok(*method);
+        }
+        if let Some(value) = name.strip_prefix("robert-asselin=") {
+            let nu = value
+                .trim()
+                .parse::<f64>()
+                .map_err(|_| format!("cannot read the Robert–Asselin ν in `{name}`"))?;
+            return Ok(Method::RobertAsselin { nu: Some(nu) });
+        }
+        Err(format!(
+            "unknown time-integration method `{name}`; accepted: {}",
+            Method::names()
+        ))
     }
 }
 
@@ -536,5 +540,63 @@ impl Settings {
             BackendKind::Reference => {}
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod spelling_tests {
+    use super::*;
+
+    /// Every variant, by an exhaustive match: a new variant does not compile until it is placed
+    /// here, and the test below then asks for its row in [`SPELLINGS`].
+    fn every_method() -> Vec<Method> {
+        let all = [
+            Method::EnergyMidpoint,
+            Method::GeneralizedAlpha,
+            Method::CentralDifference,
+            Method::ImplicitMidpoint,
+            Method::Report,
+            Method::RobertAsselin { nu: None },
+            Method::VelocityForm,
+            Method::Dopri5,
+            Method::TrBdf2,
+            Method::TrBdf2Fixed,
+            Method::Trapezoid,
+        ];
+        for m in all {
+            match m {
+                Method::EnergyMidpoint
+                | Method::GeneralizedAlpha
+                | Method::CentralDifference
+                | Method::ImplicitMidpoint
+                | Method::Report
+                | Method::RobertAsselin { .. }
+                | Method::VelocityForm
+                | Method::Dopri5
+                | Method::TrBdf2
+                | Method::TrBdf2Fixed
+                | Method::Trapezoid => {}
+            }
+        }
+        all.to_vec()
+    }
+
+    #[test]
+    fn elem_every_method_has_one_spelling_that_reads_back() {
+        for m in every_method() {
+            let rows = SPELLINGS
+                .iter()
+                .filter(|(s, _, _)| std::mem::discriminant(s) == std::mem::discriminant(&m))
+                .count();
+            assert_eq!(rows, 1, "{m:?}");
+            let name = m.name();
+            assert_eq!(name.parse::<Method>(), Ok(m), "{name}");
+        }
+        assert_eq!(SPELLINGS.len(), every_method().len());
+        assert_eq!("sdirk".parse::<Method>(), Ok(Method::TrBdf2));
+        assert_eq!(
+            "robert-asselin=0.05".parse::<Method>(),
+            Ok(Method::RobertAsselin { nu: Some(0.05) })
+        );
     }
 }
