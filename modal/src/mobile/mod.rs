@@ -113,7 +113,7 @@ pub fn set_up(
     settings: &ModalSettings,
 ) -> Result<(MobileModel, Inputs), ModalError> {
     let (n, choice) = shape_choice(settings)?;
-    let model = MobileModel::from_scene(mm, n, choice)?;
+    let model = MobileModel::new(mm, n, choice)?;
     let inputs = Inputs {
         drive: mm.platform.as_ref().map(|p| p.drive.clone()),
         arm: mm.arm.as_ref().map(|a| a.torques.clone()),
