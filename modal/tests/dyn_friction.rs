@@ -410,7 +410,10 @@ fn dyn_friction_simple_flexure_is_the_rigid_model() {
     match ModalBackend.simulate(&scene, &settings(3, 1e-8, None)) {
         Err(BackendError::InvalidSettings { message, .. }) => {
             assert!(message.contains("off the surface"), "{message}");
-            assert!(!message.contains("  "), "a run of spaces in the message: {message:?}");
+            assert!(
+                !message.contains("  "),
+                "a run of spaces in the message: {message:?}"
+            );
         }
         other => panic!("expected InvalidSettings, got {other:?}"),
     }
