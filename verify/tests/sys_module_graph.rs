@@ -446,7 +446,7 @@ fn build_graph(name: &str, sources: &[Source]) -> CrateGraph {
     let reachable = |m: &ModPath| -> bool {
         (1..=m.len()).all(|k| {
             declared
-                .get(&m[..k - 1].to_vec())
+                .get(&m[..k - 1])
                 .is_some_and(|d| d.contains(&m[k - 1]))
         })
     };
@@ -559,10 +559,10 @@ fn build_graph(name: &str, sources: &[Source]) -> CrateGraph {
             }
             if segs.len() >= 2 {
                 let first = segs[0].as_str();
-                if matches!(first, "crate" | "super" | "self") || children.contains(first) {
-                    if let Some(abs) = absolutize(&segs, &p.module, &children) {
-                        add(&abs, pos, &mut edges);
-                    }
+                if (matches!(first, "crate" | "super" | "self") || children.contains(first))
+                    && let Some(abs) = absolutize(&segs, &p.module, &children)
+                {
+                    add(&abs, pos, &mut edges);
                 }
             }
             k = j.max(k + 1);
