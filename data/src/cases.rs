@@ -44,6 +44,9 @@ use serde::{Deserialize, Serialize};
 use crate::backend::{BackendKind, Basis, FemElement};
 use crate::error::SceneError;
 
+/// Prefix of a `history:` channel that names a term of the energy ledger (`energy.NAME`).
+pub const ENERGY_PREFIX: &str = "energy.";
+
 /// A whole case file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

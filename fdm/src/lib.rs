@@ -85,11 +85,9 @@
 //!   It is evaluated at the current hub rate before every step (prescribed: its kinematics;
 //!   torque-driven: the rate of the current state), reported in `stability_bound`, and named in
 //!   forced-step refusals as kind "transverse (bending + centrifugal tension)" with the station,
-//!   the rate and the three parts of ω². At rest it is the report's 5.44. Measured: the true
-//!   ω_max (dense eigenvalues) lies 1.0 % below it at θ̇ = 60 rad/s, where the bending-only value
-//!   is 9 % too low; forced steps of 0.95 × the limit run, 1.05 × diverge (`dyn_link_tension_*`).
-//!   `spin-up` at ω_s = 12.96 rad/s (λ = 12), which stopped at t ≈ 8.5 s at the bending-only
-//!   limit 1.447e-4, completes with τ from 1.447e-4 down to 1.439e-4 (ledger closure 2.8e-10).
+//!   the rate and the three parts of ω². At rest it is the report's 5.44; under rotation it
+//!   bounds the true ω_max from above where the bending-only value does not (tests
+//!   `dyn_link_tension_*`; figures in docs/backends.md, "fdm: figures from its tests").
 //!   Not in the bound: the free hub's rank-one coupling through θ̈ (the single link runs the
 //!   velocity form, stable to 2/ω; it has not bound in any tested scene).
 //! * [`chain`]: two links in series (`two-link-free`, `two-link-free-undamped`): link 2 clamped to
@@ -111,20 +109,16 @@
 //!   the integrated station equations linearized about the set points (straight links, at rest;
 //!   M from the momenta, K = −∂F/∂q), undamped; Euler–Bernoulli chains only. Against the
 //!   spring-jointed beams (tests/chain_modes.rs): O(h²) with hinged joints (K → 0), the scene's
-//!   springs and the moment-carrying stiff elbow (K → ∞: observed orders 1.89–2.02; mode 2
-//!   0.26/0.066/0.016 % at 21/41/81 stations). The inertia terms quadratic in q̇ are taken
-//!   from the drift velocities v_{j±½} ([`method::velocity_form`]): at the predicted velocity the
-//!   foreshortening couplings turned the unresolved bending waves into a bias growing with
-//!   the number of stations (1 s mean of joint 2 on `two-link-free-undamped`: 0.681, 0.665,
-//!   0.636 at 21/41/81 stations against fem's 0.6968; now 0.6972, 0.6969, 0.6969, and the 20 Hz
-//!   low-passed joint-1 history over 10 s differs 2.0e-2, 6.1e-3 between 21/41 and 41/81 stations).
+//!   springs and the moment-carrying stiff elbow (K → ∞). The inertia terms quadratic in q̇ are
+//!   taken from the drift velocities v_{j±½} ([`method::velocity_form`]): at the predicted
+//!   velocity the foreshortening couplings would turn the unresolved bending waves into a bias
+//!   growing with the number of stations.
 //!   **Damping implicit** without contact ([`chain::implicit`]): Kelvin–Voigt and the joint
 //!   dampers (−Cq̇, C constant) Crank–Nicolson across the velocity form's two kicks,
 //!   (M + ½τC)a = F solved by a banded LDLᵀ (pentadiagonal, factored once per step length) and
-//!   a 5×5 Schur complement, O(n) per step: `two-link-free` steps at the undamped bound
-//!   (21 stations, 10 s: 2.15e5 steps instead of 2.55e6).
-//!   Measured (tests/chain.rs): undamped 10 s energy error bounded (no drift), O(τ²); damped ledger closure O(τ²) (1.24e-4, 3.10e-5 at 11 stations, safety 0.5, 0.25); joint angles O(h²)
-//!   (orders 1.99, 1.91); rigid limit within 0.5 % of the swing. Step bound: 0.9 × 2/ω_max of
+//!   a 5×5 Schur complement, O(n) per step: `two-link-free` steps at the undamped bound.
+//!   Tested (tests/chain.rs): undamped energy error bounded (no drift), O(τ²); damped ledger
+//!   closure O(τ²); joint angles O(h²); the rigid limit. Step bound: 0.9 × 2/ω_max of
 //!   the chain linearized at rest (no rates, so no centrifugal tension) and the per-link 5.44;
 //!   the 0.9 leaves room for a 23 % rise of ω_max², while the tension share N h²/(4EI) at the
 //!   undamped scene's peak rate (θ̇₁ ≈ 22 rad/s, N₁ ≈ 9e3 lbf, 21 stations) is ≈ 1e-2 —
@@ -140,9 +134,8 @@
 //!   `impact`, `release`. With contact the damping stays explicit and the step bound also takes the fastest damping rate κ_max (power
 //!   iteration on −∂a/∂q̇: the joint dampers on the clamp half-cell inertia are strongly
 //!   overdamped, limit τ ≤ 1/κ), and ¼ of the bound for 2000 steps after each velocity jump.
-//!   Measured (tests/contact.rs): momentum residual ≤ 1e-14, |Gq̇⁺| ≤ 1e-14, ledger closure
-//!   8e-7 over case 1's 3 s, resting force of the stiff elbow 140.92 vs 140.93 (static
-//!   equilibrium of the same model) vs 141.87 (rigid arm).
+//!   Tested (tests/contact.rs): momentum residual and |Gq̇⁺| at round-off, the ledger, the
+//!   resting force of the stiff elbow against the static equilibrium of the same model.
 //! * **Timoshenko links** ([`chain::timoshenko`]; `barhorst-case1-timoshenko`, `shear` on both
 //!   links, no rotary inertia): v and the section rotation ψ at the stations, U = Σ ½EI
 //!   (Δψ/h)² h + Σ ½κGA (Δv/h − ψ̄)² h (ψ̄ the cell average: no shear locking), joint angles
@@ -155,13 +148,11 @@
 //!   against finite differences), ledger exact in its own terms. Step bound: the condensed
 //!   operator's top is the shear sawtooth, ω²_max = 4κGA/(ρAh²) for every EI (derived in the
 //!   module), σ = h√(ρA/κGA) per link, with the chain's power-iteration ω_max and κ_max.
-//!   Measured (tests/timoshenko.rs): cantilever tip deflection error exactly −PLh²/(12EI)
-//!   (order 2.00 against PL³/3EI + PL/κGA, ψ(L) exact); first impact of case 1 O(h²)
-//!   (0.2807200/0.2805833/0.2805490/0.2805404 at 11/21/41/81 stations; modal poly 6 modes
-//!   0.2805348); momentum residual ≤ 1e-14; case-1 ledger 7.5e-6 over 0.4 s at safety 0.1,
-//!   the default for Timoshenko chains with contact (1.3e-4 at safety 1: the velocity form's
-//!   energy error in the impact-excited shear waves is ~first order near the bound); damped free swing 3.8e-5/9.0e-6/2.2e-6 at safety
-//!   1/½/¼; κGA → ∞ approaches the Euler chain. Refused: `rotary_inertia`, mixed
+//!   Tested (tests/timoshenko.rs): cantilever tip deflection error exactly −PLh²/(12EI)
+//!   (ψ(L) exact); first impact of case 1 O(h²); momentum residual at round-off; the ledger of
+//!   case 1 at safety 0.1, the default for Timoshenko chains with contact (the velocity form's
+//!   energy error in the impact-excited shear waves is ~first order near the bound); damped
+//!   free swing; κGA → ∞ approaches the Euler chain. Refused: `rotary_inertia`, mixed
 //!   Euler/Timoshenko chains, torque laws with shear, single floating Timoshenko links, beam
 //!   modes with shear. **Statics** of the clamped Timoshenko cantilever
 //!   (`cantilever-timoshenko`) use the same cell energy ([`beam`]): tip force error exactly
@@ -176,10 +167,12 @@
 //!   h√(ρA/EA), bending h²√(ρA/4EI), torsion h√(ρJ/GJ)); `--dt` above it refused naming the
 //!   field. Kelvin–Voigt implicit ((M + ½τC) q̈ = …, one banded factorization per run): explicit
 //!   it would bound the step at ≈ ρh²/(4C), 40× below the elastic bound of the catalog rod.
-//!   Modes (K − Ω²H against M, flexibility form), statics (K q = f_g). Measured
+//!   Modes (K − Ω²H against M, flexibility form), statics (K q = f_g). Tested
 //!   (tests/payload_link.rs): static sag and the torsion and axial frequencies with the payload
-//!   O(h²) to the closed forms (5.2e-4, 3.8e-5, 5.9e-5 at 41 stations), bending O(h²), ledger
-//!   closure 9.7e-9 (damped) and 3.0e-8 (undamped) over 0.6 s.
+//!   O(h²) to the closed forms, bending O(h²), the ledger.
+//!
+//! The figures of these tests and of the investigations behind the design: docs/backends.md,
+//! "fdm: figures from its tests".
 //! * Unsupported (precise `Unsupported` messages): chains of more than two links, axial
 //!   fields, shear outside the two-link chain and cantilever statics, tip inertia, gravity on beams, contact with
 //!   friction, circles or bilateral mode, contact with the two-step scheme, mobile

@@ -45,11 +45,11 @@
 //! and Δqᵀ∇̄Φ = ΔΦ, every step satisfies E₁ − E₀ = Δqᵀ Q(t_mid, q̄, v̄) exactly (to the Newton
 //! tolerance, which also bounds this energy defect per step at 1e-14 of the step's energy
 //! scale or its round-off floor); the works are booked with that same midpoint quadrature, so
-//! the ledger closes to the Newton tolerance at the default step (measured 5.7e-12 on
-//! `single-link`, 3.0e-11 on `two-link-free`, 6.3e-11 on `two-link-free-undamped` over 10 s)
-//! instead of the trapezoidal rule's O(h²) error (5.8e-3, 5.9e-4, 0.11), which the
-//! configuration-dependent mass M(q) causes. Second order and symmetric. Cost per step 2.3–7×
-//! generalized-α's (≈ 12 residual-type passes per Newton iteration).
+//! the ledger closes to the Newton tolerance instead of to the trapezoidal rule's O(h²), an
+//! error the configuration-dependent mass M(q) causes. Second order and symmetric. Its Newton
+//! iteration evaluates several residual-type passes per iteration (the discrete gradient) but
+//! keeps its factorization across steps. Ledger closures and cost per step against
+//! generalized-α: docs/backends.md ("fem energy-midpoint: ledger closure and cost").
 //!
 //! Elsewhere (prescribed joint motion, extensible links, an undamped Timoshenko link without
 //! rotary inertia on a free joint without hub inertia — its almost massless frame direction
@@ -72,28 +72,30 @@
 //!
 //! ## Contact (seed 000: impact, constrained sliding, release)
 //! Unilateral frictionless contact of the tip of a named link with a fixed line
-//! ([`events::contact`]), with the `energy-midpoint` scheme (also `implicit-midpoint`, whose ledger
-//! then closes to O(h²) only: [`method::implicit_midpoint`]). Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q
+//! ([`events::contact`]), with the implicit methods: `energy-midpoint` (described here),
+//! `implicit-midpoint` (ledger O(h²): [`method::implicit_midpoint`]) and `generalized-alpha`
+//! (acceleration history recomputed at every event: [`method::generalized_alpha`]).
+//! Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q
 //! (exact, [`chain::Chain::tip_jacobian`]).
 //! * Detection inside the step: the step is re-solved shortened (Illinois secant on h) until
 //!   |g(q₁(h))| ≤ 1e-10·L (event `contact-start` with the bracket width as time tolerance).
 //! * Impact, perfectly plastic: M(q̇⁺ − q̇⁻) = GᵀΛ, G q̇⁺ = 0, Λ = −G q̇⁻/(G M⁻¹Gᵀ), M(q) the
 //!   dense LU of the mass matrix assembled from exact mass products; momentum residual from an
-//!   independent mass product (round-off, ≤ 1e-14 measured); loss ½Λ²G M⁻¹Gᵀ booked `impact`.
+//!   independent mass product (at round-off); loss ½Λ²G M⁻¹Gᵀ booked `impact`.
 //! * Constrained phase: the midpoint step with the force ∇̄g λ (Gonzalez discrete gradient of g,
-//!   metric M(q̄)) and g(q₁) = 0, bordered Newton on (a, λ). The constraint does no work, so
-//!   the ledger closes to the Newton tolerance (measured 4e-11 on `barhorst-case1`, 0.45 s,
-//!   8 elements). |g| ≤ 1e-11·L; G q̇ drifts O(h²) within a step (reported) and is projected
-//!   to zero after every constrained step (plastic projection, its kinetic-energy loss booked
-//!   `contact_projection`; at a release only an inward drift).
+//!   metric M(q̄)) and g(q₁) = 0, bordered Newton on (a, λ). The constraint does no work
+//!   (Δqᵀ∇̄g = g(q₁) − g(q₀)), so it adds nothing to the ledger. |g| ≤ 1e-11·L; G q̇ drifts
+//!   O(h²) within a step (reported) and is projected to zero after every constrained step
+//!   (plastic projection, its kinetic-energy loss booked `contact_projection`; at a release
+//!   only an inward drift).
 //! * Normal force (channel `contact1.normal_force`): λ = (G M⁻¹R(q, q̇, 0) − n̂·J̇q̇)/(G M⁻¹Gᵀ)
 //!   at the state, its velocity projected onto G q̇ = 0. Release where λ crosses zero, located
 //!   inside the step (state force at the end of the re-solved shortened step) to
-//!   −1e-8·W ≤ λ ≤ 0 (W the weight) or a 1e-13 s bracket (event `release`); measured
-//!   |λ| ≤ 3.2e-7·W on `barhorst-case1` (3 s). The force carries unresolved mesh frequencies
-//!   after impacts: micro-bounces of the discretized model ([`events::contact`]). Grazing contacts
-//!   whose phase the step ends do not determine are refined (quarter steps, down to 1e-5 of
-//!   the step), never released at an arbitrary force ([`events::contact`], "Grazing").
+//!   −1e-8·W ≤ λ ≤ 0 (W the weight) or a 1e-13 s bracket (event `release`). The force
+//!   carries unresolved mesh frequencies after impacts: micro-bounces of the discretized model
+//!   ([`events::contact`]). Grazing contacts whose phase the step ends do not determine are
+//!   refined (quarter steps, down to 1e-5 of the step), never released at an arbitrary force
+//!   ([`events::contact`], "Grazing").
 //! * Timoshenko links without rotary inertia: the massless directions (every ψ, ψ(L) − θ of
 //!   the child) follow their balances Nᵀ(∂V/∂q + C q̇) = 0 (Kelvin–Voigt required), the impact
 //!   map and the normal force act on the massive block ([`events::contact`]); every step ends with the
@@ -104,21 +106,21 @@
 //! * Phase channel `contact1.phase` (0 free, 1 constrained); `contact1.gap`,
 //!   `contact1.normal_velocity`, running maxima `contact1.max_gap`, `contact1.max_normal_velocity`.
 //! * Refused (`unsupported`): unilateral circle surfaces, friction on unilateral contacts,
-//!   several contacts, prescribed joints, generalized-α and central difference, adaptive
-//!   steps, massless Timoshenko sections without Kelvin–Voigt (with `implicit-midpoint`: at
-//!   all). Without contact nothing is allocated.
+//!   several contacts, prescribed joints, central difference, adaptive steps, massless
+//!   Timoshenko sections without Kelvin–Voigt (with `implicit-midpoint` or
+//!   `generalized-alpha`: at all). Without contact nothing is allocated.
 //!
 //! ## Bilateral wall with Coulomb friction (seed 001, `constrained-arm`)
 //! [`events::contact::friction`] with the geometry in [`events::wall`] (circle g = R − |r_tip − c|, n̂ = −(r − c)/|r − c|,
 //! t̂ counter-clockwise, κ = 1/|r − c|; or a line). The tip is on the wall from t = 0 and never
 //! released (λ of either sign); the scene's default method becomes `energy-midpoint`.
 //! * Constraint as in the constrained phase above (discrete gradient, g(q₁) = 0 in Newton):
-//!   |g| at round-off (measured 3.3e-16 m), channel `contact1.gap` / `contact1.max_gap`.
+//!   |g| at round-off, channel `contact1.gap` / `contact1.max_gap`.
 //! * Sliding: friction −μ s σ λ̄ T(q̄)ᵀ in the step (T = t̂ᵀJ, σ = sign λ fixed per step, step
 //!   re-solved if λ̄ comes out with the other sign, stop if that is inconsistent too); the ledger
 //!   books D = μ s σ λ̄ ΔqᵀT(q̄) (term `friction`, channel `contact1.friction_work`), exactly
-//!   the work of the applied friction force, so the ledger closes to the Newton tolerance
-//!   (measured 4.3e-11 on the scene); D − μ∫|λ||v_t| dt is O(h²) (tested).
+//!   the work of the applied friction force, so the ledger closes to the Newton tolerance;
+//!   D − μ∫|λ||v_t| dt is O(h²) (tested).
 //! * Index-1 forces from the dense M(q): sliding λ(GM⁻¹Gᵀ − μsσGM⁻¹Tᵀ) = GM⁻¹R − n̂·J̇q̇ + κv_t²
 //!   (Painlevé GM⁻¹Gᵀ ≤ μ|GM⁻¹Tᵀ| stops the run), held tip: 2 × 2 with GM⁻¹Gᵀ, GM⁻¹Tᵀ, TM⁻¹Tᵀ.
 //! * Stick–slip: s·v_t = 0 and μ|λ_n| − |λ_t| = 0 located inside the step (secant on the step

@@ -17,7 +17,7 @@ fn scene() -> Scene {
 
 fn model(elements: usize) -> Model {
     let s = scene();
-    Model::from_scene(s.mobile_manipulator().unwrap(), elements).unwrap()
+    Model::new(s.mobile_manipulator().unwrap(), elements).unwrap()
 }
 
 /// A generic state: joints bent, platform turned and moving, the beam deflected in both planes
@@ -354,14 +354,14 @@ fn conv_mobile_rigid_limit_rate() {
     let mut rigid_scene = s.mobile_manipulator().cloned().unwrap();
     rigid_scene.flexible_link = None;
     let (h, t_end) = (1e-3, 1.0);
-    let rigid = ee_history(Model::from_scene(&rigid_scene, 1).unwrap(), h, t_end);
+    let rigid = ee_history(Model::new(&rigid_scene, 1).unwrap(), h, t_end);
     let mut gaps = Vec::new();
     for factor in [10.0, 100.0] {
         let mut mm = s.mobile_manipulator().cloned().unwrap();
         let f = mm.flexible_link.as_mut().unwrap();
         f.bending_stiffness_in_plane *= factor;
         f.bending_stiffness_out_of_plane *= factor;
-        let flex = ee_history(Model::from_scene(&mm, 2).unwrap(), h, t_end);
+        let flex = ee_history(Model::new(&mm, 2).unwrap(), h, t_end);
         gaps.push(max_gap(&flex, &rigid));
     }
     let rate = (gaps[0] / gaps[1]).log10();

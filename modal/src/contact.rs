@@ -239,7 +239,10 @@ pub fn check(pc: &PlanarChain) -> Result<(), ModalError> {
         let tol = 1e-12 * l.length;
         if !l.axial && center[0].hypot(center[1]) <= tol && (*radius - l.length).abs() <= tol {
             return Err(ModalError::Unsupported(format!(
-                "modal: bilateral circle of radius L about the hub for the inextensible link                  `{}`: the tip can stay at radius L only if the link stays straight, so this                  model degenerates to the rigid link (constraint gradient zero, normal force                  undetermined); use `axial = true` (Euler model) or the rigid closed form",
+                "modal: bilateral circle of radius L about the hub for the inextensible link \
+                 `{}`: the tip can stay at radius L only if the link stays straight, so this \
+                 model degenerates to the rigid link (constraint gradient zero, normal force \
+                 undetermined); use `axial = true` (Euler model) or the rigid closed form",
                 l.name
             )));
         }

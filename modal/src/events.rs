@@ -343,7 +343,8 @@ fn start_bilateral(
         return Err(ModalError::invalid(
             "contact",
             format!(
-                "bilateral contact: the tip starts {:.3e} off the surface (the initial state must                  satisfy the constraint to 1e-9 L)",
+                "bilateral contact: the tip starts {:.3e} off the surface (the initial state must \
+                 satisfy the constraint to 1e-9 L)",
                 c.gap
             ),
         ));

@@ -395,7 +395,10 @@ fn dyn_friction_simple_flexure_is_the_rigid_model() {
     scene.planar_chain_mut().unwrap().links[0].axial = false;
     scene.planar_chain_mut().unwrap().links[0].foreshortening = true;
     match ModalBackend.simulate(&scene, &settings(3, 1e-8, None)) {
-        Err(BackendError::Unsupported(m)) => assert!(m.contains("rigid"), "{m}"),
+        Err(BackendError::Unsupported(m)) => {
+            assert!(m.contains("rigid"), "{m}");
+            assert!(!m.contains("  "), "a run of spaces in the message: {m:?}");
+        }
         other => panic!("expected Unsupported, got {other:?}"),
     }
     // A wall of another radius is not degenerate, but the straight initial link then starts
@@ -406,7 +409,11 @@ fn dyn_friction_simple_flexure_is_the_rigid_model() {
     };
     match ModalBackend.simulate(&scene, &settings(3, 1e-8, None)) {
         Err(BackendError::InvalidSettings { message, .. }) => {
-            assert!(message.contains("off the surface"), "{message}")
+            assert!(message.contains("off the surface"), "{message}");
+            assert!(
+                !message.contains("  "),
+                "a run of spaces in the message: {message:?}"
+            );
         }
         other => panic!("expected InvalidSettings, got {other:?}"),
     }

@@ -55,8 +55,7 @@ fn state(model: &MobileModel, scene: &Scene) -> (Vec<f64>, Vec<f64>) {
 fn sys_mobile_mass_matrix_is_the_kinetic_energy_of_sampled_points() {
     let scene = load_scene("mobile-manipulator-flexible").unwrap();
     for (modes, shapes) in [(3, ShapeChoice::Poly), (4, ShapeChoice::ClampedFree)] {
-        let model =
-            MobileModel::from_scene(scene.mobile_manipulator().unwrap(), modes, shapes).unwrap();
+        let model = MobileModel::new(scene.mobile_manipulator().unwrap(), modes, shapes).unwrap();
         let l = model.layout;
         let (q, nu) = state(&model, &scene);
         let mut ws = Workspace::new(&model);
@@ -126,7 +125,7 @@ fn sys_mobile_mass_matrix_is_the_kinetic_energy_of_sampled_points() {
 fn sys_mobile_forces_match_finite_difference_lagrange_equations() {
     let scene = load_scene("mobile-manipulator-flexible").unwrap();
     let mut model =
-        MobileModel::from_scene(scene.mobile_manipulator().unwrap(), 3, ShapeChoice::Poly).unwrap();
+        MobileModel::new(scene.mobile_manipulator().unwrap(), 3, ShapeChoice::Poly).unwrap();
     // The stiffness force −K q would dominate every inertial term at this deflection; the
     // inertial, gravity and friction terms are checked with EI = 0 (K q against ∂U/∂q below).
     let strain_model = model.clone();

@@ -121,7 +121,7 @@ impl CheckKind {
 /// deflections `linkN.v@K`, and the rocket's attitude `rocket.theta` (each backend's body
 /// axis).
 pub fn frame_invariant(channel: &str) -> bool {
-    if channel.starts_with(crate::suite::history::ENERGY_PREFIX) {
+    if channel.starts_with(data::cases::ENERGY_PREFIX) {
         return true;
     }
     if matches!(
@@ -213,7 +213,7 @@ pub fn row_kinds(case: &Case, scene: &Scene) -> Vec<(CheckKind, Vec<BackendKind>
             let pair = vec![case.backend, *backend];
             match &q {
                 Some(Quantity::History { channel, .. }) if frame_invariant(channel) => {
-                    if channel.starts_with(crate::suite::history::ENERGY_PREFIX) {
+                    if channel.starts_with(data::cases::ENERGY_PREFIX) {
                         kinds.push((CheckKind::LedgerTerms, pair.clone()));
                     }
                     kinds.push((CheckKind::CrossHistory, pair));

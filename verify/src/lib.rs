@@ -26,5 +26,6 @@ pub mod shard;
 pub mod stability;
 pub mod study;
 pub mod suite;
+pub mod work;
 
 pub use error::Error;

@@ -249,7 +249,7 @@ fn sys_report_work_of_a_zero_limit_reads_back_with_absolute_errors() {
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(!err.contains("note:"), "{err}");
-    let (works, notes) = verify::report::work::read_all(&dir);
+    let (works, notes) = verify::work::read_all(&dir);
     assert!(notes.is_empty(), "{notes:?}");
     let work = works
         .iter()

@@ -3,20 +3,16 @@
 //! [`Chain::exact_massless_directions`]): M(q) N = 0 and J N = 0 at every q, so their equations
 //! of motion carry no inertia, Nᵀ(∂V/∂q + C q̇ − Q) = 0 — with Kelvin–Voigt a first-order
 //! relaxation of ψ towards its quasi-static balance at rates κGA/(γk²) + EI/γ (k the
-//! wavenumber), 2.5e4 to 5e7 1/s on `barhorst-case1-timoshenko`, far above 1/dt.
+//! wavenumber), far above 1/dt (2.5e4 to 5e7 1/s on `barhorst-case1-timoshenko`).
 //!
 //! The energy-midpoint scheme ([`crate::method::energy_midpoint`]) solves these rows at the midpoint,
 //! Nᵀ(∇V(q̄) + C v̄ − Q) = 0: an implicit-midpoint step of the relaxation, whose amplification
 //! (1 − z/2)/(1 + z/2) tends to −1 for z = rate·h ≫ 1. A deviation of ψ from its balance is not
 //! damped: the end value ψ₁ = 2ψ̄ − ψ₀ flips around the balance every step, and so does the
 //! end rate v₁ = 2v̄ − v₀, which the step does not determine at all (M N = 0). Along a smooth
-//! motion nothing excites this; impacts and releases do. Measured on
-//! `barhorst-case1-timoshenko` (8 elements, default step, before): the tip section of link 2
-//! left the first contact phase 1.8e-2 rad off its balance, its end rate alternated at
-//! ±140 rad/s, and the shear force of that deviation (κGA·δψ ~ 1e4 lbf) drove the first free
-//! step after the release into the surface; kicked off its balance by 1e-3 rad, ψ of link 2
-//! still carried −0.81e-3 after three steps (test
-//! `dyn_massless_sections_relax_to_their_balance_with_a_booked_dissipation`).
+//! motion nothing excites this; impacts and releases do, and the shear force of the deviation
+//! can drive the next free step into the surface (measurements: docs/contact.md, "fem contact:
+//! the measurements behind the design").
 //!
 //! In runs with a unilateral contact the stepper therefore finishes every step with two
 //! operations that change no mass point and no material velocity:
@@ -33,25 +29,20 @@
 //!   midpoint step restores inside the next step (ψ̄ carries it). That lag is the Kelvin–Voigt
 //!   deformation of the section, so the projection moves dissipation from `kelvin_voigt` to
 //!   `numerical_massless`, once per step: at steps above the lag time the moved share grows as
-//!   the step falls (whole scene, 16 elements: 2.26, 2.84, 3.86 ft·lbf at 5e-4, 2.5e-4,
-//!   1.25e-4 s), while the sum of the two with the impact losses stays at 23.21, 23.17, 22.95
-//!   ft·lbf and the contact episodes move by ≤ 5e-4 of the time. The split is not a converged
-//!   quantity. (Tried and dropped: ending the step on the damped balance Nᵀ(∇V + C q̇) = 0 by a
-//!   backward-Euler half step from the midpoint, which would not move it — not a discrete
-//!   gradient, it fed energy into a growing mode within 1e-3 s of free fall at 8 elements,
-//!   dt = 2.5e-5; and the same target clamped so that the strain energy never rises (the point
-//!   between static and damped balance with V = V(q₁)) — the free flight after the first
-//!   contact episode then needed steps of 1e-6 s (Newton failures above), 8 elements.)
+//!   the step falls, while the sum of the two with the impact losses and the contact episodes
+//!   stay put (docs/contact.md, "Energy losses on `barhorst-case1-timoshenko`"). The split is
+//!   not a converged quantity. Ending the step on the damped balance Nᵀ(∇V + C q̇) = 0 instead
+//!   (a backward-Euler half step from the midpoint) is not a discrete gradient and feeds energy
+//!   into the state; clamping that target so that the strain energy never rises makes the
+//!   Newton iteration fail after contact episodes (both measured: docs/contact.md).
 //! * **Consistent rates**: the end rates along every exact direction are set from the balances
 //!   at the end state, Nᵀ(∇V(q₁) + C q̇₁ − Q) = 0, affine in q̇ (one solve with NᵀCN,
 //!   [`Massless::make_consistent`]); the kinetic energy does not change (M N = 0). The
 //!   predictor and the Newton matrix then see no alternating garbage, and the
 //!   joint rate of a child joint (θ̇ along e_ψ(L) − e_θ) is the physical one.
 //!
-//! (A first version solved the massless rows at the step end instead, Nᵀ(∇V(q₁) + C v̄) = 0,
-//! with the change booked: not a discrete gradient, it fed energy into the kicked state —
-//! +14 ft·lbf in the first step after the 1e-3 rad kick above, `numerical_massless` −4.8 ft·lbf
-//! over the first 0.3 s of the scene at 4 elements — and was dropped.)
+//! Solving the massless rows at the step end instead, Nᵀ(∇V(q₁) + C v̄) = 0, is likewise not a
+//! discrete gradient and feeds energy into a kicked state (docs/contact.md).
 
 use crate::band::DenseLu;
 use crate::chain::{Chain, Parts};

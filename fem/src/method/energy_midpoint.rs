@@ -78,14 +78,13 @@
 //!   (round-off noise while the energy defect is being reduced; a new matrix there only added
 //!   noise, and its larger update was taken for divergence);
 //! * the predictor is the previous mean acceleration only if that step was not 10× shorter
-//!   (a located event just before: its mean acceleration is close to the point value, 5e6 at
-//!   the tip node 2 µs after an impact);
+//!   (a located event just before: its mean acceleration is close to the point value, which is
+//!   huge right after an impact);
 //! * constrained steps shortened to locate an event rely on the refresh above instead of a new
-//!   matrix every iteration (1.5× faster on `barhorst-case1-timoshenko`).
+//!   matrix every iteration.
 //!
-//! Measured on `barhorst-case1-timoshenko` (8 elements): 68 Newton failures in 0.51 s before
-//! (then stopped), none in 3 s now; free fall at dt = 2.5e-5: 15 rejected steps in 0.05 s
-//! before, none now.
+//! The failures and rejected steps these rules remove on `barhorst-case1-timoshenko`, and the
+//! figures above: docs/contact.md, "fem contact: the measurements behind the design".
 //!
 //! Adaptive steps (`rtol`): local error estimate e = (h²/12)(ā_k − ā_{k−1})·2h_k/(h_k + h_{k−1})
 //! (third-derivative term of the trapezoidal/midpoint family, from successive mean

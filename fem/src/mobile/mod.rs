@@ -95,7 +95,7 @@ fn elements(settings: &data::FemSettings) -> Result<usize, FemError> {
 pub fn dof_plan(mm: &MobileManipulator, settings: &data::FemSettings) -> Result<DofPlan, FemError> {
     check_flexible(mm)?;
     let n_el = elements(settings)?;
-    let md = Model::from_scene(mm, n_el)?;
+    let md = Model::new(mm, n_el)?;
     let mut plan = DofPlan::default();
     if md.platform.is_some() {
         plan.add("platform velocity freedoms (φ̇_R, φ̇_L)", 2);
@@ -252,7 +252,7 @@ pub fn prepare(
     let dt_user = settings::positive("time.dt", settings.dt)?;
     let t_end = settings::positive("time.t_end", settings.t_end)?.unwrap_or(scene.simulation.t_end);
     let out = scene.simulation.output_interval;
-    let md = Model::from_scene(mm, n_el)?;
+    let md = Model::new(mm, n_el)?;
     let arm = mm
         .arm
         .as_ref()

@@ -298,7 +298,7 @@ fn positive_semidefinite(j: &Mat3, tol: f64) -> bool {
 impl Model {
     /// Builds the model with `elements` Hermite-cubic elements on the flexible link (ignored
     /// without one: then the model is the rigid system, used by the tests).
-    pub fn from_scene(m: &MobileManipulator, elements: usize) -> Result<Self, FemError> {
+    pub fn new(m: &MobileManipulator, elements: usize) -> Result<Self, FemError> {
         let arm = m.arm.as_ref().ok_or_else(|| {
             FemError::unsupported(
                 "fem mobile manipulator: a scene without an arm (the platform alone has no \

@@ -28,44 +28,19 @@
 //!
 //! **Noise floor.** An iteration that stops contracting (θ ≥ 0.99 or too slow) from its second
 //! update on, with its last two updates both ≤ 1 error-tolerance unit, is accepted: the stage
-//! is then within the tolerance and the error test judges the step. Measured on
-//! `barhorst-case1-tipmass` (poly basis, rtol 1e-6, atol 1e-8): right after the impact,
-//! perturbing a stage value by 4 ulps moves the Newton update by 1e-2–1e-1 tolerance units at
-//! 16 modes per link and ~1–3 at 20 — the evaluation's round-off (M(q) has condition
-//! 10¹³–10¹⁷ at 12–24 modes in the polynomial coordinates: a hub rotation undone by the
-//! clamped polynomials carries almost no kinetic energy), not a Jacobian error (the spectral
-//! radius of the simplified-Newton error operator with the structured Jacobian, against
-//! central differences, was 1e-9–1e-5 at those points). In stiff directions that noise does
-//! not shrink with h, so rejecting such iterations cut h to 1e-11 s without ever converging.
-//! Where the floor exceeds the tolerance (20–24 modes at atol ≤ 1e-8 after the impact, or at
-//! atol 1e-9–1e-10 before it) the steps stay small: choose atol above the floor. The error
+//! is then within the tolerance and the error test judges the step. Near an impact of a chain
+//! in polynomial coordinates (M(q) with condition 10¹³–10¹⁷ at 12–24 modes: a hub rotation
+//! undone by the clamped polynomials carries almost no kinetic energy) the Newton update
+//! stagnates at the evaluation's round-off, not at a Jacobian error; in stiff directions that
+//! noise does not shrink with h, so rejecting such iterations would cut h without end. Where
+//! the floor exceeds the tolerance the steps stay small: choose atol above the floor. The error
 //! test has the same limit and no cure here: a stage's noise δz in a stiff component enters the
 //! estimate as h·E·δz/(hd), independent of h, and the (I − hdJ)⁻¹ filter damps it only once
-//! hd|λ| ≫ 1, so a rejection makes the next estimate *worse*; right after the impact at 24
-//! modes (|f| ~ 1e10) h went to 1e-14 s at atol 1e-8 (free flight to 0.28 s took 12 s, the
-//! first 50 ns after the impact over a minute). Only better-conditioned coordinates would
-//! remove the floor.
-//!
-//! **Measured** (that scene, rtol 1e-6, atol 1e-8, t_end 0.29 s: free flight to the impact at
-//! 0.2835 s, then 6.5 ms sliding on the surface with a drift projection after every step).
-//! Before (forward-difference Jacobian; a full reset after each projection, so one Jacobian
-//! per constrained step; first iterate accepted only at ‖Δz‖ ≤ 3e-5, later ones on the plain
-//! ratio; h/4 after a failure) the free flight cost ~2700 steps and 1–2 Jacobians at 12–20
-//! modes and everything else happened after the impact: 14 modes 2339 Newton divergences
-//! *with a fresh Jacobian* (forward-difference columns off by O(1)–5× against central
-//! differences: increments 1.5e-10 against f's round-off).
-//!
-//! | modes | before: wall, steps, rejected, Jacobians | after: wall, steps, rejected (Newton), Jacobians | first impulse after |
-//! | --- | --- | --- | --- |
-//! | 12 | 7.5 s, 5901, 484, 3189 | 1.6 s, 5837, 441 (9), 9 | 2.68064526 |
-//! | 14 | 23 s, 8305, 2836, 5601 | 3.1 s, 6197, 540 (11), 17 | 2.62835256 |
-//! | 16 | 730 s, 114 780, 123 549, — | 5.6 s, 6662, 990 (74), 303 | 2.59256634 |
-//! | 20 | — | 56 s, 22 716, 12 324 (7938), 17 066 | 2.54810473 |
-//! | 24 | — | 554 s, 117 650, 73 793 (43 860), 105 927 | 2.52257135 |
-//!
-//! At atol 1e-6 (above the floor): 24 modes 50 s, 10 880 steps, first impulse 2.52253906
-//! (1.3e-5 from atol 1e-8). 12 modes against Dormand–Prince (2.680647262): 7.5e-7 at
-//! rtol 1e-6, 3.5e-8 at rtol 1e-8 / atol 1e-10.
+//! hd|λ| ≫ 1, so a rejection makes the next estimate *worse*. Only better-conditioned
+//! coordinates would remove the floor. The measurements behind these rules (noise levels, step
+//! counts, Jacobians and first impulses on `barhorst-case1-tipmass` at 12–24 modes, against the
+//! earlier forward-difference Newton) are in docs/backends.md, "modal TR-BDF2 at the impact of
+//! `barhorst-case1-tipmass`".
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::{factor, solve};

@@ -188,7 +188,9 @@ pub struct NodeKinematics {
 }
 
 impl MobileModel {
-    pub fn from_scene(
+    /// Builds the model of the manipulator `m` with `modes` assumed modes per bending direction
+    /// of the flexible link, of the family `shapes`.
+    pub fn new(
         m: &MobileManipulator,
         modes: usize,
         shapes: ShapeChoice,

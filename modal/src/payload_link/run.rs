@@ -107,7 +107,7 @@ pub fn simulate(
     breaks.dedup();
     breaks.push(t_end);
 
-    let mut out = Output::new(&rhs, scene);
+    let mut out = Output::new(&rhs);
     let dt_out = scene.simulation.output_interval;
     let n_samples = (t_end / dt_out - 1e-9).ceil() as usize + 1;
     let sample_time = |k: usize| (k as f64 * dt_out).min(t_end);
@@ -172,9 +172,8 @@ struct Output {
 }
 
 impl Output {
-    fn new(rhs: &LinkRhs, scene: &Scene) -> Self {
+    fn new(rhs: &LinkRhs) -> Self {
         let m = &rhs.model;
-        let _ = scene;
         let fields: Vec<LinkField> = LinkField::ALL
             .into_iter()
             .filter(|f| m.block(*f).is_some())

@@ -3,6 +3,9 @@
 
 use clap::builder::PossibleValue;
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use data::{BackendKind, Settings};
+
+use super::CliError;
 
 pub use crate::output::Format;
 pub use crate::study::ladder::Refine;
@@ -358,4 +361,13 @@ impl CommonOpts {
 /// `--method`: one of [`data::Method::names`].
 fn parse_method(text: &str) -> Result<data::Method, String> {
     text.parse()
+}
+
+/// The options' settings for `kinds`; a flag none of them reads is bad input (exit 2).
+pub(crate) fn checked_settings(
+    opts: &CommonOpts,
+    kinds: &[BackendKind],
+) -> Result<Settings, CliError> {
+    opts.settings_for(kinds)
+        .map_err(|e| CliError::Input(format!("error: {e}")))
 }

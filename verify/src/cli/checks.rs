@@ -68,7 +68,7 @@ pub fn verify(
     print_survey(&studies, format);
     if let Some(dir) = out {
         plots::draw_all(dir, &cases, &outcomes, &cache);
-        for n in report::write_all(dir, &outcomes)? {
+        for n in crate::report::write_all(dir, &outcomes)? {
             eprintln!("note: {n}");
         }
         eprintln!(
@@ -150,8 +150,8 @@ pub fn merge(dirs: &[PathBuf], format: Format, out: &Path) -> Result<(), CliErro
         }
     }
     shard::copy_plots(dirs, out)?;
-    crate::report::work::copy_work_files(dirs, out)?;
-    for n in report::write_all(out, &outcomes)? {
+    crate::work::copy_work_files(dirs, out)?;
+    for n in crate::report::write_all(out, &outcomes)? {
         eprintln!("note: {n}");
     }
     eprintln!(

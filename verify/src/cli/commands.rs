@@ -3,7 +3,7 @@
 use data::{BackendError, BackendKind, Model, Scene, Settings, StabilityVerdict, load_scene};
 
 use super::CliError;
-use super::args::{Cli, Command, CommonOpts};
+use super::args::{Cli, Command, CommonOpts, checked_settings};
 use super::stdout::{out, outln};
 use crate::output::{
     Column, Format, SWITCHING_HEADER, TERMINAL_WIDTH, csv_table, fitted_table, ledger_csv,
@@ -286,15 +286,6 @@ fn describe(name: &str, opts: &CommonOpts) -> Result<(), CliError> {
             Ok(())
         }
     }
-}
-
-/// The options' settings for `kinds`; a flag none of them reads is bad input (exit 2).
-pub(crate) fn checked_settings(
-    opts: &CommonOpts,
-    kinds: &[BackendKind],
-) -> Result<Settings, CliError> {
-    opts.settings_for(kinds)
-        .map_err(|e| CliError::Input(format!("error: {e}")))
 }
 
 /// Runs `f` for each requested backend with the settings it reads; unsupported backends are reported, and the command

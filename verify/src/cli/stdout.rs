@@ -18,7 +18,7 @@ pub(crate) fn write_fmt(args: std::fmt::Arguments<'_>) {
             std::process::exit(CLOSED_PIPE_STATUS);
         }
         eprintln!("error: cannot write to standard output: {e}");
-        std::process::exit(i32::from(super::OUTPUT_STATUS));
+        std::process::exit(i32::from(super::error::OUTPUT_STATUS));
     }
 }
 

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use data::{BackendKind, Settings, load_scene};
 
 use super::CliError;
-use super::args::CommonOpts;
+use super::args::{CommonOpts, checked_settings};
 use super::progress::Bar;
 use super::stdout::{out, outln};
 use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
@@ -30,7 +30,7 @@ pub fn converge(
         quantity,
         refine,
         &opts.kinds(),
-        &super::commands::checked_settings(opts, &opts.kinds())?,
+        &checked_settings(opts, &opts.kinds())?,
         &bar,
     )?;
     bar.clear();
@@ -69,7 +69,7 @@ pub fn converge_shard(
     let scene = load_scene(scene_arg)?;
     let q = parse_quantity(&scene, quantity)?;
     let kinds = opts.kinds();
-    let base = super::commands::checked_settings(opts, &kinds)?;
+    let base = checked_settings(opts, &kinds)?;
     let flat: Vec<(BackendKind, usize, Settings)> = rung_specs(&scene, refine, &kinds, &base)
         .into_iter()
         .flat_map(|(kind, spec)| {
@@ -168,7 +168,7 @@ pub fn recommend(
         quantity,
         tol,
         &opts.kinds(),
-        &super::commands::checked_settings(opts, &opts.kinds())?,
+        &checked_settings(opts, &opts.kinds())?,
         Some(rung_budget_s),
         &bar,
     );

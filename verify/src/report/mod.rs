@@ -14,8 +14,6 @@
 //! same way as one of a single machine. [`work`] is a leaf (it depends on `data` only) used by
 //! the suite's plotting step; the pages depend on `suite` and `coverage`.
 
-pub mod work;
-
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -24,7 +22,8 @@ use crate::coverage::{CheckKind, Coverage};
 use crate::output::write_atomic;
 use crate::plot::{Mark, StyledSeries, backend_css_color, plot_styled};
 use crate::suite::evaluate::{Outcome, Status};
-use work::{CaseWork, pareto_front, work_counter};
+use crate::suite::report as suite_report;
+use crate::work::{self, CaseWork, pareto_front, work_counter};
 
 /// Suffixes of the plots a case may have, in the order they are shown.
 pub const CASE_PLOT_SUFFIXES: [&str; 5] = [
@@ -482,8 +481,26 @@ fn front_section(f: &Front<'_>) -> String {
     s
 }
 
+/// JSON, CSV and the HTML pages of the suite's outcomes (the plots are drawn before, by
+/// [`crate::suite::plots::draw_all`] or copied from shards). Returns notes on what the pages
+/// could not include.
+pub fn write_all(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<String>> {
+    std::fs::create_dir_all(dir)?;
+    write_atomic(
+        dir,
+        "verification.json",
+        suite_report::json(outcomes).as_bytes(),
+    )?;
+    write_atomic(
+        dir,
+        "verification.csv",
+        suite_report::csv(outcomes).as_bytes(),
+    )?;
+    write_pages(dir, outcomes)
+}
+
 /// Writes `index.html` and one page per scene into `dir` (the JSON and CSV it links are
-/// written by [`crate::suite::report::write_all`]). Draws the scene Pareto fronts from the
+/// written by [`write_all`]). Draws the scene Pareto fronts from the
 /// `work-*.json` files in `dir`. Returns notes on what could not be included.
 pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<String>> {
     let mut notes = Vec::new();

@@ -1,5 +1,5 @@
 //! One rung's measurement: the quantity's value and the rung's cost, measured two ways with
-//! the suite's rule ([`crate::report::work::time_rung`]): the wall time as the minimum of
+//! the suite's rule ([`crate::work::time_rung`]): the wall time as the minimum of
 //! repeats (at least 5 and 0.2 s; a rung whose first run took more than 3 s is timed once, and
 //! its `repeats` says so), with median, maximum and spread; and the backend's work counters
 //! (DOFs, steps, RHS evaluations, factorizations, Newton iterations), exact and machine
@@ -9,10 +9,10 @@ use data::{BackendKind, Scene, Settings};
 use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
-use crate::report::work::{Counters, FirstRun, Timing, time_rung};
 use crate::suite::evaluate::measure;
 use crate::suite::quantity::Quantity;
 use crate::suite::run_cache::{RunCache, compute};
+use crate::work::{Counters, FirstRun, Timing, time_rung};
 
 /// One rung's measurement: the quantity's value, the peak |channel| for time histories, the
 /// repeated timings and the work counters.

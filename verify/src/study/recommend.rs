@@ -17,8 +17,8 @@ use super::summary::Rung;
 use crate::error::Error;
 use crate::output::wrap;
 use crate::progress::Progress;
-use crate::report::work::{Counters, work_counter_of};
 use crate::suite::quantity::Quantity;
+use crate::work::{Counters, work_counter_of};
 
 /// The cheapest measured discretization meeting a tolerance.
 #[derive(Debug, Clone, Serialize)]

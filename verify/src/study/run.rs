@@ -7,13 +7,10 @@ use data::{BackendKind, Scene, Settings};
 
 use super::ladder::{Refine, rung_specs};
 use super::measure::{RungMeasurement, measure_rung, parse_quantity};
-use super::summary::{Rung, Study, summarize, summarize_ladder};
+use super::summary::{CAPPED, Rung, Study, summarize, summarize_ladder};
 use crate::error::Error;
 use crate::progress::Progress;
 use crate::suite::run_cache::RunCache;
-
-/// How the note of a ladder stopped by the rung budget begins.
-pub const CAPPED: &str = "ladder capped";
 
 /// Runs the ladders and fills errors against the best available reference, reporting each
 /// rung to `progress`.

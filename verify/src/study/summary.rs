@@ -8,10 +8,10 @@ use data::{BackendKind, Scene, Settings};
 use serde::{Deserialize, Serialize};
 
 use super::ladder::Refine;
-use crate::report::work::{Counters, Timing};
 use crate::suite::order::{falling_prefix, fit_order, richardson};
 use crate::suite::quantity::Quantity;
 use crate::suite::reference::{analytic_value, default_analytic_id};
+use crate::work::{Counters, Timing};
 
 /// One rung of a refinement ladder.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -57,12 +57,13 @@ pub struct Ladder {
     pub estimate: Option<Estimate>,
 }
 
+/// How the note of a ladder stopped by the rung budget begins.
+pub const CAPPED: &str = "ladder capped";
+
 impl Ladder {
     /// Whether the rung budget stopped this ladder before its last rung.
     pub fn capped_by_budget(&self) -> bool {
-        self.note
-            .as_deref()
-            .is_some_and(|n| n.starts_with(super::run::CAPPED))
+        self.note.as_deref().is_some_and(|n| n.starts_with(CAPPED))
     }
 }
 

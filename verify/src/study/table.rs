@@ -8,7 +8,7 @@ use super::summary::{Ladder, Study};
 use crate::error::Error;
 use crate::output::{Column, csv_table, fitted_table, text_table, wrap, write_atomic};
 use crate::plot::{Series, plot};
-use crate::report::work::{Counters, work_counter_of};
+use crate::work::{Counters, work_counter_of};
 
 /// Short name of a work counter, for table cells.
 fn counter_abbreviation(name: &str) -> &'static str {

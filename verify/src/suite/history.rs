@@ -20,11 +20,9 @@
 use std::borrow::Cow;
 
 use data::RunResult;
+use data::cases::ENERGY_PREFIX;
 
 use super::filter::{lowpass_zero_phase, resample_uniform};
-
-/// Prefix of energy-ledger terms in history channel names.
-pub const ENERGY_PREFIX: &str = "energy.";
 
 /// (times, values) of a channel or ledger term of a run.
 pub fn series<'a>(r: &'a RunResult, channel: &str) -> Option<(&'a [f64], Cow<'a, [f64]>)> {

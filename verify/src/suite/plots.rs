@@ -16,7 +16,7 @@ use super::quantity::Quantity;
 use super::reference::analytic_value;
 use super::run_cache::{Answer, RunCache, compute};
 use crate::plot::{Mark, Series, StyledSeries, plot, plot_styled};
-use crate::report::work::{CaseWork, FirstRun, WorkPoint, time_rung, work_counter};
+use crate::work::{CaseWork, FirstRun, WorkPoint, time_rung, work_counter};
 
 fn scene_of(case: &Case) -> Option<Scene> {
     if case.overrides.is_empty() {
@@ -82,7 +82,7 @@ fn concrete_unit(unit: &str, scene: &Scene) -> String {
 
 /// The y-axis label of a history channel: its name and unit.
 fn channel_label(r: &RunResult, scene: &Scene, channel: &str) -> String {
-    if channel.starts_with(super::history::ENERGY_PREFIX) {
+    if channel.starts_with(data::cases::ENERGY_PREFIX) {
         return format!("{channel} [{}]", energy_unit(scene));
     }
     match r.observables.get(channel) {

@@ -46,6 +46,11 @@ pub enum Quantity {
     },
 }
 
+/// Number of modes requested from a backend for frequency checks up to mode `n`.
+pub fn mode_count(n: usize) -> usize {
+    n.max(12)
+}
+
 /// Which backend analysis a quantity needs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Analysis {
@@ -220,10 +225,10 @@ impl Quantity {
     /// Modes to request from a backend (0 for non-modal quantities).
     pub fn modes_needed(&self) -> usize {
         match self {
-            Quantity::Frequency { n, kind: None } => super::run_cache::mode_count(*n),
+            Quantity::Frequency { n, kind: None } => mode_count(*n),
             // The n-th mode of one kind can sit far up the spectrum (the 3-D link's first axial
             // mode is its ~15th): ask for enough modes that every field has n of its own.
-            Quantity::Frequency { n, kind: Some(_) } => 4 * super::run_cache::mode_count(*n),
+            Quantity::Frequency { n, kind: Some(_) } => 4 * mode_count(*n),
             _ => 0,
         }
     }
@@ -271,7 +276,7 @@ impl Quantity {
 
     pub fn from_run(&self, r: &RunResult) -> Result<f64, String> {
         let missing = |c: &str| {
-            if c.starts_with(super::history::ENERGY_PREFIX) {
+            if c.starts_with(data::cases::ENERGY_PREFIX) {
                 let l = &r.ledger;
                 let terms: Vec<String> = l
                     .stored

@@ -1,9 +1,7 @@
-//! The verification table, its JSON/CSV forms and the HTML index.
-
-use std::path::Path;
+//! The verification table and its JSON/CSV forms (the HTML pages: [`crate::report`]).
 
 use super::evaluate::{Outcome, Status};
-use crate::output::{Column, csv_table, fitted_table, text_table, wrap, write_atomic};
+use crate::output::{Column, csv_table, fitted_table, text_table, wrap};
 
 const HEADER: [&str; 11] = [
     "check",
@@ -175,14 +173,4 @@ pub fn csv(outcomes: &[Outcome]) -> String {
 
 pub fn json(outcomes: &[Outcome]) -> String {
     serde_json::to_string_pretty(outcomes).expect("serializable outcomes")
-}
-
-/// JSON, CSV and the HTML pages of [`crate::report`] (the plots are drawn before, by
-/// [`super::plots::draw_all`] or copied from shards). Returns notes on what the pages could
-/// not include.
-pub fn write_all(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<String>> {
-    std::fs::create_dir_all(dir)?;
-    write_atomic(dir, "verification.json", json(outcomes).as_bytes())?;
-    write_atomic(dir, "verification.csv", csv(outcomes).as_bytes())?;
-    crate::report::write_pages(dir, outcomes)
 }

@@ -8,7 +8,7 @@ use data::{BackendError, BackendKind, ModalResult, RunResult, Scene, Settings, S
 
 use super::quantity::Analysis;
 use crate::registry::backend;
-use crate::report::work::Counters;
+use crate::work::Counters;
 
 #[derive(Debug, Clone)]
 pub enum Answer {
@@ -22,11 +22,6 @@ type Slot = Arc<OnceLock<Answer>>;
 #[derive(Default)]
 pub struct RunCache {
     slots: Mutex<HashMap<String, Slot>>,
-}
-
-/// Number of modes requested from a backend for frequency checks up to mode `n`.
-pub fn mode_count(n: usize) -> usize {
-    n.max(12)
 }
 
 impl RunCache {

@@ -1,8 +1,7 @@
 //! Bilateral tip contact with Coulomb friction and stick–slip (seed 001, scene
 //! `constrained-arm`) for the midpoint schemes (`energy-midpoint`, the default, whose step the
 //! text below describes; `implicit-midpoint` applies the same terms at its midpoint and books
-//! the other works by the trapezoidal rule: ledger closure 1.1e-6 on the scene at the default
-//! step, O(h²), against energy-midpoint's 1e-10).
+//! the other works by the trapezoidal rule, so its ledger closes to O(h²) only).
 //!
 //! **Constraint.** The tip of the named link stays on the wall ([`crate::events::wall`]) for all time:
 //! g(q) = 0 from t = 0 (the scene starts on the wall, checked), never released, multiplier λ
@@ -61,8 +60,7 @@
 //!    direction of motion (no stick test on a moving tip).
 //! 4. Located switches never use trial steps shorter than [`MIN_TRIAL`] of the step: on a
 //!    step of length h → 0 the constraint g(q₁) = 0, met only to the Newton tolerance at q₀,
-//!    takes a multiplier ~ε/h² (measured 5e12 N on a 7e-15 s trial, which then booked negative
-//!    friction work). A root within that first fraction is taken at the step start: the
+//!    takes a multiplier ~ε/h², whose friction work can come out negative. A root within that first fraction is taken at the step start: the
 //!    switch is applied there and the step re-solved in the new phase.
 //!
 //! Events: `data::Event::StickSlip` (`sticking` true at a stick, false at slip onset,
@@ -73,14 +71,10 @@
 //! `contact1.slip_velocity` (v_t), `contact1.friction_force` (tangential force along t̂:
 //! −μ s|λ| sliding, λ_t sticking), `contact1.friction_work` (= ledger `friction`).
 //!
-//! **Measured** (`constrained-arm`, Euler model, 16 elements): ledger closure 8.4e-11, max |g|
-//! 3.3e-16 m, ~100–150 switches in 2 s; θ(2 s) 7.57e-3 / 8.91e-3 / 9.35e-3 / 9.39e-3 rad at
-//! dt = 1e-3 / 5e-4 / 2.5e-4 / 1.25e-4 s (modal, polynomial basis, 6 modes: 9.45e-3): the wall
+//! Measured figures on `constrained-arm` (ledger, gap, switches, θ(2 s) against the step and
+//! against modal, the stiff limit against the rigid closed form): docs/contact.md. The wall
 //! load is carried by the axial field, so the default step resolves the first axial mode
-//! ([`crate::run::axial_wall_step`]: 1.25e-4 s here, against 1e-3 s from the bending rule);
-//! friction work 5.30e-3 J (modal 5.33e-3); switch times at dt = 2.5e-4 within ~1e-3 s of
-//! modal's (first stick 0.02477 / 0.02469 s). EI, EA ×1000: θ(2) = 3.744241 rad (rigid closed
-//! form 3.737974, modal 3.744246).
+//! ([`crate::run::axial_wall_step`]).
 //!
 //! Refused: the inextensible link (no axial field) on the circle of radius L about its own hub
 //! (it can stay on that circle only straight: the rigid model, gradient G = 0 and λ undefined).

@@ -1,0 +1,205 @@
+//! The contract between a method and the driver: the [`Stepper`] trait, what a method works on
+//! during a step ([`StepContext`]), how it sees a held constraint ([`StepConstraint`],
+//! [`ConstraintView`], [`HeldConstraint`]), and the Newton helpers the methods share.
+
+use super::newton::NewtonSystem;
+use super::state::{Adaptive, Counters, StepState, Works};
+use crate::chain::{Chain, Parts};
+use crate::error::FemError;
+use crate::linalg::{dot, max_abs};
+
+/// What a method works on during one step: the model, the state, the Newton system and the
+/// counters, plus the driver's step settings.
+pub struct StepContext<'a> {
+    pub chain: &'a mut Chain,
+    pub state: &'a mut StepState,
+    pub newton: &'a mut NewtonSystem,
+    pub counters: &'a mut Counters,
+    pub adaptive: Option<Adaptive>,
+    /// The fixed step (shortened steps are measured against it).
+    pub h_nominal: f64,
+    /// Largest link length (scales tolerances).
+    pub length_scale: f64,
+}
+
+/// One Newton iterate of a step, as a constraint sees it.
+pub struct ConstraintView<'a> {
+    /// Newton iteration index within the step.
+    pub it: usize,
+    /// t₀, t_mid, t₁.
+    pub t: [f64; 3],
+    pub q0: &'a [f64],
+    pub q1: &'a [f64],
+    pub qbar: &'a [f64],
+    pub dq: &'a [f64],
+    /// W Δq = M(q̄)Δq and ΔqᵀWΔq (the metric of the discrete gradients).
+    pub w_dq: &'a [f64],
+    pub denom: f64,
+    /// Constraint value at the step start, g(q₀).
+    pub g0: f64,
+    /// Normal multiplier of this iterate.
+    pub lambda: f64,
+}
+
+/// The Newton tolerance of a position update: the system's absolute tolerance, floored at the
+/// round-off level of the update itself (`c_q`|q̈| + h|q̇|).
+pub(crate) fn update_tolerance(newton_tol: f64, c_q: f64, h: f64, qdd: &[f64], qd: &[f64]) -> f64 {
+    newton_tol + 1e-13 * (c_q * max_abs(qdd) + h * max_abs(qd))
+}
+
+/// A step of length `h` from `t` whose Newton iteration did not converge (`last`: its last
+/// update): retried shorter when it can be (adaptive, or longer than 1e-6 of the nominal
+/// step: `Some(∞)`), else the run stops.
+pub(crate) fn unconverged(
+    adaptive: bool,
+    h_nominal: f64,
+    t: f64,
+    h: f64,
+    last: f64,
+) -> Result<Option<f64>, FemError> {
+    if adaptive || h > 1e-6 * h_nominal {
+        return Ok(Some(f64::INFINITY));
+    }
+    Err(FemError::Runaway {
+        t,
+        what: format!("Newton iteration did not converge (last update {last:.3e})"),
+        location: None,
+        why: "the step is too large for the nonlinearity or the solution diverged".into(),
+        remedy: "reduce --dt or give --rtol for adaptive stepping".into(),
+    })
+}
+
+/// Work buffers of a held constraint in a method's Newton iteration, and the one operation
+/// the implicit methods share: the constraint force of an iterate on the momentum residual.
+#[derive(Debug, Clone)]
+pub(crate) struct HeldConstraint {
+    /// Δq = q₁ − q₀ of the iterate (filled by the method) and W Δq = M(q̄)Δq.
+    pub dq: Vec<f64>,
+    pub w_dq: Vec<f64>,
+    /// The momentum residual with the constraint force.
+    pub res: Vec<f64>,
+    /// Zeros (the rates of the metric pass; a zero-length step's Δq).
+    pub zero: Vec<f64>,
+}
+
+impl HeldConstraint {
+    /// Buffers for `n` DOFs.
+    pub fn new(n: usize) -> Self {
+        HeldConstraint {
+            dq: vec![0.0; n],
+            w_dq: vec![0.0; n],
+            res: vec![0.0; n],
+            zero: vec![0.0; n],
+        }
+    }
+
+    /// With [`Self::dq`] filled: W Δq at q̄ (after the Newton matrix was formed: it reads the
+    /// point data of the full residual pass), then [`Self::res`] = `residual` minus the
+    /// constraint force of the iterate (times t₀, t_mid, t₁). Returns the constraint value
+    /// Newton must drive to its target ([`StepConstraint::add_force`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn force(
+        &mut self,
+        chain: &mut Chain,
+        counters: &mut Counters,
+        k: &mut dyn StepConstraint,
+        it: usize,
+        t: [f64; 3],
+        (q0, q1, qbar): (&[f64], &[f64], &[f64]),
+        (g0, lambda): (f64, f64),
+        residual: &[f64],
+    ) -> f64 {
+        chain.residual_parts(
+            t[1],
+            qbar,
+            &self.zero,
+            &self.dq,
+            Parts::INERTIA,
+            &mut self.w_dq,
+        );
+        counters.rhs += 1;
+        let view = ConstraintView {
+            it,
+            t,
+            q0,
+            q1,
+            qbar,
+            dq: &self.dq,
+            w_dq: &self.w_dq,
+            denom: dot(&self.dq, &self.w_dq),
+            g0,
+            lambda,
+        };
+        self.res.copy_from_slice(residual);
+        k.add_force(chain, &view, &mut self.res)
+    }
+}
+
+/// A bilateral constraint held during a step (a tip on a surface, optionally with friction),
+/// seen by a method through its force and its Newton border only.
+pub trait StepConstraint {
+    /// Constraint value g(q) at (t, q).
+    fn value(&self, chain: &Chain, t: f64, q: &[f64]) -> f64;
+    /// The multiplier the step starts from (the last accepted step's).
+    fn multiplier(&self) -> f64;
+    /// Stores the multiplier of a converged step.
+    fn set_multiplier(&mut self, lambda: f64);
+    /// Subtracts the constraint force (and friction) of the iterate from the momentum
+    /// residual `res`; returns the constraint value Newton must drive to its target.
+    fn add_force(&mut self, chain: &Chain, view: &ConstraintView<'_>, res: &mut [f64]) -> f64;
+    /// Bordered Newton update: leaves δa in `newton.delta` (from the residual `res`, the
+    /// Newton matrix factorized in `newton`) and returns δλ; `gap1` is the value returned by
+    /// [`StepConstraint::add_force`], `gap_target` what it must reach; `dq1_da` = ∂q₁/∂a, the
+    /// sensitivity of the step-end configuration to the method's Newton unknown a (h²/2 for
+    /// the midpoint schemes' mean acceleration, βh²(1−α_f)/(1−α_m) for generalized-α's q̈₁).
+    fn newton_update(
+        &mut self,
+        newton: &mut NewtonSystem,
+        res: &[f64],
+        dq1_da: f64,
+        gap1: f64,
+        gap_target: f64,
+    ) -> f64;
+}
+
+/// One integration method.
+pub trait Stepper: std::fmt::Debug {
+    /// Solves the step t₀ → t₁ = t₀ + h from `cx.state` into its trial end (laws evaluated at
+    /// `t_law`, = t₁ except as a left limit at a discontinuity). Returns the scaled local error
+    /// estimate when adaptive, `Some(∞)` when Newton failed (the driver retries shorter).
+    /// `constraint`: a held bilateral constraint (methods without that support refuse it).
+    fn step(
+        &mut self,
+        cx: &mut StepContext<'_>,
+        constraint: Option<&mut dyn StepConstraint>,
+        h: f64,
+        t1: f64,
+        t_law: f64,
+    ) -> Result<Option<f64>, FemError>;
+
+    /// Whether every stretch between stop times must be split into equal steps.
+    fn equal_steps(&self) -> bool {
+        false
+    }
+
+    /// Books the accepted step's works with the method's own quadrature; false when the
+    /// driver books them (trapezoidal rule on the joint quantities).
+    fn commit(&mut self, _h: f64, _works: &mut Works) -> bool {
+        false
+    }
+
+    /// Forgets the previous step (restart after a discontinuity or an event).
+    fn restart(&mut self) {}
+}
+
+/// A method without a bordered (constrained) update refuses a held contact (`run` refuses
+/// such scenes first; this guards other drivers).
+pub(crate) fn refuse_constraint(method: &str, held: bool) -> Result<(), FemError> {
+    if held {
+        return Err(FemError::unsupported(format!(
+            "fem {method}: contact constraints are stepped by the implicit methods only \
+             (energy-midpoint, implicit-midpoint, generalized-alpha)"
+        )));
+    }
+    Ok(())
+}
