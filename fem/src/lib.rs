@@ -58,8 +58,9 @@
 //! a constant-displacement predictor and Newton on q̈. Newton matrix (both implicit schemes): the
 //! analytic bordered-band matrix (mass, Coriolis C = Σm Jᵀ2J̇, inertial and elastic stiffness;
 //! cost linear in the elements) for prescribed-hub links and chains without foreshortening; for
-//! free chains *with* foreshortening the ∂s/∂q couplings are O(v′) in the joint rows, so those
-//! use an exact finite-difference Jacobian (dense LU, reused across steps). Newton failures in
+//! free chains *with* foreshortening, whose ∂s/∂q couplings reach whole links from the joint
+//! rows, the exact matrix augmented with the running sums of the foreshortening (still a
+//! bordered band: [`chain::AugmentedLayout`], factorized by a band LU). Newton failures in
 //! fixed-step mode retry the stretch with quarter steps (reported as rejected steps). Default
 //! step: min(output interval, T₁/40) with T₁ the first flexible period of the stiffest link
 //! (clamped-free on a prescribed joint, pinned-free on a free one) — and at most T₁/320 of the
