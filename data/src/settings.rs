@@ -55,13 +55,45 @@ pub enum Basis {
 }
 
 impl Basis {
-    pub fn name(self) -> &'static str {
+    /// Every basis, in the order messages and the command line list them.
+    pub const ALL: [Basis; 4] = [
+        Basis::Poly,
+        Basis::ClampedFree,
+        Basis::TipMass,
+        Basis::FreeFree,
+    ];
+    /// Accepted spellings ([`Basis::name`] of each of [`Basis::ALL`]).
+    pub const NAMES: [&'static str; 4] = [
+        Self::ALL[0].name(),
+        Self::ALL[1].name(),
+        Self::ALL[2].name(),
+        Self::ALL[3].name(),
+    ];
+
+    pub const fn name(self) -> &'static str {
         match self {
             Basis::Poly => "poly",
             Basis::ClampedFree => "clamped-free",
             Basis::TipMass => "tip-mass",
             Basis::FreeFree => "free-free",
         }
+    }
+}
+
+impl std::str::FromStr for Basis {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let name = text.trim();
+        Basis::ALL
+            .into_iter()
+            .find(|b| b.name() == name)
+            .ok_or_else(|| {
+                format!(
+                    "unknown modal basis `{name}`; accepted: {}",
+                    Basis::NAMES.join(", ")
+                )
+            })
     }
 }
 
@@ -94,14 +126,33 @@ pub enum FemElement {
 }
 
 impl FemElement {
-    /// Accepted spellings, for error messages and CLI help.
-    pub const NAMES: [&'static str; 2] = ["hermite-cubic", "hermite-quintic"];
+    /// Every element, in the order messages and the command line list them.
+    pub const ALL: [FemElement; 2] = [FemElement::HermiteCubic, FemElement::HermiteQuintic];
+    /// Accepted spellings ([`FemElement::name`] of each of [`FemElement::ALL`]).
+    pub const NAMES: [&'static str; 2] = [Self::ALL[0].name(), Self::ALL[1].name()];
 
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             FemElement::HermiteCubic => "hermite-cubic",
             FemElement::HermiteQuintic => "hermite-quintic",
         }
+    }
+}
+
+impl std::str::FromStr for FemElement {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let name = text.trim();
+        FemElement::ALL
+            .into_iter()
+            .find(|e| e.name() == name)
+            .ok_or_else(|| {
+                format!(
+                    "unknown FEM element `{name}`; accepted: {}",
+                    FemElement::NAMES.join(", ")
+                )
+            })
     }
 }
 

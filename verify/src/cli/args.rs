@@ -1,7 +1,7 @@
 //! Argument definitions (clap derive). The library's selectors ([`Format`], [`Suite`],
 //! [`Refine`]) know nothing of clap; their command-line spellings are defined here.
 
-use clap::builder::PossibleValue;
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use data::{BackendKind, Settings};
 
@@ -223,20 +223,6 @@ impl CommonOpts {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum BasisChoice {
-    Poly,
-    ClampedFree,
-    TipMass,
-    FreeFree,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ElementChoice {
-    HermiteCubic,
-    HermiteQuintic,
-}
-
 /// Options shared by the scene commands.
 #[derive(Debug, Clone, Args)]
 pub struct CommonOpts {
@@ -247,8 +233,9 @@ pub struct CommonOpts {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub elements: Option<u32>,
     /// FEM: Euler–Bernoulli element (default hermite-cubic; hermite-quintic: frequency error O(h⁸)).
-    #[arg(long, value_enum)]
-    pub element: Option<ElementChoice>,
+    #[arg(long, value_parser = PossibleValuesParser::new(data::FemElement::NAMES)
+        .try_map(|name| name.parse::<data::FemElement>()))]
+    pub element: Option<data::FemElement>,
     /// FDM: stations per link/body (both ends included).
     #[arg(long, value_parser = clap::value_parser!(u32).range(2..=1_000_000))]
     pub stations: Option<u32>,
@@ -256,8 +243,9 @@ pub struct CommonOpts {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub modes: Option<u32>,
     /// Modal: basis functions.
-    #[arg(long, value_enum)]
-    pub basis: Option<BasisChoice>,
+    #[arg(long, value_parser = PossibleValuesParser::new(data::Basis::NAMES)
+        .try_map(|name| name.parse::<data::Basis>()))]
+    pub basis: Option<data::Basis>,
     /// Time step (fixed step, or first step of adaptive methods).
     #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
     pub dt: Option<f64>,
@@ -335,16 +323,8 @@ impl CommonOpts {
                 elements: self.elements.map(|n| n as usize),
                 stations: self.stations.map(|n| n as usize),
                 modes: self.modes.map(|n| n as usize),
-                basis: self.basis.map(|b| match b {
-                    BasisChoice::Poly => data::Basis::Poly,
-                    BasisChoice::ClampedFree => data::Basis::ClampedFree,
-                    BasisChoice::TipMass => data::Basis::TipMass,
-                    BasisChoice::FreeFree => data::Basis::FreeFree,
-                }),
-                element: self.element.map(|e| match e {
-                    ElementChoice::HermiteCubic => data::FemElement::HermiteCubic,
-                    ElementChoice::HermiteQuintic => data::FemElement::HermiteQuintic,
-                }),
+                basis: self.basis,
+                element: self.element,
             },
             time: data::TimeStepping {
                 dt: self.dt,
