@@ -42,15 +42,15 @@
 //! Not built: the centrifugal tension's share of the step bound (the base rates of the catalog
 //! add < 1e-4 of ω_max²), the gyroscopic term in `modes` (K − Ω²H against M_ff, undamped).
 
-pub mod band;
 pub mod run;
+pub mod spd;
 
 use data::ledger_term;
 use data::scene::{LinkField, PayloadLink, PrescribedMotion, TorqueLaw};
 use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
-use band::Triplets;
+use spd::Triplets;
 
 /// Default stations (including the clamped root).
 pub const DEFAULT_STATIONS: usize = 21;
@@ -121,6 +121,28 @@ pub struct PayloadLinkModel {
 }
 
 impl PayloadLinkModel {
+    /// Number of field coordinates (stations 1…r × carried fields).
+    pub fn field_coordinates(&self) -> usize {
+        self.n
+    }
+
+    /// C = Σ_f (γ_f / modulus_f) K_f: the Kelvin–Voigt damping of the carried fields.
+    pub fn damping_matrix(&self) -> Triplets {
+        let mut c = Triplets::default();
+        for &(_, k, ratio) in &self.damping {
+            for &(i, j, v) in &self.stiffness[k].1.entries {
+                c.entries.push((i, j, ratio * v));
+            }
+        }
+        c
+    }
+
+    /// The matrix A = M_ff + ½τC of the step with implicit Kelvin–Voigt damping, as the scaled
+    /// parts [`spd::SpdFactor::factor`] sums (`c` from [`Self::damping_matrix`]).
+    pub fn step_matrix_parts<'a>(&'a self, c: &'a Triplets, tau: f64) -> [(&'a Triplets, f64); 2] {
+        [(&self.mff, 1.0), (c, 0.5 * tau)]
+    }
+
     /// The model of `p`, the payload link of `scene` (whose field stations it samples).
     pub fn from_payload_link(
         scene: &Scene,
@@ -550,7 +572,7 @@ impl PayloadLinkModel {
             return Ok(vec![0.0; self.n]);
         };
         let parts: Vec<(&Triplets, f64)> = self.stiffness.iter().map(|(_, k)| (k, 1.0)).collect();
-        let chol = band::BandCholesky::factor(self.n, &parts, "the stiffness matrix")?;
+        let mut chol = spd::SpdFactor::factor(self.n, &parts, "the stiffness matrix")?;
         let mut q = fg.clone();
         chol.solve_in_place(&mut q);
         Ok(q)

@@ -12,7 +12,7 @@ use data::{
     ledger_term,
 };
 
-use super::band::{BandCholesky, Triplets};
+use super::spd::{SpdFactor, Triplets};
 use super::{BaseDrive, PayloadLinkModel, apply, dot};
 use crate::error::FdmError;
 use crate::output::sample_field;
@@ -66,7 +66,7 @@ struct Level {
 struct Stepper<'a> {
     model: &'a PayloadLinkModel,
     /// A = M_ff + ½τC
-    a: BandCholesky,
+    a: SpdFactor,
     /// C = Σ ratio_f K_f
     c: Triplets,
     f: Vec<f64>,
@@ -76,15 +76,10 @@ struct Stepper<'a> {
 
 impl<'a> Stepper<'a> {
     fn new(model: &'a PayloadLinkModel, tau: f64) -> Result<Self, FdmError> {
-        let mut c = Triplets::default();
-        for &(_, k, ratio) in &model.damping {
-            for &(i, j, v) in &model.stiffness[k].1.entries {
-                c.entries.push((i, j, ratio * v));
-            }
-        }
-        let a = BandCholesky::factor(
+        let c = model.damping_matrix();
+        let a = SpdFactor::factor(
             model.n,
-            &[(&model.mff, 1.0), (&c, 0.5 * tau)],
+            &model.step_matrix_parts(&c, tau),
             "the field mass matrix",
         )?;
         let n = model.n;
