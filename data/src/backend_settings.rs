@@ -19,112 +19,84 @@ use crate::settings::{
     BackendKind, Basis, Discretization, FemElement, Method, SettingField, Settings, TimeStepping,
 };
 
-/// A time-integration method of the FEM backend.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FemMethod {
-    /// Energy-consistent implicit midpoint (discrete-gradient) scheme for free-joint chains:
-    /// the energy ledger closes to the Newton tolerance.
-    EnergyMidpoint,
-    /// Implicit generalized-α (Chung–Hulbert, Arnold–Brüls form) with Newton iterations.
-    GeneralizedAlpha,
-    /// Explicit central difference (velocity-Verlet form) under its stability bound.
-    CentralDifference,
-    /// Implicit midpoint rule (one-stage Gauss) with Newton iterations.
-    ImplicitMidpoint,
-}
-
-/// A time-integration method of the FDM backend, as spelled (`central-difference` is the
-/// report's scheme under its general name; ν of Robert–Asselin None: the backend's default).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum FdmMethod {
-    /// The report's two-step central difference.
-    Report,
-    /// The same scheme, spelled `central-difference`.
-    CentralDifference,
-    /// The report's scheme with a Robert–Asselin filter of coefficient ν.
-    RobertAsselin { nu: Option<f64> },
-    /// One-step velocity (kick–drift–kick) form.
-    VelocityForm,
-}
-
-/// A time-integration method of the modal backend.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ModalMethod {
-    /// Adaptive Dormand–Prince 5(4).
-    Dopri5,
-    /// Adaptive TR-BDF2.
-    TrBdf2,
-    /// TR-BDF2 at a fixed step.
-    TrBdf2Fixed,
-    /// Trapezoidal rule at a fixed step.
-    Trapezoid,
-}
-
-impl From<FemMethod> for Method {
-    fn from(m: FemMethod) -> Method {
-        match m {
-            FemMethod::EnergyMidpoint => Method::EnergyMidpoint,
-            FemMethod::GeneralizedAlpha => Method::GeneralizedAlpha,
-            FemMethod::CentralDifference => Method::CentralDifference,
-            FemMethod::ImplicitMidpoint => Method::ImplicitMidpoint,
+/// One backend's method enum — each variant a [`Method`] variant of the same name (with its
+/// payload) — with the conversions both ways: `From<Backend> for Method` and the accessor
+/// `Method::accessor(self) -> Option<Backend>`. A backend's method list is this one
+/// declaration.
+macro_rules! backend_methods {
+    (
+        $(#[$doc:meta])*
+        $name:ident ($($derive:ident),*), $accessor:ident {
+            $($(#[$vdoc:meta])* $variant:ident $({ $field:ident: $fty:ty })?),* $(,)?
         }
+    ) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq $(, $derive)*)]
+        pub enum $name {
+            $($(#[$vdoc])* $variant $({ $field: $fty })?),*
+        }
+
+        impl From<$name> for Method {
+            fn from(m: $name) -> Method {
+                match m {
+                    $($name::$variant $({ $field })? => Method::$variant $({ $field })?),*
+                }
+            }
+        }
+
+        impl Method {
+            #[doc = concat!("This method as [`", stringify!($name), "`], if that backend implements it.")]
+            pub fn $accessor(self) -> Option<$name> {
+                match self {
+                    $(Method::$variant $({ $field })? => Some($name::$variant $({ $field })?),)*
+                    _ => None,
+                }
+            }
+        }
+    };
+}
+
+backend_methods! {
+    /// A time-integration method of the FEM backend.
+    FemMethod (Eq), fem {
+        /// Energy-consistent implicit midpoint (discrete-gradient) scheme for free-joint
+        /// chains: the energy ledger closes to the Newton tolerance.
+        EnergyMidpoint,
+        /// Implicit generalized-α (Chung–Hulbert, Arnold–Brüls form) with Newton iterations.
+        GeneralizedAlpha,
+        /// Explicit central difference (velocity-Verlet form) under its stability bound.
+        CentralDifference,
+        /// Implicit midpoint rule (one-stage Gauss) with Newton iterations.
+        ImplicitMidpoint,
     }
 }
 
-impl From<FdmMethod> for Method {
-    fn from(m: FdmMethod) -> Method {
-        match m {
-            FdmMethod::Report => Method::Report,
-            FdmMethod::CentralDifference => Method::CentralDifference,
-            FdmMethod::RobertAsselin { nu } => Method::RobertAsselin { nu },
-            FdmMethod::VelocityForm => Method::VelocityForm,
-        }
+backend_methods! {
+    /// A time-integration method of the FDM backend, as spelled (`central-difference` is the
+    /// report's scheme under its general name; ν of Robert–Asselin None: the backend's default).
+    FdmMethod (), fdm {
+        /// The report's two-step central difference.
+        Report,
+        /// The same scheme, spelled `central-difference`.
+        CentralDifference,
+        /// The report's scheme with a Robert–Asselin filter of coefficient ν.
+        RobertAsselin { nu: Option<f64> },
+        /// One-step velocity (kick–drift–kick) form.
+        VelocityForm,
     }
 }
 
-impl From<ModalMethod> for Method {
-    fn from(m: ModalMethod) -> Method {
-        match m {
-            ModalMethod::Dopri5 => Method::Dopri5,
-            ModalMethod::TrBdf2 => Method::TrBdf2,
-            ModalMethod::TrBdf2Fixed => Method::TrBdf2Fixed,
-            ModalMethod::Trapezoid => Method::Trapezoid,
-        }
-    }
-}
-
-impl Method {
-    /// This method as the FEM backend's, if it implements it.
-    pub fn fem(self) -> Option<FemMethod> {
-        match self {
-            Method::EnergyMidpoint => Some(FemMethod::EnergyMidpoint),
-            Method::GeneralizedAlpha => Some(FemMethod::GeneralizedAlpha),
-            Method::CentralDifference => Some(FemMethod::CentralDifference),
-            Method::ImplicitMidpoint => Some(FemMethod::ImplicitMidpoint),
-            _ => None,
-        }
-    }
-
-    /// This method as the FDM backend's, if it implements it.
-    pub fn fdm(self) -> Option<FdmMethod> {
-        match self {
-            Method::Report => Some(FdmMethod::Report),
-            Method::CentralDifference => Some(FdmMethod::CentralDifference),
-            Method::RobertAsselin { nu } => Some(FdmMethod::RobertAsselin { nu }),
-            Method::VelocityForm => Some(FdmMethod::VelocityForm),
-            _ => None,
-        }
-    }
-
-    /// This method as the modal backend's, if it implements it.
-    pub fn modal(self) -> Option<ModalMethod> {
-        match self {
-            Method::Dopri5 => Some(ModalMethod::Dopri5),
-            Method::TrBdf2 => Some(ModalMethod::TrBdf2),
-            Method::TrBdf2Fixed => Some(ModalMethod::TrBdf2Fixed),
-            Method::Trapezoid => Some(ModalMethod::Trapezoid),
-            _ => None,
-        }
+backend_methods! {
+    /// A time-integration method of the modal backend.
+    ModalMethod (Eq), modal {
+        /// Adaptive Dormand–Prince 5(4).
+        Dopri5,
+        /// Adaptive TR-BDF2.
+        TrBdf2,
+        /// TR-BDF2 at a fixed step.
+        TrBdf2Fixed,
+        /// Trapezoidal rule at a fixed step.
+        Trapezoid,
     }
 }
 

@@ -29,8 +29,9 @@
 //! counters a method carries (module `state`: [`StepState`], [`Counters`], [`Works`]). This
 //! file holds only the registry, so the methods depend on `step` and `state`, never on it.
 //!
-//! Adding a method: one new file here implementing [`Stepper`], one `match` line in
-//! [`stepper`] (and the name in [`crate::settings`]).
+//! Adding a method: one new file here implementing [`Stepper`] (and its `pub mod` line), one
+//! `match` line in [`stepper`]; in `data`, its [`data::Method`] variant with one row of the
+//! spelling table and its name in the `FemMethod` list (`data::backend_settings`).
 
 pub mod central_difference;
 pub mod energy_midpoint;
