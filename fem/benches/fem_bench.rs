@@ -30,16 +30,21 @@ fn settings(n: usize, dt: f64) -> Settings {
     s
 }
 
+/// The chain of `scene` with `n` elements per link at a generic state (small deflections,
+/// uniform rates and accelerations): (chain, [q, q̇, q̈]).
+fn chain_at_a_generic_state(scene: &data::Scene, n: usize) -> (Chain, [Vec<f64>; 3]) {
+    let ch = Chain::new(scene.links(), None, n).unwrap();
+    let nd = ch.ndof;
+    let q: Vec<f64> = (0..nd).map(|i| 1e-3 * (i as f64).sin()).collect();
+    (ch, [q, vec![0.1; nd], vec![0.2; nd]])
+}
+
 fn assembly(c: &mut Criterion) {
     let sc = data::load_scene("spin-up").unwrap();
     let mut g = c.benchmark_group("assembly");
     for n in MESHES {
-        let mut ch = Chain::new(sc.links(), None, n).unwrap();
-        let nd = ch.ndof;
-        let q: Vec<f64> = (0..nd).map(|i| 1e-3 * (i as f64).sin()).collect();
-        let qd = vec![0.1; nd];
-        let qdd = vec![0.2; nd];
-        let mut r = vec![0.0; nd];
+        let (mut ch, [q, qd, qdd]) = chain_at_a_generic_state(&sc, n);
+        let mut r = vec![0.0; ch.ndof];
         let mut s = ch.new_matrix();
         let coef = NewtonCoefficients {
             c_a: 1.0,
@@ -164,12 +169,8 @@ fn assembly_foreshortening(c: &mut Criterion) {
     let sc = data::load_scene("two-link-free-undamped").unwrap();
     let mut g = c.benchmark_group("assembly-foreshortening");
     for n in MESHES {
-        let mut ch = Chain::new(sc.links(), None, n).unwrap();
-        let nd = ch.ndof;
-        let q: Vec<f64> = (0..nd).map(|i| 1e-3 * (i as f64).sin()).collect();
-        let qd = vec![0.1; nd];
-        let qdd = vec![0.2; nd];
-        let mut r = vec![0.0; nd];
+        let (mut ch, [q, qd, qdd]) = chain_at_a_generic_state(&sc, n);
+        let mut r = vec![0.0; ch.ndof];
         let layout = ch.augmented_layout();
         let mut s = ch.new_augmented_matrix(&layout);
         let mut x = vec![0.0; layout.n];
@@ -204,12 +205,8 @@ fn augmented_solver(c: &mut Criterion) {
     let sc = data::load_scene("two-link-free-undamped").unwrap();
     let mut g = c.benchmark_group("augmented-solver");
     for n in MESHES {
-        let mut ch = Chain::new(sc.links(), None, n).unwrap();
-        let nd = ch.ndof;
-        let q: Vec<f64> = (0..nd).map(|i| 1e-3 * (i as f64).sin()).collect();
-        let qd = vec![0.1; nd];
-        let qdd = vec![0.2; nd];
-        let mut r = vec![0.0; nd];
+        let (mut ch, [q, qd, qdd]) = chain_at_a_generic_state(&sc, n);
+        let mut r = vec![0.0; ch.ndof];
         ch.residual(3.0, &q, &qd, &qdd, &mut r);
         let layout = ch.augmented_layout();
         let coef = NewtonCoefficients {

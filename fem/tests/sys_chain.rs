@@ -355,17 +355,7 @@ fn sys_analytic_kinetic_gradient_matches_the_finite_difference_identity_at_real_
         FD_STEP, kinetic_gradient, kinetic_gradient_fd, mass_product,
     };
     for name in ["two-link-free", "barhorst-case1"] {
-        let sc = data::load_scene(name).unwrap();
-        let mut p = fem::run::prepare(
-            &sc,
-            sc.planar_chain().unwrap(),
-            &data::FemSettings::default(),
-        )
-        .unwrap();
-        p.driver.set_stop(0.25);
-        while p.driver.state.t < 0.25 - 1e-12 {
-            p.driver.step().unwrap();
-        }
+        let p = common::advanced_default_run(name, 0.25);
         let h = p.h_nominal;
         let st = &p.driver.state;
         let (t, q) = (st.t, st.q.clone());

@@ -6,6 +6,8 @@
 // Index loops mirror the matrix formulas being checked.
 #![allow(clippy::needless_range_loop)]
 
+mod common;
+
 use data::FemElement;
 use fem::chain::{Chain, NewtonCoefficients};
 
@@ -187,17 +189,7 @@ fn sys_exact_matrix_is_the_residual_derivative_at_real_states() {
     // The default runs advanced to 0.25 s, with the energy-midpoint coefficients of their step
     // (c_a = 1, c_v = h/2, c_q = h²/4).
     for name in ["two-link-free", "barhorst-case1"] {
-        let sc = data::load_scene(name).unwrap();
-        let mut p = fem::run::prepare(
-            &sc,
-            sc.planar_chain().unwrap(),
-            &data::FemSettings::default(),
-        )
-        .unwrap();
-        p.driver.set_stop(0.25);
-        while p.driver.state.t < 0.25 - 1e-12 {
-            p.driver.step().unwrap();
-        }
+        let p = common::advanced_default_run(name, 0.25);
         let h = p.h_nominal;
         let c = NewtonCoefficients {
             c_a: 1.0,
@@ -217,17 +209,7 @@ fn sys_band_lu_solves_the_exact_matrix_as_faer_sparse_lu_at_real_states() {
     // Schur complement (`BorderedBand::with_band_solver`); faer's sparse LU of the same pattern
     // (`BorderedBand::new`) is the reference. Real states: the default runs at 0.25 s.
     for name in ["two-link-free", "barhorst-case1"] {
-        let sc = data::load_scene(name).unwrap();
-        let mut p = fem::run::prepare(
-            &sc,
-            sc.planar_chain().unwrap(),
-            &data::FemSettings::default(),
-        )
-        .unwrap();
-        p.driver.set_stop(0.25);
-        while p.driver.state.t < 0.25 - 1e-12 {
-            p.driver.step().unwrap();
-        }
+        let p = common::advanced_default_run(name, 0.25);
         let h = p.h_nominal;
         let c = NewtonCoefficients {
             c_a: 1.0,

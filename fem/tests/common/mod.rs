@@ -270,3 +270,20 @@ pub fn weight(scene: &data::Scene) -> f64 {
         .map_or(0.0, |g| g.vector[0].hypot(g.vector[1]));
     mass * g
 }
+
+/// The default fem run of catalog scene `name` advanced to `t_stop`: real states (and the run's
+/// nominal step) for checks of the chain's operators.
+pub fn advanced_default_run(name: &str, t_stop: f64) -> fem::run::Prepared {
+    let sc = data::load_scene(name).unwrap();
+    let mut p = fem::run::prepare(
+        &sc,
+        sc.planar_chain().unwrap(),
+        &data::FemSettings::default(),
+    )
+    .unwrap();
+    p.driver.set_stop(t_stop);
+    while p.driver.state.t < t_stop - 1e-12 {
+        p.driver.step().unwrap();
+    }
+    p
+}
