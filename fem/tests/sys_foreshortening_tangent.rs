@@ -184,21 +184,29 @@ fn sys_exact_matrix_is_the_residual_derivative_at_generic_states() {
     }
 }
 
+/// The default run of `name` advanced to 0.25 s: its chain, (q, q̇, q̈) and the energy-midpoint
+/// coefficients of its step (c_a = 1, c_v = h/2, c_q = h²/4).
+fn real_state(name: &str) -> (Chain, [Vec<f64>; 3], NewtonCoefficients) {
+    let p = common::advanced_default_run(name, 0.25);
+    let h = p.h_nominal;
+    let c = NewtonCoefficients {
+        c_a: 1.0,
+        c_v: 0.5 * h,
+        c_q: 0.25 * h * h,
+    };
+    let st = &p.driver.state;
+    (
+        p.driver.chain.clone(),
+        [st.q.clone(), st.qd.clone(), st.qdd.clone()],
+        c,
+    )
+}
+
 #[test]
 fn sys_exact_matrix_is_the_residual_derivative_at_real_states() {
-    // The default runs advanced to 0.25 s, with the energy-midpoint coefficients of their step
-    // (c_a = 1, c_v = h/2, c_q = h²/4).
+    // The default runs at 0.25 s ([`real_state`]).
     for name in ["two-link-free", "barhorst-case1"] {
-        let p = common::advanced_default_run(name, 0.25);
-        let h = p.h_nominal;
-        let c = NewtonCoefficients {
-            c_a: 1.0,
-            c_v: 0.5 * h,
-            c_q: 0.25 * h * h,
-        };
-        let st = &p.driver.state;
-        let (q, qd, qdd) = (st.q.clone(), st.qd.clone(), st.qdd.clone());
-        let mut ch = p.driver.chain.clone();
+        let (mut ch, [q, qd, qdd], c) = real_state(name);
         check(name, &mut ch, &q, &qd, &qdd, c);
     }
 }
@@ -209,16 +217,7 @@ fn sys_band_lu_solves_the_exact_matrix_as_faer_sparse_lu_at_real_states() {
     // Schur complement (`BorderedBand::with_band_solver`); faer's sparse LU of the same pattern
     // (`BorderedBand::new`) is the reference. Real states: the default runs at 0.25 s.
     for name in ["two-link-free", "barhorst-case1"] {
-        let p = common::advanced_default_run(name, 0.25);
-        let h = p.h_nominal;
-        let c = NewtonCoefficients {
-            c_a: 1.0,
-            c_v: 0.5 * h,
-            c_q: 0.25 * h * h,
-        };
-        let st = &p.driver.state;
-        let (q, qd, qdd) = (st.q.clone(), st.qd.clone(), st.qdd.clone());
-        let mut ch = p.driver.chain.clone();
+        let (mut ch, [q, qd, qdd], c) = real_state(name);
         let mut r = vec![0.0; ch.ndof];
         ch.residual(T, &q, &qd, &qdd, &mut r);
         let lay = ch.augmented_layout();
