@@ -177,53 +177,65 @@ fn cli_converge_cantilever_reports_the_orders_of_each_method() {
 
 #[test]
 fn cli_recommend_names_a_discretization_that_a_rerun_confirms() {
-    let (code, out, err) = flexverify(&[
-        "recommend",
-        "spin-up",
-        "--quantity",
-        "tip_deflection@15",
-        "--tol",
-        "1e-3",
-    ]);
-    assert_eq!(code, 0, "{err}");
-    let line = out
-        .lines()
-        .find(|l| l.starts_with("re-run: flexverify "))
-        .expect(&out);
-    let value: f64 = out
-        .split("value ")
-        .nth(1)
-        .and_then(|s| s.split(',').next())
-        .and_then(|s| s.trim().parse().ok())
-        .expect(&out);
-    let args: Vec<&str> = line
-        .trim_start_matches("re-run: flexverify ")
-        .split_whitespace()
-        .collect();
-    let mut args = args.clone();
-    args.extend(["--format", "json"]);
-    let (code, rerun, err) = flexverify(&args);
-    assert_eq!(code, 0, "{err}");
-    let runs: serde_json::Value = serde_json::from_str(&rerun).unwrap();
-    let channel = runs[0]["observables"]["channels"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["name"] == "link1.tip_deflection")
-        .unwrap()
-        .clone();
-    let last = channel["values"]
-        .as_array()
-        .unwrap()
-        .last()
-        .unwrap()
-        .as_f64()
-        .unwrap();
-    // The recommendation prints 11 significant digits; the re-run is bit-identical.
-    assert!(
-        (last - value).abs() <= 1e-10 * value.abs(),
-        "{last} vs {value}"
-    );
+    // In space (the backends' ladders) and in time (fem's step at the mesh given, which the
+    // re-run must keep): the re-run reproduces the recommended value.
+    let time_refined = ["--refine", "time", "--backend", "fem", "--elements", "4"];
+    for extra in [&[][..], &time_refined[..]] {
+        let mut args = vec![
+            "recommend",
+            "spin-up",
+            "--quantity",
+            "tip_deflection@15",
+            "--tol",
+            "1e-3",
+        ];
+        args.extend(extra);
+        let (code, out, err) = flexverify(&args);
+        assert_eq!(code, 0, "{err}");
+        let line = out
+            .lines()
+            .find(|l| l.starts_with("re-run: flexverify "))
+            .expect(&out);
+        if !extra.is_empty() {
+            assert!(
+                line.contains(" --elements 4 ") && line.contains(" --dt "),
+                "{line}"
+            );
+        }
+        let value: f64 = out
+            .split("value ")
+            .nth(1)
+            .and_then(|s| s.split(',').next())
+            .and_then(|s| s.trim().parse().ok())
+            .expect(&out);
+        let mut args: Vec<&str> = line
+            .trim_start_matches("re-run: flexverify ")
+            .split_whitespace()
+            .collect();
+        args.extend(["--format", "json"]);
+        let (code, rerun, err) = flexverify(&args);
+        assert_eq!(code, 0, "{err}");
+        let runs: serde_json::Value = serde_json::from_str(&rerun).unwrap();
+        let channel = runs[0]["observables"]["channels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["name"] == "link1.tip_deflection")
+            .unwrap()
+            .clone();
+        let last = channel["values"]
+            .as_array()
+            .unwrap()
+            .last()
+            .unwrap()
+            .as_f64()
+            .unwrap();
+        // The recommendation prints 11 significant digits; the re-run is bit-identical.
+        assert!(
+            (last - value).abs() <= 1e-10 * value.abs(),
+            "{line}: {last} vs {value}"
+        );
+    }
     // And an impossible tolerance is refused with the best error found; a rung budget every
     // run exceeds stops the ladder after its first rung, and says so.
     for budget in [None, Some("1e-9")] {

@@ -87,6 +87,7 @@ fn lib_bad_requests_are_typed_errors() {
         &scene,
         "freq1",
         1e-30,
+        Refine::Space,
         &[BackendKind::Fdm],
         &settings,
         None,

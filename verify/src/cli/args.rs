@@ -113,6 +113,10 @@ pub enum Command {
         /// Relative tolerance the quantity must meet.
         #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
         tol: f64,
+        /// Refine space (elements/stations/modes) or time (dt, at the mesh given or the
+        /// backend's default): switching times of contact scenes are set by the step.
+        #[arg(long, value_enum, default_value_t = Refine::Space)]
+        refine: Refine,
         /// Wall-time budget per rung in seconds: a backend's ladder stops after the first rung
         /// that took longer (the next would cost several times more), and the answer says so.
         #[arg(long, value_parser = positive_f64, default_value_t = crate::study::recommend::DEFAULT_RUNG_BUDGET_S)]

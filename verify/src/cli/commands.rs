@@ -45,9 +45,10 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
             scene,
             quantity,
             tol,
+            refine,
             rung_budget,
             opts,
-        } => super::studies::recommend(&scene, &quantity, tol, rung_budget, &opts),
+        } => super::studies::recommend(&scene, &quantity, tol, refine, rung_budget, &opts),
         Command::Coverage { format } => super::checks::coverage(format),
         Command::Stability {
             suite,

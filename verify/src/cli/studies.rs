@@ -158,6 +158,7 @@ pub fn recommend(
     scene: &str,
     quantity: &str,
     tol: f64,
+    refine: Refine,
     rung_budget_s: f64,
     opts: &CommonOpts,
 ) -> Result<(), CliError> {
@@ -167,6 +168,7 @@ pub fn recommend(
         &scene,
         quantity,
         tol,
+        refine,
         &opts.kinds(),
         &checked_settings(opts, &opts.kinds())?,
         Some(rung_budget_s),

@@ -48,13 +48,15 @@ pub struct Recommendation {
 /// cost, so the rung after a 5 s one would take half a minute or more.
 pub const DEFAULT_RUNG_BUDGET_S: f64 = 5.0;
 
-/// The cheapest backend and space discretization whose measured error on `quantity` is at
-/// most `tol`, from a space-refinement study of `kinds` (each ladder capped by
-/// `rung_budget_s`, if given).
+/// The cheapest backend and discretization whose measured error on `quantity` is at most
+/// `tol`, from a refinement study of `kinds` in space or, at the base settings' mesh, in the time
+/// step (`refine`; each ladder capped by `rung_budget_s`, if given).
+#[allow(clippy::too_many_arguments)]
 pub fn recommend(
     scene: &Scene,
     quantity: &str,
     tol: f64,
+    refine: Refine,
     kinds: &[BackendKind],
     base: &Settings,
     rung_budget_s: Option<f64>,
@@ -63,7 +65,7 @@ pub fn recommend(
     let study = run_study(
         scene,
         quantity,
-        Refine::Space,
+        refine,
         kinds,
         base,
         rung_budget_s,
@@ -153,13 +155,13 @@ pub fn recommend(
             capped,
         });
     };
-    let flag = r.discretization.replace('=', " ");
     // Ending the re-run at the quantity's time makes its final value the quantity.
     let parsed = Quantity::parse(quantity, scene);
     let until = match parsed {
-        Ok(Quantity::At { t, .. }) => format!(" --t-end {t}"),
-        _ => String::new(),
+        Ok(Quantity::At { t, .. }) => Some(t),
+        _ => None,
     };
+    let flags = rerun_flags(&r.settings, until);
     let what = match parsed {
         Ok(Quantity::Frequency { .. }) => "modes",
         Ok(Quantity::StaticTip) => "statics",
@@ -179,10 +181,7 @@ pub fn recommend(
             ),
             _ => study.reference_label.clone(),
         },
-        rerun: format!(
-            "{what} {} --backend {} --{flag}{until}",
-            scene.name, r.backend
-        ),
+        rerun: format!("{what} {} --backend {}{flags}", scene.name, r.backend),
         runners_up: picks
             .iter()
             .filter(|(p, _)| !std::ptr::eq(*p, r))
@@ -192,6 +191,31 @@ pub fn recommend(
         meeting,
         measured: study.ladders.iter().map(|l| l.rungs.len()).sum(),
     })
+}
+
+/// The command-line options that reproduce the settings of a rung (the refined parameter and
+/// every option the study was given), ending at `until` when the quantity is a value at a time.
+fn rerun_flags(s: &Settings, until: Option<f64>) -> String {
+    let d = &s.discretization;
+    let t = &s.time;
+    let mut flags = String::new();
+    let mut add = |name: &str, value: Option<String>| {
+        if let Some(v) = value {
+            flags += &format!(" --{name} {v}");
+        }
+    };
+    add("elements", d.elements.map(|v| v.to_string()));
+    add("element", d.element.map(|v| v.name().to_string()));
+    add("stations", d.stations.map(|v| v.to_string()));
+    add("modes", d.modes.map(|v| v.to_string()));
+    add("basis", d.basis.map(|v| v.name().to_string()));
+    add("method", t.method.map(|v| v.name()));
+    add("dt", t.dt.map(|v| v.to_string()));
+    add("rtol", t.rtol.map(|v| v.to_string()));
+    add("atol", t.atol.map(|v| v.to_string()));
+    add("safety-factor", t.safety_factor.map(|v| v.to_string()));
+    add("t-end", until.or(t.t_end).map(|v| v.to_string()));
+    flags
 }
 
 impl Recommendation {
