@@ -485,3 +485,34 @@ fn sys_refined_normal_force_matches_a_fresh_factorization() {
         }
     }
 }
+
+#[test]
+fn dyn_fine_euler_bernoulli_mesh_stops_at_an_undetermined_grazing_release_with_its_remedy() {
+    // At 64 elements per link the release that ends `barhorst-case1`'s long sliding phase
+    // (t ≈ 0.93 s) stays undetermined down to the shortest step: the constrained normal force
+    // pulls while the free motion, carrying the fine mesh's tip modes, enters the surface. The
+    // run stops there; the diagnostic names the Euler–Bernoulli cause and remedy, not the
+    // Timoshenko one (its chain has no massless directions).
+    let sc = scene("barhorst-case1");
+    let r = FemBackend
+        .simulate(&sc, &settings(Some(64), Some(1.0)))
+        .unwrap();
+    let StabilityVerdict::Stopped { diagnostic } = &r.verdict else {
+        panic!("{:?}", r.verdict);
+    };
+    assert!(
+        diagnostic.what.starts_with("grazing contact undetermined"),
+        "{diagnostic:?}"
+    );
+    assert!(diagnostic.why.contains("Euler–Bernoulli"), "{diagnostic:?}");
+    assert!(
+        diagnostic.remedy.contains("fewer elements"),
+        "{diagnostic:?}"
+    );
+    assert!(
+        !diagnostic.remedy.contains("rotary inertia"),
+        "{diagnostic:?}"
+    );
+    // The coarser default mesh runs through the same release (`sim` asserts completion).
+    sim(&sc, &settings(None, Some(1.0)));
+}
