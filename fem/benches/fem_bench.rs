@@ -123,6 +123,25 @@ fn arms(c: &mut Criterion) {
     g.finish();
 }
 
+/// The contact scenes (3 s) at the resolution whose contact-episode boundaries lie within
+/// 1e-3 s of the converged ones: a coarser mesh with a finer step than the default
+/// (docs/contact.md, "Run time at switching times within 1e-3 s of converged").
+fn contact_at_converged_switching(c: &mut Criterion) {
+    let mut g = c.benchmark_group("contact-3s-converged-switching");
+    g.sample_size(10);
+    for (name, elements, dt) in [
+        ("barhorst-case1", 5, 3e-4),
+        ("barhorst-case1-timoshenko", 6, 3e-4),
+    ] {
+        let sc = data::load_scene(name).unwrap();
+        let st = settings(elements, dt);
+        g.bench_function(format!("{name} {elements} elements dt {dt:e}"), |b| {
+            b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
+        });
+    }
+    g.finish();
+}
+
 /// One scene at default settings shortened to `t_end`, as its own group: the per-step cost of
 /// a phase without the whole run.
 fn shortened_run(c: &mut Criterion, group: &str, scene: &str, t_end: f64) {
@@ -289,6 +308,7 @@ criterion_group!(
     arms_short,
     contact_short,
     contact_timoshenko_short,
+    contact_at_converged_switching,
     midpoint_forces
 );
 criterion_main!(benches);

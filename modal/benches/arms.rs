@@ -1,4 +1,4 @@
-//! Criterion benches of the Barhorst arm without contact (issue 16), 10 s each, at the default
+//! Criterion benches of the Barhorst arm (issue 16). Without contact, 10 s each, at the default
 //! settings (basis, modes, method and step chosen by the backend) and, for the undamped arm,
 //! at fixed-step TR-BDF2 (h = 2.5e-4). The fixed step is a cost reference, not an equivalent
 //! answer: it damps the ringing high modes, and its 20 Hz low-passed joint angles lie 5.3e-3 rad
@@ -10,11 +10,17 @@
 //! a minute a run on an idle 2-core machine: its 10 samples take ~10 minutes. The group
 //! `arm 1 s` runs the first simulated second of the undamped arm only
 //! (`cargo bench -p modal --bench arms -- 'arm 1 s'`).
+//!
+//! With contact, the group `contact 3 s converged switching` runs `barhorst-case1` and
+//! `barhorst-case1-timoshenko` (3 s) at the resolution whose contact-episode boundaries lie
+//! within 1e-3 s of the converged ones (10 modes, adaptive TR-BDF2 at rtol 1e-3, atol 1e-5;
+//! the distances and the converged reference are in docs/contact.md):
+//! `cargo bench -p modal --bench arms -- 'contact 3 s'`.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use data::{Backend, Settings, TimeStepping, load_scene};
+use data::{Backend, Discretization, Settings, TimeStepping, load_scene};
 use modal::ModalBackend;
 
 fn arms(c: &mut Criterion) {
@@ -80,5 +86,36 @@ fn arm_first_second(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, arms, arm_first_second);
+/// The contact scenes at the resolution whose switching times are within 1e-3 s of converged
+/// (docs/contact.md, "Run time at switching times within 1e-3 s of converged").
+fn contact_at_converged_switching(c: &mut Criterion) {
+    let mut group = c.benchmark_group("contact 3 s converged switching");
+    group.sample_size(10);
+    let settings = Settings {
+        discretization: Discretization {
+            modes: Some(10),
+            ..Default::default()
+        },
+        time: TimeStepping {
+            method: Some("trbdf2".parse().expect("a method name")),
+            rtol: Some(1e-3),
+            atol: Some(1e-5),
+            ..Default::default()
+        },
+    };
+    for name in ["barhorst-case1", "barhorst-case1-timoshenko"] {
+        let scene = load_scene(name).unwrap();
+        group.bench_function(format!("{name} 10 modes trbdf2 rtol 1e-3"), |b| {
+            b.iter(|| black_box(ModalBackend.simulate(&scene, &settings).unwrap()))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    arms,
+    arm_first_second,
+    contact_at_converged_switching
+);
 criterion_main!(benches);

@@ -461,3 +461,40 @@ fn ode_fixed_step_trbdf2_damps_what_the_step_does_not_resolve() {
         amp(slow, 1.0)
     );
 }
+
+#[test]
+fn ode_sdirk_stiff_transient_after_a_kick_does_not_cascade_rejections() {
+    // y' = −λ(y − cos t) − sin t with λ = 1e6, kicked by 1e-2 (10⁶ atol) every 0.5 s: each
+    // kick starts a transient that decays within ~20/λ. TR-BDF2 is L-stable, so a step far
+    // longer than 1/λ damps it as the exact flow does; the once-filtered error estimate
+    // h(I − hdJ)⁻¹E·f would still see the transient's whole amplitude at any such step (it
+    // tends to E·δ/d) and reject down to h ~ 1/λ. The re-estimate of a failed test falls
+    // like 1/(hdλ) instead (module docs), so a kick costs a few rejections, not a cascade.
+    let lambda = 1e6;
+    let tol = Tolerances {
+        rtol: 1e-6,
+        atol: 1e-8,
+    };
+    let mut f = StiffRelax { lambda };
+    let mut s = Sdirk::new(1, tol, None, None);
+    let (mut t, mut y) = (0.0, [1.0]);
+    let kicks = 10;
+    for kick in 1..=kicks {
+        let stop = 0.5 * kick as f64;
+        while t < stop {
+            s.step(&mut f, &mut t, &mut y, stop).unwrap();
+        }
+        y[0] += 1e-2;
+        s.state_changed();
+    }
+    let st = *s.stats();
+    println!("{st:?}");
+    // After the last kick the transient is gone well before the next 0.5 s: one more stretch
+    // shows the solution back on cos t.
+    while t < 0.5 * (kicks + 1) as f64 {
+        s.step(&mut f, &mut t, &mut y, 0.5 * (kicks + 1) as f64)
+            .unwrap();
+    }
+    assert!((y[0] - t.cos()).abs() < 1e-5, "y({t}) = {}", y[0]);
+    assert!(st.rejected <= 6 * kicks, "{st:?}");
+}
