@@ -51,9 +51,8 @@ pub const STEPS_PER_AXIAL_PERIOD: f64 = 16.0;
 
 /// Default-step bound for a bilateral wall on an extensible link: the wall load is carried by
 /// the link's axial field (both ends held: ω_ax = π·sqrt(EA/ρA)/L), which the bending rule
-/// alone leaves unresolved. Measured on `constrained-arm` (ω_ax = 3142 rad/s, bending rule 1 ms):
-/// θ(2 s) = 7.57e-3, 8.91e-3, 9.35e-3, 9.39e-3 rad at 2, 4, 8, 16 steps per axial period
-/// (1e-3 … 1.25e-4 s): 16 steps leave ~0.1 % (second order) against 19 % at the bending rule.
+/// alone leaves unresolved ([`STEPS_PER_AXIAL_PERIOD`] steps per axial period; the
+/// step ladder behind the choice is in docs/backends.md, "Defaults").
 pub fn axial_wall_step(pc: &PlanarChain) -> Option<f64> {
     let c = pc
         .contacts
@@ -266,12 +265,10 @@ pub fn prepare(
         if matches!(method, Method::ImplicitMidpoint | Method::GeneralizedAlpha)
             && let Some(i) = pc.links.iter().position(|l| l.shear && !l.rotary_inertia)
         {
-            // Measured on `barhorst-case1-timoshenko` (0.5 s): with the massless rotations
-            // projected as for energy-midpoint (the removed strain energy booked), the
-            // Kelvin–Voigt work on ψ' has no consistent quadrature: 0.16 ft·lbf at the
-            // projected end rates, 24.1 at Δq/h, against energy-midpoint's 18.1 (ledger
-            // residual −18.1 / +5.9 ft·lbf); without the projection the end rates flip sign
-            // every step (615 events against energy-midpoint's 419).
+            // With the massless rotations projected as for energy-midpoint (the removed strain
+            // energy booked), these methods have no consistent quadrature of the Kelvin–Voigt
+            // work on ψ′ (neither the projected end rates nor Δq/h close the ledger); without
+            // the projection the end rates flip sign every step.
             return Err(FemError::unsupported(format!(
                 "fem {}: contact on link {} (a Timoshenko link without `rotary_inertia`) is not \
                  implemented: the method leaves the end rates of its massless section rotations \

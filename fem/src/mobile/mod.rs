@@ -31,13 +31,12 @@
 //! Elements: [`DEFAULT_ELEMENTS`]. Step: min(output interval, T₁/[`STEPS_PER_PERIOD`]) with T₁
 //! the first flexible period of the whole (unconstrained-joint) system linearized at the start
 //! (stiffness K against the Schur complement of M̄ on the elastic speeds), fitted to divide the
-//! output interval. The steps land on the torque schedules' breakpoints. On
-//! `mobile-manipulator-flexible` (22 speeds): h = 3.2e-4 s, 31 000 steps and 3.6 Newton
-//! iterations per step over the 10 s, ~1-3 s of run time on a shared 2-core machine.
-//! The midpoint rule has no numerical damping: the link's ringing from its undeformed start
-//! (gravity) persists, undamped as in the model, and its phase is not converged at the
-//! default step (the end-effector path is: 3.3e-7 of its peak against h = 1e-4 s;
-//! data/cases/mobile_flex_fem.toml). Modes above ~1/h are not resolved but stay bounded.
+//! output interval. The steps land on the torque schedules' breakpoints (the cost of the default
+//! run: docs/mobile-manipulator.md). The midpoint rule has no numerical damping: the link's
+//! ringing from its undeformed start (gravity) persists, undamped as in the model, and its phase
+//! is not converged at the default step (the end-effector path is: 3.3e-7 of its peak against
+//! h = 1e-4 s; data/cases/mobile_flex_fem.toml). Modes above ~1/h are not resolved but stay
+//! bounded.
 //! A finer mesh raises |K| and with it the round-off of the elastic forces, so the Newton
 //! iteration also accepts an update that has stalled at that floor ([`step::STALL_TOL`]).
 //!

@@ -55,9 +55,9 @@
 //! `w̃′(x) = tan(x(2a − x)/(2b))`, b = EI/F, a = L − δ, δ the foreshortening ([`seed_sag`]).
 //! The exact elastica of a tip-loaded cantilever has sin θ = X(2a − X)/(2b) at the horizontal
 //! coordinate X (integrate EIκ = F(a − X) once), so the seed's tan(·) = tan θ is the elastica
-//! only to first order in the argument: the formula is exact to O((FL²/EI)²) relative (measured:
-//! −0.029 (FL²/EI)² for small loads, −2.4 % at FL²/EI = 1, −11 % at 3; `cargo run --release -p
-//! verify --example seed_sag`). The reference it is measured against is the shooting solution of the elastica with tip load, payload offset and self-weight ([`sag_elastica`]).
+//! only to first order in the argument: the formula is exact to O((FL²/EI)²) relative, against
+//! the shooting solution of the elastica with tip load, payload offset and self-weight
+//! ([`sag_elastica`]; the error table is in docs/single-link-3d.md).
 //! δ is taken as the second-order foreshortening ½∫₀ᵃ w̃′² dx (the seed prints −½∫ w̃′², whose
 //! sign would make a > L), with a + δ(a) = L solved by Brent.
 //!
