@@ -743,11 +743,6 @@ fn synthetic(files: &[(&str, &str)]) -> Vec<Cycle> {
 /// are, and an entry without a cycle fails the test.
 const KNOWN_PARENT_FILE_CYCLES: &[(&str, &str)] = &[
     (
-        "fem::driver submodules",
-        "`Driver` (driver/mod.rs) is extended by impl blocks in contact_events.rs and \
-         stick_slip.rs; driver/mod.rs uses `contact_events::Post`",
-    ),
-    (
         "fem::element submodules",
         "the `Element` trait, `Local`, `Shapes`, `Mat4` live in element/mod.rs beside the \
          element selection (`euler_bernoulli::HermiteCubic`, …) and `MAXE = timoshenko::NDOF`",
