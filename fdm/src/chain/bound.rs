@@ -5,7 +5,7 @@
 // Index loops over the power-iteration vectors read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
+use super::model::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
 use crate::system::{Bound, BoundKind, System, damped_step_factor};
 
 impl TwoLinkChain {

@@ -41,12 +41,12 @@
 #![allow(clippy::needless_range_loop)]
 
 use data::Event;
-use data::scene::{ContactMode, PlanarChain, Surface};
 use faer::Mat;
 use faer::prelude::Solve;
 
-use super::TwoLinkChain;
 use super::kinetic::{BE, TH, seg_energy, seg_grad, seg_rate};
+use super::model::TwoLinkChain;
+use super::surface::TipContact;
 use crate::error::FdmError;
 use crate::output::Outputs;
 use crate::system::System;
@@ -54,70 +54,6 @@ use crate::system::System;
 /// Relative gap (× L₁ + L₂) at which the contact-start location stops, and the tolerance of
 /// the position projection.
 pub(crate) const GAP_TOLERANCE: f64 = 1e-13;
-
-/// The tip of link 2 against the line n̂·(p − p₀) = 0.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TipContact {
-    /// unit normal to the free side
-    normal: [f64; 2],
-    /// n̂·p₀
-    offset: f64,
-}
-
-impl TipContact {
-    /// The contact of `pc` (the chain of scene `name`), if any; `unsupported: …` for what this
-    /// model does not carry.
-    pub fn from_planar_chain(name: &str, pc: &PlanarChain) -> Result<Option<Self>, FdmError> {
-        let Some(c) = pc.contacts.first() else {
-            return Ok(None);
-        };
-        let unsupported = |what: String| {
-            Err(FdmError::Unsupported(format!(
-                "fdm: `{name}`: {what} (the finite-difference chain carries one frictionless \
-                 unilateral contact of link 2's tip with a line)"
-            )))
-        };
-        if pc.contacts.len() > 1 {
-            return unsupported(format!("{} contacts", pc.contacts.len()));
-        }
-        if pc.link_index(&c.link) != Some(1) {
-            return unsupported(format!("contact of link `{}`", c.link));
-        }
-        if c.friction != 0.0 {
-            return unsupported(format!("friction μ = {}", c.friction));
-        }
-        if c.mode == ContactMode::Bilateral {
-            return unsupported("bilateral contact".into());
-        }
-        let Surface::Line { point, normal } = c.surface else {
-            return unsupported("a non-line contact surface".into());
-        };
-        let len = normal[0].hypot(normal[1]);
-        if !(len > 0.0 && len.is_finite()) {
-            return Err(FdmError::invalid("contact.surface.normal", "zero normal"));
-        }
-        let normal = [normal[0] / len, normal[1] / len];
-        Ok(Some(TipContact {
-            normal,
-            offset: normal[0] * point[0] + normal[1] * point[1],
-        }))
-    }
-
-    fn nc(&self, a: f64) -> f64 {
-        self.normal[0] * a.cos() + self.normal[1] * a.sin()
-    }
-    fn ns(&self, a: f64) -> f64 {
-        -self.normal[0] * a.sin() + self.normal[1] * a.cos()
-    }
-
-    /// g(q) from the chord-frame coordinates `qk` (ghost slots zero).
-    pub fn gap(&self, chain: &TwoLinkChain, qk: &[f64]) -> f64 {
-        let (s1, s2) = chain.shortenings(qk);
-        self.nc(qk[TH]) * (chain.links[0].length - s1)
-            + self.nc(qk[BE]) * (chain.links[1].length - s2)
-            - self.offset
-    }
-}
 
 impl TwoLinkChain {
     /// Whether the scene has a tip contact.
@@ -158,7 +94,17 @@ impl TwoLinkChain {
 
     /// g of chord-frame coordinates `qk` (ghost slots zero).
     pub(crate) fn gap_of_chord(&self, qk: &[f64]) -> f64 {
-        self.contact.as_ref().expect("contact").gap(self, qk)
+        self.gap_on(self.contact.as_ref().expect("contact"), qk)
+    }
+
+    /// g of chord-frame coordinates `qk` (ghost slots zero) against the surface `ct`.
+    pub(super) fn gap_on(&self, ct: &TipContact, qk: &[f64]) -> f64 {
+        let (s1, s2) = self.shortenings(qk);
+        ct.gap(
+            qk[TH],
+            qk[BE],
+            [self.links[0].length - s1, self.links[1].length - s2],
+        )
     }
 
     /// Foreshortenings S₁, S₂ (0 where off) of the chord-frame `qk`.
@@ -200,7 +146,7 @@ impl TwoLinkChain {
                 g[2 + ine.r1 + j] = -c * seg_grad(w, ine.h2, None, j);
             }
         }
-        ct.gap(self, &self.qk)
+        self.gap_on(&ct, &self.qk)
     }
 
     /// Ġq̇ at (`self.qk`, `self.vk`) (module docs).
@@ -254,7 +200,7 @@ impl TwoLinkChain {
             self.qk[s] = 0.0;
         }
         let ct = self.contact.clone().expect("contact");
-        ct.gap(self, &self.qk)
+        self.gap_on(&ct, &self.qk)
     }
 
     /// Projects q onto g = 0 along M⁻¹Gᵀ (Newton, at most 3 passes); returns |g| before.
