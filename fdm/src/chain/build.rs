@@ -8,7 +8,7 @@ use data::{DofPlan, Scene};
 use super::dual::Dual;
 use super::kinetic::{BE, ChainInertia, TH};
 use super::model::{JointLaw, LinkProps, TwoLinkChain};
-use super::surface::TipContact;
+use super::surface::{TipConstraint, TipContact};
 use super::timoshenko::{self, TimoFields};
 use crate::error::FdmError;
 use crate::system::System;
@@ -225,11 +225,13 @@ impl TwoLinkChain {
             gravity: pc.gravity.as_ref().map(|g| g.vector),
             mu1g,
             contact,
-            constrained: false,
-            lambda: 0.0,
-            grow: vec![0.0; nd],
-            minv_g: vec![0.0; nd],
-            last_projection: [0.0; 3],
+            constraint: TipConstraint {
+                constrained: false,
+                lambda: 0.0,
+                grow: vec![0.0; nd],
+                minv_g: vec![0.0; nd],
+                last_projection: [0.0; 3],
+            },
             implicit: None,
             skip_damping: false,
             vd: vec![0.0; nd],

@@ -63,23 +63,23 @@ impl TwoLinkChain {
 
     /// Whether the tip is held on the surface (the constrained phase).
     pub fn is_constrained(&self) -> bool {
-        self.constrained
+        self.constraint.constrained
     }
 
     /// Switches the constraint g = 0 on (sliding) or off (free flight).
     pub(crate) fn set_constrained(&mut self, on: bool) {
-        self.constrained = on;
+        self.constraint.constrained = on;
     }
 
     /// Normal force λ of the last constrained `accel` (0 in free flight).
     pub fn normal_force(&self) -> f64 {
-        self.lambda
+        self.constraint.lambda
     }
 
     /// (|g| before the position projection, |Gq̇| before the velocity projection, kinetic
     /// energy the latter removed) of the last constrained step.
     pub(crate) fn last_projection(&self) -> [f64; 3] {
-        self.last_projection
+        self.constraint.last_projection
     }
 
     /// L₁ + L₂.
@@ -130,7 +130,7 @@ impl TwoLinkChain {
         let qk = &self.qk;
         let (s1, s2) = self.shortenings(qk);
         let (l1, l2) = (self.links[0].length, self.links[1].length);
-        let g = &mut self.grow;
+        let g = &mut self.constraint.grow;
         g.iter_mut().for_each(|x| *x = 0.0);
         g[TH] = ct.ns(qk[TH]) * (l1 - s1);
         g[BE] = ct.ns(qk[BE]) * (l2 - s2);
@@ -184,12 +184,12 @@ impl TwoLinkChain {
     /// returns (GM⁻¹Gᵀ, Ġq̇).
     pub(super) fn constraint_solve(&mut self) -> (f64, f64) {
         self.gap_row();
-        let grow = std::mem::take(&mut self.grow);
-        let mut mg = std::mem::take(&mut self.minv_g);
+        let grow = std::mem::take(&mut self.constraint.grow);
+        let mut mg = std::mem::take(&mut self.constraint.minv_g);
         self.solve_mass(&grow, &mut mg);
         let gmg: f64 = grow.iter().zip(&mg).map(|(a, b)| a * b).sum();
-        self.grow = grow;
-        self.minv_g = mg;
+        self.constraint.grow = grow;
+        self.constraint.minv_g = mg;
         (gmg, self.gap_curvature())
     }
 
@@ -218,15 +218,15 @@ impl TwoLinkChain {
                 break;
             }
             self.build_columns();
-            let grow = std::mem::take(&mut self.grow);
-            let mut mg = std::mem::take(&mut self.minv_g);
+            let grow = std::mem::take(&mut self.constraint.grow);
+            let mut mg = std::mem::take(&mut self.constraint.minv_g);
             self.solve_mass(&grow, &mut mg);
             let gmg: f64 = grow.iter().zip(&mg).map(|(a, b)| a * b).sum();
             for i in 0..q.len() {
                 q[i] -= mg[i] * g / gmg;
             }
-            self.grow = grow;
-            self.minv_g = mg;
+            self.constraint.grow = grow;
+            self.constraint.minv_g = mg;
         }
         first.unwrap_or(0.0)
     }
@@ -234,10 +234,11 @@ impl TwoLinkChain {
     /// Projects q̇ onto Gq̇ = 0 along M⁻¹Gᵀ with G, M⁻¹Gᵀ of the last constrained `accel`;
     /// returns (|Gq̇| before, kinetic energy removed).
     pub(super) fn remove_normal_velocity(&self, v: &mut [f64]) -> (f64, f64) {
-        let gv: f64 = self.grow.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
-        let gmg: f64 = self.grow.iter().zip(&self.minv_g).map(|(a, b)| a * b).sum();
+        let c = &self.constraint;
+        let gv: f64 = c.grow.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
+        let gmg: f64 = c.grow.iter().zip(&c.minv_g).map(|(a, b)| a * b).sum();
         for i in 0..v.len() {
-            v[i] -= self.minv_g[i] * gv / gmg;
+            v[i] -= c.minv_g[i] * gv / gmg;
         }
         (gv.abs(), 0.5 * gv * gv / gmg)
     }
@@ -261,11 +262,11 @@ impl TwoLinkChain {
         if !(gmg > 0.0 && gmg.is_finite()) {
             return None;
         }
-        let gv: f64 = (0..n).map(|i| self.grow[i] * v[i]).sum();
+        let gv: f64 = (0..n).map(|i| self.constraint.grow[i] * v[i]).sum();
         let impulse = -gv / gmg;
         let mut dv = vec![0.0; n];
         for i in 0..n {
-            dv[i] = self.minv_g[i] * impulse;
+            dv[i] = self.constraint.minv_g[i] * impulse;
             v[i] += dv[i];
         }
         // ‖M(q̇⁺ − q̇⁻) − GᵀΛ‖ / ‖M(q̇⁺ − q̇⁻)‖ with the product M·Δq̇ formed independently
@@ -273,7 +274,7 @@ impl TwoLinkChain {
         self.mass_mul(&dv, &mut mdv);
         let (mut res2, mut mom2) = (0.0, 0.0);
         for i in 0..n {
-            res2 += (mdv[i] - self.grow[i] * impulse).powi(2);
+            res2 += (mdv[i] - self.constraint.grow[i] * impulse).powi(2);
             mom2 += mdv[i] * mdv[i];
         }
         let momentum_residual = if mom2 > 0.0 {
@@ -281,7 +282,7 @@ impl TwoLinkChain {
         } else {
             res2.sqrt()
         };
-        let normal_velocity_after: f64 = (0..n).map(|i| self.grow[i] * v[i]).sum();
+        let normal_velocity_after: f64 = (0..n).map(|i| self.constraint.grow[i] * v[i]).sum();
         let kinetic_energy_lost = ke_before - self.kinetic_energy(q, v);
 
         Some(Event::Impact {
@@ -316,7 +317,7 @@ impl TwoLinkChain {
             sys.forces(0.0, q, &zeros, &mut f);
             let g = sys.gap_row();
             for i in 0..n {
-                out[i] = f[i] + sys.grow[i] * x[n];
+                out[i] = f[i] + sys.constraint.grow[i] * x[n];
             }
             out[n] = g;
         };

@@ -123,7 +123,7 @@ impl TwoLinkChain {
         self.add_damping_forces(drift.current, &mut rhs);
         self.solve_damped_mass(tau, &rhs, a);
         self.rhs = rhs;
-        self.lambda = 0.0;
+        self.constraint.lambda = 0.0;
         let mut imp = self.implicit.take().expect("implicit damping");
         for i in 0..a.len() {
             imp.vnew[i] = drift.current[i] + 0.5 * tau * a[i];

@@ -56,12 +56,12 @@
 //! **Modules.** The chain's data sit in modules that use no operation of the chain: `model`
 //! ([`TwoLinkChain`], its joints and links, and the coordinate maps: clamp, tip and elbow
 //! angles, chord-frame copies, the lumped diagonal of M) and the types of its parts —
-//! [`kinetic`], [`dual`], [`timoshenko`], `surface` (the contact line), `damping_matrix` (C and
-//! the banded factorization of the implicit kick) and `schur` (the dense block of the mass
-//! solves). The operations extend [`TwoLinkChain`] in their own modules: `build` (construction,
-//! DOF plan, initial state), `forces` (forces, energies, momenta, powers), `mass` (the
-//! Schur-complement solve), [`contact`] (gap, constraint, impact, projections), [`implicit`]
-//! (the damping kick), `bound` (step bound), `system` (the chain as a
+//! [`kinetic`], [`dual`], [`timoshenko`], `surface` (the contact line and the constraint state),
+//! `damping_matrix` (C and the banded factorization of the implicit kick) and `schur` (the dense
+//! block of the mass solves). The operations extend [`TwoLinkChain`] in their own modules:
+//! `build` (construction, DOF plan, initial state), `forces` (forces, energies, momenta,
+//! powers), `mass` (the Schur-complement solve), [`contact`] (gap, constraint, impact,
+//! projections), [`implicit`] (the damping kick), `bound` (step bound), `system` (the chain as a
 //! [`System`](crate::system::System)), `outputs` (channels, ledger) and [`modes`] (linearized
 //! modes).
 

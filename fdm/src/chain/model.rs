@@ -1,22 +1,24 @@
 //! The chain's data and its coordinate maps: [`TwoLinkChain`] (links, joints, the lumped
-//! inertia, the ghost slots, the tip contact, the implicit damping, scratch), and the angles and
-//! inertia directions read off q: clamp tangents, link 1's tip slope ψ and tip-section angle,
-//! the elbow angle θ₂, the chord-frame copies with the ghost slots zeroed, the lumped diagonal
-//! of M (module docs of [`super`]).
+//! inertia, the ghost slots, the tip contact and its constraint state, the implicit damping,
+//! scratch), and the angles and inertia directions read off q: clamp tangents, link 1's tip
+//! slope ψ and tip-section angle, the elbow angle θ₂, the chord-frame copies with the ghost
+//! slots zeroed, the lumped diagonal of M (module docs of [`super`]).
+
+use data::scene::TorqueLaw;
 
 use super::damping_matrix::ImplicitDamping;
 use super::dual::Dual;
 use super::kinetic::{BE, ChainInertia, TH};
 use super::schur::MAX_FULL;
-use super::surface::TipContact;
+use super::surface::{TipConstraint, TipContact};
 use super::timoshenko::TimoFields;
-use data::scene::TorqueLaw;
 
 /// Bound sites ≥ this are the Timoshenko links' shear bounds.
 pub(super) const SHEAR_SITE: usize = 10;
 /// Bound site of link 1's tip-ghost rotation mode (Euler links).
 pub(super) const TIP_SITE: usize = 5;
 
+/// A joint's spring, damper, set point and applied torque law.
 #[derive(Debug, Clone, Default)]
 pub(super) struct JointLaw {
     pub(super) stiffness: f64,
@@ -31,6 +33,7 @@ impl JointLaw {
     }
 }
 
+/// A link's length, bending stiffness EI, Kelvin–Voigt coefficient γ and mass per length ρA.
 #[derive(Debug, Clone)]
 pub(super) struct LinkProps {
     pub(super) length: f64,
@@ -83,15 +86,9 @@ pub struct TwoLinkChain {
     pub(super) mu1g: Vec<f64>,
     /// the tip contact of link 2, if any ([`super::contact`])
     pub(super) contact: Option<TipContact>,
-    /// whether the tip is held on the surface (constrained phase)
-    pub(super) constrained: bool,
-    /// normal force λ of the last constrained `accel` (0 in free flight)
-    pub(super) lambda: f64,
-    /// scratch of the constraint: G = ∂g/∂q and M⁻¹Gᵀ
-    pub(super) grow: Vec<f64>,
-    pub(super) minv_g: Vec<f64>,
-    /// (|g|, |Gq̇|, energy removed) of the last constrained step's projections
-    pub(super) last_projection: [f64; 3],
+    /// the state of the contact constraint g = 0: phase, normal force, G and M⁻¹Gᵀ, last
+    /// projections
+    pub(super) constraint: TipConstraint,
     /// the damping matrix C and the banded factorization of the implicit kick ([`super::implicit`]);
     /// none: damping explicit in the forces
     pub(super) implicit: Option<Box<ImplicitDamping>>,

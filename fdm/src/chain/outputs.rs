@@ -117,8 +117,12 @@ impl Outputs for TwoLinkChain {
         }
         if let Some(ct) = &self.contact {
             // λ of the last evaluation: the step end of the sampled interval (O(τ) in time)
-            out[k] = self.lambda;
-            out[k + 1] = if self.constrained { 1.0 } else { 0.0 };
+            out[k] = self.constraint.lambda;
+            out[k + 1] = if self.constraint.constrained {
+                1.0
+            } else {
+                0.0
+            };
             out[k + 2] = self.gap_on(ct, &qk);
         }
     }

@@ -1,5 +1,7 @@
-//! The contact surface of link 2's tip: a fixed line n̂·(p − p₀) = 0 with the unit normal n̂ to
-//! the free side, checked against what the chain's contact carries ([`super::contact`]).
+//! The tip contact's data ([`super::contact`] operates on them): the surface, a fixed line
+//! n̂·(p − p₀) = 0 with the unit normal n̂ to the free side, checked against what the chain's
+//! contact carries; and the state of the constraint g = 0 (phase, normal force, the constraint
+//! row and its mass solve, the residuals of the last drift projections).
 
 use data::scene::{ContactMode, PlanarChain, Surface};
 
@@ -64,4 +66,18 @@ impl TipContact {
     pub fn gap(&self, theta: f64, beta: f64, lengths: [f64; 2]) -> f64 {
         self.nc(theta) * lengths[0] + self.nc(beta) * lengths[1] - self.offset
     }
+}
+
+/// The state of the contact constraint g(q) = 0 (free flight, λ = 0 without a contact).
+#[derive(Debug, Clone)]
+pub(super) struct TipConstraint {
+    /// whether the tip is held on the surface (constrained phase)
+    pub(super) constrained: bool,
+    /// normal force λ of the last constrained `accel` (0 in free flight)
+    pub(super) lambda: f64,
+    /// scratch of the constraint: G = ∂g/∂q and M⁻¹Gᵀ
+    pub(super) grow: Vec<f64>,
+    pub(super) minv_g: Vec<f64>,
+    /// (|g|, |Gq̇|, energy removed) of the last constrained step's projections
+    pub(super) last_projection: [f64; 3],
 }

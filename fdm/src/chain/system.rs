@@ -21,12 +21,12 @@ impl System for TwoLinkChain {
         self.build_columns();
         self.solve_mass(&rhs, a);
         self.rhs = rhs;
-        self.lambda = 0.0;
-        if self.constrained {
+        self.constraint.lambda = 0.0;
+        if self.constraint.constrained {
             // M q̈ = f + Gᵀλ with G q̈ + Ġq̇ = 0: q̈ = a_free + M⁻¹Gᵀ λ,
             // λ = −(G a_free + Ġq̇)/(G M⁻¹Gᵀ) — one more solve with the same M.
             let (gmg, curv) = self.constraint_solve();
-            let ga: f64 = (0..n).map(|i| self.grow[i] * a[i]).sum();
+            let ga: f64 = (0..n).map(|i| self.constraint.grow[i] * a[i]).sum();
             // a non-positive GM⁻¹Gᵀ means M lost definiteness: NaN stops the contact driver
             let lam = if gmg > 0.0 {
                 -(ga + curv) / gmg
@@ -34,9 +34,9 @@ impl System for TwoLinkChain {
                 f64::NAN
             };
             for i in 0..n {
-                a[i] += self.minv_g[i] * lam;
+                a[i] += self.constraint.minv_g[i] * lam;
             }
-            self.lambda = lam;
+            self.constraint.lambda = lam;
         }
     }
 
@@ -48,7 +48,7 @@ impl System for TwoLinkChain {
         tau: f64,
         a: &mut [f64],
     ) -> bool {
-        if self.implicit.is_none() || self.constrained {
+        if self.implicit.is_none() || self.constraint.constrained {
             return false;
         }
         self.implicit_kick_solve(t, q, inertia, tau, a);
@@ -63,7 +63,7 @@ impl System for TwoLinkChain {
         inertia: DriftVelocities,
         a: &mut [f64],
     ) {
-        if self.constrained {
+        if self.constraint.constrained {
             // the constrained phase runs in the contact driver (`accel`): Ġq̇ and Γ at `v`
             self.accel(t, q, v, a);
             return;
@@ -81,22 +81,22 @@ impl System for TwoLinkChain {
         self.build_columns();
         self.solve_mass(&rhs, a);
         self.rhs = rhs;
-        self.lambda = 0.0;
+        self.constraint.lambda = 0.0;
     }
 
     /// On the surface g = 0 along M⁻¹Gᵀ while the tip is held ([`super::contact`]).
     fn project_position(&mut self, q: &mut [f64]) {
-        if self.constrained {
-            self.last_projection[0] = self.project_onto_surface(q);
+        if self.constraint.constrained {
+            self.constraint.last_projection[0] = self.project_onto_surface(q);
         }
     }
 
     /// Onto Gq̇ = 0 along M⁻¹Gᵀ while the tip is held ([`super::contact`]).
     fn project_velocity(&mut self, v: &mut [f64]) {
-        if self.constrained {
+        if self.constraint.constrained {
             let (gv, energy) = self.remove_normal_velocity(v);
-            self.last_projection[1] = gv;
-            self.last_projection[2] = energy;
+            self.constraint.last_projection[1] = gv;
+            self.constraint.last_projection[2] = energy;
         }
     }
 
