@@ -735,35 +735,10 @@ fn synthetic(files: &[(&str, &str)]) -> Vec<Cycle> {
     find_cycles(&build_graph("demo", &sources))
 }
 
-/// Cycles between a parent module's own file and its submodules that existed when this test was
-/// written: the parent's file both defines what its submodules share and uses them. Each is
-/// broken by moving the shared items to a sibling file that the parent re-exports (as
-/// `verify::cli::error`, `modal::mobile::modes` and `fem::method::{state, step}` were). Only a
-/// cycle through the listed parent file is tolerated; sibling cycles and top-level cycles never
-/// are, and an entry without a cycle fails the test.
-const KNOWN_PARENT_FILE_CYCLES: &[(&str, &str)] = &[
-    (
-        "fem::driver submodules",
-        "`Driver` (driver/mod.rs) is extended by impl blocks in contact_events.rs and \
-         stick_slip.rs; driver/mod.rs uses `contact_events::Post`",
-    ),
-    (
-        "fem::element submodules",
-        "the `Element` trait, `Local`, `Shapes`, `Mat4` live in element/mod.rs beside the \
-         element selection (`euler_bernoulli::HermiteCubic`, …) and `MAXE = timoshenko::NDOF`",
-    ),
-    (
-        "fdm::chain submodules",
-        "`TwoLinkChain` (chain/mod.rs) is extended by impl blocks in bound, contact, implicit, \
-         mass, modes, outputs and holds fields of contact/dual/implicit/kinetic/timoshenko types",
-    ),
-];
-
 #[test]
 fn sys_module_graph_workspace_has_no_cycle() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut report = String::new();
-    let mut seen_known = BTreeSet::new();
     for name in ["data", "fem", "fdm", "modal", "verify"] {
         let g = build_graph(name, &read_crate(&root.join(name).join("src")));
         // The scanner must see the crate's structure, or "no cycle" would mean nothing.
@@ -777,27 +752,14 @@ fn sys_module_graph_workspace_has_no_cycle() {
             "{name}: no dependency between top-level modules found"
         );
         for c in find_cycles(&g) {
-            let known = KNOWN_PARENT_FILE_CYCLES
-                .iter()
-                .any(|(graph, _)| *graph == c.graph)
-                && c.nodes.iter().any(|n| n.ends_with("(own file)"));
-            if known {
-                seen_known.insert(c.graph.clone());
-            } else {
-                report.push_str(&c.to_string());
-            }
+            report.push_str(&c.to_string());
         }
     }
+    // A cycle through a parent's own file ("(own file)") means that file both defines what its
+    // submodules share and uses them: the shared items belong in a sibling leaf module that the
+    // parent re-exports (as in `fem::driver::state`, `fem::element::contract`,
+    // `fdm::chain::model`).
     assert!(report.is_empty(), "module cycles:\n{report}");
-    let stale: Vec<&str> = KNOWN_PARENT_FILE_CYCLES
-        .iter()
-        .map(|(graph, _)| *graph)
-        .filter(|graph| !seen_known.contains(*graph))
-        .collect();
-    assert!(
-        stale.is_empty(),
-        "no longer a cycle, remove from KNOWN_PARENT_FILE_CYCLES: {stale:?}"
-    );
 }
 
 #[test]
@@ -922,4 +884,34 @@ fn sys_module_graph_ignores_tests_comments_and_literals() {
     ]);
     assert_eq!(cycles.len(), 1, "{cycles:?}");
     assert_eq!(cycles[0].nodes, ["demo::a", "demo::b", "demo::a"]);
+}
+
+#[test]
+fn sys_module_graph_reports_a_parent_file_cycle_and_accepts_its_leaf_split() {
+    // The parent's own file defines what its child extends and calls into the child.
+    let cycles = synthetic(&[
+        ("lib.rs", "pub mod a;\n"),
+        (
+            "a/mod.rs",
+            "mod x;\npub struct S;\nfn f() -> usize { x::g() }\n",
+        ),
+        ("a/x.rs", "use super::S;\npub fn g() -> usize { 1 }\n"),
+    ]);
+    assert_eq!(cycles.len(), 1, "{cycles:?}");
+    assert_eq!(cycles[0].graph, "demo::a submodules");
+    assert_eq!(
+        cycles[0].nodes,
+        ["demo::a (own file)", "demo::a::x", "demo::a (own file)"]
+    );
+    // The shared type in a sibling leaf that the parent re-exports: no cycle.
+    let cycles = synthetic(&[
+        ("lib.rs", "pub mod a;\n"),
+        (
+            "a/mod.rs",
+            "mod s;\nmod x;\npub use s::S;\nfn f() -> usize { x::g() }\n",
+        ),
+        ("a/s.rs", "pub struct S;\n"),
+        ("a/x.rs", "use super::S;\npub fn g() -> usize { 1 }\n"),
+    ]);
+    assert!(cycles.is_empty(), "{cycles:?}");
 }

@@ -5,7 +5,7 @@
 // Index loops over the power-iteration vectors read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
+use super::model::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
 use crate::system::{Bound, BoundKind, System, damped_step_factor};
 
 impl TwoLinkChain {
@@ -39,7 +39,7 @@ impl TwoLinkChain {
     pub(super) fn top_eigen(&mut self, t: f64, q0: &[f64], v0: &[f64], wrt_v: bool) -> f64 {
         let n = self.dofs();
         let (q0, v) = (q0, v0);
-        let lambda = self.lambda;
+        let lambda = self.constraint.lambda;
         let mut a0 = vec![0.0; n];
         self.accel(t, q0, v, &mut a0);
         let mut jac = vec![0.0; n * n];
@@ -63,7 +63,7 @@ impl TwoLinkChain {
                 jac[i * n + j] = -(a[i] - a0[i]) / eps;
             }
         }
-        self.lambda = lambda;
+        self.constraint.lambda = lambda;
         let mut x: Vec<f64> = (0..n).map(|i| 1.0 + 0.1 * i as f64).collect();
         let mut y = vec![0.0; n];
         let mut lam = 0.0;

@@ -41,12 +41,12 @@
 #![allow(clippy::needless_range_loop)]
 
 use data::Event;
-use data::scene::{ContactMode, PlanarChain, Surface};
 use faer::Mat;
 use faer::prelude::Solve;
 
-use super::TwoLinkChain;
 use super::kinetic::{BE, TH, seg_energy, seg_grad, seg_rate};
+use super::model::TwoLinkChain;
+use super::surface::TipContact;
 use crate::error::FdmError;
 use crate::output::Outputs;
 use crate::system::System;
@@ -54,70 +54,6 @@ use crate::system::System;
 /// Relative gap (× L₁ + L₂) at which the contact-start location stops, and the tolerance of
 /// the position projection.
 pub(crate) const GAP_TOLERANCE: f64 = 1e-13;
-
-/// The tip of link 2 against the line n̂·(p − p₀) = 0.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TipContact {
-    /// unit normal to the free side
-    normal: [f64; 2],
-    /// n̂·p₀
-    offset: f64,
-}
-
-impl TipContact {
-    /// The contact of `pc` (the chain of scene `name`), if any; `unsupported: …` for what this
-    /// model does not carry.
-    pub fn from_planar_chain(name: &str, pc: &PlanarChain) -> Result<Option<Self>, FdmError> {
-        let Some(c) = pc.contacts.first() else {
-            return Ok(None);
-        };
-        let unsupported = |what: String| {
-            Err(FdmError::Unsupported(format!(
-                "fdm: `{name}`: {what} (the finite-difference chain carries one frictionless \
-                 unilateral contact of link 2's tip with a line)"
-            )))
-        };
-        if pc.contacts.len() > 1 {
-            return unsupported(format!("{} contacts", pc.contacts.len()));
-        }
-        if pc.link_index(&c.link) != Some(1) {
-            return unsupported(format!("contact of link `{}`", c.link));
-        }
-        if c.friction != 0.0 {
-            return unsupported(format!("friction μ = {}", c.friction));
-        }
-        if c.mode == ContactMode::Bilateral {
-            return unsupported("bilateral contact".into());
-        }
-        let Surface::Line { point, normal } = c.surface else {
-            return unsupported("a non-line contact surface".into());
-        };
-        let len = normal[0].hypot(normal[1]);
-        if !(len > 0.0 && len.is_finite()) {
-            return Err(FdmError::invalid("contact.surface.normal", "zero normal"));
-        }
-        let normal = [normal[0] / len, normal[1] / len];
-        Ok(Some(TipContact {
-            normal,
-            offset: normal[0] * point[0] + normal[1] * point[1],
-        }))
-    }
-
-    fn nc(&self, a: f64) -> f64 {
-        self.normal[0] * a.cos() + self.normal[1] * a.sin()
-    }
-    fn ns(&self, a: f64) -> f64 {
-        -self.normal[0] * a.sin() + self.normal[1] * a.cos()
-    }
-
-    /// g(q) from the chord-frame coordinates `qk` (ghost slots zero).
-    pub fn gap(&self, chain: &TwoLinkChain, qk: &[f64]) -> f64 {
-        let (s1, s2) = chain.shortenings(qk);
-        self.nc(qk[TH]) * (chain.links[0].length - s1)
-            + self.nc(qk[BE]) * (chain.links[1].length - s2)
-            - self.offset
-    }
-}
 
 impl TwoLinkChain {
     /// Whether the scene has a tip contact.
@@ -127,23 +63,23 @@ impl TwoLinkChain {
 
     /// Whether the tip is held on the surface (the constrained phase).
     pub fn is_constrained(&self) -> bool {
-        self.constrained
+        self.constraint.constrained
     }
 
     /// Switches the constraint g = 0 on (sliding) or off (free flight).
     pub(crate) fn set_constrained(&mut self, on: bool) {
-        self.constrained = on;
+        self.constraint.constrained = on;
     }
 
     /// Normal force λ of the last constrained `accel` (0 in free flight).
     pub fn normal_force(&self) -> f64 {
-        self.lambda
+        self.constraint.lambda
     }
 
     /// (|g| before the position projection, |Gq̇| before the velocity projection, kinetic
     /// energy the latter removed) of the last constrained step.
     pub(crate) fn last_projection(&self) -> [f64; 3] {
-        self.last_projection
+        self.constraint.last_projection
     }
 
     /// L₁ + L₂.
@@ -158,7 +94,17 @@ impl TwoLinkChain {
 
     /// g of chord-frame coordinates `qk` (ghost slots zero).
     pub(crate) fn gap_of_chord(&self, qk: &[f64]) -> f64 {
-        self.contact.as_ref().expect("contact").gap(self, qk)
+        self.gap_on(self.contact.as_ref().expect("contact"), qk)
+    }
+
+    /// g of chord-frame coordinates `qk` (ghost slots zero) against the surface `ct`.
+    pub(super) fn gap_on(&self, ct: &TipContact, qk: &[f64]) -> f64 {
+        let (s1, s2) = self.shortenings(qk);
+        ct.gap(
+            qk[TH],
+            qk[BE],
+            [self.links[0].length - s1, self.links[1].length - s2],
+        )
     }
 
     /// Foreshortenings S₁, S₂ (0 where off) of the chord-frame `qk`.
@@ -184,7 +130,7 @@ impl TwoLinkChain {
         let qk = &self.qk;
         let (s1, s2) = self.shortenings(qk);
         let (l1, l2) = (self.links[0].length, self.links[1].length);
-        let g = &mut self.grow;
+        let g = &mut self.constraint.grow;
         g.iter_mut().for_each(|x| *x = 0.0);
         g[TH] = ct.ns(qk[TH]) * (l1 - s1);
         g[BE] = ct.ns(qk[BE]) * (l2 - s2);
@@ -200,7 +146,7 @@ impl TwoLinkChain {
                 g[2 + ine.r1 + j] = -c * seg_grad(w, ine.h2, None, j);
             }
         }
-        ct.gap(self, &self.qk)
+        self.gap_on(&ct, &self.qk)
     }
 
     /// Ġq̇ at (`self.qk`, `self.vk`) (module docs).
@@ -238,12 +184,12 @@ impl TwoLinkChain {
     /// returns (GM⁻¹Gᵀ, Ġq̇).
     pub(super) fn constraint_solve(&mut self) -> (f64, f64) {
         self.gap_row();
-        let grow = std::mem::take(&mut self.grow);
-        let mut mg = std::mem::take(&mut self.minv_g);
+        let grow = std::mem::take(&mut self.constraint.grow);
+        let mut mg = std::mem::take(&mut self.constraint.minv_g);
         self.solve_mass(&grow, &mut mg);
         let gmg: f64 = grow.iter().zip(&mg).map(|(a, b)| a * b).sum();
-        self.grow = grow;
-        self.minv_g = mg;
+        self.constraint.grow = grow;
+        self.constraint.minv_g = mg;
         (gmg, self.gap_curvature())
     }
 
@@ -254,7 +200,7 @@ impl TwoLinkChain {
             self.qk[s] = 0.0;
         }
         let ct = self.contact.clone().expect("contact");
-        ct.gap(self, &self.qk)
+        self.gap_on(&ct, &self.qk)
     }
 
     /// Projects q onto g = 0 along M⁻¹Gᵀ (Newton, at most 3 passes); returns |g| before.
@@ -272,15 +218,15 @@ impl TwoLinkChain {
                 break;
             }
             self.build_columns();
-            let grow = std::mem::take(&mut self.grow);
-            let mut mg = std::mem::take(&mut self.minv_g);
+            let grow = std::mem::take(&mut self.constraint.grow);
+            let mut mg = std::mem::take(&mut self.constraint.minv_g);
             self.solve_mass(&grow, &mut mg);
             let gmg: f64 = grow.iter().zip(&mg).map(|(a, b)| a * b).sum();
             for i in 0..q.len() {
                 q[i] -= mg[i] * g / gmg;
             }
-            self.grow = grow;
-            self.minv_g = mg;
+            self.constraint.grow = grow;
+            self.constraint.minv_g = mg;
         }
         first.unwrap_or(0.0)
     }
@@ -288,10 +234,11 @@ impl TwoLinkChain {
     /// Projects q̇ onto Gq̇ = 0 along M⁻¹Gᵀ with G, M⁻¹Gᵀ of the last constrained `accel`;
     /// returns (|Gq̇| before, kinetic energy removed).
     pub(super) fn remove_normal_velocity(&self, v: &mut [f64]) -> (f64, f64) {
-        let gv: f64 = self.grow.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
-        let gmg: f64 = self.grow.iter().zip(&self.minv_g).map(|(a, b)| a * b).sum();
+        let c = &self.constraint;
+        let gv: f64 = c.grow.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
+        let gmg: f64 = c.grow.iter().zip(&c.minv_g).map(|(a, b)| a * b).sum();
         for i in 0..v.len() {
-            v[i] -= self.minv_g[i] * gv / gmg;
+            v[i] -= c.minv_g[i] * gv / gmg;
         }
         (gv.abs(), 0.5 * gv * gv / gmg)
     }
@@ -315,11 +262,11 @@ impl TwoLinkChain {
         if !(gmg > 0.0 && gmg.is_finite()) {
             return None;
         }
-        let gv: f64 = (0..n).map(|i| self.grow[i] * v[i]).sum();
+        let gv: f64 = (0..n).map(|i| self.constraint.grow[i] * v[i]).sum();
         let impulse = -gv / gmg;
         let mut dv = vec![0.0; n];
         for i in 0..n {
-            dv[i] = self.minv_g[i] * impulse;
+            dv[i] = self.constraint.minv_g[i] * impulse;
             v[i] += dv[i];
         }
         // ‖M(q̇⁺ − q̇⁻) − GᵀΛ‖ / ‖M(q̇⁺ − q̇⁻)‖ with the product M·Δq̇ formed independently
@@ -327,7 +274,7 @@ impl TwoLinkChain {
         self.mass_mul(&dv, &mut mdv);
         let (mut res2, mut mom2) = (0.0, 0.0);
         for i in 0..n {
-            res2 += (mdv[i] - self.grow[i] * impulse).powi(2);
+            res2 += (mdv[i] - self.constraint.grow[i] * impulse).powi(2);
             mom2 += mdv[i] * mdv[i];
         }
         let momentum_residual = if mom2 > 0.0 {
@@ -335,7 +282,7 @@ impl TwoLinkChain {
         } else {
             res2.sqrt()
         };
-        let normal_velocity_after: f64 = (0..n).map(|i| self.grow[i] * v[i]).sum();
+        let normal_velocity_after: f64 = (0..n).map(|i| self.constraint.grow[i] * v[i]).sum();
         let kinetic_energy_lost = ke_before - self.kinetic_energy(q, v);
 
         Some(Event::Impact {
@@ -370,7 +317,7 @@ impl TwoLinkChain {
             sys.forces(0.0, q, &zeros, &mut f);
             let g = sys.gap_row();
             for i in 0..n {
-                out[i] = f[i] + sys.grow[i] * x[n];
+                out[i] = f[i] + sys.constraint.grow[i] * x[n];
             }
             out[n] = g;
         };

@@ -28,91 +28,10 @@
 // Index loops over band positions and full columns read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::TwoLinkChain;
-use super::mass::{MAX_FULL, solve_small};
+use super::damping_matrix::{ImplicitDamping, STATE_COLUMNS};
+use super::model::TwoLinkChain;
+use super::schur::{MAX_FULL, solve_small};
 use crate::system::{DriftVelocities, System};
-
-/// Full columns of M that depend on the state (θ, β come first; the ghost columns after them
-/// are constant).
-const STATE_COLUMNS: usize = 2;
-
-/// C and the banded factorization of the implicit kick (module docs).
-#[derive(Debug, Clone)]
-pub struct ImplicitDamping {
-    /// q-index of each band position (the coordinates outside the full columns, in q order)
-    band: Vec<usize>,
-    /// C on the band: diagonal, first and second sub-diagonals (by band position)
-    c0: Vec<f64>,
-    c1: Vec<f64>,
-    c2: Vec<f64>,
-    /// C's full columns over q
-    cf: [Vec<f64>; MAX_FULL],
-    /// LDLᵀ of D_B + ½τC_BB for the step `tau` (NaN: none yet)
-    d: Vec<f64>,
-    l1: Vec<f64>,
-    l2: Vec<f64>,
-    tau: f64,
-    /// Schur complement block of the constant (ghost) columns, rows and columns ≥ `STATE_COLUMNS`
-    /// (computed with the factorization)
-    s_ghost: [[f64; MAX_FULL]; MAX_FULL],
-    /// scratch: A_BF columns and Z = A_BB⁻¹A_BF over band positions (the ghost columns' kept
-    /// from the factorization), A_BB⁻¹ r_B, v_{j+1}
-    abf: [Vec<f64>; MAX_FULL],
-    z: [Vec<f64>; MAX_FULL],
-    zb: Vec<f64>,
-    vnew: Vec<f64>,
-}
-
-impl ImplicitDamping {
-    /// LDLᵀ of the pentadiagonal D_B + ½τC_BB.
-    fn factor(&mut self, diag: impl Fn(usize) -> f64, tau: f64) {
-        let nb = self.band.len();
-        let ht = 0.5 * tau;
-        for j in 0..nb {
-            let mut dj = diag(self.band[j]) + ht * self.c0[j];
-            if j >= 1 {
-                dj -= self.l1[j - 1] * self.l1[j - 1] * self.d[j - 1];
-            }
-            if j >= 2 {
-                dj -= self.l2[j - 2] * self.l2[j - 2] * self.d[j - 2];
-            }
-            self.d[j] = dj;
-            if j + 1 < nb {
-                let mut a = ht * self.c1[j];
-                if j >= 1 {
-                    a -= self.l2[j - 1] * self.l1[j - 1] * self.d[j - 1];
-                }
-                self.l1[j] = a / dj;
-            }
-            if j + 2 < nb {
-                self.l2[j] = ht * self.c2[j] / dj;
-            }
-        }
-        self.tau = tau;
-    }
-
-    /// x ← (LDLᵀ)⁻¹ x.
-    fn solve(d: &[f64], l1: &[f64], l2: &[f64], x: &mut [f64]) {
-        let nb = x.len();
-        for i in 1..nb {
-            let mut s = x[i] - l1[i - 1] * x[i - 1];
-            if i >= 2 {
-                s -= l2[i - 2] * x[i - 2];
-            }
-            x[i] = s;
-        }
-        for i in 0..nb {
-            x[i] /= d[i];
-        }
-        for i in (0..nb.saturating_sub(1)).rev() {
-            let mut s = x[i] - l1[i] * x[i + 1];
-            if i + 2 < nb {
-                s -= l2[i] * x[i + 2];
-            }
-            x[i] = s;
-        }
-    }
-}
 
 impl TwoLinkChain {
     /// Switches the velocity form's closing kick to implicit damping (module docs) when the
@@ -204,7 +123,7 @@ impl TwoLinkChain {
         self.add_damping_forces(drift.current, &mut rhs);
         self.solve_damped_mass(tau, &rhs, a);
         self.rhs = rhs;
-        self.lambda = 0.0;
+        self.constraint.lambda = 0.0;
         let mut imp = self.implicit.take().expect("implicit damping");
         for i in 0..a.len() {
             imp.vnew[i] = drift.current[i] + 0.5 * tau * a[i];

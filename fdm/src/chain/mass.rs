@@ -5,12 +5,10 @@
 // Index loops over the columns of M read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::TwoLinkChain;
 use super::kinetic::{BE, TH};
+use super::model::TwoLinkChain;
+use super::schur::{MAX_FULL, solve_small};
 use crate::system::System;
-
-/// Largest number of full columns (θ, β, x₁, x₂, y).
-pub(super) const MAX_FULL: usize = 5;
 
 impl TwoLinkChain {
     /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`; the ghost
@@ -120,32 +118,4 @@ impl TwoLinkChain {
             }
         }
     }
-}
-
-/// Gaussian elimination with partial pivoting on the leading `n`×`n` block (n ≤ 5).
-pub(super) fn solve_small(
-    mut a: [[f64; MAX_FULL]; MAX_FULL],
-    mut b: [f64; MAX_FULL],
-    n: usize,
-) -> [f64; MAX_FULL] {
-    for col in 0..n {
-        let piv = (col..n)
-            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
-            .unwrap_or(col);
-        a.swap(col, piv);
-        b.swap(col, piv);
-        for row in col + 1..n {
-            let f = a[row][col] / a[col][col];
-            for k in col..n {
-                a[row][k] -= f * a[col][k];
-            }
-            b[row] -= f * b[col];
-        }
-    }
-    let mut x = [0.0; MAX_FULL];
-    for row in (0..n).rev() {
-        let s: f64 = (row + 1..n).map(|k| a[row][k] * x[k]).sum();
-        x[row] = (b[row] - s) / a[row][row];
-    }
-    x
 }

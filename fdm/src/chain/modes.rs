@@ -18,8 +18,8 @@ use data::scene::PlanarChain;
 use data::{BackendKind, Cost, ModalResult, ModeShape, Scene};
 use faer::{Mat, Side};
 
-use super::TwoLinkChain;
 use super::kinetic::{BE, TH};
+use super::model::TwoLinkChain;
 use crate::error::FdmError;
 use crate::settings::ValidatedSettings;
 

@@ -5,7 +5,7 @@
 use data::{channel, ledger_term};
 
 use super::kinetic::{BE, TH, seg_energy};
-use super::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
+use super::model::{SHEAR_SITE, TIP_SITE, TwoLinkChain};
 use crate::output::{Outputs, sample_field};
 use crate::system::Bound;
 
@@ -117,9 +117,13 @@ impl Outputs for TwoLinkChain {
         }
         if let Some(ct) = &self.contact {
             // λ of the last evaluation: the step end of the sampled interval (O(τ) in time)
-            out[k] = self.lambda;
-            out[k + 1] = if self.constrained { 1.0 } else { 0.0 };
-            out[k + 2] = ct.gap(self, &qk);
+            out[k] = self.constraint.lambda;
+            out[k + 1] = if self.constraint.constrained {
+                1.0
+            } else {
+                0.0
+            };
+            out[k + 2] = self.gap_on(ct, &qk);
         }
     }
 

@@ -209,12 +209,9 @@ impl Driver {
         Ok((b, width))
     }
 
-    /// Event handling after a converged trial step of length h (state in q₁, q̇₁): returns the
-    /// step length to accept (the trial for it solved) and what to do after accepting it.
+    /// Unilateral events after a converged trial step of length h (state in q₁, q̇₁): returns
+    /// the step length to accept (the trial for it solved) and what to do after accepting it.
     pub(crate) fn contact_after_trial(&mut self, h: f64) -> Result<(f64, Post), FemError> {
-        if self.contact_mut().bilateral.is_some() {
-            return self.bilateral_after_trial(h);
-        }
         let (t0, t1) = (self.state.t, self.state.t + h);
         let c = self.contact_mut();
         if c.record.n_events >= MAX_EVENTS {
@@ -330,12 +327,9 @@ impl Driver {
         Ok((h, Post::Release { time_tolerance: h }))
     }
 
-    /// Records the drift of an accepted constrained step and applies the located event at the
-    /// new state.
+    /// Records the drift of an accepted constrained step and applies the located unilateral
+    /// event at the new state.
     pub(crate) fn contact_after_accept(&mut self, post: Post) -> Result<(), FemError> {
-        if self.contact_mut().bilateral.is_some() {
-            return self.bilateral_after_accept();
-        }
         let t = self.state.t;
         let Some(mut c) = self.contact.take() else {
             return Ok(());

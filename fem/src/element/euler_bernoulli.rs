@@ -12,10 +12,12 @@
 //! operators; for the von Kármán energy the force and tangent are the exact derivatives of the
 //! *same* quadrature of the energy, which is what energy consistency needs.
 
-use super::Mat4;
+use super::contract::{
+    Element, ElementDofs, InteriorDof, Local, MAXE, Mat4, MeshElement, NONE, Row, Shapes,
+    linear_internal_force, linear_strain_energy, linear_tangent, pad,
+};
 use super::hermite::{dot4, hermite};
 use super::quadrature::gauss01;
-use super::{Element, ElementDofs, InteriorDof, Local, MAXE, MeshElement, NONE, Row, Shapes, pad};
 
 /// Consistent transverse mass ∫ρA NᵢNⱼ (+ ∫ρI Nᵢ′Nⱼ′ when `rho_i` > 0).
 pub fn mass(rho_a: f64, rho_i: f64, h: f64) -> Mat4 {
@@ -218,7 +220,7 @@ impl Element for HermiteCubic {
                 fe[a] += fv[2 + a];
             }
         } else {
-            super::linear_internal_force(el, u, d, fu, fe);
+            linear_internal_force(el, u, d, fu, fe);
         }
     }
     fn tangent(
@@ -242,14 +244,14 @@ impl Element for HermiteCubic {
                 }
             }
         } else {
-            super::linear_tangent(el, dofs, u, d, c_q, add);
+            linear_tangent(el, dofs, u, d, c_q, add);
         }
     }
     fn add_strain_energy(&self, el: &MeshElement, u: [f64; 2], d: &Row, strain: &mut f64) {
         if el.axial {
             *strain += von_karman_energy(el.ea, el.ei, el.h, &[u[0], u[1], d[0], d[1], d[2], d[3]]);
         } else {
-            super::linear_strain_energy(el, u, d, strain);
+            linear_strain_energy(el, u, d, strain);
         }
     }
     fn consistent_load(&self, el: &MeshElement, q0: f64) -> Row {

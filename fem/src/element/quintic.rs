@@ -10,9 +10,9 @@
 //! geometric ½∫N v′². All integrals by 6-point Gauss: exact for the degree-10 mass and for the
 //! geometric stiffness with N of degree ≤ 2 (the centrifugal force).
 
+use super::contract::{Element, InteriorDof, InteriorField, Local, Shapes, pad};
 use super::hermite::hermite;
 use super::quadrature::gauss01;
-use super::{Element, InteriorDof, InteriorField, Local, Shapes, pad};
 
 /// Number of local DOFs of one element.
 pub const NDOF: usize = 6;

@@ -18,8 +18,8 @@
 //! θ′ and γ), unlike the interdependent-interpolation element (IIE), whose constant shear strain
 //! cannot follow the linearly varying shear force of a vibrating element and converges at O(h²).
 
+use super::contract::{Element, InteriorDof, InteriorField, Local, Shapes};
 use super::quadrature::gauss01;
-use super::{Element, InteriorDof, InteriorField, Local, Shapes};
 
 /// Number of local DOFs of one element.
 pub const NDOF: usize = 7;

@@ -1,0 +1,346 @@
+//! Construction of the chain from a planar chain of the scene (the checks of what the model
+//! carries, the lumped masses and segment weights, the constant ghost columns of M, the step
+//! bound's frequencies at t = 0), its DOF plan and its initial state.
+
+use data::scene::{Link, PlanarChain};
+use data::{DofPlan, Scene};
+
+use super::dual::Dual;
+use super::kinetic::{BE, ChainInertia, TH};
+use super::model::{JointLaw, LinkProps, TwoLinkChain};
+use super::surface::{TipConstraint, TipContact};
+use super::timoshenko::{self, TimoFields};
+use crate::error::FdmError;
+use crate::system::System;
+
+/// Default stations per link.
+pub const DEFAULT_STATIONS: usize = 21;
+
+fn check_link(name: &str, l: &Link) -> Result<(), FdmError> {
+    FdmError::check_switches(
+        &format!("`{name}` (link `{}`)", l.name),
+        "chain",
+        &[
+            ("axial", l.axial),
+            ("tip_inertia", l.tip_inertia.is_some()),
+            ("prescribed joint", l.joint.prescribed.is_some()),
+        ],
+    )?;
+    if !l.foreshortening {
+        // The chain's floating frames are the links' tip chords (module docs). With
+        // foreshortening the kinematics are those of the clamped frame to the order kept; the
+        // linear model without it is frame-dependent at second order in the deflection, so it
+        // would not be the scene's clamped-frame linear beam (measured on `two-link-free` with
+        // both links linear: 8.5e-4 of the peak hub angle from fem and modal, which agree).
+        return Err(FdmError::Unsupported(format!(
+            "fdm: `{name}` (link `{}`) is a linear beam (no `foreshortening`): the \
+             finite-difference chain measures deflections from the link's tip chord, which \
+             matches the clamped frame of the scene only with foreshortening; switch it on, \
+             or use the fem or modal backend",
+            l.name
+        )));
+    }
+    Ok(())
+}
+
+impl TwoLinkChain {
+    /// The chain model of `pc`, the planar chain of `scene`.
+    pub fn from_planar_chain(
+        scene: &Scene,
+        pc: &PlanarChain,
+        stations: Option<usize>,
+    ) -> Result<Self, FdmError> {
+        if pc.links.len() != 2 {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: `{}` has {} links; the finite-difference chain handles exactly two",
+                scene.name,
+                pc.links.len()
+            )));
+        }
+        for l in &pc.links {
+            check_link(&scene.name, l)?;
+        }
+        let shear = pc.links[0].shear;
+        if pc.links[1].shear != shear {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: `{}` mixes a Timoshenko (`shear`) and an Euler link; the finite-difference \
+                 chain needs both links of one model",
+                scene.name
+            )));
+        }
+        for l in &pc.links {
+            if l.rotary_inertia {
+                return Err(FdmError::Unsupported(format!(
+                    "fdm: `{}` (link `{}`) switches on rotary_inertia — the finite-difference \
+                     chain has no section inertia: {}",
+                    scene.name,
+                    l.name,
+                    if l.shear {
+                        "its Timoshenko ψ is massless and condensed (chain::timoshenko)"
+                    } else {
+                        "Euler links carry only the lumped masses"
+                    }
+                )));
+            }
+            if l.shear && l.joint.torque.is_some() {
+                return Err(FdmError::Unsupported(format!(
+                    "fdm: `{}` (link `{}`): an applied joint torque law with Timoshenko links \
+                     is not implemented (the condensed ψ would follow the torque's rate)",
+                    scene.name, l.name
+                )));
+            }
+        }
+        if pc.links[1].joint.hub_inertia.unwrap_or(0.0) != 0.0 {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: `{}`: a rotor inertia at the elbow is not implemented",
+                scene.name
+            )));
+        }
+        let n = stations.unwrap_or(DEFAULT_STATIONS);
+        let lump = |l: &Link| -> (usize, f64, Vec<f64>) {
+            let r = n - 1;
+            let h = l.length / r as f64;
+            let mut m = vec![l.mass_per_length * h; r];
+            m[r - 1] = 0.5 * l.mass_per_length * h + l.tip_mass.unwrap_or(0.0);
+            (r, h, m)
+        };
+        let (r1, h1, m1) = lump(&pc.links[0]);
+        let (r2, h2, m2) = lump(&pc.links[1]);
+        // outboard sums per segment: Σ_{i > seg} mᵢ xᵢ and Σ_{i > seg} mᵢ
+        let outboard = |m: &[f64], h: f64, moment: bool| -> Vec<f64> {
+            let mut out = vec![0.0; m.len()];
+            let mut acc = 0.0;
+            for seg in (0..m.len()).rev() {
+                acc += m[seg] * if moment { (seg + 1) as f64 * h } else { 1.0 };
+                out[seg] = acc;
+            }
+            out
+        };
+        // Rotary inertia ρA h³/24 of the half cell at each clamp: its section turns with the
+        // clamp tangent (module docs). O(h³): the O(h²) convergence is unaffected.
+        let clamp = |l: &Link, h: f64| l.mass_per_length * h.powi(3) / 24.0;
+        // Timoshenko: the clamp section's turn is ψ₀ (massless, condensed), no ghost inertia
+        let jc = if shear {
+            [0.0; 2]
+        } else {
+            [clamp(&pc.links[0], h1), clamp(&pc.links[1], h2)]
+        };
+        let timo = if shear {
+            let mut lk = [(0, 0.0, 0.0, 0.0, 0.0); 2];
+            for (k, (l, (r, h))) in pc.links.iter().zip([(r1, h1), (r2, h2)]).enumerate() {
+                lk[k] = (
+                    r,
+                    h,
+                    l.bending_stiffness,
+                    timoshenko::shear_stiffness(&scene.name, l)?,
+                    l.kelvin_voigt.unwrap_or(0.0),
+                );
+            }
+            let jt = |l: &Link| {
+                (
+                    l.joint.stiffness.unwrap_or(0.0),
+                    l.joint.damping.unwrap_or(0.0),
+                    l.joint.set_point.unwrap_or(0.0),
+                )
+            };
+            Some(TimoFields::new(lk, [jt(&pc.links[0]), jt(&pc.links[1])])?)
+        } else {
+            None
+        };
+        let inertia = ChainInertia {
+            hub: pc.links[0].joint.hub_inertia.unwrap_or(0.0),
+            l1: pc.links[0].length,
+            h1,
+            h2,
+            r1,
+            r2,
+            fs1: pc.links[0].foreshortening,
+            fs2: pc.links[1].foreshortening,
+            w1: outboard(&m1, h1, true),
+            w2: outboard(&m2, h2, true),
+            mu2: outboard(&m2, h2, false),
+            sum_mx2_1: (0..r1).map(|k| m1[k] * ((k + 1) as f64 * h1).powi(2)).sum(),
+            // link 2's clamp half cell (mass ρA₂h₂/2 at ξ = 0) rides on the elbow
+            mass2: m2.iter().sum::<f64>() + 0.5 * pc.links[1].mass_per_length * h2,
+            q2: (0..r2).map(|j| m2[j] * (j + 1) as f64 * h2).sum(),
+            i2: (0..r2).map(|j| m2[j] * ((j + 1) as f64 * h2).powi(2)).sum(),
+            m1,
+            m2,
+        };
+        let props = |l: &Link| LinkProps {
+            length: l.length,
+            ei: l.bending_stiffness,
+            gamma: l.kelvin_voigt.unwrap_or(0.0),
+            rho_a: l.mass_per_length,
+        };
+        let joint = |l: &Link| JointLaw {
+            stiffness: l.joint.stiffness.unwrap_or(0.0),
+            damping: l.joint.damping.unwrap_or(0.0),
+            set_point: l.joint.set_point.unwrap_or(0.0),
+            law: l.joint.torque.clone(),
+        };
+        // Euler links: link 1's tip ghost y after the inertia's coordinates
+        let tip_ghost = (!shear).then(|| inertia.dofs());
+        let jt = if shear { 0.0 } else { clamp(&pc.links[0], h1) };
+        let nd = inertia.dofs() + usize::from(tip_ghost.is_some());
+        let contact = TipContact::from_planar_chain(&scene.name, pc)?;
+        let mu1g = {
+            let mut acc = inertia.mass2;
+            let mut out = vec![0.0; r1];
+            for seg in (0..r1).rev() {
+                acc += inertia.m1[seg];
+                out[seg] = acc;
+            }
+            out
+        };
+        let (j1, j2) = (&pc.links[0].joint, &pc.links[1].joint);
+        let mut chain = TwoLinkChain {
+            links: [props(&pc.links[0]), props(&pc.links[1])],
+            joints: [joint(&pc.links[0]), joint(&pc.links[1])],
+            init: [
+                (j1.initial_angle, j1.initial_rate),
+                (j2.initial_angle, j2.initial_rate),
+            ],
+            field_stations: scene.simulation.field_stations.max(2),
+            p: vec![Dual::default(); nd],
+            cols: std::array::from_fn(|_| vec![0.0; nd]),
+            unit: vec![0.0; nd],
+            rhs: vec![0.0; nd],
+            fv: vec![0.0; r1],
+            fw: vec![0.0; r2],
+            power: [0.0; 3],
+            torques: [0.0; 2],
+            omega_max: 0.0,
+            kappa_max: 0.0,
+            jc,
+            tip_ghost,
+            jt,
+            slots: [1 + r1, 1 + r1 + r2],
+            hs: [h1, h2],
+            qk: vec![0.0; nd],
+            vk: vec![0.0; nd],
+            obs_scratch: std::cell::RefCell::new(vec![0.0; nd]),
+            obs_scratch_v: std::cell::RefCell::new(vec![0.0; nd]),
+            inertia,
+            gravity: pc.gravity.as_ref().map(|g| g.vector),
+            mu1g,
+            contact,
+            constraint: TipConstraint {
+                constrained: false,
+                lambda: 0.0,
+                grow: vec![0.0; nd],
+                minv_g: vec![0.0; nd],
+                last_projection: [0.0; 3],
+            },
+            implicit: None,
+            skip_damping: false,
+            vd: vec![0.0; nd],
+            timo,
+        };
+        // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
+        // built once here, `accel` refreshes only the θ and β columns.
+        for k in 0..2 {
+            let mut col = std::mem::take(&mut chain.cols[2 + k]);
+            if chain.timo.is_some() {
+                // unused slot: a decoupled unit mass with no force keeps it at rest at zero
+                col[chain.slots[k]] = 1.0;
+            } else {
+                chain.add_clamp(k, -chain.jc[k] / (2.0 * chain.hs[k]), &mut col);
+            }
+            chain.cols[2 + k] = col;
+        }
+        if let Some(y) = chain.tip_ghost {
+            let mut col = std::mem::take(&mut chain.cols[4]);
+            chain.add_tip(chain.jt / (2.0 * chain.hs[0]), &mut col);
+            debug_assert_eq!(col[y], chain.jt / (4.0 * chain.hs[0] * chain.hs[0]));
+            chain.cols[4] = col;
+        }
+        chain.omega_max = chain.top_frequency();
+        chain.kappa_max = chain.top_damping_rate();
+        Ok(chain)
+    }
+
+    pub fn dof_plan(&self) -> DofPlan {
+        let mut plan = DofPlan::default();
+        plan.add("link-1 tip-chord angle θ", 1);
+        plan.add("link-2 tip-chord angle β", 1);
+        if self.timo.is_some() {
+            plan.add(
+                "unused ghost slots (Timoshenko: held at zero, decoupled unit mass)",
+                2,
+            );
+        } else {
+            plan.add(
+                "clamp ghost deflections x₁, x₂ (clamp turn against the chord)",
+                2,
+            );
+        }
+        if self.tip_ghost.is_some() {
+            plan.add(
+                "link 1 tip ghost y = v_{r+1} (elbow section turn and moment against the chord)",
+                1,
+            );
+        }
+        plan.add(
+            "link 1 transverse v at stations 1…r−1 (tip-chord frame: v₀ = v_r = 0)",
+            self.inertia.r1 - 1,
+        );
+        plan.add(
+            "link 2 transverse w at stations 1…r−1 (tip-chord frame: w₀ = w_r = 0)",
+            self.inertia.r2 - 1,
+        );
+        if self.inertia.fs1 || self.inertia.fs2 {
+            plan.builds
+                .push("foreshortening (inertial axial-load) stiffening".into());
+        }
+        if let Some(t) = &self.timo {
+            plan.builds.push(format!(
+                "Timoshenko shear ½κGA(Δv/h − ψ̄)² and bending ½EI(Δψ/h)²: {} massless section \
+                 rotations ψ condensed on their slow manifold (tridiagonal solve per evaluation)",
+                t.nz()
+            ));
+        }
+        if self.any_kv() {
+            plan.builds.push("Kelvin–Voigt damping".into());
+        }
+        if self.any_damper() {
+            plan.builds.push("joint dampers".into());
+        }
+        plan.builds.push(
+            "default time method: velocity-form (the hub coupling is velocity dependent)".into(),
+        );
+        plan
+    }
+
+    pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
+        let n = self.dofs();
+        let mut q = vec![0.0; n];
+        let mut v = vec![0.0; n];
+        // elastic fields at rest and straight: ψ = 0, β = θ₁ + θ₂
+        q[TH] = self.init[0].0;
+        q[BE] = self.init[0].0 + self.init[1].0;
+        v[TH] = self.init[0].1;
+        v[BE] = self.init[0].1 + self.init[1].1;
+        if let Some(t) = &self.timo {
+            // The condensed sections turn with the elbow spring's load: set the chord angles
+            // so that the joint angles Θ₁ = θ + ψ¹₀, Θ₂ = β + ψ²₀ − θ − ψ¹_r (and their rates)
+            // are the scene's. ∂Θ/∂(θ, β) is 1 up to the ψ response (≪ 1): fixed point.
+            for (x, rate) in [(&mut q, false), (&mut v, true)] {
+                let want = [
+                    if rate { self.init[0].1 } else { self.init[0].0 },
+                    if rate { self.init[1].1 } else { self.init[1].0 },
+                ];
+                for _ in 0..50 {
+                    let th = t.joint_angles(x, rate);
+                    let d = [want[0] - th[0], want[1] - th[1]];
+                    x[TH] += d[0];
+                    x[BE] += d[0] + d[1];
+                    if d[0].abs().max(d[1].abs()) <= 1e-16 * (1.0 + want[0].abs()) {
+                        break;
+                    }
+                }
+            }
+        }
+        (q, v)
+    }
+}

@@ -1,0 +1,319 @@
+//! The chain's forces and energies: the ghost-node bending energy (clamp ghosts, link 1's tip
+//! term) and its Kelvin–Voigt dissipation, the joint springs, dampers and torque laws, the
+//! gravity potential of the lumped masses, the inertia terms ∂T/∂q − (∂p/∂q)q̇ and the momenta
+//! p = M q̇, and the input/dissipation powers of the ledger (module docs of [`super`]).
+
+use super::dual::Dual;
+use super::kinetic::{BE, TH, seg_energy, seg_grad};
+use super::model::TwoLinkChain;
+use crate::link::FloatingLink;
+use crate::output::Outputs;
+use crate::system::System;
+
+impl TwoLinkChain {
+    /// Link 1's tip term of the trapezoid bending energy, ¼h c κ_r² with κ_r = (y + u)/h²
+    /// (u = v_{r−1}, v_r = 0, y = v_{r+1}): (energy, ∂/∂y = ∂/∂u).
+    pub(super) fn tip_bending(h: f64, c: f64, u: f64, y: f64) -> (f64, f64) {
+        let h3 = h * h * h;
+        (c * (y + u).powi(2) / (4.0 * h3), c * (y + u) / (2.0 * h3))
+    }
+
+    /// Bending energy of one link in the tip-chord frame with the clamp ghost x: the
+    /// single-link energy on u (u_r = 0) with κ₀ = 2u₁/h² replaced by (u₁ + x)/h². Adds −∂/∂u
+    /// into f (its tip entry left untouched) and returns (energy, −∂/∂x).
+    fn ghost_bending(h: f64, c: f64, u: &[f64], x: f64, f: &mut [f64]) -> (f64, f64) {
+        let r = u.len();
+        let tip = f[r - 1];
+        let e = FloatingLink::add_bending(h, c, u, f);
+        f[r - 1] = tip;
+        let h3 = h * h * h;
+        f[0] += 2.0 * c * u[0] / h3;
+        let g = c * (u[0] + x) / (2.0 * h3);
+        f[0] -= g;
+        (
+            e - c * u[0] * u[0] / h3 + c * (u[0] + x).powi(2) / (4.0 * h3),
+            -g,
+        )
+    }
+
+    /// Generalized momenta p = M(q) q̇ of the whole chain (chord-frame kinetic energy plus the
+    /// clamp rotary inertias).
+    pub fn momenta(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
+        self.chord(q, qd);
+        out.iter_mut().for_each(|x| *x = 0.0);
+        self.inertia.momenta_values(&self.qk, &self.vk, out);
+        for s in self.ghosts() {
+            out[s] = 0.0;
+        }
+        for k in 0..2 {
+            let w = self.jc[k] * self.clamp_angle(qd, k);
+            self.add_clamp(k, w, out);
+        }
+        if self.tip_ghost.is_some() {
+            self.add_tip(self.jt * self.tip_angle(qd), out);
+        }
+    }
+
+    pub fn total_energy(&self, q: &[f64], v: &[f64]) -> f64 {
+        let mut e = [0.0; 4];
+        let k = self.ledger_names().0.len();
+        self.stored_energies(0.0, q, v, &mut e[..k]);
+        e.iter().sum()
+    }
+
+    /// Gravity potential V_g = −g·Σ m r of the lumped masses, from the chord-frame coordinates
+    /// `qk` (ghost slots zero); adds −∂V_g/∂q into `out` when given (not at the ghost slots:
+    /// the ghosts move no mass). With A(α) = g·(cos α, sin α), B(α) = g·(−sin α, cos α),
+    /// ∂A/∂α = B, ∂B/∂α = −A:
+    /// V_g = −[A(θ)X₁ + B(θ)Y₁ + A(β)X₂ + B(β)Y₂], X₁ = Σm₁x + M₂L₁ − Σ_seg c₁ ½h g²
+    /// (foreshortening; c₁ = outboard mass of link 1 + M₂), Y₁ = Σm₁v, X₂ = Q₂ − Ψ, Y₂ = Σm₂w:
+    /// the positions the kinetic energy uses, so the gravity work is exactly −ΔV_g.
+    pub(super) fn gravity_potential(&self, qk: &[f64], out: Option<&mut [f64]>) -> f64 {
+        let Some([gx, gy]) = self.gravity else {
+            return 0.0;
+        };
+        let ine = &self.inertia;
+        let (v, w) = (&qk[ine.iv()], &qk[ine.iw()]);
+        let ab = |a: f64| {
+            let (s, c) = a.sin_cos();
+            (gx * c + gy * s, -gx * s + gy * c)
+        };
+        let (a1, b1) = ab(qk[TH]);
+        let (a2, b2) = ab(qk[BE]);
+        let mut x1 = ine.mass2 * ine.l1;
+        let mut y1 = 0.0;
+        for k in 0..ine.r1 {
+            x1 += ine.m1[k] * (k + 1) as f64 * ine.h1;
+            y1 += ine.m1[k] * v[k];
+        }
+        if ine.fs1 {
+            x1 -= seg_energy(v, ine.h1, Some(&self.mu1g));
+        }
+        let mut x2 = ine.q2;
+        let y2: f64 = (0..ine.r2).map(|j| ine.m2[j] * w[j]).sum();
+        if ine.fs2 {
+            x2 -= seg_energy(w, ine.h2, Some(&ine.mu2));
+        }
+        if let Some(out) = out {
+            out[TH] += b1 * x1 - a1 * y1;
+            out[BE] += b2 * x2 - a2 * y2;
+            // the tip entries (k = r − 1) are the ghost slots: no mass moves with them
+            for k in 0..ine.r1 - 1 {
+                let mut f = b1 * ine.m1[k];
+                if ine.fs1 {
+                    f -= a1 * seg_grad(v, ine.h1, Some(&self.mu1g), k);
+                }
+                out[2 + k] += f;
+            }
+            for j in 0..ine.r2 - 1 {
+                let mut f = b2 * ine.m2[j];
+                if ine.fs2 {
+                    f -= a2 * seg_grad(w, ine.h2, Some(&ine.mu2), j);
+                }
+                out[2 + ine.r1 + j] += f;
+            }
+        }
+        -(a1 * x1 + b1 * y1 + a2 * x2 + b2 * y2)
+    }
+
+    /// Stores the input/dissipation powers at (q, q̇) — without the force evaluation — and
+    /// writes them as [`System::powers`] does. The velocity form evaluates the forces of a step
+    /// end at the *predicted* velocity; its ledger takes the powers at the final one (the
+    /// overdamped clamp-rotation modes make the two differ at O(1) near the step bound).
+    pub(crate) fn powers_at(&mut self, t: f64, v: &[f64], out: &mut [f64]) {
+        if let Some(tf) = &self.timo {
+            let pw = tf.powers(v);
+            self.power = [0.0, pw[0], pw[1]];
+            self.powers(out);
+            return;
+        }
+        self.vk.copy_from_slice(v);
+        for s in self.ghosts() {
+            self.vk[s] = 0.0;
+        }
+        let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
+        let mut p_kv = 0.0;
+        if let Some(y) = self.tip_ghost {
+            let u = v[self.inertia.i_tip1() - 1];
+            p_kv += 2.0 * Self::tip_bending(self.hs[0], self.links[0].gamma, u, v[y]).0;
+        }
+        for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
+            .into_iter()
+            .enumerate()
+        {
+            let lp = &self.links[link];
+            if lp.gamma == 0.0 {
+                continue;
+            }
+            f.iter_mut().for_each(|x| *x = 0.0);
+            let (d2, _) = Self::ghost_bending(
+                self.hs[link],
+                lp.gamma,
+                &self.vk[range],
+                v[self.slots[link]],
+                f,
+            );
+            p_kv += 2.0 * d2;
+        }
+        let (th1d, th2d) = (self.clamp_angle(v, 0), self.elbow(v));
+        let j = &self.joints;
+        self.power = [
+            j[0].torque(t) * th1d + j[1].torque(t) * th2d,
+            j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
+            p_kv,
+        ];
+        self.powers(out);
+    }
+
+    /// rhs += scale·(∂T/∂q − (∂p/∂q)q̇) at the chord copies (`qk`, `vk`) of the last
+    /// [`Self::chord`]; `scratch` (length n) is overwritten. The clamp inertias are constant
+    /// and the chord-frame T does not see the ghost slots.
+    pub(super) fn add_inertia_terms(&mut self, scale: f64, scratch: &mut [f64], rhs: &mut [f64]) {
+        self.inertia.grad_q(&self.qk, &self.vk, scratch);
+        self.inertia
+            .momenta(&self.qk, &self.vk, &self.vk, &mut self.p);
+        for s in self.ghosts() {
+            scratch[s] = 0.0;
+            self.p[s] = Dual::default();
+        }
+        for i in 0..rhs.len() {
+            rhs[i] += scale * (scratch[i] - self.p[i].du);
+        }
+    }
+
+    /// Generalized forces Q − ∂V/∂q − ∂D/∂q̇ into `out`; sets the powers.
+    pub(super) fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 0.0);
+        if let Some(tf) = &self.timo {
+            // condensed ψ (chain::timoshenko): −∂U_c/∂q − ∂D_c/∂q̇, no torque laws (refused)
+            let (pw, [th, thd]) = tf.forces(q, v, out);
+            let j = &self.joints;
+            self.torques =
+                [0, 1].map(|k| -j[k].stiffness * (th[k] - j[k].set_point) - j[k].damping * thd[k]);
+            self.power = [0.0, pw[0], pw[1]];
+            let qk = std::mem::take(&mut self.qk);
+            self.gravity_potential(&qk, Some(out));
+            self.qk = qk;
+            return;
+        }
+        // the implicit kick (`implicit`) takes the damping forces separately
+        let damp = !self.skip_damping;
+        let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
+        let mut p_kv = 0.0;
+        for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
+            .into_iter()
+            .enumerate()
+        {
+            f.iter_mut().for_each(|x| *x = 0.0);
+            let h = if link == 0 {
+                self.inertia.h1
+            } else {
+                self.inertia.h2
+            };
+            let lp = &self.links[link];
+            let slot = self.slots[link];
+            let (_, gx) = Self::ghost_bending(h, lp.ei, &self.qk[range.clone()], q[slot], f);
+            let mut fx = gx;
+            if lp.gamma != 0.0 && damp {
+                let (d2, gv) =
+                    Self::ghost_bending(h, lp.gamma, &self.vk[range.clone()], v[slot], f);
+                p_kv += 2.0 * d2;
+                fx += gv;
+            }
+            let r = f.len();
+            f[r - 1] = fx; // the tip entry carries the ghost's force
+            out[range].copy_from_slice(f);
+        }
+        if let Some(y) = self.tip_ghost {
+            // link 1's tip term of the bending energy (elbow moment EIκ_r) and its Kelvin–Voigt
+            // dissipation
+            let (h, lp, u) = (self.hs[0], &self.links[0], self.inertia.i_tip1() - 1);
+            let (_, g) = Self::tip_bending(h, lp.ei, q[u], q[y]);
+            let (mut fy, mut fu) = (-g, -g);
+            if lp.gamma != 0.0 && damp {
+                let (d2, gv) = Self::tip_bending(h, lp.gamma, v[u], v[y]);
+                p_kv += 2.0 * d2;
+                fy -= gv;
+                fu -= gv;
+            }
+            out[y] = fy;
+            out[u] += fu;
+        }
+        let th2 = self.elbow(q);
+        let th2d = self.elbow(v);
+        let j = &self.joints;
+        let ext = [j[0].torque(t), j[1].torque(t)];
+        let th1 = self.clamp_angle(q, 0);
+        let th1d = self.clamp_angle(v, 0);
+        let dj = if damp {
+            [j[0].damping, j[1].damping]
+        } else {
+            [0.0; 2]
+        };
+        let tau1 = ext[0] - j[0].stiffness * (th1 - j[0].set_point) - dj[0] * th1d;
+        let tau2 = ext[1] - j[1].stiffness * (th2 - j[1].set_point) - dj[1] * th2d;
+        // τ₁ on θ₁ (clamp angle of link 1); τ₂ on θ₂ = clamp angle of link 2 − θ − ψ(v)
+        self.add_clamp(0, tau1, out);
+        self.add_clamp(1, tau2, out);
+        out[TH] -= tau2;
+        for (i, c) in self.slope_stencil() {
+            out[i] -= tau2 * c;
+        }
+        self.torques = [tau1, tau2];
+        let qk = std::mem::take(&mut self.qk);
+        self.gravity_potential(&qk, Some(out));
+        self.qk = qk;
+        self.power = [
+            ext[0] * th1d + ext[1] * th2d,
+            j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
+            p_kv,
+        ];
+    }
+
+    /// Adds the damping forces −∂D/∂q̇ = −C q̇ at `v` into `out`: Kelvin–Voigt (the ghost-node
+    /// bending stencil on the rates, link 1's tip term) and the joint dampers (Euler links;
+    /// the same terms as [`Self::forces`]). Linear in `v` with constant C.
+    pub(crate) fn add_damping_forces(&mut self, v: &[f64], out: &mut [f64]) {
+        let mut vd = std::mem::take(&mut self.vd);
+        vd.copy_from_slice(v);
+        for s in self.ghosts() {
+            vd[s] = 0.0;
+        }
+        let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
+        for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
+            .into_iter()
+            .enumerate()
+        {
+            let lp = &self.links[link];
+            if lp.gamma == 0.0 {
+                continue;
+            }
+            f.iter_mut().for_each(|x| *x = 0.0);
+            let slot = self.slots[link];
+            let (_, gv) =
+                Self::ghost_bending(self.hs[link], lp.gamma, &vd[range.clone()], v[slot], f);
+            let r = f.len();
+            f[r - 1] = gv;
+            for (o, x) in out[range].iter_mut().zip(f.iter()) {
+                *o += x;
+            }
+        }
+        if let Some(y) = self.tip_ghost {
+            let (h, lp, u) = (self.hs[0], &self.links[0], self.inertia.i_tip1() - 1);
+            if lp.gamma != 0.0 {
+                let (_, g) = Self::tip_bending(h, lp.gamma, v[u], v[y]);
+                out[y] -= g;
+                out[u] -= g;
+            }
+        }
+        let tau1 = -self.joints[0].damping * self.clamp_angle(v, 0);
+        let tau2 = -self.joints[1].damping * self.elbow(v);
+        self.add_clamp(0, tau1, out);
+        self.add_clamp(1, tau2, out);
+        out[TH] -= tau2;
+        for (i, c) in self.slope_stencil() {
+            out[i] -= tau2 * c;
+        }
+        self.vd = vd;
+    }
+}

@@ -1,0 +1,235 @@
+//! The chain's data and its coordinate maps: [`TwoLinkChain`] (links, joints, the lumped
+//! inertia, the ghost slots, the tip contact and its constraint state, the implicit damping,
+//! scratch), and the angles and inertia directions read off q: clamp tangents, link 1's tip
+//! slope ψ and tip-section angle, the elbow angle θ₂, the chord-frame copies with the ghost
+//! slots zeroed, the lumped diagonal of M (module docs of [`super`]).
+
+use data::scene::TorqueLaw;
+
+use super::damping_matrix::ImplicitDamping;
+use super::dual::Dual;
+use super::kinetic::{BE, ChainInertia, TH};
+use super::schur::MAX_FULL;
+use super::surface::{TipConstraint, TipContact};
+use super::timoshenko::TimoFields;
+
+/// Bound sites ≥ this are the Timoshenko links' shear bounds.
+pub(super) const SHEAR_SITE: usize = 10;
+/// Bound site of link 1's tip-ghost rotation mode (Euler links).
+pub(super) const TIP_SITE: usize = 5;
+
+/// A joint's spring, damper, set point and applied torque law.
+#[derive(Debug, Clone, Default)]
+pub(super) struct JointLaw {
+    pub(super) stiffness: f64,
+    pub(super) damping: f64,
+    pub(super) set_point: f64,
+    pub(super) law: Option<TorqueLaw>,
+}
+
+impl JointLaw {
+    pub(super) fn torque(&self, t: f64) -> f64 {
+        self.law.as_ref().map_or(0.0, |l| l.torque(t))
+    }
+}
+
+/// A link's length, bending stiffness EI, Kelvin–Voigt coefficient γ and mass per length ρA.
+#[derive(Debug, Clone)]
+pub(super) struct LinkProps {
+    pub(super) length: f64,
+    pub(super) ei: f64,
+    pub(super) gamma: f64,
+    pub(super) rho_a: f64,
+}
+
+/// The two-link chain as a [`System`](crate::system::System).
+#[derive(Debug, Clone)]
+pub struct TwoLinkChain {
+    pub inertia: ChainInertia,
+    pub(super) links: [LinkProps; 2],
+    pub(super) joints: [JointLaw; 2],
+    pub(super) init: [(f64, f64); 2],
+    pub(super) field_stations: usize,
+    /// highest angular frequency of the linearized chain at t = 0 (power iteration)
+    pub omega_max: f64,
+    /// fastest damping rate of the linearized chain at t = 0 (power iteration on −∂a/∂q̇)
+    pub kappa_max: f64,
+    /// clamp half-cell rotary inertias ρA h³/24 of links 1 and 2
+    pub(super) jc: [f64; 2],
+    /// Euler links: q-slot of link 1's tip ghost y = v_{r+1} (the elbow section's turn from
+    /// the chord, ψ = (y − v_{r−1})/(2h₁)) and the tip half cell's rotary inertia ρA₁h₁³/24;
+    /// Timoshenko links: none (link 1's tip section is the condensed ψ)
+    pub(super) tip_ghost: Option<usize>,
+    pub(super) jt: f64,
+    /// q-slots of the clamp ghost deflections x₁, x₂ (station 1 of each link is the chord
+    /// frame's zero) and the link steps
+    pub(super) slots: [usize; 2],
+    pub(super) hs: [f64; 2],
+    pub(super) qk: Vec<f64>,
+    pub(super) vk: Vec<f64>,
+    pub(super) obs_scratch: std::cell::RefCell<Vec<f64>>,
+    pub(super) obs_scratch_v: std::cell::RefCell<Vec<f64>>,
+    // scratch (allocated once)
+    pub(super) p: Vec<Dual>,
+    /// the full columns of M: θ, β, x₁, x₂ and (Euler) the tip ghost y
+    pub(super) cols: [Vec<f64>; MAX_FULL],
+    pub(super) unit: Vec<f64>,
+    pub(super) rhs: Vec<f64>,
+    pub(super) fv: Vec<f64>,
+    pub(super) fw: Vec<f64>,
+    pub(super) power: [f64; 3],
+    pub(super) torques: [f64; 2],
+    /// uniform gravity (inertial gx, gy), if the scene has it
+    pub(super) gravity: Option<[f64; 2]>,
+    /// gravity weights of link 1's foreshortening: outboard mass of each segment plus the
+    /// whole of link 2 (which rides on link 1's tip)
+    pub(super) mu1g: Vec<f64>,
+    /// the tip contact of link 2, if any ([`super::contact`])
+    pub(super) contact: Option<TipContact>,
+    /// the state of the contact constraint g = 0: phase, normal force, G and M⁻¹Gᵀ, last
+    /// projections
+    pub(super) constraint: TipConstraint,
+    /// the damping matrix C and the banded factorization of the implicit kick ([`super::implicit`]);
+    /// none: damping explicit in the forces
+    pub(super) implicit: Option<Box<ImplicitDamping>>,
+    /// `forces` leaves the damping out (the implicit kick adds it at the drift velocity)
+    pub(super) skip_damping: bool,
+    /// scratch of [`Self::add_damping_forces`] and the implicit kick (length n)
+    pub(super) vd: Vec<f64>,
+    /// Timoshenko links (`shear` on both): the condensed section rotations ([`super::timoshenko`]);
+    /// the ghost slots are then unused (held at zero with a unit dummy mass)
+    pub(super) timo: Option<TimoFields>,
+}
+
+impl TwoLinkChain {
+    pub(super) fn any_law(&self) -> bool {
+        self.joints.iter().any(|j| j.law.is_some())
+    }
+
+    pub(super) fn any_damper(&self) -> bool {
+        self.joints.iter().any(|j| j.damping != 0.0)
+    }
+
+    pub(super) fn any_kv(&self) -> bool {
+        self.links.iter().any(|l| l.gamma != 0.0)
+    }
+
+    /// Joint angles (θ₁, θ₂) at q: the clamp angle of link 1 and the elbow (Euler: clamp
+    /// tangents and the tip slope; Timoshenko: clamp sections and link 1's tip section on the
+    /// condensed ψ).
+    pub fn joint_angles(&self, q: &[f64]) -> [f64; 2] {
+        match &self.timo {
+            Some(t) => t.joint_angles(q, false),
+            None => [self.clamp_angle(q, 0), self.elbow(q)],
+        }
+    }
+
+    /// Joint rates (θ̇₁, θ̇₂) at q̇ (both models: linear in q̇ alone).
+    pub fn joint_rates(&self, v: &[f64]) -> [f64; 2] {
+        match &self.timo {
+            Some(t) => t.joint_angles(v, true),
+            None => [self.clamp_angle(v, 0), self.elbow(v)],
+        }
+    }
+
+    /// The condensed Timoshenko fields, if the links are Timoshenko links.
+    pub fn timoshenko(&self) -> Option<&TimoFields> {
+        self.timo.as_ref()
+    }
+
+    /// Tip slope ψ of link 1 and the stencil (indices into q, weights).
+    pub(super) fn slope_stencil(&self) -> [(usize, f64); 2] {
+        let i = self.inertia.i_tip1();
+        let h = self.inertia.h1;
+        match self.tip_ghost {
+            // central (y − v_{r−1})/(2h) with the tip ghost y = v_{r+1}
+            Some(y) => [(y, 1.0 / (2.0 * h)), (i - 1, -1.0 / (2.0 * h))],
+            // Timoshenko (joint angles from the condensed ψ; unused): one-sided
+            // (3v_r − 4v_{r−1} + v_{r−2})/(2h) with v_r = 0 in the chord frame
+            None => [(i - 1, -4.0 / (2.0 * h)), (i - 2, 1.0 / (2.0 * h))],
+        }
+    }
+
+    /// Link 1's tip-section angle θ + ψ (applied to q or q̇; Euler links).
+    pub(super) fn tip_angle(&self, q: &[f64]) -> f64 {
+        let psi: f64 = self.slope_stencil().iter().map(|(i, c)| c * q[*i]).sum();
+        q[TH] + psi
+    }
+
+    /// Adds J_t e eᵀ·(scale) of link 1's tip-section rotation to a column/momentum vector:
+    /// e = ∂(θ + ψ)/∂q (1 at θ, 1/(2h) at y, −1/(2h) at v_{r−1}); nothing without a tip ghost.
+    pub(super) fn add_tip(&self, weight: f64, out: &mut [f64]) {
+        if self.tip_ghost.is_some() {
+            out[TH] += weight;
+            for (i, c) in self.slope_stencil() {
+                out[i] += weight * c;
+            }
+        }
+    }
+
+    /// q-index of station 1 of link ℓ.
+    pub(super) fn first(&self, link: usize) -> usize {
+        if link == 0 { 2 } else { 2 + self.inertia.r1 }
+    }
+
+    /// Clamp tangent angle of link ℓ: chord angle + (v₁ − x)/(2h) (applied to q or q̇).
+    pub fn clamp_angle(&self, q: &[f64], link: usize) -> f64 {
+        let frame = if link == 0 { q[TH] } else { q[BE] };
+        frame + (q[self.first(link)] - q[self.slots[link]]) / (2.0 * self.hs[link])
+    }
+
+    /// The turn −ε of each link's chord against its clamp tangent, ε = (v₁ − x)/(2h) the clamp
+    /// slope in the chord frame (Timoshenko: −ψ₀, the clamp section's rotation): deflections
+    /// in the clamp-tangent frame are u − Xε (small angle).
+    pub(super) fn clamp_frame_turns(&self, q: &[f64]) -> [f64; 2] {
+        match &self.timo {
+            Some(t) => t.clamp_turns(q).map(|z| -z),
+            None => [0, 1].map(|l| -(q[self.first(l)] - q[self.slots[l]]) / (2.0 * self.hs[l])),
+        }
+    }
+
+    /// Elbow angle θ₂ = (clamp tangent of link 2) − θ − ψ (applied to q or q̇).
+    pub fn elbow(&self, q: &[f64]) -> f64 {
+        let psi: f64 = self.slope_stencil().iter().map(|(i, c)| c * q[*i]).sum();
+        self.clamp_angle(q, 1) - q[TH] - psi
+    }
+
+    /// Copies of (q, q̇) with the ghost slots zeroed: the chord-frame deflections (v₁ = 0).
+    pub(super) fn chord(&mut self, q: &[f64], v: &[f64]) {
+        self.qk.copy_from_slice(q);
+        self.vk.copy_from_slice(v);
+        for s in self.ghosts() {
+            self.qk[s] = 0.0;
+            self.vk[s] = 0.0;
+        }
+    }
+
+    /// The q-slots that move no lumped mass: the clamp ghosts and (Euler) link 1's tip ghost.
+    pub(super) fn ghosts(&self) -> impl Iterator<Item = usize> + use<> {
+        self.slots.into_iter().chain(self.tip_ghost)
+    }
+
+    /// Diagonal mass of coordinate i outside the full columns θ, β, x₁, x₂.
+    pub(super) fn diag_mass(&self, i: usize) -> f64 {
+        let mut d = self.inertia.diag_mass(i);
+        for k in 0..2 {
+            if i == self.first(k) {
+                d += self.jc[k] / (4.0 * self.hs[k] * self.hs[k]);
+            }
+        }
+        if self.tip_ghost.is_some() && i == self.inertia.i_tip1() - 1 {
+            d += self.jt / (4.0 * self.hs[0] * self.hs[0]);
+        }
+        d
+    }
+
+    /// Adds J_c e eᵀ·(scale at `along`) of link ℓ's clamp rotation to a column/momentum vector:
+    /// e = ∂(clamp angle)/∂q (1 at the frame, ±1/(2h) at station 1 and the ghost).
+    pub(super) fn add_clamp(&self, link: usize, weight: f64, out: &mut [f64]) {
+        let frame = if link == 0 { TH } else { BE };
+        let a = 1.0 / (2.0 * self.hs[link]);
+        out[frame] += weight;
+        out[self.first(link)] += weight * a;
+        out[self.slots[link]] -= weight * a;
+    }
+}
