@@ -95,6 +95,14 @@ fn mode_number(q: &Quantity, want_kind: Option<&str>) -> Result<usize, String> {
     }
 }
 
+/// The channel and time of a `CHANNEL@T` quantity, which reference `id` needs.
+fn channel_at<'q>(id: &str, q: &'q Quantity) -> Result<(&'q String, f64), String> {
+    match q {
+        Quantity::At { channel, t } => Ok((channel, *t)),
+        _ => Err(format!("`{id}` applies to CHANNEL@T")),
+    }
+}
+
 fn nth(v: ana::Result<Vec<f64>>, n: usize) -> Result<f64, String> {
     let v = v.map_err(|e| e.to_string())?;
     v.get(n - 1)
@@ -304,14 +312,12 @@ fn static_linear(_id: &str, scene: &Scene, q: &Quantity) -> Result<f64, String> 
 
 /// Rigid link, hub and tip mass under the torque law.
 fn rigid_single_link(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, String> {
-    let Quantity::At { channel, t } = q else {
-        return Err("`rigid-single-link` applies to CHANNEL@T".into());
-    };
+    let (channel, t) = channel_at(id, q)?;
     let chain = planar_chain(scene, || {
         "rigid single-link reference: the scene must have exactly one link".into()
     })?;
     let st = ana::RigidLink::from_chain(chain)
-        .and_then(|r| r.state(*t))
+        .and_then(|r| r.state(t))
         .map_err(|e| e.to_string())?;
     offered_channel(
         id,
@@ -325,14 +331,12 @@ fn rigid_single_link(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Strin
 
 /// Rigid two-link arm with the scene's springs and dampers.
 fn rigid_two_link(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, String> {
-    let Quantity::At { channel, t } = q else {
-        return Err("`rigid-two-link` applies to CHANNEL@T".into());
-    };
+    let (channel, t) = channel_at(id, q)?;
     let chain = planar_chain(scene, || {
         "rigid two-link reference: the scene must have exactly two links".into()
     })?;
     let h = ana::RigidTwoLink::from_chain(chain)
-        .and_then(|r| r.simulate(&[0.0, *t]))
+        .and_then(|r| r.simulate(&[0.0, t]))
         .map_err(|e| e.to_string())?;
     let last = |v: &Vec<f64>| v.last().copied().ok_or("empty rigid history".to_string());
     offered_channel(
@@ -347,14 +351,12 @@ fn rigid_two_link(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, String> 
 
 /// Rigid link on the bilateral wall with Coulomb friction.
 fn constrained_rigid_link(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, String> {
-    let Quantity::At { channel, t } = q else {
-        return Err("`constrained-rigid-link` applies to CHANNEL@T".into());
-    };
+    let (channel, t) = channel_at(id, q)?;
     let chain = planar_chain(scene, || {
         "constrained rigid link: the scene must have exactly one link".into()
     })?;
     let st = ana::ConstrainedRigidLink::from_chain(chain)
-        .and_then(|r| r.state(*t))
+        .and_then(|r| r.state(t))
         .map_err(|e| e.to_string())?;
     offered_channel(
         id,
@@ -370,14 +372,12 @@ fn constrained_rigid_link(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, 
 
 /// Rocket equation with gravity: the material velocity and the mass.
 fn rocket_translation(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, String> {
-    let Quantity::At { channel, t } = q else {
-        return Err("`rocket-translation` applies to CHANNEL@T".into());
-    };
+    let (channel, t) = channel_at(id, q)?;
     let r = rocket(scene, || {
         "rocket translation: the scene has no [rocket]".into()
     })?;
     let st = ana::RocketTranslation::from_rocket(r)
-        .and_then(|r| r.state(*t))
+        .and_then(|r| r.state(t))
         .map_err(|e| e.to_string())?;
     offered_channel(
         id,
@@ -460,11 +460,9 @@ fn payload_static_sag(_id: &str, scene: &Scene, q: &Quantity) -> Result<f64, Str
 
 /// 3-D link with E, G → ∞: the rigid base motion.
 fn payload_rigid_base(id: &str, scene: &Scene, q: &Quantity) -> Result<f64, String> {
-    let Quantity::At { channel, t } = q else {
-        return Err("`payload-rigid-base` applies to CHANNEL@T".into());
-    };
+    let (channel, t) = channel_at(id, q)?;
     let (angle, rate) = ana::payload_link::RigidPayloadBase::from_link(payload_link(scene)?)
-        .and_then(|r| r.state(*t))
+        .and_then(|r| r.state(t))
         .map_err(|e| e.to_string())?;
     offered_channel(
         id,
