@@ -189,6 +189,7 @@ pub mod run;
 pub mod settings;
 pub mod statics;
 pub mod support;
+pub mod system;
 
 use std::time::Instant;
 
