@@ -26,7 +26,7 @@
 pub mod contact_events;
 pub mod stick_slip;
 
-use crate::chain::{Chain, NONE};
+use crate::chain::{AugmentedLayout, Chain, NONE};
 use crate::error::FemError;
 use crate::events::contact::{Contact, GRAZING_LOCATION};
 use crate::method::{
@@ -76,9 +76,9 @@ struct JointStart {
 pub struct Driver {
     pub chain: Chain,
     pub method: Method,
-    stepper: Box<dyn Stepper>,
+    stepper: Box<dyn Stepper<Chain>>,
     pub state: StepState,
-    pub newton: NewtonSystem,
+    pub newton: NewtonSystem<AugmentedLayout>,
     pub h: f64,
     /// The fixed step (the step returns to it after Newton-failure retries).
     pub h_nominal: f64,
@@ -202,7 +202,7 @@ impl Driver {
     /// quantities of the next step's start.
     fn initial_acceleration(&mut self, t_law: f64) -> Result<(), FemError> {
         let mut cx = StepContext {
-            chain: &mut self.chain,
+            system: &mut self.chain,
             state: &mut self.state,
             newton: &mut self.newton,
             counters: &mut self.counters,
@@ -223,9 +223,9 @@ impl Driver {
         let held = contact
             .as_deref_mut()
             .filter(|c| c.phase.constrained)
-            .map(|c| c as &mut dyn crate::method::StepConstraint);
+            .map(|c| c as &mut dyn crate::method::StepConstraint<Chain>);
         let mut cx = StepContext {
-            chain: &mut self.chain,
+            system: &mut self.chain,
             state: &mut self.state,
             newton: &mut self.newton,
             counters: &mut self.counters,
