@@ -137,9 +137,10 @@ pub trait System {
         res: &mut [f64],
     );
 
-    /// The groups `parts` (no inertia) at (t, q, q̇, 0), where the previous call of
-    /// [`System::residual_parts`] or of this was at (t, q): it may reuse that pass's
-    /// configuration data (bit-identical to a fresh evaluation up to the sign of exact zeros).
+    /// The groups `parts` (no inertia) at (t, q, q̇, 0), where the last evaluation of the
+    /// residual or of its groups was at the same (t, q) (any rates, any groups): it may reuse
+    /// that pass's configuration data (equal to [`System::residual_parts`] at (t, q, q̇, 0) up
+    /// to the sign of exact zeros).
     fn residual_parts_at_last_q(
         &mut self,
         t: f64,
@@ -175,8 +176,8 @@ pub trait System {
     /// A container with the pattern of `layout`.
     fn new_augmented_matrix(&self, layout: &Self::Augmented) -> BorderedBand;
 
-    /// The exact S at (q, q̇, q̈) as the augmented matrix of `layout`, at the state of the last
-    /// [`System::residual`] (at that state).
+    /// The exact S at (q, q̇, q̈) as the augmented matrix of `layout`; the last
+    /// [`System::residual`] must have been at that state.
     fn exact_newton_matrix(
         &self,
         q: &[f64],

@@ -149,7 +149,7 @@ fn regularized_acceleration<S: System + ?Sized>(
             message: "could not compute a consistent initial acceleration".into(),
         });
     }
-    // Leave the chain's cached data (joint torques) at the initial state.
+    // Leave the system's cached data (a chain's joint torques) at the initial state.
     cx.system
         .residual(t_law, &st.q, &st.qd, &st.qdd, &mut cx.newton.res);
     cx.newton.matrix_h = f64::NAN;
