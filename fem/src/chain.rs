@@ -49,10 +49,9 @@ use crate::element::{self, ElementDofs, InteriorField, MeshElement, dotn};
 use crate::error::FemError;
 
 pub use crate::element::{MAXE, NONE};
+pub use crate::system::{NewtonCoefficients, Parts};
 pub use augmented::AugmentedLayout;
-pub use forces::Parts;
 pub use geometry::V2;
-pub use newton::NewtonCoefficients;
 
 mod augmented;
 mod energies;
@@ -61,6 +60,7 @@ mod geometry;
 mod kinematics;
 pub mod linearized;
 mod newton;
+mod system;
 /// Longest chain the backend builds (fixed-size per-point column buffers, no allocation).
 pub const MAX_LINKS: usize = 6;
 /// Ancestor columns of J at most: joint, tip slope, tip v, tip u per link.

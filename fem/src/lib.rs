@@ -149,15 +149,29 @@
 //! planes (linear floating frame), implicit midpoint in time. It shares the Hermite tables and
 //! Gauss rules with the planar chains, nothing else. Rigid mobile scenes are the reference's.
 
+//! ## Problem, method, events
+//! The planar chains' time integration is split three ways. The problem is the discretized
+//! system R(t, q, q̇, q̈) = 0 behind the [`system::System`] trait: residual and its force
+//! groups, Newton matrix c_a·∂R/∂q̈ + c_v·∂R/∂q̇ + c_q·∂R/∂q, mass products, ∂T/∂q, energies and
+//! the midpoint works of the ledger; [`chain::Chain`] implements it. The methods
+//! ([`method`], one type per method behind [`method::Stepper`]) are generic over the system
+//! and name nothing else of the model. The events are objects the driver consumes: a held
+//! constraint reaches a method only through [`method::StepConstraint`], implemented for the
+//! system it constrains (the tip contact for the chain, which needs its tip kinematics); the
+//! driver ([`driver`]) locates impacts, releases and stick–slip switches and applies the
+//! resets. The rocket, 3-D payload-link and mobile-manipulator steppers are their own.
+//!
 //! ## Layers
 //! Each layer imports only the ones above it:
 //! 1. model: [`element`] (the element trait and its registry; element operators tested alone)
 //!    → [`linear`] (assembled linear link: modes, statics) and [`chain`] (nonlinear
 //!    floating-frame system), [`band`] (faer sparse LU of the bordered-band Newton matrix,
-//!    symbolic part reused; linear cost per step);
+//!    symbolic part reused; linear cost per step); [`system`] (what a method may ask of a
+//!    discretized system; the chain implements it);
 //! 2. methods: [`method`] — one type per integration method behind
 //!    [`method::Stepper`] ([`method::generalized_alpha`], [`method::central_difference`],
-//!    [`method::energy_midpoint`]), the Newton system and the consistent start; a held
+//!    [`method::energy_midpoint`], [`method::implicit_midpoint`]), generic over the
+//!    [`system::System`] they step, the Newton system and the consistent start; a held
 //!    contact reaches a method only through [`method::StepConstraint`];
 //! 3. events: [`events`] — contact (gap, impact map, drift projection, normal force),
 //!    bilateral wall friction and stick constraint, massless-section balances;
@@ -189,6 +203,7 @@ pub mod run;
 pub mod settings;
 pub mod statics;
 pub mod support;
+pub mod system;
 
 use std::time::Instant;
 

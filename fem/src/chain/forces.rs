@@ -4,42 +4,7 @@
 
 use super::geometry::{V2, rot, rot_t};
 use super::{Chain, MAXE, NONE, dotn};
-
-/// Which force groups [`Chain::residual_parts`] includes. The energy-consistent integrator
-/// needs them apart: the inertial operator alone gives mass products M(q)x = R_in(q, 0, x) and
-/// the velocity terms R_in(q, v, 0) = Ṁv − ∂T/∂q; the conservative group is ∇V; the rest is −Q.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Parts {
-    /// Σ m Jᵀ r̈ (with hub and tip rotary inertias).
-    pub inertia: bool,
-    /// ∂V/∂q: strain, joint springs, gravity.
-    pub conservative: bool,
-    /// −Q: applied joint torques and loads, joint dampers, Kelvin–Voigt.
-    pub nonconservative: bool,
-}
-
-impl Parts {
-    pub const ALL: Parts = Parts {
-        inertia: true,
-        conservative: true,
-        nonconservative: true,
-    };
-    pub const INERTIA: Parts = Parts {
-        inertia: true,
-        conservative: false,
-        nonconservative: false,
-    };
-    pub const CONSERVATIVE: Parts = Parts {
-        inertia: false,
-        conservative: true,
-        nonconservative: false,
-    };
-    pub const NONCONSERVATIVE: Parts = Parts {
-        inertia: false,
-        conservative: false,
-        nonconservative: true,
-    };
-}
+use crate::system::Parts;
 
 impl Chain {
     /// Residual R(q, q̇, q̈) of the equations of motion at time t (see module docs), written

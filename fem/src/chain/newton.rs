@@ -6,6 +6,7 @@ use super::augmented::AugmentedLayout;
 use super::geometry::{V2, perp, rot, rot_t};
 use super::{Chain, ElementDofs, FrameState, LinkModel, MAX_COLUMNS, MAX_LINKS, MAXE, NONE, dotn};
 use crate::band::BorderedBand;
+use crate::system::NewtonCoefficients;
 
 /// A column of J contributed by an ancestor (or own joint) DOF, in frame-i coordinates.
 #[derive(Debug, Clone, Copy, Default)]
@@ -35,14 +36,6 @@ struct ColumnAt {
     /// Angular velocity and acceleration of the frame a translation column is attached to.
     rate: f64,
     rate_dot: f64,
-}
-
-/// What the Newton matrix is a derivative of: S = ∂R/∂q̈ + c_v ∂R/∂q̇ + c_q ∂R/∂q.
-#[derive(Debug, Clone, Copy)]
-pub struct NewtonCoefficients {
-    pub c_a: f64,
-    pub c_v: f64,
-    pub c_q: f64,
 }
 
 impl Chain {

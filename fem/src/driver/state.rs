@@ -4,7 +4,7 @@
 //! constraint; a contact run with massless sections ends the step on their balance), and the
 //! acceptance of a step with its work integrals (module docs of [`super`]).
 
-use crate::chain::{Chain, NONE};
+use crate::chain::{AugmentedLayout, Chain, NONE};
 use crate::error::FemError;
 use crate::events::contact::Contact;
 use crate::method::{
@@ -53,9 +53,9 @@ struct JointStart {
 pub struct Driver {
     pub chain: Chain,
     pub method: Method,
-    pub(super) stepper: Box<dyn Stepper>,
+    pub(super) stepper: Box<dyn Stepper<Chain>>,
     pub state: StepState,
-    pub newton: NewtonSystem,
+    pub newton: NewtonSystem<AugmentedLayout>,
     pub h: f64,
     /// The fixed step (the step returns to it after Newton-failure retries).
     pub h_nominal: f64,
@@ -166,7 +166,7 @@ impl Driver {
     /// quantities of the next step's start.
     pub(super) fn initial_acceleration(&mut self, t_law: f64) -> Result<(), FemError> {
         let mut cx = StepContext {
-            chain: &mut self.chain,
+            system: &mut self.chain,
             state: &mut self.state,
             newton: &mut self.newton,
             counters: &mut self.counters,
@@ -187,9 +187,9 @@ impl Driver {
         let held = contact
             .as_deref_mut()
             .filter(|c| c.phase.constrained)
-            .map(|c| c as &mut dyn crate::method::StepConstraint);
+            .map(|c| c as &mut dyn crate::method::StepConstraint<Chain>);
         let mut cx = StepContext {
-            chain: &mut self.chain,
+            system: &mut self.chain,
             state: &mut self.state,
             newton: &mut self.newton,
             counters: &mut self.counters,

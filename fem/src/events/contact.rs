@@ -168,7 +168,7 @@ pub mod friction;
 use data::Event;
 use data::scene::{PlanarChain, Surface};
 
-use crate::chain::{Chain, MAX_LINKS, Parts, V2};
+use crate::chain::{AugmentedLayout, Chain, MAX_LINKS, Parts, V2};
 use crate::error::FemError;
 use crate::events::mass_solve::MassSolver;
 use crate::events::massless::Massless;
@@ -820,7 +820,7 @@ impl Contact {
 /// the Gonzalez discrete gradient of the gap (metric W = M(q̄), as for the potential, so
 /// Δqᵀ∇̄g = g(q₁) − g(q₀) and the constraint does no work), friction and the stick constraint
 /// of a bilateral wall ([`crate::events::contact::friction`]), and the bordered Newton update.
-impl StepConstraint for Contact {
+impl StepConstraint<Chain> for Contact {
     fn value(&self, chain: &Chain, t: f64, q: &[f64]) -> f64 {
         self.gap_at(chain, t, q)
     }
@@ -865,7 +865,7 @@ impl StepConstraint for Contact {
 
     fn newton_update(
         &mut self,
-        newton: &mut NewtonSystem,
+        newton: &mut NewtonSystem<AugmentedLayout>,
         res: &[f64],
         dq1_da: f64,
         gap1: f64,

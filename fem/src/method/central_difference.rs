@@ -5,20 +5,20 @@
 //! into equal steps ≤ dt (a periodic short step near the bound makes the composed map
 //! unstable; [`Stepper::equal_steps`]).
 
-use crate::chain::{Chain, NewtonCoefficients};
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::method::{StepConstraint, StepContext, StepState, Stepper, refuse_constraint};
+use crate::system::{NewtonCoefficients, System};
 
 /// Central difference (no state of its own).
 #[derive(Debug, Clone, Copy)]
 pub struct CentralDifference;
 
-impl Stepper for CentralDifference {
+impl<S: System + ?Sized> Stepper<S> for CentralDifference {
     fn step(
         &mut self,
-        cx: &mut StepContext<'_>,
-        constraint: Option<&mut dyn StepConstraint>,
+        cx: &mut StepContext<'_, S>,
+        constraint: Option<&mut dyn StepConstraint<S>>,
         h: f64,
         t1: f64,
         t_law: f64,
@@ -39,11 +39,11 @@ impl Stepper for CentralDifference {
         };
         // M(q1) q̈1 = −rest: R is affine in q̈; iterate on the mass-matrix approximation.
         for it in 0..20 {
-            cx.chain
+            cx.system
                 .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
             cx.counters.rhs += 1;
             if it == 0 {
-                cx.newton.form(cx.chain, st, cx.counters, c, t1)?;
+                cx.newton.form(cx.system, st, cx.counters, c, t1)?;
                 cx.newton.matrix_h = f64::NAN;
             }
             cx.newton.delta.copy_from_slice(&cx.newton.res);
@@ -72,15 +72,15 @@ impl Stepper for CentralDifference {
 
 /// Largest natural frequency of the linearized system at the current state (power iteration
 /// on M⁻¹K with the band solver) and the DOF where its mode is largest.
-pub fn max_frequency(
-    chain: &mut Chain,
+pub fn max_frequency<S: System + ?Sized>(
+    system: &mut S,
     st: &StepState,
     res: &mut [f64],
 ) -> Result<(f64, usize), FemError> {
     let n = st.q.len();
-    chain.residual(st.t, &st.q, &st.qd, &st.qdd, res);
-    let mut kmat = chain.new_matrix();
-    chain.newton_matrix(
+    system.residual(st.t, &st.q, &st.qd, &st.qdd, res);
+    let mut kmat = system.new_matrix();
+    system.newton_matrix(
         &st.q,
         NewtonCoefficients {
             c_a: 0.0,
@@ -89,8 +89,8 @@ pub fn max_frequency(
         },
         &mut kmat,
     );
-    let mut mmat = chain.new_matrix();
-    chain.newton_matrix(
+    let mut mmat = system.new_matrix();
+    system.newton_matrix(
         &st.q,
         NewtonCoefficients {
             c_a: 1.0,

@@ -19,16 +19,17 @@
 //! Q_load(q̄)·Δq), so the ledger closes by construction. The scheme is symmetric and second
 //! order: ∇g(q) = ½∇(v₀ᵀMv₁) approximates ∂T/∂q|_v̄, i.e. it discretizes Lagrange's equations.
 //!
-//! Ingredients, each one O(n) pass of [`Chain::residual_parts`]:
+//! Ingredients, each one O(n) pass of [`System::residual_parts`]:
 //! * M(q)x = R_in(q, 0, x) (inertial part only, exact: R is affine in q̈);
 //! * ∂T/∂q(q, x) analytic, one forward and one backward sweep
-//!   ([`Chain::add_kinetic_gradient`]: T written in link-frame coordinates, reverse sweep of
-//!   the velocity recursion). The identity R_in(q, x, 0) = Ṁ(x)x − ∂T/∂q with a central
-//!   difference for Ṁ(x)x ([`kinetic_gradient_fd`], 3 inertial passes) is its test oracle;
+//!   ([`System::add_kinetic_gradient`]; the chain's: T written in link-frame coordinates,
+//!   reverse sweep of the velocity recursion). The identity R_in(q, x, 0) = Ṁ(x)x − ∂T/∂q
+//!   with a central difference for Ṁ(x)x ([`kinetic_gradient_fd`], 3 inertial passes) is
+//!   its test oracle;
 //! * ∇g(q̄) = ∂T/∂q(q̄, a) − ∂T/∂q(q̄, b), a = v̄, b = ½(v₁ − v₀) (polarization);
-//! * ∇V(q̄) = conservative part; Q = −(non-conservative part); V(q₁) from [`Chain::energies`].
+//! * ∇V(q̄) = conservative part; Q = −(non-conservative part); V(q₁) from [`System::energies`].
 //!   Both on the kinematic pass of the metric product M(q̄)Δq
-//!   ([`Chain::residual_parts_at_last_q`]: positions and frame angles depend on q̄ alone), so
+//!   ([`System::residual_parts_at_last_q`]: positions and frame angles depend on q̄ alone), so
 //!   an iteration makes one kinematic pass at q̄ instead of three.
 //!
 //! Newton on the mean acceleration a = (v₁ − v₀)/h with the generalized-α matrix machinery at
@@ -90,12 +91,12 @@
 //! (third-derivative term of the trapezoidal/midpoint family, from successive mean
 //! accelerations), step ratio 0.9·err^(−1/3) as for generalized-α.
 
-use crate::chain::{Chain, NONE, NewtonCoefficients, Parts};
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
     ConstraintView, StepConstraint, StepContext, Stepper, Works, unconverged, update_tolerance,
 };
+use crate::system::{NewtonCoefficients, Parts, System};
 
 /// Relative size of the finite-difference perturbation of q for Ṁ(x)x in the oracle
 /// [`kinetic_gradient_fd`].
@@ -340,11 +341,16 @@ fn solve_small(
     true
 }
 
-/// ∂T/∂q at (q, x) with T = ½xᵀM(q)x, analytic ([`Chain::add_kinetic_gradient`], the one the
-/// scheme uses). Allocates: for checks, not for step loops.
-pub fn kinetic_gradient(chain: &mut Chain, t: f64, q: &[f64], x: &[f64]) -> Vec<f64> {
+/// ∂T/∂q at (q, x) with T = ½xᵀM(q)x, analytic ([`System::add_kinetic_gradient`], the one
+/// the scheme uses). Allocates: for checks, not for step loops.
+pub fn kinetic_gradient<S: System + ?Sized>(
+    system: &mut S,
+    t: f64,
+    q: &[f64],
+    x: &[f64],
+) -> Vec<f64> {
     let mut out = vec![0.0; q.len()];
-    chain.add_kinetic_gradient(t, q, x, 1.0, &mut out);
+    system.add_kinetic_gradient(t, q, x, 1.0, &mut out);
     out
 }
 
@@ -352,8 +358,8 @@ pub fn kinetic_gradient(chain: &mut Chain, t: f64, q: &[f64], x: &[f64]) -> Vec<
 /// Ṁ(x)x = [M(q + εx)x − M(q − εx)x]/(2ε), ε‖x‖∞ = `delta` (truncation ~10⁻¹⁰, round-off
 /// ~10⁻¹¹ relative at `delta` = [`FD_STEP`]): 3 inertial passes of the residual, independent of
 /// the analytic sweep — its test oracle. Allocates: for checks, not for step loops.
-pub fn kinetic_gradient_fd(
-    chain: &mut Chain,
+pub fn kinetic_gradient_fd<S: System + ?Sized>(
+    system: &mut S,
     t: f64,
     q: &[f64],
     x: &[f64],
@@ -369,13 +375,13 @@ pub fn kinetic_gradient_fd(
     let eps = delta / xmax;
     let (mut tmp, mut tmp2) = (zero.clone(), zero.clone());
     let qp: Vec<f64> = q.iter().zip(x).map(|(a, b)| a + eps * b).collect();
-    chain.residual_parts(t, &qp, &zero, x, Parts::INERTIA, &mut tmp);
+    system.residual_parts(t, &qp, &zero, x, Parts::INERTIA, &mut tmp);
     let qm: Vec<f64> = q.iter().zip(x).map(|(a, b)| a - eps * b).collect();
-    chain.residual_parts(t, &qm, &zero, x, Parts::INERTIA, &mut tmp2);
+    system.residual_parts(t, &qm, &zero, x, Parts::INERTIA, &mut tmp2);
     for i in 0..n {
         out[i] = (tmp[i] - tmp2[i]) / (2.0 * eps);
     }
-    chain.residual_parts(t, q, x, &zero, Parts::INERTIA, &mut tmp);
+    system.residual_parts(t, q, x, &zero, Parts::INERTIA, &mut tmp);
     for i in 0..n {
         out[i] -= tmp[i];
     }
@@ -383,11 +389,11 @@ pub fn kinetic_gradient_fd(
 }
 
 /// The mass product M(q)x = R_in(q, 0, x). Allocates: for checks, not for step loops.
-pub fn mass_product(chain: &mut Chain, t: f64, q: &[f64], x: &[f64]) -> Vec<f64> {
+pub fn mass_product<S: System + ?Sized>(system: &mut S, t: f64, q: &[f64], x: &[f64]) -> Vec<f64> {
     let n = q.len();
     let zero = vec![0.0; n];
     let mut out = zero.clone();
-    chain.residual_parts(t, q, &zero, x, Parts::INERTIA, &mut out);
+    system.residual_parts(t, q, &zero, x, Parts::INERTIA, &mut out);
     out
 }
 
@@ -405,13 +411,13 @@ impl EnergyMidpoint {
     }
 }
 
-impl Stepper for EnergyMidpoint {
+impl<S: System + ?Sized> Stepper<S> for EnergyMidpoint {
     /// One energy-midpoint step; returns the scaled error estimate when adaptive (infinite when
     /// Newton failed). A held `constraint` borders the Newton system (module docs).
     fn step(
         &mut self,
-        cx: &mut StepContext<'_>,
-        mut constraint: Option<&mut dyn StepConstraint>,
+        cx: &mut StepContext<'_, S>,
+        mut constraint: Option<&mut dyn StepConstraint<S>>,
         h: f64,
         t1: f64,
         t_law: f64,
@@ -424,16 +430,16 @@ impl Stepper for EnergyMidpoint {
         // steps land on their breakpoints.
         let t_mid = t0 + 0.5 * h;
         // Start-of-step momentum and potential.
-        cx.chain
+        cx.system
             .residual_parts(t_mid, &st.q, &w.zero, &st.qd, Parts::INERTIA, &mut w.p0);
-        let [k0, s0, sp0, g0] = cx.chain.energies(t0, &st.q, &st.qd);
+        let [k0, s0, sp0, g0] = cx.system.energies(t0, &st.q, &st.qd);
         let v0_pot = s0 + sp0 + g0;
         let scale0 = k0.abs() + s0.abs() + sp0.abs() + g0.abs();
         let mut passes = 2usize;
         // Constrained phase: g(q₀) and the multiplier's start value (the last step's).
         let g0 = constraint
             .as_ref()
-            .map_or(0.0, |c| c.value(cx.chain, t0, &st.q));
+            .map_or(0.0, |c| c.value(cx.system, t0, &st.q));
         let mut lambda = constraint.as_ref().map_or(0.0, |c| c.multiplier());
         let mut gap1 = 0.0;
         // Target of g(q₁): 0 for a full step; a step shortened to h removes only the share
@@ -513,23 +519,23 @@ impl Stepper for EnergyMidpoint {
                 st.qd1[i] = st.qd[i] + h * a;
             }
             // Momentum and potential at the end point.
-            cx.chain
+            cx.system
                 .residual_parts(t_mid, &st.q1, &w.zero, &st.qd1, Parts::INERTIA, &mut w.mv1);
-            let [k1, s1, sp1, g1] = cx.chain.energies(t1, &st.q1, &st.qd1);
+            let [k1, s1, sp1, g1] = cx.system.energies(t1, &st.q1, &st.qd1);
             let v1_pot = s1 + sp1 + g1;
             let scale1 = k1.abs() + s1.abs() + sp1.abs() + g1.abs();
             // Metric W = M(q̄) (the kinematic pass at q̄), then the forces at the midpoint on
             // its positions and frames.
-            cx.chain
+            cx.system
                 .residual_parts(t_mid, &w.qbar, &w.zero, &w.dq, Parts::INERTIA, &mut w.w_dq);
-            cx.chain.residual_parts_at_last_q(
+            cx.system.residual_parts_at_last_q(
                 t_mid,
                 &w.qbar,
                 &w.zero,
                 Parts::CONSERVATIVE,
                 &mut w.grad_v,
             );
-            cx.chain.residual_parts_at_last_q(
+            cx.system.residual_parts_at_last_q(
                 t_mid,
                 &w.qbar,
                 &w.vbar,
@@ -540,7 +546,7 @@ impl Stepper for EnergyMidpoint {
             // ∇g(q̄) = ∂T/∂q(q̄, v̄) − ∂T/∂q(q̄, ½Δv).
             w.grad_g.iter_mut().for_each(|x| *x = 0.0);
             for (x, sign) in [(&w.vbar, 1.0), (&w.half_dv, -1.0)] {
-                cx.chain
+                cx.system
                     .add_kinetic_gradient(t_mid, &w.qbar, x, sign, &mut w.grad_g);
             }
             passes += 2;
@@ -581,7 +587,7 @@ impl Stepper for EnergyMidpoint {
                     g0,
                     lambda,
                 };
-                gap1 = c.add_force(cx.chain, &view, &mut w.res);
+                gap1 = c.add_force(cx.system, &view, &mut w.res);
             }
             cx.counters.newton += 1;
             // Newton matrix at (q̄, v̄, a), formed at the first iteration of a step unless an
@@ -602,10 +608,10 @@ impl Stepper for EnergyMidpoint {
                 force_refresh = false;
                 st.q1.copy_from_slice(&w.qbar);
                 st.qd1.copy_from_slice(&w.vbar);
-                cx.chain
+                cx.system
                     .residual(t_mid, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
                 passes += 1;
-                if let Err(e) = cx.newton.form(cx.chain, st, cx.counters, c, t1) {
+                if let Err(e) = cx.newton.form(cx.system, st, cx.counters, c, t1) {
                     // A singular matrix at an iterate far from the solution: a Newton failure
                     // (the caller retries shorter), unless the step is already tiny.
                     if robust && h > 1e-6 * cx.h_nominal && matches!(e, FemError::Singular { .. }) {
@@ -743,27 +749,9 @@ impl Stepper for EnergyMidpoint {
             w.resolve_a.copy_from_slice(&st.qdd1);
         }
         // Works with the scheme's own quadrature: their sum is Δqᵀ Q(t_mid, q̄, v̄).
-        let mut pending = Works::default();
-        let (_, p_kv) = cx.chain.dissipation_power(t_mid, &w.vbar);
-        pending.kelvin_voigt = p_kv * h;
-        for li in 0..cx.chain.links.len() {
-            let j = &cx.chain.links[li].joint;
-            if j.dof == NONE {
-                continue;
-            }
-            let dth = w.dq[j.dof];
-            let law = j.applied(t_mid);
-            pending.applied_torque += law * dth;
-            pending.joint_damper += j.damping * w.vbar[j.dof] * dth;
-            // The torque channel reports the law at the sample time.
-            cx.chain.joint_torque[li] = j.applied(t_law);
-        }
-        if cx.chain.tip_load != 0.0 || cx.chain.distributed_load != 0.0 {
-            let total = -dot(&w.minus_q, &w.dq);
-            pending.applied_load =
-                total - pending.applied_torque + pending.joint_damper + pending.kelvin_voigt;
-        }
-        w.pending = pending;
+        w.pending = cx
+            .system
+            .midpoint_works(h, t_mid, t_law, &w.dq, &w.vbar, &w.minus_q);
         // q̈ slot holds the mean acceleration ā (predictor and error estimate of the next step).
         st.a1.copy_from_slice(&st.qdd1);
         Ok(cx.adaptive.map(|ad| {

@@ -42,13 +42,13 @@
 //! force the driver computes at each contact event; the friction force or stick multiplier of
 //! the current friction phase), by Newton with S = M.
 
-use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
-    ConstraintView, HeldConstraint, StepConstraint, StepContext, Stepper, start, unconverged,
-    update_tolerance,
+    ConstraintView, HeldConstraint, StepConstraint, StepContext, Stepper, Works, start,
+    unconverged, update_tolerance,
 };
+use crate::system::{NewtonCoefficients, System};
 
 #[derive(Debug, Clone, Copy)]
 struct AlphaParams {
@@ -113,17 +113,17 @@ impl GeneralizedAlpha {
     /// q̈ₙ = aₙ consistent with the held constraint at the step start (module docs), by Newton
     /// with S = M; R is affine in q̈, so this converges in one or two passes. Keeps the
     /// constraint force applied as the next step's start force.
-    fn constrained_start(
+    fn constrained_start<S: System + ?Sized>(
         &mut self,
-        cx: &mut StepContext<'_>,
-        k: &mut dyn StepConstraint,
+        cx: &mut StepContext<'_, S>,
+        k: &mut dyn StepConstraint<S>,
         t_law: f64,
     ) -> Result<(), FemError> {
         let t0 = cx.state.t;
-        let g0 = k.value(cx.chain, t0, &cx.state.q);
+        let g0 = k.value(cx.system, t0, &cx.state.q);
         let lambda = k.multiplier();
         let (zero, before, force) = (&self.held.zero, &mut self.held.res, &mut self.force_start);
-        start::accelerate_with(cx, t_law, |chain, q, res| {
+        start::accelerate_with(cx, t_law, |system, q, res| {
             // The force at q₀ itself: a view of zero length (∇̄g = ∇g(q₀)).
             let view = ConstraintView {
                 it: 0,
@@ -138,7 +138,7 @@ impl GeneralizedAlpha {
                 lambda,
             };
             before.copy_from_slice(res);
-            k.add_force(chain, &view, res);
+            k.add_force(system, &view, res);
             for i in 0..res.len() {
                 force[i] = before[i] - res[i];
             }
@@ -155,11 +155,11 @@ impl GeneralizedAlpha {
     }
 }
 
-impl Stepper for GeneralizedAlpha {
+impl<S: System + ?Sized> Stepper<S> for GeneralizedAlpha {
     fn step(
         &mut self,
-        cx: &mut StepContext<'_>,
-        mut constraint: Option<&mut dyn StepConstraint>,
+        cx: &mut StepContext<'_, S>,
+        mut constraint: Option<&mut dyn StepConstraint<S>>,
         h: f64,
         t1: f64,
         t_law: f64,
@@ -202,7 +202,7 @@ impl Stepper for GeneralizedAlpha {
         let t_mid = t0 + 0.5 * h;
         let g0 = constraint
             .as_ref()
-            .map_or(0.0, |k| k.value(cx.chain, t0, &st.q));
+            .map_or(0.0, |k| k.value(cx.system, t0, &st.q));
         let mut lambda = constraint.as_ref().map_or(0.0, |k| k.multiplier());
         let shortened = (h / cx.h_nominal).min(1.0);
         let gap_target = g0 * (1.0 - shortened * shortened);
@@ -220,12 +220,12 @@ impl Stepper for GeneralizedAlpha {
             if converged {
                 break;
             }
-            cx.chain
+            cx.system
                 .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
             cx.counters.rhs += 1;
             cx.counters.newton += 1;
             cx.newton
-                .form_if_due(it, h, cx.chain, st, cx.counters, c, t1)?;
+                .form_if_due(it, h, cx.system, st, cx.counters, c, t1)?;
             if let Some(k) = constraint.as_deref_mut() {
                 let held = &mut self.held;
                 for i in 0..n {
@@ -233,7 +233,7 @@ impl Stepper for GeneralizedAlpha {
                     self.q_mid[i] = st.q[i] + 0.5 * held.dq[i];
                 }
                 let gap1 = held.force(
-                    cx.chain,
+                    cx.system,
                     cx.counters,
                     k,
                     it,
@@ -321,7 +321,7 @@ impl Stepper for GeneralizedAlpha {
         }))
     }
 
-    fn commit(&mut self, _h: f64, _works: &mut crate::method::Works) -> bool {
+    fn commit(&mut self, _h: f64, _works: &mut Works) -> bool {
         std::mem::swap(&mut self.force_start, &mut self.force_end);
         false
     }

@@ -34,12 +34,12 @@
 //! The constraint force enters through λ only (its dependence on ā through ∇̄g(q̄) is not in
 //! S), so a constrained step converges linearly at the rate λh²|∇²g|/|M|.
 
-use crate::chain::NewtonCoefficients;
 use crate::error::FemError;
 use crate::linalg::max_abs;
 use crate::method::{
     HeldConstraint, StepConstraint, StepContext, Stepper, unconverged, update_tolerance,
 };
+use crate::system::{NewtonCoefficients, System};
 
 /// Newton iterations at most before the step is retried shorter.
 const MAX_ITERATIONS: usize = 30;
@@ -63,11 +63,11 @@ impl ImplicitMidpoint {
     }
 }
 
-impl Stepper for ImplicitMidpoint {
+impl<S: System + ?Sized> Stepper<S> for ImplicitMidpoint {
     fn step(
         &mut self,
-        cx: &mut StepContext<'_>,
-        mut constraint: Option<&mut dyn StepConstraint>,
+        cx: &mut StepContext<'_, S>,
+        mut constraint: Option<&mut dyn StepConstraint<S>>,
         h: f64,
         t1: f64,
         t_law: f64,
@@ -85,7 +85,7 @@ impl Stepper for ImplicitMidpoint {
         // target of g(q₁) (module docs).
         let g0 = constraint
             .as_ref()
-            .map_or(0.0, |k| k.value(cx.chain, t0, &st.q));
+            .map_or(0.0, |k| k.value(cx.system, t0, &st.q));
         let mut lambda = constraint.as_ref().map_or(0.0, |k| k.multiplier());
         let r = (h / cx.h_nominal).min(1.0);
         let gap_target = g0 * (1.0 - r * r);
@@ -100,12 +100,12 @@ impl Stepper for ImplicitMidpoint {
                 st.qd1[i] = st.qd[i] + 0.5 * h * st.qdd1[i];
                 st.q1[i] = st.q[i] + 0.5 * h * st.qd1[i];
             }
-            cx.chain
+            cx.system
                 .residual(t_mid, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
             cx.counters.rhs += 1;
             cx.counters.newton += 1;
             cx.newton
-                .form_if_due(it, h, cx.chain, st, cx.counters, c, t1)?;
+                .form_if_due(it, h, cx.system, st, cx.counters, c, t1)?;
             let mut dlambda = 0.0;
             let mut on_surface = true;
             if let Some(k) = constraint.as_deref_mut() {
@@ -115,7 +115,7 @@ impl Stepper for ImplicitMidpoint {
                     self.q_end[i] = st.q[i] + held.dq[i];
                 }
                 let gap1 = held.force(
-                    cx.chain,
+                    cx.system,
                     cx.counters,
                     k,
                     it,
@@ -179,7 +179,7 @@ impl Stepper for ImplicitMidpoint {
         }
         st.a1.copy_from_slice(&st.qdd1);
         // Joint torques (laws and required torques) at the end point, for the ledger.
-        cx.chain
+        cx.system
             .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
         cx.counters.rhs += 1;
         Ok(cx.adaptive.map(|ad| {

@@ -1,6 +1,6 @@
 //! Time-integration methods: one type per method behind the [`Stepper`] trait.
 //!
-//! A method advances R(q, q̇, q̈, t) = 0 ([`crate::chain::Chain::residual`]) over one step of
+//! A method advances R(q, q̇, q̈, t) = 0 of a [`crate::system::System`] over one step of
 //! length h from the state at the step start to a trial end ([`StepState`]); the driver
 //! ([`crate::driver`]) chooses h, accepts or rejects the trial, books the works and handles
 //! events. A method never names a scene family or a contact: a bilateral constraint (a tip
@@ -48,9 +48,11 @@ pub use step::{ConstraintView, StepConstraint, StepContext, Stepper};
 pub(crate) use step::{HeldConstraint, refuse_constraint, unconverged, update_tolerance};
 
 use crate::settings::Method;
+use crate::system::System;
 
-/// The stepper of a method, for `n` DOFs (`rho_inf`: generalized-α spectral radius).
-pub fn stepper(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper> {
+/// The stepper of a method for a system of `n` DOFs (`rho_inf`: generalized-α spectral
+/// radius).
+pub fn stepper<S: System + ?Sized>(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper<S>> {
     match method {
         Method::GeneralizedAlpha => Box::new(generalized_alpha::GeneralizedAlpha::new(rho_inf, n)),
         Method::CentralDifference => Box::new(central_difference::CentralDifference),

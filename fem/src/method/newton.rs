@@ -1,42 +1,44 @@
 //! The Newton system of the implicit methods: S = c_a M + c_v C + c_q K at a trial point,
-//! formed analytically and factorized once per formation by a sparse LU whose symbolic
-//! factorization is built once per run ([`crate::band::BorderedBand`]). Chains without
-//! foreshortening use the bordered-band matrix of the chain DOFs; chains with foreshortening
-//! use the exact matrix as an augmented bordered band ([`crate::chain::AugmentedLayout`]: the
-//! dense ∂s/∂q couplings through running-sum unknowns), solved with zero auxiliary right-hand
-//! sides. Both cost O(n) per formation and solve.
+//! formed analytically by the [`System`] and factorized once per formation by a sparse LU
+//! whose symbolic factorization is built once per run ([`crate::band::BorderedBand`]). A
+//! system whose band matrix is exact (chains without foreshortening) uses the bordered-band
+//! matrix of its DOFs; one with an [`Augmentation`] (chains with foreshortening: the dense
+//! ∂s/∂q couplings through running-sum unknowns) uses the exact matrix as an augmented
+//! bordered band, solved with zero auxiliary right-hand sides. Both cost O(n) per formation
+//! and solve for the chains.
 
 use crate::band::BorderedBand;
-use crate::chain::{AugmentedLayout, Chain, NewtonCoefficients};
 use crate::error::FemError;
 use crate::method::{Counters, StepState};
+use crate::system::{Augmentation, NewtonCoefficients, System};
 
 /// How the Newton matrix is formed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum JacobianKind {
-    /// Bordered-band matrix of the chain DOFs (exact without foreshortening).
+    /// Bordered-band matrix of the system DOFs (exact without an augmentation).
     Banded,
-    /// Exact matrix of a chain with foreshortening, augmented with the running-sum unknowns
-    /// of the foreshortening and its tail load.
+    /// Exact matrix augmented with the system's auxiliary unknowns (a chain with
+    /// foreshortening: the running sums of the foreshortening and its tail load).
     Augmented,
 }
 
 /// The augmented system of [`JacobianKind::Augmented`]: layout, matrix and solve vector.
 #[derive(Debug, Clone)]
-pub struct AugmentedSystem {
-    pub layout: AugmentedLayout,
+pub struct AugmentedSystem<A> {
+    pub layout: A,
     pub matrix: BorderedBand,
     x: Vec<f64>,
 }
 
-/// The Newton matrix, its factorization, and the residual and update vectors.
+/// The Newton matrix, its factorization, and the residual and update vectors, for a system
+/// whose exact matrix has the augmentation `A` ([`System::Augmented`]).
 #[derive(Debug, Clone)]
-pub struct NewtonSystem {
-    /// The bordered-band matrix of the chain DOFs (also the mass/stiffness estimates of the
+pub struct NewtonSystem<A> {
+    /// The bordered-band matrix of the system DOFs (also the mass/stiffness estimates of the
     /// explicit method and the regularized start use it).
     pub matrix: BorderedBand,
     pub jacobian: JacobianKind,
-    pub augmented: Option<AugmentedSystem>,
+    pub augmented: Option<AugmentedSystem<A>>,
     /// Step size the current matrix was formed with, and whether it must be refreshed.
     pub matrix_h: f64,
     pub slow_convergence: bool,
@@ -51,18 +53,17 @@ pub struct NewtonSystem {
     pub unilateral_contact: bool,
 }
 
-impl NewtonSystem {
-    /// The Newton system of `chain` (`length_scale`: the longest link, scales the tolerance).
-    pub fn new(chain: &Chain, length_scale: f64) -> Self {
-        let n = chain.ndof;
-        let augmented = chain.has_foreshortening().then(|| {
-            let layout = chain.augmented_layout();
-            let matrix = chain.new_augmented_matrix(&layout);
-            let x = vec![0.0; layout.n];
+impl<A: Augmentation> NewtonSystem<A> {
+    /// The Newton system of `system` (`length_scale`: the longest link, scales the tolerance).
+    pub fn new<S: System<Augmented = A> + ?Sized>(system: &S, length_scale: f64) -> Self {
+        let n = system.ndof();
+        let augmented = system.exact_layout().map(|layout| {
+            let matrix = system.new_augmented_matrix(&layout);
+            let x = vec![0.0; layout.size()];
             AugmentedSystem { layout, matrix, x }
         });
         NewtonSystem {
-            matrix: chain.new_matrix(),
+            matrix: system.new_matrix(),
             jacobian: if augmented.is_some() {
                 JacobianKind::Augmented
             } else {
@@ -82,18 +83,18 @@ impl NewtonSystem {
     /// first iteration (the matrix is cheap; near-quadratic convergence keeps the iteration
     /// error far below the tolerance, which the tight ledger checks need) and every 6th.
     #[allow(clippy::too_many_arguments)]
-    pub fn form_if_due(
+    pub fn form_if_due<S: System<Augmented = A> + ?Sized>(
         &mut self,
         it: usize,
         h: f64,
-        chain: &mut Chain,
+        system: &mut S,
         st: &StepState,
         counters: &mut Counters,
         c: NewtonCoefficients,
         t: f64,
     ) -> Result<(), FemError> {
         if it == 0 || it == 6 || it == 12 || it == 18 {
-            self.form(chain, st, counters, c, t)?;
+            self.form(system, st, counters, c, t)?;
             self.matrix_h = h;
             self.slow_convergence = false;
         }
@@ -101,10 +102,10 @@ impl NewtonSystem {
     }
 
     /// Forms and factorizes the Newton matrix at (q1, q̇1, q̈1) after a full residual
-    /// evaluation there (the matrix reads the chain's point data of that pass).
-    pub fn form(
+    /// evaluation there (the matrix reads the system's data of that pass).
+    pub fn form<S: System<Augmented = A> + ?Sized>(
         &mut self,
-        chain: &mut Chain,
+        system: &mut S,
         st: &StepState,
         counters: &mut Counters,
         c: NewtonCoefficients,
@@ -114,11 +115,11 @@ impl NewtonSystem {
         counters.factorizations += 1;
         match self.augmented.as_mut() {
             None => {
-                chain.newton_matrix(&st.q1, c, &mut self.matrix);
+                system.newton_matrix(&st.q1, c, &mut self.matrix);
                 self.matrix.factorize().map_err(|e| with_time(e, t))
             }
             Some(aug) => {
-                chain.exact_newton_matrix(
+                system.exact_newton_matrix(
                     &st.q1,
                     &st.qd1,
                     &st.qdd1,
@@ -136,13 +137,13 @@ impl NewtonSystem {
         match self.augmented.as_mut() {
             None => self.matrix.solve_in_place(&mut self.delta),
             Some(aug) => {
-                // Chain rows carry the right-hand side, the running-sum rows zero.
+                // System rows carry the right-hand side, the auxiliary rows zero.
                 aug.x.iter_mut().for_each(|v| *v = 0.0);
-                for (&i, &r) in aug.layout.map.iter().zip(&self.delta) {
+                for (&i, &r) in aug.layout.map().iter().zip(&self.delta) {
                     aug.x[i] = r;
                 }
                 aug.matrix.solve_in_place(&mut aug.x);
-                for (&i, d) in aug.layout.map.iter().zip(self.delta.iter_mut()) {
+                for (&i, d) in aug.layout.map().iter().zip(self.delta.iter_mut()) {
                     *d = aug.x[i];
                 }
             }

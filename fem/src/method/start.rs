@@ -2,32 +2,32 @@
 //! t = 0 and after a torque-law discontinuity), with the Newton machinery of
 //! [`crate::method::newton`].
 
-use crate::chain::{Chain, NewtonCoefficients};
 use crate::error::FemError;
 use crate::linalg::max_abs;
 use crate::method::StepContext;
 use crate::method::newton::with_time;
+use crate::system::{NewtonCoefficients, System};
 
 /// Consistent q̈ at the current state: solves R(q, q̇, q̈) = 0 for q̈ (R is affine in q̈; the
 /// iteration converges because the mass-matrix approximation misses only O(v′²) terms).
-pub fn consistent_acceleration(
-    cx: &mut StepContext<'_>,
+pub fn consistent_acceleration<S: System + ?Sized>(
+    cx: &mut StepContext<'_, S>,
     h: f64,
     t_law: f64,
 ) -> Result<(), FemError> {
-    if cx.chain.has_massless_dofs() {
+    if cx.system.has_massless_dofs() {
         return regularized_acceleration(cx, h, t_law);
     }
     accelerate_with(cx, t_law, |_, _, _| {})
 }
 
 /// Consistent q̈ under extra forces: solves R(q, q̇, q̈) − F = 0 for q̈, where
-/// `subtract_forces(chain, q, res)` subtracts F(q) from the residual (a held constraint's
-/// force, for a method's restart; chains without massless directions).
-pub fn accelerate_with(
-    cx: &mut StepContext<'_>,
+/// `subtract_forces(system, q, res)` subtracts F(q) from the residual (a held constraint's
+/// force, for a method's restart; systems without massless directions).
+pub fn accelerate_with<S: System + ?Sized>(
+    cx: &mut StepContext<'_, S>,
     t_law: f64,
-    mut subtract_forces: impl FnMut(&Chain, &[f64], &mut [f64]),
+    mut subtract_forces: impl FnMut(&S, &[f64], &mut [f64]),
 ) -> Result<(), FemError> {
     let st = &mut *cx.state;
     let c = NewtonCoefficients {
@@ -36,17 +36,17 @@ pub fn accelerate_with(
         c_q: 0.0,
     };
     for it in 0..50 {
-        cx.chain
+        cx.system
             .residual(t_law, &st.q, &st.qd, &st.qdd, &mut cx.newton.res);
         cx.counters.rhs += 1;
         if it == 0 {
             st.q1.copy_from_slice(&st.q);
             st.qd1.copy_from_slice(&st.qd);
             st.qdd1.copy_from_slice(&st.qdd);
-            cx.newton.form(cx.chain, st, cx.counters, c, st.t)?;
+            cx.newton.form(cx.system, st, cx.counters, c, st.t)?;
             cx.newton.matrix_h = f64::NAN;
         }
-        subtract_forces(cx.chain, &st.q, &mut cx.newton.res);
+        subtract_forces(cx.system, &st.q, &mut cx.newton.res);
         cx.newton.delta.copy_from_slice(&cx.newton.res);
         cx.newton.solve();
         let mut big = 0.0f64;
@@ -85,7 +85,11 @@ pub fn accelerate_with(
 /// is analytic; refinement passes (below) then drive the mass rows to R = 0 (measured:
 /// Timoshenko cantilever without rotary inertia, step load, trapezoidal ledger 4e-12
 /// instead of 1.6e-8 after the single solve).
-fn regularized_acceleration(cx: &mut StepContext<'_>, h: f64, t_law: f64) -> Result<(), FemError> {
+fn regularized_acceleration<S: System + ?Sized>(
+    cx: &mut StepContext<'_, S>,
+    h: f64,
+    t_law: f64,
+) -> Result<(), FemError> {
     let st = &mut *cx.state;
     let c = NewtonCoefficients {
         c_a: 1.0,
@@ -98,9 +102,9 @@ fn regularized_acceleration(cx: &mut StepContext<'_>, h: f64, t_law: f64) -> Res
     cx.counters.factorizations += 1;
     // The band matrix of the chain DOFs (also for chains with foreshortening): the
     // iteration only needs a contracting approximation of M + ε·K.
-    cx.chain
+    cx.system
         .residual(t_law, &st.q1, &st.qd, &st.qdd, &mut cx.newton.res);
-    cx.chain.newton_matrix(&st.q1, c, &mut cx.newton.matrix);
+    cx.system.newton_matrix(&st.q1, c, &mut cx.newton.matrix);
     cx.newton
         .matrix
         .factorize()
@@ -112,7 +116,7 @@ fn regularized_acceleration(cx: &mut StepContext<'_>, h: f64, t_law: f64) -> Res
     let n = st.qdd.len();
     let mut best = f64::INFINITY;
     for _ in 0..10 {
-        cx.chain
+        cx.system
             .residual(t_law, &st.q, &st.qd, &st.qdd, &mut cx.newton.res);
         cx.counters.rhs += 1;
         let r = max_abs(&cx.newton.res);
@@ -145,8 +149,8 @@ fn regularized_acceleration(cx: &mut StepContext<'_>, h: f64, t_law: f64) -> Res
             message: "could not compute a consistent initial acceleration".into(),
         });
     }
-    // Leave the chain's cached data (joint torques) at the initial state.
-    cx.chain
+    // Leave the system's cached data (a chain's joint torques) at the initial state.
+    cx.system
         .residual(t_law, &st.q, &st.qd, &st.qdd, &mut cx.newton.res);
     cx.newton.matrix_h = f64::NAN;
     st.a.copy_from_slice(&st.qdd);

@@ -5,6 +5,8 @@ use std::time::Instant;
 
 use data::Cost;
 
+pub use crate::system::Works;
+
 /// Work counters.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Counters {
@@ -57,19 +59,6 @@ impl FixedStepCounters {
             newton_iterations: self.newton,
         }
     }
-}
-
-/// Running energy-ledger integrals (cumulative works).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Works {
-    pub applied_torque: f64,
-    pub applied_load: f64,
-    pub prescribed_motion: f64,
-    pub joint_damper: f64,
-    pub kelvin_voigt: f64,
-    /// Strain energy removed by projecting the massless section rotations onto their balance
-    /// (`crate::events::massless`, ledger `numerical_massless`).
-    pub numerical_massless: f64,
 }
 
 /// Adaptive step control.

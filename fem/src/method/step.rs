@@ -1,24 +1,27 @@
 //! The contract between a method and the driver: the [`Stepper`] trait, what a method works on
 //! during a step ([`StepContext`]), how it sees a held constraint ([`StepConstraint`],
-//! [`ConstraintView`], [`HeldConstraint`]), and the Newton helpers the methods share.
+//! [`ConstraintView`], [`HeldConstraint`]), and the Newton helpers the methods share. All of
+//! it is generic over the stepped [`System`]: a method knows the system through the trait
+//! only, a constraint is implemented for the system it constrains.
 
 use super::newton::NewtonSystem;
 use super::state::{Adaptive, Counters, StepState, Works};
-use crate::chain::{Chain, Parts};
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
+use crate::system::{Parts, System};
 
-/// What a method works on during one step: the model, the state, the Newton system and the
+/// What a method works on during one step: the system, the state, the Newton system and the
 /// counters, plus the driver's step settings.
-pub struct StepContext<'a> {
-    pub chain: &'a mut Chain,
+pub struct StepContext<'a, S: System + ?Sized> {
+    pub system: &'a mut S,
     pub state: &'a mut StepState,
-    pub newton: &'a mut NewtonSystem,
+    pub newton: &'a mut NewtonSystem<S::Augmented>,
     pub counters: &'a mut Counters,
     pub adaptive: Option<Adaptive>,
     /// The fixed step (shortened steps are measured against it).
     pub h_nominal: f64,
-    /// Largest link length (scales tolerances).
+    /// Largest link length (scales tolerances; for a system other than a chain, its
+    /// length scale).
     pub length_scale: f64,
 }
 
@@ -98,18 +101,18 @@ impl HeldConstraint {
     /// constraint force of the iterate (times t₀, t_mid, t₁). Returns the constraint value
     /// Newton must drive to its target ([`StepConstraint::add_force`]).
     #[allow(clippy::too_many_arguments)]
-    pub fn force(
+    pub fn force<S: System + ?Sized>(
         &mut self,
-        chain: &mut Chain,
+        system: &mut S,
         counters: &mut Counters,
-        k: &mut dyn StepConstraint,
+        k: &mut dyn StepConstraint<S>,
         it: usize,
         t: [f64; 3],
         (q0, q1, qbar): (&[f64], &[f64], &[f64]),
         (g0, lambda): (f64, f64),
         residual: &[f64],
     ) -> f64 {
-        chain.residual_parts(
+        system.residual_parts(
             t[1],
             qbar,
             &self.zero,
@@ -131,22 +134,22 @@ impl HeldConstraint {
             lambda,
         };
         self.res.copy_from_slice(residual);
-        k.add_force(chain, &view, &mut self.res)
+        k.add_force(system, &view, &mut self.res)
     }
 }
 
-/// A bilateral constraint held during a step (a tip on a surface, optionally with friction),
-/// seen by a method through its force and its Newton border only.
-pub trait StepConstraint {
+/// A bilateral constraint held during a step on the system `S` (a tip on a surface,
+/// optionally with friction), seen by a method through its force and its Newton border only.
+pub trait StepConstraint<S: System + ?Sized> {
     /// Constraint value g(q) at (t, q).
-    fn value(&self, chain: &Chain, t: f64, q: &[f64]) -> f64;
+    fn value(&self, system: &S, t: f64, q: &[f64]) -> f64;
     /// The multiplier the step starts from (the last accepted step's).
     fn multiplier(&self) -> f64;
     /// Stores the multiplier of a converged step.
     fn set_multiplier(&mut self, lambda: f64);
     /// Subtracts the constraint force (and friction) of the iterate from the momentum
     /// residual `res`; returns the constraint value Newton must drive to its target.
-    fn add_force(&mut self, chain: &Chain, view: &ConstraintView<'_>, res: &mut [f64]) -> f64;
+    fn add_force(&mut self, system: &S, view: &ConstraintView<'_>, res: &mut [f64]) -> f64;
     /// Bordered Newton update: leaves δa in `newton.delta` (from the residual `res`, the
     /// Newton matrix factorized in `newton`) and returns δλ; `gap1` is the value returned by
     /// [`StepConstraint::add_force`], `gap_target` what it must reach; `dq1_da` = ∂q₁/∂a, the
@@ -154,7 +157,7 @@ pub trait StepConstraint {
     /// the midpoint schemes' mean acceleration, βh²(1−α_f)/(1−α_m) for generalized-α's q̈₁).
     fn newton_update(
         &mut self,
-        newton: &mut NewtonSystem,
+        newton: &mut NewtonSystem<S::Augmented>,
         res: &[f64],
         dq1_da: f64,
         gap1: f64,
@@ -162,16 +165,16 @@ pub trait StepConstraint {
     ) -> f64;
 }
 
-/// One integration method.
-pub trait Stepper: std::fmt::Debug {
+/// One integration method, stepping the system `S`.
+pub trait Stepper<S: System + ?Sized>: std::fmt::Debug {
     /// Solves the step t₀ → t₁ = t₀ + h from `cx.state` into its trial end (laws evaluated at
     /// `t_law`, = t₁ except as a left limit at a discontinuity). Returns the scaled local error
     /// estimate when adaptive, `Some(∞)` when Newton failed (the driver retries shorter).
     /// `constraint`: a held bilateral constraint (methods without that support refuse it).
     fn step(
         &mut self,
-        cx: &mut StepContext<'_>,
-        constraint: Option<&mut dyn StepConstraint>,
+        cx: &mut StepContext<'_, S>,
+        constraint: Option<&mut dyn StepConstraint<S>>,
         h: f64,
         t1: f64,
         t_law: f64,

@@ -83,7 +83,7 @@
 
 use data::scene::{ContactMode, Surface};
 
-use crate::chain::{Chain, MAX_LINKS, V2};
+use crate::chain::{AugmentedLayout, Chain, MAX_LINKS, V2};
 use crate::error::FemError;
 use crate::events::contact::Contact;
 use crate::events::mass_solve::MassSolver;
@@ -480,7 +480,7 @@ pub fn phase(c: &Contact) -> f64 {
 /// complement (three solves of S). Leaves δa in `delta`, stores δλ_t for the next iterate,
 /// returns δλ_n.
 pub(crate) fn stick_newton_update(
-    newton: &mut NewtonSystem,
+    newton: &mut NewtonSystem<AugmentedLayout>,
     c: &mut Contact,
     res: &[f64],
     dq1_da: f64,
