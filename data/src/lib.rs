@@ -20,6 +20,7 @@ pub mod channel;
 pub mod coverage;
 pub mod error;
 pub mod locate;
+mod methods;
 pub mod reader;
 pub mod results;
 pub mod scene;

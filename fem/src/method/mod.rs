@@ -30,8 +30,9 @@
 //! file holds only the registry, so the methods depend on `step` and `state`, never on it.
 //!
 //! Adding a method: one new file here implementing [`Stepper`] (and its `pub mod` line), one
-//! `match` line in [`stepper`]; in `data`, its [`data::Method`] variant with one row of the
-//! spelling table and its name in the `FemMethod` list (`data::backend_settings`).
+//! `match` line in [`stepper`]; in `data`, one row of the method table (`data/src/methods.rs`:
+//! its [`data::Method`] variant, spellings and backends, from which [`data::FemMethod`]
+//! follows).
 
 pub mod central_difference;
 pub mod energy_midpoint;

@@ -18,7 +18,8 @@
 //! and [`method_for`] maps the settings' [`data::ModalMethod`] to its entry: a driver holds a
 //! `Box<dyn Stepper>` built from the registry entry and never names a method. Adding a method
 //! is one new file (the method type, its `Stepper` impl and its [`MethodInfo`]) plus its
-//! variant of [`data::ModalMethod`] and its lines in [`METHODS`] and [`method_for`].
+//! row in `data`'s method table (from which [`data::ModalMethod`] follows) and its lines in
+//! [`METHODS`] and [`method_for`].
 
 mod dopri5;
 mod sdirk;
