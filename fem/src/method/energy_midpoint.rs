@@ -419,8 +419,8 @@ impl<S: System + ?Sized> Stepper<S> for EnergyMidpoint {
     /// Phases: the step's fixed data (`begin`), the predictor (`predict`), then per Newton
     /// iteration the iterate (`set_iterate`), its momentum residual (`momentum_residual`) with
     /// the constraint force, the Newton matrix when due (`form_matrix`), the update
-    /// (`solve_update`) and its test (`Iteration::judge`); finally the matrix bookkeeping, the
-    /// accepted step's works and the error estimate.
+    /// (`solve_update`), its test (`Iteration::judge`) and the next iterate (`apply_update`);
+    /// finally the matrix bookkeeping, the accepted step's works and the error estimate.
     fn step(
         &mut self,
         cx: &mut StepContext<'_, S>,
@@ -474,18 +474,9 @@ impl<S: System + ?Sized> Stepper<S> for EnergyMidpoint {
                 Verdict::Refresh => continue,
                 Verdict::Apply => {}
             }
-            if accelerate {
-                if it == 0 || iter.formed_it == Some(it) {
-                    // A new matrix or a new step is a new fixed-point map: its history starts
-                    // here.
-                    w.anderson.reset();
-                }
-                w.anderson.advance(&mut cx.state.qdd1, &cx.newton.delta);
-            } else {
-                for (a, d) in cx.state.qdd1.iter_mut().zip(&cx.newton.delta) {
-                    *a -= d;
-                }
-            }
+            // A new matrix or a new step is a new fixed-point map.
+            let new_map = it == 0 || iter.formed_it == Some(it);
+            w.apply_update(cx.state, &cx.newton.delta, accelerate, new_map);
             lambda -= dlambda;
         }
         if let Some(c) = constraint.filter(|_| iter.converged) {
@@ -932,6 +923,21 @@ impl MidpointWork {
             defect: (h * dot(&self.vbar, &self.res)).abs(),
             e_scale: setup.scale0 + scale1 + dot(&self.minus_q, &self.dq).abs(),
             on_surface: (gap1 - setup.gap_target).abs() <= cx.newton.tol,
+        }
+    }
+
+    /// The next iterate a ← a − δa, or with `accelerate` Anderson's extrapolation of it (its
+    /// history restarted on a `new_map`).
+    fn apply_update(&mut self, st: &mut StepState, delta: &[f64], accelerate: bool, new_map: bool) {
+        if accelerate {
+            if new_map {
+                self.anderson.reset();
+            }
+            self.anderson.advance(&mut st.qdd1, delta);
+        } else {
+            for (a, d) in st.qdd1.iter_mut().zip(delta) {
+                *a -= d;
+            }
         }
     }
 
