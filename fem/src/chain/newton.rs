@@ -56,8 +56,8 @@ struct LinkAssembly {
     rot_dofs: [usize; MAX_COLUMNS + 1],
     nr: usize,
     /// Axial displacement directions of a point whose variation comes through auxiliary
-    /// unknowns: [0] its own link's foreshortening (set per point), [1..=nanc] each
-    /// ancestor's s(L).
+    /// unknowns: `virt[0]` its own link's foreshortening (set per point), `virt[1..=nanc]`
+    /// each ancestor's s(L).
     virt: [Virtual; MAX_LINKS + 1],
     nanc: usize,
     /// Per-point column buffer (filled up to the point's column count).
