@@ -28,22 +28,25 @@
 //! station, half-bandwidth ≤ 3 × fields). With a prescribed base the second line gives the
 //! torque the base needs.
 //!
-//! ## Time stepping ([`run`])
-//! The report's central difference in its one-step velocity form (kick–drift–kick, stable to
-//! 2/ω_max), step τ = safety × min over the carried fields of the Gershgorin bound of the
-//! lumped operator — axial h√(ρA/EA), bending h²√(ρA/4EI), torsion h√(ρJ/GJ) inside the rod
-//! (rotary and payload inertia only lower ω_max, so the lumped bound is safe). A forced `--dt`
-//! above it is refused naming the field. **Kelvin–Voigt implicitly**: explicit, the strain-rate
-//! damping bounds the step by ≈ ρh²/(4C) (axial, 2.5e-7 s for the catalog rod at 21 stations,
-//! 40× below the elastic bound), so the damping force is taken at the step-end velocity,
-//! (M_ff + ½τC) q̈_{j+1} = F(q_{j+1}, v_pred) − C v_{j+½}, one banded factorization per run; the
-//! remaining velocity terms (Coriolis, motor friction) at the predicted velocity.
+//! ## Time stepping ([`run`], [`system`])
+//! The model is a [`crate::system::System`] ([`system::PayloadLinkSystem`]) stepped by the
+//! report's central difference in its one-step velocity form ([`crate::method::velocity_form`],
+//! kick–drift–kick, stable to 2/ω_max) inside the backend's driver, step τ = safety × min over
+//! the carried fields of the Gershgorin bound of the lumped operator — axial h√(ρA/EA), bending
+//! h²√(ρA/4EI), torsion h√(ρJ/GJ) inside the rod (rotary and payload inertia only lower ω_max,
+//! so the lumped bound is safe). A forced `--dt` above it is refused naming the field.
+//! **Kelvin–Voigt implicitly**: explicit, the strain-rate damping bounds the step by ≈ ρh²/(4C)
+//! (axial, 2.5e-7 s for the catalog rod at 21 stations, 40× below the elastic bound), so the
+//! closing kick takes the damping force at the step-end velocity,
+//! (M_ff + ½τC) q̈_{j+1} = F(q_{j+1}, v_pred) − C v_{j+½}, one sparse factorization per step
+//! length; the remaining velocity terms (Coriolis, motor friction) at the predicted velocity.
 //!
 //! Not built: the centrifugal tension's share of the step bound (the base rates of the catalog
 //! add < 1e-4 of ω_max²), the gyroscopic term in `modes` (K − Ω²H against M_ff, undamped).
 
 pub mod run;
 pub mod spd;
+pub mod system;
 
 use data::ledger_term;
 use data::scene::{LinkField, PayloadLink, PrescribedMotion, TorqueLaw};
