@@ -171,7 +171,19 @@ pub struct DriftVelocities<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::damped_step_factor;
+    use super::{BoundKind, damped_step_factor};
+    use data::scene::LinkField;
+
+    /// The 3-D link's refusal names the field as the scene spells it: "axial (u)".
+    #[test]
+    fn elem_link_field_bound_names_field_and_symbol() {
+        for f in LinkField::ALL {
+            assert_eq!(
+                BoundKind::LinkField(f).name(),
+                format!("{} ({})", f.name(), f.symbol())
+            );
+        }
+    }
 
     /// log of the spectral radius of the velocity form's step matrix on (x, v, a) for
     /// ẍ + cẋ + ω²x = 0, from ‖A^(2^k)‖ by repeated squaring.
