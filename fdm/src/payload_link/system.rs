@@ -118,10 +118,6 @@ impl PayloadLinkSystem {
         })
     }
 
-    pub fn model(&self) -> &PayloadLinkModel {
-        &self.model
-    }
-
     /// Factors A = M_ff + ½τC for the step τ (nothing to do if it already is).
     pub fn set_step(&mut self, tau: f64) -> Result<(), FdmError> {
         if self.step.as_ref().is_some_and(|(t, _)| *t == tau) {
@@ -204,16 +200,13 @@ impl PayloadLinkSystem {
         md.m_theta(qf, m);
         let mtt = md.m_thth(qf);
         let vel = md.theta_velocity_terms(qf, vf, rate);
-        let torque = match (&md.drive, prescribed) {
-            (
-                BaseDrive::Free {
-                    law,
-                    stiffness,
-                    damping,
-                    set_point,
-                },
-                _,
-            ) => {
+        let torque = match &md.drive {
+            BaseDrive::Free {
+                law,
+                stiffness,
+                damping,
+                set_point,
+            } => {
                 let ext = law.as_ref().map_or(0.0, |l| l.torque(t));
                 let rhs = ext - damping * rate - stiffness * (th - set_point) - vel;
                 let acc = &mut a[o..];
@@ -228,8 +221,9 @@ impl PayloadLinkSystem {
                 a[0] = thdd;
                 ext
             }
-            (BaseDrive::Prescribed(_), thdd) => {
-                let thdd = thdd.unwrap_or(f64::NAN);
+            BaseDrive::Prescribed(_) => {
+                // θ̈ of the motion (`prescribed_at` is Some for a prescribed drive)
+                let thdd = prescribed.unwrap_or(f64::NAN);
                 let acc = &mut a[o..];
                 for i in 0..md.n {
                     acc[i] = f[i] - m[i] * thdd;
