@@ -225,34 +225,34 @@ pub fn run<S: Model, E: Events<S>>(
             _ => tau_next,
         };
         method.predict(tau, tau_step, &mut st);
-        // Monitor the computational mode: |Δ²v| over the elastic coordinates.
-        let mut d2 = 0.0f64;
-        let mut vmax = 0.0f64;
-        let mut qmax = 0.0f64;
-        let mut finite = true;
-        let (mut worst_d2, mut worst_q) = (mon.start, mon.start);
+        // Monitor the computational mode: |Δ²v| over the elastic coordinates. The maxima alone
+        // while every value is finite (the common case: max is exact, so they equal the full
+        // scan's); the full scan with the worst coordinates when anything is off.
         let new_v = method.predicted_velocity(&st);
-        let (prev, cur, next) = (&st.prev, &st.cur, &st.next);
-        for i in mon.clone() {
-            let nv = new_v[i];
-            finite &= nv.is_finite() && next.q[i].is_finite();
-            let d = (nv - 2.0 * cur.v[i] + prev.v[i]).abs();
-            if d > d2 || d.is_nan() {
-                d2 = d;
-                worst_d2 = i;
-            }
-            vmax = vmax.max(nv.abs());
-            if next.q[i].abs() > qmax || next.q[i].is_nan() {
-                qmax = next.q[i].abs();
-                worst_q = i;
-            }
+        let (mut w, clean) = Watch::maxima(mon.clone(), new_v, &st);
+        if !clean {
+            w = Watch::scan(mon.clone(), new_v, &st);
         }
         for i in 0..n {
-            finite &= next.q[i].is_finite();
+            w.finite &= st.next.q[i].is_finite();
         }
         let step_count = cost.steps;
-        let parasitic = step_count > 4 && d2 > parasitic_threshold * peak_v;
-        let runaway = qmax > 1e8 * peak_q && step_count > 4;
+        let parasitic = step_count > 4 && w.d2 > parasitic_threshold * peak_v;
+        let runaway = w.qmax > 1e8 * peak_q && step_count > 4;
+        if (!w.finite || parasitic || runaway) && clean {
+            // the worst coordinates for the diagnostic (same maxima)
+            let finite = w.finite;
+            w = Watch::scan(mon.clone(), new_v, &st);
+            w.finite &= finite;
+        }
+        let Watch {
+            d2,
+            vmax,
+            qmax,
+            finite,
+            worst_d2,
+            worst_q,
+        } = w;
         if !finite || parasitic || runaway {
             verdict = StabilityVerdict::Stopped {
                 diagnostic: growth_diagnostic(
@@ -345,6 +345,86 @@ pub fn run<S: Model, E: Events<S>>(
         tau_min,
         tau_max,
     })
+}
+
+/// The watch's scan of a new level over the monitored coordinates: max |Δ²v| of the predicted
+/// velocities, max |v|, max |q|, whether they are finite, and where the maxima sit.
+struct Watch {
+    d2: f64,
+    vmax: f64,
+    qmax: f64,
+    finite: bool,
+    worst_d2: usize,
+    worst_q: usize,
+}
+
+impl Watch {
+    /// The maxima only, and whether every Δ²v and q was finite (then they equal [`Watch::scan`]'s;
+    /// a finite Δ²v has finite terms). The worst coordinates are left at the range's start.
+    fn maxima(mon: std::ops::Range<usize>, new_v: &[f64], st: &StepState) -> (Self, bool) {
+        let (prev, cur, next) = (&st.prev.v[mon.clone()], &st.cur.v[mon.clone()], &st.next.q);
+        let (nv, q) = (&new_v[mon.clone()], &next[mon.clone()]);
+        // four independent lanes: the maxima's dependency chains overlap
+        const L: usize = 4;
+        let (mut d2, mut vmax, mut qmax) = ([0.0f64; L], [0.0f64; L], [0.0f64; L]);
+        let mut clean = [true; L];
+        let mut lane = |l: usize, i: usize| {
+            let d = (nv[i] - 2.0 * cur[i] + prev[i]).abs();
+            let (v, x) = (nv[i].abs(), q[i].abs());
+            clean[l] &= d.is_finite() & x.is_finite();
+            d2[l] = if d > d2[l] { d } else { d2[l] };
+            vmax[l] = if v > vmax[l] { v } else { vmax[l] };
+            qmax[l] = if x > qmax[l] { x } else { qmax[l] };
+        };
+        let m = nv.len();
+        for c in 0..m / L {
+            for l in 0..L {
+                lane(l, c * L + l);
+            }
+        }
+        for i in m / L * L..m {
+            lane(0, i);
+        }
+        let max = |a: [f64; L]| a.into_iter().fold(0.0f64, |m, x| if x > m { x } else { m });
+        let clean = clean.into_iter().all(|c| c);
+        let w = Watch {
+            d2: max(d2),
+            vmax: max(vmax),
+            qmax: max(qmax),
+            finite: clean,
+            worst_d2: mon.start,
+            worst_q: mon.start,
+        };
+        (w, clean)
+    }
+
+    /// The full scan: non-finite values propagate into the maxima and name their coordinate.
+    fn scan(mon: std::ops::Range<usize>, new_v: &[f64], st: &StepState) -> Self {
+        let (prev, cur, next) = (&st.prev, &st.cur, &st.next);
+        let mut w = Watch {
+            d2: 0.0,
+            vmax: 0.0,
+            qmax: 0.0,
+            finite: true,
+            worst_d2: mon.start,
+            worst_q: mon.start,
+        };
+        for i in mon {
+            let nv = new_v[i];
+            w.finite &= nv.is_finite() && next.q[i].is_finite();
+            let d = (nv - 2.0 * cur.v[i] + prev.v[i]).abs();
+            if d > w.d2 || d.is_nan() {
+                w.d2 = d;
+                w.worst_d2 = i;
+            }
+            w.vmax = w.vmax.max(nv.abs());
+            if next.q[i].abs() > w.qmax || next.q[i].is_nan() {
+                w.qmax = next.q[i].abs();
+                w.worst_q = i;
+            }
+        }
+        w
+    }
 }
 
 /// What the watch saw when it stopped the run.
@@ -451,5 +531,47 @@ fn growth_diagnostic<S: Model + ?Sized>(sys: &S, g: Growth) -> Diagnostic {
         location: Some(location),
         why,
         remedy,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Watch;
+    use crate::method::StepState;
+
+    /// The lane-wise maxima of the common case are the full scan's, for every range length
+    /// (lanes and remainder); a non-finite Δ²v or q is flagged so that the full scan decides.
+    #[test]
+    fn elem_watch_maxima_are_the_full_scans() {
+        let n = 23;
+        let mut st = StepState::new(n, 0);
+        let val = |k: usize, s: f64| ((k as f64 * 0.7 + s).sin() * 1e3).round() / 7.0;
+        for i in 0..n {
+            st.prev.v[i] = val(i, 0.1);
+            st.cur.v[i] = val(i, 1.3);
+            st.next.q[i] = val(i, 2.9);
+            st.pred[i] = val(i, 4.1);
+        }
+        for start in [0, 1, 2] {
+            for end in start..=n {
+                let (fast, clean) = Watch::maxima(start..end, &st.pred, &st);
+                let full = Watch::scan(start..end, &st.pred, &st);
+                assert!(clean && full.finite);
+                assert_eq!(
+                    (fast.d2, fast.vmax, fast.qmax),
+                    (full.d2, full.vmax, full.qmax),
+                    "{start}..{end}"
+                );
+            }
+        }
+        for bad in [f64::NAN, f64::INFINITY] {
+            let mut s2 = StepState::new(n, 0);
+            s2.pred.copy_from_slice(&st.pred);
+            s2.next.q[n - 1] = bad;
+            assert!(!Watch::maxima(0..n, &s2.pred, &s2).1);
+            let mut s3 = StepState::new(n, 0);
+            s3.cur.v[n - 2] = bad;
+            assert!(!Watch::maxima(0..n, &s3.pred, &s3).1);
+        }
     }
 }

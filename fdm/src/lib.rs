@@ -3,8 +3,8 @@
 //! ## Layout
 //! * **Model** — [`system::System`]: a semi-discrete q̇ = v, v̇ = a(t, q, v) (accelerations,
 //!   powers, stored energies, step bound, constraint projections). Implementations:
-//!   [`rocket::system`], [`link`], [`chain`]; [`beam`] for modes and statics; [`payload_link`]
-//!   (the 3-D link) carries its own model, stepping and outputs.
+//!   [`rocket::system`], [`link`], [`chain`], [`payload_link::system`] (the 3-D link); [`beam`]
+//!   for modes and statics.
 //!   The backend's entries match the scene's family once; [`ChainModel`] classifies a planar
 //!   chain.
 //! * **Method** — [`method::Stepper`], one type per method ([`method::two_step`],
@@ -165,9 +165,10 @@
 //!   mass, affine θ coupling, quadratic M_θθ; θ̈ by a Schur complement. Velocity form of the
 //!   central difference at τ = safety × min over fields of the report's bounds (axial
 //!   h√(ρA/EA), bending h²√(ρA/4EI), torsion h√(ρJ/GJ)); `--dt` above it refused naming the
-//!   field. Kelvin–Voigt implicit ((M + ½τC) q̈ = …, one banded factorization per run): explicit
-//!   it would bound the step at ≈ ρh²/(4C), 40× below the elastic bound of the catalog rod.
-//!   Modes (K − Ω²H against M, flexibility form), statics (K q = f_g). Tested
+//!   field; only the velocity form steps it (a requested two-step method is refused).
+//!   Kelvin–Voigt implicit in the closing kick ((M + ½τC) q̈ = …, one sparse factorization per
+//!   step length): explicit it would bound the step at ≈ ρh²/(4C), 40× below the elastic bound
+//!   of the catalog rod. Modes (K − Ω²H against M, flexibility form), statics (K q = f_g). Tested
 //!   (tests/payload_link.rs): static sag and the torsion and axial frequencies with the payload
 //!   O(h²) to the closed forms, bending O(h²), the ledger.
 //!
@@ -175,7 +176,8 @@
 //! "fdm: figures from its tests".
 //! * Unsupported (precise `Unsupported` messages): chains of more than two links, axial
 //!   fields, shear outside the two-link chain and cantilever statics, tip inertia, gravity on beams, contact with
-//!   friction, circles or bilateral mode, contact with the two-step scheme, mobile
+//!   friction, circles or bilateral mode, contact with the two-step scheme, the 3-D link with
+//!   the two-step scheme, mobile
 //!   scenes.
 
 pub mod beam;
@@ -311,7 +313,7 @@ impl Backend for FdmBackend {
                 ChainModel::SingleLink => runs::single_link(scene, pc, &s)?,
             },
             Model::Rocket(r) => runs::rocket(scene, r, &s)?,
-            Model::PayloadLink(p) => payload_link::run::simulate(scene, p, &s)?,
+            Model::PayloadLink(p) => runs::payload_link(scene, p, &s)?,
             Model::MobileManipulator(_) => return Err(unsupported_family(scene).into()),
         })
     }

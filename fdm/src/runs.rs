@@ -1,16 +1,19 @@
 //! Each model's run, built from the scene: the model, its method (the scene's `time.method` or
 //! the model's default), its events, the step control, then [`crate::driver::run`].
 
-use data::scene::{PlanarChain, Rocket};
+use data::scene::{LinkInitialShape, PayloadLink, PlanarChain, Rocket};
 use data::{RunResult, Scene};
 
 use crate::chain::TwoLinkChain;
-use crate::driver::{StepControl, integrate, run};
+use crate::driver::{StepControl, choose_step, integrate, run};
 use crate::error::FdmError;
+use crate::events::NoEvents;
 use crate::events::tip_contact::{ContactReport, TipContactEvents};
 use crate::link::FloatingLink;
-use crate::method::VelocityForm;
+use crate::method::{Stepper, VelocityForm};
 use crate::output::{Outcome, Outputs};
+use crate::payload_link::PayloadLinkModel;
+use crate::payload_link::system::PayloadLinkSystem;
 use crate::rocket::system::RocketSystem;
 use crate::settings::{Method, ValidatedSettings};
 use crate::system::System;
@@ -129,4 +132,33 @@ pub fn two_link_chain_with_contact(
         &ctl,
     )?;
     Ok((out.into_run_result(scene, s), events.report))
+}
+
+/// Runs `p`, the payload link of `scene`. Only the velocity form steps the 3-D link: a requested two-step method is
+/// refused (its explicit damping would need the damped step bound, and its computational mode
+/// grows under the Kelvin–Voigt and Coriolis forces).
+pub fn payload_link(
+    scene: &Scene,
+    p: &PayloadLink,
+    s: &ValidatedSettings,
+) -> Result<RunResult, FdmError> {
+    if s.requested.method.is_some() && s.method != Method::VelocityForm {
+        return Err(FdmError::Unsupported(format!(
+            "fdm: the 3-D payload link with time.method = {}: only velocity-form steps it (its \
+             Kelvin–Voigt damping is implicit in the velocity form's closing kick)",
+            s.method.name()
+        )));
+    }
+    let model = PayloadLinkModel::from_payload_link(scene, p, s.stations)?;
+    let mut sys = PayloadLinkSystem::new(model)?;
+    let ctl = StepControl::for_scene(scene, s, Method::VelocityForm, false, true);
+    let mut method = VelocityForm::drift_split();
+    // the step is constant (the bound does not move): A = M_ff + ½τC factored once, before
+    // the start level needs it
+    let (tau, _, _) = choose_step(&sys, &ctl, method.bound_factor(), 0.0)?;
+    sys.set_step(tau)?;
+    let (q0, v0) = sys.initial_state(p.initial_shape == LinkInitialShape::StaticSag)?;
+    let mut out = run(&mut sys, &mut method, &mut NoEvents, &q0, &v0, &ctl)?;
+    out.cost.factorizations = sys.factorizations();
+    Ok(out.into_run_result(scene, s))
 }

@@ -9,6 +9,8 @@
 //! Kelvin–Voigt or discrete damper acts. The method scales it by its own factor
 //! ([`crate::method::Stepper::bound_factor`]) and the user's safety factor.
 
+use data::scene::LinkField;
+
 /// Which stability bound is binding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BoundKind {
@@ -20,6 +22,8 @@ pub enum BoundKind {
     /// A discrete mass on its springs (not in the report's 5.45; checked so that no step is ever
     /// taken above a known limit).
     DiscreteMass,
+    /// One elastic field of the 3-D payload link (its lumped operator's bound).
+    LinkField(LinkField),
 }
 
 impl BoundKind {
@@ -29,6 +33,12 @@ impl BoundKind {
             BoundKind::Transverse => "transverse",
             BoundKind::TransverseTension => "transverse (bending + centrifugal tension)",
             BoundKind::DiscreteMass => "discrete-mass",
+            BoundKind::LinkField(f) => match f {
+                LinkField::Axial => "axial (u)",
+                LinkField::Horizontal => "horizontal (v)",
+                LinkField::Vertical => "vertical (w)",
+                LinkField::Torsion => "torsion (phi)",
+            },
         }
     }
 }
@@ -72,7 +82,9 @@ pub trait System {
     }
     /// The velocity form's closing kick with the damping implicit (Crank–Nicolson in the
     /// damping across the step): writes a with (M + ½τC) a = F(q, v_{j+½}) (damping C at the
-    /// drift velocity `inertia.current`, inertia terms as [`System::accel_split`]), so that
+    /// drift velocity `inertia.current`, inertia terms as [`System::accel_split`], other
+    /// velocity-dependent forces at the drift or the predicted velocity as the system
+    /// documents), so that
     /// v_{j+1} = v_{j+½} + ½τa carries −½τM⁻¹C v_{j+1}; stores the powers at v_{j+1}. Returns
     /// false (a untouched) for systems whose damping is explicit (the default).
     fn implicit_kick(
@@ -151,11 +163,27 @@ pub struct DriftVelocities<'a> {
     pub previous: &'a [f64],
     /// w = τ_{j+1}/(τ_{j+1} + τ_j): ½ for equal steps
     pub w: f64,
+    /// v_pred = v_{j+½} + ½τa_j, the predicted step-end velocity (where
+    /// [`System::accel_split`] takes the velocity-dependent forces; an implicit kick may take
+    /// the forces other than the implicit damping there)
+    pub predicted: &'a [f64],
 }
 
 #[cfg(test)]
 mod tests {
-    use super::damped_step_factor;
+    use super::{BoundKind, damped_step_factor};
+    use data::scene::LinkField;
+
+    /// The 3-D link's refusal names the field as the scene spells it: "axial (u)".
+    #[test]
+    fn elem_link_field_bound_names_field_and_symbol() {
+        for f in LinkField::ALL {
+            assert_eq!(
+                BoundKind::LinkField(f).name(),
+                format!("{} ({})", f.name(), f.symbol())
+            );
+        }
+    }
 
     /// log of the spectral radius of the velocity form's step matrix on (x, v, a) for
     /// ẍ + cẋ + ω²x = 0, from ‖A^(2^k)‖ by repeated squaring.

@@ -338,3 +338,137 @@ fn dyn_payload_link_constant_rate_gravity_does_not_reach_the_horizontal_pair() {
     let wb = channel(&b, "link1.tip_w");
     assert!(wb.iter().all(|x| *x == 0.0), "without gravity w stays zero");
 }
+
+/// The payload link is a `System` the backend's driver steps: its coordinates are the field
+/// DOFs (plus θ with a free base), the step matrix is factored once per step length, and a
+/// short run through `driver::run` with the velocity form books a ledger that closes, with the
+/// Kelvin–Voigt dissipation positive — on a free base with a torque law and on a prescribed one.
+#[test]
+fn sys_payload_link_is_a_system_stepped_by_the_driver() {
+    use fdm::driver::{StepControl, run};
+    use fdm::events::NoEvents;
+    use fdm::method::VelocityForm;
+    use fdm::payload_link::system::PayloadLinkSystem;
+    use fdm::system::{BoundKind, System};
+
+    for (name, free) in [
+        ("single-link-3d", true),
+        ("single-link-3d-constant-rate", false),
+    ] {
+        let s = load_scene(name).unwrap();
+        let p = s.payload_link().unwrap();
+        let model = PayloadLinkModel::from_payload_link(&s, p, None).unwrap();
+        let n = model.field_coordinates();
+        let bounds = model.field_bounds();
+        let mut sys = PayloadLinkSystem::new(model).unwrap();
+        let off = usize::from(free);
+        assert_eq!(sys.dofs(), n + off, "{name}");
+        assert_eq!(sys.monitored(), off..n + off, "{name}");
+        // the binding bound is the smallest field bound, named by its field
+        let b = sys.bound(0.0);
+        let (field, sigma, station) = bounds
+            .iter()
+            .copied()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap();
+        assert_eq!(
+            (b.kind, b.sigma, b.site),
+            (BoundKind::LinkField(field), sigma, station)
+        );
+
+        let tau = 0.9 * sigma;
+        sys.set_step(tau).unwrap();
+        sys.set_step(tau).unwrap();
+        assert_eq!(
+            sys.factorizations(),
+            1,
+            "{name}: one factorization per step length"
+        );
+        let ctl = StepControl {
+            method: fdm::Method::VelocityForm,
+            safety: 0.9,
+            forced_dt: None,
+            t_end: 0.05,
+            output_interval: 1e-3,
+            log_change: f64::INFINITY,
+            lookahead: false,
+            enforce_bound: true,
+        };
+        let sag = p.initial_shape == data::scene::LinkInitialShape::StaticSag;
+        let (q0, v0) = sys.initial_state(sag).unwrap();
+        let out = run(
+            &mut sys,
+            &mut VelocityForm::drift_split(),
+            &mut NoEvents,
+            &q0,
+            &v0,
+            &ctl,
+        )
+        .unwrap();
+        assert_eq!(out.verdict, StabilityVerdict::Completed, "{name}");
+        assert_eq!(out.cost.dofs, n + off, "{name}");
+        assert_eq!(out.tau_min, tau, "{name}");
+        assert_eq!(out.tau_max, tau, "{name}");
+        assert_eq!(
+            sys.factorizations(),
+            1,
+            "{name}: no refactorization in the loop"
+        );
+        assert_eq!(out.observables.time.len(), 51, "{name}");
+        let closure = out.ledger.relative_closure();
+        let diss: f64 = out
+            .ledger
+            .dissipation
+            .iter()
+            .map(|t| *t.values.last().unwrap())
+            .sum();
+        let input: f64 = out
+            .ledger
+            .inputs
+            .iter()
+            .map(|t| t.values.last().unwrap().abs())
+            .sum();
+        println!("{name}: closure {closure:.3e}, dissipated {diss:.3e}, |input| {input:.3e}");
+        assert!(closure < 1e-6, "{name}: {closure}");
+        assert!(diss > 0.0, "{name}");
+        assert!(input > 0.0, "{name}: the base does work on the link");
+        if !free {
+            // θ is no coordinate here: the observable follows the prescribed constant rate
+            let rate = 2.0 * std::f64::consts::PI;
+            let angle = &out
+                .observables
+                .channels
+                .iter()
+                .find(|c| c.name == "joint1.angle")
+                .unwrap()
+                .values;
+            for (t, a) in out.observables.time.iter().zip(angle) {
+                assert!((a - rate * t).abs() <= 1e-13 * (1.0 + rate * t), "{t}: {a}");
+            }
+        }
+    }
+}
+
+#[test]
+fn sys_payload_link_refuses_the_two_step_methods() {
+    let s = load_scene("single-link-3d").unwrap();
+    for m in [
+        data::Method::Report,
+        data::Method::RobertAsselin { nu: None },
+    ] {
+        let mut st = settings(None, Some(1e-3), None);
+        st.time.method = Some(m);
+        match FdmBackend.simulate(&s, &st) {
+            Err(BackendError::Unsupported(msg)) => {
+                assert!(msg.contains("velocity-form"), "{msg}")
+            }
+            other => panic!("expected a refusal of {m:?}, got {other:?}"),
+        }
+    }
+    let mut st = settings(None, Some(1e-3), None);
+    st.time.method = Some(data::Method::VelocityForm);
+    assert_eq!(
+        FdmBackend.simulate(&s, &st).unwrap().verdict,
+        StabilityVerdict::Completed
+    );
+}

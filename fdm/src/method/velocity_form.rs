@@ -120,6 +120,7 @@ impl Stepper for VelocityForm {
                 } else {
                     0.0
                 },
+                predicted: &st.pred,
             };
             if !sys.implicit_kick(t_new, &st.next.q, drift, tau, &mut st.acc_next) {
                 sys.accel_split(t_new, &st.next.q, &st.pred, drift, &mut st.acc_next);

@@ -28,22 +28,26 @@
 //! station, half-bandwidth ≤ 3 × fields). With a prescribed base the second line gives the
 //! torque the base needs.
 //!
-//! ## Time stepping ([`run`])
-//! The report's central difference in its one-step velocity form (kick–drift–kick, stable to
-//! 2/ω_max), step τ = safety × min over the carried fields of the Gershgorin bound of the
-//! lumped operator — axial h√(ρA/EA), bending h²√(ρA/4EI), torsion h√(ρJ/GJ) inside the rod
-//! (rotary and payload inertia only lower ω_max, so the lumped bound is safe). A forced `--dt`
-//! above it is refused naming the field. **Kelvin–Voigt implicitly**: explicit, the strain-rate
-//! damping bounds the step by ≈ ρh²/(4C) (axial, 2.5e-7 s for the catalog rod at 21 stations,
-//! 40× below the elastic bound), so the damping force is taken at the step-end velocity,
-//! (M_ff + ½τC) q̈_{j+1} = F(q_{j+1}, v_pred) − C v_{j+½}, one banded factorization per run; the
-//! remaining velocity terms (Coriolis, motor friction) at the predicted velocity.
+//! ## Time stepping ([`system`], run by [`crate::runs::payload_link`])
+//! The model is a [`crate::system::System`] ([`system::PayloadLinkSystem`]) stepped by the
+//! report's central difference in its one-step velocity form ([`crate::method::velocity_form`],
+//! kick–drift–kick, stable to 2/ω_max) inside the backend's driver, step τ = safety × min over
+//! the carried fields of the Gershgorin bound of the lumped operator — axial h√(ρA/EA), bending
+//! h²√(ρA/4EI), torsion h√(ρJ/GJ) inside the rod (rotary and payload inertia only lower ω_max,
+//! so the lumped bound is safe). A forced `--dt` above it is refused naming the field.
+//! **Kelvin–Voigt implicitly**: explicit, the strain-rate damping bounds the step by ≈ ρh²/(4C)
+//! (axial, 2.5e-7 s for the catalog rod at 21 stations, 40× below the elastic bound), so the
+//! closing kick takes the damping force at the step-end velocity,
+//! (M_ff + ½τC) q̈_{j+1} = F(q_{j+1}, v_pred) − C v_{j+½}, one sparse factorization per step
+//! length; the remaining velocity terms (Coriolis, motor friction) at the predicted velocity.
+//! A requested two-step method is refused: explicit, the damping would need the damped bound,
+//! and the scheme's computational mode grows under the Kelvin–Voigt and Coriolis forces.
 //!
 //! Not built: the centrifugal tension's share of the step bound (the base rates of the catalog
 //! add < 1e-4 of ω_max²), the gyroscopic term in `modes` (K − Ω²H against M_ff, undamped).
 
-pub mod run;
 pub mod spd;
+pub mod system;
 
 use data::ledger_term;
 use data::scene::{LinkField, PayloadLink, PrescribedMotion, TorqueLaw};
@@ -610,6 +614,37 @@ impl PayloadLinkModel {
             out.push((*f, best.0, best.1));
         }
         out
+    }
+
+    /// Ledger term names: stored, inputs, dissipation.
+    pub fn ledger_names(&self) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
+        let mut stored = vec![ledger_term::KINETIC, ledger_term::STRAIN];
+        if self.f_gravity.is_some() {
+            stored.push(ledger_term::GRAVITY);
+        }
+        let mut inputs = Vec::new();
+        let mut diss = Vec::new();
+        match &self.drive {
+            BaseDrive::Prescribed(_) => inputs.push(ledger_term::PRESCRIBED_MOTION),
+            BaseDrive::Free {
+                law,
+                stiffness,
+                damping,
+                ..
+            } => {
+                if *stiffness != 0.0 {
+                    stored.push(ledger_term::JOINT_SPRING);
+                }
+                if law.is_some() {
+                    inputs.push(ledger_term::APPLIED_TORQUE);
+                }
+                if *damping != 0.0 {
+                    diss.push(ledger_term::JOINT_DAMPER);
+                }
+            }
+        }
+        diss.extend(self.kv_names());
+        (stored, inputs, diss)
     }
 
     /// The ledger's Kelvin–Voigt term names, in the order of `damping`.
