@@ -158,9 +158,10 @@
 //!   (`cantilever-timoshenko`) use the same cell energy ([`beam`]): tip force error exactly
 //!   −PLh²/(12EI) with ψ(L) exact; distributed load v(L) exact, ψ(L) O(h²).
 //! * [`payload_link`]: the 3-D link with an offset payload of seed 002 (`single-link-3d`,
-//!   `-constant-rate`, `-soft-sag`, `-stiff`): u, v, w, φ at the stations (only the carried
-//!   fields built), the payload's mass, offset and full inertia at the tip, base angle free
-//!   (torque, friction, spring) or prescribed, gravity, per-field Kelvin–Voigt. Discrete
+//!   `-constant-rate`, `-soft-sag`, `-stiff`, `-thin`, `-heavy-payload`): u, v, w, φ at the
+//!   stations (only the carried fields built), the payload's mass, offset and full inertia at
+//!   the tip, base angle free (torque, friction, spring) or prescribed, gravity, per-field
+//!   Kelvin–Voigt. Discrete
 //!   Lagrangian to second order in the fields (docs/single-link-3d.md): constant banded field
 //!   mass, affine θ coupling, quadratic M_θθ; θ̈ by a Schur complement. Velocity form of the
 //!   central difference at τ = safety × min over fields of the report's bounds (axial

@@ -451,10 +451,6 @@ impl PayloadLinkModel {
         })
     }
 
-    pub fn field_dofs(&self) -> usize {
-        self.n
-    }
-
     pub fn free_base(&self) -> bool {
         matches!(self.drive, BaseDrive::Free { .. })
     }
