@@ -507,12 +507,38 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
     let (works, work_notes) = work::read_all(dir);
     notes.extend(work_notes);
     let fronts = draw_fronts(dir, &works);
+    let scenes = first_seen(outcomes.iter().map(|o| o.scene.as_str()));
+    let ladders = ladder_plots(dir);
+    let index = index_page(dir, outcomes, &scenes, &fronts, &ladders, &mut notes);
+    write_atomic(
+        dir,
+        "index.html",
+        page("flexverify verification report", &index).as_bytes(),
+    )?;
+    for sc in &scenes {
+        let b = scene_page_body(dir, outcomes, sc, &works, &fronts, &ladders);
+        write_atomic(
+            dir,
+            &scene_page(sc),
+            page(&format!("{sc} — flexverify"), &b).as_bytes(),
+        )?;
+    }
+    Ok(notes)
+}
+
+/// The index page's body: the summary and navigation, the failures, the rows by check kind and
+/// by scene, the coverage matrix, the work–precision fronts and the full suite's ladders.
+fn index_page(
+    dir: &Path,
+    outcomes: &[Outcome],
+    scenes: &[&str],
+    fronts: &[Front<'_>],
+    ladders: &[String],
+    notes: &mut Vec<String>,
+) -> String {
     let coverage = crate::coverage::analyse_embedded();
     let (passed, failed) = counts(outcomes.iter());
-    let scenes = first_seen(outcomes.iter().map(|o| o.scene.as_str()));
     let kinds = first_seen(outcomes.iter().map(|o| o.check.as_str()));
-
-    // Index.
     let mut b = String::new();
     let _ = write!(
         b,
@@ -582,7 +608,7 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
         "</table>\n<h2 id=\"scenes\">By scene</h2>\n<table><tr><th>scene</th>\
                 <th>rows</th><th>passed</th><th>failed</th><th>backends</th><th>plots</th></tr>\n",
     );
-    for sc in &scenes {
+    for sc in scenes {
         let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.scene == *sc).collect();
         let (p, f) = counts(rows.iter().copied());
         let backends: Vec<String> = first_seen(rows.iter().map(|o| backend_kind(o)))
@@ -612,7 +638,7 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
                  exc: a gap listed in data/cases/coverage-exceptions.toml (hover for the \
                  reason). Scenes without rows in this run have no page (no link).</p>\n",
             );
-            b.push_str(&coverage_table(c, &scenes));
+            b.push_str(&coverage_table(c, scenes));
         }
         Err(e) => {
             notes.push(format!("coverage matrix not included: {e}"));
@@ -632,7 +658,7 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
                     of every backend and method, with the Pareto front of minimum wall time \
                     against error.</p>\n<ul>\n",
         );
-        for f in &fronts {
+        for f in fronts {
             let _ = writeln!(
                 b,
                 "<li><a href=\"{}#{}\">{} {}{}</a> ({} cases)</li>",
@@ -646,134 +672,132 @@ pub fn write_pages(dir: &Path, outcomes: &[Outcome]) -> std::io::Result<Vec<Stri
         }
         b.push_str("</ul>\n");
     }
-    let ladders = ladder_plots(dir);
     if !ladders.is_empty() {
         b.push_str("<h2 id=\"ladders\">Refinement ladders (full suite)</h2>\n<ul>\n");
-        for l in &ladders {
+        for l in ladders {
             let _ = writeln!(b, "<li><a href=\"ladders/{f}\">{f}</a></li>", f = esc(l));
         }
         b.push_str("</ul>\n");
     }
-    write_atomic(
-        dir,
-        "index.html",
-        page("flexverify verification report", &b).as_bytes(),
-    )?;
+    b
+}
 
-    // Scene pages.
-    for sc in &scenes {
-        let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.scene == *sc).collect();
-        let (p, f) = counts(rows.iter().copied());
-        let mut b = format!(
-            "<nav><a href=\"index.html\">← index</a><a href=\"#rows\">Rows</a>\
-             <a href=\"#plots\">Plots</a><a href=\"#fronts\">Work–precision</a></nav>\n\
-             <h1>{}</h1>\n<p class=\"summary\">{} rows: <span class=\"pass\">{p} passed</span>, \
-             <span class=\"{}\">{f} failed</span>.</p>\n{}<h2 id=\"rows\">Rows</h2>\n\
-             <p class=\"muted\">Each row, then on a line of its own the check kind and why \
-             the tolerance is what it is.</p>\n\
-             <table><tr><th>status</th><th>case</th><th>backend</th><th>quantity</th>\
-             <th>value</th><th>reference</th><th>error</th><th>tolerance</th>\
-             <th>wall [s]</th></tr>\n",
-            esc(sc),
-            rows.len(),
-            if f > 0 { "FAIL" } else { "muted" },
-            failed_list(&rows),
-        );
-        for o in &rows {
-            let has_plots = !case_plots(dir, &o.id).is_empty();
-            let id = if has_plots {
-                format!("<a href=\"#{}\">{}</a>", row_anchor(&o.id), esc(&o.id))
+/// The body of one scene's page: its rows (each with its check kind and why), the plots of the
+/// rows that draw, the scene's work–precision fronts and its refinement ladders.
+fn scene_page_body(
+    dir: &Path,
+    outcomes: &[Outcome],
+    sc: &str,
+    works: &[work::CaseWork],
+    fronts: &[Front<'_>],
+    ladders: &[String],
+) -> String {
+    let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.scene == *sc).collect();
+    let (p, f) = counts(rows.iter().copied());
+    let mut b = format!(
+        "<nav><a href=\"index.html\">← index</a><a href=\"#rows\">Rows</a>\
+         <a href=\"#plots\">Plots</a><a href=\"#fronts\">Work–precision</a></nav>\n\
+         <h1>{}</h1>\n<p class=\"summary\">{} rows: <span class=\"pass\">{p} passed</span>, \
+         <span class=\"{}\">{f} failed</span>.</p>\n{}<h2 id=\"rows\">Rows</h2>\n\
+         <p class=\"muted\">Each row, then on a line of its own the check kind and why \
+         the tolerance is what it is.</p>\n\
+         <table><tr><th>status</th><th>case</th><th>backend</th><th>quantity</th>\
+         <th>value</th><th>reference</th><th>error</th><th>tolerance</th>\
+         <th>wall [s]</th></tr>\n",
+        esc(sc),
+        rows.len(),
+        if f > 0 { "FAIL" } else { "muted" },
+        failed_list(&rows),
+    );
+    for o in &rows {
+        let has_plots = !case_plots(dir, &o.id).is_empty();
+        let id = if has_plots {
+            format!("<a href=\"#{}\">{}</a>", row_anchor(&o.id), esc(&o.id))
+        } else {
+            esc(&o.id)
+        };
+        let _ = writeln!(
+            b,
+            "<tr class=\"main{failed}\" id=\"{line}\"><td class=\"{s}\">{s}</td>\
+             <td class=\"id\">{id}</td>\
+             <td>{backend}</td><td>{q}</td><td class=\"num\">{v}</td>\
+             <td class=\"ref\">{r}<br><span class=\"muted\">{rl}</span></td>\
+             <td class=\"num\">{e}</td><td class=\"num\">{t:.1e} {norm}</td>\
+             <td class=\"num\">{w:.3}</td></tr>\n<tr class=\"whyrow{failed}\"><td></td>\
+             <td colspan=\"8\"><b>{check}</b>: {why}{msg}</td></tr>",
+            s = status_name(o.status),
+            failed = if o.status == Status::Pass {
+                ""
             } else {
-                esc(&o.id)
-            };
-            let _ = writeln!(
-                b,
-                "<tr class=\"main{failed}\" id=\"{line}\"><td class=\"{s}\">{s}</td>\
-                 <td class=\"id\">{id}</td>\
-                 <td>{backend}</td><td>{q}</td><td class=\"num\">{v}</td>\
-                 <td class=\"ref\">{r}<br><span class=\"muted\">{rl}</span></td>\
-                 <td class=\"num\">{e}</td><td class=\"num\">{t:.1e} {norm}</td>\
-                 <td class=\"num\">{w:.3}</td></tr>\n<tr class=\"whyrow{failed}\"><td></td>\
-                 <td colspan=\"8\"><b>{check}</b>: {why}{msg}</td></tr>",
-                s = status_name(o.status),
-                failed = if o.status == Status::Pass {
-                    ""
-                } else {
-                    " failed"
-                },
-                line = line_anchor(&o.id),
-                check = esc(&o.check),
-                backend = backend_cell(&o.backend),
-                q = esc(&o.quantity),
-                v = num(o.value),
-                r = num(o.reference),
-                rl = esc(&o.reference_label),
-                e = o.error.map_or("-".into(), |e| format!("{e:.2e}")),
-                t = o.tolerance,
-                norm = match o.norm {
-                    data::cases::Norm::Relative => "rel.",
-                    data::cases::Norm::Absolute => "abs.",
-                    data::cases::Norm::RelativeToPeak => "rel. to peak",
-                },
-                w = o.wall_time_s,
-                why = esc(&o.why),
-                msg = if o.status == Status::Pass {
-                    String::new()
-                } else {
-                    format!("<br><span class=\"FAIL\">{}</span>", esc(&o.message))
-                },
-            );
-        }
-        b.push_str("</table>\n<h2 id=\"plots\">Plots</h2>\n");
-        let mut any = false;
-        for o in &rows {
-            let plots = case_plots(dir, &o.id);
-            if plots.is_empty() {
-                continue;
-            }
-            any = true;
-            let _ = writeln!(
-                b,
-                "<h3 id=\"{}\">{} <span class=\"{s}\">{s}</span></h3>\n<p class=\"small\">{}</p>",
-                row_anchor(&o.id),
-                esc(&o.id),
-                esc(&o.why),
-                s = status_name(o.status)
-            );
-            for plot in &plots {
-                b.push_str(&figure(plot));
-            }
-            if let Some(w) = works.iter().find(|w| w.case == o.id) {
-                b.push_str(&work_table(w));
-            }
-        }
-        if !any {
-            b.push_str(
-                "<p>No row of this scene has plots (only history, ledger and ladder \
-                        rows draw).</p>\n",
-            );
-        }
-        b.push_str("<h2 id=\"fronts\">Work–precision across backends and methods</h2>\n");
-        let mine: Vec<&Front<'_>> = fronts.iter().filter(|f| f.scene == *sc).collect();
-        if mine.is_empty() {
-            b.push_str("<p>No ladder case of this scene ran.</p>\n");
-        }
-        for f in mine {
-            b.push_str(&front_section(f));
-        }
-        let prefix = format!("converge-{sc}-");
-        let own_ladders: Vec<&String> = ladders.iter().filter(|l| l.starts_with(&prefix)).collect();
-        if !own_ladders.is_empty() {
-            b.push_str("<h2 id=\"ladders\">Refinement ladders (full suite)</h2>\n");
-            for l in own_ladders {
-                b.push_str(&figure(&format!("ladders/{l}")));
-            }
-        }
-        write_atomic(
-            dir,
-            &scene_page(sc),
-            page(&format!("{sc} — flexverify"), &b).as_bytes(),
-        )?;
+                " failed"
+            },
+            line = line_anchor(&o.id),
+            check = esc(&o.check),
+            backend = backend_cell(&o.backend),
+            q = esc(&o.quantity),
+            v = num(o.value),
+            r = num(o.reference),
+            rl = esc(&o.reference_label),
+            e = o.error.map_or("-".into(), |e| format!("{e:.2e}")),
+            t = o.tolerance,
+            norm = match o.norm {
+                data::cases::Norm::Relative => "rel.",
+                data::cases::Norm::Absolute => "abs.",
+                data::cases::Norm::RelativeToPeak => "rel. to peak",
+            },
+            w = o.wall_time_s,
+            why = esc(&o.why),
+            msg = if o.status == Status::Pass {
+                String::new()
+            } else {
+                format!("<br><span class=\"FAIL\">{}</span>", esc(&o.message))
+            },
+        );
     }
-    Ok(notes)
+    b.push_str("</table>\n<h2 id=\"plots\">Plots</h2>\n");
+    let mut any = false;
+    for o in &rows {
+        let plots = case_plots(dir, &o.id);
+        if plots.is_empty() {
+            continue;
+        }
+        any = true;
+        let _ = writeln!(
+            b,
+            "<h3 id=\"{}\">{} <span class=\"{s}\">{s}</span></h3>\n<p class=\"small\">{}</p>",
+            row_anchor(&o.id),
+            esc(&o.id),
+            esc(&o.why),
+            s = status_name(o.status)
+        );
+        for plot in &plots {
+            b.push_str(&figure(plot));
+        }
+        if let Some(w) = works.iter().find(|w| w.case == o.id) {
+            b.push_str(&work_table(w));
+        }
+    }
+    if !any {
+        b.push_str(
+            "<p>No row of this scene has plots (only history, ledger and ladder \
+                    rows draw).</p>\n",
+        );
+    }
+    b.push_str("<h2 id=\"fronts\">Work–precision across backends and methods</h2>\n");
+    let mine: Vec<&Front<'_>> = fronts.iter().filter(|f| f.scene == sc).collect();
+    if mine.is_empty() {
+        b.push_str("<p>No ladder case of this scene ran.</p>\n");
+    }
+    for f in mine {
+        b.push_str(&front_section(f));
+    }
+    let prefix = format!("converge-{sc}-");
+    let own_ladders: Vec<&String> = ladders.iter().filter(|l| l.starts_with(&prefix)).collect();
+    if !own_ladders.is_empty() {
+        b.push_str("<h2 id=\"ladders\">Refinement ladders (full suite)</h2>\n");
+        for l in own_ladders {
+            b.push_str(&figure(&format!("ladders/{l}")));
+        }
+    }
+    b
 }
