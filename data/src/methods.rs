@@ -1,4 +1,4 @@
-//! The time-integration methods, declared once: each row of [`method_table!`]'s one invocation
+//! The time-integration methods, declared once: each row of `method_table!`'s one invocation
 //! gives a method's [`Method`] variant (with its payload and documentation), its canonical
 //! spelling and aliases ([`SPELLINGS`]) and the backends that implement it, from which the
 //! backends' own method enums ([`FemMethod`], [`FdmMethod`], [`ModalMethod`]) and the
@@ -50,7 +50,7 @@ macro_rules! backend_methods {
 
 /// The method table: `Variant [{ field: Type = spelled_default }] => "spelling" [aliases] for
 /// backends;` per method. Generates [`Method`], [`SPELLINGS`] and, by sorting the rows into
-/// per-backend lists (`@split`), the three backend enums through [`backend_methods!`].
+/// per-backend lists (`@split`), the three backend enums through `backend_methods!`.
 macro_rules! method_table {
     ($(
         $(#[$doc:meta])*

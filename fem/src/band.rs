@@ -487,7 +487,7 @@ pub struct DenseLu {
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
     /// Row interchanges equivalent to the pivoting permutation: applying
-    /// swap(k, swaps[k]) for k = 0, 1, … moves row perm[k] of the right-hand side to k.
+    /// swap(k, `swaps[k]`) for k = 0, 1, … moves row `perm[k]` of the right-hand side to k.
     swaps: Vec<usize>,
     row_at: Vec<usize>,
     /// Workspace of `lu_in_place` (allocated once).

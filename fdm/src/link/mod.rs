@@ -78,7 +78,7 @@ pub struct FloatingLink {
     /// W_seg for segments 0…r−1
     wseg: Vec<f64>,
     field_stations: usize,
-    /// Gershgorin row sums Σ_j |K_b[k][j]| / m_k of the bending operator (1/time²), per station.
+    /// Gershgorin row sums Σ_j |`K_b[k][j]`| / m_k of the bending operator (1/time²), per station.
     bend_row: Vec<f64>,
     /// Gershgorin row sums Σ_j |∂²Φ/∂v_k∂v_j| / m_k of the foreshortening (geometric) operator
     /// per unit θ̇² (zero without foreshortening): θ̇² ∂²Φ is the centrifugal tension

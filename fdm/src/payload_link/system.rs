@@ -63,7 +63,7 @@ impl BaseLevel {
 #[derive(Debug)]
 pub struct PayloadLinkSystem {
     model: PayloadLinkModel,
-    /// index of the first field coordinate in q: 1 with a free base (q[0] = θ), else 0
+    /// index of the first field coordinate in q: 1 with a free base (`q[0]` = θ), else 0
     off: usize,
     /// the binding field bound (kind [`BoundKind::LinkField`], site = station)
     bound: Bound,

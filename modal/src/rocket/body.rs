@@ -82,12 +82,12 @@ pub struct Body {
     /// None when no stage burns: no thrust, no chamber pressure, no internal flow.
     pub burn: Option<Burn>,
     pub gravity: f64,
-    /// Launch angle θ₀ [rad] of the body axis from the horizontal.
+    /// Launch angle θ₀ (rad) of the body axis from the horizontal.
     pub launch_angle: f64,
     pub exhaust_velocity: f64,
     /// Chamber pressure force p·A_f (acts while the stage burns).
     pub pressure_force: f64,
-    /// Nozzle angle γ [rad] of the thrust from the body axis.
+    /// Nozzle angle γ (rad) of the thrust from the body axis.
     pub nozzle_angle: f64,
     pub masses: Vec<PointMass>,
     pub couplings: Vec<Coupling>,

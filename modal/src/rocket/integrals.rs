@@ -4,7 +4,7 @@
 //!
 //! The case mass per length is m(x, t) = m₀(x) − s(t)·Δm·χ(x), with χ the indicator of the
 //! burning chamber, Δm the burnable mass per length and s(t) ∈ [0, 1] the burnt fraction; every
-//! mass integral is therefore affine in s: I(t) = I[m₀] − s·Δm·I[χ]. No quadrature runs per step.
+//! mass integral is therefore affine in s: I(t) = `I[m₀] − s·Δm·I[χ]`. No quadrature runs per step.
 
 use super::basis::Basis;
 use crate::basis::quadrature::gauss_legendre_unit;
