@@ -233,19 +233,32 @@ fn conv_ode_sdirk_dense_output_order() {
     assert!(p > 1.7, "dense output order {p}, errors {es:?}");
 }
 
+/// Tolerances of the stiff-relaxation tests.
+const STIFF_TOL: Tolerances = Tolerances {
+    rtol: 1e-6,
+    atol: 1e-8,
+};
+
+/// [`StiffRelax`] at λ = 1e6 with adaptive TR-BDF2 at [`STIFF_TOL`].
+fn stiff_relaxation() -> (StiffRelax, Sdirk) {
+    (
+        StiffRelax { lambda: 1e6 },
+        Sdirk::new(1, STIFF_TOL, None, None),
+    )
+}
+
+/// Steps `s` on `f` from (t, y) until t reaches `stop`.
+fn advance(s: &mut Sdirk, f: &mut impl OdeRhs, t: &mut f64, y: &mut [f64], stop: f64) {
+    while *t < stop {
+        s.step(f, t, y, stop).unwrap();
+    }
+}
+
 #[test]
 fn ode_sdirk_is_not_limited_by_stiffness() {
-    let lambda = 1e6;
-    let tol = Tolerances {
-        rtol: 1e-6,
-        atol: 1e-8,
-    };
-    let mut f = StiffRelax { lambda };
-    let mut s = Sdirk::new(1, tol, None, None);
+    let (mut f, mut s) = stiff_relaxation();
     let (mut t, mut y) = (0.0, [1.0]);
-    while t < 5.0 {
-        s.step(&mut f, &mut t, &mut y, 5.0).unwrap();
-    }
+    advance(&mut s, &mut f, &mut t, &mut y, 5.0);
     // Explicit stability would need h < 3.3/λ, i.e. > 1.5e6 steps; an L-stable method follows
     // the smooth solution cos t with steps set by accuracy only.
     assert!(s.stats().steps < 2000, "steps {}", s.stats().steps);
@@ -254,7 +267,7 @@ fn ode_sdirk_is_not_limited_by_stiffness() {
 
     // The same problem with Dopri5 is stability-limited.
     let mut g = StiffRelax { lambda: 1e4 };
-    let mut e = Dopri5::new(1, tol, None, None);
+    let mut e = Dopri5::new(1, STIFF_TOL, None, None);
     let (mut t, mut y) = (0.0, [1.0]);
     while t < 1.0 {
         e.step(&mut g, &mut t, &mut y, 1.0).unwrap();
@@ -470,20 +483,11 @@ fn ode_sdirk_stiff_transient_after_a_kick_does_not_cascade_rejections() {
     // h(I − hdJ)⁻¹E·f would still see the transient's whole amplitude at any such step (it
     // tends to E·δ/d) and reject down to h ~ 1/λ. The re-estimate of a failed test falls
     // like 1/(hdλ) instead (module docs), so a kick costs a few rejections, not a cascade.
-    let lambda = 1e6;
-    let tol = Tolerances {
-        rtol: 1e-6,
-        atol: 1e-8,
-    };
-    let mut f = StiffRelax { lambda };
-    let mut s = Sdirk::new(1, tol, None, None);
+    let (mut f, mut s) = stiff_relaxation();
     let (mut t, mut y) = (0.0, [1.0]);
     let kicks = 10;
     for kick in 1..=kicks {
-        let stop = 0.5 * kick as f64;
-        while t < stop {
-            s.step(&mut f, &mut t, &mut y, stop).unwrap();
-        }
+        advance(&mut s, &mut f, &mut t, &mut y, 0.5 * kick as f64);
         y[0] += 1e-2;
         s.state_changed();
     }
@@ -491,10 +495,7 @@ fn ode_sdirk_stiff_transient_after_a_kick_does_not_cascade_rejections() {
     println!("{st:?}");
     // After the last kick the transient is gone well before the next 0.5 s: one more stretch
     // shows the solution back on cos t.
-    while t < 0.5 * (kicks + 1) as f64 {
-        s.step(&mut f, &mut t, &mut y, 0.5 * (kicks + 1) as f64)
-            .unwrap();
-    }
+    advance(&mut s, &mut f, &mut t, &mut y, 0.5 * (kicks + 1) as f64);
     assert!((y[0] - t.cos()).abs() < 1e-5, "y({t}) = {}", y[0]);
     assert!(st.rejected <= 6 * kicks, "{st:?}");
 }

@@ -162,10 +162,9 @@ impl Driver {
         self.stop = t_stop;
     }
 
-    /// Consistent q̈ at the current state ([`start::consistent_acceleration`]) and the joint
-    /// quantities of the next step's start.
-    pub(super) fn initial_acceleration(&mut self, t_law: f64) -> Result<(), FemError> {
-        let mut cx = StepContext {
+    /// The stepper and what it works on during a step (disjoint borrows of the driver).
+    fn method_parts(&mut self) -> (&mut dyn Stepper<Chain>, StepContext<'_, Chain>) {
+        let cx = StepContext {
             system: &mut self.chain,
             state: &mut self.state,
             newton: &mut self.newton,
@@ -174,7 +173,15 @@ impl Driver {
             h_nominal: self.h_nominal,
             length_scale: self.length_scale,
         };
-        start::consistent_acceleration(&mut cx, self.h, t_law)?;
+        (self.stepper.as_mut(), cx)
+    }
+
+    /// Consistent q̈ at the current state ([`start::consistent_acceleration`]) and the joint
+    /// quantities of the next step's start.
+    pub(super) fn initial_acceleration(&mut self, t_law: f64) -> Result<(), FemError> {
+        let h = self.h;
+        let (_, mut cx) = self.method_parts();
+        start::consistent_acceleration(&mut cx, h, t_law)?;
         self.record_step_start(t_law);
         Ok(())
     }
@@ -188,16 +195,8 @@ impl Driver {
             .as_deref_mut()
             .filter(|c| c.phase.constrained)
             .map(|c| c as &mut dyn crate::method::StepConstraint<Chain>);
-        let mut cx = StepContext {
-            system: &mut self.chain,
-            state: &mut self.state,
-            newton: &mut self.newton,
-            counters: &mut self.counters,
-            adaptive: self.adaptive,
-            h_nominal: self.h_nominal,
-            length_scale: self.length_scale,
-        };
-        let result = self.stepper.step(&mut cx, held, h, t1, t_law);
+        let (stepper, mut cx) = self.method_parts();
+        let result = stepper.step(&mut cx, held, h, t1, t_law);
         self.contact = contact;
         match result {
             Ok(Some(e)) if e.is_infinite() => Ok(Some(e)),
