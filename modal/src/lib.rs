@@ -64,7 +64,7 @@
 //! Layout of a chain run, each module knowing only those before it: [`basis`] →
 //! [`model`] (integrals, bodies, the chain's M, f, energies and tangents) → [`rhs`] (the chain
 //! as y' = f(t, y) with its structured Newton linear algebra, [`newton`]) ; [`integrate`] (one
-//! type per method behind [`integrate::Stepper`], registered in [`integrate::METHODS`]) ;
+//! type per method behind [`integrate::Stepper`], registered in [`integrate::method_for`]) ;
 //! [`contact`] (constraint geometry and state) → [`events`] (event functions, location on the
 //! dense output, resets, projection) ; [`output`] (samples, ledger, stop diagnostics) →
 //! [`simulate`] (the driver). Dense kernels: [`linalg`].

@@ -1,5 +1,5 @@
 //! The driver of a chain run: builds the model ([`ChainRhs`]) and the registered integration
-//! method ([`crate::integrate::METHODS`]), then steps to each forcing discontinuity and to
+//! method ([`crate::integrate::method_for`]), then steps to each forcing discontinuity and to
 //! t_end; after every accepted step it hands the step to the contact events
 //! ([`crate::events`]: locate on the dense output, reset, project), takes the samples due
 //! ([`crate::output`]) and checks for runaway growth; it maps the run to a [`RunResult`].
@@ -41,7 +41,7 @@ pub const KELVIN_VOIGT_DEFAULT_TOL: (f64, f64) = (1e-6, 1e-8);
 /// Dormand–Prince at rtol 1e-8 (docs/backends.md).
 pub const KELVIN_VOIGT_CONTACT_TOL: (f64, f64) = (3e-7, 3e-9);
 
-/// An integration method of the registry ([`crate::integrate::METHODS`]).
+/// An integration method of the registry ([`crate::integrate::method_for`]).
 pub type Method = &'static MethodInfo;
 
 /// The method of a run: the one named in the settings, else the default ([`default_method`]).

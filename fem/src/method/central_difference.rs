@@ -7,12 +7,20 @@
 
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
-use crate::method::{StepConstraint, StepContext, StepState, Stepper, refuse_constraint};
+use crate::method::{
+    MethodParams, StepConstraint, StepContext, StepState, Stepper, refuse_constraint,
+};
 use crate::system::{NewtonCoefficients, System};
 
 /// Central difference (no state of its own).
 #[derive(Debug, Clone, Copy)]
 pub struct CentralDifference;
+
+impl From<MethodParams> for CentralDifference {
+    fn from(_: MethodParams) -> Self {
+        CentralDifference
+    }
+}
 
 impl<S: System + ?Sized> Stepper<S> for CentralDifference {
     fn step(

@@ -45,7 +45,8 @@
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
-    ConstraintView, HeldConstraint, StepConstraint, StepContext, Stepper, Works, start,
+    ConstraintView, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, Works,
+    start,
     unconverged, update_tolerance,
 };
 use crate::system::{NewtonCoefficients, System};
@@ -94,6 +95,12 @@ pub struct GeneralizedAlpha {
     force_start: Vec<f64>,
     /// The end force of the step being solved; the start force of the next once accepted.
     force_end: Vec<f64>,
+}
+
+impl From<MethodParams> for GeneralizedAlpha {
+    fn from(p: MethodParams) -> Self {
+        GeneralizedAlpha::new(p.rho_inf, p.n)
+    }
 }
 
 impl GeneralizedAlpha {

@@ -37,7 +37,8 @@
 use crate::error::FemError;
 use crate::linalg::max_abs;
 use crate::method::{
-    HeldConstraint, StepConstraint, StepContext, Stepper, unconverged, update_tolerance,
+    HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, unconverged,
+    update_tolerance,
 };
 use crate::system::{NewtonCoefficients, System};
 
@@ -51,6 +52,12 @@ pub struct ImplicitMidpoint {
     /// Step end q₁ = 2q̄ − q₀ of the iterate (q̄ lives in the state's trial-end slot).
     q_end: Vec<f64>,
     held: HeldConstraint,
+}
+
+impl From<MethodParams> for ImplicitMidpoint {
+    fn from(p: MethodParams) -> Self {
+        ImplicitMidpoint::new(p.n)
+    }
 }
 
 impl ImplicitMidpoint {

@@ -29,15 +29,11 @@
 //! counters a method carries (module `state`: [`StepState`], [`Counters`], [`Works`]). This
 //! file holds only the registry, so the methods depend on `step` and `state`, never on it.
 //!
-//! Adding a method: one new file here implementing [`Stepper`] (and its `pub mod` line), one
-//! `match` line in [`stepper`]; in `data`, one row of the method table (`data/src/methods.rs`:
-//! its [`data::Method`] variant, spellings and backends, from which [`data::FemMethod`]
-//! follows).
+//! Adding a method: one new file here implementing [`Stepper`] and `From<`[`MethodParams`]`>`,
+//! and its line in the registry at the end of this file (which declares the module and maps the
+//! settings' method to it); in `data`, one row of the method table (`data/src/methods.rs`: its
+//! [`data::Method`] variant, spellings and backends, from which [`data::FemMethod`] follows).
 
-pub mod central_difference;
-pub mod energy_midpoint;
-pub mod generalized_alpha;
-pub mod implicit_midpoint;
 pub mod newton;
 pub mod start;
 mod state;
@@ -51,13 +47,38 @@ pub(crate) use step::{HeldConstraint, refuse_constraint, unconverged, update_tol
 use crate::settings::Method;
 use crate::system::System;
 
-/// The stepper of a method for a system of `n` DOFs (`rho_inf`: generalized-α spectral
-/// radius).
-pub fn stepper<S: System + ?Sized>(method: Method, n: usize, rho_inf: f64) -> Box<dyn Stepper<S>> {
-    match method {
-        Method::GeneralizedAlpha => Box::new(generalized_alpha::GeneralizedAlpha::new(rho_inf, n)),
-        Method::CentralDifference => Box::new(central_difference::CentralDifference),
-        Method::EnergyMidpoint => Box::new(energy_midpoint::EnergyMidpoint::new(n)),
-        Method::ImplicitMidpoint => Box::new(implicit_midpoint::ImplicitMidpoint::new(n)),
-    }
+/// What a method is built from: the system's number of DOFs and the settings' generalized-α
+/// spectral radius (the methods that need neither ignore them).
+#[derive(Debug, Clone, Copy)]
+pub struct MethodParams {
+    pub n: usize,
+    pub rho_inf: f64,
+}
+
+/// The registry: one line per method, `Variant => module::Type`, declaring the method's module
+/// and building its `Type` (from [`MethodParams`]) for the settings' `Method::Variant`.
+macro_rules! registry {
+    ($($variant:ident => $module:ident :: $method:ident,)*) => {
+        $(pub mod $module;)*
+
+        /// The stepper of a method for a system of `n` DOFs (`rho_inf`: generalized-α spectral
+        /// radius).
+        pub fn stepper<S: System + ?Sized>(
+            method: Method,
+            n: usize,
+            rho_inf: f64,
+        ) -> Box<dyn Stepper<S>> {
+            let params = MethodParams { n, rho_inf };
+            match method {
+                $(Method::$variant => Box::new($module::$method::from(params)),)*
+            }
+        }
+    };
+}
+
+registry! {
+    GeneralizedAlpha => generalized_alpha::GeneralizedAlpha,
+    CentralDifference => central_difference::CentralDifference,
+    EnergyMidpoint => energy_midpoint::EnergyMidpoint,
+    ImplicitMidpoint => implicit_midpoint::ImplicitMidpoint,
 }

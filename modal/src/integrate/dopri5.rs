@@ -53,7 +53,7 @@ const SAFETY: f64 = 0.9;
 const FAC_MIN: f64 = 0.2; // largest decrease per step
 const FAC_MAX: f64 = 10.0; // largest increase per step
 
-/// Registry entry ([`super::METHODS`]).
+/// Registry entry ([`super::method_for`]).
 pub const DOPRI5: MethodInfo = MethodInfo {
     method: data::ModalMethod::Dopri5,
     name: "dopri5",

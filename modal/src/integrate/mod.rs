@@ -14,12 +14,12 @@
 //! Both keep all work arrays in the struct: a step performs no heap allocation.
 //!
 //! Every method implements [`Stepper`] (one accepted step, dense output over it, work
-//! counters, restart after a discontinuity) and is registered in [`METHODS`] under its name,
-//! and [`method_for`] maps the settings' [`data::ModalMethod`] to its entry: a driver holds a
-//! `Box<dyn Stepper>` built from the registry entry and never names a method. Adding a method
-//! is one new file (the method type, its `Stepper` impl and its [`MethodInfo`]) plus its
-//! row in `data`'s method table (from which [`data::ModalMethod`] follows) and its lines in
-//! [`METHODS`] and [`method_for`].
+//! counters, restart after a discontinuity) and has a [`MethodInfo`] (its name and how it is
+//! built); the registry [`method_for`] maps the settings' [`data::ModalMethod`] to it: a driver
+//! holds a `Box<dyn Stepper>` built from the registry entry and never names a method. Adding a
+//! method is one new file (the method type, its `Stepper` impl and its [`MethodInfo`]) with its
+//! `mod` line, its line in [`method_for`], and its row in `data`'s method table (from which
+//! [`data::ModalMethod`] follows).
 
 mod dopri5;
 mod sdirk;
@@ -101,10 +101,7 @@ impl std::fmt::Debug for MethodInfo {
     }
 }
 
-/// Every integration method of the crate, the first one being the default.
-pub const METHODS: &[&MethodInfo] = &[&DOPRI5, &TRBDF2, &TRBDF2_FIXED, &TRAPEZOID];
-
-/// The registered implementation of `method`.
+/// The registry: the implementation of each method of the settings.
 pub fn method_for(method: data::ModalMethod) -> &'static MethodInfo {
     match method {
         data::ModalMethod::Dopri5 => &DOPRI5,

@@ -127,7 +127,7 @@ impl IterationMatrix {
     }
 }
 
-/// Registry entries ([`super::METHODS`]): adaptive TR-BDF2, fixed-step TR-BDF2 and the
+/// Registry entries ([`super::method_for`]): adaptive TR-BDF2, fixed-step TR-BDF2 and the
 /// fixed-step trapezoidal rule.
 pub const TRBDF2: MethodInfo = MethodInfo {
     method: data::ModalMethod::TrBdf2,

@@ -100,7 +100,7 @@ mod work;
 pub use gradients::{FD_STEP, kinetic_gradient, kinetic_gradient_fd, mass_product};
 pub use work::MidpointWork;
 
-use crate::method::{StepConstraint, StepContext, Stepper, Works, unconverged};
+use crate::method::{MethodParams, StepConstraint, StepContext, Stepper, Works, unconverged};
 use crate::system::System;
 use iteration::{Iteration, MAX_ITERATIONS, Verdict};
 use work::{MOMENTUM_PASSES, form_matrix, solve_update};
@@ -109,6 +109,12 @@ use work::{MOMENTUM_PASSES, form_matrix, solve_update};
 #[derive(Debug, Clone)]
 pub struct EnergyMidpoint {
     pub work: MidpointWork,
+}
+
+impl From<MethodParams> for EnergyMidpoint {
+    fn from(p: MethodParams) -> Self {
+        EnergyMidpoint::new(p.n)
+    }
 }
 
 impl EnergyMidpoint {
