@@ -116,30 +116,47 @@ pub struct Discretization {
     pub element: Option<FemElement>,
 }
 
-/// Euler–Bernoulli beam element of the FEM backend. Both keep the nodal DOFs (v, v′), so tip
-/// bodies, loads and supports attach the same way.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum FemElement {
-    /// Hermite cubic: frequency error O(h⁴).
-    #[default]
-    HermiteCubic,
-    /// Hermite cubic plus two interior C¹ bubbles (complete quintic): frequency error O(h⁸).
-    HermiteQuintic,
+/// The FEM elements a setting can name, declared once: each row `Variant => "spelling",` (with
+/// its doc) gives a [`FemElement`] variant, its spelling (serde, [`FemElement::name`],
+/// [`FemElement::NAMES`]) and its place in [`FemElement::ALL`]; the first row is the default. A
+/// new element is one row here (plus its file and registry line in fem).
+macro_rules! fem_element_table {
+    (
+        $(#[$default_doc:meta])* $default:ident => $default_name:literal,
+        $($(#[$doc:meta])* $variant:ident => $name:literal,)*
+    ) => {
+        /// Euler–Bernoulli beam element of the FEM backend. All keep the nodal DOFs (v, v′), so
+        /// tip bodies, loads and supports attach the same way.
+        #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+        pub enum FemElement {
+            $(#[$default_doc])*
+            #[default]
+            #[serde(rename = $default_name)]
+            $default,
+            $($(#[$doc])* #[serde(rename = $name)] $variant,)*
+        }
+
+        impl FemElement {
+            /// Every element, in the order messages and the command line list them.
+            pub const ALL: &'static [FemElement] = &[FemElement::$default, $(FemElement::$variant,)*];
+            /// Accepted spellings ([`FemElement::name`] of each of [`FemElement::ALL`]).
+            pub const NAMES: &'static [&'static str] = &[$default_name, $($name,)*];
+
+            pub const fn name(self) -> &'static str {
+                match self {
+                    FemElement::$default => $default_name,
+                    $(FemElement::$variant => $name,)*
+                }
+            }
+        }
+    };
 }
 
-impl FemElement {
-    /// Every element, in the order messages and the command line list them.
-    pub const ALL: [FemElement; 2] = [FemElement::HermiteCubic, FemElement::HermiteQuintic];
-    /// Accepted spellings ([`FemElement::name`] of each of [`FemElement::ALL`]).
-    pub const NAMES: [&'static str; 2] = [Self::ALL[0].name(), Self::ALL[1].name()];
-
-    pub const fn name(self) -> &'static str {
-        match self {
-            FemElement::HermiteCubic => "hermite-cubic",
-            FemElement::HermiteQuintic => "hermite-quintic",
-        }
-    }
+fem_element_table! {
+    /// Hermite cubic: frequency error O(h⁴).
+    HermiteCubic => "hermite-cubic",
+    /// Hermite cubic plus two interior C¹ bubbles (complete quintic): frequency error O(h⁸).
+    HermiteQuintic => "hermite-quintic",
 }
 
 impl std::str::FromStr for FemElement {
@@ -148,7 +165,8 @@ impl std::str::FromStr for FemElement {
     fn from_str(text: &str) -> Result<Self, String> {
         let name = text.trim();
         FemElement::ALL
-            .into_iter()
+            .iter()
+            .copied()
             .find(|e| e.name() == name)
             .ok_or_else(|| {
                 format!(

@@ -18,7 +18,8 @@
 //! The elements use only [`contract`] (and the interpolation and quadrature modules); this file
 //! is the registry, which names them.
 //!
-//! A new element is one new file implementing [`Element`] plus one line in [`for_link`].
+//! A new Euler–Bernoulli element is one new file implementing [`Element`], its `pub mod` line and
+//! its line in [`for_link`], with its row in `data`'s element table ([`data::FemElement`]).
 
 pub mod beam3d;
 pub mod contract;
@@ -50,12 +51,13 @@ pub fn for_link(link: &Link, choice: Option<FemElement>) -> Result<&'static dyn 
         (false, FemElement::HermiteCubic) => Ok(&euler_bernoulli::HermiteCubic),
         (false, FemElement::HermiteQuintic) => Ok(&quintic::HermiteQuintic),
         (true, FemElement::HermiteCubic) => Ok(&timoshenko::Timoshenko),
-        (true, FemElement::HermiteQuintic) => Err(FemError::InvalidSettings {
+        (true, other) => Err(FemError::InvalidSettings {
             field: "discretization.element".into(),
-            message: "`hermite-quintic` is an Euler–Bernoulli element; a `shear` link uses \
-                      the Timoshenko (cubic v, quadratic θ) element: omit the field or use \
-                      `hermite-cubic`"
-                .into(),
+            message: format!(
+                "`{}` is an Euler–Bernoulli element; a `shear` link uses the Timoshenko \
+                 (cubic v, quadratic θ) element: omit the field or use `hermite-cubic`",
+                other.name()
+            ),
         }),
     }
 }
