@@ -13,7 +13,7 @@ use crate::chain::{Chain, NONE, V2};
 use crate::driver::{Driver, Rejection, StopReason};
 use crate::error::FemError;
 use crate::events::contact::Contact;
-use crate::method::Adaptive;
+use crate::method::{Adaptive, capabilities, names_with};
 use crate::settings::{self, Method};
 
 /// Safety factor below the central-difference bound when the backend picks the step.
@@ -168,10 +168,19 @@ fn undamped_massless_hub(l: &Link) -> bool {
 /// The energy-midpoint scheme needs every joint free: a prescribed joint would need the work
 /// of its actuator booked with the scheme's quadrature, which is not implemented.
 fn check_midpoint(links: &[Link]) -> Result<(), FemError> {
+    check_prescribed_joints(Method::EnergyMidpoint, links)
+}
+
+/// Refuses prescribed joint motion to a method that cannot step it.
+fn check_prescribed_joints(method: Method, links: &[Link]) -> Result<(), FemError> {
+    if capabilities(method).prescribed_joints {
+        return Ok(());
+    }
     if let Some(i) = links.iter().position(|l| l.joint.prescribed.is_some()) {
         return Err(FemError::unsupported(format!(
-            "fem energy-midpoint: prescribed joint motion (link {}); use generalized-alpha",
-            i + 1
+            "fem {method}: prescribed joint motion (link {}); use {}",
+            i + 1,
+            names_with("or", |c| c.prescribed_joints)
         )));
     }
     Ok(())
@@ -195,9 +204,8 @@ pub fn prepare(
 ) -> Result<Prepared, FemError> {
     let mut chain = Chain::from_planar_chain(&scene.name, pc, settings)?;
     let method = settings.method.unwrap_or_else(|| default_method(pc));
-    if method == Method::EnergyMidpoint {
-        check_midpoint(&pc.links)?;
-    }
+    let caps = capabilities(method);
+    check_prescribed_joints(method, &pc.links)?;
     let dt_user = settings::positive("time.dt", settings.dt)?;
     let rtol = settings::positive("time.rtol", settings.rtol)?;
     let atol = settings::positive("time.atol", settings.atol)?;
@@ -209,22 +217,24 @@ pub fn prepare(
             message: format!("must lie in (0, 1], got {safety}"),
         });
     }
-    if method == Method::CentralDifference
+    if caps.explicit
         && let Some(i) = pc.links.iter().position(|l| l.shear && !l.rotary_inertia)
     {
         return Err(FemError::unsupported(format!(
-            "fem central-difference: link {} is a Timoshenko link without `rotary_inertia`: \
-             its section rotations carry no mass (M is singular), which an explicit scheme \
-             cannot step; use generalized-alpha or energy-midpoint",
-            i + 1
+            "fem {method}: link {} is a Timoshenko link without `rotary_inertia`: its section \
+             rotations carry no mass (M is singular), which an explicit scheme cannot step; use \
+             {}",
+            i + 1,
+            names_with("or", |c| !c.explicit)
         )));
     }
-    if rtol.is_some() && method == Method::CentralDifference {
+    if rtol.is_some() && !caps.adaptive {
         return Err(FemError::InvalidSettings {
             field: "time.rtol".into(),
-            message: "adaptive stepping is available with generalized-alpha and energy-midpoint \
-                      only"
-                .into(),
+            message: format!(
+                "adaptive stepping is available with {} only",
+                names_with("and", |c| c.adaptive)
+            ),
         });
     }
     if let Some(st) = &pc.statics {
@@ -255,16 +265,17 @@ pub fn prepare(
     }
     let contact = Contact::from_planar_chain(&scene.name, pc, &chain)?;
     if contact.is_some() {
-        if method == Method::CentralDifference {
+        if !caps.held_constraint {
             return Err(FemError::unsupported(format!(
-                "fem: contact is implemented for `energy-midpoint`, `implicit-midpoint` and \
-                 `generalized-alpha` (scene `{}`; method {:?})",
-                scene.name, method
+                "fem: contact is implemented for {} (scene `{}`; method `{method}`)",
+                names_with("and", |c| c.held_constraint),
+                scene.name
             )));
         }
-        if matches!(method, Method::ImplicitMidpoint | Method::GeneralizedAlpha)
+        if !caps.projects_massless
             && let Some(i) = pc.links.iter().position(|l| l.shear && !l.rotary_inertia)
         {
+            let projecting = names_with("or", |c| c.projects_massless);
             // With the massless rotations projected as for energy-midpoint (the removed strain
             // energy booked), these methods have no consistent quadrature of the Kelvin–Voigt
             // work on ψ′ (neither the projected end rates nor Δq/h close the ledger); without
@@ -272,10 +283,10 @@ pub fn prepare(
             return Err(FemError::unsupported(format!(
                 "fem {}: contact on link {} (a Timoshenko link without `rotary_inertia`) is not \
                  implemented: the method leaves the end rates of its massless section rotations \
-                 undetermined, which only energy-midpoint projects and books consistently; use \
-                 energy-midpoint",
+                 undetermined, which only {projecting} projects and books consistently; use \
+                 {projecting}",
                 method,
-                i + 1
+                i + 1,
             )));
         }
         if rtol.is_some() {
@@ -305,7 +316,7 @@ pub fn prepare(
     }
     // Explicit central difference: the step under its stability bound; the implicit methods:
     // the user step or the default rule, adaptive with `rtol`.
-    let h_nominal = if method == Method::CentralDifference {
+    let h_nominal = if caps.explicit {
         let (w, dof) = integ.max_frequency()?;
         let bound = 2.0 / w;
         let location = integ.chain.describe_dof(dof);

@@ -138,7 +138,7 @@ impl Driver {
     /// the step loop).
     pub fn enable_unilateral_contact(&mut self) -> Result<(), FemError> {
         self.newton.unilateral_contact = true;
-        if self.method != Method::EnergyMidpoint {
+        if !crate::method::capabilities(self.method).projects_massless {
             return Ok(());
         }
         let Some(ml) = self

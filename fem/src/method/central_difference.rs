@@ -8,13 +8,24 @@
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
-    MethodParams, StepConstraint, StepContext, StepState, Stepper, refuse_constraint,
+    Capabilities, MethodParams, StepConstraint, StepContext, StepState, Stepper, refuse_constraint,
 };
 use crate::system::{NewtonCoefficients, System};
 
 /// Central difference (no state of its own).
 #[derive(Debug, Clone, Copy)]
 pub struct CentralDifference;
+
+impl CentralDifference {
+    /// Registry entry: what the method supports.
+    pub const CAPABILITIES: Capabilities = Capabilities {
+        explicit: true,
+        adaptive: false,
+        prescribed_joints: true,
+        held_constraint: false,
+        projects_massless: false,
+    };
+}
 
 impl From<MethodParams> for CentralDifference {
     fn from(_: MethodParams) -> Self {

@@ -45,7 +45,7 @@
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
-    ConstraintView, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, Works,
+    Capabilities, ConstraintView, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, Works,
     start,
     unconverged, update_tolerance,
 };
@@ -104,6 +104,15 @@ impl From<MethodParams> for GeneralizedAlpha {
 }
 
 impl GeneralizedAlpha {
+    /// Registry entry: what the method supports.
+    pub const CAPABILITIES: Capabilities = Capabilities {
+        explicit: false,
+        adaptive: true,
+        prescribed_joints: true,
+        held_constraint: true,
+        projects_massless: false,
+    };
+
     /// The method with spectral radius `rho_inf` for `n` DOFs.
     pub fn new(rho_inf: f64, n: usize) -> Self {
         GeneralizedAlpha {

@@ -37,7 +37,7 @@
 use crate::error::FemError;
 use crate::linalg::max_abs;
 use crate::method::{
-    HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, unconverged,
+    Capabilities, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, unconverged,
     update_tolerance,
 };
 use crate::system::{NewtonCoefficients, System};
@@ -61,6 +61,15 @@ impl From<MethodParams> for ImplicitMidpoint {
 }
 
 impl ImplicitMidpoint {
+    /// Registry entry: what the method supports.
+    pub const CAPABILITIES: Capabilities = Capabilities {
+        explicit: false,
+        adaptive: true,
+        prescribed_joints: true,
+        held_constraint: true,
+        projects_massless: false,
+    };
+
     /// The method for `n` DOFs.
     pub fn new(n: usize) -> Self {
         ImplicitMidpoint {

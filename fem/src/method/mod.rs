@@ -47,6 +47,24 @@ pub(crate) use step::{HeldConstraint, refuse_constraint, unconverged, update_tol
 use crate::settings::Method;
 use crate::system::System;
 
+/// What a method supports; the run refuses a scene or a setting a method cannot step, naming
+/// the methods that can ([`names_with`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Capabilities {
+    /// Stepped under its stability bound 2/ω_max in equal steps: needs a non-singular M, no
+    /// adaptive steps and no held constraint.
+    pub explicit: bool,
+    /// Has a local error estimate (adaptive steps with `time.rtol`).
+    pub adaptive: bool,
+    /// Steps prescribed joint motion.
+    pub prescribed_joints: bool,
+    /// Accepts a held contact ([`StepConstraint`]).
+    pub held_constraint: bool,
+    /// Projects massless section rotations onto their balance in contact runs, booking the
+    /// removed strain energy (Timoshenko links without rotary inertia).
+    pub projects_massless: bool,
+}
+
 /// What a method is built from: the system's number of DOFs and the settings' generalized-α
 /// spectral radius (the methods that need neither ignore them).
 #[derive(Debug, Clone, Copy)]
@@ -55,8 +73,9 @@ pub struct MethodParams {
     pub rho_inf: f64,
 }
 
-/// The registry: one line per method, `Variant => module::Type`, declaring the method's module
-/// and building its `Type` (from [`MethodParams`]) for the settings' `Method::Variant`.
+/// The registry: one line per method, `Variant => module::Type`, declaring the method's module,
+/// building its `Type` (from [`MethodParams`]) for the settings' `Method::Variant` and reading
+/// its `Type::CAPABILITIES`.
 macro_rules! registry {
     ($($variant:ident => $module:ident :: $method:ident,)*) => {
         $(pub mod $module;)*
@@ -71,6 +90,28 @@ macro_rules! registry {
             let params = MethodParams { n, rho_inf };
             match method {
                 $(Method::$variant => Box::new($module::$method::from(params)),)*
+            }
+        }
+
+        /// What `method` supports.
+        pub fn capabilities(method: Method) -> Capabilities {
+            match method {
+                $(Method::$variant => $module::$method::CAPABILITIES,)*
+            }
+        }
+
+        /// The spellings of the methods with a capability, in registry order, for messages
+        /// (`` `a`, `b` or `c` `` with `conjunction` "or").
+        pub fn names_with(conjunction: &str, has: impl Fn(&Capabilities) -> bool) -> String {
+            let names: Vec<String> = [$(Method::$variant),*]
+                .into_iter()
+                .filter(|&m| has(&capabilities(m)))
+                .map(|m| format!("`{m}`"))
+                .collect();
+            match names.split_last() {
+                Some((last, [])) => last.clone(),
+                Some((last, rest)) => format!("{} {conjunction} {last}", rest.join(", ")),
+                None => String::new(),
             }
         }
     };

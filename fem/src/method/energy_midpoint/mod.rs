@@ -100,7 +100,7 @@ mod work;
 pub use gradients::{FD_STEP, kinetic_gradient, kinetic_gradient_fd, mass_product};
 pub use work::MidpointWork;
 
-use crate::method::{MethodParams, StepConstraint, StepContext, Stepper, Works, unconverged};
+use crate::method::{Capabilities, MethodParams, StepConstraint, StepContext, Stepper, Works, unconverged};
 use crate::system::System;
 use iteration::{Iteration, MAX_ITERATIONS, Verdict};
 use work::{MOMENTUM_PASSES, form_matrix, solve_update};
@@ -118,6 +118,15 @@ impl From<MethodParams> for EnergyMidpoint {
 }
 
 impl EnergyMidpoint {
+    /// Registry entry: what the method supports.
+    pub const CAPABILITIES: Capabilities = Capabilities {
+        explicit: false,
+        adaptive: true,
+        prescribed_joints: false,
+        held_constraint: true,
+        projects_massless: true,
+    };
+
     pub fn new(n: usize) -> Self {
         EnergyMidpoint {
             work: MidpointWork::new(n),
