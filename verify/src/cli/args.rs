@@ -256,10 +256,9 @@ pub struct CommonOpts {
     /// End time (overrides the scene).
     #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
     pub t_end: Option<f64>,
-    /// Integration method (backend-specific; see `flexverify describe`): energy-midpoint,
-    /// generalized-alpha, central-difference, implicit-midpoint (fem); report,
-    /// robert-asselin[=nu], velocity-form (fdm); dopri5, trbdf2, trbdf2-fixed, trapezoid (modal).
-    #[arg(long, value_parser = parse_method)]
+    /// Integration method (backend-specific; the help lists each backend's from the method
+    /// table, `method_help`).
+    #[arg(long, value_parser = parse_method, help = method_help())]
     pub method: Option<data::Method>,
     /// Relative tolerance of adaptive integrators.
     #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
@@ -340,6 +339,18 @@ impl CommonOpts {
             },
         }
     }
+}
+
+/// `--method`'s help: each backend's spellings, from the method table.
+fn method_help() -> String {
+    let lists: Vec<String> = [BackendKind::Fem, BackendKind::Fdm, BackendKind::Modal]
+        .into_iter()
+        .map(|b| format!("{} ({b})", data::Method::names_for(b)))
+        .collect();
+    format!(
+        "Integration method (backend-specific; see `flexverify describe`): {}",
+        lists.join("; ")
+    )
 }
 
 /// `--method`: one of [`data::Method::names`].
