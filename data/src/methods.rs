@@ -122,6 +122,8 @@ method_table! {
     CentralDifference => "central-difference" [] for fem fdm;
     /// fem: implicit midpoint rule (one-stage Gauss).
     ImplicitMidpoint => "implicit-midpoint" [] for fem;
+    /// fem: Bathe's composite method (trapezoidal half step, three-point backward difference).
+    Bathe => "bathe" [] for fem;
     /// fdm: the report's scheme with a Robert–Asselin filter of coefficient ν (None: the
     /// backend's default ν). Spelled `robert-asselin` or `robert-asselin=ν`.
     RobertAsselin { nu: Option<f64> = None } => "robert-asselin" [] for fdm;

@@ -8,7 +8,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use fem::band::BorderedBand;
-use fem::method::{Counters, NewtonSystem, StepContext, StepState, Works, start, stepper};
+use fem::method::{
+    Adaptive, Counters, NewtonSystem, StepContext, StepState, Stepper, Works, start, stepper,
+};
 use fem::settings::Method;
 use fem::system::{NewtonCoefficients, NoAugmentation, Parts, System};
 
@@ -248,29 +250,57 @@ fn run(
     steps: usize,
 ) -> (f64, Vec<(f64, Option<f64>)>) {
     let h = t_end / steps as f64;
+    let start = (Q0, V0);
+    with_context(sys, kind, rho_inf, h, start, None, |cx, method| {
+        errors_and_ledger(cx, method, kind, h, steps)
+    })
+}
+
+/// Sets up what the driver would — state at (q₀, q̇₀) with the consistent acceleration, Newton
+/// system, counters, the `kind` stepper — and hands them to `body`.
+fn with_context<R>(
+    sys: &mut Oscillator,
+    kind: Method,
+    rho_inf: f64,
+    h: f64,
+    (q0, v0): ([f64; 2], [f64; 2]),
+    adaptive: Option<Adaptive>,
+    body: impl FnOnce(&mut StepContext<'_, Oscillator>, &mut dyn Stepper<Oscillator>) -> R,
+) -> R {
     let mut state = StepState::new(2);
-    state.q.copy_from_slice(&Q0);
-    state.qd.copy_from_slice(&V0);
+    state.q.copy_from_slice(&q0);
+    state.qd.copy_from_slice(&v0);
     let mut newton = NewtonSystem::new(&*sys, 1.0);
     let mut counters = Counters::default();
-    let mut works = Works::default();
     let mut method = stepper::<Oscillator>(kind, 2, rho_inf);
     let mut cx = StepContext {
         system: sys,
         state: &mut state,
         newton: &mut newton,
         counters: &mut counters,
-        adaptive: None,
+        adaptive,
         h_nominal: h,
         length_scale: 1.0,
     };
     start::consistent_acceleration(&mut cx, h, 0.0).expect("a consistent start");
+    body(&mut cx, method.as_mut())
+}
+
+/// The body of [`run`].
+fn errors_and_ledger(
+    cx: &mut StepContext<'_, Oscillator>,
+    method: &mut dyn Stepper<Oscillator>,
+    kind: Method,
+    h: f64,
+    steps: usize,
+) -> (f64, Vec<(f64, Option<f64>)>) {
+    let mut works = Works::default();
     let energy = |s: &Oscillator, st: &StepState| s.energies(st.t, &st.q, &st.qd).iter().sum();
     let mut ledger = vec![(energy(cx.system, cx.state), Some(0.0))];
     let (mut err, mut q_max) = (0.0f64, 0.0f64);
     for k in 0..steps {
         let t1 = (k + 1) as f64 * h;
-        let estimate = method.step(&mut cx, None, h, t1, t1).expect("a fixed step");
+        let estimate = method.step(cx, None, h, t1, t1).expect("a fixed step");
         assert_eq!(estimate, None, "{kind:?}: Newton converged at step {k}");
         let booked = method.commit(h, &mut works);
         cx.state.swap_in(t1);
@@ -296,6 +326,7 @@ fn sys_every_method_steps_a_system_that_is_not_a_chain_at_second_order() {
         (Method::GeneralizedAlpha, 0.8),
         (Method::EnergyMidpoint, 1.0),
         (Method::CentralDifference, 1.0),
+        (Method::Bathe, 1.0),
     ] {
         let errors: Vec<f64> = [100, 200, 400]
             .map(|steps| run(&mut sys, method, rho, t_end, steps).0)
@@ -332,4 +363,139 @@ fn sys_energy_midpoint_closes_the_ledger_of_a_system_that_is_not_a_chain() {
     // The load does work: the closure is not that of a constant energy.
     let (e_end, w_end) = ledger[steps];
     assert!(w_end.expect("booked").abs() > 1e-3 * e_scale && (e_end - e0).abs() > 1e-3 * e_scale);
+}
+
+/// Two uncoupled undamped, unloaded oscillators q̈ᵢ = −ωᵢ²qᵢ (M = I).
+fn uncoupled(omega: [f64; 2]) -> Oscillator {
+    Oscillator {
+        m: [[1.0, 0.0], [0.0, 1.0]],
+        k: [[omega[0] * omega[0], 0.0], [0.0, omega[1] * omega[1]]],
+        rayleigh: (0.0, 0.0),
+        f0: [0.0, 0.0],
+        omega_load: 0.0,
+    }
+}
+
+/// Bathe's step map of q̈ = −ω²q, (q₀, q̇₀) → (q₁, q̇₁), solved by hand from the two sub-step
+/// formulas of the method's docs (a₀ = −ω²q₀; trapezoidal half step; three-point backward
+/// difference).
+fn bathe_map(omega: f64, h: f64, q0: f64, v0: f64) -> (f64, f64) {
+    let w2 = omega * omega;
+    let a0 = -w2 * q0;
+    let q_m = (q0 * (1.0 - w2 * h * h / 16.0) + 0.5 * h * v0) / (1.0 + w2 * h * h / 16.0);
+    let v_m = v0 + 0.25 * h * (a0 - w2 * q_m);
+    let q1 = ((4.0 * q_m - q0) / 3.0 + h / 9.0 * (4.0 * v_m - v0)) / (1.0 + w2 * h * h / 9.0);
+    let v1 = (4.0 * v_m - v0) / 3.0 - h / 3.0 * w2 * q1;
+    (q1, v1)
+}
+
+/// Spectral radius of a real 2 × 2 matrix.
+fn spectral_radius(a: [[f64; 2]; 2]) -> f64 {
+    let (tr, det) = (a[0][0] + a[1][1], a[0][0] * a[1][1] - a[0][1] * a[1][0]);
+    let disc = 0.25 * tr * tr - det;
+    if disc >= 0.0 {
+        (0.5 * tr).abs() + disc.sqrt()
+    } else {
+        det.sqrt()
+    }
+}
+
+#[test]
+fn sys_bathe_steps_its_amplification_map_which_damps_only_the_unresolved() {
+    let h = 1e-2;
+    // ωh = 0.1 (resolved) and 1e4 (far beyond the step).
+    let omega = [10.0, 1e6];
+    let mut sys = uncoupled(omega);
+    // Columns of the step map: one step from (q, q̇) = (1, 0) and from (0, 1) in both DOFs.
+    let mut map = [[[0.0; 2]; 2]; 2];
+    for (col, start) in [([1.0, 1.0], [0.0, 0.0]), ([0.0, 0.0], [1.0, 1.0])]
+        .into_iter()
+        .enumerate()
+    {
+        let end = with_context(
+            &mut sys,
+            Method::Bathe,
+            1.0,
+            h,
+            start,
+            None,
+            |cx, method| {
+                method.step(cx, None, h, h, h).expect("a step");
+                (cx.state.q1.clone(), cx.state.qd1.clone())
+            },
+        );
+        for dof in 0..2 {
+            map[dof][0][col] = end.0[dof];
+            map[dof][1][col] = end.1[dof];
+        }
+    }
+    for dof in 0..2 {
+        for (col, (q0, v0)) in [(1.0, 0.0), (0.0, 1.0)].into_iter().enumerate() {
+            let (q1, v1) = bathe_map(omega[dof], h, q0, v0);
+            // Newton on a linear system: exact after one update, up to its tolerance.
+            for (got, want, scale) in [
+                (map[dof][0][col], q1, 1.0),
+                (map[dof][1][col], v1, omega[dof]),
+            ] {
+                assert!(
+                    (got - want).abs() <= 1e-10 * scale,
+                    "ω = {}: step map entry {got:.15e}, by hand {want:.15e}",
+                    omega[dof]
+                );
+            }
+        }
+    }
+    // In the normalized state (q, q̇/ω) the map's spectral radius: near 1 where the step resolves
+    // the motion (the loss is O((ωh)⁴)), near 0 where it does not (ρ∞ = 0).
+    let radius = |dof: usize| {
+        let w = omega[dof];
+        let m = map[dof];
+        spectral_radius([[m[0][0], m[0][1] * w], [m[1][0] / w, m[1][1]]])
+    };
+    let (resolved, unresolved) = (radius(0), radius(1));
+    assert!(
+        1.0 - resolved < 1e-6 && resolved <= 1.0,
+        "ωh = 0.1: ρ = {resolved}"
+    );
+    assert!(unresolved < 1e-3, "ωh = 1e4: ρ = {unresolved}");
+}
+
+#[test]
+fn sys_bathe_error_estimate_is_its_local_error() {
+    // q̈ = f₀ sin Ωt with M = I, no stiffness, from rest: the exact step is
+    // q(h) = f₀(h/Ω − sin(Ωh)/Ω²), q⃛(0) = f₀Ω, and the method's local error h³q⃛/24.
+    let (f0, big_omega) = (1.0, 7.0);
+    let mut sys = Oscillator {
+        m: [[1.0, 0.0], [0.0, 1.0]],
+        k: [[0.0, 0.0], [0.0, 0.0]],
+        rayleigh: (0.0, 0.0),
+        f0: [f0, 0.0],
+        omega_load: big_omega,
+    };
+    for h in [1e-2, 1e-3] {
+        let tol = Adaptive {
+            rtol: 0.0,
+            atol: 1.0,
+        };
+        let (estimate, q1) = with_context(
+            &mut sys,
+            Method::Bathe,
+            1.0,
+            h,
+            ([0.0; 2], [0.0; 2]),
+            Some(tol),
+            |cx, method| {
+                let e = method.step(cx, None, h, h, h).expect("a step");
+                (e.expect("adaptive: an estimate"), cx.state.q1[0])
+            },
+        );
+        let exact = f0 * (h / big_omega - (big_omega * h).sin() / (big_omega * big_omega));
+        let error = (q1 - exact).abs();
+        // Leading terms agree; the next is O(Ωh) relative.
+        let rel = (estimate - error).abs() / error;
+        assert!(
+            rel <= 2.0 * big_omega * h,
+            "h = {h}: estimate {estimate:.4e}, error {error:.4e} (rel. difference {rel:.2e})"
+        );
+    }
 }

@@ -482,7 +482,7 @@ fn cli_flag_no_requested_backend_reads_exits_2_naming_flag_and_readers() {
             ],
             "`--method dopri5` applies to modal; the requested backend fem does not implement \
              it; fem offers energy-midpoint, generalized-alpha, central-difference, \
-             implicit-midpoint",
+             implicit-midpoint, bathe",
         ),
         (
             &[

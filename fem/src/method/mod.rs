@@ -14,6 +14,8 @@
 //! * [`energy_midpoint`]: the energy-consistent midpoint (discrete-gradient) scheme;
 //! * [`implicit_midpoint`]: the implicit midpoint rule (one-stage Gauss), fixed or adaptive
 //!   steps.
+//! * [`bathe`]: Bathe's composite method (trapezoidal half step, then a three-point backward
+//!   difference): second order, no high-frequency ringing, fixed or adaptive steps.
 //!
 //! A held [`StepConstraint`] is accepted by the implicit methods. The two midpoint schemes
 //! take the mean acceleration ā as Newton unknown, q₁ = q₀ + h q̇₀ + (h²/2) ā (border factor
@@ -122,4 +124,5 @@ registry! {
     CentralDifference => central_difference::CentralDifference,
     EnergyMidpoint => energy_midpoint::EnergyMidpoint,
     ImplicitMidpoint => implicit_midpoint::ImplicitMidpoint,
+    Bathe => bathe::Bathe,
 }
