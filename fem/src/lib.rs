@@ -66,10 +66,13 @@
 //! (clamped-free on a prescribed joint, pinned-free on a free one) — and at most T₁/320 of the
 //! most flexible link in a free chain where nothing dissipates
 //! ([`run::UNDAMPED_STEPS_PER_PERIOD`]) — fitted to divide the output interval. Central
-//! difference: 2/ω_max by power iteration on the linearized K, M at t = 0; a user step above it is refused, the automatic step is 0.9× it.
-//! On request also the implicit midpoint rule `implicit-midpoint` (one-stage Gauss, second
-//! order, no numerical damping, works booked by the trapezoidal rule:
-//! [`method::implicit_midpoint`]).
+//! difference: 2/(κ + √(κ² + ω²)) of the stiffest and of the most damped mode (power
+//! iterations on the linearized K, C, M at t = 0; 2/ω_max undamped); a user step above it is
+//! refused, the automatic step is 0.9× it. On request also the implicit midpoint rule
+//! `implicit-midpoint` (one-stage Gauss, second order, no numerical damping, works booked by the
+//! trapezoidal rule: [`method::implicit_midpoint`]) and Bathe's composite method `bathe`
+//! (trapezoidal half step, three-point backward difference: second order, damps what the step
+//! does not resolve; [`method::bathe`]).
 //!
 //! ## Contact (seed 000: impact, constrained sliding, release)
 //! Unilateral frictionless contact of the tip of a named link with a fixed line

@@ -317,15 +317,15 @@ pub fn prepare(
     // Explicit central difference: the step under its stability bound; the implicit methods:
     // the user step or the default rule, adaptive with `rtol`.
     let h_nominal = if caps.explicit {
-        let (w, dof) = integ.max_frequency()?;
-        let bound = 2.0 / w;
+        let (bound, dof) = integ.stability_bound()?;
         let location = integ.chain.describe_dof(dof);
         match dt_user {
             Some(dt) if dt > bound => {
                 return Err(FemError::StabilityBound {
                     dt,
                     bound,
-                    bound_kind: "central-difference (2/ω_max)".into(),
+                    bound_kind: "central-difference (2/(κ + √(κ² + ω²)) of the binding mode)"
+                        .into(),
                     location,
                 });
             }

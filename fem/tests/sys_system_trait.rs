@@ -8,6 +8,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use fem::band::BorderedBand;
+use fem::method::central_difference;
 use fem::method::{
     Adaptive, Counters, NewtonSystem, StepContext, StepState, Stepper, Works, start, stepper,
 };
@@ -498,4 +499,58 @@ fn sys_bathe_error_estimate_is_its_local_error() {
             "h = {h}: estimate {estimate:.4e}, error {error:.4e} (rel. difference {rel:.2e})"
         );
     }
+}
+
+#[test]
+fn sys_central_difference_bound_holds_with_damping() {
+    // Stiffness-proportional damping b = 0.2: the fast mode (ω ≈ 17.5 rad/s) has κ = bω² ≈ 61,
+    // so the damped bound is several times below the undamped 2/ω_max.
+    let mut sys = Oscillator::new((0.0, 0.2));
+    let mut state = StepState::new(2);
+    state.q.copy_from_slice(&Q0);
+    let mut res = [0.0; 2];
+    let (bound, _) =
+        central_difference::stability_bound(&mut sys, &state, &mut res).expect("a bound");
+    let omega_max = sys.modes()[1].0.sqrt();
+    assert!(
+        bound < 0.5 * 2.0 / omega_max,
+        "bound {bound:.4e}, 2/ω_max {:.4e}",
+        2.0 / omega_max
+    );
+    // Largest |q| over the last quarter of 2000 steps, from (Q0, V0), at step h.
+    let mut late_amplitude = |h: f64| {
+        let steps = 2000;
+        with_context(
+            &mut sys,
+            Method::CentralDifference,
+            1.0,
+            h,
+            (Q0, V0),
+            None,
+            |cx, method| {
+                let mut late = 0.0f64;
+                for k in 0..steps {
+                    let t1 = (k + 1) as f64 * h;
+                    method.step(cx, None, h, t1, t1).expect("a step");
+                    cx.state.swap_in(t1);
+                    if k >= 3 * steps / 4 {
+                        late = late.max(max_abs(&cx.state.q));
+                    }
+                }
+                late
+            },
+        )
+    };
+    // The load keeps the forced response at the size of the initial state: below the bound it
+    // stays there, above it the fast mode grows without bound.
+    let start = max_abs(&Q0);
+    let (below, above) = (late_amplitude(0.95 * bound), late_amplitude(1.05 * bound));
+    assert!(below < 10.0 * start, "0.95 × bound: late |q| {below:.3e}");
+    // (a run that overflowed to ∞ or NaN has grown too)
+    let grew = above.is_nan() || above >= 1e6 * start;
+    assert!(grew, "1.05 × bound: late |q| {above:.3e}");
+}
+
+fn max_abs(x: &[f64]) -> f64 {
+    x.iter().fold(0.0f64, |m, v| m.max(v.abs()))
 }

@@ -237,10 +237,10 @@ impl Driver {
         Ok(())
     }
 
-    /// Largest natural frequency of the linearized system at the current state and the DOF
-    /// where its mode is largest ([`central_difference::max_frequency`]).
-    pub fn max_frequency(&mut self) -> Result<(f64, usize), FemError> {
-        central_difference::max_frequency(&mut self.chain, &self.state, &mut self.newton.res)
+    /// Explicit step bound of the linearized system at the current state and the DOF where
+    /// the binding mode is largest ([`central_difference::stability_bound`]).
+    pub fn stability_bound(&mut self) -> Result<(f64, usize), FemError> {
+        central_difference::stability_bound(&mut self.chain, &self.state, &mut self.newton.res)
     }
 
     /// Stores the joint quantities at the start of a step for the work integrals.

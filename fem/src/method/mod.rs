@@ -10,7 +10,7 @@
 //! * [`generalized_alpha`]: implicit generalized-α (Chung–Hulbert, Arnold–Brüls form),
 //!   fixed or adaptive steps;
 //! * [`central_difference`]: explicit central difference (velocity-Verlet form) under its
-//!   stability bound 2/ω_max;
+//!   stability bound 2/(κ + √(κ² + ω²)) (2/ω_max undamped);
 //! * [`energy_midpoint`]: the energy-consistent midpoint (discrete-gradient) scheme;
 //! * [`implicit_midpoint`]: the implicit midpoint rule (one-stage Gauss), fixed or adaptive
 //!   steps.
@@ -53,7 +53,7 @@ use crate::system::System;
 /// the methods that can ([`names_with`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Capabilities {
-    /// Stepped under its stability bound 2/ω_max in equal steps: needs a non-singular M, no
+    /// Stepped under its stability bound in equal steps: needs a non-singular M, no
     /// adaptive steps and no held constraint.
     pub explicit: bool,
     /// Has a local error estimate (adaptive steps with `time.rtol`).
