@@ -54,6 +54,8 @@ pub struct LinkSystem {
     kcv: Vec<f64>,
     ga: Vec<f64>,
     tmp: Vec<f64>,
+    /// Scratch of the kinetic gradient (K_c d, G x), apart from the point data.
+    grad: [Vec<f64>; 2],
     zero: Vec<f64>,
 }
 
@@ -85,6 +87,7 @@ impl LinkSystem {
             kcv: z.clone(),
             ga: z.clone(),
             tmp: z.clone(),
+            grad: [z.clone(), z.clone()],
             zero: z,
         }
     }
@@ -104,25 +107,35 @@ impl LinkSystem {
         }
     }
 
-    /// Fills the point data J(d), b(d), j₁ + K_c d, (j₁ + K_c d)·ḋ, G ḋ, Gᵀḋ, K_c ḋ and G d̈ at
-    /// (d, ḋ, d̈).
-    fn point(&mut self, d: &[f64], dd: &[f64], ddd: &[f64]) {
+    /// Fills the point data of the base equation at (d, ḋ): b(d), j₁ + K_c d, J(d) and
+    /// (j₁ + K_c d)·ḋ, G ḋ.
+    fn point_base(&mut self, d: &[f64], dd: &[f64]) {
         let md = &self.model;
         md.g.matvec_transpose(d, &mut self.bd);
         md.kc.matvec(d, &mut self.jd);
         md.g.matvec(dd, &mut self.gv);
-        md.g.matvec_transpose(dd, &mut self.gtv);
-        md.kc.matvec(dd, &mut self.kcv);
-        md.g.matvec(ddd, &mut self.ga);
         for i in 0..md.n {
             self.bd[i] += md.b0[i];
             self.jd[i] += md.j1[i];
         }
-        self.polar = md.polar(d);
+        // J(d) = J₀ + 2j₁·d + dᵀK_c d = J₀ + j₁·d + d·(j₁ + K_c d).
+        self.polar = md.j0 + dot(&md.j1, d) + dot(d, &self.jd);
         self.jd_dot_v = dot(&self.jd, dd);
     }
 
-    /// Inertial part of the base equation at the point data of the last [`Self::point`]:
+    /// Fills the point data of the residual and the Newton matrix at (d, ḋ, d̈): that of
+    /// [`Self::point_base`], Gᵀḋ, and for a free base (its border) K_c ḋ and G d̈.
+    fn point(&mut self, d: &[f64], dd: &[f64], ddd: &[f64]) {
+        self.point_base(d, dd);
+        let md = &self.model;
+        md.g.matvec_transpose(dd, &mut self.gtv);
+        if md.free_base() {
+            md.kc.matvec(dd, &mut self.kcv);
+            md.g.matvec(ddd, &mut self.ga);
+        }
+    }
+
+    /// Inertial part of the base equation at the point data of the last [`Self::point_base`]:
     /// J(d)θ̈ + b(d)·d̈ + 2θ̇(j₁ + K_c d)·ḋ + ḋᵀGḋ.
     fn base_inertia(&self, dd: &[f64], ddd: &[f64], rate: f64, acc: f64) -> f64 {
         self.polar * acc + dot(&self.bd, ddd) + 2.0 * rate * self.jd_dot_v + dot(dd, &self.gv)
@@ -134,7 +147,7 @@ impl LinkSystem {
     pub fn base_torque(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> f64 {
         let n = self.model.n;
         let (theta, rate, acc) = self.base(t, q, qd, qdd);
-        self.point(&q[..n], &qd[..n], &qdd[..n]);
+        self.point_base(&q[..n], &qd[..n]);
         let (k, th0) = self.model.spring();
         self.base_inertia(&qd[..n], &qdd[..n], rate, acc)
             + self.model.motor_friction * rate
@@ -288,10 +301,11 @@ impl System for LinkSystem {
         let md = &self.model;
         let n = md.n;
         let xt = x[n];
-        md.kc.matvec(&q[..n], &mut self.tmp);
-        md.g.matvec(&x[..n], &mut self.gv);
+        let [kcd, gx] = &mut self.grad;
+        md.kc.matvec(&q[..n], kcd);
+        md.g.matvec(&x[..n], gx);
         for i in 0..n {
-            out[i] += sign * (xt * xt * (md.j1[i] + self.tmp[i]) + xt * self.gv[i]);
+            out[i] += sign * (xt * xt * (md.j1[i] + kcd[i]) + xt * gx[i]);
         }
     }
 
