@@ -72,6 +72,7 @@ impl LinkSystem {
             }
         }
         let z = vec![0.0; n];
+        let zero = vec![0.0; n + usize::from(model.free_base())];
         LinkSystem {
             model,
             gt,
@@ -88,7 +89,7 @@ impl LinkSystem {
             ga: z.clone(),
             tmp: z.clone(),
             grad: [z.clone(), z.clone()],
-            zero: z,
+            zero,
         }
     }
 
@@ -286,8 +287,7 @@ impl System for LinkSystem {
         res: &mut [f64],
     ) {
         // The point data is a few band products: recomputed (R is affine in q̈; d̈ = 0 here).
-        let mut zero = std::mem::take(&mut self.zero);
-        zero.resize(q.len(), 0.0);
+        let zero = std::mem::take(&mut self.zero);
         self.residual_parts(t, q, qd, &zero, parts, res);
         self.zero = zero;
     }
