@@ -13,7 +13,46 @@ use fem::FemBackend;
 use fem::element::beam3d::rows_at;
 use fem::element::quadrature::gauss01;
 use fem::payload_link::model::Model;
-use fem::payload_link::step::{State, Stepper};
+use fem::payload_link::system::LinkSystem;
+use fem::system::{NewtonCoefficients, System};
+
+/// The implicit midpoint rule's residual R(q̄, v̄, ā, t₀ + h/2) and its dense Newton matrix
+/// S = M + (h/2)C + (h²/4)K of a step of length h from (t₀, d, ḋ, θ, θ̇) at the midpoint
+/// acceleration (a_d, a_θ): v̄ = v₀ + (h/2)ā, q̄ = q₀ + (h/2)v̄ (a prescribed base has no θ
+/// unknown: its law gives θ at t₀ + h/2).
+#[allow(clippy::too_many_arguments)]
+fn residual_and_newton(
+    sys: &mut LinkSystem,
+    t0: f64,
+    h: f64,
+    (d, dd): (&[f64], &[f64]),
+    (theta, rate): (f64, f64),
+    a: &[f64],
+    a_theta: f64,
+) -> (Vec<f64>, faer::Mat<f64>) {
+    let mut q0 = d.to_vec();
+    let mut v0 = dd.to_vec();
+    let mut acc = a.to_vec();
+    if sys.free_base() {
+        q0.push(theta);
+        v0.push(rate);
+        acc.push(a_theta);
+    }
+    let nq = q0.len();
+    let vbar: Vec<f64> = (0..nq).map(|i| v0[i] + 0.5 * h * acc[i]).collect();
+    let qbar: Vec<f64> = (0..nq).map(|i| q0[i] + 0.5 * h * vbar[i]).collect();
+    let mut res = vec![0.0; nq];
+    sys.residual(t0 + 0.5 * h, &qbar, &vbar, &acc, &mut res);
+    let mut s = sys.new_matrix();
+    let c = NewtonCoefficients {
+        c_a: 1.0,
+        c_v: 0.5 * h,
+        c_q: 0.25 * h * h,
+    };
+    sys.newton_matrix(&qbar, c, &mut s);
+    let jac = faer::Mat::from_fn(nq, nq, |i, j| s.get(i, j));
+    (res, jac)
+}
 
 fn scene(name: &str) -> Scene {
     data::load_scene(name).expect("catalog scene")
@@ -220,20 +259,20 @@ fn lagrange_check(name: &str) {
     let h = 1e-3;
     let a: Vec<f64> = (0..n).map(|i| 50.0 * (0.9 * i as f64).sin()).collect();
     let a_theta = if free { 1.7 } else { 0.0 };
-    let st = State {
-        t: 0.2,
-        d: d.clone(),
-        dd: dd.clone(),
-        theta: theta0,
-        rate: rate0,
-    };
-    let mut stepper = Stepper::new(md.clone(), st);
-    let (res, _) = stepper.residual_and_newton(h, &a, a_theta);
-    // Midpoint state (q̄, v̄) and generalized coordinates q = (d, θ).
+    let t0 = 0.2;
+    let mut sys = LinkSystem::new(md.clone());
+    let (res, _) = residual_and_newton(&mut sys, t0, h, (&d, &dd), (theta0, rate0), &a, a_theta);
+    // Midpoint state (q̄, v̄) and generalized coordinates q = (d, θ); a prescribed base's θ
+    // from its law at the midpoint.
     let vb: Vec<f64> = (0..n).map(|i| dd[i] + 0.5 * h * a[i]).collect();
     let db: Vec<f64> = (0..n).map(|i| d[i] + 0.5 * h * vb[i]).collect();
-    let rate = rate0 + 0.5 * h * a_theta;
-    let theta = theta0 + 0.5 * h * rate;
+    let (theta, rate, a_theta) = match md.prescribed(t0 + 0.5 * h) {
+        Some(law) => law,
+        None => {
+            let rate = rate0 + 0.5 * h * a_theta;
+            (theta0 + 0.5 * h * rate, rate, a_theta)
+        }
+    };
     let nq = n + 1;
     let pack = |d: &[f64], th: f64| -> Vec<f64> {
         let mut q = d.to_vec();
@@ -309,18 +348,15 @@ fn sys_payload_newton_matrix_is_the_residual_jacobian() {
         let n = md.n;
         let free = md.free_base();
         let (d, dd) = state(&md, 0.01);
-        let st = State {
-            t: 0.1,
-            d,
-            dd,
-            theta: 0.2,
-            rate: 3.0,
-        };
-        let mut s = Stepper::new(md, st);
+        let mut sys = LinkSystem::new(md);
+        let (t0, theta0, rate0) = (0.1, 0.2, 3.0);
         let h = 2e-3;
         let a: Vec<f64> = (0..n).map(|i| 20.0 * (0.4 * i as f64).cos()).collect();
         let a_theta = 0.8;
-        let (_, jac) = s.residual_and_newton(h, &a, a_theta);
+        let mut at = |a: &[f64], a_theta: f64| {
+            residual_and_newton(&mut sys, t0, h, (&d, &dd), (theta0, rate0), a, a_theta)
+        };
+        let (_, jac) = at(&a, a_theta);
         let nn = n + usize::from(free);
         let big = (0..nn)
             .flat_map(|i| (0..nn).map(move |j| (i, j)))
@@ -336,8 +372,8 @@ fn sys_payload_newton_matrix_is_the_residual_jacobian() {
                 tp += delta;
                 tm -= delta;
             }
-            let (rp, _) = s.residual_and_newton(h, &ap, tp);
-            let (rm, _) = s.residual_and_newton(h, &am, tm);
+            let (rp, _) = at(&ap, tp);
+            let (rm, _) = at(&am, tm);
             for i in 0..nn {
                 let fd = (rp[i] - rm[i]) / (2.0 * delta);
                 assert!(

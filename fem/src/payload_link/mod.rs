@@ -50,20 +50,27 @@
 //! `static-sag` initial shape.
 //!
 //! ## Dynamics ([`simulate`])
-//! Implicit midpoint rule with an analytic Newton matrix ([`step`]); works booked with the
-//! scheme's midpoint quadrature. Default mesh 16 elements ([`crate::settings::DEFAULT_ELEMENTS`]);
-//! default step [`default_step`]: the largest step (fitted to divide the output interval) whose
+//! The link is a [`crate::system::System`] ([`system::LinkSystem`]: residual groups, analytic
+//! Newton matrix S = c_a ∂R/∂q̈ + c_v ∂R/∂q̇ + c_q ∂R/∂q, energies) stepped by a method of the
+//! registry ([`crate::method::stepper`]) on the link's driver path ([`driver`]): fixed steps onto
+//! the output times and the motor law's switches, works booked with the midpoint rule,
+//! Kelvin–Voigt per damped field. Methods: `implicit-midpoint` (the default), `generalized-alpha`
+//! (ρ∞ = 0.9 with the axial field, else 1), `energy-midpoint`, and `central-difference` on rods
+//! without Kelvin–Voigt damping (its step under 2/ω_max; the damped bound of the kHz axial and
+//! torsion modes is not computed, so damped rods refuse it). Adaptive steps are refused.
+//! Default mesh 16 elements ([`crate::settings::DEFAULT_ELEMENTS`]); default step of the implicit
+//! methods [`default_step`]: the largest step (fitted to divide the output interval) whose
 //! estimated phase error of the modes the scene's loads excite (gravity against the initial
 //! shape, centrifugal load, motor torque and its switches, a prescribed base's acceleration),
 //! each damped by its Kelvin–Voigt decay, stays below [`PHASE_ERROR_TOLERANCE`] of the scale of
-//! the payload's height, its turning-plane position and the base angle. Torsion and axial modes
-//! (hundreds of Hz to kHz on the catalog rods) hardly move those observables and are not
-//! resolved by that step: the midpoint rule keeps them bounded and undamped, with a phase error
-//! in `tip_twist`. Only `implicit-midpoint` (the default) is accepted; adaptive steps are
-//! refused.
+//! the payload's height, its turning-plane position and the base angle (the estimate is the
+//! implicit midpoint rule's phase error). Torsion and axial modes (hundreds of Hz to kHz on the
+//! catalog rods) hardly move those observables and are not resolved by that step: the midpoint
+//! rule keeps them bounded and undamped, with a phase error in `tip_twist`.
 
+pub mod driver;
 pub mod model;
-pub mod step;
+pub mod system;
 
 use std::time::Instant;
 
@@ -79,8 +86,10 @@ use crate::band::BorderedBand;
 use crate::element::beam3d::{PHI, U, V, W};
 use crate::error::FemError;
 use crate::settings;
+use crate::settings::Method;
+use crate::system::System;
+use driver::LinkDriver;
 use model::Model;
-use step::{State, Stepper};
 
 /// Default step: the largest h whose estimated phase error of the modes the loads excite stays
 /// below this fraction of each observable's scale ([`default_step`]).
@@ -480,7 +489,7 @@ pub fn statics(
 
 /// Everything `simulate` needs, built once (benches reuse it).
 pub struct Prepared {
-    pub stepper: Stepper,
+    pub stepper: LinkDriver,
     pub h: f64,
     pub t_end: f64,
     pub output_interval: f64,
@@ -679,14 +688,16 @@ pub fn prepare(
     settings: &FemSettings,
 ) -> Result<Prepared, FemError> {
     let n_el = elements(settings)?;
-    match settings.method {
-        None | Some(data::FemMethod::ImplicitMidpoint) => {}
-        Some(other) => {
-            return Err(FemError::unsupported(format!(
-                "fem payload link: method `{other}`; only `implicit-midpoint` is implemented \
-                 for the 3-D link"
-            )));
-        }
+    let method = settings.method.unwrap_or(Method::ImplicitMidpoint);
+    if method == Method::CentralDifference
+        && l.fields.iter().any(|&f| l.kelvin_voigt_on(f).is_some())
+    {
+        // Stiffness-proportional damping makes the explicit bound 2/ω(√(1 + ζ²) − ζ), ζ ∝ ω:
+        // for the kHz axial and torsion modes far below the undamped 2/ω_max computed here.
+        return Err(FemError::unsupported(
+            "fem payload link: central-difference with Kelvin–Voigt damping (its stability \
+             bound is not computed); use an implicit method",
+        ));
     }
     if settings.rtol.is_some() || settings.atol.is_some() {
         return Err(FemError::unsupported(
@@ -702,40 +713,106 @@ pub fn prepare(
     } else {
         vec![0.0; md.n]
     };
-    let h = match dt_user {
-        Some(h) => h,
-        None => fit(default_step(&md, &d, t_end, out)?.min(out), out),
-    };
-    let (theta, rate) = match md.prescribed(0.0) {
-        Some((th, r, _)) => (th, r),
-        None => (md.initial_angle, md.initial_rate),
-    };
-    let n = md.n;
-    let state = State {
-        t: 0.0,
-        d,
-        dd: vec![0.0; n],
-        theta,
-        rate,
-    };
-    Ok(Prepared {
-        stepper: Stepper::new(md, state),
-        h,
-        t_end,
-        output_interval: out,
-        stations: scene.simulation.field_stations.max(2),
-    })
+    let rho_inf = default_rho_inf(&md);
+    match method {
+        Method::CentralDifference => {
+            // Explicit: the step under its stability bound 2/ω_max (at the initial state).
+            let mut driver = LinkDriver::new(md, &d, method, out, rho_inf)?;
+            let mut res = vec![0.0; driver.system.ndof()];
+            let (w, dof) = crate::method::central_difference::max_frequency(
+                &mut driver.system,
+                &driver.state,
+                &mut res,
+            )?;
+            let bound = 2.0 / w;
+            let h = match dt_user {
+                Some(dt) if dt > bound => {
+                    return Err(FemError::StabilityBound {
+                        dt,
+                        bound,
+                        bound_kind: "central-difference (2/ω_max)".into(),
+                        location: describe_dof(&driver.system.model, dof),
+                    });
+                }
+                Some(dt) => dt,
+                None => fit(crate::run::DEFAULT_SAFETY * bound, out),
+            };
+            driver.h_nominal = h;
+            Ok(Prepared {
+                stepper: driver,
+                h,
+                t_end,
+                output_interval: out,
+                stations: scene.simulation.field_stations.max(2),
+            })
+        }
+        _ => {
+            let h = match dt_user {
+                Some(h) => h,
+                None => fit(default_step(&md, &d, t_end, out)?.min(out), out),
+            };
+            Ok(Prepared {
+                stepper: LinkDriver::new(md, &d, method, h, rho_inf)?,
+                h,
+                t_end,
+                output_interval: out,
+                stations: scene.simulation.field_stations.max(2),
+            })
+        }
+    }
+}
+
+/// Generalized-α's spectral radius for the link: 1 (no numerical damping, as the implicit
+/// midpoint rule), or 0.9 when the rod carries the axial field, whose kHz modes the default
+/// step does not resolve (the chain's rule, [`crate::run::default_rho_inf`]).
+fn default_rho_inf(md: &Model) -> f64 {
+    if md.fields.contains(&LinkField::Axial) {
+        0.9
+    } else {
+        1.0
+    }
+}
+
+/// A DOF of the link by name: the base angle or the slot and node of a field DOF.
+fn describe_dof(md: &Model, dof: usize) -> String {
+    if dof >= md.n {
+        return "joint1 angle".into();
+    }
+    let node = dof / md.layout.per_node + 1;
+    let slot = ["u", "v", "v′", "w", "w′", "φ"][slot_of(md, dof)];
+    format!("link1 node {node} {slot}")
+}
+
+/// Torque of the base at the driver's state: the motor law of a free base; for a prescribed
+/// base, the torque its motion needs, with d̈ from the field equations M d̈ = −R_d(t, d, ḋ, 0)
+/// (`mass_lu`: M factorized once; `scratch`: two vectors of n).
+fn state_torque(
+    st: &mut LinkDriver,
+    mass_lu: &mut BorderedBand,
+    scratch: &mut [Vec<f64>; 2],
+) -> f64 {
+    let s = &st.state;
+    if st.system.free_base() {
+        return st.system.model.motor_torque(s.t);
+    }
+    let [zero, acc] = scratch;
+    st.system.residual(s.t, &s.q, &s.qd, zero, acc);
+    acc.iter_mut().for_each(|v| *v = -*v);
+    mass_lu.solve_in_place(acc);
+    st.system.base_torque(s.t, &s.q, &s.qd, acc)
 }
 
 /// Samples the channels of [`channel::payload_link`] (the fields the rod carries) into `buf`.
-fn sample(st: &Stepper, torque: f64, stations: usize, buf: &mut Vec<f64>) {
+fn sample(st: &LinkDriver, torque: f64, stations: usize, buf: &mut Vec<f64>) {
     buf.clear();
-    let md = &st.model;
+    let sys = &st.system;
+    let md = &sys.model;
     let s = &st.state;
-    let d = &s.d;
+    let d = &s.q[..md.n];
+    let (theta, rate, _) = sys.base(s.t, &s.q, &s.qd, &s.qdd);
     let [x, y, z] = md.payload_position(d);
-    let (c, sn) = (s.theta.cos(), s.theta.sin());
-    buf.extend([s.theta, s.rate, torque, c * x - sn * y, sn * x + c * y, z]);
+    let (c, sn) = (theta.cos(), theta.sin());
+    buf.extend([theta, rate, torque, c * x - sn * y, sn * x + c * y, z]);
     let has = |f| md.fields.contains(&f);
     let t = &md.tip;
     for (j, q) in channel::PAYLOAD_LINK_TIP.iter().enumerate() {
@@ -787,21 +864,25 @@ fn ledger_names(md: &Model) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'stat
     (stored, inputs, diss)
 }
 
-fn push_ledger(st: &Stepper, ledger: &mut EnergyLedger) {
-    let md = &st.model;
+fn push_ledger(st: &LinkDriver, ledger: &mut EnergyLedger) {
+    let sys = &st.system;
+    let md = &sys.model;
     let s = &st.state;
+    let n = md.n;
+    let (d, dd) = (&s.q[..n], &s.qd[..n]);
+    let (theta, rate, _) = sys.base(s.t, &s.q, &s.qd, &s.qdd);
     let mut stored = [0.0; 4];
     let mut k = 0;
-    stored[k] = md.kinetic(&s.d, s.rate, &s.dd);
+    stored[k] = md.kinetic(d, rate, dd);
     k += 1;
-    stored[k] = md.strain(&s.d);
+    stored[k] = md.strain(d);
     k += 1;
     if md.has_gravity {
-        stored[k] = md.gravity(&s.d);
+        stored[k] = md.gravity(d);
         k += 1;
     }
     if md.spring().0 > 0.0 {
-        stored[k] = md.joint_spring(s.theta);
+        stored[k] = md.joint_spring(theta);
         k += 1;
     }
     let w = &st.works;
@@ -816,7 +897,7 @@ fn push_ledger(st: &Stepper, ledger: &mut EnergyLedger) {
         diss[nd] = w.joint_damper;
         nd += 1;
     }
-    for kv in &w.kelvin_voigt {
+    for kv in &w.kelvin_voigt[..md.c_field.len()] {
         diss[nd] = *kv;
         nd += 1;
     }
@@ -837,48 +918,52 @@ pub fn simulate(
         output_interval,
         stations,
     } = prepare(scene, l, settings)?;
-    let specs = channel::payload_link(&stepper.model.fields, stations);
+    let md = &stepper.system.model;
+    let specs = channel::payload_link(&md.fields, stations);
     let mut obs = Observables::with_channels(&specs);
-    let (s, i, d) = ledger_names(&stepper.model);
+    let (s, i, d) = ledger_names(md);
     let mut ledger = EnergyLedger::new(&s, &i, &d);
-    let n = stepper.model.n;
+    let n = md.n;
+    let free = md.free_base();
     // Mass matrix factorized once: the torque a prescribed base needs at the output samples.
-    let mut mass_lu = BorderedBand::new(n, 0, stepper.model.layout.half_bandwidth());
-    if !stepper.model.free_base() {
+    let mut mass_lu = BorderedBand::new(n, 0, md.layout.half_bandwidth());
+    if !free {
         for r in 0..n {
-            for c in stepper.model.m.cols(r) {
-                mass_lu.add(r, c, stepper.model.m.get(r, c));
+            for c in md.m.cols(r) {
+                mass_lu.add(r, c, md.m.get(r, c));
             }
         }
         mass_lu.factorize()?;
     }
-    let mut scratch = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+    let mut scratch = [vec![0.0; n], vec![0.0; n]];
     let mut buf = Vec::with_capacity(specs.len());
-    let torque = stepper.state_torque(&mut mass_lu, &mut scratch);
+    let torque = state_torque(&mut stepper, &mut mass_lu, &mut scratch);
     sample(&stepper, torque, stations, &mut buf);
     obs.push(0.0, &buf);
     push_ledger(&stepper, &mut ledger);
     let n_out = (t_end / output_interval - 1e-9).ceil().max(1.0) as usize;
     let mut verdict = StabilityVerdict::Completed;
     'outer: for k in 1..=n_out {
-        let t_stop = (k as f64 * output_interval).min(t_end);
-        while stepper.state.t < t_stop - 1e-9 * h {
-            // Steps of h onto the output time (a shorter last step only when h does not divide
-            // the interval); the time is snapped to the output grid against round-off.
+        let t_out = (k as f64 * output_interval).min(t_end);
+        while stepper.state.t < t_out - 1e-9 * h {
+            // Steps of h onto the next output time or motor-law breakpoint (a shorter last
+            // step only when h does not divide the stretch); the end is snapped to the stop
+            // time against round-off.
+            let t_stop = stepper.next_breakpoint().map_or(t_out, |b| b.min(t_out));
             let rest = t_stop - stepper.state.t;
             let hk = if rest < h * (1.0 - 1e-9) { rest } else { h };
-            let stepped = stepper.step(hk);
-            if (stepper.state.t - t_stop).abs() < 1e-9 * h {
-                stepper.state.t = t_stop;
+            let mut t1 = stepper.state.t + hk;
+            if (t1 - t_stop).abs() < 1e-9 * h {
+                t1 = t_stop;
             }
-            if let Err(e) = stepped {
+            if let Err(e) = stepper.step(hk, t1) {
                 verdict = StabilityVerdict::Stopped {
                     diagnostic: e.into_stop_diagnostic()?,
                 };
                 break 'outer;
             }
         }
-        let torque = stepper.state_torque(&mut mass_lu, &mut scratch);
+        let torque = state_torque(&mut stepper, &mut mass_lu, &mut scratch);
         sample(&stepper, torque, stations, &mut buf);
         if buf.iter().any(|v| !v.is_finite()) {
             verdict = StabilityVerdict::Stopped {
@@ -895,9 +980,7 @@ pub fn simulate(
         obs,
         ledger,
         Vec::new(),
-        stepper
-            .counters
-            .cost(n + usize::from(stepper.model.free_base()), start),
+        stepper.counters.cost(n + usize::from(free), start),
         verdict,
     ))
 }
