@@ -55,9 +55,10 @@
 //! registry ([`crate::method::stepper`]) on the link's driver path ([`driver`]): fixed steps onto
 //! the output times and the motor law's switches, works booked with the midpoint rule,
 //! Kelvin–Voigt per damped field. Methods: `implicit-midpoint` (the default), `generalized-alpha`
-//! (ρ∞ = 0.9 with the axial field, else 1), `energy-midpoint`, and `central-difference` on rods
-//! without Kelvin–Voigt damping (its step under 2/ω_max; the damped bound of the kHz axial and
-//! torsion modes is not computed, so damped rods refuse it). Adaptive steps are refused.
+//! (ρ∞ = 0.9 with the axial field, else 1), `energy-midpoint`, `bathe`, and `central-difference`
+//! (its step under the damped bound of [`crate::method::central_difference::stability_bound`]:
+//! with Kelvin–Voigt damping of the kHz axial and torsion modes far below 2/ω_max). Adaptive
+//! steps are refused.
 //! Default mesh 16 elements ([`crate::settings::DEFAULT_ELEMENTS`]); default step of the implicit
 //! methods [`default_step`]: the largest step (fitted to divide the output interval) whose
 //! estimated phase error of the modes the scene's loads excite (gravity against the initial
@@ -689,16 +690,6 @@ pub fn prepare(
 ) -> Result<Prepared, FemError> {
     let n_el = elements(settings)?;
     let method = settings.method.unwrap_or(Method::ImplicitMidpoint);
-    if method == Method::CentralDifference
-        && l.fields.iter().any(|&f| l.kelvin_voigt_on(f).is_some())
-    {
-        // Stiffness-proportional damping makes the explicit bound 2/ω(√(1 + ζ²) − ζ), ζ ∝ ω:
-        // for the kHz axial and torsion modes far below the undamped 2/ω_max computed here.
-        return Err(FemError::unsupported(
-            "fem payload link: central-difference with Kelvin–Voigt damping (its stability \
-             bound is not computed); use an implicit method",
-        ));
-    }
     if settings.rtol.is_some() || settings.atol.is_some() {
         return Err(FemError::unsupported(
             "fem payload link: adaptive steps (`time.rtol`/`time.atol`); use --dt",
@@ -716,21 +707,23 @@ pub fn prepare(
     let rho_inf = default_rho_inf(&md);
     match method {
         Method::CentralDifference => {
-            // Explicit: the step under its stability bound 2/ω_max (at the initial state).
+            // Explicit: the step under its stability bound at the initial state (Kelvin–Voigt
+            // damping of the kHz axial and torsion modes included).
             let mut driver = LinkDriver::new(md, &d, method, out, rho_inf)?;
             let mut res = vec![0.0; driver.system.ndof()];
-            let (w, dof) = crate::method::central_difference::max_frequency(
+            let (bound, dof) = crate::method::central_difference::stability_bound(
                 &mut driver.system,
                 &driver.state,
                 &mut res,
             )?;
-            let bound = 2.0 / w;
             let h = match dt_user {
                 Some(dt) if dt > bound => {
                     return Err(FemError::StabilityBound {
                         dt,
                         bound,
-                        bound_kind: "central-difference (2/ω_max)".into(),
+                        bound_kind: "central-difference (2/(κ + √(κ² + ω²)) of the binding \
+                                     mode)"
+                            .into(),
                         location: describe_dof(&driver.system.model, dof),
                     });
                 }
