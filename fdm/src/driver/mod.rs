@@ -144,10 +144,10 @@ pub fn integrate<S: Model>(
 
 /// Integrates from (q0, v0) at t = 0 to `ctl.t_end` with `method`, consuming `events`.
 ///
-/// Phases: [`RunState::begin`] (initial accelerations, powers, first step and sample),
-/// [`RunState::start_up`] (a two-step form's second level), then per step
-/// [`RunState::next_step`] (the bound's step, logged when it moves), the method's prediction,
-/// [`RunState::watch`] (stop on growth or overextension) and [`RunState::advance`] (force
+/// Phases: `RunState::begin` (initial accelerations, powers, first step and sample),
+/// `RunState::start_up` (a two-step form's second level), then per step
+/// `RunState::next_step` (the bound's step, logged when it moves), the method's prediction,
+/// `RunState::watch` (stop on growth or overextension) and `RunState::advance` (force
 /// evaluation, event location, work, sample, reset).
 pub fn run<S: Model, E: Events<S>>(
     sys: &mut S,

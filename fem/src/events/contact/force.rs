@@ -10,8 +10,8 @@ use crate::linalg::{dot, max_abs};
 impl Contact {
     /// Makes `qd` consistent with the massless balances Nᵀ R(q, q̇, 0) = 0 by changing it along
     /// N only (no kinetic energy, no tip velocity changes: M N = 0, G N = 0); see
-    /// [`Massless::make_consistent`]. Returns the residual passes used. No-op without
-    /// massless directions.
+    /// [`Massless::make_consistent`](crate::events::massless::Massless::make_consistent).
+    /// Returns the residual passes used. No-op without massless directions.
     pub fn make_consistent(
         &mut self,
         chain: &mut Chain,

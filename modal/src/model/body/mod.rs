@@ -130,12 +130,12 @@ struct Reductions {
 /// Fills 𝕄 (d × d row-major), h and the gravity force Q_g (zero without gravity) for one link
 /// at elastic state (a, b) and body velocities ν. `g_loc` is gravity in frame axes.
 ///
-/// Phases: the matrix–vector contractions of the state ([`contract_state`]) and its scalar
-/// reductions ([`reductions`]); 𝕄 and h of the distributed mass ([`distributed_mass`],
-/// [`distributed_h`]); the exact-inextensible and stretch–foreshortening completions; the tip
-/// point ([`tip_point`]) and the tip mass on it ([`tip_mass_terms`]); the rotational inertias
-/// of the tip body and the sections ([`rotational_inertia`]); the first moment of mass and the
-/// gravity force ([`first_moment_and_gravity`]).
+/// Phases: the matrix–vector contractions of the state (`contract_state`) and its scalar
+/// reductions (`reductions`); 𝕄 and h of the distributed mass (`distributed_mass`,
+/// `distributed_h`); the exact-inextensible and stretch–foreshortening completions; the tip
+/// point (`tip_point`) and the tip mass on it (`tip_mass_terms`); the rotational inertias
+/// of the tip body and the sections (`rotational_inertia`); the first moment of mass and the
+/// gravity force (`first_moment_and_gravity`).
 #[allow(clippy::too_many_arguments)]
 pub fn body_terms(
     link: &LinkModel,
