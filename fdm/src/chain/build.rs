@@ -43,6 +43,169 @@ fn check_link(name: &str, l: &Link) -> Result<(), FdmError> {
     Ok(())
 }
 
+/// Refuses what the chain does not carry: other than two links, a link `check_link` refuses,
+/// a mix of Timoshenko and Euler links, section rotary inertia, a joint torque law on
+/// Timoshenko links and a rotor inertia at the elbow. Returns whether the links are Timoshenko.
+fn check_chain(scene: &Scene, pc: &PlanarChain) -> Result<bool, FdmError> {
+    if pc.links.len() != 2 {
+        return Err(FdmError::Unsupported(format!(
+            "fdm: `{}` has {} links; the finite-difference chain handles exactly two",
+            scene.name,
+            pc.links.len()
+        )));
+    }
+    for l in &pc.links {
+        check_link(&scene.name, l)?;
+    }
+    let shear = pc.links[0].shear;
+    if pc.links[1].shear != shear {
+        return Err(FdmError::Unsupported(format!(
+            "fdm: `{}` mixes a Timoshenko (`shear`) and an Euler link; the finite-difference \
+             chain needs both links of one model",
+            scene.name
+        )));
+    }
+    for l in &pc.links {
+        if l.rotary_inertia {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: `{}` (link `{}`) switches on rotary_inertia — the finite-difference \
+                 chain has no section inertia: {}",
+                scene.name,
+                l.name,
+                if l.shear {
+                    "its Timoshenko ψ is massless and condensed (chain::timoshenko)"
+                } else {
+                    "Euler links carry only the lumped masses"
+                }
+            )));
+        }
+        if l.shear && l.joint.torque.is_some() {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: `{}` (link `{}`): an applied joint torque law with Timoshenko links \
+                 is not implemented (the condensed ψ would follow the torque's rate)",
+                scene.name, l.name
+            )));
+        }
+    }
+    if pc.links[1].joint.hub_inertia.unwrap_or(0.0) != 0.0 {
+        return Err(FdmError::Unsupported(format!(
+            "fdm: `{}`: a rotor inertia at the elbow is not implemented",
+            scene.name
+        )));
+    }
+    Ok(shear)
+}
+
+/// Segments r = n − 1, spacing h = L/r and the lumped masses of stations 1…r: ρAh inside,
+/// ρAh/2 plus the tip mass at the tip.
+fn lump(l: &Link, n: usize) -> (usize, f64, Vec<f64>) {
+    let r = n - 1;
+    let h = l.length / r as f64;
+    let mut m = vec![l.mass_per_length * h; r];
+    m[r - 1] = 0.5 * l.mass_per_length * h + l.tip_mass.unwrap_or(0.0);
+    (r, h, m)
+}
+
+/// Outboard sums per segment: Σ_{i > seg} mᵢ xᵢ (`moment`) or Σ_{i > seg} mᵢ.
+fn outboard(m: &[f64], h: f64, moment: bool) -> Vec<f64> {
+    let mut out = vec![0.0; m.len()];
+    let mut acc = 0.0;
+    for seg in (0..m.len()).rev() {
+        acc += m[seg] * if moment { (seg + 1) as f64 * h } else { 1.0 };
+        out[seg] = acc;
+    }
+    out
+}
+
+/// Rotary inertia ρA h³/24 of the half cell at each clamp: its section turns with the clamp
+/// tangent (module docs). O(h³): the O(h²) convergence is unaffected.
+fn clamp_inertia(l: &Link, h: f64) -> f64 {
+    l.mass_per_length * h.powi(3) / 24.0
+}
+
+/// The condensed Timoshenko fields of both links (segments, spacing, EI, κGA, Kelvin–Voigt)
+/// with their joints' springs and dampers.
+fn timoshenko_fields(
+    scene: &Scene,
+    pc: &PlanarChain,
+    grids: [(usize, f64); 2],
+) -> Result<TimoFields, FdmError> {
+    let mut lk = [(0, 0.0, 0.0, 0.0, 0.0); 2];
+    for (k, (l, (r, h))) in pc.links.iter().zip(grids).enumerate() {
+        lk[k] = (
+            r,
+            h,
+            l.bending_stiffness,
+            timoshenko::shear_stiffness(&scene.name, l)?,
+            l.kelvin_voigt.unwrap_or(0.0),
+        );
+    }
+    let jt = |l: &Link| {
+        (
+            l.joint.stiffness.unwrap_or(0.0),
+            l.joint.damping.unwrap_or(0.0),
+            l.joint.set_point.unwrap_or(0.0),
+        )
+    };
+    TimoFields::new(lk, [jt(&pc.links[0]), jt(&pc.links[1])])
+}
+
+/// The chain's mass data from the lumped masses (r, h, m) of both links: outboard moments and
+/// masses, Σmx² of link 1, and link 2's mass, first and second moments about the elbow.
+fn chain_inertia(pc: &PlanarChain, lumps: [(usize, f64, Vec<f64>); 2]) -> ChainInertia {
+    let [(r1, h1, m1), (r2, h2, m2)] = lumps;
+    ChainInertia {
+        hub: pc.links[0].joint.hub_inertia.unwrap_or(0.0),
+        l1: pc.links[0].length,
+        h1,
+        h2,
+        r1,
+        r2,
+        fs1: pc.links[0].foreshortening,
+        fs2: pc.links[1].foreshortening,
+        w1: outboard(&m1, h1, true),
+        w2: outboard(&m2, h2, true),
+        mu2: outboard(&m2, h2, false),
+        sum_mx2_1: (0..r1).map(|k| m1[k] * ((k + 1) as f64 * h1).powi(2)).sum(),
+        // link 2's clamp half cell (mass ρA₂h₂/2 at ξ = 0) rides on the elbow
+        mass2: m2.iter().sum::<f64>() + 0.5 * pc.links[1].mass_per_length * h2,
+        q2: (0..r2).map(|j| m2[j] * (j + 1) as f64 * h2).sum(),
+        i2: (0..r2).map(|j| m2[j] * ((j + 1) as f64 * h2).powi(2)).sum(),
+        m1,
+        m2,
+    }
+}
+
+fn link_props(l: &Link) -> LinkProps {
+    LinkProps {
+        length: l.length,
+        ei: l.bending_stiffness,
+        gamma: l.kelvin_voigt.unwrap_or(0.0),
+        rho_a: l.mass_per_length,
+    }
+}
+
+fn joint_law(l: &Link) -> JointLaw {
+    JointLaw {
+        stiffness: l.joint.stiffness.unwrap_or(0.0),
+        damping: l.joint.damping.unwrap_or(0.0),
+        set_point: l.joint.set_point.unwrap_or(0.0),
+        law: l.joint.torque.clone(),
+    }
+}
+
+/// Mass outboard of each segment of link 1, link 2 (with its clamp half cell) included.
+fn link1_outboard_mass(inertia: &ChainInertia) -> Vec<f64> {
+    let r1 = inertia.r1;
+    let mut acc = inertia.mass2;
+    let mut out = vec![0.0; r1];
+    for seg in (0..r1).rev() {
+        acc += inertia.m1[seg];
+        out[seg] = acc;
+    }
+    out
+}
+
 impl TwoLinkChain {
     /// The chain model of `pc`, the planar chain of `scene`.
     pub fn from_planar_chain(
@@ -50,153 +213,39 @@ impl TwoLinkChain {
         pc: &PlanarChain,
         stations: Option<usize>,
     ) -> Result<Self, FdmError> {
-        if pc.links.len() != 2 {
-            return Err(FdmError::Unsupported(format!(
-                "fdm: `{}` has {} links; the finite-difference chain handles exactly two",
-                scene.name,
-                pc.links.len()
-            )));
-        }
-        for l in &pc.links {
-            check_link(&scene.name, l)?;
-        }
-        let shear = pc.links[0].shear;
-        if pc.links[1].shear != shear {
-            return Err(FdmError::Unsupported(format!(
-                "fdm: `{}` mixes a Timoshenko (`shear`) and an Euler link; the finite-difference \
-                 chain needs both links of one model",
-                scene.name
-            )));
-        }
-        for l in &pc.links {
-            if l.rotary_inertia {
-                return Err(FdmError::Unsupported(format!(
-                    "fdm: `{}` (link `{}`) switches on rotary_inertia — the finite-difference \
-                     chain has no section inertia: {}",
-                    scene.name,
-                    l.name,
-                    if l.shear {
-                        "its Timoshenko ψ is massless and condensed (chain::timoshenko)"
-                    } else {
-                        "Euler links carry only the lumped masses"
-                    }
-                )));
-            }
-            if l.shear && l.joint.torque.is_some() {
-                return Err(FdmError::Unsupported(format!(
-                    "fdm: `{}` (link `{}`): an applied joint torque law with Timoshenko links \
-                     is not implemented (the condensed ψ would follow the torque's rate)",
-                    scene.name, l.name
-                )));
-            }
-        }
-        if pc.links[1].joint.hub_inertia.unwrap_or(0.0) != 0.0 {
-            return Err(FdmError::Unsupported(format!(
-                "fdm: `{}`: a rotor inertia at the elbow is not implemented",
-                scene.name
-            )));
-        }
+        let shear = check_chain(scene, pc)?;
         let n = stations.unwrap_or(DEFAULT_STATIONS);
-        let lump = |l: &Link| -> (usize, f64, Vec<f64>) {
-            let r = n - 1;
-            let h = l.length / r as f64;
-            let mut m = vec![l.mass_per_length * h; r];
-            m[r - 1] = 0.5 * l.mass_per_length * h + l.tip_mass.unwrap_or(0.0);
-            (r, h, m)
-        };
-        let (r1, h1, m1) = lump(&pc.links[0]);
-        let (r2, h2, m2) = lump(&pc.links[1]);
-        // outboard sums per segment: Σ_{i > seg} mᵢ xᵢ and Σ_{i > seg} mᵢ
-        let outboard = |m: &[f64], h: f64, moment: bool| -> Vec<f64> {
-            let mut out = vec![0.0; m.len()];
-            let mut acc = 0.0;
-            for seg in (0..m.len()).rev() {
-                acc += m[seg] * if moment { (seg + 1) as f64 * h } else { 1.0 };
-                out[seg] = acc;
-            }
-            out
-        };
-        // Rotary inertia ρA h³/24 of the half cell at each clamp: its section turns with the
-        // clamp tangent (module docs). O(h³): the O(h²) convergence is unaffected.
-        let clamp = |l: &Link, h: f64| l.mass_per_length * h.powi(3) / 24.0;
+        let (r1, h1, m1) = lump(&pc.links[0], n);
+        let (r2, h2, m2) = lump(&pc.links[1], n);
         // Timoshenko: the clamp section's turn is ψ₀ (massless, condensed), no ghost inertia
         let jc = if shear {
             [0.0; 2]
         } else {
-            [clamp(&pc.links[0], h1), clamp(&pc.links[1], h2)]
+            [
+                clamp_inertia(&pc.links[0], h1),
+                clamp_inertia(&pc.links[1], h2),
+            ]
         };
         let timo = if shear {
-            let mut lk = [(0, 0.0, 0.0, 0.0, 0.0); 2];
-            for (k, (l, (r, h))) in pc.links.iter().zip([(r1, h1), (r2, h2)]).enumerate() {
-                lk[k] = (
-                    r,
-                    h,
-                    l.bending_stiffness,
-                    timoshenko::shear_stiffness(&scene.name, l)?,
-                    l.kelvin_voigt.unwrap_or(0.0),
-                );
-            }
-            let jt = |l: &Link| {
-                (
-                    l.joint.stiffness.unwrap_or(0.0),
-                    l.joint.damping.unwrap_or(0.0),
-                    l.joint.set_point.unwrap_or(0.0),
-                )
-            };
-            Some(TimoFields::new(lk, [jt(&pc.links[0]), jt(&pc.links[1])])?)
+            Some(timoshenko_fields(scene, pc, [(r1, h1), (r2, h2)])?)
         } else {
             None
         };
-        let inertia = ChainInertia {
-            hub: pc.links[0].joint.hub_inertia.unwrap_or(0.0),
-            l1: pc.links[0].length,
-            h1,
-            h2,
-            r1,
-            r2,
-            fs1: pc.links[0].foreshortening,
-            fs2: pc.links[1].foreshortening,
-            w1: outboard(&m1, h1, true),
-            w2: outboard(&m2, h2, true),
-            mu2: outboard(&m2, h2, false),
-            sum_mx2_1: (0..r1).map(|k| m1[k] * ((k + 1) as f64 * h1).powi(2)).sum(),
-            // link 2's clamp half cell (mass ρA₂h₂/2 at ξ = 0) rides on the elbow
-            mass2: m2.iter().sum::<f64>() + 0.5 * pc.links[1].mass_per_length * h2,
-            q2: (0..r2).map(|j| m2[j] * (j + 1) as f64 * h2).sum(),
-            i2: (0..r2).map(|j| m2[j] * ((j + 1) as f64 * h2).powi(2)).sum(),
-            m1,
-            m2,
-        };
-        let props = |l: &Link| LinkProps {
-            length: l.length,
-            ei: l.bending_stiffness,
-            gamma: l.kelvin_voigt.unwrap_or(0.0),
-            rho_a: l.mass_per_length,
-        };
-        let joint = |l: &Link| JointLaw {
-            stiffness: l.joint.stiffness.unwrap_or(0.0),
-            damping: l.joint.damping.unwrap_or(0.0),
-            set_point: l.joint.set_point.unwrap_or(0.0),
-            law: l.joint.torque.clone(),
-        };
+        let inertia = chain_inertia(pc, [(r1, h1, m1), (r2, h2, m2)]);
         // Euler links: link 1's tip ghost y after the inertia's coordinates
         let tip_ghost = (!shear).then(|| inertia.dofs());
-        let jt = if shear { 0.0 } else { clamp(&pc.links[0], h1) };
+        let jt = if shear {
+            0.0
+        } else {
+            clamp_inertia(&pc.links[0], h1)
+        };
         let nd = inertia.dofs() + usize::from(tip_ghost.is_some());
         let contact = TipContact::from_planar_chain(&scene.name, pc)?;
-        let mu1g = {
-            let mut acc = inertia.mass2;
-            let mut out = vec![0.0; r1];
-            for seg in (0..r1).rev() {
-                acc += inertia.m1[seg];
-                out[seg] = acc;
-            }
-            out
-        };
+        let mu1g = link1_outboard_mass(&inertia);
         let (j1, j2) = (&pc.links[0].joint, &pc.links[1].joint);
         let mut chain = TwoLinkChain {
-            links: [props(&pc.links[0]), props(&pc.links[1])],
-            joints: [joint(&pc.links[0]), joint(&pc.links[1])],
+            links: [link_props(&pc.links[0]), link_props(&pc.links[1])],
+            joints: [joint_law(&pc.links[0]), joint_law(&pc.links[1])],
             init: [
                 (j1.initial_angle, j1.initial_rate),
                 (j2.initial_angle, j2.initial_rate),
@@ -237,27 +286,31 @@ impl TwoLinkChain {
             vd: vec![0.0; nd],
             timo,
         };
-        // The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state:
-        // built once here, `accel` refreshes only the θ and β columns.
-        for k in 0..2 {
-            let mut col = std::mem::take(&mut chain.cols[2 + k]);
-            if chain.timo.is_some() {
-                // unused slot: a decoupled unit mass with no force keeps it at rest at zero
-                col[chain.slots[k]] = 1.0;
-            } else {
-                chain.add_clamp(k, -chain.jc[k] / (2.0 * chain.hs[k]), &mut col);
-            }
-            chain.cols[2 + k] = col;
-        }
-        if let Some(y) = chain.tip_ghost {
-            let mut col = std::mem::take(&mut chain.cols[4]);
-            chain.add_tip(chain.jt / (2.0 * chain.hs[0]), &mut col);
-            debug_assert_eq!(col[y], chain.jt / (4.0 * chain.hs[0] * chain.hs[0]));
-            chain.cols[4] = col;
-        }
+        chain.set_ghost_columns();
         chain.omega_max = chain.top_frequency();
         chain.kappa_max = chain.top_damping_rate();
         Ok(chain)
+    }
+
+    /// The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state: built
+    /// once here, `accel` refreshes only the θ and β columns.
+    fn set_ghost_columns(&mut self) {
+        for k in 0..2 {
+            let mut col = std::mem::take(&mut self.cols[2 + k]);
+            if self.timo.is_some() {
+                // unused slot: a decoupled unit mass with no force keeps it at rest at zero
+                col[self.slots[k]] = 1.0;
+            } else {
+                self.add_clamp(k, -self.jc[k] / (2.0 * self.hs[k]), &mut col);
+            }
+            self.cols[2 + k] = col;
+        }
+        if let Some(y) = self.tip_ghost {
+            let mut col = std::mem::take(&mut self.cols[4]);
+            self.add_tip(self.jt / (2.0 * self.hs[0]), &mut col);
+            debug_assert_eq!(col[y], self.jt / (4.0 * self.hs[0] * self.hs[0]));
+            self.cols[4] = col;
+        }
     }
 
     pub fn dof_plan(&self) -> DofPlan {

@@ -26,6 +26,7 @@
 
 pub mod analysis;
 pub mod basis;
+mod build;
 pub mod dynamics;
 pub mod model;
 pub mod run;

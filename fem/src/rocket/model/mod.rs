@@ -4,13 +4,14 @@
 //! (ξ along the body axis at launch, η across it), rigid motion included — then per discrete
 //! mass (U_j, W_j) in the same axes. Every operator is integrated by 4-point Gauss quadrature
 //! on each part of an element between breakpoints (stage junctions), which is exact for the
-//! piecewise-constant sections (mass integrands are of degree 6).
+//! piecewise-constant sections (mass integrands are of degree 6). [`Model::new`] builds it in
+//! phases (the `build` submodule).
 
-use data::scene::{InitialShape, Rocket};
+use data::scene::InitialShape;
 
-use crate::element::hermite::{HermiteAt, hermite};
-use crate::element::quadrature::gauss01;
-use crate::error::FemError;
+use crate::element::hermite::hermite;
+
+mod build;
 
 /// Nodal DOFs: axial u, transverse w, slope w′.
 pub const DOFS_PER_NODE: usize = 3;
@@ -180,268 +181,18 @@ fn dofs_of(e: usize) -> ([usize; 2], [usize; 4]) {
     ([a, b], [a + 1, a + 2, b + 1, b + 2])
 }
 
-impl Model {
-    pub fn new(r: &Rocket, elements: usize) -> Result<Self, FemError> {
-        if r.stages.is_empty() {
-            return Err(FemError::unsupported("rocket without stages"));
-        }
-        if r.exit_pressure != 0.0 {
-            return Err(FemError::unsupported(
-                "rocket exit pressure p_e ≠ 0 (the report's vacuum expansion, eq. 5.16, assumes p_e = 0)",
-            ));
-        }
-        if r.stages.iter().skip(1).any(|s| s.burn_rate != 0.0) {
-            return Err(FemError::unsupported(
-                "rocket: only the first (aft) stage may burn",
-            ));
-        }
-        let g = r.gravity;
-        let length = r.length();
-        let h = length / elements as f64;
-        let nodes = elements + 1;
-        let nm = r.discrete_masses.len();
-        let n = DOFS_PER_NODE * nodes + 2 * nm;
-        let l1 = r.stages[0].length;
-        let e_mod = r.youngs_modulus;
-        // Stage intervals and breakpoints.
-        let mut bounds = Vec::new();
-        let mut a = 0.0;
-        for s in &r.stages {
-            bounds.push((a, a + s.length));
-            a += s.length;
-        }
-        let mut quad = Vec::new();
-        for el in 0..elements {
-            let (xa, xb) = (el as f64 * h, (el + 1) as f64 * h);
-            for (k, (st, &(ba, bb))) in r.stages.iter().zip(&bounds).enumerate() {
-                let (lo, hi) = (ba.max(xa), bb.min(xb));
-                if hi - lo <= 1e-12 * h {
-                    continue;
-                }
-                let (nodes, weights) = gauss01(4);
-                for (&z, &wg) in nodes.iter().zip(weights) {
-                    let x = lo + (hi - lo) * z;
-                    quad.push(Quad {
-                        element: el,
-                        s: (x - xa) / h,
-                        weight: (hi - lo) * wg,
-                        ea: e_mod * st.area,
-                        ei: e_mod * st.inertia,
-                        fixed_mass: if k == 0 {
-                            0.0
-                        } else {
-                            st.weight_per_length / g
-                        },
-                        burning: k == 0,
-                    });
-                }
-            }
-        }
-        let mut mb = std::collections::BTreeMap::new();
-        let mut mf = std::collections::BTreeMap::new();
-        let mut kb = std::collections::BTreeMap::new();
-        let mut cor_u = vec![0.0; n];
-        let mut cor_w = vec![0.0; n];
-        for q in &quad {
-            let (nu, du) = linear(q.s, h);
-            let HermiteAt {
-                n: hw, ddn: hdd, ..
-            } = hermite(q.s, h);
-            let (iu, iw) = dofs_of(q.element);
-            let (mass_b, mass_f) = (
-                if q.burning { q.weight } else { 0.0 },
-                q.weight * q.fixed_mass,
-            );
-            for a in 0..2 {
-                for b in 0..2 {
-                    *mb.entry((iu[a], iu[b])).or_insert(0.0) += mass_b * nu[a] * nu[b];
-                    *mf.entry((iu[a], iu[b])).or_insert(0.0) += mass_f * nu[a] * nu[b];
-                    *kb.entry((iu[a], iu[b])).or_insert(0.0) += q.weight * q.ea * du[a] * du[b];
-                }
-            }
-            for a in 0..4 {
-                for b in 0..4 {
-                    *mb.entry((iw[a], iw[b])).or_insert(0.0) += mass_b * hw[a] * hw[b];
-                    *mf.entry((iw[a], iw[b])).or_insert(0.0) += mass_f * hw[a] * hw[b];
-                    *kb.entry((iw[a], iw[b])).or_insert(0.0) += q.weight * q.ei * hdd[a] * hdd[b];
-                }
-            }
-            let x = (q.element as f64 + q.s) * h;
-            let flow = if q.burning {
-                (1.0 - x / l1).max(0.0)
-            } else {
-                0.0
-            };
-            for a in 0..2 {
-                cor_u[iu[a]] += q.weight * flow * nu[a];
-            }
-            for a in 0..4 {
-                cor_w[iw[a]] += q.weight * flow * hw[a];
-            }
-        }
-        let point = |x: f64| -> Point {
-            let el = ((x / h).floor() as usize).min(elements - 1);
-            let s = x / h - el as f64;
-            let (nu, _) = linear(s, h);
-            let hw = hermite(s, h).n;
-            let (iu, iw) = dofs_of(el);
-            Point { x, iu, nu, iw, hw }
-        };
-        let base = DOFS_PER_NODE * nodes;
-        let mut masses = Vec::new();
-        for (k, dm) in r.discrete_masses.iter().enumerate() {
-            if !(0.0..=length).contains(&dm.position) {
-                return Err(FemError::InvalidSettings {
-                    field: "rocket.discrete_mass".into(),
-                    message: format!(
-                        "mass {} at x = {} lies outside the body",
-                        k + 1,
-                        dm.position
-                    ),
-                });
-            }
-            masses.push(Attached {
-                at: point(dm.position),
-                mass: dm.weight / g,
-                ku: dm.axial_stiffness,
-                kw: dm.transverse_stiffness,
-                cu: dm.axial_damping,
-                cw: dm.transverse_damping,
-            });
-        }
-        let mut couplings = Vec::new();
-        for sp in &r.springs {
-            let [a, b] = sp.between;
-            if a >= nm || b >= nm || a == b {
-                return Err(FemError::InvalidSettings {
-                    field: "rocket.spring".into(),
-                    message: format!("spring between masses {a} and {b}: no such pair"),
-                });
-            }
-            couplings.push(Coupling {
-                a,
-                b,
-                ku: sp.axial_stiffness,
-                kw: sp.transverse_stiffness,
-                cu: sp.axial_damping,
-                cw: sp.transverse_damping,
-            });
-        }
-        // A mass held by no spring in one direction would drift through the case as a rigid
-        // body of its own (the model has no contact): refused, as modal does.
-        for (j, m) in masses.iter().enumerate() {
-            let held = |own: f64, coupled: fn(&Coupling) -> f64| {
-                own > 0.0
-                    || couplings
-                        .iter()
-                        .any(|c| (c.a == j || c.b == j) && coupled(c) > 0.0)
-            };
-            if !(held(m.ku, |c| c.ku) && held(m.kw, |c| c.kw)) {
-                return Err(FemError::Unsupported(format!(
-                    "rocket.discrete_mass[{j}] has no axial or no transverse spring to the case \
-                     or to another mass: it would drift freely (no contact model)"
-                )));
-            }
-        }
-        let mut x_ref = vec![0.0; n];
-        let mut t_xi = vec![0.0; n];
-        let mut t_eta = vec![0.0; n];
-        for i in 0..nodes {
-            x_ref[DOFS_PER_NODE * i] = i as f64 * h;
-            t_xi[DOFS_PER_NODE * i] = 1.0;
-            t_eta[DOFS_PER_NODE * i + 1] = 1.0;
-        }
-        let (t_xi_case, t_eta_case) = (t_xi.clone(), t_eta.clone());
-        for (j, m) in masses.iter().enumerate() {
-            x_ref[base + j] = m.at.x;
-            t_xi[base + j] = 1.0;
-            t_eta[base + nm + j] = 1.0;
-        }
-        let s1 = &r.stages[0];
-        let m1_0 = s1.weight_per_length / g;
-        let m1_casing = s1.casing_weight_per_length.unwrap_or(0.0) / g;
-        let mut model = Model {
-            elements,
-            nodes,
-            n,
-            h,
-            length,
-            l1,
-            theta0: r.launch_angle_deg.to_radians(),
-            g,
-            gamma: r.nozzle_angle_deg.to_radians(),
-            m1_0,
-            m1_casing,
-            burn_rate: s1.burn_rate / g,
-            exhaust_velocity: r.exhaust_velocity,
-            pressure_force: r.chamber_pressure * r.port_area,
-            m_burn: Triplets::from_map(mb),
-            m_fixed: Triplets::from_map(mf),
-            k_beam: Triplets::from_map(kb),
-            quad,
-            masses,
-            couplings,
-            pressure_point: point(l1),
-            x_ref,
-            t_xi,
-            t_eta,
-            m0: 0.0,
-            x_bar: 0.0,
-            a_c_xi: Vec::new(),
-            a_c_eta: Vec::new(),
-            a_s_xi: Vec::new(),
-            a_s_eta: Vec::new(),
-            b_s_xi: Vec::new(),
-            b_s_eta: Vec::new(),
-            cor_u,
-            cor_w,
-        };
-        // Mean-axis functionals with the case's ignition mass M₀ (discrete masses excluded).
-        let m0_apply = |m: &Model, x: &[f64]| {
-            let mut y = vec![0.0; n];
-            m.m_fixed.mul_add(1.0, x, &mut y);
-            m.m_burn.mul_add(m.m1_0, x, &mut y);
-            y
-        };
-        let a_xi = m0_apply(&model, &t_xi_case);
-        let a_eta = m0_apply(&model, &t_eta_case);
-        let m0 = crate::linalg::dot(&a_xi, &t_xi_case);
-        let x_bar = crate::linalg::dot(&a_xi, &model.x_ref) / m0;
-        let mut lin_u = vec![0.0; n];
-        let mut lin_w = vec![0.0; n];
-        for i in 0..nodes {
-            lin_u[DOFS_PER_NODE * i] = i as f64 * h - x_bar;
-            lin_w[DOFS_PER_NODE * i + 1] = i as f64 * h - x_bar;
-            lin_w[DOFS_PER_NODE * i + 2] = 1.0;
-        }
-        model.a_s_xi = m0_apply(&model, &lin_u);
-        model.a_s_eta = m0_apply(&model, &lin_w);
-        // the whole body: about its centroid x̄_b, ∫m₀(x − x̄_b)R = a_s·R + m₀(x̄ − x̄_b)c, and
-        // each mass adds M_j(x_j − x̄_b)R_j
-        let masses_total: f64 = model.masses.iter().map(|m| m.mass).sum();
-        let x_body = (m0 * x_bar + model.masses.iter().map(|m| m.mass * m.at.x).sum::<f64>())
-            / (m0 + masses_total);
-        let shift = |a_s: &[f64], a_total: &[f64]| -> Vec<f64> {
-            a_s.iter()
-                .zip(a_total)
-                .map(|(s, t)| s + (x_bar - x_body) * t)
-                .collect()
-        };
-        model.b_s_xi = shift(&model.a_s_xi, &a_xi);
-        model.b_s_eta = shift(&model.a_s_eta, &a_eta);
-        for j in 0..model.masses.len() {
-            let (iu, iw) = model.mass_dofs(j);
-            let moment = model.masses[j].mass * (model.masses[j].at.x - x_body);
-            model.b_s_xi[iu] += moment;
-            model.b_s_eta[iw] += moment;
-        }
-        model.a_c_xi = a_xi.iter().map(|v| v / m0).collect();
-        model.a_c_eta = a_eta.iter().map(|v| v / m0).collect();
-        model.m0 = m0;
-        model.x_bar = x_bar;
-        Ok(model)
-    }
+/// The shape functions of the point x on a mesh of `elements` elements of length h (the last
+/// element takes x = L).
+fn mesh_point(x: f64, h: f64, elements: usize) -> Point {
+    let el = ((x / h).floor() as usize).min(elements - 1);
+    let s = x / h - el as f64;
+    let (nu, _) = linear(s, h);
+    let hw = hermite(s, h).n;
+    let (iu, iw) = dofs_of(el);
+    Point { x, iu, nu, iw, hw }
+}
 
+impl Model {
     pub fn base(&self) -> usize {
         DOFS_PER_NODE * self.nodes
     }
@@ -540,12 +291,7 @@ impl Model {
 
     /// Point on the mesh at x.
     pub fn point(&self, x: f64) -> Point {
-        let el = ((x / self.h).floor() as usize).min(self.elements - 1);
-        let s = x / self.h - el as f64;
-        let (nu, _) = linear(s, self.h);
-        let hw = hermite(s, self.h).n;
-        let (iu, iw) = dofs_of(el);
-        Point { x, iu, nu, iw, hw }
+        mesh_point(x, self.h, self.elements)
     }
 
     /// Strain energy V = ∫½EA u′² + ½EI w″² + ½EA u′w′² (report eq. 3.50, P = EA u′).

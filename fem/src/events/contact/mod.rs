@@ -142,7 +142,8 @@
 //! driven by [`crate::events::contact::friction`] (`Contact::bilateral`).
 //!
 //! **Methods.** The driver locates the events and applies the resets whatever the method;
-//! a method only has to step the constrained phase through [`StepConstraint`]. The
+//! a method only has to step the constrained phase through
+//! [`StepConstraint`](crate::method::StepConstraint). The
 //! `energy-midpoint` and `implicit-midpoint` steps do (both have the mean acceleration ā as
 //! Newton unknown, ∂q₁/∂ā = h²/2, and both apply the discrete-gradient force above, so the
 //! held constraint does no work in either). `generalized-alpha` does too, with that force at t₁
@@ -162,18 +163,25 @@
 //! links without rotary inertia at all (the end rates of the massless rotations:
 //! `crate::run`), contact with `central-difference` (no Newton iteration to border:
 //! [`crate::method`]), and contact with adaptive stepping (`time.rtol`).
+//!
+//! **Layout.** This file: the contact's parts, its construction and the gap with its gradient;
+//! `mass`: the solves with M(q) + μNNᵀ; `force`: the index-1 normal force; `impact`: the impact
+//! map and the plastic projection; `step`: the [`StepConstraint`](crate::method::StepConstraint)
+//! the methods consume; [`friction`]: the bilateral walls.
 
+mod force;
 pub mod friction;
+mod impact;
+mod mass;
+mod step;
 
 use data::Event;
 use data::scene::{PlanarChain, Surface};
 
-use crate::chain::{AugmentedLayout, Chain, MAX_LINKS, Parts, V2};
+use crate::chain::{Chain, MAX_LINKS, V2};
 use crate::error::FemError;
 use crate::events::mass_solve::MassSolver;
 use crate::events::massless::Massless;
-use crate::linalg::{dot, max_abs};
-use crate::method::{ConstraintView, NewtonSystem, StepConstraint};
 
 /// Gap tolerance of a located contact start, relative to the longest link.
 pub const GAP_TOL: f64 = 1e-10;
@@ -212,7 +220,7 @@ pub const GRAZING_LOCATION: &str = "contact1 (grazing)";
 #[derive(Debug, Clone)]
 pub struct Contact {
     /// Gap g, its gradient G and discrete gradient ∇̄g, the step multiplier: the rows a
-    /// constrained step adds to the method's equations ([`StepConstraint`]).
+    /// constrained step adds to the method's equations ([`crate::method::StepConstraint`]).
     pub constraint: TipConstraint,
     /// Phase and state of the impact law (held or free, normal force, gap and drift at the
     /// current state) and the event tolerances.
@@ -439,370 +447,6 @@ impl Contact {
         self.gap_of(r)
     }
 
-    /// Forms and factorizes M(q) + μNNᵀ sparsely ([`crate::events::mass_solve`]; reused at
-    /// the same (t, q)). Returns the residual passes used.
-    fn factor_mass(&mut self, chain: &mut Chain, t: f64, q: &[f64]) -> Result<usize, FemError> {
-        let n = chain.ndof;
-        let mut passes = 0;
-        if !self.solve.reg_dirs.is_empty() && self.solve.mass_scale == 0.0 {
-            // μ: the largest diagonal mass (any positive scale works on the exact directions;
-            // module docs), from n mass products once per run.
-            for j in 0..n {
-                self.solve.unit[j] = 1.0;
-                chain.residual_parts(
-                    t,
-                    q,
-                    &self.solve.zero,
-                    &self.solve.unit,
-                    Parts::INERTIA,
-                    &mut self.solve.col,
-                );
-                self.solve.unit[j] = 0.0;
-                self.solve.mass_scale = self.solve.mass_scale.max(self.solve.col[j].abs());
-            }
-            passes += n;
-        }
-        Ok(passes + self.solve.mass.factor(chain, t, q, self.solve.mass_scale)?)
-    }
-
-    /// `minv_gt` ← (M(q) + μNNᵀ)⁻¹ `g_row` (G at (t, q)); returns the residual passes used.
-    ///
-    /// Kept while (t, q) is unchanged (the normal force at a step end, then its drift
-    /// projection). Otherwise, with a factorization at hand from an earlier configuration
-    /// (the previous step end: M moves by O(h·q̇) between them), iterative refinement against
-    /// the current matrix, x ← x + M₀⁻¹(Gᵀ − M(q)x) with the exact mass product of one
-    /// inertial residual pass, replaces a new assembly and factorization (one pass and one
-    /// solve each, against an assembly of the exact Newton matrix, a factorization with its
-    /// border solves and a pass). It stops at a correction within [`REFINE_TOL`] of x (the
-    /// round-off floor of the refinement, measured 1e-14..1e-13 relative); a first correction
-    /// beyond [`FAR_REFINE`], a contraction slower than [`REFINE_RATE`] per iteration, or
-    /// [`MAX_REFINE`] iterations without reaching the tolerance form and factorize M(q) and
-    /// solve directly, as does the solve after one that needed [`SLOW_REFINE`] iterations
-    /// (the factorization at hand has fallen too far behind). Not with massless section
-    /// rotations (Timoshenko links without rotary inertia): there the residual R carries the
-    /// stiff shear forces, which amplify the refinement's tolerance into the normal force
-    /// (measured: a release located with λ = −2.7e-2 lbf at a bracket of 9e-13 s on
-    /// `barhorst-case1-timoshenko`, 8 elements) — those runs factorize at every configuration.
-    fn solve_gradient(
-        &mut self,
-        chain: &mut Chain,
-        t: f64,
-        q: &[f64],
-        g_row: &[f64],
-        fresh: bool,
-    ) -> Result<(usize, bool), FemError> {
-        let sv = &self.solve;
-        if !fresh
-            && sv.minv_key_t.is_some_and(|k| k.to_bits() == t.to_bits())
-            && sv
-                .minv_key_q
-                .iter()
-                .zip(q)
-                .all(|(a, b)| a.to_bits() == b.to_bits())
-        {
-            return Ok((0, self.solve.minv_refined));
-        }
-        self.solve.minv_key_t = None;
-        let mut passes = 0;
-        let mu = self.solve.mass_scale;
-        let stale = !fresh
-            && self.solve.massless.is_none()
-            && self.solve.mass.factored()
-            && !self.solve.refactor_next
-            && !self.solve.mass.is_at(t, q, mu);
-        let mut refined = false;
-        if stale {
-            self.solve.minv_gt.copy_from_slice(g_row);
-            self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
-            let mut last = f64::INFINITY;
-            for k in 0..MAX_REFINE {
-                passes += 1;
-                self.mass_product(chain, t, q);
-                for i in 0..g_row.len() {
-                    self.solve.dx[i] = g_row[i] - self.solve.col[i];
-                }
-                self.solve.mass.solve_in_place(&mut self.solve.dx);
-                let dn = max_abs(&self.solve.dx);
-                for i in 0..g_row.len() {
-                    self.solve.minv_gt[i] += self.solve.dx[i];
-                }
-                let xn = max_abs(&self.solve.minv_gt);
-                if dn <= REFINE_TOL * xn {
-                    refined = true;
-                    self.solve.refactor_next = k + 1 >= SLOW_REFINE;
-                    break;
-                }
-                // A NaN correction is no contraction either.
-                let contracting = dn <= REFINE_RATE * last;
-                if !contracting || (k == 0 && dn > FAR_REFINE * xn) {
-                    break;
-                }
-                last = dn;
-            }
-        }
-        if !refined {
-            self.solve.refactor_next = false;
-            passes += self.factor_mass(chain, t, q)?;
-            self.solve.minv_gt.copy_from_slice(g_row);
-            self.solve.mass.solve_in_place(&mut self.solve.minv_gt);
-        }
-        self.solve.minv_key_t = Some(t);
-        self.solve.minv_key_q.copy_from_slice(q);
-        self.solve.minv_refined = refined;
-        Ok((passes, refined))
-    }
-
-    /// `col` ← (M(q) + μNNᵀ)·`minv_gt`: one inertial residual pass and the regularization.
-    fn mass_product(&mut self, chain: &mut Chain, t: f64, q: &[f64]) {
-        let sv = &mut self.solve;
-        chain.residual_parts(t, q, &sv.zero, &sv.minv_gt, Parts::INERTIA, &mut sv.col);
-        for d in &sv.reg_dirs {
-            let w: f64 = d.iter().map(|&(i, c)| c * sv.minv_gt[i]).sum();
-            for &(i, c) in d {
-                sv.col[i] += sv.mass_scale * c * w;
-            }
-        }
-    }
-
-    /// Makes `qd` consistent with the massless balances Nᵀ R(q, q̇, 0) = 0 by changing it along
-    /// N only (no kinetic energy, no tip velocity changes: M N = 0, G N = 0); see
-    /// [`Massless::make_consistent`]. Returns the residual passes used. No-op without
-    /// massless directions.
-    pub fn make_consistent(
-        &mut self,
-        chain: &mut Chain,
-        t: f64,
-        q: &[f64],
-        qd: &mut [f64],
-    ) -> Result<usize, FemError> {
-        match self.solve.massless.as_mut() {
-            Some(ml) => ml.make_consistent(chain, t, q, qd),
-            None => Ok(0),
-        }
-    }
-
-    /// Normal force of the constrained dynamics at (q, q̇) (module docs); also sets G (in
-    /// `g_end`), M⁻¹Gᵀ, the gap and the normal velocity. Returns (λ, G M⁻¹Gᵀ, passes).
-    pub fn state_force(
-        &mut self,
-        chain: &mut Chain,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-    ) -> Result<(f64, f64, usize), FemError> {
-        let mut g_row = std::mem::take(&mut self.constraint.g_end);
-        self.phase.gap = self.gradient(chain, t, q, &mut g_row);
-        let mut qd_c = std::mem::take(&mut self.solve.qd_c);
-        let out = self.state_force_with(chain, t, q, qd, &g_row, &mut qd_c);
-        self.constraint.g_end = g_row;
-        self.solve.qd_c = qd_c;
-        out
-    }
-
-    /// [`Contact::state_force`] with G in `g_row`; `qd_c` receives the consistent velocity.
-    fn state_force_with(
-        &mut self,
-        chain: &mut Chain,
-        t: f64,
-        q: &[f64],
-        qd: &[f64],
-        g_row: &[f64],
-        qd_c: &mut [f64],
-    ) -> Result<(f64, f64, usize), FemError> {
-        let mut n = 0;
-        let mut fresh = false;
-        loop {
-            let (passes, refined) = self.solve_gradient(chain, t, q, g_row, fresh)?;
-            n += passes;
-            let gmg = dot(g_row, &self.solve.minv_gt);
-            // The force of the constrained dynamics at the velocity it allows: q̇ projected onto
-            // G q̇ = 0 (the plastic projection applied after every constrained step, module
-            // docs), and, with massless directions, made consistent with their balances (the
-            // stepper's end rate there is not determined by its equations). The drift
-            // G q̇ = O(h²) of a step end otherwise entered λ through the velocity terms:
-            // measured up to 9.6 lbf between the end of a step and its projected state
-            // (`barhorst-case1-tipmass`), a jump that the release location then met at a
-            // bracket of 4e-14 s.
-            qd_c.copy_from_slice(qd);
-            let vn = dot(g_row, qd_c);
-            for i in 0..qd_c.len() {
-                qd_c[i] -= self.solve.minv_gt[i] * vn / gmg;
-            }
-            n += self.make_consistent(chain, t, q, qd_c)?;
-            // R(q, q̇, 0): everything but the inertia of q̈; G M⁻¹R = (M⁻¹Gᵀ)ᵀR (M symmetric).
-            chain.residual(t, q, qd_c, &self.solve.zero, &mut self.solve.tmp);
-            let [_, _, a] = chain.tip_motion(t, self.constraint.link, q, qd_c, &self.solve.zero);
-            // The normal velocity of the state itself (the drift, before any projection).
-            self.phase.normal_velocity = vn;
-            let conv = self.constraint.normal.dot(&a);
-            let sv = &mut self.solve;
-            let g_minv_r = if refined {
-                dot(&sv.minv_gt, &sv.tmp)
-            } else {
-                sv.dx.copy_from_slice(&sv.tmp);
-                sv.mass.solve_in_place(&mut sv.dx);
-                dot(g_row, &sv.dx)
-            };
-            let lambda = (g_minv_r - conv) / gmg;
-            n += 2;
-            if refined {
-                // A refined M⁻¹Gᵀ is exact to REFINE_TOL·‖x‖∞ only, which large elastic forces
-                // in R amplify: near zero — where the release is decided and located, and λ(h)
-                // must be continuous in h — the force is evaluated again with a factorization
-                // at q (and G M⁻¹R by a second solve, as without refinement).
-                let sum_abs = |v: &[f64]| v.iter().map(|x| x.abs()).sum::<f64>();
-                let bound = REFINE_TOL
-                    * max_abs(&self.solve.minv_gt)
-                    * (sum_abs(&self.solve.tmp) + lambda.abs() * sum_abs(g_row))
-                    / gmg.abs();
-                let clear_of_zero = lambda.abs() > REFINE_MARGIN * bound;
-                if !clear_of_zero {
-                    fresh = true;
-                    continue;
-                }
-            }
-            return Ok((lambda, gmg, n));
-        }
-    }
-
-    /// Perfectly plastic impact at (q, q̇⁻) (module docs): updates `qd` to q̇⁺ and returns the
-    /// event (None when the tip does not move into the surface, G q̇⁻ ≥ 0).
-    pub fn impact(
-        &mut self,
-        chain: &mut Chain,
-        t: f64,
-        q: &[f64],
-        qd: &mut [f64],
-    ) -> Result<Option<Event>, FemError> {
-        let n = chain.ndof;
-        // Massless directions (module docs): q̇⁻ consistent with their balances first (changes
-        // neither the kinetic energy nor G q̇).
-        self.make_consistent(chain, t, q, qd)?;
-        let mut g_row = std::mem::take(&mut self.constraint.g_end);
-        self.phase.gap = self.gradient(chain, t, q, &mut g_row);
-        let v_before = dot(&g_row, qd);
-        // A normal velocity at the round-off level of G q̇ is no impact.
-        let roundoff = 1e-14
-            * g_row
-                .iter()
-                .zip(qd.iter())
-                .map(|(g, v)| (g * v).abs())
-                .sum::<f64>();
-        if v_before >= -roundoff {
-            self.constraint.g_end = g_row;
-            return Ok(None);
-        }
-        if let Err(e) = self.solve_gradient(chain, t, q, &g_row, false) {
-            self.constraint.g_end = g_row;
-            return Err(e);
-        }
-        let gmg = dot(&g_row, &self.solve.minv_gt);
-        let impulse = -v_before / gmg;
-        let velocity_before = qd.to_vec();
-        for i in 0..n {
-            qd[i] += self.solve.minv_gt[i] * impulse;
-        }
-        // The massless balances hold after the jump too: Nᵀ C Δq̇ = 0 fixes its N-component
-        // (zero kinetic energy, no mass product, no normal velocity).
-        self.make_consistent(chain, t, q, qd)?;
-        // Independent mass product of the velocity jump (not the factorized matrix). The jump
-        // is the increment applied, M⁻¹GᵀΛ: the difference of the stored velocities would add
-        // their rounding (|q̇|·1e-16), which dominates for grazing impacts with tiny Λ.
-        for i in 0..n {
-            self.solve.unit[i] = self.solve.minv_gt[i] * impulse;
-        }
-        chain.residual_parts(
-            t,
-            q,
-            &self.solve.zero,
-            &self.solve.unit,
-            Parts::INERTIA,
-            &mut self.solve.col,
-        );
-        // Massive-block balance: M Δq̇ − GᵀΛ ∈ span N, the N-part being −μN NᵀΔq̇ (module
-        // docs; zero along the exactly massless directions).
-        self.solve.tmp.copy_from_slice(&self.solve.col);
-        for d in &self.solve.reg_dirs {
-            let w: f64 = d.iter().map(|&(i, c)| c * self.solve.unit[i]).sum();
-            for &(i, c) in d {
-                self.solve.tmp[i] += self.solve.mass_scale * c * w;
-            }
-        }
-        self.solve.unit.iter_mut().for_each(|x| *x = 0.0);
-        let (mut res2, mut mom2) = (0.0, 0.0);
-        for i in 0..n {
-            let r = self.solve.tmp[i] - g_row[i] * impulse;
-            res2 += r * r;
-            mom2 += self.solve.col[i] * self.solve.col[i];
-        }
-        let momentum_residual = if mom2 > 0.0 {
-            (res2 / mom2).sqrt()
-        } else {
-            res2.sqrt()
-        };
-        // The kinetic energy lost, booked as the difference of the evaluated kinetic energies
-        // (the ledger then closes exactly). For the massive block alone it is the loss of the
-        // plastic map ½Λ²(G M⁻¹Gᵀ) ≥ 0; the reaction that keeps the frame directions' velocity
-        // (module docs) does work where they move, which the formula omits (measured up to
-        // 3e-3 ft·lbf of 0.45 at the fifth impact of 4 elements, which broke the ledger
-        // closure to 4.7e-5 when the formula was booked).
-        let ke_before = chain.energies(t, q, &velocity_before)[0];
-        let loss = ke_before - chain.energies(t, q, qd)[0];
-        self.record.impact_loss += loss;
-        self.phase.normal_velocity = dot(&g_row, qd);
-        self.constraint.g_end = g_row;
-        Ok(Some(Event::Impact {
-            t,
-            contact: 1,
-            velocity_before,
-            velocity_after: qd.to_vec(),
-            impulse,
-            momentum_residual,
-            normal_velocity_before: v_before,
-            normal_velocity_after: self.phase.normal_velocity,
-            kinetic_energy_lost: loss,
-        }))
-    }
-
-    /// Plastic projection of the velocity onto G q̇ = 0 (q̇ ← q̇ − M⁻¹Gᵀ(G q̇)/(G M⁻¹Gᵀ)),
-    /// only when `inward_only` is false or G q̇ < 0; returns the kinetic energy it removes,
-    /// ½(G q̇)²/(G M⁻¹Gᵀ) ≥ 0, and the residual passes of the mass factorization. Records the
-    /// gap and the drift G q̇ before the projection.
-    pub(crate) fn project(
-        &mut self,
-        chain: &mut Chain,
-        t: f64,
-        q: &[f64],
-        qd: &mut [f64],
-        inward_only: bool,
-    ) -> Result<(f64, usize), FemError> {
-        let mut g_row = std::mem::take(&mut self.constraint.g_end);
-        self.phase.gap = self.gradient(chain, t, q, &mut g_row);
-        let vn = dot(&g_row, qd);
-        self.phase.drift_velocity = vn;
-        let mut loss = 0.0;
-        let mut passes = 0;
-        if !inward_only || vn < 0.0 {
-            passes = match self.solve_gradient(chain, t, q, &g_row, false) {
-                Ok((p, _)) => p,
-                Err(e) => {
-                    self.constraint.g_end = g_row;
-                    return Err(e);
-                }
-            };
-            let gmg = dot(&g_row, &self.solve.minv_gt);
-            let ke0 = chain.energies(t, q, qd)[0];
-            for i in 0..qd.len() {
-                qd[i] -= self.solve.minv_gt[i] * vn / gmg;
-            }
-            self.make_consistent(chain, t, q, qd)?;
-            loss = ke0 - chain.energies(t, q, qd)[0];
-        }
-        self.phase.normal_velocity = dot(&g_row, qd);
-        self.constraint.g_end = g_row;
-        Ok((loss, passes))
-    }
-
     /// Reports a pending release (the free motion after it was stepped).
     pub fn flush_pending(&mut self) {
         if let Some(e) = self.phase.pending_release.take() {
@@ -813,83 +457,5 @@ impl Contact {
     pub(crate) fn push(&mut self, e: Event) {
         self.record.n_events += 1;
         self.record.events.push(e);
-    }
-}
-
-/// The contact held in a constrained phase, as the method sees it: the force ∇̄g λ with ∇̄g
-/// the Gonzalez discrete gradient of the gap (metric W = M(q̄), as for the potential, so
-/// Δqᵀ∇̄g = g(q₁) − g(q₀) and the constraint does no work), friction and the stick constraint
-/// of a bilateral wall ([`crate::events::contact::friction`]), and the bordered Newton update.
-impl StepConstraint<Chain> for Contact {
-    fn value(&self, chain: &Chain, t: f64, q: &[f64]) -> f64 {
-        self.gap_at(chain, t, q)
-    }
-
-    fn multiplier(&self) -> f64 {
-        self.constraint.step_lambda
-    }
-
-    fn set_multiplier(&mut self, lambda: f64) {
-        self.constraint.step_lambda = lambda;
-    }
-
-    fn add_force(&mut self, chain: &Chain, v: &ConstraintView<'_>, res: &mut [f64]) -> f64 {
-        let c = self;
-        let n = res.len();
-        let [_, t_mid, t1] = v.t;
-        let (lambda, denom, g0) = (v.lambda, v.denom, v.g0);
-        // Constraint force ∇̄g λ with ∇̄g the discrete gradient of the gap in the same
-        // metric: Δqᵀ∇̄g = g(q₁) − g(q₀), so the constraint does no work.
-        let mut g_mid = std::mem::take(&mut c.constraint.g_mid);
-        let mut g_end = std::mem::take(&mut c.constraint.g_end);
-        c.gradient(chain, t_mid, v.qbar, &mut g_mid);
-        let gap1 = c.gradient(chain, t1, v.q1, &mut g_end);
-        let gd = dot(&g_mid, v.dq);
-        let corr_g = if denom > 0.0 {
-            (gap1 - g0 - gd) / denom
-        } else {
-            0.0
-        };
-        for i in 0..n {
-            c.constraint.g_bar[i] = g_mid[i] + corr_g * v.w_dq[i];
-            res[i] -= lambda * c.constraint.g_bar[i];
-        }
-        c.constraint.g_mid = g_mid;
-        c.constraint.g_end = g_end;
-        if c.bilateral.is_some() {
-            // Friction (sliding) or the tangential stick constraint: crate::events::contact::friction.
-            return crate::events::contact::friction::midpoint_terms(c, chain, v, gap1, res);
-        }
-        gap1
-    }
-
-    fn newton_update(
-        &mut self,
-        newton: &mut NewtonSystem<AugmentedLayout>,
-        res: &[f64],
-        dq1_da: f64,
-        gap1: f64,
-        gap_target: f64,
-    ) -> f64 {
-        let c = self;
-        if crate::events::contact::friction::sticking(c) {
-            // Sticking friction contact: two multipliers (crate::events::contact::friction).
-            return crate::events::contact::friction::stick_newton_update(newton, c, res, dq1_da);
-        }
-        let n = res.len();
-        // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (∂q₁/∂a) ∇g(q₁)·δa = g(q₁) − target,
-        // by the Schur complement with two solves of S.
-        newton.delta.copy_from_slice(&c.constraint.g_bar);
-        newton.solve();
-        c.constraint.s_inv_g.copy_from_slice(&newton.delta);
-        newton.delta.copy_from_slice(res);
-        newton.solve();
-        let cx = dq1_da * dot(&c.constraint.g_end, &newton.delta);
-        let cy = dq1_da * dot(&c.constraint.g_end, &c.constraint.s_inv_g);
-        let dlambda = (gap1 - gap_target - cx) / cy;
-        for i in 0..n {
-            newton.delta[i] += c.constraint.s_inv_g[i] * dlambda;
-        }
-        dlambda
     }
 }

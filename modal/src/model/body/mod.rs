@@ -30,6 +30,9 @@
 
 use super::link::LinkModel;
 use crate::linalg::{dot, mat_vec};
+use inextensible::{exact_inextensible_terms, stretch_foreshortening_terms};
+
+mod inextensible;
 
 /// Work vectors and tip quantities of one body evaluation.
 #[derive(Debug, Clone)]
@@ -109,8 +112,30 @@ impl BodyScratch {
     }
 }
 
+/// The state's scalar reductions shared by 𝕄, h and the gravity force: Φ₁ᵀb, Φ₁ᵀḃ, Ψ₁ᵀa,
+/// Ψ₁ᵀȧ and, with foreshortening, bᵀS₁b, bᵀS₁ḃ, bᵀSₓb, ḃᵀSₓb, ḃᵀS₁ḃ (zero without).
+#[derive(Debug, Clone, Copy)]
+struct Reductions {
+    phi1_b: f64,
+    phi1_bd: f64,
+    psi1_a: f64,
+    psi1_ad: f64,
+    bs1b: f64,
+    bs1bd: f64,
+    bsxb: f64,
+    bsxbd: f64,
+    bds1bd: f64,
+}
+
 /// Fills 𝕄 (d × d row-major), h and the gravity force Q_g (zero without gravity) for one link
 /// at elastic state (a, b) and body velocities ν. `g_loc` is gravity in frame axes.
+///
+/// Phases: the matrix–vector contractions of the state (`contract_state`) and its scalar
+/// reductions (`reductions`); 𝕄 and h of the distributed mass (`distributed_mass`,
+/// `distributed_h`); the exact-inextensible and stretch–foreshortening completions; the tip
+/// point (`tip_point`) and the tip mass on it (`tip_mass_terms`); the rotational inertias
+/// of the tip body and the sections (`rotational_inertia`); the first moment of mass and the
+/// gravity force (`first_moment_and_gravity`).
 #[allow(clippy::too_many_arguments)]
 pub fn body_terms(
     link: &LinkModel,
@@ -125,13 +150,47 @@ pub fn body_terms(
 ) {
     let it = &link.ints;
     let (na, nb) = (it.na, it.nb);
-    let d = link.body_dim();
     let (ia, ib) = (3, 3 + na);
     let f = if link.foreshortening { 1.0 } else { 0.0 };
-    let (vx, vy, om) = (nu[0], nu[1], nu[2]);
+    let om = nu[2];
     let ad = &nu[ia..ia + na];
     let bd = &nu[ib..ib + nb];
 
+    contract_state(link, a, b, ad, bd, s);
+    let r = reductions(link, a, b, ad, bd, s);
+    let m02 = -r.phi1_b;
+    let m12 = it.c0 + r.psi1_a - 0.5 * f * r.bs1b;
+    distributed_mass(link, a, b, &r, m02, m12, mb, s);
+    distributed_h(link, a, b, nu, &r, m02, m12, h, s);
+
+    if link.foreshortening {
+        exact_inextensible_terms(it, b, bd, om, mb, h, s);
+        if na > 0 {
+            stretch_foreshortening_terms(it, a, ad, b, bd, om, mb, h, s);
+        }
+    }
+
+    tip_point(link, a, b, nu, s);
+    if link.tip_mass > 0.0 {
+        tip_mass_terms(link, bd, om, mb, h, s);
+    }
+    rotational_inertia(link, mb);
+    first_moment_and_gravity(link, &r, g_loc, qg, s);
+}
+
+/// The state's matrix–vector products into the scratch: M_φb, M_φḃ; with foreshortening S₁b,
+/// S₁ḃ, Sₓb, S_Lb, S_Lḃ; with an axial field M_ψa, M_ψȧ, Cb, Cḃ, Cᵀa, Cᵀȧ.
+#[inline]
+fn contract_state(
+    link: &LinkModel,
+    a: &[f64],
+    b: &[f64],
+    ad: &[f64],
+    bd: &[f64],
+    s: &mut BodyScratch,
+) {
+    let it = &link.ints;
+    let (na, nb) = (it.na, it.nb);
     mat_vec(&it.mphi, nb, b, &mut s.mphib);
     mat_vec(&it.mphi, nb, bd, &mut s.mphibd);
     if link.foreshortening {
@@ -159,6 +218,19 @@ pub fn body_terms(
             s.ctad[l] = y;
         }
     }
+}
+
+/// The scalar reductions of the state (after [`contract_state`]).
+#[inline]
+fn reductions(
+    link: &LinkModel,
+    a: &[f64],
+    b: &[f64],
+    ad: &[f64],
+    bd: &[f64],
+    s: &BodyScratch,
+) -> Reductions {
+    let it = &link.ints;
     let phi1_b = dot(&it.phi1, b);
     let phi1_bd = dot(&it.phi1, bd);
     let psi1_a = dot(&it.psi1, a);
@@ -174,13 +246,42 @@ pub fn body_terms(
     } else {
         (0.0, 0.0, 0.0, 0.0, 0.0)
     };
-    let inertia = it.c2 + 2.0 * dot(&it.psix, a) + dot(a, &s.mpsia) - f * bsxb + dot(b, &s.mphib);
-    let m02 = -phi1_b;
-    let m12 = it.c0 + psi1_a - 0.5 * f * bs1b;
+    Reductions {
+        phi1_b,
+        phi1_bd,
+        psi1_a,
+        psi1_ad,
+        bs1b,
+        bs1bd,
+        bsxb,
+        bsxbd,
+        bds1bd,
+    }
+}
 
-    // 𝕄 of the distributed mass (the ψ coordinates c, if any, only get section/tip inertia).
+/// 𝕄 of the distributed mass (overwrites `mb`): m on V, 𝕄_Vω = (−Φ₁ᵀb, c₀ + Ψ₁ᵀa − ½f bᵀS₁b),
+/// 𝕄_ωω = c₂ + 2Ψₓᵀa + aᵀM_ψa − f bᵀSₓb + bᵀM_φb + J_hub, 𝕄_Va = Ψ₁, 𝕄_ωa = −Cb, 𝕄_aa = M_ψ,
+/// 𝕄_Vb = (−f S₁b, Φ₁), 𝕄_ωb = Φₓ + Cᵀa, 𝕄_bb = M_φ (the ψ coordinates c, if any, only get
+/// section and tip inertia later).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn distributed_mass(
+    link: &LinkModel,
+    a: &[f64],
+    b: &[f64],
+    r: &Reductions,
+    m02: f64,
+    m12: f64,
+    mb: &mut [f64],
+    s: &BodyScratch,
+) {
+    let it = &link.ints;
+    let (na, nb) = (it.na, it.nb);
+    let d = link.body_dim();
+    let (ia, ib) = (3, 3 + na);
+    let f = if link.foreshortening { 1.0 } else { 0.0 };
+    let inertia = it.c2 + 2.0 * dot(&it.psix, a) + dot(a, &s.mpsia) - f * r.bsxb + dot(b, &s.mphib);
     mb.iter_mut().for_each(|v| *v = 0.0);
-    h.iter_mut().for_each(|v| *v = 0.0);
     mb[0] = it.m;
     mb[d + 1] = it.m;
     mb[2] = m02;
@@ -210,8 +311,39 @@ pub fn body_terms(
             mb[(ib + k) * d + ib + l] = it.mphi[k * nb + l];
         }
     }
+}
 
-    // Momenta and h of the distributed mass.
+/// h = 𝕄̇ν + (ω J P, −(J P)·V, −∂T/∂e) of the distributed mass (overwrites `h`), with the
+/// momenta P = (m V_x + 𝕄_xω ω + Ψ₁ᵀȧ − f S₁b·ḃ, m V_y + 𝕄_yω ω + Φ₁ᵀḃ).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn distributed_h(
+    link: &LinkModel,
+    a: &[f64],
+    b: &[f64],
+    nu: &[f64],
+    r: &Reductions,
+    m02: f64,
+    m12: f64,
+    h: &mut [f64],
+    s: &BodyScratch,
+) {
+    let it = &link.ints;
+    let (na, nb) = (it.na, it.nb);
+    let (ia, ib) = (3, 3 + na);
+    let f = if link.foreshortening { 1.0 } else { 0.0 };
+    let (vx, vy, om) = (nu[0], nu[1], nu[2]);
+    let ad = &nu[ia..ia + na];
+    let bd = &nu[ib..ib + nb];
+    let Reductions {
+        phi1_bd,
+        psi1_ad,
+        bs1bd,
+        bsxbd,
+        bds1bd,
+        ..
+    } = *r;
+    h.iter_mut().for_each(|v| *v = 0.0);
     let px = it.m * vx + m02 * om + psi1_ad - f * dot(&s.s1b, bd);
     let py = it.m * vy + m12 * om + phi1_bd;
     let d_inertia = 2.0 * dot(&it.psix, ad) + 2.0 * dot(a, &s.mpsiad) - 2.0 * f * bsxbd
@@ -234,15 +366,19 @@ pub fn body_terms(
             - om * ctad;
         h[ib + k] = mdot - dtdb;
     }
+}
 
-    if link.foreshortening {
-        exact_inextensible_terms(it, b, bd, om, mb, h, s);
-        if na > 0 {
-            stretch_foreshortening_terms(it, a, ad, b, bd, om, mb, h, s);
-        }
-    }
-
-    // Tip point p(L) = (L + ψ(L)ᵀa − ½f bᵀS_L b, φ(L)ᵀb), exact.
+/// Tip point p(L) = (L + ψ(L)ᵀa − ½f bᵀS_L b, φ(L)ᵀb), exact, its rate ṗ(L) and the tip's
+/// local velocity w = V + ωJp + ṗ, into the scratch.
+#[inline]
+fn tip_point(link: &LinkModel, a: &[f64], b: &[f64], nu: &[f64], s: &mut BodyScratch) {
+    let it = &link.ints;
+    let (na, nb) = (it.na, it.nb);
+    let (ia, ib) = (3, 3 + na);
+    let f = if link.foreshortening { 1.0 } else { 0.0 };
+    let (vx, vy, om) = (nu[0], nu[1], nu[2]);
+    let ad = &nu[ia..ia + na];
+    let bd = &nu[ib..ib + nb];
     let pl = [
         it.length + dot(&it.psi_l, a) - 0.5 * f * dot(b, &s.slb),
         dot(&it.phi_l, b),
@@ -252,41 +388,64 @@ pub fn body_terms(
     s.p_tip = pl;
     s.pd_tip = pld;
     s.w_tip = wl;
+}
 
-    if link.tip_mass > 0.0 {
-        let mt = link.tip_mass;
-        // Columns of B_L (2 × d): w = B_L ν.
-        let (bx, by) = s.bl.split_at_mut(d);
-        bx.iter_mut().for_each(|v| *v = 0.0);
-        by.iter_mut().for_each(|v| *v = 0.0);
-        bx[0] = 1.0;
-        by[1] = 1.0;
-        bx[2] = -pl[1];
-        by[2] = pl[0];
-        bx[ia..ia + na].copy_from_slice(&it.psi_l[..na]);
-        for k in 0..nb {
-            bx[ib + k] = -f * s.slb[k];
-            by[ib + k] = it.phi_l[k];
-        }
-        // Inertial acceleration (frame axes) minus B_L ν̇: Ḃ_L ν + ω J w.
-        let bsb = if link.foreshortening {
-            dot(bd, &s.slbd)
-        } else {
-            0.0
-        };
-        let cx = -om * pld[1] - bsb - om * wl[1];
-        let cy = om * pld[0] + om * wl[0];
-        for r in 0..d {
-            h[r] += mt * (bx[r] * cx + by[r] * cy);
-            for c in 0..d {
-                mb[r * d + c] += mt * (bx[r] * bx[c] + by[r] * by[c]);
-            }
+/// The tip mass at p(L) (after [`tip_point`]): with w = B_L ν, 𝕄 += m_t B_Lᵀ B_L and
+/// h += m_t B_Lᵀ(Ḃ_L ν + ω J w).
+#[inline]
+fn tip_mass_terms(
+    link: &LinkModel,
+    bd: &[f64],
+    om: f64,
+    mb: &mut [f64],
+    h: &mut [f64],
+    s: &mut BodyScratch,
+) {
+    let it = &link.ints;
+    let (na, nb) = (it.na, it.nb);
+    let d = link.body_dim();
+    let (ia, ib) = (3, 3 + na);
+    let f = if link.foreshortening { 1.0 } else { 0.0 };
+    let (pl, pld, wl) = (s.p_tip, s.pd_tip, s.w_tip);
+    let mt = link.tip_mass;
+    // Columns of B_L (2 × d): w = B_L ν.
+    let (bx, by) = s.bl.split_at_mut(d);
+    bx.iter_mut().for_each(|v| *v = 0.0);
+    by.iter_mut().for_each(|v| *v = 0.0);
+    bx[0] = 1.0;
+    by[1] = 1.0;
+    bx[2] = -pl[1];
+    by[2] = pl[0];
+    bx[ia..ia + na].copy_from_slice(&it.psi_l[..na]);
+    for k in 0..nb {
+        bx[ib + k] = -f * s.slb[k];
+        by[ib + k] = it.phi_l[k];
+    }
+    // Inertial acceleration (frame axes) minus B_L ν̇: Ḃ_L ν + ω J w.
+    let bsb = if link.foreshortening {
+        dot(bd, &s.slbd)
+    } else {
+        0.0
+    };
+    let cx = -om * pld[1] - bsb - om * wl[1];
+    let cy = om * pld[0] + om * wl[0];
+    for r in 0..d {
+        h[r] += mt * (bx[r] * cx + by[r] * cy);
+        for c in 0..d {
+            mb[r * d + c] += mt * (bx[r] * bx[c] + by[r] * by[c]);
         }
     }
+}
+
+/// Constant rotational inertias: the tip body turning with the tip section, α + r(L)ᵀe,
+/// T = ½J(ω + r(L)ᵀė)², and the sections' rotary inertia ½∫ρI(ω + r(x)ᵀė)² (no convective
+/// terms).
+#[inline]
+fn rotational_inertia(link: &LinkModel, mb: &mut [f64]) {
+    let d = link.body_dim();
     let ne = d - 3;
     let rot_l = &link.section.rot_l;
     if link.tip_inertia > 0.0 {
-        // Tip body rotates with the tip section, α + ψ(L) = α + r(L)ᵀe: T = ½ J (ω + r(L)ᵀė)².
         let jt = link.tip_inertia;
         mb[2 * d + 2] += jt;
         for k in 0..ne {
@@ -302,7 +461,6 @@ pub fn body_terms(
         }
     }
     if let Some(rot) = &link.section.rotary {
-        // Section rotary inertia ½∫ρI (ω + r(x)ᵀė)²: constant entries, no convective terms.
         mb[2 * d + 2] += rot.j0;
         for k in 0..ne {
             mb[2 * d + 3 + k] += rot.r1[k];
@@ -313,11 +471,28 @@ pub fn body_terms(
             }
         }
     }
+}
 
-    // First moment of mass (frame axes) and gravity.
+/// First moment of mass p̄ = ∫ρA p + m_t p(L) (frame axes, after [`tip_point`]) and the
+/// generalized gravity force (overwrites `qg`; zero without gravity): Q_V = (m + m_t)g,
+/// Q_ω = g_y p̄_x − g_x p̄_y, Q_a = g_x(Ψ₁ + m_t ψ(L)), Q_b = −f g_x(S₁b + m_t S_L b)
+/// + g_y(Φ₁ + m_t φ(L)).
+#[inline]
+fn first_moment_and_gravity(
+    link: &LinkModel,
+    r: &Reductions,
+    g_loc: Option<[f64; 2]>,
+    qg: &mut [f64],
+    s: &mut BodyScratch,
+) {
+    let it = &link.ints;
+    let (na, nb) = (it.na, it.nb);
+    let (ia, ib) = (3, 3 + na);
+    let f = if link.foreshortening { 1.0 } else { 0.0 };
+    let pl = s.p_tip;
     s.p_bar = [
-        it.c0 + psi1_a - 0.5 * f * bs1b + link.tip_mass * pl[0],
-        phi1_b + link.tip_mass * pl[1],
+        it.c0 + r.psi1_a - 0.5 * f * r.bs1b + link.tip_mass * pl[0],
+        r.phi1_b + link.tip_mass * pl[1],
     ];
     qg.iter_mut().for_each(|v| *v = 0.0);
     if let Some(g) = g_loc {
@@ -332,161 +507,5 @@ pub fn body_terms(
             qg[ib + k] = g[0] * (-f * (s.s1b[k] + link.tip_mass * s.slb[k]))
                 + g[1] * (it.phi1[k] + link.tip_mass * it.phi_l[k]);
         }
-    }
-}
-
-/// Kinetic coupling of the axial stretch u = ψᵀa with the foreshortening s = ½bᵀS b (axial
-/// field on: the axial displacement is u − s, so the strain u' + ½v'² of the von Kármán
-/// model is the stretch u' alone and the axial basis carries no ½v'²). From
-/// ½∫ρA |V + ωJp + ṗ|² with p = (x + u − s, v), the products of u and s give
-///
-///   ΔT_us = −ȧᵀP(b, ḃ) − ½ω² aᵀP(b, b),   P_k(x, y) = Σ_ij P_kij x_i y_j,  P_kij = ∫ρA ψ_k S_ij,
-///
-/// so 𝕄_{a_k b} −= P_k b, 𝕄_ωω −= aᵀP(b, b), and (h = 𝕄̇ν − ∂T/∂e)
-///   h_a,k += −P_k(ḃ, ḃ) + ½ω² P_k(b, b),   h_b += ω² Σ_k a_k P_k b,
-///   h_ω += −ω [ȧᵀP(b, b) + 2 aᵀP(b, ḃ)].
-#[allow(clippy::too_many_arguments)]
-fn stretch_foreshortening_terms(
-    it: &super::integrals::LinkIntegrals,
-    a: &[f64],
-    ad: &[f64],
-    b: &[f64],
-    bd: &[f64],
-    om: f64,
-    mb: &mut [f64],
-    h: &mut [f64],
-    s: &mut BodyScratch,
-) {
-    let (na, nb) = (it.na, it.nb);
-    let nn = nb * nb;
-    let d = h.len();
-    let (ia, ib) = (3, 3 + na);
-    let mut m_omega = 0.0;
-    let mut h_omega = 0.0;
-    for k in 0..na {
-        let pk = &it.p3[k * nn..(k + 1) * nn];
-        let pb = &mut s.pb[k * nb..(k + 1) * nb];
-        let pbd = &mut s.pbd[k * nb..(k + 1) * nb];
-        mat_vec(pk, nb, b, pb);
-        mat_vec(pk, nb, bd, pbd);
-        let pkbb = dot(pb, b);
-        let pkbbd = dot(pb, bd);
-        let pkbdbd = dot(pbd, bd);
-        for j in 0..nb {
-            mb[(ia + k) * d + ib + j] -= pb[j];
-            mb[(ib + j) * d + ia + k] -= pb[j];
-            h[ib + j] += om * om * a[k] * pb[j];
-        }
-        m_omega += a[k] * pkbb;
-        h_omega += ad[k] * pkbb + 2.0 * a[k] * pkbbd;
-        h[ia + k] += -pkbdbd + 0.5 * om * om * pkbb;
-    }
-    mb[2 * d + 2] -= m_omega;
-    h[2] -= om * h_omega;
-}
-
-/// Terms that make the inextensible (foreshortening) kinetic energy exact:
-/// ΔT = ½∫ρA [ω² s² + 2ω(v ṡ − s v̇) + ṡ²], with s = ½bᵀS b, ṡ = bᵀS ḃ. Without them the
-/// truncated T loses positive definiteness in the stiff direction "turn the frame, counter-bend
-/// the link" (its inertia there is ∫ρA(ωx + v̇)², while the kept −ω²∫ρA·2xs is negative).
-///
-/// With Q_ijkl = ∫ρA S_ij S_kl, R_mij = ∫ρA φ_m S_ij, Bq = Q:(b⊗b) (= 2∫ρA s S),
-/// Eq = Q:(ḃ⊗ḃ), A_jl = ∫ρA (Sb)_j (Sb)_l, Rv = R·b (= ∫ρA v S), Rvd = R·ḃ,
-/// z_p = R_p:(b⊗ḃ), w_j = R_j:(b⊗b):
-///   𝕄_ωω += ¼ bᵀBq b,   𝕄_ωb += Rv b − ½w,   𝕄_bb += A,
-///   h_ω += ω ḃᵀBq b + ḃ·(Rvd b + Rv ḃ − z),
-///   h_b += 2ω (Rvd b − z) + Eq b − ½ω² Bq b.
-///
-/// Evaluation (O(n⁴)/2 once, O(n³) after): one contraction of Q with b,
-/// C_ij,l = Σ_k Q_ij,kl b_k (symmetric in ij: n²(n+1)/2 rows of n² products), gives
-/// A_jl = Σ_i b_i C_ij,l and Eq b = Σ_ij ḃ_iḃ_j C_ij; by the symmetries of Q
-/// (Q_ij,kl = Q_ji,kl = Q_kl,ij) Bq b = A b, so bᵀBq b = bᵀA b and ḃᵀBq b = ḃᵀA b, and
-/// neither Bq nor Eq is formed. R enters through D_mj = Σ_l R_mjl b_l and E_mj = Σ_l R_mjl ḃ_l:
-/// Rv b = Dᵀb, w = D b, Rvd b = Dᵀḃ, Rv ḃ = Eᵀb, z = E b.
-fn exact_inextensible_terms(
-    it: &super::integrals::LinkIntegrals,
-    b: &[f64],
-    bd: &[f64],
-    om: f64,
-    mb: &mut [f64],
-    h: &mut [f64],
-    s: &mut BodyScratch,
-) {
-    let n = it.nb;
-    let nn = n * n;
-    let na = it.na;
-    let d = h.len();
-    let ib = 3 + na;
-    // C_ij = Σ_k b_k Q_ij,k· for i ≤ j, mirrored to C_ji.
-    for i in 0..n {
-        for j in i..n {
-            let row = &it.q4[(i * n + j) * nn..(i * n + j + 1) * nn];
-            let cij = &mut s.cq[(i * n + j) * n..(i * n + j + 1) * n];
-            cij.iter_mut().for_each(|v| *v = 0.0);
-            for (bk, qk) in b.iter().zip(row.chunks_exact(n)) {
-                for (c, q) in cij.iter_mut().zip(qk) {
-                    *c += bk * q;
-                }
-            }
-        }
-        for j in 0..i {
-            let (lo, hi) = s.cq.split_at_mut((i * n + j) * n);
-            hi[..n].copy_from_slice(&lo[(j * n + i) * n..(j * n + i + 1) * n]);
-        }
-    }
-    // A_j· = Σ_i b_i C_ij·;  Eq b = Σ_{i≤j} (2 − δ_ij) ḃ_iḃ_j C_ij.
-    s.amat.iter_mut().for_each(|v| *v = 0.0);
-    s.eqb.iter_mut().for_each(|v| *v = 0.0);
-    for i in 0..n {
-        let bi = b[i];
-        for j in 0..n {
-            let cij = &s.cq[(i * n + j) * n..(i * n + j + 1) * n];
-            for (a, c) in s.amat[j * n..(j + 1) * n].iter_mut().zip(cij) {
-                *a += bi * c;
-            }
-            if j >= i {
-                let wgt = if i == j { 1.0 } else { 2.0 };
-                let e = wgt * bd[i] * bd[j];
-                for (v, c) in s.eqb.iter_mut().zip(cij) {
-                    *v += e * c;
-                }
-            }
-        }
-    }
-    mat_vec(&s.amat, n, b, &mut s.ab);
-    // D_m· = R_m b, E_m· = R_m ḃ (R_m symmetric n × n).
-    for m in 0..n {
-        let r = &it.r3[m * nn..(m + 1) * nn];
-        mat_vec(r, n, b, &mut s.dr[m * n..(m + 1) * n]);
-        mat_vec(r, n, bd, &mut s.er[m * n..(m + 1) * n]);
-    }
-    // w = D b, z = E b, Rvd b = Dᵀḃ (t1), Rv b = Dᵀb, Rv ḃ = Eᵀb.
-    for p in 0..n {
-        s.t2[p] = dot(&s.dr[p * n..(p + 1) * n], b);
-        s.zv[p] = dot(&s.er[p * n..(p + 1) * n], b);
-    }
-    let bqbb = dot(b, &s.ab);
-    let bqbdb = dot(bd, &s.ab);
-    mb[2 * d + 2] += 0.25 * bqbb;
-    let mut h_om = om * bqbdb;
-    for j in 0..n {
-        let (mut rvb, mut rvdb, mut rvbd) = (0.0, 0.0, 0.0);
-        for m in 0..n {
-            rvb += b[m] * s.dr[m * n + j];
-            rvdb += bd[m] * s.dr[m * n + j];
-            rvbd += b[m] * s.er[m * n + j];
-        }
-        let c = rvb - 0.5 * s.t2[j];
-        mb[2 * d + ib + j] += c;
-        mb[(ib + j) * d + 2] += c;
-        for l in 0..n {
-            mb[(ib + j) * d + ib + l] += s.amat[j * n + l];
-        }
-        h_om += bd[j] * (rvdb + rvbd - s.zv[j]);
-        s.t1[j] = rvdb;
-    }
-    h[2] += h_om;
-    for p in 0..n {
-        h[ib + p] += 2.0 * om * (s.t1[p] - s.zv[p]) + s.eqb[p] - 0.5 * om * om * s.ab[p];
     }
 }

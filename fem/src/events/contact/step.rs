@@ -1,0 +1,84 @@
+//! The contact as a step constraint of the methods ([`StepConstraint`]).
+
+use super::Contact;
+use crate::chain::{AugmentedLayout, Chain};
+use crate::linalg::dot;
+use crate::method::{ConstraintView, NewtonSystem, StepConstraint};
+
+/// The contact held in a constrained phase, as the method sees it: the force ∇̄g λ with ∇̄g
+/// the Gonzalez discrete gradient of the gap (metric W = M(q̄), as for the potential, so
+/// Δqᵀ∇̄g = g(q₁) − g(q₀) and the constraint does no work), friction and the stick constraint
+/// of a bilateral wall ([`crate::events::contact::friction`]), and the bordered Newton update.
+impl StepConstraint<Chain> for Contact {
+    fn value(&self, chain: &Chain, t: f64, q: &[f64]) -> f64 {
+        self.gap_at(chain, t, q)
+    }
+
+    fn multiplier(&self) -> f64 {
+        self.constraint.step_lambda
+    }
+
+    fn set_multiplier(&mut self, lambda: f64) {
+        self.constraint.step_lambda = lambda;
+    }
+
+    fn add_force(&mut self, chain: &Chain, v: &ConstraintView<'_>, res: &mut [f64]) -> f64 {
+        let c = self;
+        let n = res.len();
+        let [_, t_mid, t1] = v.t;
+        let (lambda, denom, g0) = (v.lambda, v.denom, v.g0);
+        // Constraint force ∇̄g λ with ∇̄g the discrete gradient of the gap in the same
+        // metric: Δqᵀ∇̄g = g(q₁) − g(q₀), so the constraint does no work.
+        let mut g_mid = std::mem::take(&mut c.constraint.g_mid);
+        let mut g_end = std::mem::take(&mut c.constraint.g_end);
+        c.gradient(chain, t_mid, v.qbar, &mut g_mid);
+        let gap1 = c.gradient(chain, t1, v.q1, &mut g_end);
+        let gd = dot(&g_mid, v.dq);
+        let corr_g = if denom > 0.0 {
+            (gap1 - g0 - gd) / denom
+        } else {
+            0.0
+        };
+        for i in 0..n {
+            c.constraint.g_bar[i] = g_mid[i] + corr_g * v.w_dq[i];
+            res[i] -= lambda * c.constraint.g_bar[i];
+        }
+        c.constraint.g_mid = g_mid;
+        c.constraint.g_end = g_end;
+        if c.bilateral.is_some() {
+            // Friction (sliding) or the tangential stick constraint: crate::events::contact::friction.
+            return crate::events::contact::friction::midpoint_terms(c, chain, v, gap1, res);
+        }
+        gap1
+    }
+
+    fn newton_update(
+        &mut self,
+        newton: &mut NewtonSystem<AugmentedLayout>,
+        res: &[f64],
+        dq1_da: f64,
+        gap1: f64,
+        gap_target: f64,
+    ) -> f64 {
+        let c = self;
+        if crate::events::contact::friction::sticking(c) {
+            // Sticking friction contact: two multipliers (crate::events::contact::friction).
+            return crate::events::contact::friction::stick_newton_update(newton, c, res, dq1_da);
+        }
+        let n = res.len();
+        // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (∂q₁/∂a) ∇g(q₁)·δa = g(q₁) − target,
+        // by the Schur complement with two solves of S.
+        newton.delta.copy_from_slice(&c.constraint.g_bar);
+        newton.solve();
+        c.constraint.s_inv_g.copy_from_slice(&newton.delta);
+        newton.delta.copy_from_slice(res);
+        newton.solve();
+        let cx = dq1_da * dot(&c.constraint.g_end, &newton.delta);
+        let cy = dq1_da * dot(&c.constraint.g_end, &c.constraint.s_inv_g);
+        let dlambda = (gap1 - gap_target - cx) / cy;
+        for i in 0..n {
+            newton.delta[i] += c.constraint.s_inv_g[i] * dlambda;
+        }
+        dlambda
+    }
+}
