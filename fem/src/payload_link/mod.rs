@@ -80,8 +80,8 @@ use data::{
     BackendKind, Cost, DofPlan, EnergyLedger, FemSettings, ModalResult, ModeShape, Observables,
     RunResult, Scene, StabilityVerdict, StaticResult, channel, ledger_term,
 };
-use faer::Mat;
 use faer::prelude::*;
+use faer::{Mat, c64};
 
 use crate::band::BorderedBand;
 use crate::element::beam3d::{PHI, U, V, W};
@@ -301,10 +301,13 @@ fn group_of(md: &Model, i: usize) -> usize {
 /// The lowest `count` modes of a rod turning at the prescribed constant rate Ω with the
 /// gyroscopic coupling: M q̈ + Ω(Gᵀ − G) q̇ + (K_s − Ω²K_c) q = 0. With z = (q̇, q),
 /// A = diag(M, K) and the skew B = [[Ω(Gᵀ − G), K], [−K, 0]], A ż + B z = 0; for A = LLᵀ the
-/// matrix S = L⁻¹BL⁻ᵀ is skew with eigenvalues ±iω, so the ω² are the eigenvalues of the
-/// symmetric SᵀS, each twice, its two eigenvectors y spanning the mode's real plane
-/// (z = L⁻ᵀy). Kinds from the kinetic energy ½q̇ᵀMq̇ of both; the shape is the displacement
-/// part q of the one with the larger one.
+/// matrix S = L⁻¹BL⁻ᵀ is skew with eigenvalues ±iω: the ω are the positive eigenvalues of the
+/// Hermitian iS, and the real and imaginary parts y of an eigenvector span the mode's real
+/// plane (z = L⁻ᵀy). Kinds from the kinetic energy ½q̇ᵀMq̇ of both; the shape is the
+/// displacement part q of the one with the larger one. (The eigenvalues of the symmetric SᵀS,
+/// the ω² twice, are not accurate enough: with ω_max² ~ 1e11 the squared matrix split the
+/// horizontal pair of `single-link-3d-constant-rate` by 5e-4 relative and gave one of them as
+/// the mode.)
 pub fn gyroscopic_modes(md: &Model, count: usize) -> Result<Vec<Mode3d>, FemError> {
     let n = md.n;
     if md.free_base() {
@@ -336,20 +339,34 @@ pub fn gyroscopic_modes(md: &Model, count: usize) -> Result<Vec<Mode3d>, FemErro
     l.solve_lower_triangular_in_place(&mut t);
     let mut sk = t.transpose().to_owned();
     l.solve_lower_triangular_in_place(&mut sk);
-    // sk = (L⁻¹BL⁻ᵀ)ᵀ; SᵀS is the same from either sign.
-    let c = sk.transpose() * &sk;
-    let c = Mat::<f64>::from_fn(2 * n, 2 * n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
-    let ev = c
+    // sk = (L⁻¹BL⁻ᵀ)ᵀ = −S, skew up to round-off; i·sk is Hermitian with eigenvalues ∓ω, and
+    // its lower triangle (all the eigensolver reads) is that of the skew part.
+    let h = Mat::<c64>::from_fn(2 * n, 2 * n, |i, j| {
+        c64::new(0.0, 0.5 * (sk[(i, j)] - sk[(j, i)]))
+    });
+    let ev = h
         .self_adjoint_eigen(faer::Side::Lower)
         .map_err(|_| FemError::Numerical {
             t: 0.0,
             message: "eigensolver did not converge".into(),
         })?;
-    let w2 = ev.S().column_vector();
-    let mut z = ev.U().to_owned();
+    // Ascending: the n positive eigenvalues are the upper half (A is definite, so none is 0).
+    let values = ev.S().column_vector();
+    let vectors = ev.U();
+    let modes = n.min(count);
+    let mut omega = Vec::with_capacity(modes);
+    let mut z = Mat::<f64>::zeros(2 * n, 2 * modes);
+    for p in 0..modes {
+        let j = n + p;
+        omega.push(values[j].re.max(0.0));
+        for r in 0..2 * n {
+            z[(r, 2 * p)] = vectors[(r, j)].re;
+            z[(r, 2 * p + 1)] = vectors[(r, j)].im;
+        }
+    }
     l.transpose().solve_upper_triangular_in_place(&mut z);
     let mut out = Vec::new();
-    for p in 0..n.min(count) {
+    for p in 0..modes {
         let (j0, j1) = (2 * p, 2 * p + 1);
         let mut share = [0.0; 5];
         let mut best = (f64::MIN, j0);
@@ -365,7 +382,7 @@ pub fn gyroscopic_modes(md: &Model, count: usize) -> Result<Vec<Mode3d>, FemErro
         }
         let (kind, field) = kind_of(&share);
         out.push(Mode3d {
-            omega: (0.5 * (w2[j0] + w2[j1])).max(0.0).sqrt(),
+            omega: omega[p],
             kind: kind.to_string(),
             field,
             vector: (0..n).map(|r| z[(n + r, best.1)]).collect(),
