@@ -141,9 +141,11 @@
 //! Scenes of the `[payload_link]` family are solved by [`payload_link`]: 3-D beam elements
 //! ([`element::beam3d`]: axial, two bending planes, torsion) in the turning frame with the
 //! second-order kinematics of docs/single-link-3d.md, the payload as a rigid body at the tip,
-//! modes, gravity statics and implicit-midpoint dynamics. It shares the element tables
-//! (Hermite cubics, Gauss rules), the bordered-band LU ([`band`]) and the dense eigensolver
-//! ([`modes`]) with the planar chains, nothing else.
+//! modes (gyroscopic at a constant base rate), gravity statics and dynamics: the link is a
+//! [`system::System`] ([`payload_link::system`]) stepped by the method registry on its own
+//! driver path (implicit midpoint by default). It shares the element tables (Hermite cubics,
+//! Gauss rules), the bordered-band LU ([`band`]), the dense eigensolver ([`modes`]) and the
+//! methods with the planar chains, nothing else.
 //!
 //! ## Mobile manipulator with a flexible pitch link (seed 004, issue 19)
 //! Scenes of the `[mobile_manipulator]` family with a `flexible_link` are solved by [`mobile`]:
@@ -156,13 +158,13 @@
 //! The planar chains' time integration is split three ways. The problem is the discretized
 //! system R(t, q, q̇, q̈) = 0 behind the [`system::System`] trait: residual and its force
 //! groups, Newton matrix c_a·∂R/∂q̈ + c_v·∂R/∂q̇ + c_q·∂R/∂q, mass products, ∂T/∂q, energies and
-//! the midpoint works of the ledger; [`chain::Chain`] implements it. The methods
+//! the midpoint works of the ledger; [`chain::Chain`] and the 3-D link implement it. The methods
 //! ([`method`], one type per method behind [`method::Stepper`]) are generic over the system
 //! and name nothing else of the model. The events are objects the driver consumes: a held
 //! constraint reaches a method only through [`method::StepConstraint`], implemented for the
 //! system it constrains (the tip contact for the chain, which needs its tip kinematics); the
 //! driver ([`driver`]) locates impacts, releases and stick–slip switches and applies the
-//! resets. The rocket, 3-D payload-link and mobile-manipulator steppers are their own.
+//! resets. The rocket and mobile-manipulator steppers are their own.
 //!
 //! ## Layers
 //! Each layer imports only the ones above it:

@@ -6,10 +6,11 @@
 //! and the method restarts there from a consistent acceleration ([`crate::method::start`]), as
 //! the chain's driver does ([`crate::driver`]). A step whose Newton iteration fails is retried
 //! as four quarter steps (the chain's driver retries a quarter step and grows back). The works
-//! are booked after every accepted step with the midpoint rule ([`LinkSystem::step_works`]), Kelvin–Voigt per damped field: the implicit midpoint rule's own
-//! quadrature, and energy-midpoint's (which books the same terms, its fields summed, through
-//! [`crate::system::System::midpoint_works`]); for generalized-α and central difference a
-//! second-order quadrature of the works.
+//! are booked after every accepted step with the midpoint rule ([`LinkSystem::step_works`]),
+//! Kelvin–Voigt per damped field: the implicit midpoint rule's own quadrature, and
+//! energy-midpoint's (which books the same terms, its fields summed, through
+//! [`crate::system::System::midpoint_works`]); for the other methods a second-order quadrature
+//! of the works.
 
 use crate::error::FemError;
 use crate::method::{Counters, NewtonSystem, StepContext, StepState, Stepper, Works, start};
