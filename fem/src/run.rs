@@ -113,14 +113,12 @@ pub fn default_rho_inf(links: &[Link]) -> f64 {
 /// constrained) takes `energy-midpoint` even with extensible links: its ledger closes to the
 /// Newton tolerance, so the closure is the friction-work check.
 pub fn default_method(pc: &PlanarChain) -> Method {
-    if check_midpoint(&pc.links).is_ok()
-        && pc.contacts.iter().any(|c| c.mode == ContactMode::Bilateral)
-    {
+    let midpoint_steps_it = capabilities(Method::EnergyMidpoint).prescribed_joints
+        || pc.links.iter().all(|l| l.joint.prescribed.is_none());
+    if midpoint_steps_it && pc.contacts.iter().any(|c| c.mode == ContactMode::Bilateral) {
         return Method::EnergyMidpoint;
     }
-    if check_midpoint(&pc.links).is_ok()
-        && !pc.links.iter().any(|l| l.axial || undamped_massless_hub(l))
-    {
+    if midpoint_steps_it && !pc.links.iter().any(|l| l.axial || undamped_massless_hub(l)) {
         Method::EnergyMidpoint
     } else {
         Method::GeneralizedAlpha
@@ -165,13 +163,9 @@ fn undamped_massless_hub(l: &Link) -> bool {
         && l.joint.damping.unwrap_or(0.0) == 0.0
 }
 
-/// The energy-midpoint scheme needs every joint free: a prescribed joint would need the work
-/// of its actuator booked with the scheme's quadrature, which is not implemented.
-fn check_midpoint(links: &[Link]) -> Result<(), FemError> {
-    check_prescribed_joints(Method::EnergyMidpoint, links)
-}
-
-/// Refuses prescribed joint motion to a method that cannot step it.
+/// Refuses prescribed joint motion to a method that cannot step it (energy-midpoint: a
+/// prescribed joint would need the work of its actuator booked with the scheme's quadrature,
+/// which is not implemented).
 fn check_prescribed_joints(method: Method, links: &[Link]) -> Result<(), FemError> {
     if capabilities(method).prescribed_joints {
         return Ok(());

@@ -169,24 +169,32 @@ pub trait System {
     /// [`System::residual`] (exact where [`System::exact_layout`] is `None`).
     fn newton_matrix(&self, q: &[f64], c: NewtonCoefficients, s: &mut BorderedBand);
 
-    /// The augmentation of the exact Newton matrix, `None` where [`System::newton_matrix`]
-    /// is exact.
-    fn exact_layout(&self) -> Option<Self::Augmented>;
+    /// The augmentation of the exact Newton matrix, `None` (the default) where
+    /// [`System::newton_matrix`] is exact.
+    fn exact_layout(&self) -> Option<Self::Augmented> {
+        None
+    }
 
-    /// A container with the pattern of `layout`.
-    fn new_augmented_matrix(&self, layout: &Self::Augmented) -> BorderedBand;
+    /// A container with the pattern of `layout` (by default, for a system whose band matrix is
+    /// exact, the band container).
+    fn new_augmented_matrix(&self, _layout: &Self::Augmented) -> BorderedBand {
+        self.new_matrix()
+    }
 
     /// The exact S at (q, q̇, q̈) as the augmented matrix of `layout`; the last
-    /// [`System::residual`] must have been at that state.
+    /// [`System::residual`] must have been at that state (by default, for a system whose band
+    /// matrix is exact, [`System::newton_matrix`]).
     fn exact_newton_matrix(
         &self,
         q: &[f64],
-        qd: &[f64],
-        qdd: &[f64],
+        _qd: &[f64],
+        _qdd: &[f64],
         c: NewtonCoefficients,
-        layout: &Self::Augmented,
+        _layout: &Self::Augmented,
         s: &mut BorderedBand,
-    );
+    ) {
+        self.newton_matrix(q, c, s);
+    }
 
     /// The ledger terms of a step q₀ → q₀ + Δq of length h by the midpoint rule, every
     /// non-conservative force at t_mid and the mean velocity v̄ = Δq/h: an applied force books

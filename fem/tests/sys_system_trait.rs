@@ -196,26 +196,6 @@ impl System for Oscillator {
         }
     }
 
-    fn exact_layout(&self) -> Option<NoAugmentation> {
-        None
-    }
-
-    fn new_augmented_matrix(&self, layout: &NoAugmentation) -> BorderedBand {
-        match *layout {}
-    }
-
-    fn exact_newton_matrix(
-        &self,
-        _: &[f64],
-        _: &[f64],
-        _: &[f64],
-        _: NewtonCoefficients,
-        layout: &NoAugmentation,
-        _: &mut BorderedBand,
-    ) {
-        match *layout {}
-    }
-
     /// The load's work f(t_mid)·Δq and the damper's dissipation h v̄ᵀC v̄.
     fn midpoint_works(
         &mut self,

@@ -366,26 +366,6 @@ impl System for LinkSystem {
         }
     }
 
-    fn exact_layout(&self) -> Option<NoAugmentation> {
-        None
-    }
-
-    fn new_augmented_matrix(&self, layout: &NoAugmentation) -> BorderedBand {
-        match *layout {}
-    }
-
-    fn exact_newton_matrix(
-        &self,
-        _: &[f64],
-        _: &[f64],
-        _: &[f64],
-        _: NewtonCoefficients,
-        layout: &NoAugmentation,
-        _: &mut BorderedBand,
-    ) {
-        match *layout {}
-    }
-
     /// The applied torque T_mot(t_mid)Δθ and the joint damper b_m v̄_θΔθ of a free base,
     /// Kelvin–Voigt h v̄ᵀC v̄ (all fields together); the rest of −minus_q·Δq is the moving
     /// frame's work on the field of a prescribed base (`prescribed_motion`). The run's ledger
