@@ -35,7 +35,8 @@ impl Counters {
 }
 
 /// Work counters of the mobile manipulator's fixed-step implicit-midpoint stepper: every
-/// Newton iteration evaluates one residual and factorizes one Newton matrix (a Jacobian evaluation per factorization); no step is rejected.
+/// Newton iteration evaluates one residual and factorizes one Newton matrix (a Jacobian
+/// evaluation per factorization); no step is rejected.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct FixedStepCounters {
     pub steps: usize,

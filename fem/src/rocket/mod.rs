@@ -153,7 +153,8 @@ pub fn prepare(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Prep
     if !caps.variable_mass {
         return Err(FemError::unsupported(format!(
             "fem rocket: method `{method}` cannot step the burning rocket's time-varying mass \
-             M(t) (the rocket's module docs); use {}",
+             M(t) (its momentum form would book the momentum the burnt mass carries off as a \
+             force); use {}",
             crate::method::names_with("or", |c| c.variable_mass)
         )));
     }
@@ -179,7 +180,7 @@ pub fn prepare(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Prep
                     bound_kind: "central-difference (2/(κ + √(κ² + ω²)) of the binding mode, \
                                  at the run's smallest mass)"
                         .into(),
-                    location: format!("rocket DOF {}", bound.1),
+                    location: describe_dof(&driver.system.model, bound.1),
                 });
             }
             Some(dt) => dt,
@@ -213,6 +214,18 @@ fn explicit_bound(driver: &mut RocketDriver, t_end: f64) -> Result<(f64, usize),
     st.t = driver.burnout.min(t_end);
     let mut res = vec![0.0; driver.system.ndof()];
     crate::method::central_difference::stability_bound(&mut driver.system, &st, &mut res)
+}
+
+/// A DOF of the rocket by name: the node and slot of a case DOF, or a discrete mass's U or W.
+fn describe_dof(model: &Model, dof: usize) -> String {
+    let base = model.base();
+    if dof < base {
+        let slot = ["u", "w", "w′"][dof % model::DOFS_PER_NODE];
+        return format!("rocket node {} {slot}", dof / model::DOFS_PER_NODE + 1);
+    }
+    let nm = model.masses.len();
+    let (j, slot) = ((dof - base) % nm, if dof - base < nm { "U" } else { "W" });
+    format!("rocket discrete_mass[{j}] {slot}")
 }
 
 /// A run of `r`, the rocket of `scene`.
