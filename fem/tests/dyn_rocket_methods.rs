@@ -78,8 +78,9 @@ fn dyn_rocket_methods_agree_to_their_order_and_close_the_ledger() {
     for m in ["generalized-alpha", "bathe"] {
         let (x, closure) = sweep(m);
         // Second-order methods: the closure (their energy error) falls by 2² per halving; a
-        // booking error that does not vanish with h would stop it. Accepted: an observed
-        // order above 1.5 on both halvings.
+        // booking error that does not vanish with h would stop it, and so would a step across
+        // burn-out (the thrust's jump inside a step: first order, observed 0.76 when the driver
+        // does not stop there). Accepted: an observed order above 1.5 on both halvings.
         for k in 0..2 {
             let order = (closure[k] / closure[k + 1]).log2();
             assert!(
