@@ -164,7 +164,9 @@
 //! constraint reaches a method only through [`method::StepConstraint`], implemented for the
 //! system it constrains (the tip contact for the chain, which needs its tip kinematics); the
 //! driver ([`driver`]) locates impacts, releases and stick–slip switches and applies the
-//! resets. The rocket and mobile-manipulator steppers are their own.
+//! resets. The 3-D link and the variable-mass rocket ([`rocket::system`]: M(t)q̈ = F, stepped on
+//! its own driver path [`rocket::driver`], which lands on burn-out) are systems stepped by the same
+//! methods; the mobile manipulator's stepper is its own.
 //!
 //! ## Layers
 //! Each layer imports only the ones above it:

@@ -18,6 +18,12 @@
 //! a chain's foreshortening) gives its [`System::Augmented`] layout; the methods then solve the
 //! augmented system with zero auxiliary right-hand sides ([`crate::method::newton`]).
 //!
+//! M may also depend on t (the burning rocket, [`crate::rocket::system`]: M(t)q̈ = F, the
+//! burnt mass leaving at the local velocity). Every evaluation takes it at the time it is given,
+//! the Newton matrix at the time of the last full residual; a method that steps such a system
+//! keeps no M from one step to the next (the capability
+//! [`crate::method::Capabilities::variable_mass`]).
+//!
 //! Energies E = T + V with T = ½q̇ᵀM(q)q̇, and the gradient ∂T/∂q(q, x) of T at generalized
 //! velocity x: the energy-consistent method ([`crate::method::energy_midpoint`]) builds its
 //! discrete gradient from them. Its ledger books the works of a step with the same midpoint

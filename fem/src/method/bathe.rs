@@ -55,6 +55,7 @@ impl Bathe {
         prescribed_joints: true,
         held_constraint: false,
         projects_massless: false,
+        variable_mass: true,
     };
 
     /// The method for `n` DOFs.

@@ -36,6 +36,7 @@ impl CentralDifference {
         prescribed_joints: true,
         held_constraint: false,
         projects_massless: false,
+        variable_mass: true,
     };
 }
 

@@ -111,6 +111,7 @@ impl GeneralizedAlpha {
         prescribed_joints: true,
         held_constraint: true,
         projects_massless: false,
+        variable_mass: true,
     };
 
     /// The method with spectral radius `rho_inf` for `n` DOFs.

@@ -68,6 +68,7 @@ impl ImplicitMidpoint {
         prescribed_joints: true,
         held_constraint: true,
         projects_massless: false,
+        variable_mass: true,
     };
 
     /// The method for `n` DOFs.

@@ -65,6 +65,12 @@ pub struct Capabilities {
     /// Projects massless section rotations onto their balance in contact runs, booking the
     /// removed strain energy (Timoshenko links without rotary inertia).
     pub projects_massless: bool,
+    /// Steps a mass that changes in time, M(t)q̈ = F (the burning rocket, whose burnt mass
+    /// leaves at the local velocity: no Ṁq̇ term): the method's equations hold at its
+    /// evaluation times with M taken there, and it keeps no M from one step to the next. The
+    /// energy-consistent midpoint scheme does not: its momentum form M(q₁)q̇₁ − M(q₀)q̇₀ would
+    /// book the burnt mass's momentum as a force.
+    pub variable_mass: bool,
 }
 
 /// What a method is built from: the system's number of DOFs and the settings' generalized-α

@@ -34,9 +34,9 @@ impl Counters {
     }
 }
 
-/// Work counters of the fixed-step implicit-midpoint steppers of the rocket and the mobile
-/// manipulator: every Newton iteration evaluates one residual and
-/// factorizes one Newton matrix (a Jacobian evaluation per factorization); no step is rejected.
+/// Work counters of the mobile manipulator's fixed-step implicit-midpoint stepper: every
+/// Newton iteration evaluates one residual and factorizes one Newton matrix (a Jacobian
+/// evaluation per factorization); no step is rejected.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct FixedStepCounters {
     pub steps: usize,

@@ -125,6 +125,7 @@ impl EnergyMidpoint {
         prescribed_joints: false,
         held_constraint: true,
         projects_massless: true,
+        variable_mass: false,
     };
 
     pub fn new(n: usize) -> Self {

@@ -1,0 +1,231 @@
+//! The rocket's driver path: the [`RocketSystem`] stepped by a method of the registry
+//! ([`crate::method::stepper`]) in fixed steps, with the rocket's ledger works.
+//!
+//! Steps land on the output times and on burn-out (the caller stops there: thrust, pressure and
+//! the mass rate jump). A step that ends on burn-out evaluates the laws as their left limit, and
+//! the method restarts there from a consistent acceleration ([`crate::method::start`]), as the
+//! payload link does at its motor-law switches. A step whose Newton iteration fails is retried as
+//! four quarter steps.
+//!
+//! **Works** are booked after every accepted step from its end states only, so the booking is
+//! the same for every method: the loads' powers P(t_mid, q̄, v̄) at q̄ = ½(q₀ + q₁),
+//! v̄ = ½(q̇₀ + q̇₁) times h, and the energy the burnt mass carries off,
+//!
+//!   D_out = −½[(m₁(t_mid) − m₁(t₀)) q̇₀ᵀM_burn q̇₀ + (m₁(t₁) − m₁(t_mid)) q̇₁ᵀM_burn q̇₁]
+//!           + (m₁(t₁) − m₁(t₀)) Gᵀ M_burn (x_ref + q̄),
+//!
+//! the trapezoidal rule of its kinetic part −½∫ṁ₁ q̇ᵀM_burn q̇ dt and the midpoint rule of its
+//! potential part ∫ṁ₁ GᵀM_burn(x_ref + q) dt (ṁ₁ is constant within a step: steps stop at
+//! burn-out). For the implicit midpoint rule (q̄, v̄) is the scheme's own midpoint and the
+//! balance is exact: with M(t_mid)(q̇₁ − q̇₀) = hF and v̄ = ½(q̇₀ + q̇₁), ½q̇₁ᵀM(t₁)q̇₁ −
+//! ½q̇₀ᵀM(t₀)q̇₀ = h v̄·F + the kinetic part above, and the gravity potential's change is
+//! h v̄·M(t_mid)G − its potential part; the ledger then closes to the Newton tolerance and the
+//! O(h³) midpoint error of the cubic strain term. For the other (second-order) methods the same
+//! booking is a second-order quadrature of the works, and the ledger closes to the method's
+//! O(h²) energy error.
+
+use crate::error::FemError;
+use crate::method::{Counters, NewtonSystem, StepContext, StepState, Stepper, start};
+use crate::settings::Method;
+use crate::system::{NoAugmentation, System};
+
+use super::model::Model;
+use super::system::RocketSystem;
+
+/// Cumulative works (inputs) and dissipations of the rocket's ledger.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RocketWorks {
+    pub thrust: f64,
+    pub pressure: f64,
+    pub coriolis: f64,
+    pub damper: f64,
+    pub outflow: f64,
+}
+
+/// The stepped rocket: system, method, state and works.
+#[derive(Debug)]
+pub struct RocketDriver {
+    pub system: RocketSystem,
+    pub method: Method,
+    stepper: Box<dyn Stepper<RocketSystem>>,
+    pub state: StepState,
+    pub newton: NewtonSystem<NoAugmentation>,
+    pub counters: Counters,
+    pub works: RocketWorks,
+    /// The nominal step (a method's retries and tolerances are measured against it).
+    pub h_nominal: f64,
+    /// Burn-out time (∞ without a burn).
+    pub burnout: f64,
+    qbar: Vec<f64>,
+    vbar: Vec<f64>,
+}
+
+impl RocketDriver {
+    /// The rocket `model` in the shape `q0` at rest at t = 0, stepped by `method` with nominal
+    /// step `h` (`rho_inf`: generalized-α's spectral radius); the start's consistent
+    /// acceleration solved.
+    pub fn new(
+        model: Model,
+        q0: &[f64],
+        method: Method,
+        h: f64,
+        rho_inf: f64,
+    ) -> Result<Self, FemError> {
+        let n = model.n;
+        let burnout = model.burnout_time();
+        let length = model.length;
+        let system = RocketSystem::new(model);
+        let mut state = StepState::new(n);
+        state.q.copy_from_slice(q0);
+        let mut newton = NewtonSystem::new(&system, length);
+        newton.tol = newton_tolerance(&system.model, h);
+        let mut it = RocketDriver {
+            system,
+            method,
+            stepper: crate::method::stepper(method, n, rho_inf),
+            state,
+            newton,
+            counters: Counters::default(),
+            works: RocketWorks::default(),
+            h_nominal: h,
+            burnout,
+            qbar: vec![0.0; n],
+            vbar: vec![0.0; n],
+        };
+        it.consistent_acceleration(h, 0.0)?;
+        Ok(it)
+    }
+
+    /// Sets the nominal step (and the Newton tolerance that scales with it).
+    pub fn set_step(&mut self, h: f64) {
+        self.h_nominal = h;
+        self.newton.tol = newton_tolerance(&self.system.model, h);
+    }
+
+    /// The method and its step context (disjoint borrows of the driver).
+    fn method_parts(
+        &mut self,
+    ) -> (
+        &mut dyn Stepper<RocketSystem>,
+        StepContext<'_, RocketSystem>,
+    ) {
+        let length_scale = self.system.model.length;
+        let cx = StepContext {
+            system: &mut self.system,
+            state: &mut self.state,
+            newton: &mut self.newton,
+            counters: &mut self.counters,
+            adaptive: None,
+            h_nominal: self.h_nominal,
+            length_scale,
+        };
+        (self.stepper.as_mut(), cx)
+    }
+
+    fn consistent_acceleration(&mut self, h: f64, t_law: f64) -> Result<(), FemError> {
+        let (_, mut cx) = self.method_parts();
+        start::consistent_acceleration(&mut cx, h, t_law)
+    }
+
+    /// Whether the method needs every stretch between stop times split into equal steps.
+    pub fn equal_steps(&self) -> bool {
+        self.stepper.equal_steps()
+    }
+
+    /// One step of length h onto t₁ (the caller snaps t₁ to its stop time); books its works.
+    /// A step whose Newton iteration fails is retried as four quarter steps (recursively, down
+    /// to 10⁻⁶ of the nominal step), the method restarted.
+    pub fn step(&mut self, h: f64, t1: f64) -> Result<(), FemError> {
+        if self.try_step(h, t1)? {
+            return Ok(());
+        }
+        let t0 = self.state.t;
+        if h <= 1e-6 * self.h_nominal {
+            return Err(FemError::Runaway {
+                t: t0,
+                what: format!(
+                    "Newton iteration of the {} step did not converge",
+                    self.method
+                ),
+                location: None,
+                why: format!("step h = {h:.3e} s too long for the motion"),
+                remedy: "reduce --dt".into(),
+            });
+        }
+        self.counters.rejected += 1;
+        self.stepper.restart();
+        for k in 1..=4 {
+            let tk = if k == 4 { t1 } else { t0 + 0.25 * k as f64 * h };
+            self.step(tk - self.state.t, tk)?;
+        }
+        Ok(())
+    }
+
+    /// One step; false (state unchanged) when its Newton iteration did not converge.
+    fn try_step(&mut self, h: f64, t1: f64) -> Result<bool, FemError> {
+        let at_burnout = t1 == self.burnout;
+        let t_law = if at_burnout { t1 - 1e-9 * h } else { t1 };
+        let (stepper, mut cx) = self.method_parts();
+        if let Some(e) = stepper.step(&mut cx, None, h, t1, t_law)?
+            && e.is_infinite()
+        {
+            return Ok(false);
+        }
+        self.book(h);
+        self.state.swap_in(t1);
+        self.counters.steps += 1;
+        if at_burnout {
+            // Restart after the jump of the loads and of the mass rate.
+            self.consistent_acceleration(h, t1)?;
+            self.stepper.restart();
+        }
+        Ok(true)
+    }
+
+    /// Books the works of the solved step t₀ → t₀ + h (module docs).
+    fn book(&mut self, h: f64) {
+        let st = &self.state;
+        let (t0, tm, t1) = (st.t, st.t + 0.5 * h, st.t + h);
+        for i in 0..st.q.len() {
+            self.qbar[i] = 0.5 * (st.q[i] + st.q1[i]);
+            self.vbar[i] = 0.5 * (st.qd[i] + st.qd1[i]);
+        }
+        let p = self.system.powers(tm, &self.qbar, &self.vbar);
+        self.counters.rhs += 1;
+        let m = &self.system.model;
+        let (m0, mm, m1) = (m.m1(t0), m.m1(tm), m.m1(t1));
+        let kin = -0.5
+            * ((m1 - mm) * m.m_burn.form(&st.qd1, &st.qd1)
+                + (mm - m0) * m.m_burn.form(&st.qd, &st.qd));
+        for i in 0..st.q.len() {
+            self.qbar[i] += m.x_ref[i];
+        }
+        let pot = (m1 - m0) * m.m_burn.form(&self.system.gravity, &self.qbar);
+        let w = &mut self.works;
+        w.thrust += h * p.thrust;
+        w.pressure += h * p.pressure;
+        w.coriolis += h * p.coriolis;
+        w.damper += h * p.damper;
+        w.outflow += kin + pot;
+    }
+
+    /// Stored energies at the current state, in the ledger's order: kinetic, strain, gravity,
+    /// discrete springs.
+    pub fn stored(&self) -> [f64; 4] {
+        let st = &self.state;
+        let [kinetic, strain, spring, gravity] = self.system.energies(st.t, &st.q, &st.qd);
+        [kinetic, strain, gravity, spring]
+    }
+}
+
+/// The Newton tolerance on the position update of a step h: a velocity update of 10⁻¹³ of
+/// the rocket's velocity scale (the exhaust velocity, of which every rigid velocity change is a
+/// fraction ln(M₀/M); √(gL) without a burn) as a position change over half a step (the
+/// methods add the round-off floor 10⁻¹³(c_q|q̈| + h|q̇|), [`crate::method`]). On the catalog
+/// rocket 7·10⁻⁹ in/s: below it the quasi-Newton updates stall at round-off (the rigid
+/// translation in K q) and steps were retried shorter; the methods' default 10⁻¹¹ of the length
+/// (1.5·10⁻⁹ in) is far above the displacements one step of 10 µs resolves.
+fn newton_tolerance(model: &Model, h: f64) -> f64 {
+    let v_scale = model.exhaust_velocity.max((model.g * model.length).sqrt());
+    1e-13 * v_scale * 0.5 * h
+}
