@@ -64,13 +64,9 @@ fn sys_registry_capabilities_match_the_refusals() {
     let payload = load_scene("single-link-3d").unwrap();
     let mut refused = [0, 0];
     for (m, caps) in registered() {
-        check_refusal(
-            &contact,
-            &settings(m, Some(11), 2e-3),
-            m,
-            caps,
-            |c| c.restarts_at_events,
-        );
+        check_refusal(&contact, &settings(m, Some(11), 2e-3), m, caps, |c| {
+            c.restarts_at_events
+        });
         check_refusal(&payload, &settings(m, None, 2e-3), m, caps, |c| {
             c.implicit_damping
         });
