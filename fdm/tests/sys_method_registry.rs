@@ -4,7 +4,7 @@
 
 use data::{Backend, BackendError, Settings, StabilityVerdict, load_scene};
 use fdm::FdmBackend;
-use fdm::method::{Capabilities, MethodParams, build, capabilities, names_with, registered};
+use fdm::method::{Capabilities, METHODS, MethodParams, build, capabilities, names_with};
 
 /// `m` (a registered `data` method) as `time.method`, with a short horizon.
 fn settings(m: data::FdmMethod, stations: Option<usize>, t_end: f64) -> Settings {
@@ -17,9 +17,8 @@ fn settings(m: data::FdmMethod, stations: Option<usize>, t_end: f64) -> Settings
 
 #[test]
 fn sys_registry_methods_build_and_spell_themselves() {
-    let all = registered();
-    assert!(all.len() >= 3, "{all:?}");
-    for (m, caps) in all {
+    assert!(METHODS.len() >= 3, "{METHODS:?}");
+    for &(m, caps) in METHODS {
         let method = fdm::Method::from_data(m).unwrap();
         assert_eq!(capabilities(method), caps, "{m}");
         for restartable in [false, true] {
@@ -63,7 +62,7 @@ fn sys_registry_capabilities_match_the_refusals() {
     let contact = load_scene("barhorst-case1").unwrap();
     let payload = load_scene("single-link-3d").unwrap();
     let mut refused = [0, 0];
-    for (m, caps) in registered() {
+    for &(m, caps) in METHODS {
         check_refusal(&contact, &settings(m, Some(11), 2e-3), m, caps, |c| {
             c.restarts_at_events
         });

@@ -21,6 +21,7 @@
 //! function of the same name in `crate::settings::payload`.
 
 use crate::error::FdmError;
+use crate::settings::payload;
 use crate::system::System;
 
 pub use two_step::TwoStep;
@@ -138,8 +139,8 @@ pub struct MethodParams {
 /// The registry: one entry per method type, `module::Type { Variant, … }`, declaring the
 /// type's module, the [`Method`] variants it steps (with their documentation and payload), the
 /// conversion from [`data::FdmMethod`] (`Variant [Alias]`: `data` variants that mean this one
-/// here), the spellings ([`Method::name`]), and the dispatch to `Type::from`
-/// ([`MethodParams`]) and `Type::CAPABILITIES`.
+/// here), the spellings ([`Method::name`]), the dispatch to `Type::from` ([`MethodParams`]) and
+/// `Type::CAPABILITIES`, and the list [`METHODS`].
 macro_rules! registry {
     (
         $(
@@ -167,9 +168,8 @@ macro_rules! registry {
                 Ok(match method {
                     $($(
                         data::FdmMethod::$variant $({ $field })? $($(| data::FdmMethod::$alias)+)?
-                            => Method::$variant $({
-                        $field: crate::settings::payload::$field($field)?
-                    })?,)+)*
+                            => Method::$variant $({ $field: payload::$field($field)? })?,
+                    )+)*
                 })
             }
 
@@ -205,12 +205,10 @@ macro_rules! registry {
 
         /// Every registered method (a payload at its default) with its capabilities, in
         /// registry order.
-        pub fn registered() -> Vec<(data::FdmMethod, Capabilities)> {
-            vec![$($((
-                data::FdmMethod::$variant $({ $field: None })?,
-                $module::$method::CAPABILITIES,
-            ),)+)*]
-        }
+        pub const METHODS: &[(data::FdmMethod, Capabilities)] = &[$($((
+            data::FdmMethod::$variant $({ $field: None })?,
+            $module::$method::CAPABILITIES,
+        ),)+)*];
     };
 }
 
@@ -225,10 +223,10 @@ pub fn stepper(method: Method) -> Box<dyn Stepper> {
 /// The spellings of the methods with a capability, in registry order, for messages
 /// (`` `a`, `b` or `c` `` with `conjunction` "or").
 pub fn names_with(conjunction: &str, has: impl Fn(&Capabilities) -> bool) -> String {
-    let names: Vec<String> = registered()
-        .into_iter()
+    let names: Vec<String> = METHODS
+        .iter()
         .filter(|(_, caps)| has(caps))
-        .map(|(m, _)| format!("`{}`", data::Method::from(m).name()))
+        .map(|&(m, _)| format!("`{}`", data::Method::from(m).name()))
         .collect();
     match names.split_last() {
         Some((last, [])) => last.clone(),
