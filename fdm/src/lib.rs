@@ -8,7 +8,9 @@
 //!   The backend's entries match the scene's family once; [`ChainModel`] classifies a planar
 //!   chain.
 //! * **Method** — [`method::Stepper`], one type per method ([`method::two_step`],
-//!   [`method::velocity_form`]); [`method::stepper`] maps `time.method` to its type.
+//!   [`method::velocity_form`]), each registered in one entry of the method registry, which
+//!   maps `time.method` to its type ([`method::stepper`]) and its [`method::Capabilities`]
+//!   (the runs refuse a method that lacks what their model needs, naming those that have it).
 //! * **Events** — [`events::Events`]: located inside a step, applied as resets and constraint
 //!   switches ([`events::tip_contact`]).
 //! * **Driver and outputs** — [`driver::run`] (step choice, watch, ledger work),
@@ -166,7 +168,8 @@
 //!   mass, affine θ coupling, quadratic M_θθ; θ̈ by a Schur complement. Velocity form of the
 //!   central difference at τ = safety × min over fields of the report's bounds (axial
 //!   h√(ρA/EA), bending h²√(ρA/4EI), torsion h√(ρJ/GJ)); `--dt` above it refused naming the
-//!   field; only the velocity form steps it (a requested two-step method is refused).
+//!   field; only a method with implicit damping (the velocity form) steps it (a requested
+//!   two-step method is refused).
 //!   Kelvin–Voigt implicit in the closing kick ((M + ½τC) q̈ = …, one sparse factorization per
 //!   step length): explicit it would bound the step at ≈ ρh²/(4C), 40× below the elastic bound
 //!   of the catalog rod. Modes (K − Ω²H against M, flexibility form), statics (K q = f_g). Tested

@@ -10,7 +10,7 @@ use crate::error::FdmError;
 use crate::events::NoEvents;
 use crate::events::tip_contact::{ContactReport, TipContactEvents};
 use crate::link::FloatingLink;
-use crate::method::{Stepper, VelocityForm};
+use crate::method::{MethodParams, build, capabilities, names_with, stepper};
 use crate::output::{Outcome, Outputs};
 use crate::payload_link::PayloadLinkModel;
 use crate::payload_link::system::PayloadLinkSystem;
@@ -89,7 +89,7 @@ pub fn two_link_chain(
     } else {
         s.method
     };
-    if method == Method::VelocityForm {
+    if capabilities(method).implicit_damping {
         // damping implicit in the closing kick: the step stays at the undamped bound
         sys.enable_implicit_damping();
     }
@@ -98,24 +98,31 @@ pub fn two_link_chain(
     Ok(integrate(&mut sys, &q0, &v0, &ctl)?.into_run_result(scene, s))
 }
 
-/// Runs a two-link chain with its tip contact: the velocity form with every force at the
-/// predicted velocity (its steps can be re-taken from the same level), the contact as events
-/// ([`TipContactEvents`]). Returns the run and the contact diagnostics.
+/// Runs a two-link chain with its tip contact: a method that restarts at located events
+/// ([`crate::method::Capabilities::restarts_at_events`]; default the velocity form), built to
+/// re-take steps from the same level (the velocity form: every force at the predicted
+/// velocity), the contact as events ([`TipContactEvents`]). Returns the run and the contact
+/// diagnostics.
 pub fn two_link_chain_with_contact(
     scene: &Scene,
     pc: &PlanarChain,
     s: &ValidatedSettings,
 ) -> Result<(RunResult, ContactReport), FdmError> {
-    if s.requested.method.is_some() && s.method != Method::VelocityForm {
-        return Err(FdmError::Unsupported(format!(
-            "fdm: contact with time.method = {}: only velocity-form restarts at a located \
-             event (the two-step scheme needs a second level there)",
-            s.method.name()
-        )));
-    }
+    let method = match s.requested.method {
+        None => Method::VelocityForm,
+        Some(_) if capabilities(s.method).restarts_at_events => s.method,
+        Some(_) => {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: contact with time.method = {}: the method cannot restart at a located \
+                 event (it needs a second level there); use {}",
+                s.method.name(),
+                names_with("or", |c| c.restarts_at_events)
+            )));
+        }
+    };
     let mut sys = TwoLinkChain::from_planar_chain(scene, pc, s.stations)?;
     let (q0, v0) = sys.initial_state();
-    let mut ctl = StepControl::for_scene(scene, s, Method::VelocityForm, false, true);
+    let mut ctl = StepControl::for_scene(scene, s, method, false, true);
     if sys.timoshenko().is_some() && s.requested.safety_factor.is_none() {
         ctl.safety = TIMOSHENKO_CONTACT_SAFETY;
     }
@@ -125,7 +132,11 @@ pub fn two_link_chain_with_contact(
     let mut events = TipContactEvents::new(&sys, inp.len() + dis.len());
     let out = run(
         &mut sys,
-        &mut VelocityForm::predicted(),
+        build(MethodParams {
+            method,
+            restartable: true,
+        })
+        .as_mut(),
         &mut events,
         &q0,
         &v0,
@@ -134,31 +145,37 @@ pub fn two_link_chain_with_contact(
     Ok((out.into_run_result(scene, s), events.report))
 }
 
-/// Runs `p`, the payload link of `scene`. Only the velocity form steps the 3-D link: a requested two-step method is
-/// refused (its explicit damping would need the damped step bound, and its computational mode
-/// grows under the Kelvin–Voigt and Coriolis forces).
+/// Runs `p`, the payload link of `scene` (default method: the velocity form). A requested method
+/// without implicit damping ([`crate::method::Capabilities::implicit_damping`]) is refused: its
+/// explicit damping would need the damped step bound (and the two-step scheme's computational
+/// mode grows under the Kelvin–Voigt and Coriolis forces).
 pub fn payload_link(
     scene: &Scene,
     p: &PayloadLink,
     s: &ValidatedSettings,
 ) -> Result<RunResult, FdmError> {
-    if s.requested.method.is_some() && s.method != Method::VelocityForm {
-        return Err(FdmError::Unsupported(format!(
-            "fdm: the 3-D payload link with time.method = {}: only velocity-form steps it (its \
-             Kelvin–Voigt damping is implicit in the velocity form's closing kick)",
-            s.method.name()
-        )));
-    }
+    let method = match s.requested.method {
+        None => Method::VelocityForm,
+        Some(_) if capabilities(s.method).implicit_damping => s.method,
+        Some(_) => {
+            return Err(FdmError::Unsupported(format!(
+                "fdm: the 3-D payload link with time.method = {}: the method cannot take the \
+                 link's Kelvin–Voigt damping implicit in its closing kick; use {}",
+                s.method.name(),
+                names_with("or", |c| c.implicit_damping)
+            )));
+        }
+    };
     let model = PayloadLinkModel::from_payload_link(scene, p, s.stations)?;
     let mut sys = PayloadLinkSystem::new(model)?;
-    let ctl = StepControl::for_scene(scene, s, Method::VelocityForm, false, true);
-    let mut method = VelocityForm::drift_split();
+    let ctl = StepControl::for_scene(scene, s, method, false, true);
+    let mut method = stepper(method);
     // the step is constant (the bound does not move): A = M_ff + ½τC factored once, before
     // the start level needs it
     let (tau, _, _) = choose_step(&sys, &ctl, method.bound_factor(), 0.0)?;
     sys.set_step(tau)?;
     let (q0, v0) = sys.initial_state(p.initial_shape == LinkInitialShape::StaticSag)?;
-    let mut out = run(&mut sys, &mut method, &mut NoEvents, &q0, &v0, &ctl)?;
+    let mut out = run(&mut sys, method.as_mut(), &mut NoEvents, &q0, &v0, &ctl)?;
     out.cost.factorizations = sys.factorizations();
     Ok(out.into_run_result(scene, s))
 }

@@ -11,45 +11,25 @@ pub const DEFAULT_ASSELIN_NU: f64 = 0.01;
 /// follows the burning mass; 1 % changes mark the burn without flooding the event list).
 pub const STEP_LOG_CHANGE: f64 = 0.01;
 
-/// Time-integration method (`time.method`); [`crate::method::stepper`] gives its type.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Method {
-    /// The report's two-step central difference (5.21, 5.24–5.30):
-    /// y_{j+1} = y_{j−1} + (τ_j + τ_{j+1}) f(t_j, y_j).
-    Report,
-    /// The report's scheme with a Robert–Asselin filter of the middle level:
-    /// ȳ_j = y_j + ν (ȳ_{j−1} − 2 y_j + y_{j+1}).
-    RobertAsselin { nu: f64 },
-    /// One-step velocity (kick–drift–kick) form: no computational mode.
-    VelocityForm,
-}
+/// Time-integration method (`time.method`), declared by the method registry.
+pub use crate::method::Method;
 
-impl Method {
-    /// The method named in the settings (`central-difference` is the report's scheme; ν of
-    /// Robert–Asselin checked, [`DEFAULT_ASSELIN_NU`] when not given).
-    pub fn from_data(method: data::FdmMethod) -> Result<Self, FdmError> {
-        match method {
-            data::FdmMethod::Report | data::FdmMethod::CentralDifference => Ok(Method::Report),
-            data::FdmMethod::VelocityForm => Ok(Method::VelocityForm),
-            data::FdmMethod::RobertAsselin { nu } => {
-                let nu = nu.unwrap_or(DEFAULT_ASSELIN_NU);
-                if !(nu > 0.0 && nu < 0.5) {
-                    return Err(FdmError::invalid(
-                        "time.method",
-                        format!("Robert–Asselin ν = {nu} must lie in (0, 0.5)"),
-                    ));
-                }
-                Ok(Method::RobertAsselin { nu })
-            }
-        }
-    }
+/// Checks of the methods' payloads, one function per payload field (named as the field), called
+/// by [`Method::from_data`]: `data`'s `Option<T>` (None: the default) to a checked `T`.
+pub(crate) mod payload {
+    use super::DEFAULT_ASSELIN_NU;
+    use crate::error::FdmError;
 
-    pub fn name(&self) -> String {
-        match self {
-            Method::Report => "report".into(),
-            Method::RobertAsselin { nu } => format!("robert-asselin={nu}"),
-            Method::VelocityForm => "velocity-form".into(),
+    /// Robert–Asselin ν ([`DEFAULT_ASSELIN_NU`] when not given), in (0, 0.5).
+    pub(crate) fn nu(nu: Option<f64>) -> Result<f64, FdmError> {
+        let nu = nu.unwrap_or(DEFAULT_ASSELIN_NU);
+        if !(nu > 0.0 && nu < 0.5) {
+            return Err(FdmError::invalid(
+                "time.method",
+                format!("Robert–Asselin ν = {nu} must lie in (0, 0.5)"),
+            ));
         }
+        Ok(nu)
     }
 }
 

@@ -5,16 +5,23 @@
 //! force evaluation), the driver checks them ([`crate::driver`]: growth of the computational
 //! mode, non-finite states), then [`Stepper::complete`] evaluates the forces at the new level.
 //! A method knows nothing of scene families, events or outputs; it reports its stability limit
-//! relative to the model's σ ([`Stepper::bound_factor`]).
+//! relative to the model's σ ([`Stepper::bound_factor`]) and what it supports
+//! ([`Capabilities`]), from which a run refuses a model the method cannot step, naming the
+//! methods that can ([`names_with`]).
 //!
 //! Methods: [`two_step`] (the report's central difference 5.21, optionally Robert–Asselin
-//! filtered) and [`velocity_form`] (one-step kick–drift–kick). [`stepper`] maps the setting
-//! `time.method` to its type.
+//! filtered) and [`velocity_form`] (one-step kick–drift–kick).
+//!
+//! Adding a method: one new file here with the method type, its [`Stepper`] impl, its
+//! `CAPABILITIES` and `From<`[`MethodParams`]`>`, and its entry in the registry at the end of
+//! this file (`module::Type { Variant }`: declares the module, the [`Method`] variant, the
+//! conversion from [`data::FdmMethod`] and the dispatch); in `data`, one row of the method
+//! table (`data/src/methods.rs`, from which [`data::FdmMethod`] follows). A payload field of a
+//! variant is `Option<T>` in `data` (None: the backend's default) and `T` here, checked by the
+//! function of the same name in `crate::settings::payload`.
 
-pub mod two_step;
-pub mod velocity_form;
-
-use crate::settings::Method;
+use crate::error::FdmError;
+use crate::settings::payload;
 use crate::system::System;
 
 pub use two_step::TwoStep;
@@ -106,11 +113,141 @@ pub trait Stepper {
     );
 }
 
-/// The method of the setting `time.method` (the registration point of a new method).
+/// What a method supports; a run refuses a model that needs what its method lacks, naming the
+/// methods that have it ([`names_with`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Capabilities {
+    /// Built with [`MethodParams::restartable`], a step depends on level j alone, so it can be
+    /// re-taken from the same level with another length: event location (the two-link chain's
+    /// tip contact).
+    pub restarts_at_events: bool,
+    /// Built without [`MethodParams::restartable`], takes the closing kick with the system's
+    /// linear damping implicit ([`System::implicit_kick`]), so the step stays at the undamped
+    /// bound (required by the 3-D payload link; switched on in the two-link chain).
+    pub implicit_damping: bool,
+}
+
+/// What a method is built from: the validated method (with its payload) and whether the run
+/// re-takes steps from a located event ([`Capabilities::restarts_at_events`]; the methods
+/// without that capability ignore it).
+#[derive(Debug, Clone, Copy)]
+pub struct MethodParams {
+    pub method: Method,
+    pub restartable: bool,
+}
+
+/// The registry: one entry per method type, `module::Type { Variant, … }`, declaring the
+/// type's module, the [`Method`] variants it steps (with their documentation and payload), the
+/// conversion from [`data::FdmMethod`] (`Variant [Alias]`: `data` variants that mean this one
+/// here), the spellings ([`Method::name`]), the dispatch to `Type::from` ([`MethodParams`]) and
+/// `Type::CAPABILITIES`, and the list [`METHODS`].
+macro_rules! registry {
+    (
+        $(
+            $module:ident :: $method:ident {
+                $(
+                    $(#[$doc:meta])*
+                    $variant:ident $({ $field:ident: $fty:ty })? $([$($alias:ident),+])?
+                ),+ $(,)?
+            }
+        )*
+    ) => {
+        $(pub mod $module;)*
+
+        /// Time-integration method (`time.method`) with its payload checked; [`stepper`] gives
+        /// its type.
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub enum Method {
+            $($($(#[$doc])* $variant $({ $field: $fty })?,)+)*
+        }
+
+        impl Method {
+            /// The method named in the settings (payloads checked, their defaults filled in by
+            /// `crate::settings::payload`).
+            pub fn from_data(method: data::FdmMethod) -> Result<Self, FdmError> {
+                Ok(match method {
+                    $($(
+                        data::FdmMethod::$variant $({ $field })? $($(| data::FdmMethod::$alias)+)?
+                            => Method::$variant $({ $field: payload::$field($field)? })?,
+                    )+)*
+                })
+            }
+
+            /// The canonical spelling (`data`'s table; a payload with its value).
+            pub fn name(&self) -> String {
+                data::Method::from(data::FdmMethod::from(*self)).name()
+            }
+        }
+
+        impl From<Method> for data::FdmMethod {
+            fn from(method: Method) -> Self {
+                match method {
+                    $($(Method::$variant $({ $field })? => data::FdmMethod::$variant $({
+                        $field: Some($field)
+                    })?,)+)*
+                }
+            }
+        }
+
+        /// The stepper of a method built from `params`.
+        pub fn build(params: MethodParams) -> Box<dyn Stepper> {
+            match params.method {
+                $($(Method::$variant { .. } => Box::new($module::$method::from(params)),)+)*
+            }
+        }
+
+        /// What `method` supports.
+        pub fn capabilities(method: Method) -> Capabilities {
+            match method {
+                $($(Method::$variant { .. } => $module::$method::CAPABILITIES,)+)*
+            }
+        }
+
+        /// Every registered method (a payload at its default) with its capabilities, in
+        /// registry order.
+        pub const METHODS: &[(data::FdmMethod, Capabilities)] = &[$($((
+            data::FdmMethod::$variant $({ $field: None })?,
+            $module::$method::CAPABILITIES,
+        ),)+)*];
+    };
+}
+
+/// The stepper of the setting `time.method` (steps never re-taken).
 pub fn stepper(method: Method) -> Box<dyn Stepper> {
-    match method {
-        Method::Report => Box::new(TwoStep::central_difference()),
-        Method::RobertAsselin { nu } => Box::new(TwoStep::robert_asselin(nu)),
-        Method::VelocityForm => Box::new(VelocityForm::drift_split()),
+    build(MethodParams {
+        method,
+        restartable: false,
+    })
+}
+
+/// The spellings of the methods with a capability, in registry order, for messages
+/// (`` `a`, `b` or `c` `` with `conjunction` "or").
+pub fn names_with(conjunction: &str, has: impl Fn(&Capabilities) -> bool) -> String {
+    let names: Vec<String> = METHODS
+        .iter()
+        .filter(|(_, caps)| has(caps))
+        .map(|&(m, _)| format!("`{}`", data::Method::from(m).name()))
+        .collect();
+    match names.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} {conjunction} {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
+registry! {
+    two_step::TwoStep {
+        /// The report's two-step central difference (5.21, 5.24–5.30):
+        /// y_{j+1} = y_{j−1} + (τ_j + τ_{j+1}) f(t_j, y_j).
+        ///
+        /// `central-difference` (fem's explicit method) is this scheme here.
+        Report [CentralDifference],
+        /// The report's scheme with a Robert–Asselin filter of the middle level:
+        /// ȳ_j = y_j + ν (ȳ_{j−1} − 2 y_j + y_{j+1}).
+        RobertAsselin { nu: f64 },
+    }
+    velocity_form::VelocityForm {
+        /// One-step velocity (kick–drift–kick) form: no computational mode.
+        VelocityForm,
     }
 }

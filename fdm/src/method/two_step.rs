@@ -21,7 +21,7 @@
 // Index loops run over several parallel level buffers at once.
 #![allow(clippy::needless_range_loop)]
 
-use super::{StepState, Stepper};
+use super::{Capabilities, Method, MethodParams, StepState, Stepper};
 use crate::system::System;
 
 /// The two-step central difference, with the Robert–Asselin coefficient ν if filtered.
@@ -39,6 +39,23 @@ impl TwoStep {
     /// The scheme with the middle level filtered by ν.
     pub fn robert_asselin(nu: f64) -> Self {
         TwoStep { filter: Some(nu) }
+    }
+
+    /// Neither capability: a step needs the level before it (no restart at an event), and its
+    /// damping is explicit.
+    pub const CAPABILITIES: Capabilities = Capabilities {
+        restarts_at_events: false,
+        implicit_damping: false,
+    };
+}
+
+impl From<MethodParams> for TwoStep {
+    /// `robert-asselin=ν` filtered by ν; the report's scheme otherwise.
+    fn from(params: MethodParams) -> Self {
+        match params.method {
+            Method::RobertAsselin { nu } => TwoStep::robert_asselin(nu),
+            _ => TwoStep::central_difference(),
+        }
     }
 }
 

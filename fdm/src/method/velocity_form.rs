@@ -31,7 +31,7 @@
 // Index loops run over several parallel level buffers at once.
 #![allow(clippy::needless_range_loop)]
 
-use super::{StepState, Stepper};
+use super::{Capabilities, MethodParams, StepState, Stepper};
 use crate::system::{DriftVelocities, System};
 
 /// The velocity form; where the velocity-quadratic inertia terms are evaluated.
@@ -60,6 +60,24 @@ impl VelocityForm {
             split: false,
             drift_prev: Vec::new(),
             have_drift_prev: false,
+        }
+    }
+
+    /// Restartable ([`VelocityForm::predicted`]) and with implicit damping (module docs).
+    pub const CAPABILITIES: Capabilities = Capabilities {
+        restarts_at_events: true,
+        implicit_damping: true,
+    };
+}
+
+impl From<MethodParams> for VelocityForm {
+    /// [`VelocityForm::predicted`] for a run that re-takes steps, else
+    /// [`VelocityForm::drift_split`].
+    fn from(params: MethodParams) -> Self {
+        if params.restartable {
+            VelocityForm::predicted()
+        } else {
+            VelocityForm::drift_split()
         }
     }
 }

@@ -15,14 +15,17 @@
 //!
 //! Every method implements [`Stepper`] (one accepted step, dense output over it, work
 //! counters, restart after a discontinuity) and has a [`MethodInfo`] (its name and how it is
-//! built); the registry [`method_for`] maps the settings' [`data::ModalMethod`] to it: a driver
-//! holds a `Box<dyn Stepper>` built from the registry entry and never names a method. Adding a
-//! method is one new file (the method type, its `Stepper` impl and its [`MethodInfo`]) with its
-//! `mod` line, its line in [`method_for`], and its row in `data`'s method table (from which
+//! built: error-controlled or fixed steps, [`Build`]); the registry ([`method_for`],
+//! [`METHODS`]) maps the settings' [`data::ModalMethod`] to it: a driver holds a
+//! `Box<dyn Stepper>` built from the registry entry and never names a method, and a model that
+//! needs error-controlled steps (the rocket) refuses the fixed-step methods naming the methods
+//! that can ([`names_with`]).
+//!
+//! Adding a method: one new file here (the method type, its `Stepper` impl and its
+//! [`MethodInfo`]) and its entry in the registry at the end of this file
+//! (`module { Variant => INFO }`: declares the module and maps the settings' variant to the
+//! entry); in `data`, one row of the method table (`data/src/methods.rs`, from which
 //! [`data::ModalMethod`] follows).
-
-mod dopri5;
-mod sdirk;
 
 pub use dopri5::{DOPRI5, Dopri5};
 pub use sdirk::{Sdirk, TRAPEZOID, TRBDF2, TRBDF2_FIXED};
@@ -101,14 +104,43 @@ impl std::fmt::Debug for MethodInfo {
     }
 }
 
-/// The registry: the implementation of each method of the settings.
-pub fn method_for(method: data::ModalMethod) -> &'static MethodInfo {
-    match method {
-        data::ModalMethod::Dopri5 => &DOPRI5,
-        data::ModalMethod::TrBdf2 => &TRBDF2,
-        data::ModalMethod::TrBdf2Fixed => &TRBDF2_FIXED,
-        data::ModalMethod::Trapezoid => &TRAPEZOID,
+/// The registry: one entry per module, `module { Variant => INFO, … }`, declaring the module
+/// and mapping each settings' [`data::ModalMethod`] variant to the module's [`MethodInfo`]
+/// constant ([`method_for`]; [`METHODS`] in registry order).
+macro_rules! registry {
+    ($($module:ident { $($variant:ident => $info:ident),+ $(,)? })*) => {
+        $(mod $module;)*
+
+        /// The implementation of each method of the settings.
+        pub fn method_for(method: data::ModalMethod) -> &'static MethodInfo {
+            match method {
+                $($(data::ModalMethod::$variant => &$module::$info,)+)*
+            }
+        }
+
+        /// Every registered method, in registry order.
+        pub const METHODS: &[&MethodInfo] = &[$($(&$module::$info,)+)*];
+    };
+}
+
+/// The spellings of the registered methods for which `has` holds, in registry order, for
+/// messages (`` `a`, `b` or `c` `` with `conjunction` "or").
+pub fn names_with(conjunction: &str, has: impl Fn(&MethodInfo) -> bool) -> String {
+    let names: Vec<String> = METHODS
+        .iter()
+        .filter(|m| has(m))
+        .map(|m| format!("`{}`", m.name))
+        .collect();
+    match names.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} {conjunction} {last}", rest.join(", ")),
+        None => String::new(),
     }
+}
+
+registry! {
+    dopri5 { Dopri5 => DOPRI5 }
+    sdirk { TrBdf2 => TRBDF2, TrBdf2Fixed => TRBDF2_FIXED, Trapezoid => TRAPEZOID }
 }
 
 /// [`StopReason`] of a step that ended at `t` with target `t_stop`.

@@ -3,6 +3,7 @@
 use data::{Basis as BasisKind, ModalSettings};
 
 use super::error::RocketError;
+use crate::integrate::{DOPRI5, MethodInfo, method_for, names_with};
 
 /// Default number of axial and of transverse elastic modes.
 pub const DEFAULT_MODES: usize = 6;
@@ -13,13 +14,23 @@ pub const MAX_MODES: usize = 40;
 pub const DEFAULT_RTOL: f64 = 1e-8;
 pub const DEFAULT_ATOL: f64 = 1e-10;
 
-/// Time integration method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// Explicit adaptive Dormand–Prince 5(4) (`dopri5`, default).
-    Dopri5,
-    /// Implicit L-stable TR-BDF2 (`tr-bdf2`, alias `sdirk`).
-    TrBdf2,
+/// Time integration method: a registered method with error-controlled steps (default
+/// Dormand–Prince 5(4), [`DOPRI5`]).
+pub type Method = &'static MethodInfo;
+
+/// The rocket's refusal of a fixed-step method: `time.dt` is only its initial step, and it has
+/// no default fixed step.
+pub(crate) fn fixed_step_refused(method: Method) -> RocketError {
+    RocketError::invalid(
+        "time.method",
+        format!(
+            "`{}` is not a rocket integrator (a fixed-step method; the rocket takes \
+             error-controlled steps); use {} (default `{}`)",
+            method.name,
+            names_with("or", |m| !m.is_fixed_step()),
+            DOPRI5.name
+        ),
+    )
 }
 
 pub fn modes(settings: &ModalSettings) -> Result<usize, RocketError> {
@@ -69,18 +80,10 @@ fn positive(field: &str, v: Option<f64>) -> Result<Option<f64>, RocketError> {
 
 pub fn time(scene: &data::Scene, settings: &ModalSettings) -> Result<TimeConfig, RocketError> {
     let ts = settings;
-    let method = match ts.method {
-        None | Some(data::ModalMethod::Dopri5) => Method::Dopri5,
-        Some(data::ModalMethod::TrBdf2) => Method::TrBdf2,
-        Some(other) => {
-            return Err(RocketError::invalid(
-                "time.method",
-                format!(
-                    "`{other}` is not a rocket integrator; use `dopri5` (default) or `tr-bdf2`"
-                ),
-            ));
-        }
-    };
+    let method = ts.method.map_or(&DOPRI5, method_for);
+    if method.is_fixed_step() {
+        return Err(fixed_step_refused(method));
+    }
     let rtol = positive("time.rtol", ts.rtol)?.unwrap_or(DEFAULT_RTOL);
     let atol = positive("time.atol", ts.atol)?.unwrap_or(DEFAULT_ATOL);
     let t_end = positive("time.t_end", ts.t_end)?.unwrap_or(scene.simulation.t_end);

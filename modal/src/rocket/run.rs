@@ -14,7 +14,7 @@ use super::body::Body;
 use super::config::{self, Method, TimeConfig};
 use super::dynamics::{Model, Phase, StationModes, Workspace, quad, rhs, snapshot};
 use super::error::RocketError;
-use crate::integrate::{Dopri5, IntegrateError, OdeRhs, Sdirk, Stepper, Tolerances};
+use crate::integrate::{Build, IntegrateError, OdeRhs, Stepper, Tolerances};
 
 /// The ODE right-hand side handed to the integrators.
 struct RocketRhs<'a> {
@@ -77,10 +77,17 @@ fn initial_state(model: &Model) -> Vec<f64> {
     y
 }
 
-fn stepper(method: Method, dim: usize, tol: Tolerances, h0: Option<f64>) -> Box<dyn Stepper> {
-    match method {
-        Method::Dopri5 => Box::new(Dopri5::new(dim, tol, h0, None)),
-        Method::TrBdf2 => Box::new(Sdirk::new(dim, tol, h0, None)),
+/// The stepper of an error-controlled method from the initial step `h0` (a fixed-step method,
+/// possible in a [`TimeConfig`] built by hand, is refused as [`config::time`] refuses it).
+fn stepper(
+    method: Method,
+    dim: usize,
+    tol: Tolerances,
+    h0: Option<f64>,
+) -> Result<Box<dyn Stepper>, RocketError> {
+    match method.build {
+        Build::Adaptive(build) => Ok(build(dim, tol, h0)),
+        Build::Fixed(_) => Err(config::fixed_step_refused(method)),
     }
 }
 
@@ -346,7 +353,7 @@ pub fn simulate_detailed(
         rtol: tc.rtol,
         atol: tc.atol,
     };
-    let mut stepper = stepper(tc.method, dim, tol, tc.dt);
+    let mut stepper = stepper(tc.method, dim, tol, tc.dt)?;
 
     // Output grid and the one discontinuity of the loads (burn-out).
     // the last sample is t_end itself, also when it is not a multiple of the interval
