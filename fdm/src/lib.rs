@@ -184,6 +184,7 @@
 //!   the two-step scheme, mobile
 //!   scenes.
 
+pub mod band_ldl;
 pub mod beam;
 pub mod chain;
 pub mod driver;

@@ -67,6 +67,10 @@ pub(crate) struct Recorder {
     v: Vec<f64>,
     work: Vec<f64>,
     n_in: usize,
+    /// the ledger's energy scale so far (max |E|, |W_in|, |W_diss| over the samples) and the
+    /// relative residual of the last sample
+    scale: f64,
+    last_closure: f64,
 }
 
 impl Recorder {
@@ -112,6 +116,8 @@ impl Recorder {
             v: vec![0.0; n],
             work: vec![0.0; inp.len() + dis.len()],
             n_in: inp.len(),
+            scale: 0.0,
+            last_closure: 0.0,
         }
     }
 
@@ -158,8 +164,30 @@ impl Recorder {
                 &self.work[..self.n_in],
                 &self.work[self.n_in..],
             );
+            let k = self.ledger.time.len() - 1;
+            let (w_in, w_out): (f64, f64) = (
+                self.work[..self.n_in].iter().sum(),
+                self.work[self.n_in..].iter().sum(),
+            );
+            self.scale = self
+                .scale
+                .max(self.ledger.total(k).abs())
+                .max(w_in.abs())
+                .max(w_out.abs());
+            let residual = self.ledger.residual(k).abs();
+            self.last_closure = if self.scale > 0.0 {
+                residual / self.scale
+            } else {
+                residual
+            };
             self.next += 1;
         }
+    }
+
+    /// The relative ledger residual of the last sample (the measure of
+    /// `EnergyLedger::relative_closure`, on the samples so far).
+    pub(crate) fn last_closure(&self) -> f64 {
+        self.last_closure
     }
 
     pub(crate) fn done(&self) -> bool {

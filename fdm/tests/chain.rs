@@ -6,88 +6,98 @@
 use data::{Backend, RunResult, Settings, StabilityVerdict, load_scene};
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
-use fdm::chain::dual::Dual;
+use fdm::chain::kinetic::ChainInertia;
+use fdm::chain::kinetic::PointScratch;
 use fdm::system::System;
 
 mod common;
 
-#[test]
-fn elem_chain_momenta_and_gradient_are_derivatives_of_the_kinetic_energy() {
-    let scene = load_scene("two-link-free").unwrap();
-    let sys =
-        TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9)).unwrap();
-    let ine = &sys.inertia;
-    let n = sys.dofs();
-    let (q, v) = common::moving_chain_state(sys.dofs());
-    let mut p = vec![Dual::default(); n];
-    ine.momenta(&q, &v, &v, &mut p);
-    let mut g = vec![0.0; n];
-    ine.grad_q(&q, &v, &mut g);
-    let t0 = ine.kinetic(&q, &v);
-    // T is homogeneous quadratic in q̇: T = ½ q̇·p exactly (round-off only)
-    let half: f64 = 0.5 * (0..n).map(|i| v[i] * p[i].re).sum::<f64>();
-    assert!((half - t0).abs() < 1e-12 * t0.abs(), "{half} vs {t0}");
-    let eps = 1e-6;
-    // dual part: (∂p/∂q)·q̇ against a central difference of p along q̇
-    let (mut qa, mut qb) = (q.clone(), q.clone());
-    for i in 0..n {
-        qa[i] += eps * v[i];
-        qb[i] -= eps * v[i];
+/// Inertial positions of the chain's lumped points (link 1's stations, the elbow, link 2's
+/// stations) written from the geometry alone, independently of the kinetic-energy kernel.
+fn point_positions(ine: &ChainInertia, q: &[f64]) -> Vec<[f64; 2]> {
+    let fore = |u: &[f64], h: f64, on: bool| -> Vec<f64> {
+        let mut s = 0.0;
+        let mut prev = 0.0;
+        u.iter()
+            .map(|&x| {
+                if on {
+                    s += 0.5 * h * ((x - prev) / h).powi(2);
+                }
+                prev = x;
+                s
+            })
+            .collect()
+    };
+    let (v, w) = (&q[ine.iv()], &q[ine.iw()]);
+    let (s1, s2) = (fore(v, ine.h1, ine.fs1), fore(w, ine.h2, ine.fs2));
+    let rot = |a: f64, x: f64, y: f64| [a.cos() * x - a.sin() * y, a.sin() * x + a.cos() * y];
+    let mut out = Vec::new();
+    for k in 0..ine.r1 {
+        out.push(rot(q[0], (k + 1) as f64 * ine.h1 - s1[k], v[k]));
     }
-    let (mut pa, mut pb) = (p.clone(), p.clone());
-    ine.momenta(&qa, &v, &v, &mut pa);
-    ine.momenta(&qb, &v, &v, &mut pb);
-    for i in 0..n {
-        let (mut va, mut vb) = (v.clone(), v.clone());
-        va[i] += eps;
-        vb[i] -= eps;
-        let dp = (ine.kinetic(&q, &va) - ine.kinetic(&q, &vb)) / (2.0 * eps);
-        let (mut qa, mut qb) = (q.clone(), q.clone());
-        qa[i] += eps;
-        qb[i] -= eps;
-        let dg = (ine.kinetic(&qa, &v) - ine.kinetic(&qb, &v)) / (2.0 * eps);
-        let dd = (pa[i].re - pb[i].re) / (2.0 * eps);
-        // central differences: truncation O(ε²·T''') ≈ 1e-12 relative, round-off
-        // ≈ 1e-16·T/ε ≈ 1e-10 relative to the scale of T
-        let tol = 1e-7 * (1.0 + t0);
-        assert!((p[i].re - dp).abs() < tol, "p[{i}] {} vs {dp}", p[i].re);
-        assert!((g[i] - dg).abs() < tol, "∂T/∂q[{i}] {} vs {dg}", g[i]);
-        assert!((p[i].du - dd).abs() < tol, "ṗ[{i}] {} vs {dd}", p[i].du);
+    let e = *out.last().unwrap();
+    out.push(e);
+    for j in 0..ine.r2 {
+        let r = rot(q[1], (j + 1) as f64 * ine.h2 - s2[j], w[j]);
+        out.push([e[0] + r[0], e[1] + r[1]]);
     }
-    // mass matrix structure: only θ, β and V have off-diagonal entries
-    let full = [0, 1, ine.i_tip1()];
-    let zeros = vec![0.0; n];
-    // (the chain's tip ghost y, after the inertia's coordinates, moves no lumped mass)
-    for k in 0..ine.dofs() {
-        if full.contains(&k) {
-            continue;
-        }
-        let mut e = vec![0.0; n];
-        e[k] = 1.0;
-        ine.momenta(&q, &zeros, &e, &mut p);
-        for i in 0..ine.dofs() {
-            if i != k && !full.contains(&i) {
-                assert_eq!(p[i].re, 0.0, "M[{i}][{k}]");
-            }
-        }
-        assert!((p[k].re - ine.diag_mass(k)).abs() < 1e-15, "M[{k}][{k}]");
-    }
+    out
 }
 
 #[test]
-fn elem_chain_momentum_values_are_the_dual_values_bit_for_bit() {
+fn elem_chain_kinetic_energy_is_that_of_the_moving_lumped_points() {
+    // T = ½J₁θ̇² + ½Σm|ṙ|² with ṙ a central difference of the positions along q̇; p = ∂T/∂q̇
+    // and the inertia forces ∂T/∂q − (∂p/∂q)q̇ against central differences of T and p
     let scene = load_scene("two-link-free").unwrap();
     let sys =
         TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9)).unwrap();
     let ine = &sys.inertia;
     let n = ine.dofs();
-    let (q, v) = common::moving_chain_state(sys.dofs());
-    let mut dual = vec![Dual::default(); n];
-    ine.momenta(&q, &v, &v, &mut dual);
-    let mut values = vec![f64::NAN; n];
-    ine.momenta_values(&q, &v, &mut values);
+    let (q, v) = common::moving_chain_state(n);
+    let mut sc = PointScratch::new(ine);
+    let t0 = ine.kinetic(&q, &v, &mut sc);
+    let eps = 1e-6;
+    let shifted = |s: f64| -> Vec<f64> { (0..n).map(|i| q[i] + s * v[i]).collect() };
+    let (ra, rb) = (
+        point_positions(ine, &shifted(eps)),
+        point_positions(ine, &shifted(-eps)),
+    );
+    let mut t_points = 0.5 * ine.hub * v[0] * v[0];
+    for p in 0..ine.points() {
+        let d = [0, 1].map(|c| (ra[p][c] - rb[p][c]) / (2.0 * eps));
+        t_points += 0.5 * ine.point_mass(p) * (d[0] * d[0] + d[1] * d[1]);
+    }
+    // central difference of smooth positions: O(ε²) truncation, round-off ≈ 1e-16/ε relative
+    assert!((t_points - t0).abs() < 1e-8 * t0, "{t_points} vs {t0}");
+    let mut p = vec![0.0; n];
+    ine.momenta_values(&q, &v, &mut sc, &mut p);
+    let half: f64 = 0.5 * (0..n).map(|i| v[i] * p[i]).sum::<f64>();
+    assert!((half - t0).abs() < 1e-12 * t0, "{half} vs {t0}");
+    let mut f = vec![0.0; n];
+    ine.inertia_forces(&q, &v, &mut sc, &mut f);
+    let (mut pa, mut pb) = (vec![0.0; n], vec![0.0; n]);
+    ine.momenta_values(&shifted(eps), &v, &mut sc, &mut pa);
+    ine.momenta_values(&shifted(-eps), &v, &mut sc, &mut pb);
     for i in 0..n {
-        assert_eq!(values[i].to_bits(), dual[i].re.to_bits(), "p[{i}]");
+        let (mut va, mut vb) = (v.clone(), v.clone());
+        va[i] += eps;
+        vb[i] -= eps;
+        let dp = (ine.kinetic(&q, &va, &mut sc) - ine.kinetic(&q, &vb, &mut sc)) / (2.0 * eps);
+        let (mut qa, mut qb) = (q.clone(), q.clone());
+        qa[i] += eps;
+        qb[i] -= eps;
+        let dg = (ine.kinetic(&qa, &v, &mut sc) - ine.kinetic(&qb, &v, &mut sc)) / (2.0 * eps);
+        let dd = (pa[i] - pb[i]) / (2.0 * eps);
+        // central differences: truncation O(ε²·T''') ≈ 1e-12 relative, round-off
+        // ≈ 1e-16·T/ε ≈ 1e-10 relative to the scale of T
+        let tol = 1e-7 * (1.0 + t0);
+        assert!((p[i] - dp).abs() < tol, "p[{i}] {} vs {dp}", p[i]);
+        assert!(
+            (f[i] - (dg - dd)).abs() < tol,
+            "inertia force [{i}] {} vs {}",
+            f[i],
+            dg - dd
+        );
     }
 }
 
@@ -293,8 +303,11 @@ fn conv_chain_undamped_mean_joint_angles_converge_under_refinement() {
     // wave left a mean bias ∝ (ωτ)² and the sum grew with the number of stations: the 1 s
     // mean of joint 2 went 0.68137, 0.66542, 0.63554 at 21/41/81 stations, away from fem's
     // 0.69676. With the drift-velocity inertia terms (integrator docs) the means must settle:
-    // successive differences shrink by at least 2 (first order or better) and the 41-station
-    // value sits within twice the last difference of fdm's own Richardson limit.
+    // joint 2's successive differences shrink by at least 2 (first order or better) and its
+    // 41-station value sits within twice the last difference of fdm's own Richardson limit.
+    // Joint 1's mean carries no such bias: it is settled at the coarsest grid, its differences
+    // (2e-5 of 0.62 rad) the size of the runs' 1 s averaging of undamped oscillation, without a
+    // sign pattern; it must stay within a tenth of joint 2's first difference at every grid.
     let means: Vec<[f64; 2]> = [11, 21, 41]
         .iter()
         .map(|&n| {
@@ -306,23 +319,28 @@ fn conv_chain_undamped_mean_joint_angles_converge_under_refinement() {
             ]
         })
         .collect();
+    let differences = |j: usize| (means[1][j] - means[0][j], means[2][j] - means[1][j]);
+    let (d1, d2) = differences(1);
+    let p = (d1 / d2).abs().log2();
+    let limit = means[2][1] + d2 / (2f64.powf(p) - 1.0);
     for j in 0..2 {
-        let (d1, d2) = (means[1][j] - means[0][j], means[2][j] - means[1][j]);
-        let p = (d1 / d2).abs().log2();
-        let limit = means[2][j] + d2 / (2f64.powf(p) - 1.0);
         eprintln!(
-            "joint{} 1 s mean: {:.7} {:.7} {:.7}, observed order {p:.2}, Richardson limit {limit:.7}",
+            "joint{} 1 s mean: {:.7} {:.7} {:.7}",
             j + 1,
             means[0][j],
             means[1][j],
             means[2][j]
         );
+    }
+    eprintln!("joint2: observed order {p:.2}, Richardson limit {limit:.7}");
+    assert!(d2.abs() < 0.5 * d1.abs(), "joint2: {d1:e} then {d2:e}");
+    assert!((means[2][1] - limit).abs() <= 2.0 * d2.abs());
+    let (e1, e2) = differences(0);
+    for e in [e1, e2, e1 + e2] {
         assert!(
-            d2.abs() < 0.5 * d1.abs(),
-            "joint{}: {d1:e} then {d2:e}",
-            j + 1
+            e.abs() < 0.1 * d1.abs(),
+            "joint1: {e1:e}, {e2:e} against {d1:e}"
         );
-        assert!((means[2][j] - limit).abs() <= 2.0 * d2.abs());
     }
 }
 
@@ -550,13 +568,14 @@ fn dyn_chain_two_step_scheme_is_caught_and_velocity_form_is_default() {
 
 #[test]
 fn dyn_chain_deflected_beyond_its_length_stops_with_a_diagnostic() {
-    // EI 1000 times lower: released from 45°/60° against the joint springs, the soft links
-    // swing far out of the range of the chain's small-slope chord frames (fem and modal
-    // reach tip deflections of two thirds of link 1). The clamp-frame tip deflection L·(−ε)
-    // passes a link length and the run stops, keeping what it computed up to there.
+    // EI 10⁴ times lower: released from 45°/60° against the joint springs, the string-like
+    // links swing out of the range of the chain's small-slope chord frames within
+    // milliseconds. The clamp-frame tip deflection L·(−ε) passes a link length and the run
+    // stops, keeping what it computed up to there. (At 10³ times lower the chain still
+    // completes 2 s, link 1's tip deflection peaking at 2.58 of its 3 ft, fem 2.28.)
     let soft = |sc: &mut data::Scene| {
         for l in &mut sc.planar_chain_mut().unwrap().links {
-            l.bending_stiffness *= 1e-3;
+            l.bending_stiffness *= 1e-4;
         }
     };
     let out = run("two-link-free", soft, &with(21, 2.0));
@@ -613,4 +632,39 @@ fn sys_chain_overextension_is_the_clamp_frame_tip_deflection_past_the_length() {
             "{name}: {o:?}"
         );
     }
+}
+
+#[test]
+fn dyn_chain_whip_beyond_the_default_step_stops_when_the_ledger_opens() {
+    // EI 1000 times lower: the release whips the soft links faster than the default step (the
+    // elastic bound of the chain linearized at t = 0) resolves. The run must not complete as
+    // if it were a solution: the driver stops when the ledger's residual passes 5 % of the
+    // energy that flowed. At a step that resolves the whip the same run closes its ledger,
+    // and the closure falls at second order.
+    let soft = |sc: &mut data::Scene| {
+        for l in &mut sc.planar_chain_mut().unwrap().links {
+            l.bending_stiffness *= 1e-3;
+        }
+    };
+    let out = run("two-link-free", soft, &with(21, 0.1));
+    match &out.verdict {
+        StabilityVerdict::Stopped { diagnostic } => {
+            eprintln!("soft chain, default step: {diagnostic}");
+            assert!(diagnostic.what.contains("energy ledger"), "{diagnostic:?}");
+            assert!(diagnostic.remedy.contains("--dt"), "{diagnostic:?}");
+        }
+        v => panic!("expected a stop, got {v:?}"),
+    }
+    let closure = |dt: f64| {
+        let mut s = with(21, 0.1);
+        s.time.dt = Some(dt);
+        let out = run("two-link-free", soft, &s);
+        assert!(matches!(out.verdict, StabilityVerdict::Completed));
+        out.ledger.relative_closure()
+    };
+    let (c1, c2) = (closure(2e-5), closure(1e-5));
+    eprintln!("soft chain: ledger closure {c1:.2e} at dt 2e-5, {c2:.2e} at 1e-5");
+    assert!(c1 < 1e-3, "{c1}");
+    let order = (c1 / c2).log2();
+    assert!((1.7..2.3).contains(&order), "closure order {order}");
 }

@@ -71,7 +71,9 @@ fn dyn_contact_case1_impacts_balance_momentum_and_lose_energy() {
             lam > -1e-9,
             "impulse {lam} must push the tip off the surface"
         );
-        assert!(lost >= 0.0, "kinetic energy gained {lost:e} at t = {t}");
+        // ΔKE = ½(Gq̇⁻)²/(GM⁻¹Gᵀ) ≥ 0; a grazing one is a difference of two kinetic energies
+        // of ~10 ft·lbf, exact to their round-off (1e-15 relative)
+        assert!(lost >= -1e-13, "kinetic energy gained {lost:e} at t = {t}");
     }
     // the first impact is a real hit: a loss of order the kinetic energy of the fall
     assert!(imp[0].4 > 1.0, "first impact lost {}", imp[0].4);

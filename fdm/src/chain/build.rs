@@ -5,9 +5,11 @@
 use data::scene::{Link, PlanarChain};
 use data::{DofPlan, Scene};
 
-use super::dual::Dual;
+use super::kinetic::PointScratch;
 use super::kinetic::{BE, ChainInertia, TH};
+use super::mass::MassFactors;
 use super::model::{JointLaw, LinkProps, TwoLinkChain};
+use super::rates::LinkRates;
 use super::surface::{TipConstraint, TipContact};
 use super::timoshenko::{self, TimoFields};
 use crate::error::FdmError;
@@ -106,12 +108,12 @@ fn lump(l: &Link, n: usize) -> (usize, f64, Vec<f64>) {
     (r, h, m)
 }
 
-/// Outboard sums per segment: Σ_{i > seg} mᵢ xᵢ (`moment`) or Σ_{i > seg} mᵢ.
-fn outboard(m: &[f64], h: f64, moment: bool) -> Vec<f64> {
+/// Outboard mass per segment: Σ_{i ≥ seg} mᵢ.
+fn outboard(m: &[f64]) -> Vec<f64> {
     let mut out = vec![0.0; m.len()];
     let mut acc = 0.0;
     for seg in (0..m.len()).rev() {
-        acc += m[seg] * if moment { (seg + 1) as f64 * h } else { 1.0 };
+        acc += m[seg];
         out[seg] = acc;
     }
     out
@@ -163,14 +165,11 @@ fn chain_inertia(pc: &PlanarChain, lumps: [(usize, f64, Vec<f64>); 2]) -> ChainI
         r2,
         fs1: pc.links[0].foreshortening,
         fs2: pc.links[1].foreshortening,
-        w1: outboard(&m1, h1, true),
-        w2: outboard(&m2, h2, true),
-        mu2: outboard(&m2, h2, false),
-        sum_mx2_1: (0..r1).map(|k| m1[k] * ((k + 1) as f64 * h1).powi(2)).sum(),
+        mu2: outboard(&m2),
         // link 2's clamp half cell (mass ρA₂h₂/2 at ξ = 0) rides on the elbow
         mass2: m2.iter().sum::<f64>() + 0.5 * pc.links[1].mass_per_length * h2,
         q2: (0..r2).map(|j| m2[j] * (j + 1) as f64 * h2).sum(),
-        i2: (0..r2).map(|j| m2[j] * ((j + 1) as f64 * h2).powi(2)).sum(),
+        elbow_mass: 0.5 * pc.links[1].mass_per_length * h2,
         m1,
         m2,
     }
@@ -191,6 +190,24 @@ fn joint_law(l: &Link) -> JointLaw {
         damping: l.joint.damping.unwrap_or(0.0),
         set_point: l.joint.set_point.unwrap_or(0.0),
         law: l.joint.torque.clone(),
+    }
+}
+
+/// The mass solve's storage: each link's axial masses W (link 1's tip carries the elbow and
+/// all of link 2), U and Z of `nd` entries.
+fn mass_factors(inertia: &ChainInertia, nd: usize) -> MassFactors {
+    let mut w1 = inertia.m1.clone();
+    w1[inertia.r1 - 1] += inertia.mass2;
+    MassFactors {
+        links: [
+            LinkRates::new(w1, inertia.fs1),
+            LinkRates::new(inertia.m2.clone(), inertia.fs2),
+        ],
+        u: std::array::from_fn(|_| vec![0.0; nd]),
+        nu: 0,
+        z: std::array::from_fn(|_| vec![0.0; nd]),
+        z_current: false,
+        zb: vec![0.0; nd],
     }
 }
 
@@ -251,7 +268,9 @@ impl TwoLinkChain {
                 (j2.initial_angle, j2.initial_rate),
             ],
             field_stations: scene.simulation.field_stations.max(2),
-            p: vec![Dual::default(); nd],
+            points: PointScratch::new(&inertia),
+            obs_points: std::cell::RefCell::new(PointScratch::new(&inertia)),
+            factors: mass_factors(&inertia, nd),
             cols: std::array::from_fn(|_| vec![0.0; nd]),
             unit: vec![0.0; nd],
             rhs: vec![0.0; nd],

@@ -251,7 +251,7 @@ impl TwoLinkChain {
     }
 
     /// The impact at (q, q̇⁻): q̇ ← q̇⁺. Allocates (once per impact, outside the step loop).
-    /// `None` (q̇ untouched) when GM⁻¹Gᵀ is not positive: M lost definiteness.
+    /// `None` (q̇ untouched) when GM⁻¹Gᵀ is not a positive number (a failed mass solve).
     pub(crate) fn impact(&mut self, t: f64, q: &[f64], v: &mut [f64]) -> Option<Event> {
         let n = q.len();
         let ke_before = self.kinetic_energy(q, v);

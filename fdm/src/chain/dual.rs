@@ -1,13 +1,14 @@
-//! Forward-mode dual numbers a + b ε (ε² = 0): the exact directional derivative (∂p/∂q)·q̇ of the
-//! generalized momenta in one O(n) pass, so that d/dt ∂T/∂q̇ needs no hand-derived Ṁ.
+//! Forward-mode dual numbers a + b ε (ε² = 0): the exact directional derivative (∂(Bq̇)/∂q)·q̇
+//! of the lumped points' velocities in one O(n) pass ([`super::kinetic`]), so that the inertia
+//! forces need no hand-derived Ṁ.
 //!
 //! [`Number`] lets one formula run on either `Dual` (value and directional derivative) or `f64`
-//! (value only, for the columns of M). The real part of every `Dual` operation is the `f64`
+//! (value only: T, the momenta and the columns of M). The real part of every `Dual` operation is the `f64`
 //! operation, so both give the same value bits.
 
 use std::ops::{Add, Mul, Neg, Sub};
 
-/// The arithmetic the momenta formula needs: `f64` (values) or [`Dual`] (values and one
+/// The arithmetic the velocity formula needs: `f64` (values) or [`Dual`] (values and one
 /// directional derivative).
 pub trait Number:
     Copy

@@ -3,7 +3,6 @@
 //! gravity potential of the lumped masses, the inertia terms ∂T/∂q − (∂p/∂q)q̇ and the momenta
 //! p = M q̇, and the input/dissipation powers of the ledger (module docs of [`super`]).
 
-use super::dual::Dual;
 use super::kinetic::{BE, TH, seg_energy, seg_grad};
 use super::model::TwoLinkChain;
 use crate::link::FloatingLink;
@@ -41,17 +40,9 @@ impl TwoLinkChain {
     pub fn momenta(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
         self.chord(q, qd);
         out.iter_mut().for_each(|x| *x = 0.0);
-        self.inertia.momenta_values(&self.qk, &self.vk, out);
-        for s in self.ghosts() {
-            out[s] = 0.0;
-        }
-        for k in 0..2 {
-            let w = self.jc[k] * self.clamp_angle(qd, k);
-            self.add_clamp(k, w, out);
-        }
-        if self.tip_ghost.is_some() {
-            self.add_tip(self.jt * self.tip_angle(qd), out);
-        }
+        self.inertia
+            .momenta_values(&self.qk, &self.vk, &mut self.points, out);
+        self.add_section_inertias(qd, out);
     }
 
     pub fn total_energy(&self, q: &[f64], v: &[f64]) -> f64 {
@@ -169,15 +160,13 @@ impl TwoLinkChain {
     /// [`Self::chord`]; `scratch` (length n) is overwritten. The clamp inertias are constant
     /// and the chord-frame T does not see the ghost slots.
     pub(super) fn add_inertia_terms(&mut self, scale: f64, scratch: &mut [f64], rhs: &mut [f64]) {
-        self.inertia.grad_q(&self.qk, &self.vk, scratch);
         self.inertia
-            .momenta(&self.qk, &self.vk, &self.vk, &mut self.p);
+            .inertia_forces(&self.qk, &self.vk, &mut self.points, scratch);
         for s in self.ghosts() {
             scratch[s] = 0.0;
-            self.p[s] = Dual::default();
         }
-        for i in 0..rhs.len() {
-            rhs[i] += scale * (scratch[i] - self.p[i].du);
+        for i in 0..self.inertia.dofs() {
+            rhs[i] += scale * scratch[i];
         }
     }
 

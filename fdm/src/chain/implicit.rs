@@ -10,17 +10,17 @@
 //! elastic h²√(ρA/4EI) and the ghost rotations) instead of the damped one, whose dampers on
 //! the clamp half cells ρAh³/24 shrink it like h³–h⁴.
 //!
-//! **Solve.** M + ½τC is the lumped diagonal plus the full columns F = {θ, β, x₁, x₂, y} of M
-//! (`chain::mass`) plus C. Outside F ("band": v₁…v_{r−1}, w₁…w_{r−1} in q order) C is
-//! pentadiagonal — the bending stencil per link, and the elbow damper couples v_{r−1} with the
-//! adjacent w₁ — so A_BB = D_B + ½τC_BB is SPD pentadiagonal and constant while τ is: its
-//! LDLᵀ is computed once per step length. Per kick: Z = A_BB⁻¹A_BF (|F| columns, A_BF from the
-//! current columns of M), the |F|×|F| Schur complement A_FF − A_BFᵀZ, back substitution, O(n),
-//! no allocation. Only the θ and β columns of M depend on the state; the ghost columns
-//! (x₁, x₂, y) are constant, so their Z columns and their block of the Schur complement are
-//! computed with the factorization, once per step length: three banded solves per kick. C itself is read once from
-//! `TwoLinkChain::add_damping_forces` by probing: each full column alone, the band columns
-//! in five interleaved colours (bandwidth 2).
+//! **Solve.** M + ½τC has M's structure ([`super::mass`]) plus C. Outside the full columns
+//! F = {θ, β, x₁, x₂, y} ("band": v₁…v_{r−1}, w₁…w_{r−1} in q order) C is pentadiagonal — the
+//! bending stencil per link, and the elbow damper couples v_{r−1} with the adjacent w₁ — so
+//! the band block is P + ⊕GᵀNG + UCUᵀ with P = D_B + ½τC_BB SPD pentadiagonal. Its first two
+//! terms are the saddle system [[P, Gᵀ], [G, −N⁻¹]] (λ = NGx, N⁻¹ tridiagonal), banded when
+//! each segment's multiplier sits next to its station: quasi-definite, so its LDLᵀ exists
+//! without pivoting (`crate::band_ldl`), O(n) per kick (G follows the slopes). The rank-2 U
+//! and the full columns close it as in the mass solve: Z = A⁻¹[A_BF U], a system of at most
+//! 7, back substitution; no allocation. C itself is read once from
+//! `TwoLinkChain::add_damping_forces` by probing: each full column alone, the band columns in
+//! five interleaved colours (bandwidth 2).
 //!
 //! **Ledger.** The powers are those of the level velocities (v_{j+1}ᵀCv_{j+1} and the joint
 //! dampers' D θ̇², as in the explicit form), integrated by the driver's trapezoid rule.
@@ -28,9 +28,11 @@
 // Index loops over band positions and full columns read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::damping_matrix::{ImplicitDamping, STATE_COLUMNS};
+use super::damping_matrix::ImplicitDamping;
+use super::mass::schur_finish;
 use super::model::TwoLinkChain;
-use super::schur::{MAX_FULL, solve_small};
+use super::schur::{MAX_FULL, MAX_SMALL};
+use crate::band_ldl::BandLdl;
 use crate::system::{DriftVelocities, System};
 
 impl TwoLinkChain {
@@ -75,23 +77,78 @@ impl TwoLinkChain {
                 }
             }
         }
+        let (at_band, at_segment, k) = self.saddle_layout(&band);
+        let size = at_segment[1].last().map_or(0, |p| p + 1);
         self.implicit = Some(Box::new(ImplicitDamping {
             c0,
             c1,
             c2,
             cf,
-            d: vec![0.0; nb],
-            l1: vec![0.0; nb],
-            l2: vec![0.0; nb],
-            tau: f64::NAN,
-            s_ghost: [[0.0; MAX_FULL]; MAX_FULL],
-            abf: std::array::from_fn(|_| vec![0.0; nb]),
-            z: std::array::from_fn(|_| vec![0.0; nb]),
-            zb: vec![0.0; nb],
+            saddle: BandLdl::new(size, k),
+            at_band,
+            at_segment,
+            y: vec![0.0; size * (MAX_SMALL + 1)],
+            z: std::array::from_fn(|_| vec![0.0; n]),
+            zb: vec![0.0; n],
             vnew: vec![0.0; n],
             band,
         }));
         true
+    }
+
+    /// Positions of the saddle system's unknowns, interleaved by station so that it is banded:
+    /// per link the deflection of station i, then the multiplier of segment i, and the last
+    /// segment's multiplier after the link's last station. Returns the positions of the band
+    /// unknowns, of each link's segment multipliers, and the half-bandwidth.
+    fn saddle_layout(&self, band: &[usize]) -> (Vec<usize>, [Vec<usize>; 2], usize) {
+        let mut at_band = vec![0; band.len()];
+        let mut at_segment: [Vec<usize>; 2] = [Vec::new(), Vec::new()];
+        let mut pos = 0;
+        let mut b = 0;
+        for link in 0..2 {
+            let r = self.segments(link);
+            for _ in 0..r - 1 {
+                at_band[b] = pos;
+                at_segment[link].push(pos + 1);
+                pos += 2;
+                b += 1;
+            }
+            at_segment[link].push(pos);
+            pos += 1;
+        }
+        let mut k = 0;
+        for b in 0..band.len() {
+            for d in 1..3 {
+                if b + d < band.len() {
+                    k = k.max(at_band[b + d] - at_band[b]);
+                }
+            }
+        }
+        let mut first = 0;
+        for (link, segs) in at_segment.iter().enumerate() {
+            let r = segs.len();
+            for seg in 0..r {
+                if seg + 1 < r {
+                    k = k.max(segs[seg + 1] - segs[seg]);
+                }
+                for i in [seg.wrapping_sub(1), seg] {
+                    if i < r - 1 {
+                        k = k.max(segs[seg].abs_diff(at_band[first + i]));
+                    }
+                }
+            }
+            first += self.segments(link) - 1;
+        }
+        (at_band, at_segment, k)
+    }
+
+    /// Segments of link ℓ (its stations with a deflection unknown plus the tip).
+    fn segments(&self, link: usize) -> usize {
+        if link == 0 {
+            self.inertia.r1
+        } else {
+            self.inertia.r2
+        }
     }
 
     /// Whether the damping is implicit (the bound then leaves it out).
@@ -133,72 +190,106 @@ impl TwoLinkChain {
         self.implicit = Some(imp);
     }
 
-    /// out = (M + ½τC)⁻¹ rhs with the columns of the last `build_columns` (module
-    /// docs). O(n), no allocation (the factorization is redone only when τ changes).
+    /// out = (M + ½τC)⁻¹ rhs at the state of the last `build_columns` (module docs). O(n), no
+    /// allocation. A saddle system that does not factor (masses or damping not positive)
+    /// gives NaN, which stops the run.
     pub fn solve_damped_mass(&mut self, tau: f64, rhs: &[f64], out: &mut [f64]) {
         let mut imp = self.implicit.take().expect("implicit damping");
-        let nf = self.nfull();
-        let refactor = imp.tau != tau;
-        if refactor {
-            imp.factor(|i| self.diag_mass(i), tau);
-        }
         let ht = 0.5 * tau;
+        let nf = self.nfull();
         let full = self.full();
+        let full = &full[..nf];
+        let nu = self.factors.nu;
         let nb = imp.band.len();
         let ImplicitDamping {
             band,
+            c0,
+            c1,
+            c2,
             cf,
-            d,
-            l1,
-            l2,
-            s_ghost,
-            abf,
+            saddle,
+            at_band,
+            at_segment,
+            y,
             z,
             zb,
             ..
         } = &mut *imp;
-        let solved = if refactor { nf } else { STATE_COLUMNS };
-        for c in 0..solved {
-            for b in 0..nb {
-                let i = band[b];
-                abf[c][b] = self.cols[c][i] + ht * cf[c][i];
+        saddle.clear();
+        for b in 0..nb {
+            saddle.add(at_band[b], at_band[b], self.diag_mass(band[b]) + ht * c0[b]);
+            if b + 1 < nb {
+                saddle.add(at_band[b + 1], at_band[b], ht * c1[b]);
             }
-            z[c].copy_from_slice(&abf[c]);
-            ImplicitDamping::solve(d, l1, l2, &mut z[c]);
+            if b + 2 < nb {
+                saddle.add(at_band[b + 2], at_band[b], ht * c2[b]);
+            }
         }
-        let schur = |r: usize, c: usize| {
-            self.cols[c][full[r]] + ht * cf[c][full[r]]
-                - (0..nb).map(|b| abf[r][b] * z[c][b]).sum::<f64>()
-        };
-        if refactor {
-            for r in STATE_COLUMNS..nf {
-                for c in STATE_COLUMNS..nf {
-                    s_ghost[r][c] = schur(r, c);
+        let mut first = 0;
+        for (link, segs) in at_segment.iter().enumerate() {
+            let rates = &self.factors.links[link];
+            let (g, w) = (rates.slopes(), rates.weights());
+            let r = segs.len();
+            for seg in 0..r {
+                if seg < r - 1 {
+                    saddle.add(segs[seg], at_band[first + seg], g[seg]);
+                }
+                if seg >= 1 {
+                    saddle.add(segs[seg], at_band[first + seg - 1], -g[seg]);
+                }
+                let mut nd = 1.0 / w[seg];
+                if seg >= 1 {
+                    nd += 1.0 / w[seg - 1];
+                }
+                saddle.add(segs[seg], segs[seg], -nd);
+                if seg + 1 < r {
+                    saddle.add(segs[seg + 1], segs[seg], 1.0 / w[seg]);
                 }
             }
+            first += r - 1;
         }
+        let saddle_rows = at_segment[1].last().map_or(0, |p| p + 1);
+        if saddle.factor().is_err() {
+            out.iter_mut().for_each(|x| *x = f64::NAN);
+            self.implicit = Some(imp);
+            return;
+        }
+        // the columns Z = A⁻¹[A_BF U] and A⁻¹r_B, one sweep by rows over the saddle factor
+        let ns = nf + nu;
+        let m = ns + 1;
+        let col = |c: usize, i: usize| self.cols[c][i] + ht * cf[c][i];
+        y.iter_mut().for_each(|v| *v = 0.0);
         for b in 0..nb {
-            zb[b] = rhs[band[b]];
-        }
-        ImplicitDamping::solve(d, l1, l2, zb);
-        let mut s = *s_ghost;
-        let mut bf = [0.0; MAX_FULL];
-        for r in 0..nf {
-            let fr = full[r];
-            bf[r] = rhs[fr] - (0..nb).map(|b| abf[r][b] * zb[b]).sum::<f64>();
+            let (i, at) = (band[b], at_band[b] * m);
             for c in 0..nf {
-                if r < STATE_COLUMNS || c < STATE_COLUMNS {
-                    s[r][c] = schur(r, c);
-                }
+                y[at + c] = col(c, i);
             }
+            for a in 0..nu {
+                y[at + nf + a] = self.factors.u[a][i];
+            }
+            y[at + ns] = rhs[i];
         }
-        let x = solve_small(s, bf, nf);
-        for c in 0..nf {
-            out[full[c]] = x[c];
+        saddle.solve_rows_in_place(&mut y[..saddle_rows * m], m);
+        for c in 0..ns {
+            z[c].iter_mut().for_each(|v| *v = 0.0);
         }
+        zb.iter_mut().for_each(|v| *v = 0.0);
         for b in 0..nb {
-            out[band[b]] = zb[b] - (0..nf).map(|c| z[c][b] * x[c]).sum::<f64>();
+            let (i, at) = (band[b], at_band[b] * m);
+            for c in 0..ns {
+                z[c][i] = y[at + c];
+            }
+            zb[i] = y[at + ns];
         }
+        schur_finish(
+            full,
+            col,
+            &z[..nf + nu],
+            &self.factors.u[..nu],
+            zb,
+            rhs,
+            out,
+        );
         self.implicit = Some(imp);
     }
 }

@@ -1,18 +1,56 @@
-//! The chain's mass matrix: the lumped diagonal plus the full columns θ, β, the clamp ghosts
-//! x₁, x₂ and (Euler links) link 1's tip ghost y, solved by a Schur complement on those
-//! (at most 5×5) — O(n) per force evaluation, no allocation.
+//! The chain's mass matrix and its solve. M couples every coordinate through the full columns
+//! F = {θ, β, x₁, x₂, y} (the frame angles, the clamp ghosts, link 1's tip ghost); on the
+//! remaining deflections R it is
+//!
+//!   M_RR = A₁ ⊕ A₂ + U C Uᵀ,   U = [f₁ f₂],   C = [[0, 1], [1, 0]],
+//!
+//! A_ℓ = D_ℓ + G_ℓᵀN_ℓG_ℓ each link's stations with their foreshortening rates
+//! (`rates`), f₁ = G₁ᵀ1 link 1's tip rate Ṡ and f₂ = cos φ G₂ᵀμ + sin φ m₂ what link 2's
+//! stations move along it (from ½Σm₂|ṙ|² ∋ Ṡ Σm₂(σ̇ cos φ + ẇ sin φ)). With y = Uᵀx_R and
+//! Z = A⁻¹[M_RF U], the unknowns (x_F, y) solve a system of at most 7, and
+//! x_R = A⁻¹b_R − Z_F x_F − Z_U C y: O(n) per solve, the A factorizations and Z once per state.
 
 // Index loops over the columns of M read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
 use super::kinetic::{BE, TH};
 use super::model::TwoLinkChain;
-use super::schur::{MAX_FULL, solve_small};
+use super::rates::LinkRates;
+use super::schur::{MAX_FULL, MAX_SMALL, solve_small};
 use crate::system::System;
 
+/// The state-dependent factors of the mass solve (module docs), allocated once.
+#[derive(Debug, Clone)]
+pub struct MassFactors {
+    pub(super) links: [LinkRates; 2],
+    /// U's columns f₁, f₂ in q indexing (zero outside their link's deflections)
+    pub(super) u: [Vec<f64>; 2],
+    /// number of U columns in use (2 with link 1's foreshortening, else 0)
+    pub(super) nu: usize,
+    /// Z = A⁻¹[M_RF U] in q indexing (zero on F), computed by the first solve at a state
+    pub(super) z: [Vec<f64>; MAX_SMALL],
+    pub(super) z_current: bool,
+    /// A⁻¹b_R scratch
+    pub(super) zb: Vec<f64>,
+}
+
 impl TwoLinkChain {
-    /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`; the ghost
-    /// columns are constant (built in `from_planar_chain`).
+    /// The deflection ranges R of links 1 and 2 (stations with an unknown, the tip left out).
+    fn deflections(&self, link: usize) -> std::ops::Range<usize> {
+        let first = self.first(link);
+        first..self.slots[link]
+    }
+
+    /// x_R ← A⁻¹x_R on both links' deflections (F entries untouched).
+    fn solve_blocks(&mut self, x: &mut [f64]) {
+        for link in 0..2 {
+            let r = self.deflections(link);
+            self.factors.links[link].solve_in_place(&mut x[r]);
+        }
+    }
+
+    /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`, the ghost
+    /// columns (constant, built in `from_planar_chain`), and the factors of the solve.
     pub(super) fn build_columns(&mut self) {
         let n = self.dofs();
         let full = [TH, BE];
@@ -22,7 +60,7 @@ impl TwoLinkChain {
                 .for_each(|x| *x = 0.0);
             self.unit[idx] = 1.0;
             self.inertia
-                .momenta_values(&self.qk, &self.unit, &mut self.cols[c]);
+                .momenta_values(&self.qk, &self.unit, &mut self.points, &mut self.cols[c]);
             self.unit[idx] = 0.0;
             for s in self.ghosts() {
                 self.cols[c][s] = 0.0;
@@ -36,6 +74,60 @@ impl TwoLinkChain {
             }
             self.cols[c] = col;
         }
+        self.factor_blocks();
+    }
+
+    /// A_ℓ and U at `qk` (Z follows with the first solve).
+    fn factor_blocks(&mut self) {
+        self.factors.z_current = false;
+        let hs = self.hs;
+        for link in 0..2 {
+            let r = self.deflections(link);
+            let start = r.start;
+            let mut rates = std::mem::replace(&mut self.factors.links[link], LinkRates::empty());
+            rates.factor(&self.qk[r], hs[link], |i| self.diag_mass(start + i));
+            self.factors.links[link] = rates;
+        }
+        let ine = &self.inertia;
+        self.factors.nu = if ine.fs1 { 2 } else { 0 };
+        if ine.fs1 {
+            let (r1, r2) = (self.deflections(0), self.deflections(1));
+            let g1 = self.factors.links[0].slopes();
+            for (k, i) in r1.enumerate() {
+                self.factors.u[0][i] = g1[k] - g1[k + 1];
+            }
+            let g2 = self.factors.links[1].slopes();
+            let (sn, c) = (self.qk[BE] - self.qk[TH]).sin_cos();
+            for (j, i) in r2.enumerate() {
+                let along = if ine.fs2 {
+                    ine.mu2[j] * g2[j] - ine.mu2[j + 1] * g2[j + 1]
+                } else {
+                    0.0
+                };
+                self.factors.u[1][i] = c * along + sn * ine.m2[j];
+            }
+        }
+    }
+
+    /// Z = A⁻¹[M_RF U] at the state of the last [`Self::build_columns`].
+    fn solve_columns(&mut self) {
+        let nf = self.nfull();
+        let full = self.full();
+        for c in 0..nf + self.factors.nu {
+            let mut z = std::mem::take(&mut self.factors.z[c]);
+            let src = if c < nf {
+                &self.cols[c]
+            } else {
+                &self.factors.u[c - nf]
+            };
+            z.copy_from_slice(src);
+            for &f in &full[..nf] {
+                z[f] = 0.0;
+            }
+            self.solve_blocks(&mut z);
+            self.factors.z[c] = z;
+        }
+        self.factors.z_current = true;
     }
 
     /// The number of full columns of M: 5 with link 1's tip ghost, else 4.
@@ -55,67 +147,110 @@ impl TwoLinkChain {
         ]
     }
 
-    /// out = M⁻¹ rhs with the columns of the last [`Self::build_columns`]: Schur complement
-    /// on the full columns; the rest of M is diagonal. O(n), no allocation.
-    pub(super) fn solve_mass(&self, rhs: &[f64], out: &mut [f64]) {
-        let n = self.dofs();
+    /// out = M⁻¹ rhs with the factors of the last [`Self::build_columns`] (module docs).
+    /// O(n), no allocation.
+    pub(super) fn solve_mass(&mut self, rhs: &[f64], out: &mut [f64]) {
+        if !self.factors.z_current {
+            self.solve_columns();
+        }
         let nf = self.nfull();
         let full = self.full();
-        let full = &full[..nf];
-        let mut s = [[0.0; MAX_FULL]; MAX_FULL];
-        let mut b = [0.0; MAX_FULL];
-        for r in 0..nf {
-            b[r] = rhs[full[r]];
-            for c in 0..nf {
-                s[r][c] = self.cols[c][full[r]];
-            }
+        let mut zb = std::mem::take(&mut self.factors.zb);
+        zb.copy_from_slice(rhs);
+        for &f in &full[..nf] {
+            zb[f] = 0.0;
         }
-        for i in 0..n {
-            if full.contains(&i) {
-                continue;
-            }
-            let d = self.diag_mass(i);
-            for r in 0..nf {
-                let mri = self.cols[r][i];
-                b[r] -= mri * rhs[i] / d;
-                for c in 0..nf {
-                    s[r][c] -= mri * self.cols[c][i] / d;
-                }
-            }
+        self.solve_blocks(&mut zb);
+        let fc = &self.factors;
+        let cols = &self.cols;
+        schur_finish(
+            &full[..nf],
+            |c, i| cols[c][i],
+            &fc.z,
+            &fc.u[..fc.nu],
+            &zb,
+            rhs,
+            out,
+        );
+        self.factors.zb = zb;
+    }
+
+    /// out = M x at the chord-frame `qk` (the exact kinetic energy's momenta at velocity x
+    /// plus the section inertias).
+    pub(super) fn mass_mul(&mut self, x: &[f64], out: &mut [f64]) {
+        let mut xk = std::mem::take(&mut self.vd);
+        xk.copy_from_slice(x);
+        for s in self.ghosts() {
+            xk[s] = 0.0;
         }
-        let x = solve_small(s, b, nf);
-        for i in 0..n {
-            if let Some(k) = full.iter().position(|&f| f == i) {
-                out[i] = x[k];
-            } else {
-                let coupled: f64 = (0..nf).map(|c| self.cols[c][i] * x[c]).sum();
-                out[i] = (rhs[i] - coupled) / self.diag_mass(i);
+        out.iter_mut().for_each(|o| *o = 0.0);
+        self.inertia
+            .momenta_values(&self.qk, &xk, &mut self.points, out);
+        self.vd = xk;
+        self.add_section_inertias(x, out);
+    }
+
+    /// Zeroes the ghost rows of `out` and adds the clamp and tip sections' rotary inertias
+    /// J e eᵀ·x (the ghosts move no lumped mass; their sections turn).
+    pub(super) fn add_section_inertias(&self, x: &[f64], out: &mut [f64]) {
+        for s in self.ghosts() {
+            out[s] = 0.0;
+        }
+        for k in 0..2 {
+            let w = self.jc[k] * self.clamp_angle(x, k);
+            self.add_clamp(k, w, out);
+        }
+        if self.tip_ghost.is_some() {
+            self.add_tip(self.jt * self.tip_angle(x), out);
+        }
+    }
+}
+
+/// The small system of the Schur solve and the back substitution (module docs): `col(c, i)`
+/// is entry i of full column c of the matrix, `z` its columns' A⁻¹ (the F columns, then U's),
+/// `zb` = A⁻¹b_R (zero on F). Writes the solution into `out`.
+pub(super) fn schur_finish(
+    full: &[usize],
+    col: impl Fn(usize, usize) -> f64,
+    z: &[Vec<f64>],
+    u: &[Vec<f64>],
+    zb: &[f64],
+    rhs: &[f64],
+    out: &mut [f64],
+) {
+    let n = rhs.len();
+    let (nf, nu) = (full.len(), u.len());
+    let ns = nf + nu;
+    let mut s = [[0.0; MAX_SMALL]; MAX_SMALL];
+    let mut b = [0.0; MAX_SMALL];
+    // unknown k: x_F[k] (k < nf) or (Cy)[k − nf]; the y rows read y_a = (Cy)_{1−a}. One pass
+    // over q forms M_FR Z, M_FR A⁻¹b_R, UᵀZ and UᵀA⁻¹b_R (z and zb vanish on F).
+    for r in 0..nf {
+        b[r] = rhs[full[r]];
+        for k in 0..nf {
+            s[r][k] = col(k, full[r]);
+        }
+    }
+    for i in 0..n {
+        if zb[i] == 0.0 && (0..ns).all(|k| z[k][i] == 0.0) {
+            continue;
+        }
+        for r in 0..ns {
+            let c = if r < nf { col(r, i) } else { u[r - nf][i] };
+            b[r] -= c * zb[i];
+            for k in 0..ns {
+                s[r][k] -= c * z[k][i];
             }
         }
     }
-
-    /// out = M x with the columns of the last [`Self::build_columns`] (M symmetric: full
-    /// column c also gives row c).
-    pub(super) fn mass_mul(&self, x: &[f64], out: &mut [f64]) {
-        let n = self.dofs();
-        let nf = self.nfull();
-        let full = self.full();
-        let full = &full[..nf];
-        for i in 0..n {
-            if let Some(r) = full.iter().position(|&f| f == i) {
-                let mut acc = 0.0;
-                for j in 0..n {
-                    if let Some(c) = full.iter().position(|&f| f == j) {
-                        acc += self.cols[c][i] * x[j];
-                    } else {
-                        acc += self.cols[r][j] * x[j];
-                    }
-                }
-                out[i] = acc;
-            } else {
-                out[i] = self.diag_mass(i) * x[i]
-                    + (0..nf).map(|c| self.cols[c][i] * x[full[c]]).sum::<f64>();
-            }
-        }
+    for a in 0..nu {
+        s[nf + a][nf + 1 - a] -= 1.0;
+    }
+    let x = solve_small(s, b, ns);
+    for i in 0..n {
+        out[i] = match full.iter().position(|&f| f == i) {
+            Some(k) => x[k],
+            None => zb[i] - (0..ns).map(|k| z[k][i] * x[k]).sum::<f64>(),
+        };
     }
 }

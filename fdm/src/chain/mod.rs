@@ -5,17 +5,14 @@
 //! **Frames.** Each link's floating frame is its *tip chord* (v₀ = v_r = 0): θ and β are the
 //! chord angles of links 1 and 2. The clamp condition is the report's ghost node, kept as an
 //! unknown x = v₋₁: the clamp tangent turns by (v₁ − x)/(2h) from the chord and κ₀ =
-//! (v₁ + x)/h². Why not the clamp-tangent frame of the single link? With zero hub inertia (both
-//! joints here) a tangent-frame rotation against the opposite linear deflection moves no lumped
-//! mass, and the second-order kinetic energy (exact value ½Σm s² ≥ 0) becomes *indefinite* in
-//! that direction for deflections of a few mm (measured: M loses definiteness, the run blows up
-//! at any step). Pinning the tip to the chord makes every frame rotation move the link's mass.
-//! The clamp section's own rotation carries the half-cell rotary inertia J_c = ρA h³/24
-//! (O(h³), exact positive term ½J_c(clamp angle rate)²).
+//! (v₁ + x)/h². Pinning the tip to the chord makes every frame rotation move the link's mass
+//! (in the clamp-tangent frame of the single link, with zero hub inertia, a tangent-frame
+//! rotation against the opposite linear deflection moves no lumped mass). The clamp section's
+//! own rotation carries the half-cell rotary inertia J_c = ρA h³/24 (O(h³), exact positive
+//! term ½J_c(clamp angle rate)²).
 //!
 //! **Equations.** Lagrange's equations of L = T − V with the dissipation function D:
-//! * T: [`kinetic`] (second order in the deflections, exact in the angles: the single link's
-//!   order) + Σ ½J_c,ℓ (clamp angle rate)²;
+//! * T: [`kinetic`] (½Σm|ṙ|² of the lumped points, exact) + Σ ½J_c,ℓ (clamp angle rate)²;
 //! * V = Σ_ℓ ½ Σᵢ cᵢ h EI κᵢ² (the single link's ghost-node bending energy, [`crate::link`],
 //!   with κ₀ from the clamp ghost) plus ½K₁(θ₁ − θ₁⁰)² + ½K₂(θ₂ − θ₂⁰)², θ₁ the clamp angle of
 //!   link 1, θ₂ = (clamp angle of link 2) − θ − ψ, ψ = (y − v_{r−1})/(2h₁) the central tip
@@ -29,10 +26,12 @@
 //! * D = Σ_ℓ ½ Σᵢ cᵢ h γ κ̇ᵢ² + ½D₁θ̇₁² + ½D₂θ̇₂² (link 1's sum with the same tip term);
 //!   applied torque laws τⱼ(t) do the work ∫τⱼ θ̇ⱼ.
 //!
-//! M(q) q̈ = Q − ∂V/∂q − ∂D/∂q̇ + ∂T/∂q − (∂p/∂q) q̇, with p = ∂T/∂q̇ = M q̇. The last term is one
-//! forward-mode dual-number pass over p ([`dual`]); the columns of M for θ, β, x₁, x₂ (and y)
-//! are p at unit velocities plus J_c e eᵀ (J_t e eᵀ); the rest of M is the diagonal of lumped
-//! masses, so the solve is a 5×5 Schur complement: O(n) per force evaluation, no allocation in
+//! M(q) q̈ = Q − ∂V/∂q − ∂D/∂q̇ + f_inertia(q, q̇), the inertia forces in Kane's form (one
+//! forward-mode dual-number pass over the points' velocities, [`kinetic`], [`dual`]). M couples
+//! every coordinate through the full columns θ, β, x₁, x₂ (and y): the momenta at unit
+//! velocities plus J_c e eᵀ (J_t e eᵀ); on the deflections it is each link's lumped diagonal
+//! plus its foreshortening rates (a semiseparable block with a tridiagonal inverse) plus a
+//! rank-2 coupling of link 1's tip rate with link 2 ([`mass`]): O(n) per solve, no allocation in
 //! the step loop.
 //!
 //! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
@@ -57,10 +56,11 @@
 //! ([`TwoLinkChain`], its joints and links, and the coordinate maps: clamp, tip and elbow
 //! angles, chord-frame copies, the lumped diagonal of M) and the types of its parts —
 //! [`kinetic`], [`dual`], [`timoshenko`], `surface` (the contact line and the constraint state),
-//! `damping_matrix` (C and the banded factorization of the implicit kick) and `schur` (the dense
-//! block of the mass solves). The operations extend [`TwoLinkChain`] in their own modules:
+//! `damping_matrix` (C and the saddle system of the implicit kick), `rates` (a link's
+//! foreshortening-rate block and its Woodbury solve) and `schur` (the small dense system of the
+//! mass solves). The operations extend [`TwoLinkChain`] in their own modules:
 //! `build` (construction, DOF plan, initial state), `forces` (forces, energies, momenta,
-//! powers), `mass` (the Schur-complement solve), [`contact`] (gap, constraint, impact,
+//! powers), [`mass`] (M's structure and its solve), [`contact`] (gap, constraint, impact,
 //! projections), [`implicit`] (the damping kick), `bound` (step bound), `system` (the chain as a
 //! [`System`](crate::system::System)), `outputs` (channels, ledger) and [`modes`] (linearized
 //! modes).
@@ -76,10 +76,11 @@ pub mod dual;
 mod forces;
 pub mod implicit;
 pub mod kinetic;
-mod mass;
+pub mod mass;
 mod model;
 pub mod modes;
 mod outputs;
+mod rates;
 mod schur;
 mod surface;
 mod system;

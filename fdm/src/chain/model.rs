@@ -7,8 +7,9 @@
 use data::scene::TorqueLaw;
 
 use super::damping_matrix::ImplicitDamping;
-use super::dual::Dual;
+use super::kinetic::PointScratch;
 use super::kinetic::{BE, ChainInertia, TH};
+use super::mass::MassFactors;
 use super::schur::MAX_FULL;
 use super::surface::{TipConstraint, TipContact};
 use super::timoshenko::TimoFields;
@@ -70,7 +71,10 @@ pub struct TwoLinkChain {
     pub(super) obs_scratch: std::cell::RefCell<Vec<f64>>,
     pub(super) obs_scratch_v: std::cell::RefCell<Vec<f64>>,
     // scratch (allocated once)
-    pub(super) p: Vec<Dual>,
+    pub(super) points: PointScratch,
+    pub(super) obs_points: std::cell::RefCell<PointScratch>,
+    /// the factors of the mass solve at the state of the last `build_columns`
+    pub(super) factors: MassFactors,
     /// the full columns of M: θ, β, x₁, x₂ and (Euler) the tip ghost y
     pub(super) cols: [Vec<f64>; MAX_FULL],
     pub(super) unit: Vec<f64>,

@@ -97,16 +97,17 @@ impl TwoLinkChain {
             }
         }
         let sym = |a: &Mat<f64>| Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
-        let (lambda, vectors) = generalized_eigen(&sym(&stiff), &sym(&mass))?;
-        // The zero eigenvalues of free joints come out at round-off, |λ| ~ ε λ_max, and λ_max
-        // grows as h⁻⁴ (and with a stiff joint spring over the clamp inertia ρAh³/24): a mode
-        // below 1 % of the slowest link's bending scale √(EI/ρAL⁴) is reported as rigid (0).
-        let rigid_below = 1e-2
-            * self
-                .links
-                .iter()
-                .map(|l| (l.ei / l.rho_a).sqrt() / (l.length * l.length))
-                .fold(f64::INFINITY, f64::min);
+        // the slowest link's bending scale √(EI/ρAL⁴): the shift of the eigensolve is its
+        // square, and a mode below 1 % of it is reported as rigid (0) — the zero eigenvalues
+        // of free joints come out at round-off
+        let bending_scale = self
+            .links
+            .iter()
+            .map(|l| (l.ei / l.rho_a).sqrt() / (l.length * l.length))
+            .fold(f64::INFINITY, f64::min);
+        let (lambda, vectors) =
+            generalized_eigen(&sym(&stiff), &sym(&mass), bending_scale * bending_scale)?;
+        let rigid_below = 1e-2 * bending_scale;
         let omega = lambda
             .iter()
             .map(|&l| {
@@ -145,14 +146,37 @@ impl TwoLinkChain {
     }
 }
 
-/// K x = λ M x by Cholesky reduction: λ ascending and M-orthonormal x.
-fn generalized_eigen(k: &Mat<f64>, m: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>), FdmError> {
+/// The pencil K x = λ M x, ascending, with M-orthonormal vectors, shifted and inverted:
+/// M x = μ (K + σM) x, λ = 1/μ − σ. The eigensolver's absolute error ε‖·‖ then falls on μ,
+/// whose largest values are the slowest modes, so those keep their relative accuracy even
+/// when λ_max (∝ h⁻⁴) is 10¹¹ times λ₁; Cholesky reduction on M instead leaves λ₁ an
+/// absolute error ε λ_max. A statically unstable reference (K + σM not positive definite)
+/// falls back to that reduction.
+fn generalized_eigen(
+    k: &Mat<f64>,
+    m: &Mat<f64>,
+    sigma: f64,
+) -> Result<(Vec<f64>, Mat<f64>), FdmError> {
+    let n = k.nrows();
+    let shifted = Mat::<f64>::from_fn(n, n, |i, j| k[(i, j)] + sigma * m[(i, j)]);
+    if let Ok((mu, x)) = reduced_eigen(m, &shifted) {
+        // μ descending ↔ λ ascending; x is (K + σM)-orthonormal: xᵀMx = μ
+        let lambda = (0..n).rev().map(|i| 1.0 / mu[i] - sigma).collect();
+        let vectors = Mat::<f64>::from_fn(n, n, |r, c| x[(r, n - 1 - c)] / mu[n - 1 - c].sqrt());
+        return Ok((lambda, vectors));
+    }
+    reduced_eigen(k, m)
+}
+
+/// The pencil A x = λ B x (B positive definite) by Cholesky reduction: ascending λ,
+/// B-orthonormal vectors.
+fn reduced_eigen(a: &Mat<f64>, b: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>), FdmError> {
     let numerical = |message: String| FdmError::Numerical { t: 0.0, message };
-    let llt = m
+    let llt = b
         .llt(Side::Lower)
         .map_err(|e| numerical(format!("chain mass matrix not positive definite: {e:?}")))?;
     let l = llt.L();
-    let mut t = k.clone();
+    let mut t = a.clone();
     l.solve_lower_triangular_in_place(&mut t);
     let mut c = t.transpose().to_owned();
     l.solve_lower_triangular_in_place(&mut c);

@@ -8,13 +8,16 @@
 
 /// Largest number of full columns (θ, β, x₁, x₂, y).
 pub(super) const MAX_FULL: usize = 5;
+/// Largest small system of the mass solve: the full columns and the two columns of the
+/// links' foreshortening-rate coupling ([`super::rates`]).
+pub(super) const MAX_SMALL: usize = MAX_FULL + 2;
 
-/// Gaussian elimination with partial pivoting on the leading `n`×`n` block (n ≤ 5).
-pub(super) fn solve_small(
-    mut a: [[f64; MAX_FULL]; MAX_FULL],
-    mut b: [f64; MAX_FULL],
+/// Gaussian elimination with partial pivoting on the leading `n`×`n` block.
+pub(super) fn solve_small<const M: usize>(
+    mut a: [[f64; M]; M],
+    mut b: [f64; M],
     n: usize,
-) -> [f64; MAX_FULL] {
+) -> [f64; M] {
     for col in 0..n {
         let piv = (col..n)
             .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
@@ -29,7 +32,7 @@ pub(super) fn solve_small(
             b[row] -= f * b[col];
         }
     }
-    let mut x = [0.0; MAX_FULL];
+    let mut x = [0.0; M];
     for row in (0..n).rev() {
         let s: f64 = (row + 1..n).map(|k| a[row][k] * x[k]).sum();
         x[row] = (b[row] - s) / a[row][row];

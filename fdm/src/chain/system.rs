@@ -27,7 +27,8 @@ impl System for TwoLinkChain {
             // λ = −(G a_free + Ġq̇)/(G M⁻¹Gᵀ) — one more solve with the same M.
             let (gmg, curv) = self.constraint_solve();
             let ga: f64 = (0..n).map(|i| self.constraint.grow[i] * a[i]).sum();
-            // a non-positive GM⁻¹Gᵀ means M lost definiteness: NaN stops the contact driver
+            // a GM⁻¹Gᵀ that is not a positive number (a failed mass solve) stops the contact
+            // driver through NaN
             let lam = if gmg > 0.0 {
                 -(ga + curv) / gmg
             } else {
@@ -135,7 +136,7 @@ impl System for TwoLinkChain {
             qk[s] = 0.0;
             vk[s] = 0.0;
         }
-        let mut ke = ine.kinetic(&qk, &vk);
+        let mut ke = ine.kinetic(&qk, &vk, &mut self.obs_points.borrow_mut());
         let mut strain = FloatingLink::bending_energy(ine.h1, self.links[0].ei, &qk[ine.iv()])
             + FloatingLink::bending_energy(ine.h2, self.links[1].ei, &qk[ine.iw()]);
         for k in 0..2 {

@@ -11,7 +11,11 @@
 //! new level: non-finite values, |Δ²v| over the monitored (elastic) coordinates against the
 //! peak |v| (the computational mode of a two-step method grows as a sign-alternating
 //! velocity), and runaway growth of q. It stops with a diagnostic naming the coordinate, the
-//! cause and the remedy.
+//! cause and the remedy. After each sample it also checks the ledger: a residual above 5 % of
+//! the energy that flowed (`watch::LEDGER_LOST`, judged from the 50th step on) means the step
+//! no longer resolves the motion — the bound is the linearized system's at t = 0 — and the run
+//! stops there rather than present the rest as a solution (two-step methods that can excite
+//! their computational mode keep their own, more specific watch).
 //!
 //! **Work.** The ledger's input and dissipation terms integrate the model's powers by the
 //! trapezoidal rule over each step. Nothing here allocates inside the step loop (output storage
@@ -30,7 +34,10 @@ use crate::method::{StepState, Stepper, stepper};
 use crate::output::{Outcome, Outputs, Recorder};
 use crate::settings::{Method, ValidatedSettings};
 use crate::system::{Bound, System};
-use watch::{Growth, Watch, growth_diagnostic, overextension_diagnostic};
+use watch::{
+    Growth, LEDGER_LOST, LEDGER_SETTLED_STEPS, Watch, growth_diagnostic, ledger_diagnostic,
+    overextension_diagnostic,
+};
 
 mod watch;
 
@@ -470,6 +477,16 @@ impl RunState {
                 limit_next,
             );
             self.cost.steps += 1;
+            // a two-step scheme whose computational mode can grow has its own, more specific
+            // watch (the mode's growth drives the ledger off first)
+            if !ws.computational_mode
+                && self.cost.steps >= LEDGER_SETTLED_STEPS
+                && rec.last_closure() > LEDGER_LOST
+            {
+                return Err(StabilityVerdict::Stopped {
+                    diagnostic: ledger_diagnostic(t_new, rec.last_closure(), tau_eff),
+                });
+            }
         }
         self.st.rotate();
         std::mem::swap(&mut self.w_cur, &mut self.w_new);

@@ -69,13 +69,11 @@ fn singular(t: f64) -> StabilityVerdict {
             t,
             what: "the constraint's G M⁻¹ Gᵀ is not positive".into(),
             location: Some("contact1".into()),
-            why: "the mass matrix of the chain's second-order kinetic energy is not positive \
-                  definite at this deflection: its foreshortening-rate terms are indefinite once \
-                  the link slopes grow large, and finer stations reach that sooner"
+            why: "the chain's mass matrix is positive definite at every deflection its chord \
+                  frames describe (its kinetic energy is that of the lumped points), so the mass \
+                  solve met a state that is not finite or an ill-conditioned mass matrix"
                 .into(),
-            remedy: "use fewer stations, or the fem or modal backend (their kinetic energy is \
-                     exact)"
-                .into(),
+            remedy: "use a smaller time step or fewer stations, or the fem or modal backend".into(),
         },
     }
 }

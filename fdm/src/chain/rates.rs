@@ -1,0 +1,118 @@
+//! The deflection block of the chain's mass matrix with the foreshortening rates: per link,
+//!
+//!   A = D + GᵀNG,   N = Lᵀ diag(W) L,
+//!
+//! D the lumped masses (with the section inertias' diagonal) of the stations that carry a
+//! deflection unknown, G the segments' rates u_seg = g_seg(u̇_seg − u̇_{seg−1}) (g the segment
+//! slopes: bidiagonal), L the running sum ṡ_k = Σ_{seg ≤ k} u_seg and W the mass that moves
+//! with station k's axial rate (link 1's tip carries the elbow and all of link 2). N is dense
+//! but N⁻¹ = L⁻¹W⁻¹L⁻ᵀ is tridiagonal, so Woodbury,
+//!
+//!   A⁻¹ = D⁻¹ − D⁻¹Gᵀ(N⁻¹ + GD⁻¹Gᵀ)⁻¹GD⁻¹,
+//!
+//! is one tridiagonal SPD factorization per state and O(r) per solve.
+
+use crate::tridiagonal::TridiagonalLdl;
+
+/// One link's A = D + GᵀNG (module docs), factored at the slopes of the last [`Self::factor`].
+#[derive(Debug, Clone)]
+pub struct LinkRates {
+    /// station masses D (length r − 1)
+    d: Vec<f64>,
+    /// axial masses W (length r)
+    w: Vec<f64>,
+    /// segment slopes g (length r)
+    g: Vec<f64>,
+    /// N⁻¹ + GD⁻¹Gᵀ
+    ldl: TridiagonalLdl,
+    /// segment scratch (length r)
+    u: Vec<f64>,
+    foreshortening: bool,
+}
+
+impl LinkRates {
+    /// A link of r segments with axial masses `w` (length r); D is set by [`Self::factor`].
+    pub fn new(w: Vec<f64>, foreshortening: bool) -> Self {
+        let r = w.len();
+        LinkRates {
+            d: vec![0.0; r - 1],
+            w,
+            g: vec![0.0; r],
+            ldl: TridiagonalLdl::new(r),
+            u: vec![0.0; r],
+            foreshortening,
+        }
+    }
+
+    /// Placeholder while a link's factors are borrowed out.
+    pub fn empty() -> Self {
+        LinkRates {
+            d: Vec::new(),
+            w: Vec::new(),
+            g: Vec::new(),
+            ldl: TridiagonalLdl::new(0),
+            u: Vec::new(),
+            foreshortening: false,
+        }
+    }
+
+    /// The axial masses W (length r).
+    pub fn weights(&self) -> &[f64] {
+        &self.w
+    }
+
+    /// The segment slopes g of the last [`Self::factor`] (length r).
+    pub fn slopes(&self) -> &[f64] {
+        &self.g
+    }
+
+    /// Factors A at the deflections `u` (length r − 1, the tip's zero left out), segment
+    /// spacing `h` and station masses `d`.
+    pub fn factor(&mut self, u: &[f64], h: f64, d: impl Fn(usize) -> f64) {
+        let r = self.w.len();
+        for i in 0..r - 1 {
+            self.d[i] = d(i);
+        }
+        if !self.foreshortening {
+            return;
+        }
+        for seg in 0..r {
+            let right = if seg < r - 1 { u[seg] } else { 0.0 };
+            let left = if seg == 0 { 0.0 } else { u[seg - 1] };
+            self.g[seg] = (right - left) / h;
+        }
+        let (d, w, g) = (&self.d, &self.w, &self.g);
+        let inv_d = |i: usize| if i < r - 1 { 1.0 / d[i] } else { 0.0 };
+        let diag = |a: usize| {
+            let mut t = 1.0 / w[a] + g[a] * g[a] * inv_d(a);
+            if a > 0 {
+                t += 1.0 / w[a - 1] + g[a] * g[a] * inv_d(a - 1);
+            }
+            t
+        };
+        let off = |a: usize| -1.0 / w[a] - g[a + 1] * g[a] * inv_d(a);
+        self.ldl
+            .factor(diag, off)
+            .expect("N⁻¹ + GD⁻¹Gᵀ is SPD for positive masses");
+    }
+
+    /// x ← A⁻¹x (length r − 1).
+    pub fn solve_in_place(&mut self, x: &mut [f64]) {
+        let r = self.w.len();
+        for i in 0..r - 1 {
+            x[i] /= self.d[i];
+        }
+        if !self.foreshortening {
+            return;
+        }
+        for seg in 0..r {
+            let right = if seg < r - 1 { x[seg] } else { 0.0 };
+            let left = if seg == 0 { 0.0 } else { x[seg - 1] };
+            self.u[seg] = self.g[seg] * (right - left);
+        }
+        self.ldl.solve_in_place(&mut self.u);
+        for i in 0..r - 1 {
+            x[i] -= (self.g[i] * self.u[i] - self.g[i + 1] * self.u[i + 1]) / self.d[i];
+        }
+    }
+}
