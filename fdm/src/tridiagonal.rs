@@ -47,15 +47,28 @@ impl TridiagonalLdl {
 
     /// x ← A⁻¹ x with the factor of the last [`Self::factor`].
     pub fn solve_in_place(&self, x: &mut [f64]) {
-        let n = x.len();
+        self.solve_rows_in_place(x, 1);
+    }
+
+    /// X ← A⁻¹X for `m` right-hand sides stored by rows (X[i·m + c]): one sweep for all.
+    pub fn solve_rows_in_place(&self, x: &mut [f64], m: usize) {
+        let n = self.piv.len();
         for i in 0..n.saturating_sub(1) {
-            x[i + 1] -= self.mult[i] * x[i];
+            let (head, tail) = x.split_at_mut((i + 1) * m);
+            let l = self.mult[i];
+            for (v, u) in tail[..m].iter_mut().zip(&head[i * m..]) {
+                *v -= l * u;
+            }
         }
-        for (xi, d) in x.iter_mut().zip(&self.piv) {
-            *xi /= d;
+        for (i, d) in self.piv.iter().enumerate() {
+            x[i * m..i * m + m].iter_mut().for_each(|v| *v /= d);
         }
         for i in (0..n.saturating_sub(1)).rev() {
-            x[i] -= self.mult[i] * x[i + 1];
+            let (head, tail) = x.split_at_mut((i + 1) * m);
+            let l = self.mult[i];
+            for (v, u) in head[i * m..].iter_mut().zip(&tail[..m]) {
+                *v -= l * u;
+            }
         }
     }
 }

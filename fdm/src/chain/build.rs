@@ -10,6 +10,7 @@ use super::kinetic::{BE, ChainInertia, TH};
 use super::mass::MassFactors;
 use super::model::{JointLaw, LinkProps, TwoLinkChain};
 use super::rates::LinkRates;
+use super::schur::MAX_SMALL;
 use super::surface::{TipConstraint, TipContact};
 use super::timoshenko::{self, TimoFields};
 use crate::error::FdmError;
@@ -208,6 +209,7 @@ fn mass_factors(inertia: &ChainInertia, nd: usize) -> MassFactors {
         z: std::array::from_fn(|_| vec![0.0; nd]),
         z_current: false,
         zb: vec![0.0; nd],
+        rows: vec![0.0; nd * MAX_SMALL],
     }
 }
 

@@ -32,6 +32,8 @@ pub struct MassFactors {
     pub(super) z_current: bool,
     /// A⁻¹b_R scratch
     pub(super) zb: Vec<f64>,
+    /// the columns' deflection entries by rows (scratch of `solve_columns`)
+    pub(super) rows: Vec<f64>,
 }
 
 impl TwoLinkChain {
@@ -109,24 +111,32 @@ impl TwoLinkChain {
         }
     }
 
-    /// Z = A⁻¹[M_RF U] at the state of the last [`Self::build_columns`].
+    /// Z = A⁻¹[M_RF U] at the state of the last [`Self::build_columns`]: per link, the columns'
+    /// deflection entries by rows, one sweep.
     fn solve_columns(&mut self) {
+        let ns = self.nfull() + self.factors.nu;
         let nf = self.nfull();
-        let full = self.full();
-        for c in 0..nf + self.factors.nu {
-            let mut z = std::mem::take(&mut self.factors.z[c]);
-            let src = if c < nf {
-                &self.cols[c]
-            } else {
-                &self.factors.u[c - nf]
-            };
-            z.copy_from_slice(src);
-            for &f in &full[..nf] {
-                z[f] = 0.0;
+        let mut rows = std::mem::take(&mut self.factors.rows);
+        for link in 0..2 {
+            let r = self.deflections(link);
+            let len = r.len();
+            for (k, i) in r.clone().enumerate() {
+                for c in 0..ns {
+                    rows[k * ns + c] = if c < nf {
+                        self.cols[c][i]
+                    } else {
+                        self.factors.u[c - nf][i]
+                    };
+                }
             }
-            self.solve_blocks(&mut z);
-            self.factors.z[c] = z;
+            self.factors.links[link].solve_rows_in_place(&mut rows[..len * ns], ns);
+            for (k, i) in r.enumerate() {
+                for c in 0..ns {
+                    self.factors.z[c][i] = rows[k * ns + c];
+                }
+            }
         }
+        self.factors.rows = rows;
         self.factors.z_current = true;
     }
 

@@ -12,6 +12,7 @@
 //!
 //! is one tridiagonal SPD factorization per state and O(r) per solve.
 
+use super::schur::MAX_SMALL;
 use crate::tridiagonal::TridiagonalLdl;
 
 /// One link's A = D + GᵀNG (module docs), factored at the slopes of the last [`Self::factor`].
@@ -25,7 +26,7 @@ pub struct LinkRates {
     g: Vec<f64>,
     /// N⁻¹ + GD⁻¹Gᵀ
     ldl: TridiagonalLdl,
-    /// segment scratch (length r)
+    /// segment scratch (r rows of up to `MAX_SMALL` right-hand sides)
     u: Vec<f64>,
     foreshortening: bool,
 }
@@ -39,7 +40,7 @@ impl LinkRates {
             w,
             g: vec![0.0; r],
             ldl: TridiagonalLdl::new(r),
-            u: vec![0.0; r],
+            u: vec![0.0; r * MAX_SMALL],
             foreshortening,
         }
     }
@@ -98,21 +99,33 @@ impl LinkRates {
 
     /// x ← A⁻¹x (length r − 1).
     pub fn solve_in_place(&mut self, x: &mut [f64]) {
+        self.solve_rows_in_place(x, 1);
+    }
+
+    /// X ← A⁻¹X for `m` right-hand sides stored by rows (X[i·m + c], r − 1 rows): one sweep
+    /// of the tridiagonal factor for all.
+    pub fn solve_rows_in_place(&mut self, x: &mut [f64], m: usize) {
         let r = self.w.len();
         for i in 0..r - 1 {
-            x[i] /= self.d[i];
+            x[i * m..i * m + m].iter_mut().for_each(|v| *v /= self.d[i]);
         }
         if !self.foreshortening {
             return;
         }
+        let u = &mut self.u[..r * m];
         for seg in 0..r {
-            let right = if seg < r - 1 { x[seg] } else { 0.0 };
-            let left = if seg == 0 { 0.0 } else { x[seg - 1] };
-            self.u[seg] = self.g[seg] * (right - left);
+            for c in 0..m {
+                let right = if seg < r - 1 { x[seg * m + c] } else { 0.0 };
+                let left = if seg == 0 { 0.0 } else { x[(seg - 1) * m + c] };
+                u[seg * m + c] = self.g[seg] * (right - left);
+            }
         }
-        self.ldl.solve_in_place(&mut self.u);
+        self.ldl.solve_rows_in_place(u, m);
         for i in 0..r - 1 {
-            x[i] -= (self.g[i] * self.u[i] - self.g[i + 1] * self.u[i + 1]) / self.d[i];
+            for c in 0..m {
+                x[i * m + c] -=
+                    (self.g[i] * u[i * m + c] - self.g[i + 1] * u[(i + 1) * m + c]) / self.d[i];
+            }
         }
     }
 }
