@@ -97,11 +97,13 @@
 //!   Same stations, ghost-node bending energy, Kelvin–Voigt and foreshortening per link. Each
 //!   link's frame is its tip chord (v₀ = v_r = 0) with the clamp ghost node x = v₋₁ as an
 //!   unknown (clamp angle = chord angle + (v₁ − x)/(2h)) carrying the half-cell rotary inertia
-//!   ρAh³/24: with zero hub inertia the single link's clamp-tangent frame makes the
-//!   second-order kinetic energy indefinite (see [`chain`]). Kinetic energy to second order in
-//!   the deflections, exact in the angles (the single link's order); Lagrange's equations with
-//!   p = ∂T/∂q̇ and the exact (∂p/∂q)q̇ by dual numbers; mass matrix = lumped diagonal + four
-//!   full columns and link 1's tip ghost y = v_{r+1} (5×5 Schur complement, O(n) per step).
+//!   ρAh³/24 (with zero hub inertia a clamp-tangent frame rotation can move no lumped mass,
+//!   see [`chain`]). Kinetic energy exact, ½Σm|ṙ|² of the lumped points ([`chain::kinetic`]):
+//!   Kane's equations with the points' velocity-product accelerations by one dual-number pass;
+//!   mass matrix = full columns θ, β, the clamp ghosts and link 1's tip ghost y = v_{r+1}, each
+//!   link's lumped diagonal plus its foreshortening-rate block, and a rank-2 coupling of the
+//!   links ([`chain::mass`]: Woodbury on a tridiagonal per link, a Schur complement of at most
+//!   7, O(n) per step).
 //!   Joint springs/dampers (set-points) on θ₁ and θ₂ = β-clamp angle − θ − ψ (ψ = central tip
 //!   slope on the tip ghost; link 1's bending energy carries its trapezoid end term, so the
 //!   elbow moment EIκ(L₁) = K₂θ₂ is a second-order boundary condition). Ledger: kinetic,
@@ -117,8 +119,9 @@
 //!   growing with the number of stations.
 //!   **Damping implicit** without contact ([`chain::implicit`]): Kelvin–Voigt and the joint
 //!   dampers (−Cq̇, C constant) Crank–Nicolson across the velocity form's two kicks,
-//!   (M + ½τC)a = F solved by a banded LDLᵀ (pentadiagonal, factored once per step length) and
-//!   a 5×5 Schur complement, O(n) per step: `two-link-free` steps at the undamped bound.
+//!   (M + ½τC)a = F solved through a banded quasi-definite saddle system (the foreshortening
+//!   rates' multipliers beside their stations, band LDLᵀ) and the same small Schur complement,
+//!   O(n) per step: `two-link-free` steps at the undamped bound.
 //!   Tested (tests/chain.rs): undamped energy error bounded (no drift), O(τ²); damped ledger
 //!   closure O(τ²); joint angles O(h²); the rigid limit. Step bound: 0.9 × 2/ω_max of
 //!   the chain linearized at rest (no rates, so no centrifugal tension) and the per-link 5.44;
