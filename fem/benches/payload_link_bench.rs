@@ -8,6 +8,7 @@ use std::hint::black_box;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use data::{Backend, Settings};
 use fem::FemBackend;
+use fem::driver::fixed_steps::QuarterRetries;
 use fem::payload_link::prepare;
 
 fn one_step(c: &mut Criterion) {
@@ -25,7 +26,7 @@ fn one_step(c: &mut Criterion) {
         let h = p.h;
         g.bench_with_input(BenchmarkId::new("implicit_midpoint", n), &n, |b, _| {
             b.iter(|| {
-                let t1 = p.stepper.state.t + h;
+                let t1 = p.stepper.steps.state.t + h;
                 p.stepper.step(black_box(h), t1).unwrap()
             })
         });

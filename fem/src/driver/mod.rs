@@ -32,6 +32,7 @@
 //! ([`crate::events`]) ← driver ← outputs ([`crate::run`]).
 
 pub mod contact_events;
+pub mod fixed_steps;
 pub mod state;
 pub mod step;
 pub mod stick_slip;

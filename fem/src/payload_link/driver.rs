@@ -12,32 +12,23 @@
 //! [`crate::system::System::midpoint_works`]); for the other methods a second-order quadrature
 //! of the works.
 
+use crate::driver::fixed_steps::{FixedSteps, QuarterRetries};
 use crate::error::FemError;
-use crate::method::{Counters, NewtonSystem, StepContext, StepState, Stepper, Works, start};
+use crate::method::{StepState, Works};
 use crate::settings::Method;
-use crate::system::{NoAugmentation, System};
 
 use super::model::Model;
 use super::system::{LinkSystem, LinkWorks};
 
-/// The stepped link: system, method, state and works.
+/// The stepped link: system, method and state ([`FixedSteps`]), and the ledger works.
 #[derive(Debug)]
 pub struct LinkDriver {
-    pub system: LinkSystem,
-    pub method: Method,
-    stepper: Box<dyn Stepper<LinkSystem>>,
-    pub state: StepState,
-    pub newton: NewtonSystem<NoAugmentation>,
-    pub counters: Counters,
+    pub steps: FixedSteps<LinkSystem>,
     /// The ledger works of the run (cumulative).
     pub works: LinkWorks,
     /// What a method that books its own works books (the same terms as [`Self::works`],
     /// Kelvin–Voigt summed over the fields; not reported).
     method_works: Works,
-    /// The nominal step (a method's retries and tolerances are measured against it).
-    pub h_nominal: f64,
-    /// The link length (scales the Newton tolerance).
-    pub length_scale: f64,
     /// Motor-law discontinuities after t = 0, increasing.
     pub breakpoints: Vec<f64>,
     scratch: [Vec<f64>; 3],
@@ -67,119 +58,72 @@ impl LinkDriver {
         breakpoints.dedup();
         let (theta, rate) = (model.initial_angle, model.initial_rate);
         let system = LinkSystem::new(model);
-        let nq = system.ndof();
+        let nq = crate::system::System::ndof(&system);
         let mut state = StepState::new(nq);
         state.q[..n].copy_from_slice(d0);
         if free {
             state.q[n] = theta;
             state.qd[n] = rate;
         }
-        let newton = NewtonSystem::new(&system, length_scale);
         let mut it = LinkDriver {
-            system,
-            method,
-            stepper: crate::method::stepper(method, nq, rho_inf),
-            state,
-            newton,
-            counters: Counters::default(),
+            steps: FixedSteps::new(system, state, method, h, rho_inf, length_scale),
             works: LinkWorks::default(),
             method_works: Works::default(),
-            h_nominal: h,
-            length_scale,
             breakpoints,
             scratch: [vec![0.0; nq], vec![0.0; nq], vec![0.0; nq]],
         };
-        it.consistent_acceleration(h, 0.0)?;
+        it.steps.consistent_acceleration(h, 0.0)?;
         Ok(it)
-    }
-
-    /// The method and its step context (disjoint borrows of the driver).
-    fn method_parts(&mut self) -> (&mut dyn Stepper<LinkSystem>, StepContext<'_, LinkSystem>) {
-        let cx = StepContext {
-            system: &mut self.system,
-            state: &mut self.state,
-            newton: &mut self.newton,
-            counters: &mut self.counters,
-            adaptive: None,
-            h_nominal: self.h_nominal,
-            length_scale: self.length_scale,
-        };
-        (self.stepper.as_mut(), cx)
-    }
-
-    fn consistent_acceleration(&mut self, h: f64, t_law: f64) -> Result<(), FemError> {
-        let (_, mut cx) = self.method_parts();
-        start::consistent_acceleration(&mut cx, h, t_law)
     }
 
     /// The first breakpoint after the current time, if any.
     pub fn next_breakpoint(&self) -> Option<f64> {
-        let t = self.state.t;
+        let t = self.steps.state.t;
         self.breakpoints
             .iter()
             .copied()
-            .find(|&b| b > t + 1e-12 * self.h_nominal)
+            .find(|&b| b > t + 1e-12 * self.steps.h_nominal)
+    }
+}
+
+impl QuarterRetries for LinkDriver {
+    type System = LinkSystem;
+
+    fn steps(&mut self) -> &mut FixedSteps<LinkSystem> {
+        &mut self.steps
     }
 
-    /// One step of length h onto t₁ (the caller snaps t₁ to its stop time); books its works.
-    /// A step whose Newton iteration fails is retried as four quarter steps (recursively, down
-    /// to 10⁻⁶ of the nominal step), the method restarted.
-    pub fn step(&mut self, h: f64, t1: f64) -> Result<(), FemError> {
-        if self.try_step(h, t1)? {
-            return Ok(());
-        }
-        let t0 = self.state.t;
-        if h <= 1e-6 * self.h_nominal {
-            return Err(FemError::Runaway {
-                t: t0,
-                what: format!(
-                    "Newton iteration of the {} step did not converge",
-                    self.method
-                ),
-                location: None,
-                why: format!("step h = {h:.3e} s too long for the motion"),
-                remedy: "reduce --dt".into(),
-            });
-        }
-        self.counters.rejected += 1;
-        self.stepper.restart();
-        for k in 1..=4 {
-            let tk = if k == 4 { t1 } else { t0 + 0.25 * k as f64 * h };
-            self.step(tk - self.state.t, tk)?;
-        }
-        Ok(())
-    }
-
-    /// One step; false (state unchanged) when its Newton iteration did not converge.
+    /// Books the link's works (module docs); a step that ends on a breakpoint takes the law's
+    /// left limit and restarts the method after it.
     fn try_step(&mut self, h: f64, t1: f64) -> Result<bool, FemError> {
         let on_break = self
             .breakpoints
             .iter()
-            .any(|&b| (t1 - b).abs() <= 1e-12 * self.h_nominal.max(1.0));
+            .any(|&b| (t1 - b).abs() <= 1e-12 * self.steps.h_nominal.max(1.0));
         let t_law = if on_break { t1 - 1e-9 * h } else { t1 };
-        let t0 = self.state.t;
-        let (stepper, mut cx) = self.method_parts();
+        let t0 = self.steps.state.t;
+        let (stepper, mut cx) = self.steps.parts();
         if let Some(e) = stepper.step(&mut cx, None, h, t1, t_law)?
             && e.is_infinite()
         {
             return Ok(false);
         }
-        self.stepper.commit(h, &mut self.method_works);
-        let st = &self.state;
-        self.system.step_works(
+        self.steps.commit(h, &mut self.method_works);
+        let FixedSteps { system, state, .. } = &mut self.steps;
+        system.step_works(
             t0,
             h,
-            (&st.q, &st.q1),
-            (&st.qd, &st.qd1),
+            (&state.q, &state.q1),
+            (&state.qd, &state.qd1),
             &mut self.scratch,
             &mut self.works,
         );
-        self.state.swap_in(t1);
-        self.counters.steps += 1;
+        self.steps.state.swap_in(t1);
+        self.steps.counters.steps += 1;
         if on_break {
             // Restart from the discontinuity with the new law value.
-            self.consistent_acceleration(h, t1)?;
-            self.stepper.restart();
+            self.steps.consistent_acceleration(h, t1)?;
+            self.steps.restart();
         }
         Ok(true)
     }

@@ -84,6 +84,7 @@ use faer::prelude::*;
 use faer::{Mat, c64};
 
 use crate::band::BorderedBand;
+use crate::driver::fixed_steps::QuarterRetries;
 use crate::element::beam3d::{PHI, U, V, W};
 use crate::error::FemError;
 use crate::settings;
@@ -727,10 +728,10 @@ pub fn prepare(
             // Explicit: the step under its stability bound at the initial state (Kelvin–Voigt
             // damping of the kHz axial and torsion modes included).
             let mut driver = LinkDriver::new(md, &d, method, out, rho_inf)?;
-            let mut res = vec![0.0; driver.system.ndof()];
+            let mut res = vec![0.0; driver.steps.system.ndof()];
             let (bound, dof) = crate::method::central_difference::stability_bound(
-                &mut driver.system,
-                &driver.state,
+                &mut driver.steps.system,
+                &driver.steps.state,
                 &mut res,
             )?;
             let h = match dt_user {
@@ -741,13 +742,13 @@ pub fn prepare(
                         bound_kind: "central-difference (2/(κ + √(κ² + ω²)) of the binding \
                                      mode)"
                             .into(),
-                        location: describe_dof(&driver.system.model, dof),
+                        location: describe_dof(&driver.steps.system.model, dof),
                     });
                 }
                 Some(dt) => dt,
                 None => fit(crate::run::DEFAULT_SAFETY * bound, out),
             };
-            driver.h_nominal = h;
+            driver.steps.h_nominal = h;
             Ok(Prepared {
                 stepper: driver,
                 h,
@@ -801,23 +802,23 @@ fn state_torque(
     mass_lu: &mut BorderedBand,
     scratch: &mut [Vec<f64>; 2],
 ) -> f64 {
-    let s = &st.state;
-    if st.system.free_base() {
-        return st.system.model.motor_torque(s.t);
+    let s = &st.steps.state;
+    if st.steps.system.free_base() {
+        return st.steps.system.model.motor_torque(s.t);
     }
     let [zero, acc] = scratch;
-    st.system.residual(s.t, &s.q, &s.qd, zero, acc);
+    st.steps.system.residual(s.t, &s.q, &s.qd, zero, acc);
     acc.iter_mut().for_each(|v| *v = -*v);
     mass_lu.solve_in_place(acc);
-    st.system.base_torque(s.t, &s.q, &s.qd, acc)
+    st.steps.system.base_torque(s.t, &s.q, &s.qd, acc)
 }
 
 /// Samples the channels of [`channel::payload_link`] (the fields the rod carries) into `buf`.
 fn sample(st: &LinkDriver, torque: f64, stations: usize, buf: &mut Vec<f64>) {
     buf.clear();
-    let sys = &st.system;
+    let sys = &st.steps.system;
     let md = &sys.model;
-    let s = &st.state;
+    let s = &st.steps.state;
     let d = &s.q[..md.n];
     let (theta, rate, _) = sys.base(s.t, &s.q, &s.qd, &s.qdd);
     let [x, y, z] = md.payload_position(d);
@@ -875,9 +876,9 @@ fn ledger_names(md: &Model) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'stat
 }
 
 fn push_ledger(st: &LinkDriver, ledger: &mut EnergyLedger) {
-    let sys = &st.system;
+    let sys = &st.steps.system;
     let md = &sys.model;
-    let s = &st.state;
+    let s = &st.steps.state;
     let n = md.n;
     let (d, dd) = (&s.q[..n], &s.qd[..n]);
     let (theta, rate, _) = sys.base(s.t, &s.q, &s.qd, &s.qdd);
@@ -928,7 +929,7 @@ pub fn simulate(
         output_interval,
         stations,
     } = prepare(scene, l, settings)?;
-    let md = &stepper.system.model;
+    let md = &stepper.steps.system.model;
     let specs = channel::payload_link(&md.fields, stations);
     let mut obs = Observables::with_channels(&specs);
     let (s, i, d) = ledger_names(md);
@@ -955,14 +956,14 @@ pub fn simulate(
     let mut verdict = StabilityVerdict::Completed;
     'outer: for k in 1..=n_out {
         let t_out = (k as f64 * output_interval).min(t_end);
-        while stepper.state.t < t_out - 1e-9 * h {
+        while stepper.steps.state.t < t_out - 1e-9 * h {
             // Steps of h onto the next output time or motor-law breakpoint (a shorter last
             // step only when h does not divide the stretch); the end is snapped to the stop
             // time against round-off.
             let t_stop = stepper.next_breakpoint().map_or(t_out, |b| b.min(t_out));
-            let rest = t_stop - stepper.state.t;
+            let rest = t_stop - stepper.steps.state.t;
             let hk = if rest < h * (1.0 - 1e-9) { rest } else { h };
-            let mut t1 = stepper.state.t + hk;
+            let mut t1 = stepper.steps.state.t + hk;
             if (t1 - t_stop).abs() < 1e-9 * h {
                 t1 = t_stop;
             }
@@ -977,11 +978,11 @@ pub fn simulate(
         sample(&stepper, torque, stations, &mut buf);
         if buf.iter().any(|v| !v.is_finite()) {
             verdict = StabilityVerdict::Stopped {
-                diagnostic: crate::error::non_finite_state(stepper.state.t),
+                diagnostic: crate::error::non_finite_state(stepper.steps.state.t),
             };
             break;
         }
-        obs.push(stepper.state.t, &buf);
+        obs.push(stepper.steps.state.t, &buf);
         push_ledger(&stepper, &mut ledger);
     }
     Ok(crate::run::run_result(
@@ -990,7 +991,7 @@ pub fn simulate(
         obs,
         ledger,
         Vec::new(),
-        stepper.counters.cost(n + usize::from(free), start),
+        stepper.steps.counters.cost(n + usize::from(free), start),
         verdict,
     ))
 }

@@ -24,10 +24,11 @@
 //! booking is a second-order quadrature of the works, and the ledger closes to the method's
 //! O(h²) energy error.
 
+use crate::driver::fixed_steps::{FixedSteps, QuarterRetries};
 use crate::error::FemError;
-use crate::method::{Counters, NewtonSystem, StepContext, StepState, Stepper, start};
+use crate::method::StepState;
 use crate::settings::Method;
-use crate::system::{NoAugmentation, System};
+use crate::system::System;
 
 use super::model::Model;
 use super::system::RocketSystem;
@@ -42,18 +43,11 @@ pub struct RocketWorks {
     pub outflow: f64,
 }
 
-/// The stepped rocket: system, method, state and works.
+/// The stepped rocket: system, method and state ([`FixedSteps`]), and the ledger works.
 #[derive(Debug)]
 pub struct RocketDriver {
-    pub system: RocketSystem,
-    pub method: Method,
-    stepper: Box<dyn Stepper<RocketSystem>>,
-    pub state: StepState,
-    pub newton: NewtonSystem<NoAugmentation>,
-    pub counters: Counters,
+    pub steps: FixedSteps<RocketSystem>,
     pub works: RocketWorks,
-    /// The nominal step (a method's retries and tolerances are measured against it).
-    pub h_nominal: f64,
     /// Burn-out time (∞ without a burn).
     pub burnout: f64,
     qbar: Vec<f64>,
@@ -77,122 +71,36 @@ impl RocketDriver {
         let system = RocketSystem::new(model);
         let mut state = StepState::new(n);
         state.q.copy_from_slice(q0);
-        let mut newton = NewtonSystem::new(&system, length);
-        newton.tol = newton_tolerance(&system.model, h);
+        let mut steps = FixedSteps::new(system, state, method, h, rho_inf, length);
+        steps.newton.tol = newton_tolerance(&steps.system.model, h);
         let mut it = RocketDriver {
-            system,
-            method,
-            stepper: crate::method::stepper(method, n, rho_inf),
-            state,
-            newton,
-            counters: Counters::default(),
+            steps,
             works: RocketWorks::default(),
-            h_nominal: h,
             burnout,
             qbar: vec![0.0; n],
             vbar: vec![0.0; n],
         };
-        it.consistent_acceleration(h, 0.0)?;
+        it.steps.consistent_acceleration(h, 0.0)?;
         Ok(it)
     }
 
     /// Sets the nominal step (and the Newton tolerance that scales with it).
     pub fn set_step(&mut self, h: f64) {
-        self.h_nominal = h;
-        self.newton.tol = newton_tolerance(&self.system.model, h);
-    }
-
-    /// The method and its step context (disjoint borrows of the driver).
-    fn method_parts(
-        &mut self,
-    ) -> (
-        &mut dyn Stepper<RocketSystem>,
-        StepContext<'_, RocketSystem>,
-    ) {
-        let length_scale = self.system.model.length;
-        let cx = StepContext {
-            system: &mut self.system,
-            state: &mut self.state,
-            newton: &mut self.newton,
-            counters: &mut self.counters,
-            adaptive: None,
-            h_nominal: self.h_nominal,
-            length_scale,
-        };
-        (self.stepper.as_mut(), cx)
-    }
-
-    fn consistent_acceleration(&mut self, h: f64, t_law: f64) -> Result<(), FemError> {
-        let (_, mut cx) = self.method_parts();
-        start::consistent_acceleration(&mut cx, h, t_law)
-    }
-
-    /// Whether the method needs every stretch between stop times split into equal steps.
-    pub fn equal_steps(&self) -> bool {
-        self.stepper.equal_steps()
-    }
-
-    /// One step of length h onto t₁ (the caller snaps t₁ to its stop time); books its works.
-    /// A step whose Newton iteration fails is retried as four quarter steps (recursively, down
-    /// to 10⁻⁶ of the nominal step), the method restarted.
-    pub fn step(&mut self, h: f64, t1: f64) -> Result<(), FemError> {
-        if self.try_step(h, t1)? {
-            return Ok(());
-        }
-        let t0 = self.state.t;
-        if h <= 1e-6 * self.h_nominal {
-            return Err(FemError::Runaway {
-                t: t0,
-                what: format!(
-                    "Newton iteration of the {} step did not converge",
-                    self.method
-                ),
-                location: None,
-                why: format!("step h = {h:.3e} s too long for the motion"),
-                remedy: "reduce --dt".into(),
-            });
-        }
-        self.counters.rejected += 1;
-        self.stepper.restart();
-        for k in 1..=4 {
-            let tk = if k == 4 { t1 } else { t0 + 0.25 * k as f64 * h };
-            self.step(tk - self.state.t, tk)?;
-        }
-        Ok(())
-    }
-
-    /// One step; false (state unchanged) when its Newton iteration did not converge.
-    fn try_step(&mut self, h: f64, t1: f64) -> Result<bool, FemError> {
-        let at_burnout = t1 == self.burnout;
-        let t_law = if at_burnout { t1 - 1e-9 * h } else { t1 };
-        let (stepper, mut cx) = self.method_parts();
-        if let Some(e) = stepper.step(&mut cx, None, h, t1, t_law)?
-            && e.is_infinite()
-        {
-            return Ok(false);
-        }
-        self.book(h);
-        self.state.swap_in(t1);
-        self.counters.steps += 1;
-        if at_burnout {
-            // Restart after the jump of the loads and of the mass rate.
-            self.consistent_acceleration(h, t1)?;
-            self.stepper.restart();
-        }
-        Ok(true)
+        self.steps.h_nominal = h;
+        self.steps.newton.tol = newton_tolerance(&self.steps.system.model, h);
     }
 
     /// Books the works of the solved step t₀ → t₀ + h (module docs).
     fn book(&mut self, h: f64) {
-        let st = &self.state;
+        let st = &self.steps.state;
         let (t0, tm, t1) = (st.t, st.t + 0.5 * h, st.t + h);
         for i in 0..st.q.len() {
             self.qbar[i] = 0.5 * (st.q[i] + st.q1[i]);
             self.vbar[i] = 0.5 * (st.qd[i] + st.qd1[i]);
         }
-        let p = self.system.powers(tm, &self.qbar, &self.vbar);
-        self.counters.rhs += 1;
-        let m = &self.system.model;
+        let p = self.steps.system.powers(tm, &self.qbar, &self.vbar);
+        self.steps.counters.rhs += 1;
+        let m = &self.steps.system.model;
         let (m0, mm, m1) = (m.m1(t0), m.m1(tm), m.m1(t1));
         let kin = -0.5
             * ((m1 - mm) * m.m_burn.form(&st.qd1, &st.qd1)
@@ -200,7 +108,7 @@ impl RocketDriver {
         for i in 0..st.q.len() {
             self.qbar[i] += m.x_ref[i];
         }
-        let pot = (m1 - m0) * m.m_burn.form(&self.system.gravity, &self.qbar);
+        let pot = (m1 - m0) * m.m_burn.form(&self.steps.system.gravity, &self.qbar);
         let w = &mut self.works;
         w.thrust += h * p.thrust;
         w.pressure += h * p.pressure;
@@ -212,9 +120,39 @@ impl RocketDriver {
     /// Stored energies at the current state, in the ledger's order: kinetic, strain, gravity,
     /// discrete springs.
     pub fn stored(&self) -> [f64; 4] {
-        let st = &self.state;
-        let [kinetic, strain, spring, gravity] = self.system.energies(st.t, &st.q, &st.qd);
+        let st = &self.steps.state;
+        let [kinetic, strain, spring, gravity] = self.steps.system.energies(st.t, &st.q, &st.qd);
         [kinetic, strain, gravity, spring]
+    }
+}
+
+impl QuarterRetries for RocketDriver {
+    type System = RocketSystem;
+
+    fn steps(&mut self) -> &mut FixedSteps<RocketSystem> {
+        &mut self.steps
+    }
+
+    /// Books the step's works (module docs); a step that ends on burn-out takes the laws' left
+    /// limit and restarts the method after the jump.
+    fn try_step(&mut self, h: f64, t1: f64) -> Result<bool, FemError> {
+        let at_burnout = t1 == self.burnout;
+        let t_law = if at_burnout { t1 - 1e-9 * h } else { t1 };
+        let (stepper, mut cx) = self.steps.parts();
+        if let Some(e) = stepper.step(&mut cx, None, h, t1, t_law)?
+            && e.is_infinite()
+        {
+            return Ok(false);
+        }
+        self.book(h);
+        self.steps.state.swap_in(t1);
+        self.steps.counters.steps += 1;
+        if at_burnout {
+            // Restart after the jump of the loads and of the mass rate.
+            self.steps.consistent_acceleration(h, t1)?;
+            self.steps.restart();
+        }
+        Ok(true)
     }
 }
 

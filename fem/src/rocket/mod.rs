@@ -75,6 +75,7 @@ use data::results::ledger_term;
 use data::scene::Rocket;
 use data::{DofPlan, EnergyLedger, FemSettings, Observables, RunResult, Scene, StabilityVerdict};
 
+use crate::driver::fixed_steps::QuarterRetries;
 use crate::error::FemError;
 use crate::method::capabilities;
 use crate::settings::Method;
@@ -180,7 +181,7 @@ pub fn prepare(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Prep
                     bound_kind: "central-difference (2/(κ + √(κ² + ω²)) of the binding mode, \
                                  at the run's smallest mass)"
                         .into(),
-                    location: describe_dof(&driver.system.model, bound.1),
+                    location: describe_dof(&driver.steps.system.model, bound.1),
                 });
             }
             Some(dt) => dt,
@@ -198,7 +199,7 @@ pub fn prepare(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Prep
         driver.set_step(h);
     }
     Ok(Prepared {
-        h: driver.h_nominal,
+        h: driver.steps.h_nominal,
         driver,
         t_end,
         output_interval: scene.simulation.output_interval,
@@ -210,10 +211,10 @@ pub fn prepare(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Prep
 /// (at burn-out or t_end, whichever comes first: the bound shrinks as the stage burns; K and C
 /// are constant), and the DOF where the binding mode is largest.
 fn explicit_bound(driver: &mut RocketDriver, t_end: f64) -> Result<(f64, usize), FemError> {
-    let mut st = driver.state.clone();
+    let mut st = driver.steps.state.clone();
     st.t = driver.burnout.min(t_end);
-    let mut res = vec![0.0; driver.system.ndof()];
-    crate::method::central_difference::stability_bound(&mut driver.system, &st, &mut res)
+    let mut res = vec![0.0; driver.steps.system.ndof()];
+    crate::method::central_difference::stability_bound(&mut driver.steps.system, &st, &mut res)
 }
 
 /// A DOF of the rocket by name: the node and slot of a case DOF, or a discrete mass's U or W.
@@ -238,7 +239,7 @@ pub fn simulate(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Run
         output_interval,
         stations,
     } = prepare(scene, r, settings)?;
-    let specs = channel_specs(&driver.system.model, stations);
+    let specs = channel_specs(&driver.steps.system.model, stations);
     let mut obs = Observables::with_channels(&specs);
     let mut ledger = EnergyLedger::new(
         &[
@@ -257,10 +258,10 @@ pub fn simulate(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Run
     let mut buf = Vec::with_capacity(specs.len());
     let sample = |d: &RocketDriver, buf: &mut Vec<f64>| {
         observe(
-            &d.system.model,
-            d.state.t,
-            &d.state.q,
-            &d.state.qd,
+            &d.steps.system.model,
+            d.steps.state.t,
+            &d.steps.state.q,
+            &d.steps.state.qd,
             stations,
             buf,
         )
@@ -269,14 +270,14 @@ pub fn simulate(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Run
     obs.push(0.0, &buf);
     outputs::push_ledger(&driver, &mut ledger);
     let burnout = driver.burnout;
-    let equal = driver.equal_steps();
+    let equal = driver.steps.equal_steps();
     let n_out = (t_end / output_interval - 1e-9).ceil().max(1.0) as usize;
     let mut verdict = StabilityVerdict::Completed;
     'outer: for k in 1..=n_out {
         let t_out = (k as f64 * output_interval).min(t_end);
-        while driver.state.t < t_out - 1e-9 * h {
+        while driver.steps.state.t < t_out - 1e-9 * h {
             // Land on the output time and on burn-out (the loads and the mass rate jump there).
-            let t = driver.state.t;
+            let t = driver.steps.state.t;
             let t_stop = if t < burnout - 1e-9 * h && burnout < t_out {
                 burnout
             } else {
@@ -305,11 +306,11 @@ pub fn simulate(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Run
         sample(&driver, &mut buf);
         if buf.iter().any(|v| !v.is_finite()) {
             verdict = StabilityVerdict::Stopped {
-                diagnostic: crate::error::non_finite_state(driver.state.t),
+                diagnostic: crate::error::non_finite_state(driver.steps.state.t),
             };
             break;
         }
-        obs.push(driver.state.t, &buf);
+        obs.push(driver.steps.state.t, &buf);
         outputs::push_ledger(&driver, &mut ledger);
     }
     Ok(crate::run::run_result(
@@ -318,7 +319,10 @@ pub fn simulate(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Run
         obs,
         ledger,
         Vec::new(),
-        driver.counters.cost(driver.system.model.n, start),
+        driver
+            .steps
+            .counters
+            .cost(driver.steps.system.model.n, start),
         verdict,
     ))
 }

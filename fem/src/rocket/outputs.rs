@@ -69,7 +69,7 @@ pub fn observe(model: &Model, t: f64, q: &[f64], v: &[f64], stations: usize, out
 pub fn push_ledger(st: &RocketDriver, ledger: &mut EnergyLedger) {
     let w = st.works;
     ledger.push(
-        st.state.t,
+        st.steps.state.t,
         &st.stored(),
         &[w.thrust, w.pressure, w.coriolis],
         &[w.damper, w.outflow],
