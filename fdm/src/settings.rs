@@ -3,9 +3,7 @@
 
 use crate::error::FdmError;
 
-/// Default Robert–Asselin filter coefficient ν (Asselin 1972 used 0.01–0.25; 0.01 keeps the
-/// accuracy cost small while damping the computational mode by ≈ 4ν per step).
-pub const DEFAULT_ASSELIN_NU: f64 = 0.01;
+pub use crate::method::payload::DEFAULT_ASSELIN_NU;
 
 /// Relative change of the step τ that is logged as a `StepSizeChange` event (the rocket's step
 /// follows the burning mass; 1 % changes mark the burn without flooding the event list).
@@ -13,25 +11,6 @@ pub const STEP_LOG_CHANGE: f64 = 0.01;
 
 /// Time-integration method (`time.method`), declared by the method registry.
 pub use crate::method::Method;
-
-/// Checks of the methods' payloads, one function per payload field (named as the field), called
-/// by [`Method::from_data`]: `data`'s `Option<T>` (None: the default) to a checked `T`.
-pub(crate) mod payload {
-    use super::DEFAULT_ASSELIN_NU;
-    use crate::error::FdmError;
-
-    /// Robert–Asselin ν ([`DEFAULT_ASSELIN_NU`] when not given), in (0, 0.5).
-    pub(crate) fn nu(nu: Option<f64>) -> Result<f64, FdmError> {
-        let nu = nu.unwrap_or(DEFAULT_ASSELIN_NU);
-        if !(nu > 0.0 && nu < 0.5) {
-            return Err(FdmError::invalid(
-                "time.method",
-                format!("Robert–Asselin ν = {nu} must lie in (0, 0.5)"),
-            ));
-        }
-        Ok(nu)
-    }
-}
 
 /// The backend's settings validated: [`data::FdmSettings`] with its ranges checked and the
 /// defaults filled in.

@@ -7,9 +7,9 @@ use data::{DofPlan, Scene};
 
 use super::kinetic::PointScratch;
 use super::kinetic::{BE, ChainInertia, TH};
-use super::mass::MassFactors;
 use super::model::{JointLaw, LinkProps, TwoLinkChain};
 use super::rates::LinkRates;
+use super::rates::MassFactors;
 use super::schur::MAX_SMALL;
 use super::surface::{TipConstraint, TipContact};
 use super::timoshenko::{self, TimoFields};

@@ -19,23 +19,6 @@ use super::rates::LinkRates;
 use super::schur::{MAX_FULL, MAX_SMALL, solve_small};
 use crate::system::System;
 
-/// The state-dependent factors of the mass solve (module docs), allocated once.
-#[derive(Debug, Clone)]
-pub struct MassFactors {
-    pub(super) links: [LinkRates; 2],
-    /// U's columns f₁, f₂ in q indexing (zero outside their link's deflections)
-    pub(super) u: [Vec<f64>; 2],
-    /// number of U columns in use (2 with link 1's foreshortening, else 0)
-    pub(super) nu: usize,
-    /// Z = A⁻¹[M_RF U] in q indexing (zero on F), computed by the first solve at a state
-    pub(super) z: [Vec<f64>; MAX_SMALL],
-    pub(super) z_current: bool,
-    /// A⁻¹b_R scratch
-    pub(super) zb: Vec<f64>,
-    /// the columns' deflection entries by rows (scratch of `solve_columns`)
-    pub(super) rows: Vec<f64>,
-}
-
 impl TwoLinkChain {
     /// The deflection ranges R of links 1 and 2 (stations with an unknown, the tip left out).
     fn deflections(&self, link: usize) -> std::ops::Range<usize> {

@@ -9,7 +9,7 @@ use data::scene::TorqueLaw;
 use super::damping_matrix::ImplicitDamping;
 use super::kinetic::PointScratch;
 use super::kinetic::{BE, ChainInertia, TH};
-use super::mass::MassFactors;
+use super::rates::MassFactors;
 use super::schur::MAX_FULL;
 use super::surface::{TipConstraint, TipContact};
 use super::timoshenko::TimoFields;

@@ -10,7 +10,8 @@
 //!
 //!   A⁻¹ = D⁻¹ − D⁻¹Gᵀ(N⁻¹ + GD⁻¹Gᵀ)⁻¹GD⁻¹,
 //!
-//! is one tridiagonal SPD factorization per state and O(r) per solve.
+//! is one tridiagonal SPD factorization per state and O(r) per solve. [`MassFactors`] holds
+//! both links' blocks with the rest of the mass solve's state-dependent factors.
 
 use super::schur::MAX_SMALL;
 use crate::tridiagonal::TridiagonalLdl;
@@ -128,4 +129,21 @@ impl LinkRates {
             }
         }
     }
+}
+
+/// The state-dependent factors of the mass solve ([`super::mass`] docs), allocated once.
+#[derive(Debug, Clone)]
+pub struct MassFactors {
+    pub(super) links: [LinkRates; 2],
+    /// U's columns f₁, f₂ in q indexing (zero outside their link's deflections)
+    pub(super) u: [Vec<f64>; 2],
+    /// number of U columns in use (2 with link 1's foreshortening, else 0)
+    pub(super) nu: usize,
+    /// Z = A⁻¹[M_RF U] in q indexing (zero on F), computed by the first solve at a state
+    pub(super) z: [Vec<f64>; MAX_SMALL],
+    pub(super) z_current: bool,
+    /// A⁻¹b_R scratch
+    pub(super) zb: Vec<f64>,
+    /// the columns' deflection entries by rows (scratch of `solve_columns`)
+    pub(super) rows: Vec<f64>,
 }

@@ -18,10 +18,11 @@
 //! conversion from [`data::FdmMethod`] and the dispatch); in `data`, one row of the method
 //! table (`data/src/methods.rs`, from which [`data::FdmMethod`] follows). A payload field of a
 //! variant is `Option<T>` in `data` (None: the backend's default) and `T` here, checked by the
-//! function of the same name in `crate::settings::payload`.
+//! function of the same name in [`payload`].
+
+pub mod payload;
 
 use crate::error::FdmError;
-use crate::settings::payload;
 use crate::system::System;
 
 pub use two_step::TwoStep;
@@ -163,7 +164,7 @@ macro_rules! registry {
 
         impl Method {
             /// The method named in the settings (payloads checked, their defaults filled in by
-            /// `crate::settings::payload`).
+            /// [`payload`]).
             pub fn from_data(method: data::FdmMethod) -> Result<Self, FdmError> {
                 Ok(match method {
                     $($(
