@@ -59,6 +59,17 @@ fn impacts(r: &RunResult) -> Vec<(f64, f64, f64, f64, f64)> {
 fn dyn_contact_case1_impacts_balance_momentum_and_lose_energy() {
     let (r, _) = run("barhorst-case1", 11, 0.45);
     let imp = impacts(&r);
+    // the loss is a difference of two kinetic energies: exact to their round-off
+    let ke_peak = r
+        .ledger
+        .stored
+        .iter()
+        .find(|t| t.name == "kinetic")
+        .expect("kinetic energy in the ledger")
+        .values
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let round_off = 16.0 * f64::EPSILON * ke_peak;
     assert!(imp.len() >= 2, "{} impacts", imp.len());
     for &(t, lam, res, vn, lost) in &imp {
         println!(
@@ -71,9 +82,12 @@ fn dyn_contact_case1_impacts_balance_momentum_and_lose_energy() {
             lam > -1e-9,
             "impulse {lam} must push the tip off the surface"
         );
-        // ΔKE = ½(Gq̇⁻)²/(GM⁻¹Gᵀ) ≥ 0; a grazing one is a difference of two kinetic energies
-        // of ~10 ft·lbf, exact to their round-off (1e-15 relative)
-        assert!(lost >= -1e-13, "kinetic energy gained {lost:e} at t = {t}");
+        // ΔKE = ½(Gq̇⁻)²/(GM⁻¹Gᵀ) ≥ 0; at a grazing re-contact (Λ ≈ 0) it is zero up to the
+        // round-off of the kinetic energies it is the difference of
+        assert!(
+            lost >= -round_off,
+            "kinetic energy gained {lost:e} at t = {t} (round-off {round_off:e})"
+        );
     }
     // the first impact is a real hit: a loss of order the kinetic energy of the fall
     assert!(imp[0].4 > 1.0, "first impact lost {}", imp[0].4);

@@ -106,7 +106,7 @@ impl TwoLinkChain {
         let mut pos = 0;
         let mut b = 0;
         for link in 0..2 {
-            let r = self.segments(link);
+            let r = self.deflections(link).len() + 1;
             for _ in 0..r - 1 {
                 at_band[b] = pos;
                 at_segment[link].push(pos + 1);
@@ -137,18 +137,9 @@ impl TwoLinkChain {
                     }
                 }
             }
-            first += self.segments(link) - 1;
+            first += self.deflections(link).len();
         }
         (at_band, at_segment, k)
-    }
-
-    /// Segments of link ℓ (its stations with a deflection unknown plus the tip).
-    fn segments(&self, link: usize) -> usize {
-        if link == 0 {
-            self.inertia.r1
-        } else {
-            self.inertia.r2
-        }
     }
 
     /// Whether the damping is implicit (the bound then leaves it out).

@@ -21,7 +21,7 @@ use crate::system::System;
 
 impl TwoLinkChain {
     /// The deflection ranges R of links 1 and 2 (stations with an unknown, the tip left out).
-    fn deflections(&self, link: usize) -> std::ops::Range<usize> {
+    pub(super) fn deflections(&self, link: usize) -> std::ops::Range<usize> {
         let first = self.first(link);
         first..self.slots[link]
     }
@@ -70,7 +70,7 @@ impl TwoLinkChain {
             let r = self.deflections(link);
             let start = r.start;
             let mut rates = std::mem::replace(&mut self.factors.links[link], LinkRates::empty());
-            rates.factor(&self.qk[r], hs[link], |i| self.diag_mass(start + i));
+            rates.set_state(&self.qk[r], hs[link], |i| self.diag_mass(start + i));
             self.factors.links[link] = rates;
         }
         let ine = &self.inertia;

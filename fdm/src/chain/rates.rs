@@ -16,7 +16,8 @@
 use super::schur::MAX_SMALL;
 use crate::tridiagonal::TridiagonalLdl;
 
-/// One link's A = D + GᵀNG (module docs), factored at the slopes of the last [`Self::factor`].
+/// One link's A = D + GᵀNG (module docs) at the state of the last [`Self::set_state`],
+/// factored by the first solve at that state (the implicit kick reads only G and W).
 #[derive(Debug, Clone)]
 pub struct LinkRates {
     /// station masses D (length r − 1)
@@ -30,6 +31,10 @@ pub struct LinkRates {
     /// segment scratch (r rows of up to `MAX_SMALL` right-hand sides)
     u: Vec<f64>,
     foreshortening: bool,
+    /// `ldl` holds the factor of the current state
+    factored: bool,
+    /// the factorization failed (a state that is not finite): solves give NaN
+    failed: bool,
 }
 
 impl LinkRates {
@@ -43,6 +48,8 @@ impl LinkRates {
             ldl: TridiagonalLdl::new(r),
             u: vec![0.0; r * MAX_SMALL],
             foreshortening,
+            factored: false,
+            failed: false,
         }
     }
 
@@ -55,6 +62,8 @@ impl LinkRates {
             ldl: TridiagonalLdl::new(0),
             u: Vec::new(),
             foreshortening: false,
+            factored: false,
+            failed: false,
         }
     }
 
@@ -63,26 +72,32 @@ impl LinkRates {
         &self.w
     }
 
-    /// The segment slopes g of the last [`Self::factor`] (length r).
+    /// The segment slopes g of the last [`Self::set_state`] (length r).
     pub fn slopes(&self) -> &[f64] {
         &self.g
     }
 
-    /// Factors A at the deflections `u` (length r − 1, the tip's zero left out), segment
-    /// spacing `h` and station masses `d`.
-    pub fn factor(&mut self, u: &[f64], h: f64, d: impl Fn(usize) -> f64) {
+    /// The state: deflections `u` (length r − 1, the tip's zero left out), segment spacing `h`
+    /// and station masses `d`.
+    pub fn set_state(&mut self, u: &[f64], h: f64, d: impl Fn(usize) -> f64) {
         let r = self.w.len();
         for i in 0..r - 1 {
             self.d[i] = d(i);
         }
-        if !self.foreshortening {
-            return;
+        self.factored = false;
+        if self.foreshortening {
+            for seg in 0..r {
+                let right = if seg < r - 1 { u[seg] } else { 0.0 };
+                let left = if seg == 0 { 0.0 } else { u[seg - 1] };
+                self.g[seg] = (right - left) / h;
+            }
         }
-        for seg in 0..r {
-            let right = if seg < r - 1 { u[seg] } else { 0.0 };
-            let left = if seg == 0 { 0.0 } else { u[seg - 1] };
-            self.g[seg] = (right - left) / h;
-        }
+    }
+
+    /// Factors N⁻¹ + GD⁻¹Gᵀ (SPD for positive masses and a finite state; otherwise the
+    /// solves give NaN and the run's watch stops it).
+    fn factor(&mut self) {
+        let r = self.w.len();
         let (d, w, g) = (&self.d, &self.w, &self.g);
         let inv_d = |i: usize| if i < r - 1 { 1.0 / d[i] } else { 0.0 };
         let diag = |a: usize| {
@@ -93,9 +108,8 @@ impl LinkRates {
             t
         };
         let off = |a: usize| -1.0 / w[a] - g[a + 1] * g[a] * inv_d(a);
-        self.ldl
-            .factor(diag, off)
-            .expect("N⁻¹ + GD⁻¹Gᵀ is SPD for positive masses");
+        self.failed = self.ldl.factor(diag, off).is_err();
+        self.factored = true;
     }
 
     /// x ← A⁻¹x (length r − 1).
@@ -111,6 +125,13 @@ impl LinkRates {
             x[i * m..i * m + m].iter_mut().for_each(|v| *v /= self.d[i]);
         }
         if !self.foreshortening {
+            return;
+        }
+        if !self.factored {
+            self.factor();
+        }
+        if self.failed {
+            x[..(r - 1) * m].iter_mut().for_each(|v| *v = f64::NAN);
             return;
         }
         let u = &mut self.u[..r * m];
