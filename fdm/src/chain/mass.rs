@@ -225,7 +225,7 @@ pub(super) fn schur_finish(
         }
     }
     for i in 0..n {
-        if zb[i] == 0.0 && (0..ns).all(|k| z[k][i] == 0.0) {
+        if full.contains(&i) {
             continue;
         }
         for r in 0..ns {
