@@ -11,6 +11,13 @@
 //! own rotation carries the half-cell rotary inertia J_c = ρA h³/24 (O(h³), exact positive
 //! term ½J_c(clamp angle rate)²).
 //!
+//! The foreshortening s = ½∫v′² is written in these chord frames, while the scene defines it in
+//! the clamp-tangent frame (as fem and modal write it). The two second-order models agree to
+//! fourth order in the slopes under distributed loads but differ at order (F L²/EI)·φ when a
+//! transverse force F acts at the tip (φ the chord–tangent angle): the chord component F sin φ
+//! adds a geometric stiffness the tangent model lacks (about 1 % of link 2's deflection while the
+//! tip of `barhorst-case1-stiff-elbow` is held; docs/contact.md).
+//!
 //! **Equations.** Lagrange's equations of L = T − V with the dissipation function D:
 //! * T: [`kinetic`] (½Σm|ṙ|² of the lumped points, exact) + Σ ½J_c,ℓ (clamp angle rate)²;
 //! * V = Σ_ℓ ½ Σᵢ cᵢ h EI κᵢ² (the single link's ghost-node bending energy, [`crate::link`],
