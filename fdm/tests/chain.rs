@@ -12,81 +12,123 @@ use fdm::system::System;
 
 mod common;
 
-/// Inertial positions of the chain's lumped points (link 1's stations, the elbow, link 2's
-/// stations) written from the geometry alone, independently of the kinetic-energy kernel.
-fn point_positions(ine: &ChainInertia, q: &[f64]) -> Vec<[f64; 2]> {
-    let fore = |u: &[f64], h: f64, on: bool| -> Vec<f64> {
-        let mut s = 0.0;
-        let mut prev = 0.0;
-        u.iter()
-            .map(|&x| {
-                if on {
-                    s += 0.5 * h * ((x - prev) / h).powi(2);
-                }
-                prev = x;
-                s
-            })
-            .collect()
-    };
-    let (v, w) = (&q[ine.iv()], &q[ine.iw()]);
-    let (s1, s2) = (fore(v, ine.h1, ine.fs1), fore(w, ine.h2, ine.fs2));
-    let rot = |a: f64, x: f64, y: f64| [a.cos() * x - a.sin() * y, a.sin() * x + a.cos() * y];
+/// One link's points in its clamp-tangent frame, written from the geometry alone: `u` holds
+/// the chord-frame deflections of stations 1…r−1 and, last, the clamp ghost x (the tip sits on
+/// the chord); the clamp tangent turns by ψ = (u₁ − x)/(2h) from the chord, so the
+/// tangent-frame deflection of station k is u_k − ξ_kψ (tip −Lψ) and its axial position
+/// ξ_k − ½∫₀^ξ_k (v^t′)² (segment slopes). Returns (ψ, points (x, y) of stations 1…r).
+fn tangent_link(u: &[f64], h: f64, foreshortening: bool) -> (f64, Vec<[f64; 2]>) {
+    let r = u.len();
+    let psi = (u[0] - u[r - 1]) / (2.0 * h);
+    let (mut s, mut prev) = (0.0, 0.0);
     let mut out = Vec::new();
-    for k in 0..ine.r1 {
-        out.push(rot(q[0], (k + 1) as f64 * ine.h1 - s1[k], v[k]));
+    for k in 0..r {
+        let xi = (k + 1) as f64 * h;
+        let chord = if k + 1 < r { u[k] } else { 0.0 };
+        let vt = chord - xi * psi;
+        if foreshortening {
+            s += 0.5 * h * ((vt - prev) / h).powi(2);
+        }
+        prev = vt;
+        out.push([xi - s, vt]);
     }
+    (psi, out)
+}
+
+/// Inertial positions of the chain's lumped points (link 1's stations, the elbow, link 2's
+/// stations) in the clamp-tangent frames (the scene's model), written from the geometry alone,
+/// independently of the kinetic-energy kernel and of the chain's coordinate map; and the hub
+/// angle (link 1's clamp tangent α₁ = θ + ψ₁, on which the rotor turns).
+fn point_positions(ine: &ChainInertia, q: &[f64]) -> (Vec<[f64; 2]>, f64) {
+    let (v, w) = (&q[ine.iv()], &q[ine.iw()]);
+    let (psi1, p1) = tangent_link(v, ine.h1, ine.fs1);
+    let (psi2, p2) = tangent_link(w, ine.h2, ine.fs2);
+    let (a1, a2) = (q[0] + psi1, q[1] + psi2);
+    let rot = |a: f64, p: [f64; 2]| {
+        [
+            a.cos() * p[0] - a.sin() * p[1],
+            a.sin() * p[0] + a.cos() * p[1],
+        ]
+    };
+    let mut out: Vec<[f64; 2]> = p1.iter().map(|p| rot(a1, *p)).collect();
     let e = *out.last().unwrap();
     out.push(e);
-    for j in 0..ine.r2 {
-        let r = rot(q[1], (j + 1) as f64 * ine.h2 - s2[j], w[j]);
+    for p in &p2 {
+        let r = rot(a2, *p);
         out.push([e[0] + r[0], e[1] + r[1]]);
     }
-    out
+    (out, a1)
+}
+
+/// The chain's kinetic energy of the lumped points and the hub at chain coordinates: the
+/// kernel at the mapped coordinates P q, P q̇.
+fn chain_kinetic(sys: &TwoLinkChain, sc: &mut PointScratch, q: &[f64], v: &[f64]) -> f64 {
+    let n = q.len();
+    let (mut qk, mut vk) = (vec![0.0; n], vec![0.0; n]);
+    sys.to_kinetic(q, &mut qk);
+    sys.to_kinetic(v, &mut vk);
+    sys.inertia.kinetic(&qk, &vk, sc)
 }
 
 #[test]
 fn elem_chain_kinetic_energy_is_that_of_the_moving_lumped_points() {
-    // T = ½J₁θ̇² + ½Σm|ṙ|² with ṙ a central difference of the positions along q̇; p = ∂T/∂q̇
-    // and the inertia forces ∂T/∂q − (∂p/∂q)q̇ against central differences of T and p
+    // T = ½J₁α̇₁² + ½Σm|ṙ|² with ṙ a central difference of the clamp-tangent-frame positions
+    // along q̇; p = ∂T/∂q̇ (Pᵀ of the kernel's momenta) and the inertia forces
+    // ∂T/∂q − (∂p/∂q)q̇ against central differences of T and p
     let scene = load_scene("two-link-free").unwrap();
     let sys =
         TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9)).unwrap();
     let ine = &sys.inertia;
-    let n = ine.dofs();
+    let n = sys.dofs();
     let (q, v) = common::moving_chain_state(n);
     let mut sc = PointScratch::new(ine);
-    let t0 = ine.kinetic(&q, &v, &mut sc);
+    let t0 = chain_kinetic(&sys, &mut sc, &q, &v);
     let eps = 1e-6;
     let shifted = |s: f64| -> Vec<f64> { (0..n).map(|i| q[i] + s * v[i]).collect() };
-    let (ra, rb) = (
+    let ((ra, ha), (rb, hb)) = (
         point_positions(ine, &shifted(eps)),
         point_positions(ine, &shifted(-eps)),
     );
-    let mut t_points = 0.5 * ine.hub * v[0] * v[0];
+    let hub_rate = (ha - hb) / (2.0 * eps);
+    let mut t_points = 0.5 * ine.hub * hub_rate * hub_rate;
     for p in 0..ine.points() {
         let d = [0, 1].map(|c| (ra[p][c] - rb[p][c]) / (2.0 * eps));
         t_points += 0.5 * ine.point_mass(p) * (d[0] * d[0] + d[1] * d[1]);
     }
     // central difference of smooth positions: O(ε²) truncation, round-off ≈ 1e-16/ε relative
     assert!((t_points - t0).abs() < 1e-8 * t0, "{t_points} vs {t0}");
+    let (mut qk, mut vk) = (vec![0.0; n], vec![0.0; n]);
+    let mut momenta = |sc: &mut PointScratch, q: &[f64], out: &mut [f64]| {
+        sys.to_kinetic(q, &mut qk);
+        sys.to_kinetic(&v, &mut vk);
+        out.iter_mut().for_each(|x| *x = 0.0);
+        ine.momenta_values(&qk, &vk, sc, out);
+        sys.kinetic_transpose(out);
+    };
     let mut p = vec![0.0; n];
-    ine.momenta_values(&q, &v, &mut sc, &mut p);
+    momenta(&mut sc, &q, &mut p);
     let half: f64 = 0.5 * (0..n).map(|i| v[i] * p[i]).sum::<f64>();
     assert!((half - t0).abs() < 1e-12 * t0, "{half} vs {t0}");
-    let mut f = vec![0.0; n];
-    ine.inertia_forces(&q, &v, &mut sc, &mut f);
     let (mut pa, mut pb) = (vec![0.0; n], vec![0.0; n]);
-    ine.momenta_values(&shifted(eps), &v, &mut sc, &mut pa);
-    ine.momenta_values(&shifted(-eps), &v, &mut sc, &mut pb);
+    momenta(&mut sc, &shifted(eps), &mut pa);
+    momenta(&mut sc, &shifted(-eps), &mut pb);
+    let mut f = vec![0.0; n];
+    let (mut qk, mut vk) = (vec![0.0; n], vec![0.0; n]);
+    sys.to_kinetic(&q, &mut qk);
+    sys.to_kinetic(&v, &mut vk);
+    ine.inertia_forces(&qk, &vk, &mut sc, &mut f);
+    sys.kinetic_transpose(&mut f);
     for i in 0..n {
         let (mut va, mut vb) = (v.clone(), v.clone());
         va[i] += eps;
         vb[i] -= eps;
-        let dp = (ine.kinetic(&q, &va, &mut sc) - ine.kinetic(&q, &vb, &mut sc)) / (2.0 * eps);
+        let dp = (chain_kinetic(&sys, &mut sc, &q, &va) - chain_kinetic(&sys, &mut sc, &q, &vb))
+            / (2.0 * eps);
         let (mut qa, mut qb) = (q.clone(), q.clone());
         qa[i] += eps;
         qb[i] -= eps;
-        let dg = (ine.kinetic(&qa, &v, &mut sc) - ine.kinetic(&qb, &v, &mut sc)) / (2.0 * eps);
+        let dg = (chain_kinetic(&sys, &mut sc, &qa, &v) - chain_kinetic(&sys, &mut sc, &qb, &v))
+            / (2.0 * eps);
         let dd = (pa[i] - pb[i]) / (2.0 * eps);
         // central differences: truncation O(ε²·T''') ≈ 1e-12 relative, round-off
         // ≈ 1e-16·T/ε ≈ 1e-10 relative to the scale of T
@@ -667,4 +709,75 @@ fn dyn_chain_whip_beyond_the_default_step_stops_when_the_ledger_opens() {
     assert!(c1 < 1e-3, "{c1}");
     let order = (c1 / c2).log2();
     assert!((1.7..2.3).contains(&order), "closure order {order}");
+}
+
+#[test]
+fn elem_chain_gravity_potential_and_gap_are_those_of_the_lumped_points() {
+    // V_g = −g·Σ m r and the gap g = n̂·(r_tip − p₀) of the clamp-tangent-frame positions
+    // written independently (`point_positions`); G = ∂g/∂q against a central difference of
+    // that tip position; the gravity force against the potential: M a = −∂V/∂q at q̇ = 0
+    let scene = load_scene("barhorst-case1").unwrap();
+    let pc = scene.planar_chain().unwrap();
+    let mut sys = TwoLinkChain::from_planar_chain(&scene, pc, Some(9)).unwrap();
+    let n = sys.dofs();
+    let (q, _) = common::moving_chain_state(n);
+    let gravity = pc.gravity.as_ref().unwrap().vector;
+    let data::scene::Surface::Line { point, normal } = pc.contacts[0].surface else {
+        panic!("line surface expected")
+    };
+    let ine = sys.inertia.clone();
+    let zeros = vec![0.0; n];
+    let energies = |sys: &TwoLinkChain, q: &[f64]| {
+        let mut e = [0.0; 4];
+        sys.stored_energies(0.0, q, &zeros, &mut e);
+        e
+    };
+    let (pos, _) = point_positions(&ine, &q);
+    let vg: f64 = -(0..ine.points())
+        .map(|p| ine.point_mass(p) * (gravity[0] * pos[p][0] + gravity[1] * pos[p][1]))
+        .sum::<f64>();
+    let e = energies(&sys, &q);
+    assert!((e[3] - vg).abs() < 1e-12 * vg.abs(), "{} vs {vg}", e[3]);
+    let tip_gap = |q: &[f64]| {
+        let (pos, _) = point_positions(&ine, q);
+        let tip = pos[pos.len() - 1];
+        (tip[0] - point[0]) * normal[0] + (tip[1] - point[1]) * normal[1]
+    };
+    let mut grad = vec![0.0; n];
+    let g = sys.gap_gradient(&q, &mut grad);
+    assert!(
+        (g - tip_gap(&q)).abs() < 1e-13 * 5.0,
+        "{g} vs {}",
+        tip_gap(&q)
+    );
+    assert!((sys.gap(&q) - g).abs() == 0.0);
+    let eps = 1e-6;
+    for i in 0..n {
+        let (mut qa, mut qb) = (q.clone(), q.clone());
+        qa[i] += eps;
+        qb[i] -= eps;
+        let d = (tip_gap(&qa) - tip_gap(&qb)) / (2.0 * eps);
+        // central difference of a smooth position (lengths ≈ 5): O(ε²) truncation,
+        // round-off ≈ 1e-16·5/ε
+        assert!((grad[i] - d).abs() < 1e-8, "G[{i}] {} vs {d}", grad[i]);
+    }
+    // M a = −∂V/∂q (strain, springs, gravity) at q̇ = 0: dampers give nothing
+    let mut a = vec![0.0; n];
+    sys.accel(0.0, &q, &zeros, &mut a);
+    let mut ma = vec![0.0; n];
+    sys.momenta(&q, &a, &mut ma);
+    for i in 0..n {
+        let (mut qa, mut qb) = (q.clone(), q.clone());
+        qa[i] += eps;
+        qb[i] -= eps;
+        let (ea, eb) = (energies(&sys, &qa), energies(&sys, &qb));
+        let dv = (ea[1] + ea[2] + ea[3] - eb[1] - eb[2] - eb[3]) / (2.0 * eps);
+        // V ≈ 1e2: round-off of the central difference ≈ 1e-16·V/ε
+        assert!(
+            (ma[i] + dv).abs() < 1e-6 * (1.0 + dv.abs()),
+            "{i}: M a = {} vs −∂V/∂q = {}",
+            ma[i],
+            -dv
+        );
+    }
 }

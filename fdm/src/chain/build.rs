@@ -209,6 +209,7 @@ fn mass_factors(inertia: &ChainInertia, nd: usize) -> MassFactors {
         z: std::array::from_fn(|_| vec![0.0; nd]),
         z_current: false,
         zb: vec![0.0; nd],
+        rz: vec![0.0; nd],
         rows: vec![0.0; nd * MAX_SMALL],
     }
 }
@@ -289,6 +290,9 @@ impl TwoLinkChain {
             hs: [h1, h2],
             qk: vec![0.0; nd],
             vk: vec![0.0; nd],
+            qc: vec![0.0; nd],
+            vc: vec![0.0; nd],
+            gk: vec![0.0; nd],
             obs_scratch: std::cell::RefCell::new(vec![0.0; nd]),
             obs_scratch_v: std::cell::RefCell::new(vec![0.0; nd]),
             inertia,
@@ -313,18 +317,15 @@ impl TwoLinkChain {
         Ok(chain)
     }
 
-    /// The ghost columns of M (J_c e eᵀ at the ghost slots) do not depend on the state: built
-    /// once here, `accel` refreshes only the θ and β columns.
+    /// The constant full columns of M: link 1's tip-ghost column J_t e eᵀ (Euler links) and,
+    /// Timoshenko, the unused ghost slots (a decoupled unit mass); `build_columns` refreshes
+    /// the state-dependent θ, β and (Euler) ψ₁, ψ₂ columns.
     fn set_ghost_columns(&mut self) {
-        for k in 0..2 {
-            let mut col = std::mem::take(&mut self.cols[2 + k]);
-            if self.timo.is_some() {
+        if self.timo.is_some() {
+            for k in 0..2 {
                 // unused slot: a decoupled unit mass with no force keeps it at rest at zero
-                col[self.slots[k]] = 1.0;
-            } else {
-                self.add_clamp(k, -self.jc[k] / (2.0 * self.hs[k]), &mut col);
+                self.cols[2 + k][self.slots[k]] = 1.0;
             }
-            self.cols[2 + k] = col;
         }
         if let Some(y) = self.tip_ghost {
             let mut col = std::mem::take(&mut self.cols[4]);

@@ -1,15 +1,17 @@
 //! Unilateral frictionless contact of link 2's tip with a fixed line (`barhorst-case1`,
 //! `barhorst-case2`, `barhorst-case1-tipmass`, `barhorst-case1-stiff-elbow`; seed 000).
 //!
-//! **Gap.** In the tip-chord frames the tip of link 2 sits at
-//! r_tip(q) = R(θ)(L₁ − S₁, 0) + R(β)(L₂ − S₂, 0), S_ℓ = ½h Σ_seg g_seg² the foreshortening of
+//! **Gap.** In the kernel's coordinates ([`TwoLinkChain::to_kinetic`]: the clamp-tangent
+//! frames α_ℓ, tip deflections V_ℓ = −L_ℓψ_ℓ) the tip of link 2 sits at
+//! r_tip = R(α₁)(L₁ − S₁, V₁) + R(α₂)(L₂ − S₂, V₂), S_ℓ = ½h Σ_seg g_seg² the foreshortening of
 //! link ℓ (0 when it is off) — the positions the kinetic energy uses. With the unit normal n̂ to
-//! the free side and p₀ on the line, g(q) = n̂·(r_tip − p₀), and with nc(α) = n̂·(cos α, sin α),
-//! ns(α) = n̂·(−sin α, cos α):
+//! the free side and p₀ on the line, g = n̂·(r_tip − p₀), and with nc(α) = n̂·(cos α, sin α),
+//! ns(α) = n̂·(−sin α, cos α), X = L − S, Y = V:
 //!
-//! G = ∂g/∂q: G_θ = ns(θ)(L₁ − S₁), G_β = ns(β)(L₂ − S₂), G_v = −nc(θ) ∂S₁/∂v,
-//! G_w = −nc(β) ∂S₂/∂w (the ghost slots move no point: 0);
-//! Ġq̇ = Σ_ℓ [−nc(α)α̇²(L − S) − 2ns(α)α̇Ṡ − nc(α) h Σ ġ²] (differentiate g twice, drop G q̈).
+//! G' = ∂g/∂(kernel coordinates): G'_α = ns(α)X − nc(α)Y, G'_u = −nc(α) ∂S/∂u, G'_V += ns(α);
+//! G = PᵀG' (P constant);
+//! Ġq̇ = Σ_ℓ [−α̇²(nc(α)X + ns(α)Y) − 2α̇(ns(α)Ṡ + nc(α)Ẏ) − nc(α) h Σ ġ²] (differentiate g
+//! twice, drop G q̈).
 //!
 //! **Phases** (the velocity form, one step = kick–drift–kick; when each phase starts and ends
 //! is decided by the event object [`crate::events::tip_contact::TipContactEvents`]):
@@ -87,27 +89,25 @@ impl TwoLinkChain {
         self.links[0].length + self.links[1].length
     }
 
-    /// The q-slots of the clamp ghosts (no point of the chord frames moves with them).
-    pub(crate) fn ghost_slots(&self) -> [usize; 2] {
-        self.slots
+    /// g(q) of full coordinates (the kernel coordinates in the observation scratch; no
+    /// `&mut`, for the contact-start location).
+    pub(crate) fn gap_of(&self, q: &[f64]) -> f64 {
+        let mut qk = self.obs_scratch.borrow_mut();
+        self.to_kinetic(q, &mut qk);
+        self.gap_on(self.contact.as_ref().expect("contact"), &qk)
     }
 
-    /// g of chord-frame coordinates `qk` (ghost slots zero).
-    pub(crate) fn gap_of_chord(&self, qk: &[f64]) -> f64 {
-        self.gap_on(self.contact.as_ref().expect("contact"), qk)
-    }
-
-    /// g of chord-frame coordinates `qk` (ghost slots zero) against the surface `ct`.
+    /// g of kernel coordinates `qk` ([`Self::to_kinetic`]) against the surface `ct`.
     pub(super) fn gap_on(&self, ct: &TipContact, qk: &[f64]) -> f64 {
         let (s1, s2) = self.shortenings(qk);
         ct.gap(
-            qk[TH],
-            qk[BE],
+            [qk[TH], qk[BE]],
             [self.links[0].length - s1, self.links[1].length - s2],
+            [qk[self.slots[0]], qk[self.slots[1]]],
         )
     }
 
-    /// Foreshortenings S₁, S₂ (0 where off) of the chord-frame `qk`.
+    /// Foreshortenings S₁, S₂ (0 where off) of the kernel coordinates `qk`.
     fn shortenings(&self, qk: &[f64]) -> (f64, f64) {
         let ine = &self.inertia;
         let s1 = if ine.fs1 {
@@ -123,33 +123,40 @@ impl TwoLinkChain {
         (s1, s2)
     }
 
-    /// Fills `grow` with G = ∂g/∂q at `self.qk` and returns g.
+    /// Fills `grow` with G = ∂g/∂q at the kernel coordinates `self.qk` (G' on the kernel's
+    /// coordinates, then Pᵀ) and returns g.
     fn gap_row(&mut self) -> f64 {
         let ct = self.contact.clone().expect("contact");
         let ine = &self.inertia;
         let qk = &self.qk;
         let (s1, s2) = self.shortenings(qk);
         let (l1, l2) = (self.links[0].length, self.links[1].length);
-        let g = &mut self.constraint.grow;
+        let (y1, y2) = (qk[self.slots[0]], qk[self.slots[1]]);
+        let mut g = std::mem::take(&mut self.constraint.grow);
         g.iter_mut().for_each(|x| *x = 0.0);
-        g[TH] = ct.ns(qk[TH]) * (l1 - s1);
-        g[BE] = ct.ns(qk[BE]) * (l2 - s2);
+        // ∂/∂α n̂·R(α)(X, Y) = ns(α)X − nc(α)Y; ∂/∂V = ns(α)
+        g[TH] = ct.ns(qk[TH]) * (l1 - s1) - ct.nc(qk[TH]) * y1;
+        g[BE] = ct.ns(qk[BE]) * (l2 - s2) - ct.nc(qk[BE]) * y2;
         if ine.fs1 {
             let (v, c) = (&qk[ine.iv()], ct.nc(qk[TH]));
-            for k in 0..ine.r1 - 1 {
+            for k in 0..ine.r1 {
                 g[2 + k] = -c * seg_grad(v, ine.h1, None, k);
             }
         }
         if ine.fs2 {
             let (w, c) = (&qk[ine.iw()], ct.nc(qk[BE]));
-            for j in 0..ine.r2 - 1 {
+            for j in 0..ine.r2 {
                 g[2 + ine.r1 + j] = -c * seg_grad(w, ine.h2, None, j);
             }
         }
+        g[self.slots[0]] += ct.ns(qk[TH]);
+        g[self.slots[1]] += ct.ns(qk[BE]);
+        self.kinetic_transpose(&mut g);
+        self.constraint.grow = g;
         self.gap_on(&ct, &self.qk)
     }
 
-    /// Ġq̇ at (`self.qk`, `self.vk`) (module docs).
+    /// Ġq̇ at the kernel coordinates (`self.qk`, `self.vk`) (module docs).
     fn gap_curvature(&self) -> f64 {
         let ct = self.contact.as_ref().expect("contact");
         let ine = &self.inertia;
@@ -173,9 +180,11 @@ impl TwoLinkChain {
             } else {
                 (0.0, 0.0, 0.0)
             };
+            let (y, yd) = (qk[self.slots[l]], vk[self.slots[l]]);
             out += -ct.nc(a) * ad * ad * (self.links[l].length - s)
                 - 2.0 * ct.ns(a) * ad * sd
-                - ct.nc(a) * sdd;
+                - ct.nc(a) * sdd
+                - (ct.ns(a) * ad * ad * y + 2.0 * ct.nc(a) * ad * yd);
         }
         out
     }
@@ -193,14 +202,23 @@ impl TwoLinkChain {
         (gmg, self.gap_curvature())
     }
 
-    /// g(q) of full coordinates (uses the chord scratch).
+    /// g(q) of full coordinates (uses the kernel scratch `qk`).
     pub fn gap(&mut self, q: &[f64]) -> f64 {
-        self.qk.copy_from_slice(q);
-        for s in self.slots {
-            self.qk[s] = 0.0;
-        }
+        let mut qk = std::mem::take(&mut self.qk);
+        self.to_kinetic(q, &mut qk);
+        self.qk = qk;
         let ct = self.contact.clone().expect("contact");
         self.gap_on(&ct, &self.qk)
+    }
+
+    /// G = ∂g/∂q at q into `out` (for checks); returns g.
+    pub fn gap_gradient(&mut self, q: &[f64], out: &mut [f64]) -> f64 {
+        let mut qk = std::mem::take(&mut self.qk);
+        self.to_kinetic(q, &mut qk);
+        self.qk = qk;
+        let g = self.gap_row();
+        out.copy_from_slice(&self.constraint.grow);
+        g
     }
 
     /// Projects q onto g = 0 along M⁻¹Gᵀ (Newton, at most 3 passes); returns |g| before.
@@ -208,10 +226,9 @@ impl TwoLinkChain {
         let tol = GAP_TOLERANCE * (self.links[0].length + self.links[1].length);
         let mut first = None;
         for _ in 0..3 {
-            self.qk.copy_from_slice(q);
-            for s in self.slots {
-                self.qk[s] = 0.0;
-            }
+            let mut qk = std::mem::take(&mut self.qk);
+            self.to_kinetic(q, &mut qk);
+            self.qk = qk;
             let g = self.gap_row();
             first.get_or_insert(g.abs());
             if g.abs() <= tol {
@@ -256,7 +273,7 @@ impl TwoLinkChain {
         let n = q.len();
         let ke_before = self.kinetic_energy(q, v);
         let before = v.to_vec();
-        self.chord(q, v);
+        self.frames(q, v);
         self.build_columns();
         let (gmg, _) = self.constraint_solve();
         if !(gmg > 0.0 && gmg.is_finite()) {
@@ -313,7 +330,7 @@ impl TwoLinkChain {
         let mut f = vec![0.0; n];
         let mut resid = |sys: &mut Self, x: &[f64], out: &mut [f64]| {
             let q = &x[..n];
-            sys.chord(q, &zeros);
+            sys.frames(q, &zeros);
             sys.forces(0.0, q, &zeros, &mut f);
             let g = sys.gap_row();
             for i in 0..n {

@@ -35,13 +35,14 @@ impl TwoLinkChain {
         )
     }
 
-    /// Generalized momenta p = M(q) q̇ of the whole chain (chord-frame kinetic energy plus the
-    /// clamp rotary inertias).
+    /// Generalized momenta p = M(q) q̇ of the whole chain (Pᵀ of the kernel's momenta in the
+    /// clamp-tangent frames plus the section rotary inertias).
     pub fn momenta(&mut self, q: &[f64], qd: &[f64], out: &mut [f64]) {
-        self.chord(q, qd);
+        self.frames(q, qd);
         out.iter_mut().for_each(|x| *x = 0.0);
         self.inertia
             .momenta_values(&self.qk, &self.vk, &mut self.points, out);
+        self.kinetic_transpose(out);
         self.add_section_inertias(qd, out);
     }
 
@@ -52,13 +53,14 @@ impl TwoLinkChain {
         e.iter().sum()
     }
 
-    /// Gravity potential V_g = −g·Σ m r of the lumped masses, from the chord-frame coordinates
-    /// `qk` (ghost slots zero); adds −∂V_g/∂q into `out` when given (not at the ghost slots:
-    /// the ghosts move no mass). With A(α) = g·(cos α, sin α), B(α) = g·(−sin α, cos α),
+    /// Gravity potential V_g = −g·Σ m r of the lumped masses at the kernel coordinates `qk`
+    /// ([`Self::to_kinetic`]); writes −∂V_g/∂q' (the kernel's coordinates, tip entries
+    /// included) into `out` when given. With A(α) = g·(cos α, sin α), B(α) = g·(−sin α, cos α),
     /// ∂A/∂α = B, ∂B/∂α = −A:
-    /// V_g = −[A(θ)X₁ + B(θ)Y₁ + A(β)X₂ + B(β)Y₂], X₁ = Σm₁x + M₂L₁ − Σ_seg c₁ ½h g²
-    /// (foreshortening; c₁ = outboard mass of link 1 + M₂), Y₁ = Σm₁v, X₂ = Q₂ − Ψ, Y₂ = Σm₂w:
-    /// the positions the kinetic energy uses, so the gravity work is exactly −ΔV_g.
+    /// V_g = −[A(α₁)X₁ + B(α₁)Y₁ + A(α₂)X₂ + B(α₂)Y₂], X₁ = Σm₁x + M₂L₁ − Σ_seg c₁ ½h g²
+    /// (foreshortening; c₁ = outboard mass of link 1 + M₂), Y₁ = Σm₁v + M₂V (link 2 rides on
+    /// the elbow), X₂ = Q₂ − Ψ, Y₂ = Σm₂w: the positions the kinetic energy uses, so the
+    /// gravity work is exactly −ΔV_g.
     pub(super) fn gravity_potential(&self, qk: &[f64], out: Option<&mut [f64]>) -> f64 {
         let Some([gx, gy]) = self.gravity else {
             return 0.0;
@@ -77,6 +79,7 @@ impl TwoLinkChain {
             x1 += ine.m1[k] * (k + 1) as f64 * ine.h1;
             y1 += ine.m1[k] * v[k];
         }
+        y1 += ine.mass2 * v[ine.r1 - 1];
         if ine.fs1 {
             x1 -= seg_energy(v, ine.h1, Some(&self.mu1g));
         }
@@ -88,15 +91,18 @@ impl TwoLinkChain {
         if let Some(out) = out {
             out[TH] += b1 * x1 - a1 * y1;
             out[BE] += b2 * x2 - a2 * y2;
-            // the tip entries (k = r − 1) are the ghost slots: no mass moves with them
-            for k in 0..ine.r1 - 1 {
-                let mut f = b1 * ine.m1[k];
+            for k in 0..ine.r1 {
+                let mut m = ine.m1[k];
+                if k == ine.r1 - 1 {
+                    m += ine.mass2;
+                }
+                let mut f = b1 * m;
                 if ine.fs1 {
                     f -= a1 * seg_grad(v, ine.h1, Some(&self.mu1g), k);
                 }
                 out[2 + k] += f;
             }
-            for j in 0..ine.r2 - 1 {
+            for j in 0..ine.r2 {
                 let mut f = b2 * ine.m2[j];
                 if ine.fs2 {
                     f -= a2 * seg_grad(w, ine.h2, Some(&ine.mu2), j);
@@ -105,6 +111,22 @@ impl TwoLinkChain {
             }
         }
         -(a1 * x1 + b1 * y1 + a2 * x2 + b2 * y2)
+    }
+
+    /// Adds the gravity forces −∂V_g/∂q at the kernel coordinates `qk` of the last
+    /// [`Self::frames`] into `out` (Pᵀ of the kernel's).
+    fn add_gravity_forces(&mut self, out: &mut [f64]) {
+        if self.gravity.is_none() {
+            return;
+        }
+        let mut gk = std::mem::take(&mut self.gk);
+        gk.iter_mut().for_each(|x| *x = 0.0);
+        self.gravity_potential(&self.qk, Some(&mut gk));
+        self.kinetic_transpose(&mut gk);
+        for (o, g) in out.iter_mut().zip(&gk) {
+            *o += g;
+        }
+        self.gk = gk;
     }
 
     /// Stores the input/dissipation powers at (q, q̇) — without the force evaluation — and
@@ -118,9 +140,9 @@ impl TwoLinkChain {
             self.powers(out);
             return;
         }
-        self.vk.copy_from_slice(v);
+        self.vc.copy_from_slice(v);
         for s in self.ghosts() {
-            self.vk[s] = 0.0;
+            self.vc[s] = 0.0;
         }
         let (iv, iw) = (self.inertia.iv(), self.inertia.iw());
         let mut p_kv = 0.0;
@@ -140,7 +162,7 @@ impl TwoLinkChain {
             let (d2, _) = Self::ghost_bending(
                 self.hs[link],
                 lp.gamma,
-                &self.vk[range],
+                &self.vc[range],
                 v[self.slots[link]],
                 f,
             );
@@ -156,15 +178,13 @@ impl TwoLinkChain {
         self.powers(out);
     }
 
-    /// rhs += scale·(∂T/∂q − (∂p/∂q)q̇) at the chord copies (`qk`, `vk`) of the last
-    /// [`Self::chord`]; `scratch` (length n) is overwritten. The clamp inertias are constant
-    /// and the chord-frame T does not see the ghost slots.
+    /// rhs += scale·(∂T/∂q − (∂p/∂q)q̇) at the kernel copies (`qk`, `vk`) of the last
+    /// [`Self::frames`] (Pᵀ of the kernel's inertia forces: P is constant); `scratch` (length
+    /// n) is overwritten. The section inertias are constant.
     pub(super) fn add_inertia_terms(&mut self, scale: f64, scratch: &mut [f64], rhs: &mut [f64]) {
         self.inertia
             .inertia_forces(&self.qk, &self.vk, &mut self.points, scratch);
-        for s in self.ghosts() {
-            scratch[s] = 0.0;
-        }
+        self.kinetic_transpose(scratch);
         for i in 0..self.inertia.dofs() {
             rhs[i] += scale * scratch[i];
         }
@@ -180,9 +200,7 @@ impl TwoLinkChain {
             self.torques =
                 [0, 1].map(|k| -j[k].stiffness * (th[k] - j[k].set_point) - j[k].damping * thd[k]);
             self.power = [0.0, pw[0], pw[1]];
-            let qk = std::mem::take(&mut self.qk);
-            self.gravity_potential(&qk, Some(out));
-            self.qk = qk;
+            self.add_gravity_forces(out);
             return;
         }
         // the implicit kick (`implicit`) takes the damping forces separately
@@ -201,11 +219,11 @@ impl TwoLinkChain {
             };
             let lp = &self.links[link];
             let slot = self.slots[link];
-            let (_, gx) = Self::ghost_bending(h, lp.ei, &self.qk[range.clone()], q[slot], f);
+            let (_, gx) = Self::ghost_bending(h, lp.ei, &self.qc[range.clone()], q[slot], f);
             let mut fx = gx;
             if lp.gamma != 0.0 && damp {
                 let (d2, gv) =
-                    Self::ghost_bending(h, lp.gamma, &self.vk[range.clone()], v[slot], f);
+                    Self::ghost_bending(h, lp.gamma, &self.vc[range.clone()], v[slot], f);
                 p_kv += 2.0 * d2;
                 fx += gv;
             }
@@ -249,14 +267,12 @@ impl TwoLinkChain {
             out[i] -= tau2 * c;
         }
         self.torques = [tau1, tau2];
-        let qk = std::mem::take(&mut self.qk);
-        self.gravity_potential(&qk, Some(out));
-        self.qk = qk;
         self.power = [
             ext[0] * th1d + ext[1] * th2d,
             j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
             p_kv,
         ];
+        self.add_gravity_forces(out);
     }
 
     /// Adds the damping forces −∂D/∂q̇ = −C q̇ at `v` into `out`: Kelvin–Voigt (the ghost-node

@@ -10,16 +10,17 @@
 //! elastic h²√(ρA/4EI) and the ghost rotations) instead of the damped one, whose dampers on
 //! the clamp half cells ρAh³/24 shrink it like h³–h⁴.
 //!
-//! **Solve.** M + ½τC has M's structure ([`super::mass`]) plus C. Outside the full columns
-//! F = {θ, β, x₁, x₂, y} ("band": v₁…v_{r−1}, w₁…w_{r−1} in q order) C is pentadiagonal — the
-//! bending stencil per link, and the elbow damper couples v_{r−1} with the adjacent w₁ — so
+//! **Solve.** In the mass solve's coordinates z ([`super::mass`]: ψ in the ghost slots,
+//! C_z = Q⁻ᵀCQ⁻¹) M + ½τC has M's structure plus C. Outside the full columns
+//! F = {θ, β, ψ₁, ψ₂, y} ("band": v₁…v_{r−1}, w₁…w_{r−1} in q order) C_z is pentadiagonal — the
+//! bending stencil per link (the elbow damper reaches v_{r−1}; its w₁ term in q is ψ₂'s in z) — so
 //! the band block is P + ⊕GᵀNG + UCUᵀ with P = D_B + ½τC_BB SPD pentadiagonal. Its first two
 //! terms are the saddle system [[P, Gᵀ], [G, −N⁻¹]] (λ = NGx, N⁻¹ tridiagonal), banded when
 //! each segment's multiplier sits next to its station: quasi-definite, so its LDLᵀ exists
 //! without pivoting (`crate::band_ldl`), O(n) per kick (G follows the slopes). The rank-2 U
 //! and the full columns close it as in the mass solve: Z = A⁻¹[A_BF U], a system of at most
-//! 7, back substitution; no allocation. C itself is read once from
-//! `TwoLinkChain::add_damping_forces` by probing: each full column alone, the band columns in
+//! 7, back substitution; no allocation. C_z itself is read once from
+//! `TwoLinkChain::add_damping_forces` by probing (at Q⁻¹e, then Q⁻ᵀ): each full column alone, the band columns in
 //! five interleaved colours (bandwidth 2).
 //!
 //! **Ledger.** The powers are those of the level velocities (v_{j+1}ᵀCv_{j+1} and the joint
@@ -49,11 +50,19 @@ impl TwoLinkChain {
         let nb = band.len();
         let mut e = vec![0.0; n];
         let mut y = vec![0.0; n];
+        let mut eq = vec![0.0; n];
+        // C in the mass solve's coordinates z (ψ in the ghost slots): C_z = Q⁻ᵀCQ⁻¹
+        let mut probe = |sys: &mut Self, e: &[f64], y: &mut [f64]| {
+            eq.copy_from_slice(e);
+            sys.z_to_q_motion(&mut eq);
+            y.iter_mut().for_each(|x| *x = 0.0);
+            sys.add_damping_forces(&eq, y);
+            sys.q_to_z_forces(y);
+        };
         let mut cf: [Vec<f64>; MAX_FULL] = std::array::from_fn(|_| vec![0.0; n]);
         for c in 0..nf {
             e[full[c]] = 1.0;
-            y.iter_mut().for_each(|x| *x = 0.0);
-            self.add_damping_forces(&e, &mut y);
+            probe(self, &e, &mut y);
             e[full[c]] = 0.0;
             for i in 0..n {
                 cf[c][i] = -y[i];
@@ -65,8 +74,7 @@ impl TwoLinkChain {
             for b in (colour..nb).step_by(5) {
                 e[band[b]] = 1.0;
             }
-            y.iter_mut().for_each(|x| *x = 0.0);
-            self.add_damping_forces(&e, &mut y);
+            probe(self, &e, &mut y);
             for b in (colour..nb).step_by(5) {
                 c0[b] = -y[band[b]];
                 if b + 1 < nb {
@@ -157,16 +165,16 @@ impl TwoLinkChain {
         a: &mut [f64],
     ) {
         let mut rhs = std::mem::take(&mut self.rhs);
-        self.chord(q, drift.current);
+        self.frames(q, drift.current);
         self.skip_damping = true;
         self.forces(t, q, drift.current, &mut rhs);
         self.skip_damping = false;
         self.add_inertia_terms(1.0 + drift.w, a, &mut rhs);
         if drift.w != 0.0 {
-            self.chord(q, drift.previous);
+            self.frames(q, drift.previous);
             self.add_inertia_terms(-drift.w, a, &mut rhs);
         }
-        self.chord(q, drift.current);
+        self.frames(q, drift.current);
         self.build_columns();
         self.add_damping_forces(drift.current, &mut rhs);
         self.solve_damped_mass(tau, &rhs, a);
@@ -192,6 +200,9 @@ impl TwoLinkChain {
         let full = &full[..nf];
         let nu = self.factors.nu;
         let nb = imp.band.len();
+        let mut rz = std::mem::take(&mut self.factors.rz);
+        rz.copy_from_slice(rhs);
+        self.q_to_z_forces(&mut rz);
         let ImplicitDamping {
             band,
             c0,
@@ -243,6 +254,7 @@ impl TwoLinkChain {
         if saddle.factor().is_err() {
             out.iter_mut().for_each(|x| *x = f64::NAN);
             self.implicit = Some(imp);
+            self.factors.rz = rz;
             return;
         }
         // the columns Z = A⁻¹[A_BF U] and A⁻¹r_B, one sweep by rows over the saddle factor
@@ -258,7 +270,7 @@ impl TwoLinkChain {
             for a in 0..nu {
                 y[at + nf + a] = self.factors.u[a][i];
             }
-            y[at + ns] = rhs[i];
+            y[at + ns] = rz[i];
         }
         saddle.solve_rows_in_place(&mut y[..saddle_rows * m], m);
         for c in 0..ns {
@@ -278,10 +290,12 @@ impl TwoLinkChain {
             &z[..nf + nu],
             &self.factors.u[..nu],
             zb,
-            rhs,
+            &rz,
             out,
         );
         self.implicit = Some(imp);
+        self.factors.rz = rz;
+        self.z_to_q_motion(out);
     }
 }
 
@@ -304,7 +318,7 @@ mod tests {
             .map(|i| 0.3 + 0.02 * (0.9 * i as f64).sin())
             .collect();
         let v: Vec<f64> = (0..n).map(|i| 0.3 * (1.7 * i as f64).cos()).collect();
-        sys.chord(&q, &v);
+        sys.frames(&q, &v);
         sys.build_columns();
         let rhs: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).cos() + 0.1).collect();
         let tau = 1e-3;

@@ -1,11 +1,12 @@
 //! Kinetic energy of the two-link chain, T = ½J₁θ̇² + ½Σ m|ṙ|² of its lumped points, its
 //! momenta p = M q̇ and its inertia forces.
 //!
-//! Coordinates q = (θ, β, v₁…v_{r₁}, w₁…w_{r₂}): θ the frame angle of link 1, β the *absolute*
-//! frame angle of link 2 (the elbow angle is a function of q; the trig functions depend on
-//! φ = β − θ only), v and w the transverse deflections at the stations of links 1 and 2 in
-//! their tip-chord frames (the tip entry is the chord's zero, V = v_{r₁} = w_{r₂} = 0 where the
-//! chain uses this; the formulas keep V). The foreshortening s_k = ½h Σ_{seg ≤ k} g_seg², g the
+//! Kernel coordinates q = (θ, β, v₁…v_{r₁}, w₁…w_{r₂}): θ the frame angle of link 1, β the
+//! *absolute* frame angle of link 2 (the trig functions depend on φ = β − θ only), v and w the
+//! transverse deflections at the stations of links 1 and 2 in their frames, the tip's included
+//! (V = v_{r₁}). The chain feeds the kernel its clamp-tangent frames (tip −Lψ; Timoshenko links
+//! their tip chords, V = 0) through a constant linear map of its own coordinates
+//! ([`super::TwoLinkChain::to_kinetic`]). The foreshortening s_k = ½h Σ_{seg ≤ k} g_seg², g the
 //! segment slopes (s ≡ 0 when off).
 //!
 //! Every point's velocity is written in its link frame. Link 1's station k sits at
@@ -26,7 +27,7 @@
 //! transpose is the outboard sum of the forces.
 //!
 //! T is exact in the deflections, so it is a positive definite quadratic form in q̇ at every
-//! configuration the chord frames can describe: M stays positive definite however far the
+//! configuration the frames can describe: M stays positive definite however far the
 //! links bend (a truncation of T to second order in the deflections is indefinite once the
 //! link slopes reach ~0.2: its products of the elbow's rigid velocity with the foreshortening
 //! rates outweigh the rest in the direction that turns the chords against link 2's

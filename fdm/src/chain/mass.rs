@@ -1,14 +1,18 @@
-//! The chain's mass matrix and its solve. M couples every coordinate through the full columns
-//! F = {θ, β, x₁, x₂, y} (the frame angles, the clamp ghosts, link 1's tip ghost); on the
-//! remaining deflections R it is
+//! The chain's mass matrix and its solve. The solve works in z: q with ψ_ℓ = (v₁ − x_ℓ)/(2h_ℓ)
+//! in each clamp ghost slot (Euler links; z = q for Timoshenko links), M_z = Q⁻ᵀM Q⁻¹, so
+//! M⁻¹r = Q⁻¹M_z⁻¹Q⁻ᵀr with Q⁻ᵀ (r_{v₁} += r_x, r_ψ = −2h r_x) and Q⁻¹ (x = v₁ − 2hψ) O(1).
+//! In z every lumped point moves with its own deflection rate, its link's foreshortening rates
+//! and the full columns F = {θ, β, ψ₁, ψ₂, y} (the frame angles, the clamp tangents' turns,
+//! link 1's tip ghost); on the remaining deflections R it is
 //!
 //!   M_RR = A₁ ⊕ A₂ + U C Uᵀ,   U = [f₁ f₂],   C = [[0, 1], [1, 0]],
 //!
-//! A_ℓ = D_ℓ + G_ℓᵀN_ℓG_ℓ each link's stations with their foreshortening rates
-//! (`rates`), f₁ = G₁ᵀ1 link 1's tip rate Ṡ and f₂ = cos φ G₂ᵀμ + sin φ m₂ what link 2's
-//! stations move along it (from ½Σm₂|ṙ|² ∋ Ṡ Σm₂(σ̇ cos φ + ẇ sin φ)). With y = Uᵀx_R and
-//! Z = A⁻¹[M_RF U], the unknowns (x_F, y) solve a system of at most 7, and
-//! x_R = A⁻¹b_R − Z_F x_F − Z_U C y: O(n) per solve, the A factorizations and Z once per state.
+//! A_ℓ = D_ℓ + G_ℓᵀN_ℓG_ℓ each link's stations with their foreshortening rates (`rates`, with
+//! the clamp-tangent slopes g^t = g − ψ), f₁ = G₁ᵀ1 link 1's tip rate Ṡ and
+//! f₂ = cos φ G₂ᵀμ + sin φ m₂ what link 2's stations move along it (from
+//! ½Σm₂|ṙ|² ∋ Ṡ Σm₂(σ̇ cos φ + ẇ sin φ)), φ = α₂ − α₁. With y = Uᵀx_R and Z = A⁻¹[M_RF U],
+//! the unknowns (x_F, y) solve a system of at most 7, and x_R = A⁻¹b_R − Z_F x_F − Z_U C y:
+//! O(n) per solve, the A factorizations and Z once per state.
 
 // Index loops over the columns of M read like the formulas.
 #![allow(clippy::needless_range_loop)]
@@ -34,27 +38,48 @@ impl TwoLinkChain {
         }
     }
 
-    /// The state-dependent full columns of M (θ and β) at the chord-frame `qk`, the ghost
-    /// columns (constant, built in `from_planar_chain`), and the factors of the solve.
+    /// The full columns of M in the mass solve's coordinates z at the kernel coordinates
+    /// `qk`: θ, β and (Euler links) ψ₁, ψ₂ are state dependent — P_zᵀ of the kernel's momenta
+    /// at the unit rate P_z e_c, plus the clamp sections' J_c e eᵀ (e = 1 at the frame and at
+    /// ψ) and link 1's tip section J_t e eᵀ; link 1's tip-ghost column (and, Timoshenko, the
+    /// unused slots) are constant, built in `from_planar_chain`. Then the factors of the solve.
     pub(super) fn build_columns(&mut self) {
         let n = self.dofs();
-        let full = [TH, BE];
-        for (c, &idx) in full.iter().enumerate() {
-            self.cols[c][self.inertia.dofs()..n]
-                .iter_mut()
-                .for_each(|x| *x = 0.0);
-            self.unit[idx] = 1.0;
+        let nd = self.inertia.dofs();
+        let euler = self.timo.is_none();
+        let ncols = if euler { 4 } else { 2 };
+        for c in 0..ncols {
+            self.cols[c][nd..n].iter_mut().for_each(|x| *x = 0.0);
+            // the kernel's rates at unit ż_c: the frame angle, and for ψ_ℓ also the tangent
+            // frame's deflections −ξ_k (tip −L)
+            let link = c % 2;
+            let (frame, first, slot) = (
+                if link == 0 { TH } else { BE },
+                self.first(link),
+                self.slots[link],
+            );
+            self.unit[frame] = 1.0;
+            if c >= 2 {
+                let h = self.hs[link];
+                for (k, i) in (first..=slot).enumerate() {
+                    self.unit[i] = -((k + 1) as f64) * h;
+                }
+            }
             self.inertia
                 .momenta_values(&self.qk, &self.unit, &mut self.points, &mut self.cols[c]);
-            self.unit[idx] = 0.0;
-            for s in self.ghosts() {
-                self.cols[c][s] = 0.0;
+            self.unit[frame] = 0.0;
+            if c >= 2 {
+                self.unit[first..=slot].iter_mut().for_each(|x| *x = 0.0);
             }
-            // J_c e eᵀ: column of the frame angle gets J_c e (the ghost's −J_c e/(2h) is fixed);
-            // θ's column also gets J_t e of link 1's tip section (y's column is fixed)
             let mut col = std::mem::take(&mut self.cols[c]);
-            self.add_clamp(c, self.jc[c], &mut col);
-            if idx == TH {
+            self.kinetic_transpose_z(&mut col);
+            if euler {
+                self.add_clamp_z(link, self.jc[link], &mut col);
+            } else {
+                self.add_clamp(c, self.jc[c], &mut col);
+            }
+            // θ's column also gets J_t e of link 1's tip section (y's column is fixed)
+            if c == 0 {
                 self.add_tip(self.jt, &mut col);
             }
             self.cols[c] = col;
@@ -70,7 +95,8 @@ impl TwoLinkChain {
             let r = self.deflections(link);
             let start = r.start;
             let mut rates = std::mem::replace(&mut self.factors.links[link], LinkRates::empty());
-            rates.set_state(&self.qk[r], hs[link], |i| self.diag_mass(start + i));
+            let tip = self.qk[r.end];
+            rates.set_state(&self.qk[r], tip, hs[link], |i| self.diag_mass(start + i));
             self.factors.links[link] = rates;
         }
         let ine = &self.inertia;
@@ -148,8 +174,11 @@ impl TwoLinkChain {
         }
         let nf = self.nfull();
         let full = self.full();
+        let mut rz = std::mem::take(&mut self.factors.rz);
+        rz.copy_from_slice(rhs);
+        self.q_to_z_forces(&mut rz);
         let mut zb = std::mem::take(&mut self.factors.zb);
-        zb.copy_from_slice(rhs);
+        zb.copy_from_slice(&rz);
         for &f in &full[..nf] {
             zb[f] = 0.0;
         }
@@ -162,33 +191,29 @@ impl TwoLinkChain {
             &fc.z,
             &fc.u[..fc.nu],
             &zb,
-            rhs,
+            &rz,
             out,
         );
         self.factors.zb = zb;
+        self.factors.rz = rz;
+        self.z_to_q_motion(out);
     }
 
-    /// out = M x at the chord-frame `qk` (the exact kinetic energy's momenta at velocity x
-    /// plus the section inertias).
+    /// out = M x at the kernel coordinates `qk` (Pᵀ of the exact kinetic energy's momenta
+    /// at velocity P x, plus the section inertias).
     pub(super) fn mass_mul(&mut self, x: &[f64], out: &mut [f64]) {
         let mut xk = std::mem::take(&mut self.vd);
-        xk.copy_from_slice(x);
-        for s in self.ghosts() {
-            xk[s] = 0.0;
-        }
+        self.to_kinetic(x, &mut xk);
         out.iter_mut().for_each(|o| *o = 0.0);
         self.inertia
             .momenta_values(&self.qk, &xk, &mut self.points, out);
         self.vd = xk;
+        self.kinetic_transpose(out);
         self.add_section_inertias(x, out);
     }
 
-    /// Zeroes the ghost rows of `out` and adds the clamp and tip sections' rotary inertias
-    /// J e eᵀ·x (the ghosts move no lumped mass; their sections turn).
+    /// Adds the clamp and tip sections' rotary inertias J e eᵀ·x (q coordinates).
     pub(super) fn add_section_inertias(&self, x: &[f64], out: &mut [f64]) {
-        for s in self.ghosts() {
-            out[s] = 0.0;
-        }
         for k in 0..2 {
             let w = self.jc[k] * self.clamp_angle(x, k);
             self.add_clamp(k, w, out);

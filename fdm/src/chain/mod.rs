@@ -2,21 +2,27 @@
 //! the tip of link 1 and rotated by the elbow angle θ₂, so its clamp tangent has the angle
 //! θ₁ + ψ + θ₂ with ψ = v₁'(L₁) (scenes.md; Barhorst's q₁, q₅).
 //!
-//! **Frames.** Each link's floating frame is its *tip chord* (v₀ = v_r = 0): θ and β are the
-//! chord angles of links 1 and 2. The clamp condition is the report's ghost node, kept as an
-//! unknown x = v₋₁: the clamp tangent turns by (v₁ − x)/(2h) from the chord and κ₀ =
-//! (v₁ + x)/h². Pinning the tip to the chord makes every frame rotation move the link's mass
-//! (in the clamp-tangent frame of the single link, with zero hub inertia, a tangent-frame
-//! rotation against the opposite linear deflection moves no lumped mass). The clamp section's
-//! own rotation carries the half-cell rotary inertia J_c = ρA h³/24 (O(h³), exact positive
-//! term ½J_c(clamp angle rate)²).
+//! **Coordinates.** q = (θ, β, v, x₁, w, x₂, y): θ and β are the *tip-chord* angles of links
+//! 1 and 2, v and w the deflections from the chords (v₀ = v_r = 0). The clamp condition is the
+//! report's ghost node, kept as an unknown x = v₋₁: the clamp tangent turns by
+//! ψ = (v₁ − x)/(2h) from the chord and κ₀ = (v₁ + x)/h². The bending energy, the damping, the
+//! joint angles and the step bound are written in these coordinates.
 //!
-//! The foreshortening s = ½∫v′² is written in these chord frames, while the scene defines it in
-//! the clamp-tangent frame (as fem and modal write it). The two second-order models agree to
-//! fourth order in the slopes under distributed loads but differ at order (F L²/EI)·φ when a
-//! transverse force F acts at the tip (φ the chord–tangent angle): the chord component F sin φ
-//! adds a geometric stiffness the tangent model lacks (about 1 % of link 2's deflection while the
-//! tip of `barhorst-case1-stiff-elbow` is held; docs/contact.md).
+//! **Kinematics: the clamp-tangent frames** (the scene's model, as fem and modal write it).
+//! Each link's points sit in its clamp-tangent frame, α = (chord angle) + ψ, at
+//! (ξ − s^t, v^t) with v^t_k = v_k − ξ_kψ (v^t₀ = 0, tip −Lψ) and s^t_k = ½h Σ_{seg ≤ k}
+//! (g_seg − ψ)², g the chord-frame segment slopes; link 2 hangs from the elbow E, link 1's
+//! point r: E = R(α₁)(L₁ − S^t₁, −L₁ψ₁). This is an exact change of variables of the tangent
+//! model: ξψ has zero second difference, so κ^t = κ, and the clamp angle α and every joint
+//! angle are unchanged. The map q ↦ (α, v^t) is linear and constant (P, `to_kinetic`): T, the
+//! gravity potential and the contact gap are the kernel's ([`kinetic`]: frame angles and
+//! deflections with the tip's) at P q, their forces Pᵀ of the kernel's. (The chord frames
+//! with s = ½∫v′² of the chord-frame deflections are a different second-order model: under a
+//! transverse tip force F the chord component F sin φ adds a geometric stiffness of order
+//! (F L²/EI)·φ the tangent model lacks — about 1 % of link 2's deflection while the tip of
+//! `barhorst-case1-stiff-elbow` is held.) The clamp section's own rotation carries the
+//! half-cell rotary inertia J_c = ρA h³/24 (O(h³), exact positive term ½J_c α̇²); the hub rotor
+//! J₁ turns with α₁.
 //!
 //! **Equations.** Lagrange's equations of L = T − V with the dissipation function D:
 //! * T: [`kinetic`] (½Σm|ṙ|² of the lumped points, exact) + Σ ½J_c,ℓ (clamp angle rate)²;
@@ -34,12 +40,13 @@
 //!   applied torque laws τⱼ(t) do the work ∫τⱼ θ̇ⱼ.
 //!
 //! M(q) q̈ = Q − ∂V/∂q − ∂D/∂q̇ + f_inertia(q, q̇), the inertia forces in Kane's form (one
-//! forward-mode dual-number pass over the points' velocities, [`kinetic`], [`dual`]). M couples
-//! every coordinate through the full columns θ, β, x₁, x₂ (and y): the momenta at unit
-//! velocities plus J_c e eᵀ (J_t e eᵀ); on the deflections it is each link's lumped diagonal
-//! plus its foreshortening rates (a semiseparable block with a tridiagonal inverse) plus a
-//! rank-2 coupling of link 1's tip rate with link 2 ([`mass`]): O(n) per solve, no allocation in
-//! the step loop.
+//! forward-mode dual-number pass over the points' velocities, [`kinetic`], [`dual`], then Pᵀ).
+//! The mass solve works in z, q with ψ₁, ψ₂ in the ghost slots (x = v₁ − 2hψ): there every
+//! point moves with its own deflection rate, its link's foreshortening rates and the full
+//! columns θ, β, ψ₁, ψ₂ (and y), the momenta at unit velocities plus J_c e eᵀ (J_t e eᵀ); on
+//! the deflections M is each link's lumped diagonal plus its foreshortening rates (a
+//! semiseparable block with a tridiagonal inverse, tangent-frame slopes) plus a rank-2 coupling
+//! of link 1's tip rate with link 2 ([`mass`]): O(n) per solve, no allocation in the step loop.
 //!
 //! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
 //! on). Without contact the damping (constant C) is implicit in the closing kick ([`implicit`]:
@@ -51,13 +58,16 @@
 //! clamp half-cell inertia: overdamped modes, velocity-form limit τ → 1/κ) — and the
 //! clamp-rotation modes and link 1's tip-rotation mode with their joint-damper ratios. Gravity: V_g of the lumped masses
 //! ([`TwoLinkChain`]'s `gravity_potential`). Tip contact: [`contact`]. Observables: joint angles/rates (clamp angles),
-//! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame.
+//! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame
+//! (the kernel's v^t).
 //!
 //! **Timoshenko links** (`shear` on both links): [`timoshenko`] — ψ at the stations replaces the
 //! clamp ghost (the clamp section's turn from the chord is ψ₀), ψ is massless in the chord
 //! frames and condensed; the clamp ghost slots of q stay in place, unused (zero force, a
 //! decoupled unit mass), so the mass solve and the contact code are shared unchanged; there is
-//! no tip ghost (link 1's tip section is the condensed ψ).
+//! no tip ghost (link 1's tip section is the condensed ψ). Timoshenko links keep the
+//! *chord-frame* kinematics (P zeroes the ghost slots, z = q): in the clamp-section frame the
+//! condensed ψ₀ would move every lumped mass, and the condensation assumes a massless ψ.
 //!
 //! **Modules.** The chain's data sit in modules that use no operation of the chain: `model`
 //! ([`TwoLinkChain`], its joints and links, and the coordinate maps: clamp, tip and elbow

@@ -1,8 +1,8 @@
 //! The chain's data and its coordinate maps: [`TwoLinkChain`] (links, joints, the lumped
 //! inertia, the ghost slots, the tip contact and its constraint state, the implicit damping,
 //! scratch), and the angles and inertia directions read off q: clamp tangents, link 1's tip
-//! slope ψ and tip-section angle, the elbow angle θ₂, the chord-frame copies with the ghost
-//! slots zeroed, the lumped diagonal of M (module docs of [`super`]).
+//! slope ψ and tip-section angle, the elbow angle θ₂, the map P to the kinetic kernel's
+//! coordinates (clamp-tangent frames) and its transposes, the chord-frame copies, the lumped diagonal of M (module docs of [`super`]).
 
 use data::scene::TorqueLaw;
 
@@ -66,8 +66,14 @@ pub struct TwoLinkChain {
     /// frame's zero) and the link steps
     pub(super) slots: [usize; 2],
     pub(super) hs: [f64; 2],
+    /// (q, q̇) in the kinetic kernel's coordinates ([`TwoLinkChain::to_kinetic`])
     pub(super) qk: Vec<f64>,
     pub(super) vk: Vec<f64>,
+    /// (q, q̇) with the ghost slots zeroed: the chord-frame deflections of the bending energy
+    pub(super) qc: Vec<f64>,
+    pub(super) vc: Vec<f64>,
+    /// gravity-force scratch in the kernel's coordinates
+    pub(super) gk: Vec<f64>,
     pub(super) obs_scratch: std::cell::RefCell<Vec<f64>>,
     pub(super) obs_scratch_v: std::cell::RefCell<Vec<f64>>,
     // scratch (allocated once)
@@ -198,29 +204,127 @@ impl TwoLinkChain {
         self.clamp_angle(q, 1) - q[TH] - psi
     }
 
-    /// Copies of (q, q̇) with the ghost slots zeroed: the chord-frame deflections (v₁ = 0).
-    pub(super) fn chord(&mut self, q: &[f64], v: &[f64]) {
-        self.qk.copy_from_slice(q);
-        self.vk.copy_from_slice(v);
+    /// The copies of (q, q̇) the forces read: `qc`, `vc` with the ghost slots zeroed (the
+    /// chord-frame deflections of the bending energy, v_r = 0) and `qk`, `vk` in the kinetic
+    /// kernel's coordinates ([`Self::to_kinetic`]: the clamp-tangent frames).
+    pub(super) fn frames(&mut self, q: &[f64], v: &[f64]) {
+        self.qc.copy_from_slice(q);
+        self.vc.copy_from_slice(v);
         for s in self.ghosts() {
-            self.qk[s] = 0.0;
-            self.vk[s] = 0.0;
+            self.qc[s] = 0.0;
+            self.vc[s] = 0.0;
+        }
+        let (mut qk, mut vk) = (std::mem::take(&mut self.qk), std::mem::take(&mut self.vk));
+        self.to_kinetic(q, &mut qk);
+        self.to_kinetic(v, &mut vk);
+        self.qk = qk;
+        self.vk = vk;
+    }
+
+    /// The frame-angle slot, the first station, the ghost slot and the step of link ℓ.
+    fn link_slots(&self, link: usize) -> (usize, usize, usize, f64) {
+        let frame = if link == 0 { TH } else { BE };
+        (frame, self.first(link), self.slots[link], self.hs[link])
+    }
+
+    /// q (or q̇) → the coordinates of the kinetic kernel ([`super::kinetic`]: frame angles,
+    /// deflections of stations 1…r with the tip's in the ghost slot), a constant linear map P.
+    /// Euler links: the clamp-tangent frames, α = (chord angle) + ψ, v^t_k = v_k − ξ_kψ (tip
+    /// −Lψ), ψ = (v₁ − x)/(2h) the clamp tangent's turn from the chord. Timoshenko links:
+    /// the chord frames (ghost slots zeroed, tips on the chord). Link 1's tip ghost is zeroed.
+    pub fn to_kinetic(&self, q: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(q);
+        for s in self.ghosts() {
+            out[s] = 0.0;
+        }
+        if self.timo.is_some() {
+            return;
+        }
+        for link in 0..2 {
+            let (frame, first, slot, h) = self.link_slots(link);
+            let psi = (q[first] - q[slot]) / (2.0 * h);
+            out[frame] += psi;
+            for (k, i) in (first..=slot).enumerate() {
+                out[i] -= (k + 1) as f64 * h * psi;
+            }
         }
     }
 
-    /// The q-slots that move no lumped mass: the clamp ghosts and (Euler) link 1's tip ghost.
+    /// f ← Pᵀf in place: generalized forces in the kernel's coordinates ([`Self::to_kinetic`])
+    /// to forces on q. Zero at link 1's tip ghost (and, Timoshenko, at the ghost slots).
+    pub fn kinetic_transpose(&self, f: &mut [f64]) {
+        self.kinetic_transpose_z(f);
+        self.z_to_q_forces(f);
+    }
+
+    /// f ← P_zᵀf: as [`Self::kinetic_transpose`] but onto the mass solve's coordinates z, which
+    /// carry ψ (instead of the ghost x) in each ghost slot (Euler links; [`super::mass`]).
+    pub(super) fn kinetic_transpose_z(&self, f: &mut [f64]) {
+        for s in self.ghosts() {
+            if self.timo.is_some() || Some(s) == self.tip_ghost {
+                f[s] = 0.0;
+            }
+        }
+        if self.timo.is_some() {
+            return;
+        }
+        for link in 0..2 {
+            let (frame, first, slot, h) = self.link_slots(link);
+            let mut psi = f[frame];
+            for (k, i) in (first..=slot).enumerate() {
+                psi -= (k + 1) as f64 * h * f[i];
+            }
+            f[slot] = psi;
+        }
+    }
+
+    /// f ← Qᵀf: forces on z (ψ in the ghost slots) to forces on q (x in the ghost slots),
+    /// ψ = (v₁ − x)/(2h). Identity for Timoshenko links.
+    pub(super) fn z_to_q_forces(&self, f: &mut [f64]) {
+        if self.timo.is_some() {
+            return;
+        }
+        for link in 0..2 {
+            let (_, first, slot, h) = self.link_slots(link);
+            let psi = f[slot];
+            f[first] += psi / (2.0 * h);
+            f[slot] = -psi / (2.0 * h);
+        }
+    }
+
+    /// r ← Q⁻ᵀr: a right-hand side on q to one on z (the inverse of [`Self::z_to_q_forces`]).
+    pub(super) fn q_to_z_forces(&self, r: &mut [f64]) {
+        if self.timo.is_some() {
+            return;
+        }
+        for link in 0..2 {
+            let (_, first, slot, h) = self.link_slots(link);
+            r[first] += r[slot];
+            r[slot] *= -2.0 * h;
+        }
+    }
+
+    /// a ← Q⁻¹a: velocities/accelerations on z to q (x = v₁ − 2hψ).
+    pub(super) fn z_to_q_motion(&self, a: &mut [f64]) {
+        if self.timo.is_some() {
+            return;
+        }
+        for link in 0..2 {
+            let (_, first, slot, h) = self.link_slots(link);
+            a[slot] = a[first] - 2.0 * h * a[slot];
+        }
+    }
+
+    /// The ghost slots: the clamp ghosts and (Euler) link 1's tip ghost (no chord-frame
+    /// deflection; the tip ghost moves no lumped mass).
     pub(super) fn ghosts(&self) -> impl Iterator<Item = usize> + use<> {
         self.slots.into_iter().chain(self.tip_ghost)
     }
 
-    /// Diagonal mass of coordinate i outside the full columns θ, β, x₁, x₂.
+    /// Diagonal mass of coordinate i outside the full columns in the mass solve's coordinates
+    /// z (the clamp angle is frame + ψ there, so only link 1's tip section adds to a station).
     pub(super) fn diag_mass(&self, i: usize) -> f64 {
         let mut d = self.inertia.diag_mass(i);
-        for k in 0..2 {
-            if i == self.first(k) {
-                d += self.jc[k] / (4.0 * self.hs[k] * self.hs[k]);
-            }
-        }
         if self.tip_ghost.is_some() && i == self.inertia.i_tip1() - 1 {
             d += self.jt / (4.0 * self.hs[0] * self.hs[0]);
         }
@@ -235,5 +339,12 @@ impl TwoLinkChain {
         out[frame] += weight;
         out[self.first(link)] += weight * a;
         out[self.slots[link]] -= weight * a;
+    }
+
+    /// As [`Self::add_clamp`] in the mass solve's coordinates z: e = 1 at the frame and at ψ.
+    pub(super) fn add_clamp_z(&self, link: usize, weight: f64, out: &mut [f64]) {
+        let frame = if link == 0 { TH } else { BE };
+        out[frame] += weight;
+        out[self.slots[link]] += weight;
     }
 }

@@ -86,10 +86,10 @@ impl TwoLinkChain {
             };
             let q0 = q[j];
             q[j] = q0 + step;
-            self.chord(&q, &zeros);
+            self.frames(&q, &zeros);
             self.forces(0.0, &q, &zeros, &mut f_plus);
             q[j] = q0 - step;
-            self.chord(&q, &zeros);
+            self.frames(&q, &zeros);
             self.forces(0.0, &q, &zeros, &mut col);
             q[j] = q0;
             for i in 0..n {

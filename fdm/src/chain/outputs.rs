@@ -57,11 +57,9 @@ impl Outputs for TwoLinkChain {
     fn observe(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
         let ine = &self.inertia;
         let mut qk = self.obs_scratch.borrow_mut();
-        qk.copy_from_slice(q);
-        for s in self.slots {
-            qk[s] = 0.0;
-        }
-        // chord-frame deflections (station 1 at zero)
+        // the kernel's coordinates: Euler links in the clamp-tangent frames (deflections
+        // v^t = v − ξψ, tip −Lψ), Timoshenko links in the chord frames (tip on the chord)
+        self.to_kinetic(q, &mut qk);
         let (vs, ws) = (&qk[ine.iv()], &qk[ine.iw()]);
         let [th1, th2] = self.joint_angles(q);
         let [th1d, th2d] = self.joint_rates(v);
@@ -75,7 +73,11 @@ impl Outputs for TwoLinkChain {
         out[3] = th2;
         out[4] = th2d;
         out[5] = tau2;
-        let turns = self.clamp_frame_turns(q);
+        // Timoshenko: deflections turned into the clamp section's frame, u − Xε (small angle)
+        let turns = match &self.timo {
+            Some(_) => self.clamp_frame_turns(q),
+            None => [0.0; 2],
+        };
         let s1 = if ine.fs1 {
             seg_energy(vs, ine.h1, None)
         } else {
@@ -86,8 +88,8 @@ impl Outputs for TwoLinkChain {
         } else {
             0.0
         };
-        let (c1, n1) = (q[TH].cos(), q[TH].sin());
-        let (c2, n2) = (q[BE].cos(), q[BE].sin());
+        let (c1, n1) = (qk[TH].cos(), qk[TH].sin());
+        let (c2, n2) = (qk[BE].cos(), qk[BE].sin());
         let (x1, y1) = (self.links[0].length - s1, vs[ine.r1 - 1]);
         let tip1 = (c1 * x1 - n1 * y1, n1 * x1 + c1 * y1);
         let (x2, y2) = (self.links[1].length - s2, ws[ine.r2 - 1]);
@@ -98,7 +100,6 @@ impl Outputs for TwoLinkChain {
             .into_iter()
             .enumerate()
         {
-            // deflections reported in the clamp-tangent frame: u − Xε (small angle)
             let turn = turns[l];
             out[k] = tip.0;
             out[k + 1] = tip.1;

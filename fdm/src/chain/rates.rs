@@ -77,9 +77,10 @@ impl LinkRates {
         &self.g
     }
 
-    /// The state: deflections `u` (length r − 1, the tip's zero left out), segment spacing `h`
-    /// and station masses `d`.
-    pub fn set_state(&mut self, u: &[f64], h: f64, d: impl Fn(usize) -> f64) {
+    /// The state: deflections `u` of the stations with an unknown (length r − 1), the tip's
+    /// deflection `tip` (0 in a chord frame, −Lψ in the clamp-tangent frame), segment spacing
+    /// `h` and station masses `d`.
+    pub fn set_state(&mut self, u: &[f64], tip: f64, h: f64, d: impl Fn(usize) -> f64) {
         let r = self.w.len();
         for i in 0..r - 1 {
             self.d[i] = d(i);
@@ -87,7 +88,7 @@ impl LinkRates {
         self.factored = false;
         if self.foreshortening {
             for seg in 0..r {
-                let right = if seg < r - 1 { u[seg] } else { 0.0 };
+                let right = if seg < r - 1 { u[seg] } else { tip };
                 let left = if seg == 0 { 0.0 } else { u[seg - 1] };
                 self.g[seg] = (right - left) / h;
             }
@@ -165,6 +166,8 @@ pub struct MassFactors {
     pub(super) z_current: bool,
     /// A⁻¹b_R scratch
     pub(super) zb: Vec<f64>,
+    /// the right-hand side in the solve's coordinates z
+    pub(super) rz: Vec<f64>,
     /// the columns' deflection entries by rows (scratch of `solve_columns`)
     pub(super) rows: Vec<f64>,
 }

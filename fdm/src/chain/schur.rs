@@ -1,12 +1,12 @@
-//! The dense block of the chain's mass solves: the full columns of M (θ, β, the clamp ghosts
-//! x₁, x₂ and, with Euler links, link 1's tip ghost y) couple every coordinate, so the solves
+//! The dense block of the chain's mass solves: the full columns of M (θ, β, the clamp ghost
+//! slots — ψ₁, ψ₂ in the solve's coordinates — and, with Euler links, link 1's tip ghost y) couple every coordinate, so the solves
 //! eliminate the lumped diagonal and are left with an at most 5×5 Schur complement on those
 //! columns ([`super::mass`], [`super::implicit`]).
 
 // Index loops over the rows and columns of the block read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-/// Largest number of full columns (θ, β, x₁, x₂, y).
+/// Largest number of full columns (θ, β, the two ghost slots, y).
 pub(super) const MAX_FULL: usize = 5;
 /// Largest small system of the mass solve: the full columns and the two columns of the
 /// links' foreshortening-rate coupling ([`super::rates`]).

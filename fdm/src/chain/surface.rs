@@ -62,9 +62,11 @@ impl TipContact {
         -self.normal[0] * a.sin() + self.normal[1] * a.cos()
     }
 
-    /// g from the chord angles θ, β and the links' foreshortened lengths L_ℓ − S_ℓ.
-    pub fn gap(&self, theta: f64, beta: f64, lengths: [f64; 2]) -> f64 {
-        self.nc(theta) * lengths[0] + self.nc(beta) * lengths[1] - self.offset
+    /// g from the frame angles α₁, α₂ and the tips of links 1 and 2 in their frames,
+    /// (L_ℓ − S_ℓ, V_ℓ): n̂·R(α)(X, Y) = nc(α)X + ns(α)Y.
+    pub fn gap(&self, alpha: [f64; 2], lengths: [f64; 2], tips: [f64; 2]) -> f64 {
+        self.nc(alpha[0]) * lengths[0] + self.nc(alpha[1]) * lengths[1] - self.offset
+            + (self.ns(alpha[0]) * tips[0] + self.ns(alpha[1]) * tips[1])
     }
 }
 

@@ -15,7 +15,7 @@ impl System for TwoLinkChain {
     fn accel(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) {
         let n = self.dofs();
         let mut rhs = std::mem::take(&mut self.rhs);
-        self.chord(q, v);
+        self.frames(q, v);
         self.forces(t, q, v, &mut rhs);
         self.add_inertia_terms(1.0, a, &mut rhs);
         self.build_columns();
@@ -70,13 +70,13 @@ impl System for TwoLinkChain {
             return;
         }
         let mut rhs = std::mem::take(&mut self.rhs);
-        self.chord(q, v);
+        self.frames(q, v);
         self.forces(t, q, v, &mut rhs);
         // −Γ from the drift velocities (integrator docs): (1 + w)Γ[v_{j+½}] − wΓ[v_{j−½}]
-        self.chord(q, inertia.current);
+        self.frames(q, inertia.current);
         self.add_inertia_terms(1.0 + inertia.w, a, &mut rhs);
         if inertia.w != 0.0 {
-            self.chord(q, inertia.previous);
+            self.frames(q, inertia.previous);
             self.add_inertia_terms(-inertia.w, a, &mut rhs);
         }
         self.build_columns();
@@ -130,15 +130,17 @@ impl System for TwoLinkChain {
         let ine = &self.inertia;
         let mut qk = self.obs_scratch.borrow_mut();
         let mut vk = self.obs_scratch_v.borrow_mut();
+        // the bending energy reads the chord-frame deflections (tip on the chord)
         qk.copy_from_slice(q);
-        vk.copy_from_slice(v);
         for s in self.ghosts() {
             qk[s] = 0.0;
-            vk[s] = 0.0;
         }
-        let mut ke = ine.kinetic(&qk, &vk, &mut self.obs_points.borrow_mut());
         let mut strain = FloatingLink::bending_energy(ine.h1, self.links[0].ei, &qk[ine.iv()])
             + FloatingLink::bending_energy(ine.h2, self.links[1].ei, &qk[ine.iw()]);
+        // T and V_g: the kernel's coordinates (the clamp-tangent frames, Euler links)
+        self.to_kinetic(q, &mut qk);
+        self.to_kinetic(v, &mut vk);
+        let mut ke = ine.kinetic(&qk, &vk, &mut self.obs_points.borrow_mut());
         for k in 0..2 {
             let (h, c) = (self.hs[k], self.links[k].ei);
             let (u1, x) = (q[self.first(k)], q[self.slots[k]]);

@@ -188,16 +188,12 @@ impl Events<TwoLinkChain> for TipContactEvents {
             let g1 = sys.gap(&st.next.q);
             if g1 < 0.0 && self.g_prev > 0.0 {
                 // drift of a step of length s: q + s v + ½ s² a (exact for the velocity form)
-                let slots = sys.ghost_slots();
                 let (cur, acc, trial) = (&st.cur, &st.acc, &mut self.trial);
                 let gap_at = |s: f64| {
                     for i in 0..n {
                         trial[i] = cur.q[i] + s * cur.v[i] + 0.5 * s * s * acc[i];
                     }
-                    for k in slots {
-                        trial[k] = 0.0;
-                    }
-                    sys.gap_of_chord(trial)
+                    sys.gap_of(trial)
                 };
                 let (s_e, tol, _) = illinois(
                     gap_at,
