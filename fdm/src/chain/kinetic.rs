@@ -41,7 +41,8 @@ use super::dual::{Dual, Number};
 /// The chain's inertia data: lumped masses per station and the sums the forces use.
 #[derive(Debug, Clone)]
 pub struct ChainInertia {
-    /// hub rotor inertia J₁ (on θ̇)
+    /// hub rotor inertia J₁ (on the kernel's θ̇: the clamp angle's rate when the chain feeds its
+    /// clamp-tangent frames)
     pub hub: f64,
     pub l1: f64,
     pub h1: f64,
