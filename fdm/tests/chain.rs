@@ -680,9 +680,16 @@ fn sys_chain_overextension_is_the_clamp_frame_tip_deflection_past_the_length() {
 fn dyn_chain_whip_beyond_the_default_step_stops_when_the_ledger_opens() {
     // EI 1000 times lower: the release whips the soft links faster than the default step (the
     // elastic bound of the chain linearized at t = 0) resolves. The run must not complete as
-    // if it were a solution: the driver stops when the ledger's residual passes 5 % of the
-    // energy that flowed. At a step that resolves the whip the same run closes its ledger,
-    // and the closure falls at second order.
+    // if it were a solution. At the default step (1.35e-3 s) the unresolved whip carries link
+    // 1's tip deflection in its clamp-tangent frame, −L₁ψ₁, past the link's length in five
+    // steps (14.3 against 3: a clamp slope of 4.8 against the chord), before the ledger watch
+    // may judge (`LEDGER_SETTLED_STEPS` = 50): the overextension check stops it. (The check is
+    // the chord-frame kinematics' too; there the clamp slope stayed below 1 and the ledger
+    // stopped the run at step 50. In the clamp-tangent frames the clamp rotation moves every
+    // point, by −s^t ψ̇.) At steps still too long for the whip but whose growth is slower
+    // (1e-3, 7e-4 s) the driver stops at step 50 when the ledger's residual passes 5 % of the
+    // energy that flowed. At a step that resolves the whip the same run closes its ledger, and
+    // the closure falls at second order.
     let soft = |sc: &mut data::Scene| {
         for l in &mut sc.planar_chain_mut().unwrap().links {
             l.bending_stiffness *= 1e-3;
@@ -691,11 +698,32 @@ fn dyn_chain_whip_beyond_the_default_step_stops_when_the_ledger_opens() {
     let out = run("two-link-free", soft, &with(21, 0.1));
     match &out.verdict {
         StabilityVerdict::Stopped { diagnostic } => {
-            eprintln!("soft chain, default step: {diagnostic}");
-            assert!(diagnostic.what.contains("energy ledger"), "{diagnostic:?}");
-            assert!(diagnostic.remedy.contains("--dt"), "{diagnostic:?}");
+            eprintln!(
+                "soft chain, default step: {diagnostic} after {} steps",
+                out.cost.steps
+            );
+            assert!(
+                diagnostic.what.contains("beyond the link length"),
+                "{diagnostic:?}"
+            );
         }
         v => panic!("expected a stop, got {v:?}"),
+    }
+    for dt in [1e-3, 7e-4] {
+        let mut s = with(21, 0.1);
+        s.time.dt = Some(dt);
+        let out = run("two-link-free", soft, &s);
+        match &out.verdict {
+            StabilityVerdict::Stopped { diagnostic } => {
+                eprintln!(
+                    "soft chain, dt {dt:e}: {diagnostic} after {} steps",
+                    out.cost.steps
+                );
+                assert!(diagnostic.what.contains("energy ledger"), "{diagnostic:?}");
+                assert!(diagnostic.remedy.contains("--dt"), "{diagnostic:?}");
+            }
+            v => panic!("dt {dt:e}: expected a stop, got {v:?}"),
+        }
     }
     let closure = |dt: f64| {
         let mut s = with(21, 0.1);
