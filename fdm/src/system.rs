@@ -80,6 +80,12 @@ pub trait System {
         let _ = inertia;
         self.accel(t, q, v, a);
     }
+    /// Whether the kinetic energy depends on the configuration, so that [`System::accel_split`]
+    /// has inertia terms quadratic in the velocities (the velocity form then evaluates them
+    /// time-symmetrically without implicit damping: [`crate::method::velocity_form`]).
+    fn has_velocity_quadratic_inertia(&self) -> bool {
+        false
+    }
     /// The velocity form's closing kick with the damping implicit (Crank–Nicolson in the
     /// damping across the step): writes a with (M + ½τC) a = F(q, v_{j+½}) (damping C at the
     /// drift velocity `inertia.current`, inertia terms as [`System::accel_split`], other
@@ -153,15 +159,17 @@ pub enum DeflectionModel {
 }
 
 /// The drift velocities of the velocity form for the inertia terms quadratic in q̇
-/// ([`System::accel_split`]): Γ at the step end t_{j+1} is extrapolated linearly from
-/// Γ[v_{j+½}] and Γ[v_{j−½}] (both at q_{j+1}) with weights 1 + w and −w.
+/// ([`System::accel_split`]): Γ at the step end t_{j+1} is (1 + w)Γ[current] − wΓ[previous]
+/// (both at q_{j+1}) — extrapolated linearly from v_{j+½} and v_{j−½}, or, with w = −½ and
+/// `previous` an estimate of v_{j+3/2}, their time-symmetric mean.
 #[derive(Debug, Clone, Copy)]
 pub struct DriftVelocities<'a> {
     /// v_{j+½}, the drift velocity of the step just taken
     pub current: &'a [f64],
-    /// v_{j−½}, the previous step's drift velocity (the first step: `current`, w = 0)
+    /// v_{j−½}, the previous step's drift velocity (the first step: `current`, w = 0), or the
+    /// estimate of v_{j+3/2} (w = −½)
     pub previous: &'a [f64],
-    /// w = τ_{j+1}/(τ_{j+1} + τ_j): ½ for equal steps
+    /// w = τ_{j+1}/(τ_{j+1} + τ_j) (½ for equal steps) to extrapolate; −½ for the mean
     pub w: f64,
     /// v_pred = v_{j+½} + ½τa_j, the predicted step-end velocity (where
     /// [`System::accel_split`] takes the velocity-dependent forces; an implicit kick may take

@@ -12,6 +12,12 @@ impl System for TwoLinkChain {
         self.inertia.dofs() + usize::from(self.tip_ghost.is_some())
     }
 
+    /// The points' positions depend on the frame angles and, through foreshortening and the
+    /// clamp-tangent frames, on the deflections.
+    fn has_velocity_quadratic_inertia(&self) -> bool {
+        true
+    }
+
     fn accel(&mut self, t: f64, q: &[f64], v: &[f64], a: &mut [f64]) {
         let n = self.dofs();
         let mut rhs = std::mem::take(&mut self.rhs);
