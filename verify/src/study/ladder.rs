@@ -103,11 +103,11 @@ fn space_time_ladder(kind: BackendKind, base: &Settings, scene: &Scene) -> Vec<R
     let Some(h0) = rungs.first().map(|r| r.1) else {
         return rungs;
     };
+    let requested = base.time.dt;
     rungs
         .into_iter()
         .map(|(mut settings, h, label)| {
             let ratio = h / h0;
-            let requested = base.time.dt;
             let dt = match kind {
                 BackendKind::Fdm => requested.map(|dt| dt * ratio * ratio),
                 BackendKind::Modal | BackendKind::Reference => requested.map(|dt| dt * ratio),
