@@ -176,6 +176,49 @@ fn cli_converge_cantilever_reports_the_orders_of_each_method() {
 }
 
 #[test]
+fn cli_converge_space_time_refines_elements_and_step_together() {
+    let (code, out, err) = flexverify(&[
+        "converge",
+        "cantilever",
+        "--quantity",
+        "tip_deflection@0.01",
+        "--backend",
+        "fem",
+        "--refine",
+        "space-time",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let study: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(study["refine"], "space-time");
+    let rungs = study["ladders"][0]["rungs"].as_array().unwrap();
+    assert!(rungs.len() >= 4);
+    // Each rung doubles the elements and halves the step (labels `elements=N dt=…`).
+    let parse = |r: &serde_json::Value| -> (f64, f64, f64) {
+        let label = r["discretization"].as_str().unwrap();
+        let field = |key: &str| -> f64 {
+            let rest = &label[label.find(key).unwrap() + key.len()..];
+            rest.split_whitespace().next().unwrap().parse().unwrap()
+        };
+        (
+            field("elements="),
+            field("dt="),
+            r["value"].as_f64().unwrap(),
+        )
+    };
+    let rows: Vec<(f64, f64, f64)> = rungs.iter().map(parse).collect();
+    for w in rows.windows(2) {
+        assert_eq!(w[1].0, 2.0 * w[0].0);
+        assert!((w[1].1 - 0.5 * w[0].1).abs() <= 1e-3 * w[1].1, "{w:?}");
+    }
+    // Both errors fall: the last difference is a small fraction of the first.
+    let first = (rows[1].2 - rows[0].2).abs();
+    let last = (rows[rows.len() - 1].2 - rows[rows.len() - 2].2).abs();
+    assert!(last < 1e-2 * first, "differences {first:.3e} … {last:.3e}");
+}
+
+#[test]
 fn cli_recommend_names_a_discretization_that_a_rerun_confirms() {
     // In space (the backends' ladders) and in time (fem's step at the mesh given, which the
     // re-run must keep): the re-run reproduces the recommended value.

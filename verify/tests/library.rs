@@ -7,7 +7,7 @@ use data::{BackendKind, Settings, load_scene};
 use verify::Error;
 use verify::output::TERMINAL_WIDTH;
 use verify::progress::{Progress, Silent};
-use verify::study::ladder::Refine;
+use verify::study::ladder::{Refine, rung_specs};
 use verify::study::recommend::recommend;
 use verify::study::run::converge;
 use verify::suite::evaluate::Status;
@@ -124,6 +124,48 @@ fn lib_converge_reports_every_rung_and_the_fem_order() {
     // Hermite cubics: frequency error O(h⁴).
     let order = study.ladders[0].observed_order.unwrap();
     assert!((order - 4.0).abs() < 0.3, "{order}");
+}
+
+#[test]
+fn lib_space_time_ladder_scales_each_rungs_step_like_its_spacing() {
+    let scene = load_scene("barhorst-case1").unwrap();
+    let out = scene.simulation.output_interval;
+    let kinds = [BackendKind::Fem, BackendKind::Fdm, BackendKind::Modal];
+    let ladders = rung_specs(&scene, Refine::SpaceTime, &kinds, &Settings::default());
+    let space = rung_specs(&scene, Refine::Space, &kinds, &Settings::default());
+    for ((kind, rungs), (_, space_rungs)) in ladders.iter().zip(&space) {
+        // the space ladder's meshes and spacings, rung for rung
+        assert_eq!(rungs.len(), space_rungs.len(), "{kind:?}");
+        for ((s, h, _), (s0, h0, _)) in rungs.iter().zip(space_rungs) {
+            assert_eq!(h, h0);
+            assert_eq!(s.discretization, s0.discretization);
+        }
+        let h_first = rungs[0].1;
+        for (s, h, label) in rungs {
+            match kind {
+                // fixed steps: the coarsest rung at the output interval, dt ∝ h after it
+                BackendKind::Fem => {
+                    let dt = s.time.dt.unwrap();
+                    assert!((dt - out * h / h_first).abs() <= 1e-15 * out, "{label}");
+                    assert!(label.contains("dt="), "{label}");
+                }
+                // fdm's stability step and modal's adaptive step stay the backend's own
+                _ => assert_eq!(s.time.dt, None, "{kind:?} {label}"),
+            }
+        }
+    }
+    // A requested fdm step is scaled like h², the way its stability bound falls.
+    let mut base = Settings::default();
+    base.time.dt = Some(1e-5);
+    let fdm = &rung_specs(&scene, Refine::SpaceTime, &[BackendKind::Fdm], &base)[0].1;
+    let h_first = fdm[0].1;
+    for (s, h, label) in fdm {
+        let expected = 1e-5 * (h / h_first).powi(2);
+        assert!(
+            (s.time.dt.unwrap() - expected).abs() <= 1e-15 * expected,
+            "{label}"
+        );
+    }
 }
 
 #[test]

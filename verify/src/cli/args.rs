@@ -95,7 +95,8 @@ pub enum Command {
         /// e.g. freq1, tip_static, tip_deflection@15, joint1.angle@2.5, impulse1
         #[arg(long)]
         quantity: String,
-        /// Refine space (elements/stations/modes) or time (dt).
+        /// Refine space (elements/stations/modes), time (dt), or both together (space-time:
+        /// each space rung with its step scaled like its spacing).
         #[arg(long, value_enum, default_value_t = Refine::Space)]
         refine: Refine,
         /// Measure only shard I of N of the rungs (all ladders, flattened) and write them
@@ -113,8 +114,9 @@ pub enum Command {
         /// Relative tolerance the quantity must meet.
         #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
         tol: f64,
-        /// Refine space (elements/stations/modes) or time (dt, at the mesh given or the
-        /// backend's default): switching times of contact scenes are set by the step.
+        /// Refine space (elements/stations/modes), time (dt, at the mesh given or the
+        /// backend's default) or both together (space-time): switching times of contact scenes
+        /// are set by the step, which a space ladder keeps fixed.
         #[arg(long, value_enum, default_value_t = Refine::Space)]
         refine: Refine,
         /// Wall-time budget per rung in seconds: a backend's ladder stops after the first rung
@@ -172,13 +174,10 @@ impl ValueEnum for Suite {
 
 impl ValueEnum for Refine {
     fn value_variants<'a>() -> &'a [Self] {
-        &[Refine::Space, Refine::Time]
+        &[Refine::Space, Refine::Time, Refine::SpaceTime]
     }
     fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(match self {
-            Refine::Space => "space",
-            Refine::Time => "time",
-        }))
+        Some(PossibleValue::new(self.name()))
     }
 }
 

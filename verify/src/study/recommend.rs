@@ -49,8 +49,8 @@ pub struct Recommendation {
 pub const DEFAULT_RUNG_BUDGET_S: f64 = 5.0;
 
 /// The cheapest backend and discretization whose measured error on `quantity` is at most
-/// `tol`, from a refinement study of `kinds` in space or, at the base settings' mesh, in the time
-/// step (`refine`; each ladder capped by `rung_budget_s`, if given).
+/// `tol`, from a refinement study of `kinds` in space, in the time step at the base settings'
+/// mesh, or in both together (`refine`; each ladder capped by `rung_budget_s`, if given).
 #[allow(clippy::too_many_arguments)]
 pub fn recommend(
     scene: &Scene,

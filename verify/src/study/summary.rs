@@ -253,7 +253,7 @@ pub fn summarize(
     Study {
         scene: scene.name.clone(),
         quantity: quantity.to_string(),
-        refine: format!("{refine:?}").to_lowercase(),
+        refine: refine.name().to_string(),
         reference,
         reference_label,
         ladders,

@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use super::ladder::Refine;
 use super::summary::{Ladder, Study};
 use crate::error::Error;
 use crate::output::{Column, csv_table, fitted_table, text_table, wrap, write_atomic};
@@ -136,7 +137,7 @@ pub fn write_study(dir: &Path, study: &Study) -> Result<Vec<String>, Error> {
             )
         })
         .collect();
-    let xlabel = if study.refine == "time" {
+    let xlabel = if study.refine == Refine::Time.name() {
         "dt"
     } else {
         "h (1/elements, 1/(stations-1), 1/modes)"
