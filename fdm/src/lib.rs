@@ -95,10 +95,11 @@
 //! * [`chain`]: two links in series (`two-link-free`, `two-link-free-undamped`): link 2 clamped to
 //!   link 1's tip and turned by the elbow angle θ₂ (clamp angle of link 2 = θ₁ + v₁'(L₁) + θ₂).
 //!   Same stations, ghost-node bending energy, Kelvin–Voigt and foreshortening per link. Each
-//!   link's frame is its tip chord (v₀ = v_r = 0) with the clamp ghost node x = v₋₁ as an
-//!   unknown (clamp angle = chord angle + (v₁ − x)/(2h)) carrying the half-cell rotary inertia
-//!   ρAh³/24 (with zero hub inertia a clamp-tangent frame rotation can move no lumped mass,
-//!   see [`chain`]). Kinetic energy exact, ½Σm|ṙ|² of the lumped points ([`chain::kinetic`]):
+//!   link's coordinates are its tip-chord angle and the deflections from that chord (v₀ = v_r =
+//!   0) with the clamp ghost node x = v₋₁ as an unknown (clamp angle ψ = chord angle + (v₁ −
+//!   x)/(2h)) carrying the half-cell rotary inertia ρAh³/24; the lumped points sit in the
+//!   clamp-tangent frames (the scene's foreshortening, an exact change of variables: see
+//!   [`chain`]). Kinetic energy exact, ½Σm|ṙ|² of the lumped points ([`chain::kinetic`]):
 //!   Kane's equations with the points' velocity-product accelerations by one dual-number pass;
 //!   mass matrix = full columns θ, β, the clamp ghosts and link 1's tip ghost y = v_{r+1}, each
 //!   link's lumped diagonal plus its foreshortening-rate block, and a rank-2 coupling of the

@@ -154,7 +154,9 @@ pub enum DeflectionModel {
     Linear,
     /// A small-strain floating-frame link with foreshortening.
     SmallStrain,
-    /// The two-link chain's tip-chord frames: deflections small against each link's chord.
+    /// The two-link chain: its bending energy and foreshortening are small-slope ones about
+    /// each link's tip chord (its coordinates), so each clamp slope against the chord must
+    /// stay well below 1.
     ChordFrames,
 }
 

@@ -241,9 +241,8 @@ fn sys_chain_dof_plans() {
 
 #[test]
 fn sys_chain_of_linear_links_is_refused() {
-    // The chain's frames are the links' tip chords: without foreshortening that linear model is
-    // not the clamped-frame beam of the scene (frame-dependent at second order), so a link
-    // without foreshortening is refused by name, in `run` and in `dof_plan` alike.
+    // The chain supports links with foreshortening only (build.rs): a link without it is
+    // refused by name, in `run` and in `dof_plan` alike.
     for k in 0..2 {
         let mut scene = load_scene("two-link-free").unwrap();
         let link = &mut scene.planar_chain_mut().unwrap().links[k];

@@ -30,15 +30,15 @@ fn check_link(name: &str, l: &Link) -> Result<(), FdmError> {
         ],
     )?;
     if !l.foreshortening {
-        // The chain's floating frames are the links' tip chords (module docs). With
-        // foreshortening the kinematics are those of the clamped frame to the order kept; the
-        // linear model without it is frame-dependent at second order in the deflection, so it
-        // would not be the scene's clamped-frame linear beam (measured on `two-link-free` with
-        // both links linear: 8.5e-4 of the peak hub angle from fem and modal, which agree).
+        // Built and tested with foreshortening only. Timoshenko links keep the tip-chord
+        // frames (module docs), where a linear model is frame-dependent at second order in the
+        // deflection and so not the scene's clamped-frame linear beam (measured on
+        // `two-link-free` with both links linear in chord frames: 8.5e-4 of the peak hub angle
+        // from fem and modal, which agree); the Euler links' clamp-tangent kinematics without
+        // foreshortening have no test of their own.
         return Err(FdmError::Unsupported(format!(
             "fdm: `{name}` (link `{}`) is a linear beam (no `foreshortening`): the \
-             finite-difference chain measures deflections from the link's tip chord, which \
-             matches the clamped frame of the scene only with foreshortening; switch it on, \
+             finite-difference chain supports links with foreshortening only; switch it on, \
              or use the fem or modal backend",
             l.name
         )));

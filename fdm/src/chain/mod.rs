@@ -51,7 +51,10 @@
 //! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
 //! on). Without contact the damping (constant C) is implicit in the closing kick ([`implicit`]:
 //! Crank–Nicolson in the damping, banded solve) and the bound is the undamped one below (ζ = 0);
-//! with contact (restartable steps) it is explicit and the bound carries the damping.
+//! with contact (restartable steps) it is explicit and the bound carries the damping. Without
+//! damping the velocity-quadratic inertia terms take the velocity form's time-symmetric corrector
+//! pass: the clamp-rotation inertia J_c + Σm(s^t)² changes with the deflections, and the
+//! extrapolated rule alone lets the ledger drift ([`crate::method::velocity_form`]).
 //! Bound: 0.9 · 2/ω_max with ω_max from a power iteration on the linearized chain at t = 0
 //! (once per run, O(n²)), with ζ = max(Kelvin–Voigt ζ of that frequency, κ_max/(2ω_max)) —
 //! κ_max the fastest damping rate, a power iteration on −∂a/∂q̇ (the joint dampers act on the
