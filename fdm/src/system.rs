@@ -161,7 +161,7 @@ pub enum DeflectionModel {
 }
 
 /// The drift velocities of the velocity form for the inertia terms quadratic in q̇
-/// ([`System::accel_split`]): Γ at the step end t_{j+1} is (1 + w)Γ[current] − wΓ[previous]
+/// ([`System::accel_split`]): Γ at the step end t_{j+1} is (1 + w)Γ(`current`) − wΓ(`previous`)
 /// (both at q_{j+1}) — extrapolated linearly from v_{j+½} and v_{j−½}, or, with w = −½ and
 /// `previous` an estimate of v_{j+3/2}, their time-symmetric mean.
 #[derive(Debug, Clone, Copy)]
