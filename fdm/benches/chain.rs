@@ -1,7 +1,9 @@
 //! `two-link-free` (joint dampers + Kelvin–Voigt), 1 s, single-threaded: the default (damping
 //! implicit in the velocity form's closing kick, the undamped step bound) at 21 and 41
 //! stations per link, and the explicit damping (the damped step bound) at 21 stations over
-//! 0.1 s for comparison (×10 for the same simulated time).
+//! 0.1 s for comparison (×10 for the same simulated time); `two-link-free-undamped`, 1 s at
+//! 21 stations: the velocity form with its time-symmetric corrector pass (a second force
+//! evaluation and mass solve per step).
 //! Run: cargo bench -p fdm --bench chain -- --quick
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -51,6 +53,18 @@ fn bench(c: &mut Criterion) {
                 enforce_bound: true,
             };
             let out = integrate(&mut sys, &q0, &v0, &ctl).expect("run");
+            std::hint::black_box(out.cost.steps)
+        })
+    });
+    group.finish();
+    let undamped = load_scene("two-link-free-undamped").expect("catalog scene");
+    let mut group = c.benchmark_group("two_link_free_undamped");
+    group.sample_size(10);
+    let s = settings(21, 1.0);
+    group.bench_function("1s_21_stations_symmetric_inertia", |b| {
+        b.iter(|| {
+            let out = fdm::runs::two_link_chain(&undamped, undamped.planar_chain().unwrap(), &s)
+                .expect("run");
             std::hint::black_box(out.cost.steps)
         })
     });
