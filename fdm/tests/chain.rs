@@ -60,6 +60,14 @@ fn point_positions(ine: &ChainInertia, q: &[f64]) -> (Vec<[f64; 2]>, f64) {
     (out, a1)
 }
 
+/// Central difference of f along coordinate i of x with step eps.
+fn central_difference(mut f: impl FnMut(&[f64]) -> f64, x: &[f64], i: usize, eps: f64) -> f64 {
+    let (mut xa, mut xb) = (x.to_vec(), x.to_vec());
+    xa[i] += eps;
+    xb[i] -= eps;
+    (f(&xa) - f(&xb)) / (2.0 * eps)
+}
+
 /// The chain's kinetic energy of the lumped points and the hub at chain coordinates: the
 /// kernel at the mapped coordinates P q, P q̇.
 fn chain_kinetic(sys: &TwoLinkChain, sc: &mut PointScratch, q: &[f64], v: &[f64]) -> f64 {
@@ -119,16 +127,8 @@ fn elem_chain_kinetic_energy_is_that_of_the_moving_lumped_points() {
     ine.inertia_forces(&qk, &vk, &mut sc, &mut f);
     sys.kinetic_transpose(&mut f);
     for i in 0..n {
-        let (mut va, mut vb) = (v.clone(), v.clone());
-        va[i] += eps;
-        vb[i] -= eps;
-        let dp = (chain_kinetic(&sys, &mut sc, &q, &va) - chain_kinetic(&sys, &mut sc, &q, &vb))
-            / (2.0 * eps);
-        let (mut qa, mut qb) = (q.clone(), q.clone());
-        qa[i] += eps;
-        qb[i] -= eps;
-        let dg = (chain_kinetic(&sys, &mut sc, &qa, &v) - chain_kinetic(&sys, &mut sc, &qb, &v))
-            / (2.0 * eps);
+        let dp = central_difference(|va| chain_kinetic(&sys, &mut sc, &q, va), &v, i, eps);
+        let dg = central_difference(|qa| chain_kinetic(&sys, &mut sc, qa, &v), &q, i, eps);
         let dd = (pa[i] - pb[i]) / (2.0 * eps);
         // central differences: truncation O(ε²·T''') ≈ 1e-12 relative, round-off
         // ≈ 1e-16·T/ε ≈ 1e-10 relative to the scale of T
@@ -184,14 +184,19 @@ fn elem_chain_forces_are_minus_potential_gradients() {
         sys.stored_energies(0.0, q, &v, &mut e);
         e[1] + e[2]
     };
-    let eps = 1e-6;
-    for i in 0..n {
-        let (mut qa, mut qb) = (q.clone(), q.clone());
-        qa[i] += eps;
-        qb[i] -= eps;
-        let dv = (pot(&qa) - pot(&qb)) / (2.0 * eps);
-        // quadratic V in the deflections: central difference exact up to round-off
-        // ≈ 1e-16·V/ε; V ≈ 1e2 here
+    assert_inertia_balances_potential(&ma, pot, &q);
+}
+
+/// M a = −∂V/∂q at rest, against a central difference of V (V ≈ 1e2 in these tests: the
+/// difference's round-off ≈ 1e-16·V/ε, its truncation O(ε²) — exact for a V quadratic in the
+/// deflections).
+fn assert_inertia_balances_potential(
+    ma: &[f64],
+    mut potential: impl FnMut(&[f64]) -> f64,
+    q: &[f64],
+) {
+    for i in 0..q.len() {
+        let dv = central_difference(&mut potential, q, i, 1e-6);
         assert!(
             (ma[i] + dv).abs() < 1e-6 * (1.0 + dv.abs()),
             "{i}: M a = {} vs −∂V/∂q = {}",
@@ -780,10 +785,7 @@ fn elem_chain_gravity_potential_and_gap_are_those_of_the_lumped_points() {
     assert!((sys.gap(&q) - g).abs() == 0.0);
     let eps = 1e-6;
     for i in 0..n {
-        let (mut qa, mut qb) = (q.clone(), q.clone());
-        qa[i] += eps;
-        qb[i] -= eps;
-        let d = (tip_gap(&qa) - tip_gap(&qb)) / (2.0 * eps);
+        let d = central_difference(tip_gap, &q, i, eps);
         // central difference of a smooth position (lengths ≈ 5): O(ε²) truncation,
         // round-off ≈ 1e-16·5/ε
         assert!((grad[i] - d).abs() < 1e-8, "G[{i}] {} vs {d}", grad[i]);
@@ -793,18 +795,9 @@ fn elem_chain_gravity_potential_and_gap_are_those_of_the_lumped_points() {
     sys.accel(0.0, &q, &zeros, &mut a);
     let mut ma = vec![0.0; n];
     sys.momenta(&q, &a, &mut ma);
-    for i in 0..n {
-        let (mut qa, mut qb) = (q.clone(), q.clone());
-        qa[i] += eps;
-        qb[i] -= eps;
-        let (ea, eb) = (energies(&sys, &qa), energies(&sys, &qb));
-        let dv = (ea[1] + ea[2] + ea[3] - eb[1] - eb[2] - eb[3]) / (2.0 * eps);
-        // V ≈ 1e2: round-off of the central difference ≈ 1e-16·V/ε
-        assert!(
-            (ma[i] + dv).abs() < 1e-6 * (1.0 + dv.abs()),
-            "{i}: M a = {} vs −∂V/∂q = {}",
-            ma[i],
-            -dv
-        );
-    }
+    let potential = |x: &[f64]| {
+        let e = energies(&sys, x);
+        e[1] + e[2] + e[3]
+    };
+    assert_inertia_balances_potential(&ma, potential, &q);
 }
