@@ -14,6 +14,13 @@ fn flexverify(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// Runs flexverify with `args` (ending in `--format json`), requires exit 0 and parses stdout.
+fn flexverify_json(args: &[&str]) -> serde_json::Value {
+    let (code, out, err) = flexverify(args);
+    assert_eq!(code, 0, "{args:?}: {err}");
+    serde_json::from_str(&out).unwrap()
+}
+
 fn temp_file(name: &str, text: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("flexverify-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -130,7 +137,7 @@ fn cli_unsupported_requests_exit_3_without_results() {
 
 #[test]
 fn cli_converge_cantilever_reports_the_orders_of_each_method() {
-    let (code, out, err) = flexverify(&[
+    let study = flexverify_json(&[
         "converge",
         "cantilever",
         "--quantity",
@@ -138,8 +145,6 @@ fn cli_converge_cantilever_reports_the_orders_of_each_method() {
         "--format",
         "json",
     ]);
-    assert_eq!(code, 0, "{err}");
-    let study: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert!(
         study["reference_label"]
             .as_str()
@@ -177,7 +182,7 @@ fn cli_converge_cantilever_reports_the_orders_of_each_method() {
 
 #[test]
 fn cli_converge_space_time_refines_elements_and_step_together() {
-    let (code, out, err) = flexverify(&[
+    let study = flexverify_json(&[
         "converge",
         "cantilever",
         "--quantity",
@@ -189,8 +194,6 @@ fn cli_converge_space_time_refines_elements_and_step_together() {
         "--format",
         "json",
     ]);
-    assert_eq!(code, 0, "{err}");
-    let study: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(study["refine"], "space-time");
     let rungs = study["ladders"][0]["rungs"].as_array().unwrap();
     assert!(rungs.len() >= 4);
@@ -553,9 +556,7 @@ fn cli_flags_for_several_backends_reach_only_the_backends_that_read_them() {
     let freqs = |args: &[&str]| -> Vec<serde_json::Value> {
         let mut all = vec!["modes", "cantilever", "--count", "2", "--format", "json"];
         all.extend_from_slice(args);
-        let (code, out, err) = flexverify(&all);
-        assert_eq!(code, 0, "{args:?}: {err}");
-        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let v = flexverify_json(&all);
         v.as_array().unwrap().clone()
     };
     let both = freqs(&["--backend", "fem,modal", "--modes", "3", "--elements", "4"]);
