@@ -58,7 +58,8 @@ pub fn joint_angle(i: usize) -> String {
 pub fn joint_rate(i: usize) -> String {
     format!("joint{i}.rate")
 }
-/// Total torque the joint actuator applies (applied law, or what prescribed motion needed).
+/// Torque at the joint: a free joint's applied law plus its spring and damper,
+/// τ(t) − K(θ − θ₀) − Dθ̇; a prescribed joint's torque that the motion needed.
 pub fn joint_torque(i: usize) -> String {
     format!("joint{i}.torque")
 }

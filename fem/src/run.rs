@@ -406,7 +406,14 @@ fn sample(integ: &Driver, stations: usize, tips: &mut [V2], buf: &mut Vec<f64>) 
         let (th, rate) = ch.joint_state(i, integ.state.t, &integ.state.q, &integ.state.qd);
         buf.push(th);
         buf.push(rate);
-        buf.push(ch.joint_torque[i]);
+        // a free joint's torque: the law plus its spring and damper, −K(θ − θ₀) − Dθ̇
+        // (the scene's hub torque); a prescribed joint's: what the motion needed
+        let j = &l.joint;
+        buf.push(if j.dof != NONE {
+            ch.joint_torque[i] - j.stiffness * (th - j.set_point) - j.damping * rate
+        } else {
+            ch.joint_torque[i]
+        });
         buf.push(tips[i].x);
         buf.push(tips[i].y);
         buf.push(ch.tip_deflection(i, &integ.state.q));

@@ -352,3 +352,36 @@ fn dyn_cantilever_step_load_overshoots_the_static_deflection() {
         r.ledger.relative_closure()
     );
 }
+
+#[test]
+fn sys_free_joint_torque_channel_is_law_plus_spring_plus_damper() {
+    // The scene's hub torque of a free joint: τ(t) − K(θ − θ₀) − Dθ̇ (no torque law on
+    // two-link-free), sampled with the angle and rate it reports; K, D, θ₀ from the scene.
+    let scene = data::load_scene("two-link-free").unwrap();
+    let r = run("two-link-free", 4, None, Some(0.2), None).unwrap();
+    assert_eq!(r.verdict, StabilityVerdict::Completed);
+    for (k, link) in scene.planar_chain().unwrap().links.iter().enumerate() {
+        let j = &link.joint;
+        assert!(j.torque.is_none() && j.prescribed.is_none());
+        let (stiffness, damping) = (j.stiffness.unwrap_or(0.0), j.damping.unwrap_or(0.0));
+        let set_point = j.set_point.unwrap_or(0.0);
+        let angle = channel(&r, &format!("joint{}.angle", k + 1));
+        let rate = channel(&r, &format!("joint{}.rate", k + 1));
+        let torque = channel(&r, &format!("joint{}.torque", k + 1));
+        assert!(
+            peak(torque) > 1.0,
+            "joint {}: torque {}",
+            k + 1,
+            peak(torque)
+        );
+        for i in 0..torque.len() {
+            let expected = -stiffness * (angle[i] - set_point) - damping * rate[i];
+            assert!(
+                (torque[i] - expected).abs() <= 1e-12 * (1.0 + expected.abs()),
+                "joint {} sample {i}: {} vs {expected}",
+                k + 1,
+                torque[i]
+            );
+        }
+    }
+}
