@@ -46,9 +46,14 @@
 //! With damping, C ż = −∂U/∂z − (cross terms in ẏ) is a first-order relaxation whose rates are
 //! the eigenvalues of C⁻¹K_zz (C the ψ block of D): the bending part of K_zz is (EI/γ)× the
 //! Kelvin–Voigt part of C, so shapes with a curvature rate relax at ≥ EI/γ = 2.5·10⁴ s⁻¹
-//! (barhorst-case1-timoshenko); shapes without one (uniform ψ per link) are damped by the joint
-//! dampers alone, at ~κGA L/(D₁ + D₂) ≈ 7.5·10⁴ s⁻¹, and are algebraic where C has no term.
-//! All are far above the mechanics' frequencies (≲ 10³ rad/s) and ≳ 1/τ (τ ≈ 3e-5 s):
+//! (barhorst-case1-timoshenko); shapes without one are damped by the joint dampers alone, and
+//! are algebraic where C has no term. The slowest of these is not the uniform ψ but the
+//! boundary layer at a joint, ψ decaying over √(EI/κGA) from the section the damper turns: a
+//! damper D in series with that section's compliance 1/√(EI·κGA) relaxes at √(EI·κGA)/D ≈
+//! 3.5·10³ s⁻¹ (D = 20), not far above the mechanics' frequencies, so the first-order manifold
+//! below leaves an error linear in D at the joints: in free flight the hub and elbow angles
+//! converge to 1.3e-3 of their peaks from fem's (docs/limits.md). The other rates are ≳ 1/τ
+//! (τ ≈ 3e-5 s):
 //! explicit integration of z would need τ ≤ 2/rate_max (unbounded where C is singular), and an
 //! implicit one-step of z breaks the exact ledger; z is instead
 //! carried on its **slow manifold** (as the modal backend does): z = z₀(y) + z₁ with
