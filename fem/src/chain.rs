@@ -203,7 +203,8 @@ pub struct Chain {
     kin_vel: Vec<Vec<V2>>,
     /// Per link, per element, per sub-interval: tail axial load T (foreshortening).
     tail: Vec<Vec<f64>>,
-    /// Generalized joint torque each joint's actuator needs (prescribed) or applies (free).
+    /// Generalized joint torque each joint's actuator needs (prescribed) or applies (free: the
+    /// law; the torque channel adds the joint's spring and damper).
     pub joint_torque: Vec<f64>,
     /// Constant transverse loads on the last link, in its frame (the scene's `[statics]` loads
     /// applied as a step at t = 0): tip force P and uniform load q.

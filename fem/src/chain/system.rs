@@ -104,7 +104,8 @@ impl System for Chain {
 
     /// Applied torques τ(t_mid)Δθ and joint dampers D θ̄̇Δθ of the free joints, Kelvin–Voigt
     /// h v̄ᵀC v̄; the applied loads (tip force, distributed load) are the rest of the total
-    /// work. The reported joint torques are the laws at `t_law`.
+    /// work. `joint_torque` holds the laws at `t_law` (the torque channel adds a free joint's
+    /// spring and damper at the sample: `crate::run`).
     fn midpoint_works(
         &mut self,
         h: f64,
@@ -126,7 +127,7 @@ impl System for Chain {
             let law = j.applied(t_mid);
             works.applied_torque += law * dth;
             works.joint_damper += j.damping * vbar[j.dof] * dth;
-            // The torque channel reports the law at the sample time.
+            // the law at the sample time; the channel adds the spring and damper
             self.joint_torque[li] = j.applied(t_law);
         }
         if self.tip_load != 0.0 || self.distributed_load != 0.0 {
