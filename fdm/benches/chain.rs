@@ -2,8 +2,8 @@
 //! implicit in the velocity form's closing kick, the undamped step bound) at 21 and 41
 //! stations per link, and the explicit damping (the damped step bound) at 21 stations over
 //! 0.1 s for comparison (×10 for the same simulated time); `two-link-free-undamped`, 1 s at
-//! 21 stations: the velocity form with its time-symmetric corrector pass (a second force
-//! evaluation and mass solve per step).
+//! 21 stations: the velocity form with its time-symmetric corrector pass (one more Γ
+//! evaluation and mass solve per step, the rest kept from the first pass).
 //! Run: cargo bench -p fdm --bench chain -- --quick
 
 use criterion::{Criterion, criterion_group, criterion_main};

@@ -7,7 +7,7 @@ use data::{DofPlan, Scene};
 
 use super::kinetic::PointScratch;
 use super::kinetic::{BE, ChainInertia, TH};
-use super::model::{JointLaw, LinkProps, TwoLinkChain};
+use super::model::{JointLaw, LinkProps, SplitReuse, TwoLinkChain};
 use super::rates::LinkRates;
 use super::rates::MassFactors;
 use super::schur::MAX_SMALL;
@@ -277,6 +277,7 @@ impl TwoLinkChain {
             cols: std::array::from_fn(|_| vec![0.0; nd]),
             unit: vec![0.0; nd],
             rhs: vec![0.0; nd],
+            split_reuse: SplitReuse::new(nd),
             fv: vec![0.0; r1],
             fw: vec![0.0; r2],
             power: [0.0; 3],

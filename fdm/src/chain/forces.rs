@@ -192,6 +192,7 @@ impl TwoLinkChain {
 
     /// Generalized forces Q − ∂V/∂q − ∂D/∂q̇ into `out`; sets the powers.
     pub(super) fn forces(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        self.split_reuse.valid = false;
         out.iter_mut().for_each(|x| *x = 0.0);
         if let Some(tf) = &self.timo {
             // condensed ψ (chain::timoshenko): −∂U_c/∂q − ∂D_c/∂q̇, no torque laws (refused)

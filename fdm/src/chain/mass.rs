@@ -44,6 +44,7 @@ impl TwoLinkChain {
     /// ψ) and link 1's tip section J_t e eᵀ; link 1's tip-ghost column (and, Timoshenko, the
     /// unused slots) are constant, built in `from_planar_chain`. Then the factors of the solve.
     pub(super) fn build_columns(&mut self) {
+        self.split_reuse.valid = false;
         let n = self.dofs();
         let nd = self.inertia.dofs();
         let euler = self.timo.is_none();

@@ -85,6 +85,8 @@ pub struct TwoLinkChain {
     pub(super) cols: [Vec<f64>; MAX_FULL],
     pub(super) unit: Vec<f64>,
     pub(super) rhs: Vec<f64>,
+    /// what the velocity form's corrector pass may take from the first pass at the same level
+    pub(super) split_reuse: SplitReuse,
     pub(super) fv: Vec<f64>,
     pub(super) fw: Vec<f64>,
     pub(super) power: [f64; 3],
@@ -346,5 +348,42 @@ impl TwoLinkChain {
         let frame = if link == 0 { TH } else { BE };
         out[frame] += weight;
         out[self.slots[link]] += weight;
+    }
+}
+
+/// The velocity form's corrector pass calls `accel_split` a second time at the same level
+/// (same t, q, predicted velocity and current drift velocity; only the other drift velocity and
+/// the weights change): the forces other than the inertia terms, Γ at the current drift
+/// velocity and M's columns are those of the first pass. Valid only while nothing else has
+/// evaluated forces or rebuilt the columns since.
+#[derive(Debug, Clone)]
+pub(super) struct SplitReuse {
+    pub(super) valid: bool,
+    pub(super) t: f64,
+    pub(super) q: Vec<f64>,
+    pub(super) v: Vec<f64>,
+    pub(super) current: Vec<f64>,
+    /// the forces before the inertia terms
+    pub(super) rest: Vec<f64>,
+    /// the inertia-term forces at the current drift velocity, unscaled
+    pub(super) current_forces: Vec<f64>,
+}
+
+impl SplitReuse {
+    pub(super) fn new(n: usize) -> Self {
+        SplitReuse {
+            valid: false,
+            t: f64::NAN,
+            q: vec![0.0; n],
+            v: vec![0.0; n],
+            current: vec![0.0; n],
+            rest: vec![0.0; n],
+            current_forces: vec![0.0; n],
+        }
+    }
+
+    /// Whether a call at (t, q, v, current) repeats the stored first pass.
+    pub(super) fn matches(&self, t: f64, q: &[f64], v: &[f64], current: &[f64]) -> bool {
+        self.valid && self.t == t && self.q == q && self.v == v && self.current == current
     }
 }

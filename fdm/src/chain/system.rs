@@ -76,16 +76,36 @@ impl System for TwoLinkChain {
             return;
         }
         let mut rhs = std::mem::take(&mut self.rhs);
-        self.frames(q, v);
-        self.forces(t, q, v, &mut rhs);
-        // −Γ from the drift velocities (integrator docs): (1 + w)Γ[v_{j+½}] − wΓ[v_{j−½}]
-        self.frames(q, inertia.current);
-        self.add_inertia_terms(1.0 + inertia.w, a, &mut rhs);
+        // −Γ from the drift velocities (integrator docs): (1 + w)Γ[current] − wΓ[previous]
+        let reuse = self.split_reuse.matches(t, q, v, inertia.current);
+        if reuse {
+            // the corrector pass: the same arithmetic as below on the first pass's parts
+            let r = &self.split_reuse;
+            rhs.copy_from_slice(&r.rest);
+            for i in 0..self.inertia.dofs() {
+                rhs[i] += (1.0 + inertia.w) * r.current_forces[i];
+            }
+        } else {
+            self.frames(q, v);
+            self.forces(t, q, v, &mut rhs);
+            self.split_reuse.rest.copy_from_slice(&rhs);
+            self.frames(q, inertia.current);
+            self.add_inertia_terms(1.0 + inertia.w, a, &mut rhs);
+            self.split_reuse.current_forces.copy_from_slice(a);
+        }
         if inertia.w != 0.0 {
             self.frames(q, inertia.previous);
             self.add_inertia_terms(-inertia.w, a, &mut rhs);
         }
-        self.build_columns();
+        if !reuse {
+            self.build_columns();
+            let r = &mut self.split_reuse;
+            r.valid = true;
+            r.t = t;
+            r.q.copy_from_slice(q);
+            r.v.copy_from_slice(v);
+            r.current.copy_from_slice(inertia.current);
+        }
         self.solve_mass(&rhs, a);
         self.rhs = rhs;
         self.constraint.lambda = 0.0;

@@ -29,8 +29,10 @@
 //! the symmetry defect drops to O(τ³) (a second pass changes nothing measurable). Measured on
 //! `two-link-free-undamped`, 11 stations, 10 s at the bound: the largest ledger residual per
 //! tenth went 4.24e-2 → 8.25e-2 J without the pass and 4.16e-2 → 3.86e-2 J with it (the mean
-//! per tenth flat at −2.6e-2 J); the pass costs a second force evaluation and mass solve
-//! (+75 % per step). With implicit damping the pass is not taken: the damping removes the top
+//! per tenth flat at −2.6e-2 J). The pass repeats `accel_split` at the same level with other
+//! drift velocities; a system may keep what does not change (the chain keeps its other forces,
+//! Γ[v_{j+½}] and its mass matrix's columns), so the pass costs one Γ evaluation and one mass
+//! solve. With implicit damping the pass is not taken: the damping removes the top
 //! modes the defect acts on (`two-link-free`, same grid: 2.38e-2 → 2.36e-2 J without it).
 //!
 //! **Implicit damping** ([`System::implicit_kick`]). A system may take the closing kick with
