@@ -185,8 +185,13 @@ impl TwoLinkChain {
         self.inertia
             .inertia_forces(&self.qk, &self.vk, &mut self.points, scratch);
         self.kinetic_transpose(scratch);
+        self.add_scaled_inertia(scale, scratch, rhs);
+    }
+
+    /// rhs += scale·f for inertia-term forces f on q (the tip ghost moves no mass: not added).
+    pub(super) fn add_scaled_inertia(&self, scale: f64, f: &[f64], rhs: &mut [f64]) {
         for i in 0..self.inertia.dofs() {
-            rhs[i] += scale * scratch[i];
+            rhs[i] += scale * f[i];
         }
     }
 

@@ -80,11 +80,8 @@ impl System for TwoLinkChain {
         let reuse = self.split_reuse.matches(t, q, v, inertia.current);
         if reuse {
             // the corrector pass: the same arithmetic as below on the first pass's parts
-            let r = &self.split_reuse;
-            rhs.copy_from_slice(&r.rest);
-            for i in 0..self.inertia.dofs() {
-                rhs[i] += (1.0 + inertia.w) * r.current_forces[i];
-            }
+            rhs.copy_from_slice(&self.split_reuse.rest);
+            self.add_scaled_inertia(1.0 + inertia.w, &self.split_reuse.current_forces, &mut rhs);
         } else {
             self.frames(q, v);
             self.forces(t, q, v, &mut rhs);
