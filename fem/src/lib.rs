@@ -72,13 +72,14 @@
 //! `implicit-midpoint` (one-stage Gauss, second order, no numerical damping, works booked by the
 //! trapezoidal rule: [`method::implicit_midpoint`]) and Bathe's composite method `bathe`
 //! (trapezoidal half step, three-point backward difference: second order, damps what the step
-//! does not resolve; [`method::bathe`]).
+//! does not resolve, works booked by the midpoint rule on each sub-step; [`method::bathe`]).
 //!
 //! ## Contact (seed 000: impact, constrained sliding, release)
 //! Unilateral frictionless contact of the tip of a named link with a fixed line
 //! ([`events::contact`]), with the implicit methods: `energy-midpoint` (described here),
-//! `implicit-midpoint` (ledger O(h²): [`method::implicit_midpoint`]) and `generalized-alpha`
-//! (acceleration history recomputed at every event: [`method::generalized_alpha`]).
+//! `implicit-midpoint` (ledger O(h²): [`method::implicit_midpoint`]), `generalized-alpha`
+//! (acceleration history recomputed at every event: [`method::generalized_alpha`]) and `bathe`
+//! (the constraint held at both sub-step ends; no bilateral wall: [`method::bathe`]).
 //! Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q
 //! (exact, [`chain::Chain::tip_jacobian`]).
 //! * Detection inside the step: the step is re-solved shortened (Illinois secant on h) until

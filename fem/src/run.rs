@@ -258,11 +258,19 @@ pub fn prepare(
             h_rule.min(2.0 * std::f64::consts::PI / (UNDAMPED_STEPS_PER_PERIOD * omega_flexible));
     }
     let contact = Contact::from_planar_chain(&scene.name, pc, &chain)?;
-    if contact.is_some() {
+    if let Some(c) = &contact {
         if !caps.held_constraint {
             return Err(FemError::unsupported(format!(
                 "fem: contact is implemented for {} (scene `{}`; method `{method}`)",
                 names_with("and", |c| c.held_constraint),
+                scene.name
+            )));
+        }
+        if !caps.bilateral_constraint && c.bilateral.is_some() {
+            return Err(FemError::unsupported(format!(
+                "fem {method}: a bilateral wall (stick–slip friction phases) is implemented for \
+                 {} (scene `{}`); `{method}` holds unilateral contacts only",
+                names_with("and", |c| c.bilateral_constraint),
                 scene.name
             )));
         }

@@ -262,6 +262,7 @@ fn with_context<R>(
         adaptive,
         h_nominal: h,
         length_scale: 1.0,
+        method_works: true,
     };
     start::consistent_acceleration(&mut cx, h, 0.0).expect("a consistent start");
     body(&mut cx, method.as_mut())

@@ -59,6 +59,7 @@ impl<S: System<Augmented = NoAugmentation>> FixedSteps<S> {
             adaptive: None,
             h_nominal: self.h_nominal,
             length_scale: self.length_scale,
+            method_works: false,
         };
         (self.stepper.as_mut(), cx)
     }

@@ -172,6 +172,7 @@ impl Driver {
             adaptive: self.adaptive,
             h_nominal: self.h_nominal,
             length_scale: self.length_scale,
+            method_works: true,
         };
         (self.stepper.as_mut(), cx)
     }
@@ -265,7 +266,13 @@ impl Driver {
         // The massless projection of the step end is the driver's, whoever books the rest.
         self.works.numerical_massless += self.pending_massless;
         if self.stepper.commit(h, &mut self.works) {
-            // The method booked its works with its own quadrature (energy-midpoint).
+            // The method booked its works with its own quadrature (energy-midpoint, Bathe);
+            // the required torques of prescribed joints are not in its DOFs.
+            for li in 0..self.chain.links.len() {
+                if self.chain.links[li].joint.dof == NONE {
+                    self.book_prescribed_motion(li, t1);
+                }
+            }
             self.finish_accept(t1, t_law);
             return;
         }
@@ -288,12 +295,21 @@ impl Driver {
             self.works.joint_damper +=
                 0.5 * j.damping * (self.joint_start.rate_start[li] + rate1) * dth;
             if j.dof == NONE {
-                let req1 = self.chain.joint_torque[li];
-                self.works.prescribed_motion +=
-                    0.5 * (self.joint_start.torque_req_start[li] + req1) * dth;
+                self.book_prescribed_motion(li, t1);
             }
         }
         self.finish_accept(t1, t_law);
+    }
+
+    /// The work of the torque a prescribed joint `li` required over the accepted step, by the
+    /// trapezoidal rule on its end points.
+    fn book_prescribed_motion(&mut self, li: usize, t1: f64) {
+        let (th1, _) = self
+            .chain
+            .joint_state(li, t1, &self.state.q1, &self.state.qd1);
+        let dth = th1 - self.joint_start.theta_start[li];
+        let req1 = self.chain.joint_torque[li];
+        self.works.prescribed_motion += 0.5 * (self.joint_start.torque_req_start[li] + req1) * dth;
     }
 
     /// Swaps the new state in and starts the next step's work records.

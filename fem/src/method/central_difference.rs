@@ -35,6 +35,7 @@ impl CentralDifference {
         adaptive: false,
         prescribed_joints: true,
         held_constraint: false,
+        bilateral_constraint: false,
         projects_massless: false,
         variable_mass: true,
     };

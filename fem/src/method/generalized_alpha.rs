@@ -45,7 +45,7 @@
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
-    Capabilities, ConstraintView, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, Works,
+    Capabilities, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, Works,
     start,
     unconverged, update_tolerance,
 };
@@ -110,6 +110,7 @@ impl GeneralizedAlpha {
         adaptive: true,
         prescribed_joints: true,
         held_constraint: true,
+        bilateral_constraint: true,
         projects_massless: false,
         variable_mass: true,
     };
@@ -127,8 +128,7 @@ impl GeneralizedAlpha {
         }
     }
 
-    /// q̈ₙ = aₙ consistent with the held constraint at the step start (module docs), by Newton
-    /// with S = M; R is affine in q̈, so this converges in one or two passes. Keeps the
+    /// q̈ₙ = aₙ consistent with the held constraint at the step start (module docs); keeps the
     /// constraint force applied as the next step's start force.
     fn constrained_start<S: System + ?Sized>(
         &mut self,
@@ -136,39 +136,8 @@ impl GeneralizedAlpha {
         k: &mut dyn StepConstraint<S>,
         t_law: f64,
     ) -> Result<(), FemError> {
-        let t0 = cx.state.t;
-        let g0 = k.value(cx.system, t0, &cx.state.q);
-        let lambda = k.multiplier();
         let (zero, before, force) = (&self.held.zero, &mut self.held.res, &mut self.force_start);
-        start::accelerate_with(cx, t_law, |system, q, res| {
-            // The force at q₀ itself: a view of zero length (∇̄g = ∇g(q₀)).
-            let view = ConstraintView {
-                it: 0,
-                t: [t0; 3],
-                q0: q,
-                q1: q,
-                qbar: q,
-                dq: zero,
-                w_dq: zero,
-                denom: 0.0,
-                g0,
-                lambda,
-            };
-            before.copy_from_slice(res);
-            k.add_force(system, &view, res);
-            for i in 0..res.len() {
-                force[i] = before[i] - res[i];
-            }
-        })
-        .map_err(|e| match e {
-            FemError::Numerical { t, .. } => FemError::Numerical {
-                t,
-                message: "generalized-alpha: could not compute the constrained acceleration at \
-                          a restart"
-                    .into(),
-            },
-            other => other,
-        })
+        start::constrained_acceleration(cx, k, t_law, zero, before, force, "generalized-alpha")
     }
 }
 

@@ -67,6 +67,7 @@ impl ImplicitMidpoint {
         adaptive: true,
         prescribed_joints: true,
         held_constraint: true,
+        bilateral_constraint: true,
         projects_massless: false,
         variable_mass: true,
     };

@@ -22,8 +22,12 @@
 //! ∂q₁/∂ā = h²/2), and the force is the discrete gradient ∇̄g in the metric M(q̄), so it does
 //! no work over a step. Generalized-α takes q̈₁ (border factor βh²(1−α_f)/(1−α_m)) with the same
 //! force at t₁, balanced so that its average over the step does the end force's work, and it
-//! recomputes its acceleration history at every event ([`generalized_alpha`] docs). Explicit central difference refuses a constraint: it has no
-//! Newton iteration to border, and a constraint force would need its own projection scheme.
+//! recomputes its acceleration history at every event ([`generalized_alpha`] docs). Bathe holds
+//! the constraint at the end of each sub-step (border factors h²/16 and h²/9), with the
+//! trapezoidal sub-step's start force balanced as in generalized-α and q̈₀ recomputed at every
+//! event; it refuses the bilateral wall, whose friction work is booked per step
+//! ([`bathe`] docs). Explicit central difference refuses a constraint: it has no Newton
+//! iteration to border, and a constraint force would need its own projection scheme.
 //!
 //! Shared machinery: the Newton matrix S = c_a M + c_v C + c_q K and its solver
 //! ([`newton`]), the consistent acceleration of a (re)start ([`start`]), the method–driver
@@ -62,6 +66,9 @@ pub struct Capabilities {
     pub prescribed_joints: bool,
     /// Accepts a held contact ([`StepConstraint`]).
     pub held_constraint: bool,
+    /// Holds a bilateral wall with its stick–slip friction phases (friction work and stick
+    /// multiplier booked once per step).
+    pub bilateral_constraint: bool,
     /// Projects massless section rotations onto their balance in contact runs, booking the
     /// removed strain energy (Timoshenko links without rotary inertia).
     pub projects_massless: bool,

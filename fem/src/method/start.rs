@@ -4,8 +4,8 @@
 
 use crate::error::FemError;
 use crate::linalg::max_abs;
-use crate::method::StepContext;
 use crate::method::newton::with_time;
+use crate::method::{ConstraintView, StepConstraint, StepContext};
 use crate::system::{NewtonCoefficients, System};
 
 /// Consistent q̈ at the current state: solves R(q, q̇, q̈) = 0 for q̈ (R is affine in q̈; the
@@ -69,6 +69,54 @@ pub fn accelerate_with<S: System + ?Sized>(
     Err(FemError::Numerical {
         t: st.t,
         message: "could not compute a consistent initial acceleration".into(),
+    })
+}
+
+/// Consistent q̈ at the current state under a held constraint, R(q, q̇, q̈) − ∇g(q) λ = 0 with
+/// the constraint's current multiplier λ (a method's restart after a contact event, whose
+/// multiplier is the event's index-1 normal force): the constraint force at q itself, through
+/// a view of zero length (∇̄g = ∇g(q)). `zero` holds zeros; `before` is scratch; `force`
+/// receives the constraint force applied. `method` names the method in the error.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn constrained_acceleration<S: System + ?Sized>(
+    cx: &mut StepContext<'_, S>,
+    constraint: &mut dyn StepConstraint<S>,
+    t_law: f64,
+    zero: &[f64],
+    before: &mut [f64],
+    force: &mut [f64],
+    method: &str,
+) -> Result<(), FemError> {
+    let t0 = cx.state.t;
+    let g0 = constraint.value(cx.system, t0, &cx.state.q);
+    let lambda = constraint.multiplier();
+    accelerate_with(cx, t_law, |system, q, res| {
+        let view = ConstraintView {
+            it: 0,
+            t: [t0; 3],
+            q0: q,
+            q1: q,
+            qbar: q,
+            dq: zero,
+            w_dq: zero,
+            denom: 0.0,
+            g0,
+            lambda,
+        };
+        before.copy_from_slice(res);
+        constraint.add_force(system, &view, res);
+        for i in 0..res.len() {
+            force[i] = before[i] - res[i];
+        }
+    })
+    .map_err(|e| match e {
+        FemError::Numerical { t, .. } => FemError::Numerical {
+            t,
+            message: format!(
+                "{method}: could not compute the constrained acceleration at a restart"
+            ),
+        },
+        other => other,
     })
 }
 

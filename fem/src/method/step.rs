@@ -23,6 +23,10 @@ pub struct StepContext<'a, S: System + ?Sized> {
     /// Largest link length (scales tolerances; for a system other than a chain, its
     /// length scale).
     pub length_scale: f64,
+    /// Whether the driver takes the works a method books with its own quadrature
+    /// ([`Stepper::commit`]); drivers that book every work themselves (the rocket's, the
+    /// payload link's) spare a method the passes that would evaluate them.
+    pub method_works: bool,
 }
 
 /// One Newton iterate of a step, as a constraint sees it.

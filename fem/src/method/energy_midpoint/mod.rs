@@ -124,6 +124,7 @@ impl EnergyMidpoint {
         adaptive: true,
         prescribed_joints: false,
         held_constraint: true,
+        bilateral_constraint: true,
         projects_massless: true,
         variable_mass: false,
     };
