@@ -3,6 +3,10 @@
 //! Link `i` is clamped at its root to a frame that rotates with joint `i`. Link 1's joint is the
 //! hub (frame angle q₁ from the inertial X axis); link `i+1`'s joint sits at the tip of link `i`
 //! and its frame angle is (frame angle of link i) + (slope of link i at its tip) + (joint angle).
+//! On a Timoshenko link (`shear`) "slope" means the cross-section rotation ψ: its frame is its
+//! root cross-section (ψ(0) = 0, while the root may shear: v'(0) = v'(0) − ψ(0) is the root
+//! shear strain), and link `i+1` turns with the section at link `i`'s tip, ψᵢ(Lᵢ), so each joint
+//! angle, and the spring and damper on it, are measured between cross-sections.
 
 use serde::{Deserialize, Serialize};
 

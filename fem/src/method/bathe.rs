@@ -497,7 +497,7 @@ impl<S: System + ?Sized> Stepper<S> for Bathe {
             )?;
         }
         if let SubStep::Failed { last } = outcome {
-            return unconverged(cx.adaptive.is_some(), cx.h_nominal, cx.state.t, h, last);
+            return unconverged(cx.adaptive.is_some(), cx.h_nominal, cx.state.t, h, last, "");
         }
         if let Some(k) = constraint {
             k.set_multiplier(lambda);

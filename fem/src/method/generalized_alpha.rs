@@ -295,7 +295,7 @@ impl<S: System + ?Sized> Stepper<S> for GeneralizedAlpha {
         }
         cx.newton.slow_convergence = !converged || iterations > 3;
         if !converged {
-            return unconverged(cx.adaptive.is_some(), cx.h_nominal, st.t, h, last);
+            return unconverged(cx.adaptive.is_some(), cx.h_nominal, st.t, h, last, "");
         }
         Ok(cx.adaptive.map(|ad| {
             let mut err = 0.0f64;

@@ -188,7 +188,7 @@ impl<S: System + ?Sized> Stepper<S> for ImplicitMidpoint {
         }
         cx.newton.slow_convergence = !converged || iterations > 3;
         if !converged {
-            return unconverged(cx.adaptive.is_some(), cx.h_nominal, st.t, h, last);
+            return unconverged(cx.adaptive.is_some(), cx.h_nominal, st.t, h, last, "");
         }
         for i in 0..n {
             let v_bar = st.qd[i] + 0.5 * h * st.qdd1[i];

@@ -56,13 +56,15 @@ pub(crate) fn update_tolerance(newton_tol: f64, c_q: f64, h: f64, qdd: &[f64], q
 
 /// A step of length `h` from `t` whose Newton iteration did not converge (`last`: its last
 /// update): retried shorter when it can be (adaptive, or longer than 1e-6 of the nominal
-/// step: `Some(∞)`), else the run stops.
+/// step: `Some(∞)`), else the run stops; `also` extends the remedy with what is specific to
+/// the method.
 pub(crate) fn unconverged(
     adaptive: bool,
     h_nominal: f64,
     t: f64,
     h: f64,
     last: f64,
+    also: &str,
 ) -> Result<Option<f64>, FemError> {
     if adaptive || h > 1e-6 * h_nominal {
         return Ok(Some(f64::INFINITY));
@@ -72,7 +74,7 @@ pub(crate) fn unconverged(
         what: format!("Newton iteration did not converge (last update {last:.3e})"),
         location: None,
         why: "the step is too large for the nonlinearity or the solution diverged".into(),
-        remedy: "reduce --dt or give --rtol for adaptive stepping".into(),
+        remedy: format!("reduce --dt or give --rtol for adaptive stepping{also}"),
     })
 }
 

@@ -212,7 +212,16 @@ impl<S: System + ?Sized> Stepper<S> for EnergyMidpoint {
         cx.newton.slow_convergence = !iter.converged || iter.iterations > 8;
         if !iter.converged {
             let st = &*cx.state;
-            return unconverged(cx.adaptive.is_some(), cx.h_nominal, st.t, h, iter.last);
+            // Its energy-defect test can stall at a round-off floor that a shorter step raises
+            // (massless sections without Kelvin–Voigt: docs/limits.md).
+            return unconverged(
+                cx.adaptive.is_some(),
+                cx.h_nominal,
+                st.t,
+                h,
+                iter.last,
+                "; if shorter steps fail too, use --method implicit-midpoint or generalized-alpha",
+            );
         }
         w.accept(cx, &setup, robust, t_law);
         Ok(cx.adaptive.map(|ad| w.error_estimate(cx.state, h, ad)))
