@@ -7,6 +7,7 @@
 
 mod common;
 
+use common::max_diff;
 use data::{Backend, BackendError, FemElement, Settings};
 use fem::FemBackend;
 
@@ -252,13 +253,6 @@ fn hub_angle_history(n: usize, element: Option<FemElement>, dt: f64) -> Vec<f64>
     s.time.dt = Some(dt);
     let run = FemBackend.simulate(&sc, &s).unwrap();
     run.observables.get("joint1.angle").unwrap().values.clone()
-}
-
-fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    a.iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
 }
 
 #[test]

@@ -11,6 +11,9 @@
 //! resolves the Kelvin–Voigt relaxation of the mesh; the bilateral friction wall is refused.
 //! Explicit central difference is still refused.
 
+mod common;
+
+use common::max_diff;
 use data::{Backend, BackendError, Event, RunResult, Scene, Settings, StabilityVerdict};
 use fem::FemBackend;
 
@@ -230,14 +233,6 @@ fn dyn_generalized_alpha_steps_contact_and_balances_the_constraint_work() {
             assert!(ratio >= 1.6, "barhorst-case1 closures {closure_case1:?}");
         }
     }
-}
-
-/// Largest |a − b| over two histories of the same output times.
-fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    a.iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
 }
 
 #[test]

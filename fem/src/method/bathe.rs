@@ -330,6 +330,15 @@ fn solve_sub_step<S: System + ?Sized>(
     Ok(SubStep::Failed { last })
 }
 
+/// Which of the two sub-steps is solved: what its held constraint balances and records.
+#[derive(Clone, Copy, PartialEq)]
+enum Sub {
+    /// The trapezoidal half step: its start force is balanced (module docs).
+    Trapezoidal,
+    /// The backward difference: its end force is the next step's start force.
+    BackwardDifference,
+}
+
 impl Bathe {
     /// Sub-step 1: the trapezoidal rule to t₀ + h/2, into the intermediate point.
     fn trapezoidal_half<S: System + ?Sized>(
@@ -352,34 +361,12 @@ impl Bathe {
             st.qdd1[i] = -st.qdd[i];
         }
         let t0 = st.t;
-        let t_mid = t0 + 0.5 * h;
         self.q_start.copy_from_slice(&st.q);
-        let mut held = constraint.map(|k| {
-            let g_start = k.value(cx.system, t0, &self.q_start);
-            HeldSubStep {
-                constraint: k,
-                held: &mut self.held,
-                q_start: &self.q_start,
-                q_bar: &mut self.q_bar,
-                t: [t0, t0 + 0.25 * h, t_mid],
-                g_start,
-                target: g_start * gap_factor(0.5 * h, cx.h_nominal),
-                lambda: *lambda,
-                force_start: Some(&self.force_start),
-                force_end: None,
-            }
-        });
-        let outcome = solve_sub_step(
-            cx,
-            (&self.q_base, &self.v_base),
-            held.as_mut(),
-            c,
-            h,
-            t_mid,
-        )?;
-        if let Some(k) = held {
-            *lambda = k.lambda;
-        }
+        let h_nominal = cx.h_nominal;
+        let target = |g_start: f64| g_start * gap_factor(0.5 * h, h_nominal);
+        let times = [t0, t0 + 0.5 * h];
+        let outcome =
+            self.solve_from_start(cx, constraint, (c, h, times[1]), times, target, lambda, Sub::Trapezoidal)?;
         let st = &*cx.state;
         self.q_mid.copy_from_slice(&st.q1);
         self.qd_mid.copy_from_slice(&st.qd1);
@@ -387,7 +374,8 @@ impl Bathe {
         Ok(outcome)
     }
 
-    /// Sub-step 2: the three-point backward difference to t₁ (the predictor is q̈_m).
+    /// Sub-step 2: the three-point backward difference to t₁ (the predictor is q̈_m); `g0` is
+    /// the constraint's value at the step start.
     #[allow(clippy::too_many_arguments)]
     fn backward_difference<S: System + ?Sized>(
         &mut self,
@@ -412,29 +400,41 @@ impl Bathe {
         }
         let t_mid = st.t + 0.5 * h;
         self.q_start.copy_from_slice(&self.q_mid);
+        let target = g0 * gap_factor(h, cx.h_nominal);
+        let sub = Sub::BackwardDifference;
+        self.solve_from_start(cx, constraint, (c, h, t_law), [t_mid, t1], |_| target, lambda, sub)
+    }
+
+    /// Solves a sub-step from `q_start` over `times` (residual at `t_eval`), with the held
+    /// constraint if any: g at `target(g(q_start))` at the sub-step end, the multiplier
+    /// starting from and left in `lambda`.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_from_start<S: System + ?Sized>(
+        &mut self,
+        cx: &mut StepContext<'_, S>,
+        constraint: Option<&mut (dyn StepConstraint<S> + '_)>,
+        (c, h, t_eval): (NewtonCoefficients, f64, f64),
+        times: [f64; 2],
+        target: impl FnOnce(f64) -> f64,
+        lambda: &mut f64,
+        sub: Sub,
+    ) -> Result<SubStep, FemError> {
         let mut held = constraint.map(|k| {
-            let g_start = k.value(cx.system, t_mid, &self.q_start);
+            let g_start = k.value(cx.system, times[0], &self.q_start);
             HeldSubStep {
                 constraint: k,
                 held: &mut self.held,
                 q_start: &self.q_start,
                 q_bar: &mut self.q_bar,
-                t: [t_mid, t_mid + 0.25 * h, t1],
+                t: [times[0], 0.5 * (times[0] + times[1]), times[1]],
                 g_start,
-                target: g0 * gap_factor(h, cx.h_nominal),
+                target: target(g_start),
                 lambda: *lambda,
-                force_start: None,
-                force_end: Some(&mut self.force_end),
+                force_start: (sub == Sub::Trapezoidal).then_some(&self.force_start[..]),
+                force_end: (sub == Sub::BackwardDifference).then_some(&mut self.force_end[..]),
             }
         });
-        let outcome = solve_sub_step(
-            cx,
-            (&self.q_base, &self.v_base),
-            held.as_mut(),
-            c,
-            h,
-            t_law,
-        )?;
+        let outcome = solve_sub_step(cx, (&self.q_base, &self.v_base), held.as_mut(), c, h, t_eval)?;
         if let Some(k) = held {
             *lambda = k.lambda;
         }

@@ -287,3 +287,11 @@ pub fn advanced_default_run(name: &str, t_stop: f64) -> fem::run::Prepared {
     }
     p
 }
+
+/// Largest |a − b| over two histories of the same output times.
+pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
