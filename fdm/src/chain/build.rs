@@ -36,7 +36,7 @@ fn check_link(name: &str, l: &Link) -> Result<(), FdmError> {
         // `two-link-free` with both links linear in chord frames: 8.5e-4 of the peak hub angle
         // from fem and modal, which agree). The Euler links' clamp-tangent kinematics without
         // foreshortening do not agree either: `two-link-free` with both links linear, 2 s, the
-        // joint-2 angle at 9.4e-4 / 8.7e-4 of the peak from fem (32 elements, dt 1e-4) at 21 / 41
+        // joint-2 angle at 9.6e-4 / 8.9e-4 of the peak from fem (32 elements, dt 1e-4) at 21 / 41
         // stations, where modal lies at 1.5e-4 and fem's default 16 elements at 1.7e-4.
         return Err(FdmError::Unsupported(format!(
             "fdm: `{name}` (link `{}`) is a linear beam (no `foreshortening`): the \
