@@ -205,8 +205,8 @@ impl Output {
             let nb = l.nb();
             let b = &rhs.q[l.b0..l.b0 + nb];
             let tip = rhs.chain.tip_position(i);
-            self.values[c] = rhs.q[l.theta];
-            self.values[c + 1] = rhs.qd[l.theta];
+            self.values[c] = rhs.chain.joint_angle(i, &rhs.q);
+            self.values[c + 1] = rhs.chain.joint_rate(i, &rhs.qd);
             self.values[c + 2] = rhs.joint_torque(t, i);
             self.values[c + 3] = tip[0];
             self.values[c + 4] = tip[1];

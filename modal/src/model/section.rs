@@ -97,6 +97,25 @@ pub struct Section {
     pub psi_shapes: Option<ShapeSet>,
     /// Condensed Timoshenko only: T (nψ × nb, row-major), ψ = χᵀT b.
     pub condensation: Option<Vec<f64>>,
+    /// Condensed Timoshenko only: the uncondensed blocks, for a condensation that includes the
+    /// elbow of a child joint ([`super::elbow`]).
+    pub blocks: Option<CondensedBlocks>,
+}
+
+/// The bending block of a condensed Timoshenko link before condensation: U = ½bᵀK_bb b +
+/// bᵀK_bc c + ½cᵀK_cc c, Kelvin–Voigt ½ċᵀD_cc ċ, and ψ(L) = χ(L)ᵀc.
+#[derive(Debug, Clone)]
+pub struct CondensedBlocks {
+    /// K_bb (nb × nb).
+    pub kbb: Vec<f64>,
+    /// K_bc (nb × nψ).
+    pub kbc: Vec<f64>,
+    /// K_cc (nψ × nψ).
+    pub kcc: Vec<f64>,
+    /// D_cc (nψ × nψ; empty without Kelvin–Voigt).
+    pub dcc: Vec<f64>,
+    /// χ(L).
+    pub chi_l: Vec<f64>,
 }
 
 /// Section parameters of a link.
@@ -179,6 +198,7 @@ impl Section {
             dbc,
             psi_shapes: None,
             condensation: None,
+            blocks: None,
         }
     }
 
@@ -272,6 +292,13 @@ impl Section {
                 dbc,
                 psi_shapes: Some(chi.clone()),
                 condensation: Some(t),
+                blocks: Some(CondensedBlocks {
+                    kbb: a_vv.iter().map(|v| kappa_ga * v).collect(),
+                    kbc: a_vc.iter().map(|v| -kappa_ga * v).collect(),
+                    kcc,
+                    dcc: gamma.map_or_else(Vec::new, |g| a1_cc.iter().map(|v| g * v).collect()),
+                    chi_l,
+                }),
             });
         }
         let n = nb + nc;
@@ -333,6 +360,7 @@ impl Section {
             dbc,
             psi_shapes: Some(chi.clone()),
             condensation: None,
+            blocks: None,
         })
     }
 

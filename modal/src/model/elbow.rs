@@ -1,0 +1,222 @@
+//! A free joint i+1 whose parent link i is a condensed Timoshenko link (massless section
+//! rotations ψ = χᵀc, [`super::section`]): the condensation of c that includes the elbow.
+//!
+//! The joint acts on link i's tip cross-section: with θ the joint angle (between the tip
+//! section and link i+1), the elbow spring ½K(θ − θ₀)², damper ½Dθ̇² and applied torque τ
+//! turn that section. If θ stayed the coordinate, link i+1's frame angle αᵢ + ψᵢ(Lᵢ) + θ would
+//! depend on c, c would carry link i+1's inertia and could not be condensed. The coordinate
+//! is therefore the angle between the two link frames, φ = ψᵢ(Lᵢ) + θ, so that αᵢ₊₁ = αᵢ + φ
+//! is free of c, c stays massless, and θ = φ − χ(L)ᵀc. With s = φ − θ₀ the potential is
+//!
+//!   V = ½bᵀK_bb b + bᵀK_bc c + ½cᵀK_cc c + ½K(s − χᵀc)² − τ(φ − χᵀc),
+//!
+//! and c minimizes it: A c = −K_cb b + Kχ s − χτ, A = K_cc + Kχχᵀ, i.e.
+//! c = T b + t s + g τ with T = −A⁻¹K_cb, t = K A⁻¹χ, g = −A⁻¹χ (τ is piecewise constant in
+//! time, so ċ = T ḃ + t φ̇ almost everywhere). By the envelope theorem the generalized forces
+//! are those of V at fixed c: f_b = −(K_bb b + K_bc c), f_φ = τ − K(θ − θ₀); the stiffness over
+//! x = (b, φ) is the Schur complement H = [[K_bb + K_bc T, K_bc t], [·, K(1 − χᵀt)]], exact.
+//!
+//! Dampers (Kelvin–Voigt D_cc on ψ', joint damper D on θ) are taken to first order, as the
+//! per-link condensation takes Kelvin–Voigt: the dissipation is evaluated on the condensed
+//! rates ċ = J ẋ, J = [T, t], θ̇ = wᵀẋ, w = e_φ − JᵀX (X = χ(L)), giving the damping matrix
+//! D_eff = JᵀD_cc J + D w wᵀ. Without dampers the condensation is exact; with them, the
+//! neglected relaxation of c (rates ≥ eig(A)/(γ-terms + D χχᵀ)) changes a mode of frequency ω
+//! by a relative O(ω·(D_cc, D)/A) — the order of the per-link Kelvin–Voigt condensation
+//! ([`super::section`]), and for the joint damper O(ωD/√(EI·κGA)) (2.8e-4 s·ω at D = 20 on
+//! `barhorst-case1-timoshenko`).
+//!
+//! A prescribed joint after a condensed Timoshenko link keeps the per-link condensation
+//! (θ the coordinate, αᵢ₊₁ = αᵢ + χᵀT b + θ): its actuator moment does not enter c's
+//! balance.
+
+use super::section::CondensedBlocks;
+use crate::linalg::{cholesky_factor, cholesky_substitute, dot};
+
+/// The condensation of link `parent`'s ψ with the elbow of joint `parent + 1`.
+#[derive(Debug, Clone)]
+pub struct Elbow {
+    pub parent: usize,
+    pub nb: usize,
+    pub nc: usize,
+    /// K_bb, K_bc, K_cc, D_cc, χ(L) of the parent's bending block.
+    pub blocks: CondensedBlocks,
+    /// Elbow spring K, set point θ₀, damper D.
+    pub stiffness: f64,
+    pub set_point: f64,
+    pub damping: f64,
+    /// T (nc × nb), t (nc), g (nc): c = T b + t (φ − θ₀) + g τ.
+    pub t_b: Vec<f64>,
+    pub t_s: Vec<f64>,
+    pub t_g: Vec<f64>,
+    /// Condensed stiffness H over x = (b, φ) ((nb+1)², row-major).
+    pub h: Vec<f64>,
+    /// JᵀD_cc J over x ((nb+1)²; empty without Kelvin–Voigt).
+    pub d_kv: Vec<f64>,
+    /// θ̇ = wᵀẋ.
+    pub w: Vec<f64>,
+    /// c at the last evaluation.
+    pub c: Vec<f64>,
+}
+
+impl Elbow {
+    /// Builds the condensation (errors if A = K_cc + Kχχᵀ is not positive definite).
+    pub fn new(
+        parent: usize,
+        nb: usize,
+        blocks: &CondensedBlocks,
+        stiffness: f64,
+        set_point: f64,
+        damping: f64,
+    ) -> Result<Self, &'static str> {
+        let nc = blocks.chi_l.len();
+        let chi = &blocks.chi_l;
+        let mut a = blocks.kcc.clone();
+        for r in 0..nc {
+            for c in 0..nc {
+                a[r * nc + c] += stiffness * chi[r] * chi[c];
+            }
+        }
+        cholesky_factor(&mut a, nc).map_err(|_| {
+            "Timoshenko rotation stiffness with the elbow spring K_cc + Kχχᵀ is not positive definite"
+        })?;
+        let mut t_b = vec![0.0; nc * nb];
+        let mut col = vec![0.0; nc];
+        for j in 0..nb {
+            // Column j of T: −A⁻¹ (K_cb)_{·j}, K_cb = K_bcᵀ.
+            for k in 0..nc {
+                col[k] = -blocks.kbc[j * nc + k];
+            }
+            cholesky_substitute(&a, nc, &mut col);
+            for k in 0..nc {
+                t_b[k * nb + j] = col[k];
+            }
+        }
+        let mut t_g: Vec<f64> = chi.iter().map(|v| -v).collect();
+        cholesky_substitute(&a, nc, &mut t_g);
+        let t_s: Vec<f64> = t_g.iter().map(|v| -stiffness * v).collect();
+        let nx = nb + 1;
+        let mut h = vec![0.0; nx * nx];
+        for r in 0..nb {
+            for c in 0..nb {
+                let mut s = blocks.kbb[r * nb + c];
+                for k in 0..nc {
+                    s += blocks.kbc[r * nc + k] * t_b[k * nb + c];
+                }
+                h[r * nx + c] = s;
+            }
+            let hs = dot(&blocks.kbc[r * nc..(r + 1) * nc], &t_s);
+            h[r * nx + nb] = hs;
+            h[nb * nx + r] = hs;
+        }
+        h[nb * nx + nb] = stiffness * (1.0 - dot(chi, &t_s));
+        for r in 0..nb {
+            for c in 0..r {
+                let v = 0.5 * (h[r * nx + c] + h[c * nx + r]);
+                h[r * nx + c] = v;
+                h[c * nx + r] = v;
+            }
+        }
+        // J = [T, t] (nc × nx); w = e_φ − JᵀX.
+        let jac = |k: usize, j: usize| if j < nb { t_b[k * nb + j] } else { t_s[k] };
+        let mut w = vec![0.0; nx];
+        for (j, wj) in w.iter_mut().enumerate() {
+            *wj =
+                if j == nb { 1.0 } else { 0.0 } - (0..nc).map(|k| chi[k] * jac(k, j)).sum::<f64>();
+        }
+        let d_kv = if blocks.dcc.is_empty() {
+            Vec::new()
+        } else {
+            let mut d = vec![0.0; nx * nx];
+            for r in 0..nx {
+                for c in 0..nx {
+                    let mut s = 0.0;
+                    for k in 0..nc {
+                        for m in 0..nc {
+                            s += jac(k, r) * blocks.dcc[k * nc + m] * jac(m, c);
+                        }
+                    }
+                    d[r * nx + c] = s;
+                }
+            }
+            for r in 0..nx {
+                for c in 0..r {
+                    let v = 0.5 * (d[r * nx + c] + d[c * nx + r]);
+                    d[r * nx + c] = v;
+                    d[c * nx + r] = v;
+                }
+            }
+            d
+        };
+        Ok(Elbow {
+            parent,
+            nb,
+            nc,
+            blocks: blocks.clone(),
+            stiffness,
+            set_point,
+            damping,
+            t_b,
+            t_s,
+            t_g,
+            h,
+            d_kv,
+            w,
+            c: vec![0.0; nc],
+        })
+    }
+
+    /// c = T b + t (φ − θ₀) + g τ, stored.
+    pub fn condense(&mut self, b: &[f64], phi: f64, tau: f64) {
+        let s = phi - self.set_point;
+        for k in 0..self.nc {
+            self.c[k] = dot(&self.t_b[k * self.nb..(k + 1) * self.nb], b)
+                + self.t_s[k] * s
+                + self.t_g[k] * tau;
+        }
+    }
+
+    /// Joint angle θ = φ − χ(L)ᵀc (after [`Self::condense`]).
+    pub fn angle(&self, phi: f64) -> f64 {
+        phi - dot(&self.blocks.chi_l, &self.c)
+    }
+
+    /// Joint rate θ̇ = wᵀẋ.
+    pub fn rate(&self, bd: &[f64], phid: f64) -> f64 {
+        dot(&self.w[..self.nb], bd) + self.w[self.nb] * phid
+    }
+
+    /// Kelvin–Voigt power ẋᵀJᵀD_cc J ẋ (0 without Kelvin–Voigt) and its row (D_kv ẋ)_r.
+    pub fn kv_row(&self, r: usize, bd: &[f64], phid: f64) -> f64 {
+        if self.d_kv.is_empty() {
+            return 0.0;
+        }
+        let nx = self.nb + 1;
+        let row = &self.d_kv[r * nx..(r + 1) * nx];
+        dot(&row[..self.nb], bd) + row[self.nb] * phid
+    }
+
+    /// Strain energy ½bᵀK_bb b + bᵀK_bc c + ½cᵀK_cc c of the parent's bending block.
+    pub fn strain(&self, b: &[f64]) -> f64 {
+        let (nb, nc) = (self.nb, self.nc);
+        let k = &self.blocks;
+        let mut e = 0.0;
+        for r in 0..nb {
+            e += b[r]
+                * (0.5 * dot(&k.kbb[r * nb..(r + 1) * nb], b)
+                    + dot(&k.kbc[r * nc..(r + 1) * nc], &self.c));
+        }
+        for r in 0..nc {
+            e += 0.5 * self.c[r] * dot(&k.kcc[r * nc..(r + 1) * nc], &self.c);
+        }
+        e
+    }
+
+    /// φ(0), φ̇(0) for the scene's θ(0), θ̇(0) at b = ḃ = 0 and applied torque τ(0):
+    /// θ = (1 − χᵀt)(φ − θ₀) + θ₀ − χᵀg τ, θ̇ = (1 − χᵀt) φ̇.
+    pub fn initial_coordinate(&self, angle: f64, rate: f64, tau: f64) -> (f64, f64) {
+        let chi = &self.blocks.chi_l;
+        let f = 1.0 - dot(chi, &self.t_s);
+        let phi = self.set_point + (angle - self.set_point + dot(chi, &self.t_g) * tau) / f;
+        (phi, rate / f)
+    }
+}
