@@ -634,20 +634,21 @@ fn sys_timoshenko_elbow_modes_converge_from_above() {
         println!("n = {n}: {:?}", f[k]);
     }
     for m in 0..4 {
+        let col: Vec<f64> = f.iter().map(|fr| fr[m]).collect();
         for k in 1..ns.len() {
             assert!(
-                f[k][m] <= f[k - 1][m] * (1.0 + 1e-12),
+                col[k] <= col[k - 1] * (1.0 + 1e-12),
                 "mode {}: n = {} {} > n = {} {}",
                 m + 1,
                 ns[k],
-                f[k][m],
+                col[k],
                 ns[k - 1],
-                f[k - 1][m]
+                col[k - 1]
             );
         }
         for k in 2..ns.len() {
             assert!(
-                f[k - 1][m] - f[k][m] < f[k - 2][m] - f[k - 1][m],
+                col[k - 1] - col[k] < col[k - 2] - col[k - 1],
                 "mode {}: steps do not shrink at n = {}",
                 m + 1,
                 ns[k]

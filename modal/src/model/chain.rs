@@ -4,7 +4,9 @@
 //! body with frame origin Oᵢ, frame angle αᵢ and body velocities νᵢ = (V, ω, ė) (V = frame-origin
 //! velocity in the frame's own axes). Its kinetic energy is Tᵢ = ½ νᵢᵀ 𝕄ᵢ(e) νᵢ (see
 //! [`super::body`]). The chain kinematics of scenes.md (link i+1 clamped to the tip of link i and
-//! turned by θᵢ₊₁: αᵢ₊₁ = αᵢ + vᵢ'(Lᵢ) + θᵢ₊₁) give νᵢ = Gᵢ(q) q̇ and ν̇ᵢ = Gᵢ q̈ + γᵢ(q, q̇), so
+//! turned by θᵢ₊₁: αᵢ₊₁ = αᵢ + ψᵢ(Lᵢ) + θᵢ₊₁, ψᵢ(Lᵢ) = vᵢ'(Lᵢ) for Euler links; behind a condensed
+//! Timoshenko link the coordinate of a free joint is φ = ψᵢ(Lᵢ) + θᵢ₊₁ and αᵢ₊₁ = αᵢ + φ,
+//! [`super::elbow`]) give νᵢ = Gᵢ(q) q̇ and ν̇ᵢ = Gᵢ q̈ + γᵢ(q, q̇), so
 //! Lagrange's equations of the chain are the body equations projected by Gᵢᵀ:
 //!
 //!   Σᵢ Gᵢᵀ 𝕄ᵢ Gᵢ q̈ = Q − Σᵢ Gᵢᵀ (𝕄ᵢ γᵢ + hᵢ − Q_gravity,ᵢ)

@@ -6,7 +6,10 @@
 //! turn that section. If θ stayed the coordinate, link i+1's frame angle αᵢ + ψᵢ(Lᵢ) + θ would
 //! depend on c, c would carry link i+1's inertia and could not be condensed. The coordinate
 //! is therefore the angle between the two link frames, φ = ψᵢ(Lᵢ) + θ, so that αᵢ₊₁ = αᵢ + φ
-//! is free of c, c stays massless, and θ = φ − χ(L)ᵀc. With s = φ − θ₀ the potential is
+//! is free of c, c stays massless, and θ = φ − χᵀc (χ = χ(L) below). The scene's θ(0), θ̇(0)
+//! give φ(0), φ̇(0) through that relation with the elastic coordinates at rest. Everything
+//! that reports or books the joint (angle, rate, torque channels, spring energy, damper and
+//! applied power) uses θ, θ̇. With s = φ − θ₀ the potential is
 //!
 //!   V = ½bᵀK_bb b + bᵀK_bc c + ½cᵀK_cc c + ½K(s − χᵀc)² − τ(φ − χᵀc),
 //!
@@ -18,12 +21,13 @@
 //!
 //! Dampers (Kelvin–Voigt D_cc on ψ', joint damper D on θ) are taken to first order, as the
 //! per-link condensation takes Kelvin–Voigt: the dissipation is evaluated on the condensed
-//! rates ċ = J ẋ, J = [T, t], θ̇ = wᵀẋ, w = e_φ − JᵀX (X = χ(L)), giving the damping matrix
-//! D_eff = JᵀD_cc J + D w wᵀ. Without dampers the condensation is exact; with them, the
-//! neglected relaxation of c (rates ≥ eig(A)/(γ-terms + D χχᵀ)) changes a mode of frequency ω
-//! by a relative O(ω·(D_cc, D)/A) — the order of the per-link Kelvin–Voigt condensation
-//! ([`super::section`]), and for the joint damper O(ωD/√(EI·κGA)) (2.8e-4 s·ω at D = 20 on
-//! `barhorst-case1-timoshenko`).
+//! rates ċ = J ẋ, J = [T, t], θ̇ = wᵀẋ, w = e_φ − Jᵀχ, giving the damping matrix
+//! D_eff = JᵀD_cc J + D w wᵀ. This is the first term of the slow-manifold expansion of the damped
+//! balance (D_cc + Dχχᵀ)ċ + A c = −K_cb b + Kχ s + Dχφ̇ − χτ: its correction
+//! c₁ = A⁻¹[Dχφ̇ − (D_cc + Dχχᵀ)J ẋ] enters the forces as JᵀA c₁, which with the dampers' own
+//! forces sums to −D_eff ẋ; the terms left out are smaller by ω/r, r the relaxation rates of c
+//! (eigenvalues of (D_cc + Dχχᵀ)⁻¹A; for the joint damper r ≈ √(EI·κGA)/D, 3.5·10³ s⁻¹ at
+//! D = 20 on `barhorst-case1-timoshenko`). Without dampers the condensation is exact.
 //!
 //! A prescribed joint after a condensed Timoshenko link keeps the per-link condensation
 //! (θ the coordinate, αᵢ₊₁ = αᵢ + χᵀT b + θ): its actuator moment does not enter c's
@@ -116,7 +120,7 @@ impl Elbow {
                 h[c * nx + r] = v;
             }
         }
-        // J = [T, t] (nc × nx); w = e_φ − JᵀX.
+        // J = [T, t] (nc × nx); w = e_φ − Jᵀχ.
         let jac = |k: usize, j: usize| if j < nb { t_b[k * nb + j] } else { t_s[k] };
         let mut w = vec![0.0; nx];
         for (j, wj) in w.iter_mut().enumerate() {

@@ -49,14 +49,16 @@
 //!   model leaves the mode underdamped (ωγ/EI < 2); it is an approximation of the convention's
 //!   Kelvin–Voigt on a massless ψ, exact without Kelvin–Voigt. ψ(L) = χ(L)ᵀT b.
 //!   A tip inertia would give c inertia through ψ(L) only: refused in setup (not condensable
-//!   exactly, and a singular ψ mass otherwise). The condensation is per link: what acts on ψ(L)
-//!   through a child link (the elbow spring and damper on θᵢ₊₁, the child's inertia through
-//!   αᵢ₊₁) is not in K_cc, so link i's tip section does not turn under the elbow moment and
-//!   the elbow is too stiff — `barhorst-case1-timoshenko` in free flight lies 7.8e-4 of the
-//!   peak elbow angle from fem's converged answer, converged in the modes (docs/limits.md).
+//!   exactly, and a singular ψ mass otherwise). This per-link condensation (T, `kbc`, `dbc`)
+//!   holds where nothing else acts on ψ(L): at the last link and before a prescribed joint. Before
+//!   a free joint the elbow spring, damper and applied torque act on link i's tip section, and
+//!   the condensation includes them, with the frame-to-frame angle φ = ψᵢ(Lᵢ) + θᵢ₊₁ as the
+//!   joint coordinate so that the child's inertia does not reach c ([`super::elbow`]; the
+//!   blocks before condensation are kept in `blocks`).
 //!
 //! The joint convention (link i+1 clamped to the cross-section at the tip of link i:
-//! αᵢ₊₁ = αᵢ + ψᵢ(Lᵢ) + θᵢ₊₁) and the tip inertia ½J(ω + ψ̇(L))² use r(L) = `rot_l`.
+//! αᵢ₊₁ = αᵢ + ψᵢ(Lᵢ) + θᵢ₊₁) and the tip inertia ½J(ω + ψ̇(L))² use r(L) = `rot_l`; behind an
+//! elbow ([`super::elbow`]) the kinematics use φ = ψᵢ(Lᵢ) + θᵢ₊₁ instead.
 
 use crate::basis::ShapeSet;
 use crate::basis::quadrature::Quadrature;
