@@ -261,6 +261,15 @@ impl Output {
             diss[nd] = y[i];
             nd += 1;
         }
+        // Jumps of applied torques behind elbows (crate::model::elbow): their work on the
+        // applied input, the section relaxation's loss on the first damper channel.
+        let (jump_work, jump_loss) = rhs.chain.torque_step_books(t);
+        if jump_work != 0.0 && s.applied.is_some() {
+            inputs[0] += jump_work;
+        }
+        if jump_loss != 0.0 && nd > 0 {
+            diss[0] += jump_loss;
+        }
         if let Some(ct) = rhs.contact.as_ref().filter(|c| !c.bilateral) {
             diss[nd] = ct.impact_loss;
             nd += 1;

@@ -141,11 +141,24 @@ impl Chain {
             let Some(blocks) = &p.section.blocks else {
                 continue;
             };
-            let e = Elbow::new(i - 1, p.nb(), blocks, j.stiffness, j.set_point, j.damping)
+            let mut e = Elbow::new(i - 1, p.nb(), blocks, j.stiffness, j.set_point, j.damping)
                 .map_err(|m| format!("link {}: {m}", i))?;
+            if let Some(law) = &j.torque {
+                e.book_torque_steps(law);
+            }
             self.elbows[i] = Some(e);
         }
         Ok(())
+    }
+
+    /// Applied work and section-relaxation loss of the applied-torque jumps behind elbows at
+    /// times ≤ t (booked by the ledger beside the integrated powers, [`Elbow::book_torque_steps`]).
+    pub fn torque_step_books(&self, t: f64) -> (f64, f64) {
+        self.elbows
+            .iter()
+            .flatten()
+            .map(|e| e.torque_step_books(t))
+            .fold((0.0, 0.0), |(w, l), (a, b)| (w + a, l + b))
     }
 
     /// Whether link i's bending block is condensed with its child's elbow.

@@ -15,7 +15,8 @@
 //!
 //! and c minimizes it: A c = −K_cb b + Kχ s − χτ, A = K_cc + Kχχᵀ, i.e.
 //! c = T b + t s + g τ with T = −A⁻¹K_cb, t = K A⁻¹χ, g = −A⁻¹χ (τ is piecewise constant in
-//! time, so ċ = T ḃ + t φ̇ almost everywhere). By the envelope theorem the generalized forces
+//! time, so ċ = T ḃ + t φ̇ almost everywhere; at its jumps c jumps and the ledger books the
+//! jump's work and loss, [`Elbow::book_torque_steps`]). By the envelope theorem the generalized forces
 //! are those of V at fixed c: f_b = −(K_bb b + K_bc c), f_φ = τ − K(θ − θ₀); the stiffness over
 //! x = (b, φ) is the Schur complement H = [[K_bb + K_bc T, K_bc t], [·, K(1 − χᵀt)]], exact.
 //!
@@ -60,6 +61,9 @@ pub struct Elbow {
     pub w: Vec<f64>,
     /// c at the last evaluation.
     pub c: Vec<f64>,
+    /// Steps of the applied torque law: (time, work τ₊Δθ, loss ½χᵀA⁻¹χ Δτ²) of each jump
+    /// ([`Self::book_torque_steps`]).
+    pub torque_steps: Vec<(f64, f64, f64)>,
 }
 
 impl Elbow {
@@ -166,7 +170,36 @@ impl Elbow {
             d_kv,
             w,
             c: vec![0.0; nc],
+            torque_steps: Vec::new(),
         })
+    }
+
+    /// Records the jumps of a piecewise-constant torque law. At a jump Δτ the condensed c jumps
+    /// by gΔτ at fixed (b, φ), so θ jumps by Δθ = χᵀA⁻¹χ Δτ; the torque after the jump does the
+    /// work τ₊Δθ and, since c minimizes the new potential, the stored energy changes by
+    /// τ₊Δθ − ½ΔcᵀAΔc: the difference ½χᵀA⁻¹χ Δτ² is what the section's relaxation through
+    /// its dampers dissipates (the split between joint damper and Kelvin–Voigt is not
+    /// resolved).
+    pub fn book_torque_steps(&mut self, law: &data::scene::TorqueLaw) {
+        let s = -dot(&self.blocks.chi_l, &self.t_g);
+        let mut prev = 0.0;
+        for tb in law.breakpoints() {
+            if tb <= prev {
+                continue;
+            }
+            let (before, after) = (law.torque(0.5 * (prev + tb)), law.torque(tb));
+            let d = after - before;
+            self.torque_steps.push((tb, after * s * d, 0.5 * s * d * d));
+            prev = tb;
+        }
+    }
+
+    /// Work and loss of the torque jumps at times ≤ t.
+    pub fn torque_step_books(&self, t: f64) -> (f64, f64) {
+        self.torque_steps
+            .iter()
+            .filter(|st| st.0 <= t)
+            .fold((0.0, 0.0), |(w, l), st| (w + st.1, l + st.2))
     }
 
     /// c = T b + t (φ − θ₀) + g τ, stored.
