@@ -39,7 +39,7 @@ pub fn modes(
             q[th] = if j.stiffness > 0.0 {
                 j.set_point
             } else {
-                j.initial_angle
+                chain.initial_joint_coordinate(i).0
             };
         }
     }

@@ -205,8 +205,8 @@ impl Output {
             let nb = l.nb();
             let b = &rhs.q[l.b0..l.b0 + nb];
             let tip = rhs.chain.tip_position(i);
-            self.values[c] = rhs.q[l.theta];
-            self.values[c + 1] = rhs.qd[l.theta];
+            self.values[c] = rhs.chain.joint_angle(i, &rhs.q);
+            self.values[c + 1] = rhs.chain.joint_rate(i, &rhs.qd);
             self.values[c + 2] = rhs.joint_torque(t, i);
             self.values[c + 3] = tip[0];
             self.values[c + 4] = tip[1];
@@ -260,6 +260,15 @@ impl Output {
         for i in [s.joint_damper, s.kelvin_voigt].into_iter().flatten() {
             diss[nd] = y[i];
             nd += 1;
+        }
+        // Jumps of applied torques behind elbows (crate::model::elbow): their work on the
+        // applied input, the section relaxation's loss on the first damper channel.
+        let (jump_work, jump_loss) = rhs.chain.torque_step_books(t);
+        if jump_work != 0.0 && s.applied.is_some() {
+            inputs[0] += jump_work;
+        }
+        if jump_loss != 0.0 && nd > 0 {
+            diss[0] += jump_loss;
         }
         if let Some(ct) = rhs.contact.as_ref().filter(|c| !c.bilateral) {
             diss[nd] = ct.impact_loss;

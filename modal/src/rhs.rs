@@ -43,6 +43,9 @@ pub struct ChainRhs {
     col: Vec<f64>,
     /// Position of each coordinate among the free ones (usize::MAX for prescribed).
     free_of: Vec<usize>,
+    /// Work arrays of the power rows: ∂θ̇/∂q̇ terms of a joint, ∂(Kelvin–Voigt power)/∂q̇.
+    rate_grad: Vec<(usize, f64)>,
+    kv_grad: Vec<f64>,
     /// Factored Newton linear algebra ([`OdeRhs::newton_linearize`]).
     lin: ChainNewton,
 }
@@ -82,6 +85,8 @@ impl ChainRhs {
         }
         ChainRhs {
             free_of,
+            rate_grad: vec![(0, 0.0); n + 1],
+            kv_grad: vec![0.0; n],
             lin: ChainNewton::new(nf, slots.count),
             kt: vec![0.0; n * n],
             dt: vec![0.0; n * n],
@@ -134,8 +139,7 @@ impl ChainRhs {
         for (k, &g) in self.chain.free.iter().enumerate() {
             for (i, l) in self.chain.links.iter().enumerate() {
                 if l.theta == g {
-                    y[k] = self.chain.joints[i].initial_angle;
-                    y[nf + k] = self.chain.joints[i].initial_rate;
+                    (y[k], y[nf + k]) = self.chain.initial_joint_coordinate(i);
                 }
             }
         }
@@ -247,26 +251,27 @@ impl ChainRhs {
             if j.prescribed.is_some() {
                 continue;
             }
-            let th = self.chain.links[i].theta;
-            let k = self.free_of[th];
-            if let (Some(row), Some(law)) = (s.applied, &j.torque) {
-                p[(row - base) * nf + k] += law.torque(t);
-            }
-            if let Some(row) = s.joint_damper {
-                p[(row - base) * nf + k] += 2.0 * j.damping * self.qd[th];
+            // θ̇ = Σ g_k q̇_k (the coordinate itself unless behind an elbow).
+            let rate = self.chain.joint_rate(i, &self.qd);
+            let m = self.chain.joint_rate_gradient(i, &mut self.rate_grad);
+            for &(c, g) in &self.rate_grad[..m] {
+                let k = self.free_of[c];
+                if let (Some(row), Some(law)) = (s.applied, &j.torque) {
+                    p[(row - base) * nf + k] += law.torque(t) * g;
+                }
+                if let Some(row) = s.joint_damper {
+                    p[(row - base) * nf + k] += 2.0 * j.damping * rate * g;
+                }
             }
         }
         if let Some(row) = s.kelvin_voigt {
-            for l in &self.chain.links {
-                if l.has_kelvin_voigt() {
-                    let nbc = l.nbc();
-                    let xd = &self.qd[l.b0..l.b0 + nbc];
-                    for r in 0..nbc {
-                        let k = self.free_of[l.b0 + r];
-                        p[(row - base) * nf + k] +=
-                            2.0 * dot(&l.section.dbc[r * nbc..(r + 1) * nbc], xd);
-                    }
-                }
+            let grad = &mut self.kv_grad;
+            grad.iter_mut().for_each(|v| *v = 0.0);
+            for i in 0..self.chain.links.len() {
+                self.chain.kelvin_voigt_power_gradient(i, &self.qd, grad);
+            }
+            for (k, &g) in self.chain.free.iter().enumerate() {
+                p[(row - base) * nf + k] += grad[g];
             }
         }
     }
@@ -278,10 +283,9 @@ impl ChainRhs {
         if j.prescribed.is_some() {
             self.chain.tau_prescribed[i]
         } else {
-            let th = self.chain.links[i].theta;
             j.torque.as_ref().map_or(0.0, |l| l.torque(t))
-                - j.stiffness * (self.q[th] - j.set_point)
-                - j.damping * self.qd[th]
+                - j.stiffness * (self.chain.joint_angle(i, &self.q) - j.set_point)
+                - j.damping * self.chain.joint_rate(i, &self.qd)
         }
     }
 }
@@ -441,7 +445,7 @@ impl OdeRhs for ChainRhs {
             let mut p = 0.0;
             for (i, j) in self.chain.joints.iter().enumerate() {
                 if let (None, Some(law)) = (&j.prescribed, &j.torque) {
-                    p += law.torque(t) * self.qd[self.chain.links[i].theta];
+                    p += law.torque(t) * self.chain.joint_rate(i, &self.qd);
                 }
             }
             dydt[k] = p;
@@ -459,7 +463,7 @@ impl OdeRhs for ChainRhs {
             let mut p = 0.0;
             for (i, j) in self.chain.joints.iter().enumerate() {
                 if j.prescribed.is_none() {
-                    let w = self.qd[self.chain.links[i].theta];
+                    let w = self.chain.joint_rate(i, &self.qd);
                     p += j.damping * w * w;
                 }
             }
@@ -467,15 +471,9 @@ impl OdeRhs for ChainRhs {
         }
         if let Some(k) = s.kelvin_voigt {
             let mut p = 0.0;
-            for l in &self.chain.links {
-                if l.has_kelvin_voigt() {
-                    // ẋᵀD ẋ over the bending block x = [b, c].
-                    let nbc = l.nbc();
-                    let xd = &self.qd[l.b0..l.b0 + nbc];
-                    for r in 0..nbc {
-                        p += xd[r] * dot(&l.section.dbc[r * nbc..(r + 1) * nbc], xd);
-                    }
-                }
+            for i in 0..self.chain.links.len() {
+                // ẋᵀD ẋ over the bending block x = [b, c] (or (b, φ) behind an elbow).
+                self.chain.add_kelvin_voigt_power(i, &self.qd, &mut p);
             }
             dydt[k] = p;
         }

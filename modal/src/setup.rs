@@ -305,6 +305,9 @@ pub fn build_chain_for(
     }
     let gravity = pc.gravity.as_ref().map(|g| g.vector);
     let mut chain = Chain::new(links, joints, gravity);
+    chain
+        .attach_elbows()
+        .map_err(|message| ModalError::Numerical { t: 0.0, message })?;
     if purpose == Purpose::Dynamics {
         chain.step_load = step_load(pc, &chain)?;
     }

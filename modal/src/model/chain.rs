@@ -4,7 +4,9 @@
 //! body with frame origin Oᵢ, frame angle αᵢ and body velocities νᵢ = (V, ω, ė) (V = frame-origin
 //! velocity in the frame's own axes). Its kinetic energy is Tᵢ = ½ νᵢᵀ 𝕄ᵢ(e) νᵢ (see
 //! [`super::body`]). The chain kinematics of scenes.md (link i+1 clamped to the tip of link i and
-//! turned by θᵢ₊₁: αᵢ₊₁ = αᵢ + vᵢ'(Lᵢ) + θᵢ₊₁) give νᵢ = Gᵢ(q) q̇ and ν̇ᵢ = Gᵢ q̈ + γᵢ(q, q̇), so
+//! turned by θᵢ₊₁: αᵢ₊₁ = αᵢ + ψᵢ(Lᵢ) + θᵢ₊₁, ψᵢ(Lᵢ) = vᵢ'(Lᵢ) for Euler links; behind a condensed
+//! Timoshenko link the coordinate of a free joint is φ = ψᵢ(Lᵢ) + θᵢ₊₁ and αᵢ₊₁ = αᵢ + φ,
+//! [`super::elbow`]) give νᵢ = Gᵢ(q) q̇ and ν̇ᵢ = Gᵢ q̈ + γᵢ(q, q̇), so
 //! Lagrange's equations of the chain are the body equations projected by Gᵢᵀ:
 //!
 //!   Σᵢ Gᵢᵀ 𝕄ᵢ Gᵢ q̈ = Q − Σᵢ Gᵢᵀ (𝕄ᵢ γᵢ + hᵢ − Q_gravity,ᵢ)
@@ -14,7 +16,9 @@
 //! O(N²) products of precomputed integrals — no spatial quadrature.
 
 use super::body::{BodyScratch, body_terms};
+use super::elbow::Elbow;
 use super::link::{JointModel, LinkModel};
+use super::section::SectionKind;
 use crate::linalg::{cholesky_solve, cholesky_substitute, dot};
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -65,6 +69,9 @@ pub struct Chain {
     /// Constant generalized force of the scene's `[statics]` loads, applied as a step at t = 0
     /// (N entries; None without loads). Its work is fᵀ(q − q₀).
     pub step_load: Option<Vec<f64>>,
+    /// Per joint: the condensation with the elbow when the joint is free and its parent link
+    /// a condensed Timoshenko link ([`super::elbow`]); the joint coordinate is then φ.
+    pub elbows: Vec<Option<Elbow>>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -119,6 +126,142 @@ impl Chain {
             rhs_f: vec![0.0; nf],
             tau_prescribed: vec![0.0; nj],
             step_load: None,
+            elbows: vec![None; nj],
+        }
+    }
+
+    /// Switches every free joint after a condensed Timoshenko link to the frame-to-frame
+    /// coordinate φ with the elbow in the condensation ([`super::elbow`]).
+    pub fn attach_elbows(&mut self) -> Result<(), String> {
+        for i in 1..self.links.len() {
+            let (p, j) = (&self.links[i - 1], &self.joints[i]);
+            if j.prescribed.is_some() || p.section.kind != SectionKind::TimoshenkoCondensed {
+                continue;
+            }
+            let Some(blocks) = &p.section.blocks else {
+                continue;
+            };
+            let mut e = Elbow::new(i - 1, p.nb(), blocks, j.stiffness, j.set_point, j.damping)
+                .map_err(|m| format!("link {}: {m}", i))?;
+            if let Some(law) = &j.torque {
+                e.book_torque_steps(law);
+            }
+            self.elbows[i] = Some(e);
+        }
+        Ok(())
+    }
+
+    /// Applied work and section-relaxation loss of the applied-torque jumps behind elbows at
+    /// times ≤ t (booked by the ledger beside the integrated powers, [`Elbow::book_torque_steps`]).
+    pub fn torque_step_books(&self, t: f64) -> (f64, f64) {
+        self.elbows
+            .iter()
+            .flatten()
+            .map(|e| e.torque_step_books(t))
+            .fold((0.0, 0.0), |(w, l), (a, b)| (w + a, l + b))
+    }
+
+    /// Whether link i's bending block is condensed with its child's elbow.
+    fn has_elbow_child(&self, i: usize) -> bool {
+        self.elbows.get(i + 1).is_some_and(|e| e.is_some())
+    }
+
+    /// Joint angle θᵢ (after `evaluate`): the coordinate, or φ − χᵀc behind an elbow.
+    pub fn joint_angle(&self, i: usize, q: &[f64]) -> f64 {
+        let th = q[self.links[i].theta];
+        match &self.elbows[i] {
+            Some(e) => e.angle(th),
+            None => th,
+        }
+    }
+
+    /// Joint rate θ̇ᵢ: the coordinate's rate, or wᵀ(ḃ, φ̇) behind an elbow.
+    pub fn joint_rate(&self, i: usize, qd: &[f64]) -> f64 {
+        let th = qd[self.links[i].theta];
+        match &self.elbows[i] {
+            Some(e) => {
+                let p = &self.links[e.parent];
+                e.rate(&qd[p.b0..p.b0 + e.nb], th)
+            }
+            None => th,
+        }
+    }
+
+    /// ∂θ̇ᵢ/∂q̇ as (coordinate, coefficient) pairs written into `out` (returns the count).
+    pub fn joint_rate_gradient(&self, i: usize, out: &mut [(usize, f64)]) -> usize {
+        let th = self.links[i].theta;
+        match &self.elbows[i] {
+            Some(e) => {
+                let p = &self.links[e.parent];
+                for k in 0..e.nb {
+                    out[k] = (p.b0 + k, e.w[k]);
+                }
+                out[e.nb] = (th, e.w[e.nb]);
+                e.nb + 1
+            }
+            None => {
+                out[0] = (th, 1.0);
+                1
+            }
+        }
+    }
+
+    /// Initial coordinate and rate of joint i from the scene's θ(0), θ̇(0) (elastic
+    /// coordinates at rest).
+    pub fn initial_joint_coordinate(&self, i: usize) -> (f64, f64) {
+        let j = &self.joints[i];
+        match &self.elbows[i] {
+            Some(e) => {
+                let tau = j.torque.as_ref().map_or(0.0, |l| l.torque(0.0));
+                e.initial_coordinate(j.initial_angle, j.initial_rate, tau)
+            }
+            None => (j.initial_angle, j.initial_rate),
+        }
+    }
+
+    /// Adds the Kelvin–Voigt power ẋᵀD ẋ of link i's bending block to `p` (D_kv over (b, φ)
+    /// when condensed with its child's elbow).
+    pub fn add_kelvin_voigt_power(&self, i: usize, qd: &[f64], p: &mut f64) {
+        let l = &self.links[i];
+        if let Some(Some(e)) = self.elbows.get(i + 1) {
+            let bd = &qd[l.b0..l.b0 + e.nb];
+            let phid = qd[self.links[i + 1].theta];
+            for r in 0..e.nb {
+                *p += bd[r] * e.kv_row(r, bd, phid);
+            }
+            *p += phid * e.kv_row(e.nb, bd, phid);
+            return;
+        }
+        if !l.has_kelvin_voigt() {
+            return;
+        }
+        let nbc = l.nbc();
+        let xd = &qd[l.b0..l.b0 + nbc];
+        for r in 0..nbc {
+            *p += xd[r] * dot(&l.section.dbc[r * nbc..(r + 1) * nbc], xd);
+        }
+    }
+
+    /// ∂(Kelvin–Voigt power of link i)/∂q̇ added into `out` (length N).
+    pub fn kelvin_voigt_power_gradient(&self, i: usize, qd: &[f64], out: &mut [f64]) {
+        let l = &self.links[i];
+        if let Some(Some(e)) = self.elbows.get(i + 1) {
+            let bd = &qd[l.b0..l.b0 + e.nb];
+            let th = self.links[i + 1].theta;
+            let phid = qd[th];
+            for r in 0..e.nb {
+                out[l.b0 + r] += 2.0 * e.kv_row(r, bd, phid);
+            }
+            out[th] += 2.0 * e.kv_row(e.nb, bd, phid);
+            return;
+        }
+        if !l.has_kelvin_voigt() {
+            return;
+        }
+        let nbc = l.nbc();
+        let xd = &qd[l.b0..l.b0 + nbc];
+        for r in 0..nbc {
+            out[l.b0 + r] += 2.0 * dot(&l.section.dbc[r * nbc..(r + 1) * nbc], xd);
         }
     }
 
@@ -217,7 +360,9 @@ impl Chain {
             let xb = &q[link.b0..link.b0 + nbc];
             let xbd = &qd[link.b0..link.b0 + nbc];
             let sec = &link.section;
-            for r in 0..nbc {
+            // Behind an elbow the bending block is condensed with the joint (below).
+            let own = !self.elbows.get(i + 1).is_some_and(|e| e.is_some());
+            for r in 0..if own { nbc } else { 0 } {
                 let mut fr = dot(&sec.kbc[r * nbc..(r + 1) * nbc], xb);
                 if !sec.dbc.is_empty() {
                     fr += dot(&sec.dbc[r * nbc..(r + 1) * nbc], xbd);
@@ -231,7 +376,29 @@ impl Chain {
             }
             // Joint laws (free joints only; a prescribed joint's actuator is the unknown torque).
             let j = &self.joints[i];
-            if j.prescribed.is_none() {
+            if let Some(e) = self.elbows[i].as_mut() {
+                // f_b = −(K_bb b + K_bc c) − (D_eff ẋ)_b, f_φ = τ − K(θ − θ₀) − (D_eff ẋ)_φ.
+                let th = link.theta;
+                let p = &self.links[e.parent];
+                let (nb, nc) = (e.nb, e.nc);
+                let b = &q[p.b0..p.b0 + nb];
+                let bd = &qd[p.b0..p.b0 + nb];
+                let tau = j.torque.as_ref().map_or(0.0, |law| law.torque(t));
+                e.condense(b, q[th], tau);
+                let rate = e.rate(bd, qd[th]);
+                let blk = &e.blocks;
+                for r in 0..nb {
+                    let fr = dot(&blk.kbb[r * nb..(r + 1) * nb], b)
+                        + dot(&blk.kbc[r * nc..(r + 1) * nc], &e.c)
+                        + e.kv_row(r, bd, qd[th])
+                        + e.damping * rate * e.w[r];
+                    self.force[p.b0 + r] -= fr;
+                }
+                self.force[th] += tau
+                    - e.stiffness * (e.angle(q[th]) - e.set_point)
+                    - e.kv_row(nb, bd, qd[th])
+                    - e.damping * rate * e.w[nb];
+            } else if j.prescribed.is_none() {
                 let th = link.theta;
                 let mut tau = -j.stiffness * (q[th] - j.set_point) - j.damping * qd[th];
                 if let Some(law) = &j.torque {
@@ -278,8 +445,13 @@ impl Chain {
         }
         let bdi = &qd[li.b0..li.b0 + li.nb()];
         // Joint convention: the next frame turns with the tip cross-section, ψᵢ(Lᵢ) = r(L)ᵀe.
-        let ne = li.ne();
-        let rot_l = &li.section.rot_l;
+        // Behind an elbow the coordinate is the frame-to-frame angle φ: no ψᵢ(Lᵢ) term.
+        let ne = if self.elbows[i + 1].is_some() {
+            0
+        } else {
+            li.ne()
+        };
+        let rot_l = &li.section.rot_l[..ne];
         let delta = dot(rot_l, &q[li.a0..li.a0 + ne]) + q[ln.theta];
         let delta_d = dot(rot_l, &qd[li.a0..li.a0 + ne]) + qd[ln.theta];
         let (s, c) = delta.sin_cos();
@@ -365,7 +537,10 @@ impl Chain {
             let w = &self.work[i];
             e.kinetic += 0.5 * quad(&w.mb, link.body_dim(), &w.nu);
             let nbc = link.nbc();
-            e.strain += 0.5 * quad(&link.section.kbc, nbc, &q[link.b0..link.b0 + nbc]);
+            match self.elbows.get(i + 1) {
+                Some(Some(el)) => e.strain += el.strain(&q[link.b0..link.b0 + el.nb]),
+                _ => e.strain += 0.5 * quad(&link.section.kbc, nbc, &q[link.b0..link.b0 + nbc]),
+            }
             let na = link.na();
             if na > 0 {
                 let a = &q[link.a0..link.a0 + na];
@@ -373,7 +548,10 @@ impl Chain {
                 e.strain += 0.5 * quad(&link.ints.ka, na, a);
             }
             let j = &self.joints[i];
-            if j.prescribed.is_none() {
+            if let Some(el) = &self.elbows[i] {
+                e.joint_spring +=
+                    0.5 * el.stiffness * (el.angle(q[link.theta]) - el.set_point).powi(2);
+            } else if j.prescribed.is_none() {
                 e.joint_spring += 0.5 * j.stiffness * (q[link.theta] - j.set_point).powi(2);
             }
             if let Some(gv) = self.gravity {
@@ -472,7 +650,11 @@ impl Chain {
         kt.iter_mut().for_each(|v| *v = 0.0);
         dt.iter_mut().for_each(|v| *v = 0.0);
         for (i, link) in self.links.iter().enumerate() {
-            let nbc = link.nbc();
+            let nbc = if self.has_elbow_child(i) {
+                0
+            } else {
+                link.nbc()
+            };
             let sec = &link.section;
             for r in 0..nbc {
                 let row = link.b0 + r;
@@ -490,7 +672,24 @@ impl Chain {
                 }
             }
             let j = &self.joints[i];
-            if j.prescribed.is_none() {
+            if let Some(e) = &self.elbows[i] {
+                // H and D_eff over x = (b of the parent, φ).
+                let p = &self.links[e.parent];
+                let nx = e.nb + 1;
+                let idx = |k: usize| if k < e.nb { p.b0 + k } else { link.theta };
+                for r in 0..nx {
+                    for c in 0..nx {
+                        let (gr, gc) = (idx(r), idx(c));
+                        kt[gr * n + gc] += e.h[r * nx + c];
+                        let kv = if e.d_kv.is_empty() {
+                            0.0
+                        } else {
+                            e.d_kv[r * nx + c]
+                        };
+                        dt[gr * n + gc] += kv + e.damping * e.w[r] * e.w[c];
+                    }
+                }
+            } else if j.prescribed.is_none() {
                 let th = link.theta;
                 kt[th * n + th] += j.stiffness;
                 dt[th * n + th] += j.damping;

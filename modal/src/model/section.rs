@@ -49,14 +49,16 @@
 //!   model leaves the mode underdamped (ωγ/EI < 2); it is an approximation of the convention's
 //!   Kelvin–Voigt on a massless ψ, exact without Kelvin–Voigt. ψ(L) = χ(L)ᵀT b.
 //!   A tip inertia would give c inertia through ψ(L) only: refused in setup (not condensable
-//!   exactly, and a singular ψ mass otherwise). The condensation is per link: what acts on ψ(L)
-//!   through a child link (the elbow spring and damper on θᵢ₊₁, the child's inertia through
-//!   αᵢ₊₁) is not in K_cc, so link i's tip section does not turn under the elbow moment and
-//!   the elbow is too stiff — `barhorst-case1-timoshenko` in free flight lies 7.8e-4 of the
-//!   peak elbow angle from fem's converged answer, converged in the modes (docs/limits.md).
+//!   exactly, and a singular ψ mass otherwise). This per-link condensation (T, `kbc`, `dbc`)
+//!   holds where nothing else acts on ψ(L): at the last link and before a prescribed joint. Before
+//!   a free joint the elbow spring, damper and applied torque act on link i's tip section, and
+//!   the condensation includes them, with the frame-to-frame angle φ = ψᵢ(Lᵢ) + θᵢ₊₁ as the
+//!   joint coordinate so that the child's inertia does not reach c ([`super::elbow`]; the
+//!   blocks before condensation are kept in `blocks`).
 //!
 //! The joint convention (link i+1 clamped to the cross-section at the tip of link i:
-//! αᵢ₊₁ = αᵢ + ψᵢ(Lᵢ) + θᵢ₊₁) and the tip inertia ½J(ω + ψ̇(L))² use r(L) = `rot_l`.
+//! αᵢ₊₁ = αᵢ + ψᵢ(Lᵢ) + θᵢ₊₁) and the tip inertia ½J(ω + ψ̇(L))² use r(L) = `rot_l`; behind an
+//! elbow ([`super::elbow`]) the kinematics use φ = ψᵢ(Lᵢ) + θᵢ₊₁ instead.
 
 use crate::basis::ShapeSet;
 use crate::basis::quadrature::Quadrature;
@@ -97,6 +99,25 @@ pub struct Section {
     pub psi_shapes: Option<ShapeSet>,
     /// Condensed Timoshenko only: T (nψ × nb, row-major), ψ = χᵀT b.
     pub condensation: Option<Vec<f64>>,
+    /// Condensed Timoshenko only: the uncondensed blocks, for a condensation that includes the
+    /// elbow of a child joint ([`super::elbow`]).
+    pub blocks: Option<CondensedBlocks>,
+}
+
+/// The bending block of a condensed Timoshenko link before condensation: U = ½bᵀK_bb b +
+/// bᵀK_bc c + ½cᵀK_cc c, Kelvin–Voigt ½ċᵀD_cc ċ, and ψ(L) = χ(L)ᵀc.
+#[derive(Debug, Clone)]
+pub struct CondensedBlocks {
+    /// K_bb (nb × nb).
+    pub kbb: Vec<f64>,
+    /// K_bc (nb × nψ).
+    pub kbc: Vec<f64>,
+    /// K_cc (nψ × nψ).
+    pub kcc: Vec<f64>,
+    /// D_cc (nψ × nψ; empty without Kelvin–Voigt).
+    pub dcc: Vec<f64>,
+    /// χ(L).
+    pub chi_l: Vec<f64>,
 }
 
 /// Section parameters of a link.
@@ -179,6 +200,7 @@ impl Section {
             dbc,
             psi_shapes: None,
             condensation: None,
+            blocks: None,
         }
     }
 
@@ -272,6 +294,13 @@ impl Section {
                 dbc,
                 psi_shapes: Some(chi.clone()),
                 condensation: Some(t),
+                blocks: Some(CondensedBlocks {
+                    kbb: a_vv.iter().map(|v| kappa_ga * v).collect(),
+                    kbc: a_vc.iter().map(|v| -kappa_ga * v).collect(),
+                    kcc,
+                    dcc: gamma.map_or_else(Vec::new, |g| a1_cc.iter().map(|v| g * v).collect()),
+                    chi_l,
+                }),
             });
         }
         let n = nb + nc;
@@ -333,6 +362,7 @@ impl Section {
             dbc,
             psi_shapes: Some(chi.clone()),
             condensation: None,
+            blocks: None,
         })
     }
 
