@@ -77,6 +77,31 @@ fn random_state(chain: &Chain, scale: f64, seed: u64) -> Vec<f64> {
 }
 
 /// Symmetric positive definite, by faer's Cholesky factorization of the row-major n × n `m`.
+/// The chain's force side at (q, q̇ = 0) against −∇ of `potential` by central differences
+/// (step 1e-6): returns max |f + ∇V| / max |f| and max |f|.
+fn force_against_potential_gradient(
+    chain: &mut Chain,
+    q: &mut [f64],
+    potential: impl Fn(&mut Chain, &[f64]) -> f64,
+) -> (f64, f64) {
+    let qd = vec![0.0; chain.n];
+    chain.evaluate(0.0, q, &qd);
+    let f = chain.force().to_vec();
+    let fmax = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut worst = 0.0f64;
+    for k in 0..chain.n {
+        let h = 1e-6;
+        let q0 = q[k];
+        q[k] = q0 + h;
+        let up = potential(chain, q);
+        q[k] = q0 - h;
+        let um = potential(chain, q);
+        q[k] = q0;
+        worst = worst.max((-(up - um) / (2.0 * h) - f[k]).abs() / fmax);
+    }
+    (worst, fmax)
+}
+
 fn is_spd(m: &[f64], n: usize) -> bool {
     let a = faer::Mat::<f64>::from_fn(n, n, |i, j| m[i * n + j]);
     a.llt(faer::Side::Lower).is_ok()
@@ -199,26 +224,12 @@ fn elem_timoshenko_force_is_minus_energy_gradient() {
         .unwrap();
         let mut q = random_state(&chain, 2e-2, 3);
         let qd = vec![0.0; chain.n];
-        chain.evaluate(0.0, &q, &qd);
-        let f = chain.force().to_vec();
-        let fmax = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let potential = |chain: &mut Chain, q: &[f64]| {
             chain.evaluate(0.0, q, &qd);
             let e = chain.energy(q);
             e.strain + e.joint_spring + e.gravity
         };
-        let mut worst = 0.0f64;
-        for k in 0..chain.n {
-            let h = 1e-6;
-            let q0 = q[k];
-            q[k] = q0 + h;
-            let up = potential(&mut chain, &q);
-            q[k] = q0 - h;
-            let um = potential(&mut chain, &q);
-            q[k] = q0;
-            let g = -(up - um) / (2.0 * h);
-            worst = worst.max((g - f[k]).abs() / fmax);
-        }
+        let (worst, fmax) = force_against_potential_gradient(&mut chain, &mut q, potential);
         println!("{basis:?}: max |f + ∇V| / max|f| = {worst:.2e} (max|f| = {fmax:.3e})");
         assert!(worst < 1e-7, "{basis:?}: {worst:.2e}");
     }
@@ -678,25 +689,12 @@ fn elem_timoshenko_elbow_force_with_applied_torque_is_minus_potential_gradient()
     .unwrap();
     let mut q = random_state(&chain, 2e-2, 9);
     let qd = vec![0.0; chain.n];
-    chain.evaluate(0.0, &q, &qd);
-    let f = chain.force().to_vec();
-    let fmax = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let potential = |chain: &mut Chain, q: &[f64]| {
         chain.evaluate(0.0, q, &qd);
         let e = chain.energy(q);
         e.strain + e.joint_spring - 150.0 * chain.joint_angle(1, q)
     };
-    let mut worst = 0.0f64;
-    for k in 0..chain.n {
-        let h = 1e-6;
-        let q0 = q[k];
-        q[k] = q0 + h;
-        let up = potential(&mut chain, &q);
-        q[k] = q0 - h;
-        let um = potential(&mut chain, &q);
-        q[k] = q0;
-        worst = worst.max((-(up - um) / (2.0 * h) - f[k]).abs() / fmax);
-    }
+    let (worst, fmax) = force_against_potential_gradient(&mut chain, &mut q, potential);
     println!("max |f + ∇V| / max|f| = {worst:.2e} (max|f| = {fmax:.3e})");
     assert!(worst < 1e-7, "{worst:.2e}");
     // The torque moves c: the same state without it reports another joint angle.

@@ -219,40 +219,19 @@ impl Chain {
         }
     }
 
-    /// Adds the Kelvin–Voigt power ẋᵀD ẋ of link i's bending block to `p` (D_kv over (b, φ)
-    /// when condensed with its child's elbow).
-    pub fn add_kelvin_voigt_power(&self, i: usize, qd: &[f64], p: &mut f64) {
-        let l = &self.links[i];
-        if let Some(Some(e)) = self.elbows.get(i + 1) {
-            let bd = &qd[l.b0..l.b0 + e.nb];
-            let phid = qd[self.links[i + 1].theta];
-            for r in 0..e.nb {
-                *p += bd[r] * e.kv_row(r, bd, phid);
-            }
-            *p += phid * e.kv_row(e.nb, bd, phid);
-            return;
-        }
-        if !l.has_kelvin_voigt() {
-            return;
-        }
-        let nbc = l.nbc();
-        let xd = &qd[l.b0..l.b0 + nbc];
-        for r in 0..nbc {
-            *p += xd[r] * dot(&l.section.dbc[r * nbc..(r + 1) * nbc], xd);
-        }
-    }
-
-    /// ∂(Kelvin–Voigt power of link i)/∂q̇ added into `out` (length N).
-    pub fn kelvin_voigt_power_gradient(&self, i: usize, qd: &[f64], out: &mut [f64]) {
+    /// Visits the rows of link i's Kelvin–Voigt damping D ẋ over its bending block (over
+    /// (b, φ) with D_kv when condensed with its child's elbow): `visit(index in q, (D ẋ)_row)`,
+    /// in row order.
+    fn kelvin_voigt_rows(&self, i: usize, qd: &[f64], mut visit: impl FnMut(usize, f64)) {
         let l = &self.links[i];
         if let Some(Some(e)) = self.elbows.get(i + 1) {
             let bd = &qd[l.b0..l.b0 + e.nb];
             let th = self.links[i + 1].theta;
             let phid = qd[th];
             for r in 0..e.nb {
-                out[l.b0 + r] += 2.0 * e.kv_row(r, bd, phid);
+                visit(l.b0 + r, e.kv_row(r, bd, phid));
             }
-            out[th] += 2.0 * e.kv_row(e.nb, bd, phid);
+            visit(th, e.kv_row(e.nb, bd, phid));
             return;
         }
         if !l.has_kelvin_voigt() {
@@ -261,8 +240,18 @@ impl Chain {
         let nbc = l.nbc();
         let xd = &qd[l.b0..l.b0 + nbc];
         for r in 0..nbc {
-            out[l.b0 + r] += 2.0 * dot(&l.section.dbc[r * nbc..(r + 1) * nbc], xd);
+            visit(l.b0 + r, dot(&l.section.dbc[r * nbc..(r + 1) * nbc], xd));
         }
+    }
+
+    /// Adds the Kelvin–Voigt power ẋᵀD ẋ of link i's bending block to `p`.
+    pub fn add_kelvin_voigt_power(&self, i: usize, qd: &[f64], p: &mut f64) {
+        self.kelvin_voigt_rows(i, qd, |g, row| *p += qd[g] * row);
+    }
+
+    /// ∂(Kelvin–Voigt power of link i)/∂q̇ = 2 D ẋ added into `out` (length N).
+    pub fn kelvin_voigt_power_gradient(&self, i: usize, qd: &[f64], out: &mut [f64]) {
+        self.kelvin_voigt_rows(i, qd, |g, row| out[g] += 2.0 * row);
     }
 
     /// Kinematics, body terms, M(q) and the force side f(q, q̇, t) (everything except the

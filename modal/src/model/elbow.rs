@@ -34,7 +34,7 @@
 //! (θ the coordinate, αᵢ₊₁ = αᵢ + χᵀT b + θ): its actuator moment does not enter c's
 //! balance.
 
-use super::section::CondensedBlocks;
+use super::section::{CondensedBlocks, congruence};
 use crate::linalg::{cholesky_factor, cholesky_substitute, dot};
 
 /// The condensation of link `parent`'s ψ with the elbow of joint `parent + 1`.
@@ -134,26 +134,7 @@ impl Elbow {
         let d_kv = if blocks.dcc.is_empty() {
             Vec::new()
         } else {
-            let mut d = vec![0.0; nx * nx];
-            for r in 0..nx {
-                for c in 0..nx {
-                    let mut s = 0.0;
-                    for k in 0..nc {
-                        for m in 0..nc {
-                            s += jac(k, r) * blocks.dcc[k * nc + m] * jac(m, c);
-                        }
-                    }
-                    d[r * nx + c] = s;
-                }
-            }
-            for r in 0..nx {
-                for c in 0..r {
-                    let v = 0.5 * (d[r * nx + c] + d[c * nx + r]);
-                    d[r * nx + c] = v;
-                    d[c * nx + r] = v;
-                }
-            }
-            d
+            congruence(jac, &blocks.dcc, nc, nx, 1.0)
         };
         Ok(Elbow {
             parent,

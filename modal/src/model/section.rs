@@ -132,6 +132,32 @@ pub struct SectionParams {
     pub kelvin_voigt: Option<f64>,
 }
 
+/// The symmetric congruence JᵀDJ (n × n, row-major) of D (nc × nc, row-major) with the
+/// nc × n map J given entrywise by `jac(k, j)`, each entry scaled by `scale` and the result
+/// symmetrized (the damping of a condensed coordinate set).
+pub(super) fn congruence(
+    jac: impl Fn(usize, usize) -> f64,
+    d: &[f64],
+    nc: usize,
+    n: usize,
+    scale: f64,
+) -> Vec<f64> {
+    let mut out = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            let mut s = 0.0;
+            for k in 0..nc {
+                for m in 0..nc {
+                    s += jac(k, i) * d[k * nc + m] * jac(m, j);
+                }
+            }
+            out[i * n + j] = scale * s;
+        }
+    }
+    symmetrize(&mut out, n);
+    out
+}
+
 fn symmetrize(m: &mut [f64], n: usize) {
     for i in 0..n {
         for j in 0..i {
@@ -264,22 +290,9 @@ impl Section {
                 }
             }
             symmetrize(&mut kbc, nb);
+            // Tᵀ (γ A1_cc) T.
             let dbc = gamma.map_or_else(Vec::new, |g| {
-                // Tᵀ (γ A1_cc) T.
-                let mut d = vec![0.0; nb * nb];
-                for i in 0..nb {
-                    for j in 0..nb {
-                        let mut s = 0.0;
-                        for k in 0..nc {
-                            for m in 0..nc {
-                                s += t[k * nb + i] * a1_cc[k * nc + m] * t[m * nb + j];
-                            }
-                        }
-                        d[i * nb + j] = g * s;
-                    }
-                }
-                symmetrize(&mut d, nb);
-                d
+                congruence(|k, j| t[k * nb + j], &a1_cc, nc, nb, g)
             });
             let mut rot_l = vec![0.0; na + nb];
             for j in 0..nb {
