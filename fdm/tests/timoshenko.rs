@@ -463,3 +463,68 @@ fn prop_timoshenko_unsupported_switches_are_typed_errors() {
         "{plan:?}"
     );
 }
+
+/// The case-1 chain with κGA = 1e5 (boundary layer ℓ = √(EI/κGA) ≈ 0.22 ft) and no
+/// Kelvin–Voigt, at `stations` per link.
+fn boundary_layer_chain(stations: usize) -> TwoLinkChain {
+    let mut sc = load_scene("barhorst-case1-timoshenko").unwrap();
+    for l in &mut sc.planar_chain_mut().unwrap().links {
+        l.shear_stiffness = Some(1.0e5);
+        l.kelvin_voigt = None;
+    }
+    TwoLinkChain::from_planar_chain(&sc, sc.planar_chain().unwrap(), Some(stations)).unwrap()
+}
+
+#[test]
+fn sys_timoshenko_joint_angles_carry_the_dampers_boundary_layer_lag() {
+    // A joint damper's moment m = D·Θ̇ turns the massless section it acts on through the
+    // boundary layer ψ ∝ e^(−x/ℓ), ℓ = √(EI/κGA): with the centre line held, a section yields
+    // by m·c, c = ℓ/(EI·tanh(L/ℓ)) (the far end free of moment: K₁ = 0 at the hub, link 2's
+    // free tip; L/ℓ ≈ 13 and 9), and the elbow's two sections in series with the spring K₂ by
+    // m·s, s = (c₁ + c₂)/(1 + (c₁ + c₂)K₂). The reported joint angles sit on the
+    // first-order manifold z₀ + z₁, so for a rigid turn of the arm (Θ̇₁ = ω, K₁ = 0) and of
+    // link 2 alone they lag the quasi-static angles by that much, with m = D·Θ̇⁰ at the
+    // quasi-static rate (Θ̇₂⁰ = ω/(1 + (c₁ + c₂)K₂): the spring turns the sections with the link).
+    // The discrete layer's compliance is exact at any h: with ψᵢ = λⁱ the interior balance
+    // gives (1 − λ)/(1 + λ) = h/2ℓ, and the root moment EI(ψ₀ − ψ₁)/h + κGA h(ψ₀ + ψ₁)/4 is
+    // then ψ₀·EI/ℓ — so the check is to round-off at every resolution, up to the far end's
+    // reflection (λ²ʳ against e^(−2L/ℓ) ≈ 2e-8 at link 2, itself resolved to O(h²/ℓ²)).
+    let sc = load_scene("barhorst-case1-timoshenko").unwrap();
+    let pc = sc.planar_chain().unwrap();
+    let (ei, kga) = (pc.links[0].bending_stiffness, 1.0e5);
+    let ell = (ei / kga).sqrt();
+    let compliance = |l: usize| ell / (ei * (pc.links[l].length / ell).tanh());
+    let (c1, c2) = (compliance(0), compliance(1));
+    let (d1, d2) = (
+        pc.links[0].joint.damping.unwrap(),
+        pc.links[1].joint.damping.unwrap(),
+    );
+    let k2 = pc.links[1].joint.stiffness.unwrap();
+    let omega = 0.7;
+    let series = 1.0 + (c1 + c2) * k2;
+    let expected = [
+        -d1 * omega * c1,
+        -d2 * omega * (c1 + c2) / (series * series),
+    ];
+    for stations in [21, 81] {
+        let sys = boundary_layer_chain(stations);
+        let tf = sys.timoshenko().unwrap();
+        let (q, _) = sys.initial_state();
+        let quasi_static = sys.joint_angles(&q);
+        let mut v = vec![0.0; q.len()];
+        // the whole arm turning rigidly: Θ̇₁ = ω, Θ̇₂ = 0
+        v[0] = omega;
+        v[1] = omega;
+        let hub = tf.joint_angles_with_lag(&q, &v)[0] - quasi_static[0];
+        // link 2 alone turning about the elbow
+        v[0] = 0.0;
+        let elbow = tf.joint_angles_with_lag(&q, &v)[1] - quasi_static[1];
+        let err = [hub / expected[0] - 1.0, elbow / expected[1] - 1.0];
+        println!(
+            "{stations} stations: hub lag {hub:.9e} (boundary layer {:.9e}), elbow lag \
+             {elbow:.9e} ({:.9e}); relative errors {err:?}",
+            expected[0], expected[1]
+        );
+        assert!(err.iter().all(|e| e.abs() < 1e-8), "{err:?}");
+    }
+}

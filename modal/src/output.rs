@@ -205,7 +205,7 @@ impl Output {
             let nb = l.nb();
             let b = &rhs.q[l.b0..l.b0 + nb];
             let tip = rhs.chain.tip_position(i);
-            self.values[c] = rhs.chain.joint_angle(i, &rhs.q);
+            self.values[c] = rhs.chain.joint_angle_with_lag(i, &rhs.q, &rhs.qd);
             self.values[c + 1] = rhs.chain.joint_rate(i, &rhs.qd);
             self.values[c + 2] = rhs.joint_torque(t, i);
             self.values[c + 3] = tip[0];

@@ -730,3 +730,42 @@ fn dyn_timoshenko_elbow_torque_steps_close_the_ledger() {
     println!("closure {closure:.3e}");
     assert!(closure <= 1e-6, "ledger closure {closure:.3e}");
 }
+
+#[test]
+fn sys_timoshenko_elbow_angle_carries_the_dampers_boundary_layer_lag() {
+    // The elbow damper's moment m = D·θ̇ turns link 1's massless tip section through the
+    // boundary layer ψ ∝ sinh(x/ℓ), ℓ = √(EI/κGA): with b held the section yields by m·s,
+    // s = s₀/(1 + K s₀), s₀ = ℓ·tanh(L/ℓ)/EI (root section clamped to the frame, the elbow
+    // spring K in parallel). The reported angle lies on the first-order manifold c₀ + c₁, so
+    // for the frames turning apart at φ̇ = ω (b = ḃ = 0, no Kelvin–Voigt) it lags the
+    // quasi-static angle by −s·D·θ̇. The Ritz compliance of the polynomial χ converges to s
+    // from below (a Ritz solution is stiffer) and falls monotonically with n.
+    let mut scene = timoshenko_elbow_scene();
+    let kga = 1.0e4; // ℓ ≈ 0.71 ft, L/ℓ ≈ 4.2: a layer the polynomials resolve
+    for l in &mut scene.planar_chain_mut().unwrap().links {
+        l.shear_stiffness = Some(kga);
+    }
+    let pc = scene.planar_chain().unwrap();
+    let (ei, length) = (pc.links[0].bending_stiffness, pc.links[0].length);
+    let (k, d) = (
+        pc.links[1].joint.stiffness.unwrap(),
+        pc.links[1].joint.damping.unwrap(),
+    );
+    let ell = (ei / kga).sqrt();
+    let s0 = ell * (length / ell).tanh() / ei;
+    let exact = s0 / (1.0 + k * s0);
+    let omega = 0.7;
+    let mut errors = Vec::new();
+    for modes in [4, 6, 8] {
+        let chain = build_chain(pc, &disc(modes, Basis::Poly).modal().unwrap()).unwrap();
+        let e = chain.elbows[1].as_ref().unwrap();
+        let bd = vec![0.0; e.nb];
+        let lag = e.angle_lag(&bd, omega);
+        let s = -lag / (d * e.rate(&bd, omega));
+        println!("{modes} modes: compliance {s:.12e} against {exact:.12e}");
+        errors.push(1.0 - s / exact);
+    }
+    assert!(errors.iter().all(|&e| e > -1e-12), "{errors:?}");
+    assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
+    assert!(errors[2] < 1e-6, "{errors:?}");
+}

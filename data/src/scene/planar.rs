@@ -7,6 +7,13 @@
 //! root cross-section (ψ(0) = 0, while the root may shear: v'(0) = v'(0) − ψ(0) is the root
 //! shear strain), and link `i+1` turns with the section at link `i`'s tip, ψᵢ(Lᵢ), so each joint
 //! angle, and the spring and damper on it, are measured between cross-sections.
+//!
+//! Initial state: the links' centre lines start straight at the joints' `initial_angle`s, with
+//! the `initial_rate`s and the elastic fields at rest. Cross-sections without rotary inertia
+//! carry no mass, so they take their static balance at once: on such Timoshenko links the joint
+//! angles between sections start off `initial_angle` by the sections' turns under the joint
+//! springs' moments (4.9e-5 rad at the elbow of `barhorst-case1-timoshenko`), while every mass
+//! point is where the scene puts it — the same start in every backend.
 
 use serde::{Deserialize, Serialize};
 

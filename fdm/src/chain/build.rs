@@ -394,31 +394,15 @@ impl TwoLinkChain {
         let n = self.dofs();
         let mut q = vec![0.0; n];
         let mut v = vec![0.0; n];
-        // elastic fields at rest and straight: ψ = 0, β = θ₁ + θ₂
+        // elastic fields at rest and straight: β = θ₁ + θ₂
         q[TH] = self.init[0].0;
         q[BE] = self.init[0].0 + self.init[1].0;
         v[TH] = self.init[0].1;
         v[BE] = self.init[0].1 + self.init[1].1;
-        if let Some(t) = &self.timo {
-            // The condensed sections turn with the elbow spring's load: set the chord angles
-            // so that the joint angles Θ₁ = θ + ψ¹₀, Θ₂ = β + ψ²₀ − θ − ψ¹_r (and their rates)
-            // are the scene's. ∂Θ/∂(θ, β) is 1 up to the ψ response (≪ 1): fixed point.
-            for (x, rate) in [(&mut q, false), (&mut v, true)] {
-                let want = [
-                    if rate { self.init[0].1 } else { self.init[0].0 },
-                    if rate { self.init[1].1 } else { self.init[1].0 },
-                ];
-                for _ in 0..50 {
-                    let th = t.joint_angles(x, rate);
-                    let d = [want[0] - th[0], want[1] - th[1]];
-                    x[TH] += d[0];
-                    x[BE] += d[0] + d[1];
-                    if d[0].abs().max(d[1].abs()) <= 1e-16 * (1.0 + want[0].abs()) {
-                        break;
-                    }
-                }
-            }
-        }
+        // Timoshenko links too: the centre lines start straight at the scene's angles, and the
+        // massless sections (condensed, z₀(q)) take their balance from there, so the joint
+        // angles between sections start off the scene's by those sections' turns (data's scene
+        // docs; the same initial state in every backend).
         (q, v)
     }
 }

@@ -61,7 +61,10 @@ impl Outputs for TwoLinkChain {
         // v^t = v − ξψ, tip −Lψ), Timoshenko links in the chord frames (tip on the chord)
         self.to_kinetic(q, &mut qk);
         let (vs, ws) = (&qk[ine.iv()], &qk[ine.iw()]);
-        let [th1, th2] = self.joint_angles(q);
+        let [th1, th2] = match &self.timo {
+            Some(t) => t.joint_angles_with_lag(q, v),
+            None => self.joint_angles(q),
+        };
         let [th1d, th2d] = self.joint_rates(v);
         let j = &self.joints;
         // joint torques: applied law + spring + damper at this state

@@ -51,8 +51,8 @@
 //! boundary layer at a joint, ψ decaying over √(EI/κGA) from the section the damper turns: a
 //! damper D in series with that section's compliance 1/√(EI·κGA) relaxes at √(EI·κGA)/D ≈
 //! 3.5·10³ s⁻¹ (D = 20), not far above the mechanics' frequencies, so the first-order manifold
-//! below leaves an error linear in D at the joints: in free flight the hub and elbow angles
-//! converge to 1.3e-3 of their peaks from fem's (docs/limits.md). The other rates are ≳ 1/τ
+//! below leaves an error linear in D at the joints: its forces take the dampers at the
+//! quasi-static rates ż₀ (docs/limits.md, "Timoshenko two-link arm"). The other rates are ≳ 1/τ
 //! (τ ≈ 3e-5 s):
 //! explicit integration of z would need τ ≤ 2/rate_max (unbounded where C is singular), and an
 //! implicit one-step of z breaks the exact ledger; z is instead
@@ -73,6 +73,10 @@
 //! joint dampers agrees to 0.35 J of 167 J; the impact/Kelvin–Voigt partition is resolution
 //! dependent in both backends (fdm's impulse ∝ h: the struck lumped tip mass is ρAh/2). The ledger is exact in its own terms: strain U(y, z₀), joint springs at
 //! Θ(y, z₀), dissipation 2D_c = Σγh(Δż₀/h)² + D₁Θ̇₁² + D₂Θ̇₂² at ż₀ = Jẏ. Jᵀg = −K_yz K_zz⁻¹g.
+//! The reported joint angles are those of the sections at z₀ + z₁
+//! ([`TimoFields::joint_angles_with_lag`]): z₁ is first order, the quasi-static turn of a
+//! section under its damper's moment (D·Θ̇·ℓ/EI through the boundary layer, ℓ = √(EI/κGA)),
+//! while U(y, z₀ + z₁) differs from U_c(y) only at second order (∂U/∂z = 0 at z₀).
 //! Per force evaluation: three tridiagonal solves (z₀, ż₀, K_zz⁻¹∂D/∂ż) and four O(n) passes
 //! of the energy gradient: linear cost, no allocation.
 //!
@@ -332,6 +336,40 @@ impl TimoFields {
         self.settle(x, rate, &mut z);
         let th = self.joints_of(x, &z);
         self.scratch.borrow_mut().zd = z;
+        th
+    }
+
+    /// The section rotations on the first-order slow manifold, z = z₀(q) + z₁(q, q̇) with
+    /// z₁ = −K_zz⁻¹ ∂D/∂ż(q̇, ż₀) (module docs): the quasi-static turn of the sections under the
+    /// dampers' moments, first order in D — the joint damper's moment D·Θ̇ turns the section it
+    /// acts on by about D·Θ̇/√(EI·κGA) through the boundary layer at the joint, which the
+    /// condensed forces already carry and the reported angles must carry too. Writes z into `z`.
+    pub fn rotations_with_lag(&self, q: &[f64], v: &[f64], z: &mut [f64]) {
+        self.settle(q, false, z);
+        if !self.damped {
+            return;
+        }
+        let mut sc = self.scratch.borrow_mut();
+        let Scratch { zd, w, gz, .. } = &mut *sc;
+        w.iter_mut().for_each(|x| *x = 0.0);
+        zd.iter_mut().for_each(|x| *x = 0.0);
+        self.form(&self.elastic.without_set(), v, w, -1.0, None, Some(zd));
+        self.solve(zd);
+        // gz = −∂D/∂ż at (q̇, ż₀); z₁ = −K⁻¹∂D/∂ż = K⁻¹ gz
+        gz.iter_mut().for_each(|x| *x = 0.0);
+        self.form(&self.damping, v, zd, -1.0, None, Some(gz));
+        self.solve(gz);
+        for (zi, g) in z.iter_mut().zip(gz.iter()) {
+            *zi += g;
+        }
+    }
+
+    /// Joint angles (Θ₁, Θ₂) on the first-order manifold z₀ + z₁ ([`Self::rotations_with_lag`]).
+    pub fn joint_angles_with_lag(&self, q: &[f64], v: &[f64]) -> [f64; 2] {
+        let mut z = std::mem::take(&mut self.scratch.borrow_mut().z);
+        self.rotations_with_lag(q, v, &mut z);
+        let th = self.joints_of(q, &z);
+        self.scratch.borrow_mut().z = z;
         th
     }
 

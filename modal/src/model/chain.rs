@@ -175,6 +175,18 @@ impl Chain {
         }
     }
 
+    /// Joint angle θᵢ with the elbow section's first-order lag (after `evaluate`).
+    pub fn joint_angle_with_lag(&self, i: usize, q: &[f64], qd: &[f64]) -> f64 {
+        let th = self.joint_angle(i, q);
+        match &self.elbows[i] {
+            Some(e) => {
+                let p = &self.links[e.parent];
+                th + e.angle_lag(&qd[p.b0..p.b0 + e.nb], qd[self.links[i].theta])
+            }
+            None => th,
+        }
+    }
+
     /// Joint rate θ̇ᵢ: the coordinate's rate, or wᵀ(ḃ, φ̇) behind an elbow.
     pub fn joint_rate(&self, i: usize, qd: &[f64]) -> f64 {
         let th = qd[self.links[i].theta];
@@ -206,17 +218,14 @@ impl Chain {
         }
     }
 
-    /// Initial coordinate and rate of joint i from the scene's θ(0), θ̇(0) (elastic
-    /// coordinates at rest).
+    /// Initial coordinate and rate of joint i from the scene's θ(0), θ̇(0): the links' centre
+    /// lines straight at those angles and rates (elastic coordinates at rest). Behind an elbow
+    /// the coordinate is the frame-to-frame angle φ, which at b = 0 is the angle between the
+    /// centre lines, so φ(0) = θ(0); the massless sections then take their balance, and the
+    /// reported θ = φ − χᵀc starts off θ(0) by the tip section's turn (data's scene docs).
     pub fn initial_joint_coordinate(&self, i: usize) -> (f64, f64) {
         let j = &self.joints[i];
-        match &self.elbows[i] {
-            Some(e) => {
-                let tau = j.torque.as_ref().map_or(0.0, |l| l.torque(0.0));
-                e.initial_coordinate(j.initial_angle, j.initial_rate, tau)
-            }
-            None => (j.initial_angle, j.initial_rate),
-        }
+        (j.initial_angle, j.initial_rate)
     }
 
     /// Visits the rows of link i's Kelvin–Voigt damping D ẋ over its bending block (over

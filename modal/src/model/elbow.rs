@@ -6,8 +6,8 @@
 //! turn that section. If θ stayed the coordinate, link i+1's frame angle αᵢ + ψᵢ(Lᵢ) + θ would
 //! depend on c, c would carry link i+1's inertia and could not be condensed. The coordinate
 //! is therefore the angle between the two link frames, φ = ψᵢ(Lᵢ) + θ, so that αᵢ₊₁ = αᵢ + φ
-//! is free of c, c stays massless, and θ = φ − χᵀc (χ = χ(L) below). The scene's θ(0), θ̇(0)
-//! give φ(0), φ̇(0) through that relation with the elastic coordinates at rest. Everything
+//! is free of c, c stays massless, and θ = φ − χᵀc (χ = χ(L) below). At t = 0 the centre
+//! lines are straight at the scene's angles, so φ(0) = θ(0) and the sections settle from there. Everything
 //! that reports or books the joint (angle, rate, torque channels, spring energy, damper and
 //! applied power) uses θ, θ̇. With s = φ − θ₀ the potential is
 //!
@@ -28,7 +28,9 @@
 //! c₁ = A⁻¹[Dχφ̇ − (D_cc + Dχχᵀ)J ẋ] enters the forces as JᵀA c₁, which with the dampers' own
 //! forces sums to −D_eff ẋ; the terms left out are smaller by ω/r, r the relaxation rates of c
 //! (eigenvalues of (D_cc + Dχχᵀ)⁻¹A; for the joint damper r ≈ √(EI·κGA)/D, 3.5·10³ s⁻¹ at
-//! D = 20 on `barhorst-case1-timoshenko`). Without dampers the condensation is exact.
+//! D = 20 on `barhorst-case1-timoshenko`). Without dampers the condensation is exact. The
+//! reported joint angle includes the first-order lag −χᵀc₁ ([`Elbow::angle_lag`]): the section's
+//! quasi-static turn under the damper's moment, which fem's integrated sections show.
 //!
 //! A prescribed joint after a condensed Timoshenko link keeps the per-link condensation
 //! (θ the coordinate, αᵢ₊₁ = αᵢ + χᵀT b + θ): its actuator moment does not enter c's
@@ -198,6 +200,26 @@ impl Elbow {
         phi - dot(&self.blocks.chi_l, &self.c)
     }
 
+    /// First-order lag of θ behind its quasi-static value: −χᵀc₁ with
+    /// c₁ = A⁻¹[Dχφ̇ − (D_cc + Dχχᵀ)Jẋ] (module docs), i.e. −s·Dθ̇ − gᵀD_cc Jẋ with
+    /// s = χᵀA⁻¹χ = −χᵀg.
+    pub fn angle_lag(&self, bd: &[f64], phid: f64) -> f64 {
+        let s = -dot(&self.blocks.chi_l, &self.t_g);
+        let mut lag = -s * self.damping * self.rate(bd, phid);
+        if !self.blocks.dcc.is_empty() {
+            let nc = self.nc;
+            for k in 0..nc {
+                // ċ₀ₖ = (J ẋ)ₖ, and gᵀD_cc ċ₀ column by column (no allocation)
+                let cdk = dot(&self.t_b[k * self.nb..(k + 1) * self.nb], bd) + self.t_s[k] * phid;
+                let gd: f64 = (0..nc)
+                    .map(|r| self.t_g[r] * self.blocks.dcc[r * nc + k])
+                    .sum();
+                lag -= gd * cdk;
+            }
+        }
+        lag
+    }
+
     /// Joint rate θ̇ = wᵀẋ.
     pub fn rate(&self, bd: &[f64], phid: f64) -> f64 {
         dot(&self.w[..self.nb], bd) + self.w[self.nb] * phid
@@ -227,14 +249,5 @@ impl Elbow {
             e += 0.5 * self.c[r] * dot(&k.kcc[r * nc..(r + 1) * nc], &self.c);
         }
         e
-    }
-
-    /// φ(0), φ̇(0) for the scene's θ(0), θ̇(0) at b = ḃ = 0 and applied torque τ(0):
-    /// θ = (1 − χᵀt)(φ − θ₀) + θ₀ − χᵀg τ, θ̇ = (1 − χᵀt) φ̇.
-    pub fn initial_coordinate(&self, angle: f64, rate: f64, tau: f64) -> (f64, f64) {
-        let chi = &self.blocks.chi_l;
-        let f = 1.0 - dot(chi, &self.t_s);
-        let phi = self.set_point + (angle - self.set_point + dot(chi, &self.t_g) * tau) / f;
-        (phi, rate / f)
     }
 }
