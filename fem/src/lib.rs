@@ -65,7 +65,9 @@
 //! step: min(output interval, T₁/40) with T₁ the first flexible period of the stiffest link
 //! (clamped-free on a prescribed joint, pinned-free on a free one) — and at most T₁/320 of the
 //! most flexible link in a free chain where nothing dissipates
-//! ([`run::UNDAMPED_STEPS_PER_PERIOD`]) — fitted to divide the output interval. Central
+//! ([`run::UNDAMPED_STEPS_PER_PERIOD`]), T₁/100 with a unilateral contact
+//! ([`run::CONTACT_STEPS_PER_PERIOD`]: impacts and held phases) — fitted to divide the output
+//! interval. Central
 //! difference: 2/(κ + √(κ² + ω²)) of the stiffest and of the most damped mode (power
 //! iterations on the linearized K, C, M at t = 0; 2/ω_max undamped); a user step above it is
 //! refused, the automatic step is 0.9× it. On request also the implicit midpoint rule

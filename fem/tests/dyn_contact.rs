@@ -488,15 +488,16 @@ fn sys_refined_normal_force_matches_a_fresh_factorization() {
 
 #[test]
 fn dyn_fine_euler_bernoulli_mesh_stops_at_an_undetermined_grazing_release_with_its_remedy() {
-    // At 64 elements per link the release that ends `barhorst-case1`'s long sliding phase
-    // (t ≈ 0.93 s) stays undetermined down to the shortest step: the constrained normal force
+    // At 64 elements per link and dt 5e-4 the release that ends `barhorst-case1`'s long
+    // sliding phase (t ≈ 0.93 s) stays undetermined down to the shortest step: the constrained normal force
     // pulls while the free motion, carrying the fine mesh's tip modes, enters the surface. The
     // run stops there; the diagnostic names the Euler–Bernoulli cause and remedy, not the
-    // Timoshenko one (its chain has no massless directions).
+    // Timoshenko one (its chain has no massless directions). At dt 5e-4: at the contact
+    // default 2.5e-4 this mesh resolves the release and runs through.
     let sc = scene("barhorst-case1");
-    let r = FemBackend
-        .simulate(&sc, &settings(Some(64), Some(1.0)))
-        .unwrap();
+    let mut st = settings(Some(64), Some(1.0));
+    st.time.dt = Some(5e-4);
+    let r = FemBackend.simulate(&sc, &st).unwrap();
     let StabilityVerdict::Stopped { diagnostic } = &r.verdict else {
         panic!("{:?}", r.verdict);
     };
@@ -515,4 +516,48 @@ fn dyn_fine_euler_bernoulli_mesh_stops_at_an_undetermined_grazing_release_with_i
     );
     // The coarser default mesh runs through the same release (`sim` asserts completion).
     sim(&sc, &settings(None, Some(1.0)));
+}
+
+#[test]
+fn sys_a_unilateral_contact_takes_the_contact_step_rule() {
+    // A chain with a unilateral contact steps at T₁/100 (fem::run::CONTACT_STEPS_PER_PERIOD, T₁
+    // the first pinned-free period of the stiffest link on its free joint), fitted to divide the
+    // output interval; the same arm without the contact table at T₁/40. Both counted over the
+    // flight before the first impact (0.28 s), where no event adds a step.
+    let with_contact = scene("barhorst-case1");
+    let mut free = with_contact.clone();
+    free.planar_chain_mut().unwrap().contacts.clear();
+    let pc = with_contact.planar_chain().unwrap();
+    let beta = fem::run::pinned_free_beta1();
+    let omega1 = pc
+        .links
+        .iter()
+        .map(|l| {
+            beta * beta * (l.bending_stiffness / (l.mass_per_length * l.length.powi(4))).sqrt()
+        })
+        .fold(0.0f64, f64::max);
+    let out = with_contact.simulation.output_interval;
+    let fit = |h: f64| {
+        if h >= out {
+            out
+        } else {
+            out / (out / h).ceil()
+        }
+    };
+    let period = 2.0 * std::f64::consts::PI / omega1;
+    let t_end = 0.2;
+    for (sc, steps_per_period) in [
+        (&with_contact, fem::run::CONTACT_STEPS_PER_PERIOD),
+        (&free, fem::run::STEPS_PER_PERIOD),
+    ] {
+        let r = sim(sc, &settings(Some(4), Some(t_end)));
+        let dt = fit(period / steps_per_period);
+        let expected = (t_end / dt).round() as usize;
+        println!(
+            "{} contact(s): dt {dt:.4e}, {} steps (expected {expected})",
+            sc.planar_chain().unwrap().contacts.len(),
+            r.cost.steps
+        );
+        assert_eq!(r.cost.steps, expected);
+    }
 }
