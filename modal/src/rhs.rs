@@ -277,14 +277,16 @@ impl ChainRhs {
     }
 
     /// Total joint torque of joint i at the last solve (applied law + spring + damper for free
-    /// joints; the required actuator torque for prescribed ones).
+    /// joints, the spring at the reported angle — with an elbow section's lag; the required
+    /// actuator torque for prescribed ones).
     pub(crate) fn joint_torque(&self, t: f64, i: usize) -> f64 {
         let j = &self.chain.joints[i];
         if j.prescribed.is_some() {
             self.chain.tau_prescribed[i]
         } else {
             j.torque.as_ref().map_or(0.0, |l| l.torque(t))
-                - j.stiffness * (self.chain.joint_angle(i, &self.q) - j.set_point)
+                - j.stiffness
+                    * (self.chain.joint_angle_with_lag(i, &self.q, &self.qd) - j.set_point)
                 - j.damping * self.chain.joint_rate(i, &self.qd)
         }
     }
