@@ -157,6 +157,12 @@ impl Elbow {
         })
     }
 
+    /// The tip section's compliance at the joint with b held, s = χᵀA⁻¹χ = −χᵀg: the turn of
+    /// θ per unit moment (the boundary layer in parallel with the elbow spring).
+    pub fn compliance(&self) -> f64 {
+        -dot(&self.blocks.chi_l, &self.t_g)
+    }
+
     /// Records the jumps of a piecewise-constant torque law. At a jump Δτ the condensed c jumps
     /// by gΔτ at fixed (b, φ), so θ jumps by Δθ = χᵀA⁻¹χ Δτ; the torque after the jump does the
     /// work τ₊Δθ and, since c minimizes the new potential, the stored energy changes by
@@ -164,7 +170,7 @@ impl Elbow {
     /// its dampers dissipates (the split between joint damper and Kelvin–Voigt is not
     /// resolved).
     pub fn book_torque_steps(&mut self, law: &data::scene::TorqueLaw) {
-        let s = -dot(&self.blocks.chi_l, &self.t_g);
+        let s = self.compliance();
         let mut prev = 0.0;
         for tb in law.breakpoints() {
             if tb <= prev {
@@ -202,9 +208,9 @@ impl Elbow {
 
     /// First-order lag of θ behind its quasi-static value: −χᵀc₁ with
     /// c₁ = A⁻¹[Dχφ̇ − (D_cc + Dχχᵀ)Jẋ] (module docs), i.e. −s·Dθ̇ − gᵀD_cc Jẋ with
-    /// s = χᵀA⁻¹χ = −χᵀg.
+    /// s the [`Self::compliance`].
     pub fn angle_lag(&self, bd: &[f64], phid: f64) -> f64 {
-        let s = -dot(&self.blocks.chi_l, &self.t_g);
+        let s = self.compliance();
         let mut lag = -s * self.damping * self.rate(bd, phid);
         if !self.blocks.dcc.is_empty() {
             let nc = self.nc;
