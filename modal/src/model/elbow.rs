@@ -7,9 +7,9 @@
 //! depend on c, c would carry link i+1's inertia and could not be condensed. The coordinate
 //! is therefore the angle between the two link frames, φ = ψᵢ(Lᵢ) + θ, so that αᵢ₊₁ = αᵢ + φ
 //! is free of c, c stays massless, and θ = φ − χᵀc (χ = χ(L) below). At t = 0 the centre
-//! lines are straight at the scene's angles, so φ(0) = θ(0) and the sections settle from there. Everything
-//! that reports or books the joint (angle, rate, torque channels, spring energy, damper and
-//! applied power) uses θ, θ̇. With s = φ − θ₀ the potential is
+//! lines are straight at the scene's angles, so φ(0) = θ(0) and the sections settle from
+//! there. Everything that reports or books the joint (angle, rate, torque channels, spring
+//! energy, damper and applied power) uses θ, θ̇. With s = φ − θ₀ the potential is
 //!
 //!   V = ½bᵀK_bb b + bᵀK_bc c + ½cᵀK_cc c + ½K(s − χᵀc)² − τ(φ − χᵀc),
 //!
