@@ -250,15 +250,21 @@ pub(super) fn schur_finish(
             s[r][k] = col(k, full[r]);
         }
     }
+    // Row i of every column gathered once (the columns are separate vectors); each s[r][k]
+    // still accumulates over i in increasing order.
+    let mut zi = [0.0; MAX_SMALL];
     for i in 0..n {
         if full.contains(&i) {
             continue;
         }
+        for k in 0..ns {
+            zi[k] = z[k][i];
+        }
         for r in 0..ns {
             let c = if r < nf { col(r, i) } else { u[r - nf][i] };
             b[r] -= c * zb[i];
-            for k in 0..ns {
-                s[r][k] -= c * z[k][i];
+            for (sk, zk) in s[r][..ns].iter_mut().zip(&zi[..ns]) {
+                *sk -= c * zk;
             }
         }
     }
