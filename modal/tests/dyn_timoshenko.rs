@@ -336,6 +336,14 @@ fn sys_timoshenko_tip_inertia_without_rotary_inertia_is_refused() {
 }
 
 /// (t, kind) of impacts ("I") and releases ("R").
+/// A modal run of `scene` at `st` that must complete.
+fn completed_run(scene: &Scene, st: &Settings) -> RunResult {
+    let (r, _) =
+        simulate_detailed(scene, scene.planar_chain().unwrap(), &st.modal().unwrap()).unwrap();
+    assert_eq!(r.verdict, StabilityVerdict::Completed, "{}", scene.name);
+    r
+}
+
 fn switching(r: &RunResult) -> Vec<(f64, &'static str)> {
     r.events
         .iter()
@@ -350,13 +358,7 @@ fn switching(r: &RunResult) -> Vec<(f64, &'static str)> {
 #[test]
 fn dyn_timoshenko_barhorst_impacts_and_ledger() {
     let scene = load_scene("barhorst-case1-timoshenko").unwrap();
-    let (r, _) = simulate_detailed(
-        &scene,
-        scene.planar_chain().unwrap(),
-        &run_settings(3, None, 1e-8, Some(0.3)).modal().unwrap(),
-    )
-    .unwrap();
-    assert_eq!(r.verdict, StabilityVerdict::Completed);
+    let r = completed_run(&scene, &run_settings(3, None, 1e-8, Some(0.3)));
     let mut n_impacts = 0;
     for e in &r.events {
         if let Event::Impact {
@@ -414,18 +416,14 @@ fn dyn_timoshenko_arm_approaches_euler_as_slenderness_grows() {
         s
     };
     let euler = load_scene("constrained-arm").unwrap();
-    let (re, _) =
-        simulate_detailed(&euler, euler.planar_chain().unwrap(), &st.modal().unwrap()).unwrap();
-    assert_eq!(re.verdict, StabilityVerdict::Completed);
+    let re = completed_run(&euler, &st);
     let th_e = channel(&re, "joint1.angle").to_vec();
     let mut diffs = Vec::new();
     // Measured (3 poly modes, 0.5 s): λ = 5, 10, 20, 40 → 2.8e-2, 1.8e-2, 9.2e-3, 4.6e-3 rad
     // (stick–slip phases shift at small λ); at λ ≥ 40 the gap falls ~ 1/λ² (shear compliance).
     for lambda in [10.0, 40.0, 160.0] {
         let arm = timoshenko_arm(lambda);
-        let (r, _) =
-            simulate_detailed(&arm, arm.planar_chain().unwrap(), &st.modal().unwrap()).unwrap();
-        assert_eq!(r.verdict, StabilityVerdict::Completed);
+        let r = completed_run(&arm, &st);
         assert!(r.ledger.relative_closure() < 1e-6);
         let th = channel(&r, "joint1.angle");
         assert_eq!(th.len(), th_e.len());
@@ -462,13 +460,7 @@ fn dyn_timoshenko_rotary_inertia_chain_impact_and_ledger() {
         .dof_plan(&scene, &disc(3, Basis::ClampedFree))
         .unwrap();
     assert_eq!(plan.total(), 2 + 2 * (3 + 3));
-    let (r, _) = simulate_detailed(
-        &scene,
-        scene.planar_chain().unwrap(),
-        &run_settings(3, None, 1e-8, Some(0.3)).modal().unwrap(),
-    )
-    .unwrap();
-    assert_eq!(r.verdict, StabilityVerdict::Completed);
+    let r = completed_run(&scene, &run_settings(3, None, 1e-8, Some(0.3)));
     let sw = switching(&r);
     println!(
         "switching {sw:?}; closure {:.3e}; steps {} wall {:.2}s",
@@ -719,13 +711,7 @@ fn dyn_timoshenko_elbow_torque_steps_close_the_ledger() {
         switch: 0.05,
         off: 0.1,
     });
-    let (r, _) = simulate_detailed(
-        &scene,
-        scene.planar_chain().unwrap(),
-        &run_settings(4, None, 1e-8, Some(0.15)).modal().unwrap(),
-    )
-    .unwrap();
-    assert_eq!(r.verdict, StabilityVerdict::Completed);
+    let r = completed_run(&scene, &run_settings(4, None, 1e-8, Some(0.15)));
     let closure = r.ledger.relative_closure();
     println!("closure {closure:.3e}");
     assert!(closure <= 1e-6, "ledger closure {closure:.3e}");

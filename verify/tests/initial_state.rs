@@ -4,9 +4,7 @@ use data::{BackendKind, RunResult, Settings, load_scene};
 
 fn first_sample(run: &RunResult, name: &str) -> f64 {
     run.observables
-        .channels
-        .iter()
-        .find(|c| c.name == name)
+        .get(name)
         .unwrap_or_else(|| panic!("no channel {name}"))
         .values[0]
 }

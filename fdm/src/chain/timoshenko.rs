@@ -349,19 +349,18 @@ impl TimoFields {
         if !self.damped {
             return;
         }
+        let mut zd = std::mem::take(&mut self.scratch.borrow_mut().zd);
+        self.settle(v, true, &mut zd);
         let mut sc = self.scratch.borrow_mut();
-        let Scratch { zd, w, gz, .. } = &mut *sc;
-        w.iter_mut().for_each(|x| *x = 0.0);
-        zd.iter_mut().for_each(|x| *x = 0.0);
-        self.form(&self.elastic.without_set(), v, w, -1.0, None, Some(zd));
-        self.solve(zd);
         // gz = −∂D/∂ż at (q̇, ż₀); z₁ = −K⁻¹∂D/∂ż = K⁻¹ gz
+        let gz = &mut sc.gz;
         gz.iter_mut().for_each(|x| *x = 0.0);
-        self.form(&self.damping, v, zd, -1.0, None, Some(gz));
+        self.form(&self.damping, v, &zd, -1.0, None, Some(gz));
         self.solve(gz);
         for (zi, g) in z.iter_mut().zip(gz.iter()) {
             *zi += g;
         }
+        sc.zd = zd;
     }
 
     /// Joint angles (Θ₁, Θ₂) on the first-order manifold z₀ + z₁ ([`Self::rotations_with_lag`]).
