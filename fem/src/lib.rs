@@ -78,10 +78,12 @@
 //!
 //! ## Contact (seed 000: impact, constrained sliding, release)
 //! Unilateral frictionless contact of the tip of a named link with a fixed line
-//! ([`events::contact`]), with the implicit methods: `energy-midpoint` (described here),
+//! ([`events::contact`]), with every method: `energy-midpoint` (described here),
 //! `implicit-midpoint` (ledger O(h²): [`method::implicit_midpoint`]), `generalized-alpha`
-//! (acceleration history recomputed at every event: [`method::generalized_alpha`]) and `bathe`
-//! (the constraint held at both sub-step ends; no bilateral wall: [`method::bathe`]).
+//! (acceleration history recomputed at every event: [`method::generalized_alpha`]), `bathe`
+//! (the constraint held at both sub-step ends; no bilateral wall: [`method::bathe`]) and
+//! explicit `central-difference` (positions and velocities projected onto the constraint, no
+//! bilateral wall: [`method::central_difference`]).
 //! Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q
 //! (exact, [`chain::Chain::tip_jacobian`]).
 //! * Detection inside the step: the step is re-solved shortened (Illinois secant on h) until
@@ -113,7 +115,7 @@
 //! * Phase channel `contact1.phase` (0 free, 1 constrained); `contact1.gap`,
 //!   `contact1.normal_velocity`, running maxima `contact1.max_gap`, `contact1.max_normal_velocity`.
 //! * Refused (`unsupported`): unilateral circle surfaces, friction on unilateral contacts,
-//!   several contacts, prescribed joints, central difference, adaptive steps, massless
+//!   several contacts, prescribed joints, adaptive steps, massless
 //!   Timoshenko sections without Kelvin–Voigt (with `implicit-midpoint` or
 //!   `generalized-alpha`: at all). Without contact nothing is allocated.
 //!

@@ -15,18 +15,62 @@
 //! the stiffest one (Kelvin–Voigt damping grows with ω) or the most damped one (a joint damper
 //! on a small inertia): both are found by power iteration, on M⁻¹K and on M⁻¹C, and each
 //! gives the bound with its Rayleigh quotients (κ = xᵀCx/xᵀMx, ω² = xᵀKx/xᵀMx).
+//!
+//! **Held constraint** g(q) = 0 (a tip held on a surface; no Newton iteration to border, so
+//! by projection, as SHAKE and RATTLE do for velocity Verlet), G = ∇g:
+//!
+//! ```text
+//! q₁ = qₙ + h q̇ₙ + (h²/2)(q̈ₙ + M⁻¹Gₙᵀμ),           g(q₁) = target   (μ: chord iteration)
+//! M(q₁) q̈₁ = −(rest of R) + G₁ᵀν,                     G₁ q̇₁ = 0        (ν: with q̈₁)
+//! q̇₁ = q̇ₙ + (h/2)(q̈ₙ + M⁻¹Gₙᵀμ + q̈₁)
+//! ```
+//!
+//! M⁻¹ is the factorization at the predicted end point that the step forms anyway. μ and ν
+//! are the start and end constraint forces: the step stays second order and explicit (one
+//! mass factorization per step, as in free flight), and the held step ends with G₁q̇₁ = 0, so
+//! the driver's drift projection removes nothing. The target of g(q₁) removes the share
+//! (h/h_nominal)² of the start gap, as in the implicit methods, so that the event location's
+//! shortened steps are continuous in h. The constraint's own bound can only raise the
+//! stability bound (a constraint lowers the highest frequency). The driver books the works by
+//! the trapezoidal rule; the constraint forces do work of the order of the scheme's error
+//! (the ledger closure falls 4× per halved step through impacts and held phases). After every
+//! event (restart) of a run that has held a constraint, q̈ₙ is recomputed for the new phase:
+//! with the event's normal force while held (`start::constrained_acceleration`), without after
+//! a release. The bilateral friction wall (stick–slip phases) is refused.
 
+use crate::band::BorderedBand;
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
-    Capabilities, MethodParams, StepConstraint, StepContext, StepState, Stepper, refuse_constraint,
+    Capabilities, MethodParams, StepConstraint, StepContext, StepState, Stepper, start,
 };
-use crate::band::BorderedBand;
 use crate::system::{NewtonCoefficients, System};
 
-/// Central difference (no state of its own).
-#[derive(Debug, Clone, Copy)]
-pub struct CentralDifference;
+/// Iterations of the end-acceleration solve and of the position projection.
+const MAX_ITERATIONS: usize = 20;
+/// Gap accuracy of the position projection of a held step, relative to the length scale.
+const GAP_TOL: f64 = 1e-12;
+
+/// Central difference: the buffers of a held constraint's projections and the restart state.
+#[derive(Debug, Clone)]
+pub struct CentralDifference {
+    /// ∇g at the step start and at its end, and M⁻¹ applied to each.
+    g_start: Vec<f64>,
+    g_end: Vec<f64>,
+    minv_g_start: Vec<f64>,
+    minv_g_end: Vec<f64>,
+    /// The start acceleration of a held step with its projection force (the state's q̈ₙ stays
+    /// as it is: a rejected trial restarts from it).
+    a_start: Vec<f64>,
+    /// Zeros and scratch of the constrained restart.
+    zero: Vec<f64>,
+    before: Vec<f64>,
+    force: Vec<f64>,
+    /// A restart is due: q̈ is recomputed at the next step start (only in runs that have held
+    /// a constraint: elsewhere restarts follow no change of the force law).
+    restart_pending: bool,
+    constrained_before: bool,
+}
 
 impl CentralDifference {
     /// Registry entry: what the method supports.
@@ -34,16 +78,32 @@ impl CentralDifference {
         explicit: true,
         adaptive: false,
         prescribed_joints: true,
-        held_constraint: false,
+        held_constraint: true,
         bilateral_constraint: false,
         projects_massless: false,
         variable_mass: true,
     };
+
+    /// The method for a system of `n` DOFs.
+    pub fn new(n: usize) -> Self {
+        CentralDifference {
+            g_start: vec![0.0; n],
+            g_end: vec![0.0; n],
+            minv_g_start: vec![0.0; n],
+            minv_g_end: vec![0.0; n],
+            a_start: vec![0.0; n],
+            zero: vec![0.0; n],
+            before: vec![0.0; n],
+            force: vec![0.0; n],
+            restart_pending: true,
+            constrained_before: false,
+        }
+    }
 }
 
 impl From<MethodParams> for CentralDifference {
-    fn from(_: MethodParams) -> Self {
-        CentralDifference
+    fn from(p: MethodParams) -> Self {
+        CentralDifference::new(p.n)
     }
 }
 
@@ -51,12 +111,34 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
     fn step(
         &mut self,
         cx: &mut StepContext<'_, S>,
-        constraint: Option<&mut dyn StepConstraint<S>>,
+        mut constraint: Option<&mut dyn StepConstraint<S>>,
         h: f64,
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        refuse_constraint("central-difference", constraint.is_some())?;
+        // After an event (an impact's velocity jump, a release) q̈ₙ is recomputed for the new
+        // phase, with the event's normal force while the constraint is held (module docs).
+        self.constrained_before |= constraint.is_some();
+        if self.restart_pending && self.constrained_before {
+            self.restart_pending = false;
+            let t0 = cx.state.t;
+            match constraint.as_deref_mut() {
+                Some(k) => {
+                    let (zero, before, force) = (&self.zero, &mut self.before, &mut self.force);
+                    start::constrained_acceleration(
+                        cx,
+                        k,
+                        t0,
+                        zero,
+                        before,
+                        force,
+                        "central-difference",
+                    )?
+                }
+                None => start::consistent_acceleration(cx, h, t0)?,
+            }
+        }
+        let t0 = cx.state.t;
         let st = &mut *cx.state;
         let n = st.q.len();
         for i in 0..n {
@@ -70,14 +152,68 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
             c_v: 0.0,
             c_q: 0.0,
         };
-        // M(q1) q̈1 = −rest: R is affine in q̈; iterate on the mass-matrix approximation.
-        for it in 0..20 {
-            cx.system
-                .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
-            cx.counters.rhs += 1;
-            if it == 0 {
-                cx.newton.form(cx.system, st, cx.counters, c, t1)?;
-                cx.newton.matrix_h = f64::NAN;
+        // The mass matrix at the predicted end point, the iteration matrix of every solve of
+        // the step (R is affine in q̈; it misses only the configuration change of a held step's
+        // projection and the O(v′²) terms).
+        cx.system
+            .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
+        cx.counters.rhs += 1;
+        cx.newton.form(cx.system, st, cx.counters, c, t1)?;
+        cx.newton.matrix_h = f64::NAN;
+        if let Some(k) = constraint.as_deref_mut() {
+            // SHAKE: the start acceleration gains M⁻¹∇g(q₀)μ so that g(q₁) reaches its target
+            // (the share (h/h_nominal)² of the start gap removed, as in the implicit methods).
+            let g0 = k.gradient(cx.system, t0, &st.q, &mut self.g_start);
+            cx.newton.delta.copy_from_slice(&self.g_start);
+            cx.newton.solve();
+            self.minv_g_start.copy_from_slice(&cx.newton.delta);
+            let shortened = (h / cx.h_nominal).min(1.0);
+            let target = g0 * (1.0 - shortened * shortened);
+            let slope = 0.5 * h * h * dot(&self.g_start, &self.minv_g_start);
+            let tol = GAP_TOL * cx.length_scale;
+            let mut mu = 0.0;
+            let mut gap = k.value(cx.system, t1, &st.q1);
+            for _ in 0..MAX_ITERATIONS {
+                let off = (gap - target).abs();
+                if off <= tol || off.is_nan() {
+                    break;
+                }
+                let dmu = -(gap - target) / slope;
+                mu += dmu;
+                for i in 0..n {
+                    st.q1[i] += 0.5 * h * h * dmu * self.minv_g_start[i];
+                }
+                gap = k.value(cx.system, t1, &st.q1);
+            }
+            if (gap - target).abs() > tol || gap.is_nan() {
+                return Err(unprojected("position", t0, gap - target));
+            }
+            for i in 0..n {
+                self.a_start[i] = st.qdd[i] + mu * self.minv_g_start[i];
+                st.qd1[i] = st.qd[i] + h * self.a_start[i];
+                st.qdd1[i] = self.a_start[i];
+            }
+            // RATTLE: the end force ∇g(q₁)ν with ν such that ∇g(q₁)·q̇₁ = 0.
+            k.gradient(cx.system, t1, &st.q1, &mut self.g_end);
+            cx.newton.delta.copy_from_slice(&self.g_end);
+            cx.newton.solve();
+            self.minv_g_end.copy_from_slice(&cx.newton.delta);
+        }
+        let held = constraint.is_some();
+        let g_minv_g = dot(&self.g_end, &self.minv_g_end);
+        let mut nu = 0.0;
+        // M(q₁) q̈₁ = −rest (+ ∇g(q₁)ν), by the iteration on the mass matrix.
+        let mut converged = false;
+        for it in 0..MAX_ITERATIONS {
+            if it > 0 {
+                cx.system
+                    .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
+                cx.counters.rhs += 1;
+            }
+            if held {
+                for i in 0..n {
+                    cx.newton.res[i] -= nu * self.g_end[i];
+                }
             }
             cx.newton.delta.copy_from_slice(&cx.newton.res);
             cx.newton.solve();
@@ -85,14 +221,46 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
             for i in 0..n {
                 st.qdd1[i] -= cx.newton.delta[i];
                 big = big.max(cx.newton.delta[i].abs());
-                amax = amax.max(st.qdd1[i].abs());
             }
-            if !big.is_finite() || big <= 1e-12 * amax.max(1e-12) {
+            let mut floor = 0.0;
+            if held {
+                // ∇g(q₁)·(q̇ₙ₊½ + h/2 q̈₁) = 0 for the updated q̈₁; the round-off of that sum,
+                // divided by ½h ∇gᵀM⁻¹∇g, bounds how far the updates can settle.
+                let (mut normal, mut scale) = (0.0, 0.0);
+                for i in 0..n {
+                    let term = self.g_end[i] * (st.qd[i] + 0.5 * h * (self.a_start[i] + st.qdd1[i]));
+                    normal += term;
+                    scale += term.abs();
+                }
+                let dnu = -normal / (0.5 * h * g_minv_g);
+                nu += dnu;
+                for i in 0..n {
+                    st.qdd1[i] += dnu * self.minv_g_end[i];
+                }
+                let reach = max_abs(&self.minv_g_end);
+                big = big.max(dnu.abs() * reach);
+                floor = 16.0 * f64::EPSILON * scale / (0.5 * h * g_minv_g) * reach;
+            }
+            for v in st.qdd1.iter() {
+                amax = amax.max(v.abs());
+            }
+            if !big.is_finite() {
+                break;
+            }
+            if big <= 1e-12 * amax.max(1e-12) + floor {
+                converged = true;
                 break;
             }
         }
+        if held && !converged {
+            return Err(unprojected("velocity", t0, f64::NAN));
+        }
+        if let Some(k) = constraint {
+            k.set_multiplier(nu);
+        }
+        let a0 = if held { &self.a_start } else { &st.qdd };
         for i in 0..n {
-            st.qd1[i] = st.qd[i] + 0.5 * h * (st.qdd[i] + st.qdd1[i]);
+            st.qd1[i] = st.qd[i] + 0.5 * h * (a0[i] + st.qdd1[i]);
             st.a1[i] = st.qdd1[i];
         }
         Ok(None)
@@ -100,6 +268,24 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
 
     fn equal_steps(&self) -> bool {
         true
+    }
+
+    fn restart(&mut self) {
+        self.restart_pending = true;
+    }
+}
+
+/// A held step whose projection onto the constraint did not converge.
+fn unprojected(level: &str, t: f64, residual: f64) -> FemError {
+    FemError::Runaway {
+        t,
+        what: format!(
+            "central-difference: the {level} projection of a held contact step did not \
+             converge (residual {residual:.3e})"
+        ),
+        location: Some("contact1".into()),
+        why: "the step is too large for the constraint's curvature".into(),
+        remedy: "reduce --dt".into(),
     }
 }
 

@@ -17,7 +17,7 @@
 //! * [`bathe`]: Bathe's composite method (trapezoidal half step, then a three-point backward
 //!   difference): second order, no high-frequency ringing, fixed or adaptive steps.
 //!
-//! A held [`StepConstraint`] is accepted by the implicit methods. The two midpoint schemes
+//! A held [`StepConstraint`] is accepted by every method. The two midpoint schemes
 //! take the mean acceleration ā as Newton unknown, q₁ = q₀ + h q̇₀ + (h²/2) ā (border factor
 //! ∂q₁/∂ā = h²/2), and the force is the discrete gradient ∇̄g in the metric M(q̄), so it does
 //! no work over a step. Generalized-α takes q̈₁ (border factor βh²(1−α_f)/(1−α_m)) with the same
@@ -26,8 +26,9 @@
 //! the constraint at the end of each sub-step (border factors h²/16 and h²/9), with the
 //! trapezoidal sub-step's start force balanced as in generalized-α and q̈₀ recomputed at every
 //! event; it refuses the bilateral wall, whose friction work is booked per step
-//! ([`bathe`] docs). Explicit central difference refuses a constraint: it has no Newton
-//! iteration to border, and a constraint force would need its own projection scheme.
+//! ([`bathe`] docs). Explicit central difference has no Newton iteration to border: it holds
+//! the unilateral constraint by projection (start force so that g(q₁) is met, end force so
+//! that ∇g(q₁)·q̇₁ = 0; [`central_difference`] docs) and refuses the bilateral wall.
 //!
 //! Shared machinery: the Newton matrix S = c_a M + c_v C + c_q K and its solver
 //! ([`newton`]), the consistent acceleration of a (re)start ([`start`]), the method–driver
@@ -48,7 +49,7 @@ mod step;
 pub use newton::{JacobianKind, NewtonSystem};
 pub use state::{Adaptive, Counters, FixedStepCounters, StepState, Works};
 pub use step::{ConstraintView, StepConstraint, StepContext, Stepper};
-pub(crate) use step::{HeldConstraint, refuse_constraint, unconverged, update_tolerance};
+pub(crate) use step::{HeldConstraint, unconverged, update_tolerance};
 
 use crate::settings::Method;
 use crate::system::System;

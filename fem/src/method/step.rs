@@ -149,6 +149,9 @@ impl HeldConstraint {
 pub trait StepConstraint<S: System + ?Sized> {
     /// Constraint value g(q) at (t, q).
     fn value(&self, system: &S, t: f64, q: &[f64]) -> f64;
+    /// Constraint value g(q) at (t, q), its gradient ∇g(q) written to `out` (the projections of
+    /// a method without a Newton iteration to border: central difference).
+    fn gradient(&mut self, system: &S, t: f64, q: &[f64], out: &mut [f64]) -> f64;
     /// The multiplier the step starts from (the last accepted step's).
     fn multiplier(&self) -> f64;
     /// Stores the multiplier of a converged step.
@@ -199,16 +202,4 @@ pub trait Stepper<S: System + ?Sized>: std::fmt::Debug {
 
     /// Forgets the previous step (restart after a discontinuity or an event).
     fn restart(&mut self) {}
-}
-
-/// A method without a bordered (constrained) update refuses a held contact (`run` refuses
-/// such scenes first; this guards other drivers).
-pub(crate) fn refuse_constraint(method: &str, held: bool) -> Result<(), FemError> {
-    if held {
-        return Err(FemError::unsupported(format!(
-            "fem {method}: contact constraints are stepped by the implicit methods only \
-             (energy-midpoint, implicit-midpoint, generalized-alpha)"
-        )));
-    }
-    Ok(())
 }

@@ -1,7 +1,7 @@
 //! Unilateral, frictionless tip contact with a fixed rigid line (seed 000, Barhorst's work
-//! surface) for the implicit methods: `energy-midpoint` (the default; the measurements below are
-//! its), `implicit-midpoint` and `generalized-alpha` (same constraint object, see "Methods" at
-//! the end).
+//! surface) for every method: `energy-midpoint` (the default; the measurements below are its),
+//! `implicit-midpoint`, `generalized-alpha`, `bathe` and `central-difference` (same constraint
+//! object, see "Methods" at the end).
 //!
 //! **Gap and Jacobian.** g(q) = n̂·(r_tip(q) − p₀) with n̂ the unit normal to the free side,
 //! G = n̂ᵀJ, J = ∂r_tip/∂q from [`Chain::tip_jacobian`] (exact, O(n), checked against finite
@@ -154,15 +154,18 @@
 //! more slowly through impacts, which excite mesh modes whose energy error the non-conserving
 //! rule reduces as h² only once h ω resolves them. Switching times agree with
 //! energy-midpoint's to O(h²) (`tests/dyn_contact_methods.rs`; measurements in
-//! docs/contact.md).
+//! docs/contact.md). `bathe` holds the constraint at the end of each sub-step, and explicit
+//! `central-difference`, which has no Newton iteration, by projecting its positions and
+//! velocities onto the constraint ([`crate::method`]).
 //!
 //! Refused with `unsupported`: unilateral circle surfaces, friction on a unilateral contact,
 //! more than one contact, contact with prescribed joint motion, contact on Timoshenko links
 //! without rotary inertia and without Kelvin–Voigt damping (above; for a bilateral wall:
 //! without rotary inertia), `implicit-midpoint` or `generalized-alpha` contact on Timoshenko
 //! links without rotary inertia at all (the end rates of the massless rotations:
-//! `crate::run`), contact with `central-difference` (no Newton iteration to border:
-//! [`crate::method`]), and contact with adaptive stepping (`time.rtol`).
+//! `crate::run`), the bilateral wall with `central-difference` or `bathe` (their friction
+//! work and stick multiplier per step: [`crate::method`]), and contact with adaptive stepping
+//! (`time.rtol`).
 //!
 //! **Layout.** This file: the contact's parts, its construction and the gap with its gradient;
 //! `mass`: the solves with M(q) + μNNᵀ; `force`: the index-1 normal force; `impact`: the impact

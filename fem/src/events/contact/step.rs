@@ -14,6 +14,10 @@ impl StepConstraint<Chain> for Contact {
         self.gap_at(chain, t, q)
     }
 
+    fn gradient(&mut self, chain: &Chain, t: f64, q: &[f64], out: &mut [f64]) -> f64 {
+        Contact::gradient(self, chain, t, q, out)
+    }
+
     fn multiplier(&self) -> f64 {
         self.constraint.step_lambda
     }
