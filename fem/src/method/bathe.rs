@@ -62,6 +62,7 @@
 //! step, not per sub-step.
 
 use crate::error::FemError;
+use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
     Capabilities, HeldConstraint, MethodParams, StepConstraint, StepContext,
@@ -86,10 +87,8 @@ pub struct Bathe {
     held: HeldConstraint,
     q_start: Vec<f64>,
     q_bar: Vec<f64>,
-    /// q̈₀ must be made consistent with the contact phase before the next step (module docs).
-    restart_pending: bool,
-    /// A constraint was held in an earlier step (or is held now): restarts then recompute q̈₀.
-    constrained_before: bool,
+    /// When q̈₀ is made consistent with the contact phase (module docs).
+    restart: EventRestart,
     /// The constraint force in q̈₀ (the last step's end force, or the restart's) and the end
     /// force of the step being solved (module docs, work balance).
     force_start: Vec<f64>,
@@ -180,8 +179,7 @@ impl Bathe {
             held: HeldConstraint::new(n),
             q_start: vec![0.0; n],
             q_bar: vec![0.0; n],
-            restart_pending: true,
-            constrained_before: false,
+            restart: EventRestart::new(),
             force_start: vec![0.0; n],
             force_end: vec![0.0; n],
             works: SubStepWorks::new(n),
@@ -458,26 +456,17 @@ impl<S: System + ?Sized> Stepper<S> for Bathe {
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        // Runs that never held a constraint keep the q̈₀ the driver's start gave.
-        self.constrained_before |= constraint.is_some();
-        if self.restart_pending && self.constrained_before {
-            self.restart_pending = false;
-            let t0 = cx.state.t;
-            match constraint.as_deref_mut() {
-                Some(k) => {
-                    let (zero, before) = (&self.held.zero, &mut self.held.res);
-                    start::constrained_acceleration(
-                        cx,
-                        k,
-                        t0,
-                        zero,
-                        before,
-                        &mut self.force_start,
-                        "bathe",
-                    )?
-                }
-                None => start::consistent_acceleration(cx, h, t0)?,
-            }
+        if self.restart.due(constraint.is_some()) {
+            let (zero, before) = (&self.held.zero, &mut self.held.res);
+            start::phase_acceleration(
+                cx,
+                constraint.as_deref_mut(),
+                h,
+                zero,
+                before,
+                &mut self.force_start,
+                "bathe",
+            )?;
         }
         let g0 = match constraint.as_deref() {
             Some(k) => k.value(cx.system, cx.state.t, &cx.state.q),
@@ -523,7 +512,7 @@ impl<S: System + ?Sized> Stepper<S> for Bathe {
     }
 
     fn restart(&mut self) {
-        self.restart_pending = true;
+        self.restart.request();
     }
 
     fn commit(&mut self, _h: f64, works: &mut Works) -> bool {

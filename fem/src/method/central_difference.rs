@@ -40,6 +40,7 @@
 
 use crate::band::BorderedBand;
 use crate::error::FemError;
+use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
     Capabilities, MethodParams, StepConstraint, StepContext, StepState, Stepper, start,
@@ -66,10 +67,8 @@ pub struct CentralDifference {
     zero: Vec<f64>,
     before: Vec<f64>,
     force: Vec<f64>,
-    /// A restart is due: q̈ is recomputed at the next step start (only in runs that have held
-    /// a constraint: elsewhere restarts follow no change of the force law).
-    restart_pending: bool,
-    constrained_before: bool,
+    /// When q̈ₙ is recomputed for the phase (module docs).
+    restart: EventRestart,
 }
 
 impl CentralDifference {
@@ -95,8 +94,7 @@ impl CentralDifference {
             zero: vec![0.0; n],
             before: vec![0.0; n],
             force: vec![0.0; n],
-            restart_pending: true,
-            constrained_before: false,
+            restart: EventRestart::new(),
         }
     }
 }
@@ -118,25 +116,17 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
     ) -> Result<Option<f64>, FemError> {
         // After an event (an impact's velocity jump, a release) q̈ₙ is recomputed for the new
         // phase, with the event's normal force while the constraint is held (module docs).
-        self.constrained_before |= constraint.is_some();
-        if self.restart_pending && self.constrained_before {
-            self.restart_pending = false;
-            let t0 = cx.state.t;
-            match constraint.as_deref_mut() {
-                Some(k) => {
-                    let (zero, before, force) = (&self.zero, &mut self.before, &mut self.force);
-                    start::constrained_acceleration(
-                        cx,
-                        k,
-                        t0,
-                        zero,
-                        before,
-                        force,
-                        "central-difference",
-                    )?
-                }
-                None => start::consistent_acceleration(cx, h, t0)?,
-            }
+        if self.restart.due(constraint.is_some()) {
+            let (zero, before, force) = (&self.zero, &mut self.before, &mut self.force);
+            start::phase_acceleration(
+                cx,
+                constraint.as_deref_mut(),
+                h,
+                zero,
+                before,
+                force,
+                "central-difference",
+            )?;
         }
         let t0 = cx.state.t;
         let st = &mut *cx.state;
@@ -271,7 +261,7 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
     }
 
     fn restart(&mut self) {
-        self.restart_pending = true;
+        self.restart.request();
     }
 }
 

@@ -43,6 +43,7 @@
 //! the current friction phase), by Newton with S = M.
 
 use crate::error::FemError;
+use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
     Capabilities, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, Works,
@@ -82,11 +83,8 @@ const MAX_ITERATIONS: usize = 30;
 #[derive(Debug, Clone)]
 pub struct GeneralizedAlpha {
     params: AlphaParams,
-    /// The acceleration history must be made consistent before the next step (module docs).
-    restart_pending: bool,
-    /// A constraint was held in an earlier step (or is held now): restarts then recompute the
-    /// history.
-    constrained_before: bool,
+    /// When the acceleration history is made consistent with the phase (module docs).
+    restart: EventRestart,
     /// q̄ = (q₀ + q₁)/2 of the iterate.
     q_mid: Vec<f64>,
     held: HeldConstraint,
@@ -119,25 +117,12 @@ impl GeneralizedAlpha {
     pub fn new(rho_inf: f64, n: usize) -> Self {
         GeneralizedAlpha {
             params: AlphaParams::from_rho(rho_inf),
-            restart_pending: true,
-            constrained_before: false,
+            restart: EventRestart::new(),
             q_mid: vec![0.0; n],
             held: HeldConstraint::new(n),
             force_start: vec![0.0; n],
             force_end: vec![0.0; n],
         }
-    }
-
-    /// q̈ₙ = aₙ consistent with the held constraint at the step start (module docs); keeps the
-    /// constraint force applied as the next step's start force.
-    fn constrained_start<S: System + ?Sized>(
-        &mut self,
-        cx: &mut StepContext<'_, S>,
-        k: &mut dyn StepConstraint<S>,
-        t_law: f64,
-    ) -> Result<(), FemError> {
-        let (zero, before, force) = (&self.held.zero, &mut self.held.res, &mut self.force_start);
-        start::constrained_acceleration(cx, k, t_law, zero, before, force, "generalized-alpha")
     }
 }
 
@@ -150,16 +135,17 @@ impl<S: System + ?Sized> Stepper<S> for GeneralizedAlpha {
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        // Runs that never held a constraint keep the history the driver's start gave
-        // (their restarts follow no change of the force law).
-        self.constrained_before |= constraint.is_some();
-        if self.restart_pending && self.constrained_before {
-            self.restart_pending = false;
-            let t0 = cx.state.t;
-            match constraint.as_deref_mut() {
-                Some(k) => self.constrained_start(cx, k, t0)?,
-                None => start::consistent_acceleration(cx, h, t0)?,
-            }
+        if self.restart.due(constraint.is_some()) {
+            let (zero, before, force) = (&self.held.zero, &mut self.held.res, &mut self.force_start);
+            start::phase_acceleration(
+                cx,
+                constraint.as_deref_mut(),
+                h,
+                zero,
+                before,
+                force,
+                "generalized-alpha",
+            )?;
         }
         let st = &mut *cx.state;
         let AlphaParams {
@@ -313,6 +299,6 @@ impl<S: System + ?Sized> Stepper<S> for GeneralizedAlpha {
     }
 
     fn restart(&mut self) {
-        self.restart_pending = true;
+        self.restart.request();
     }
 }
