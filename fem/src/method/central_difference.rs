@@ -35,7 +35,7 @@
 //! the trapezoidal rule; the constraint forces do work of the order of the scheme's error
 //! (the ledger closure falls 4× per halved step through impacts and held phases). After every
 //! event (restart) of a run that has held a constraint, q̈ₙ is recomputed for the new phase:
-//! with the event's normal force while held (`start::constrained_acceleration`), without after
+//! with the event's normal force while held (`start::phase_acceleration`), without after
 //! a release. The bilateral friction wall (stick–slip phases) is refused.
 
 use crate::band::BorderedBand;

@@ -133,7 +133,7 @@ pub(crate) fn phase_acceleration<S: System + ?Sized>(
 /// a view of zero length (∇̄g = ∇g(q)). `zero` holds zeros; `before` is scratch; `force`
 /// receives the constraint force applied. `method` names the method in the error.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn constrained_acceleration<S: System + ?Sized>(
+fn constrained_acceleration<S: System + ?Sized>(
     cx: &mut StepContext<'_, S>,
     constraint: &mut dyn StepConstraint<S>,
     t_law: f64,
