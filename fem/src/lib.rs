@@ -81,7 +81,7 @@
 //! ([`events::contact`]), with every method: `energy-midpoint` (described here),
 //! `implicit-midpoint` (ledger O(h²): [`method::implicit_midpoint`]), `generalized-alpha`
 //! (acceleration history recomputed at every event: [`method::generalized_alpha`]), `bathe`
-//! (the constraint held at both sub-step ends; no bilateral wall: [`method::bathe`]) and
+//! (the constraint held at both sub-step ends: [`method::bathe`]) and
 //! explicit `central-difference` (positions and velocities projected onto the constraint, no
 //! bilateral wall: [`method::central_difference`]).
 //! Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q

@@ -25,8 +25,8 @@
 //! recomputes its acceleration history at every event ([`generalized_alpha`] docs). Bathe holds
 //! the constraint at the end of each sub-step (border factors h²/16 and h²/9), with the
 //! trapezoidal sub-step's start force balanced as in generalized-α and q̈₀ recomputed at every
-//! event; it refuses the bilateral wall, whose friction work is booked per step
-//! ([`bathe`] docs). Explicit central difference has no Newton iteration to border: it holds
+//! event; on the bilateral wall the friction work of both sub-steps adds up
+//! ([`StepConstraint::start_sub_step`], [`bathe`] docs). Explicit central difference has no Newton iteration to border: it holds
 //! the unilateral constraint by projection (start force so that g(q₁) is met, end force so
 //! that ∇g(q₁)·q̇₁ = 0; [`central_difference`] docs) and refuses the bilateral wall.
 //!

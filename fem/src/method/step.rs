@@ -156,6 +156,10 @@ pub trait StepConstraint<S: System + ?Sized> {
     fn multiplier(&self) -> f64;
     /// Stores the multiplier of a converged step.
     fn set_multiplier(&mut self, lambda: f64);
+    /// A composite method starts a sub-step of its step (`first`: the step's first): what the
+    /// constraint books over a step (a wall's friction work) restarts at the first sub-step
+    /// and accumulates over the later ones. Single-stage methods never call it.
+    fn start_sub_step(&mut self, _first: bool) {}
     /// Subtracts the constraint force (and friction) of the iterate from the momentum
     /// residual `res`; returns the constraint value Newton must drive to its target.
     fn add_force(&mut self, system: &S, view: &ConstraintView<'_>, res: &mut [f64]) -> f64;

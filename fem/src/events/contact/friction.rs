@@ -190,6 +190,9 @@ pub struct WallConstraint {
     pub(crate) h1: f64,
     /// Friction work of the step being solved (booked when it is accepted).
     pub(crate) pending_work: f64,
+    /// Friction work of the step's earlier sub-steps (a composite method's), which
+    /// `pending_work` includes.
+    pub(crate) work_before: f64,
     pub(crate) jac: Vec<f64>,
     pub(crate) g_row: Vec<f64>,
     pub(crate) t_row: Vec<f64>,
@@ -273,6 +276,7 @@ impl Bilateral {
                 g1: 0.0,
                 h1: 0.0,
                 pending_work: 0.0,
+                work_before: 0.0,
                 jac: vec![0.0; 2 * n],
                 g_row: z.clone(),
                 t_row: z.clone(),
@@ -411,7 +415,7 @@ pub(crate) fn midpoint_terms(
     let Some(b) = c.bilateral.as_deref_mut() else {
         return gap1;
     };
-    b.constraint.pending_work = 0.0;
+    b.constraint.pending_work = b.constraint.work_before;
     if b.constraint.mu == 0.0 {
         return gap1;
     }
@@ -426,7 +430,8 @@ pub(crate) fn midpoint_terms(
             res[i] += k * v.lambda * b.constraint.t_row[i];
             c.constraint.g_bar[i] -= k * b.constraint.t_row[i];
         }
-        b.constraint.pending_work = k * v.lambda * dot(v.dq, &b.constraint.t_row);
+        b.constraint.pending_work =
+            b.constraint.work_before + k * v.lambda * dot(v.dq, &b.constraint.t_row);
         return gap1;
     }
     if v.it == 0 {

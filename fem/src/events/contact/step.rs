@@ -26,6 +26,16 @@ impl StepConstraint<Chain> for Contact {
         self.constraint.step_lambda = lambda;
     }
 
+    fn start_sub_step(&mut self, first: bool) {
+        if let Some(b) = self.bilateral.as_deref_mut() {
+            b.constraint.work_before = if first {
+                0.0
+            } else {
+                b.constraint.pending_work
+            };
+        }
+    }
+
     fn add_force(&mut self, chain: &Chain, v: &ConstraintView<'_>, res: &mut [f64]) -> f64 {
         let c = self;
         let n = res.len();
