@@ -30,8 +30,8 @@
 //! mass factorization per step, as in free flight), and the held step ends with G₁q̇₁ = 0, so
 //! the driver's drift projection removes nothing. The target of g(q₁) removes the share
 //! (h/h_nominal)² of the start gap, as in the implicit methods, so that the event location's
-//! shortened steps are continuous in h. The constraint's own bound can only raise the
-//! stability bound (a constraint lowers the highest frequency). The driver books the works by
+//! shortened steps are continuous in h. The free chain's bound also covers the held phases
+//! (a constraint can only lower the highest frequency). The driver books the works by
 //! the trapezoidal rule; the constraint forces do work of the order of the scheme's error
 //! (the ledger closure falls 4× per halved step through impacts and held phases). After every
 //! event (restart) of a run that has held a constraint, q̈ₙ is recomputed for the new phase:
