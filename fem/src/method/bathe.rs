@@ -73,7 +73,7 @@ use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
     Capabilities, HeldConstraint, MethodParams, StepConstraint, StepContext,
-    StepState, Stepper, Works, start, unconverged, update_tolerance,
+    StepState, Stepper, Works, unconverged, update_tolerance,
 };
 use crate::system::Parts;
 use crate::system::{NewtonCoefficients, System};
@@ -186,7 +186,7 @@ impl Bathe {
             held: HeldConstraint::new(n),
             q_start: vec![0.0; n],
             q_bar: vec![0.0; n],
-            restart: EventRestart::new(),
+            restart: EventRestart::new(n),
             force_start: vec![0.0; n],
             force_end: vec![0.0; n],
             works: SubStepWorks::new(n),
@@ -463,18 +463,13 @@ impl<S: System + ?Sized> Stepper<S> for Bathe {
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        if self.restart.due(constraint.is_some()) {
-            let (zero, before) = (&self.held.zero, &mut self.held.res);
-            start::phase_acceleration(
-                cx,
-                constraint.as_deref_mut(),
-                h,
-                zero,
-                before,
-                &mut self.force_start,
-                "bathe",
-            )?;
-        }
+        self.restart.apply(
+            cx,
+            constraint.as_deref_mut(),
+            h,
+            &mut self.force_start,
+            "bathe",
+        )?;
         let g0 = match constraint.as_deref() {
             Some(k) => k.value(cx.system, cx.state.t, &cx.state.q),
             None => 0.0,

@@ -35,7 +35,7 @@
 //! the trapezoidal rule; the constraint forces do work of the order of the scheme's error
 //! (the ledger closure falls 4× per halved step through impacts and held phases). After every
 //! event (restart) of a run that has held a constraint, q̈ₙ is recomputed for the new phase:
-//! with the event's normal force while held (`start::phase_acceleration`), without after
+//! with the event's normal force while held (`start::EventRestart`), without after
 //! a release. The bilateral friction wall (stick–slip phases) is refused.
 
 use crate::band::BorderedBand;
@@ -43,8 +43,7 @@ use crate::error::FemError;
 use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
-    Capabilities, MethodParams, StepConstraint, StepContext, StepState, Stepper, start,
-};
+    Capabilities, MethodParams, StepConstraint, StepContext, StepState, Stepper, };
 use crate::system::{NewtonCoefficients, System};
 
 /// Iterations of the end-acceleration solve and of the position projection.
@@ -63,9 +62,8 @@ pub struct CentralDifference {
     /// The start acceleration of a held step with its projection force (the state's q̈ₙ stays
     /// as it is: a rejected trial restarts from it).
     a_start: Vec<f64>,
-    /// Zeros and scratch of the constrained restart.
-    zero: Vec<f64>,
-    before: Vec<f64>,
+    /// The constraint force of a restart's q̈ₙ (scratch: the start force is re-solved by the
+    /// projection).
     force: Vec<f64>,
     /// When q̈ₙ is recomputed for the phase (module docs).
     restart: EventRestart,
@@ -91,10 +89,8 @@ impl CentralDifference {
             minv_g_start: vec![0.0; n],
             minv_g_end: vec![0.0; n],
             a_start: vec![0.0; n],
-            zero: vec![0.0; n],
-            before: vec![0.0; n],
             force: vec![0.0; n],
-            restart: EventRestart::new(),
+            restart: EventRestart::new(n),
         }
     }
 }
@@ -116,18 +112,13 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
     ) -> Result<Option<f64>, FemError> {
         // After an event (an impact's velocity jump, a release) q̈ₙ is recomputed for the new
         // phase, with the event's normal force while the constraint is held (module docs).
-        if self.restart.due(constraint.is_some()) {
-            let (zero, before, force) = (&self.zero, &mut self.before, &mut self.force);
-            start::phase_acceleration(
-                cx,
-                constraint.as_deref_mut(),
-                h,
-                zero,
-                before,
-                force,
-                "central-difference",
-            )?;
-        }
+        self.restart.apply(
+            cx,
+            constraint.as_deref_mut(),
+            h,
+            &mut self.force,
+            "central-difference",
+        )?;
         let t0 = cx.state.t;
         let st = &mut *cx.state;
         let n = st.q.len();

@@ -47,7 +47,6 @@ use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
     Capabilities, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, Works,
-    start,
     unconverged, update_tolerance,
 };
 use crate::system::{NewtonCoefficients, System};
@@ -117,7 +116,7 @@ impl GeneralizedAlpha {
     pub fn new(rho_inf: f64, n: usize) -> Self {
         GeneralizedAlpha {
             params: AlphaParams::from_rho(rho_inf),
-            restart: EventRestart::new(),
+            restart: EventRestart::new(n),
             q_mid: vec![0.0; n],
             held: HeldConstraint::new(n),
             force_start: vec![0.0; n],
@@ -135,18 +134,13 @@ impl<S: System + ?Sized> Stepper<S> for GeneralizedAlpha {
         t1: f64,
         t_law: f64,
     ) -> Result<Option<f64>, FemError> {
-        if self.restart.due(constraint.is_some()) {
-            let (zero, before, force) = (&self.held.zero, &mut self.held.res, &mut self.force_start);
-            start::phase_acceleration(
-                cx,
-                constraint.as_deref_mut(),
-                h,
-                zero,
-                before,
-                force,
-                "generalized-alpha",
-            )?;
-        }
+        self.restart.apply(
+            cx,
+            constraint.as_deref_mut(),
+            h,
+            &mut self.force_start,
+            "generalized-alpha",
+        )?;
         let st = &mut *cx.state;
         let AlphaParams {
             alpha_m,

@@ -72,21 +72,27 @@ pub fn accelerate_with<S: System + ?Sized>(
     })
 }
 
-/// When a method that carries q̈ₙ from step to step recomputes it for the phase a step starts
-/// in: after every event (impact, release: [`crate::method::Stepper::restart`]) of a run that
-/// has held a constraint, and at the first held step. Runs that never held one keep the q̈₀ of
-/// the driver's start (their restarts follow no change of the force law).
+/// When and how a method that carries q̈ₙ from step to step recomputes it for the phase a step
+/// starts in: after every event (impact, release: [`crate::method::Stepper::restart`]) of a run
+/// that has held a constraint, and at the first held step. Runs that never held one keep the
+/// q̈₀ of the driver's start (their restarts follow no change of the force law).
 #[derive(Debug, Clone)]
 pub(crate) struct EventRestart {
     pending: bool,
     constrained_before: bool,
+    /// Zeros (the zero-length view of the constrained start) and scratch.
+    zero: Vec<f64>,
+    before: Vec<f64>,
 }
 
 impl EventRestart {
-    pub fn new() -> Self {
+    /// For a system of `n` DOFs.
+    pub fn new(n: usize) -> Self {
         EventRestart {
             pending: true,
             constrained_before: false,
+            zero: vec![0.0; n],
+            before: vec![0.0; n],
         }
     }
 
@@ -95,35 +101,30 @@ impl EventRestart {
         self.pending = true;
     }
 
-    /// Whether q̈ₙ must be recomputed at this step start (`held`: the step holds a
-    /// constraint); clears the request.
-    pub fn due(&mut self, held: bool) -> bool {
-        self.constrained_before |= held;
-        let due = self.pending && self.constrained_before;
-        if due {
-            self.pending = false;
+    /// At a step start: when a restart is due, q̈ₙ for the phase the step is in, with the held
+    /// constraint's force (the event's normal force, [`constrained_acceleration`]; `force`
+    /// receives the force applied) or free ([`consistent_acceleration`]). `method` names the
+    /// method in an error.
+    pub fn apply<S: System + ?Sized>(
+        &mut self,
+        cx: &mut StepContext<'_, S>,
+        constraint: Option<&mut (dyn StepConstraint<S> + '_)>,
+        h: f64,
+        force: &mut [f64],
+        method: &str,
+    ) -> Result<(), FemError> {
+        self.constrained_before |= constraint.is_some();
+        if !(self.pending && self.constrained_before) {
+            return Ok(());
         }
-        due
-    }
-}
-
-/// q̈ₙ at the step start for the phase the step is in: with the held constraint's force (the
-/// event's normal force, [`constrained_acceleration`]) or free ([`consistent_acceleration`]).
-/// `zero`, `before` and `force` as for [`constrained_acceleration`].
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn phase_acceleration<S: System + ?Sized>(
-    cx: &mut StepContext<'_, S>,
-    constraint: Option<&mut (dyn StepConstraint<S> + '_)>,
-    h: f64,
-    zero: &[f64],
-    before: &mut [f64],
-    force: &mut [f64],
-    method: &str,
-) -> Result<(), FemError> {
-    let t0 = cx.state.t;
-    match constraint {
-        Some(k) => constrained_acceleration(cx, k, t0, zero, before, force, method),
-        None => consistent_acceleration(cx, h, t0),
+        self.pending = false;
+        let t0 = cx.state.t;
+        match constraint {
+            Some(k) => {
+                constrained_acceleration(cx, k, t0, &self.zero, &mut self.before, force, method)
+            }
+            None => consistent_acceleration(cx, h, t0),
+        }
     }
 }
 
