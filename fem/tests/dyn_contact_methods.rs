@@ -293,6 +293,9 @@ fn dyn_central_difference_steps_unilateral_contact_to_second_order() {
     let ref_switches = switches(&reference);
     assert!(ref_switches.len() >= 4, "{ref_switches:?}");
     let steps = [1e-5, 5e-6, 2.5e-6];
+    let pc = sc.planar_chain().unwrap();
+    let longest = pc.links.iter().fold(0.0f64, |m, l| m.max(l.length));
+    let gap_tol = fem::events::contact::GAP_TOL * longest;
     let mut runs = Vec::new();
     for &dt in &steps {
         let r = run(&sc, "central-difference", Some(4), dt, t_end);
@@ -302,11 +305,16 @@ fn dyn_central_difference_steps_unilateral_contact_to_second_order() {
             "dt = {dt}: the same contact phases as the reference"
         );
         assert_plastic_impacts(&r);
-        // Held steps end on the surface (the projection's tolerance) with G q̇ = 0 (RATTLE), so
-        // the driver's drift projection removes nothing.
+        // Held steps end on the surface — within the gap tolerance of a located contact start,
+        // which a shortened step's target keeps a share of (measured 1.1e-11 ft) — with G q̇ = 0
+        // to round-off (RATTLE; measured 1.4e-14 ft/s), so the driver's drift projection
+        // removes nothing.
         let last = |name: &str| *channel(&r, name).last().unwrap();
-        assert!(last("contact1.max_gap") <= 1e-10, "dt = {dt}");
-        assert!(last("contact1.max_normal_velocity") <= 1e-10, "dt = {dt}");
+        assert!(last("contact1.max_gap") <= gap_tol, "dt = {dt}");
+        assert!(
+            last("contact1.max_normal_velocity") <= 1e-12 * tip_speed(&r, longest),
+            "dt = {dt}"
+        );
         runs.push(r);
     }
     // Successive differences of the joint-1 history, of the switching times and of the ledger
@@ -364,15 +372,24 @@ fn dyn_bathe_holds_the_friction_wall_and_books_the_friction_of_both_sub_steps() 
     let mut closure = Vec::new();
     for dt in [2.5e-4, 1.25e-4, 6.25e-5] {
         let b = run(&sc, "bathe", None, dt, t_end);
-        // The stick is located to the friction rules' trial-step floor (module docs of
-        // fem::events::contact::friction; measured 3.0e-6, 3.3e-6, 1.3e-6 s, energy-midpoint
-        // 2.1e-6, 2.0e-6, 2.9e-6 s at the same steps).
-        let stick = first_stick(&b);
+        let em = run(&sc, "energy-midpoint", None, dt, t_end);
+        // As accurate as energy-midpoint at the same step, within a factor 2: the first stick
+        // (measured 3.0e-6, 3.3e-6, 1.3e-6 s against 2.1e-6, 2.0e-6, 2.9e-6 s) and the
+        // joint-1 angle (1.2e-5, 5.0e-6, 2.2e-6 rad against 1.2e-5, 2.8e-6, 1.9e-6 rad).
+        let stick_error = |r: &RunResult| (first_stick(r) - ref_stick).abs();
         assert!(
-            (stick - ref_stick).abs() <= 5e-6,
-            "dt = {dt}: stick at {stick}"
+            stick_error(&b) <= 2.0 * stick_error(&em),
+            "dt = {dt}: first stick {:.2e} s off, energy-midpoint {:.2e} s",
+            stick_error(&b),
+            stick_error(&em)
         );
-        angle_error.push(max_diff(channel(&b, "joint1.angle"), ref_angle));
+        let angle = max_diff(channel(&b, "joint1.angle"), ref_angle);
+        let em_angle = max_diff(channel(&em, "joint1.angle"), ref_angle);
+        assert!(
+            angle <= 2.0 * em_angle,
+            "dt = {dt}: joint-1 angle {angle:.2e} rad off, energy-midpoint {em_angle:.2e}"
+        );
+        angle_error.push(angle);
         // The friction work of both sub-steps is booked (with the second's alone the closure
         // was 3.9e-2 at the default step, 0.5 s).
         let c = b.ledger.relative_closure();
@@ -382,9 +399,9 @@ fn dyn_bathe_holds_the_friction_wall_and_books_the_friction_of_both_sub_steps() 
     // Both fall at least 1.8× per halving (measured: joint-1 angle 1.2e-5, 5.0e-6, 2.2e-6 rad;
     // closure 3.8e-4, 1.9e-4, 8.9e-5). The start-up switches (the flexible link's
     // non-minimum-phase response to the hub torque, friction rule 2) keep both methods from
-    // their asymptotic order on this stretch: energy-midpoint's angle errors are 1.2e-5,
-    // 2.8e-6, 1.9e-6 rad; its ledger closes by construction, Bathe's backward difference does
-    // not (as on the unilateral contact's held phases, docs/contact.md).
+    // their asymptotic order on this stretch; energy-midpoint's ledger closes by construction,
+    // Bathe's backward difference does not (as on the unilateral contact's held phases,
+    // docs/contact.md).
     for (what, d) in [
         ("joint-1 angle", &angle_error),
         ("ledger closure", &closure),
@@ -397,6 +414,15 @@ fn dyn_bathe_holds_the_friction_wall_and_books_the_friction_of_both_sub_steps() 
             );
         }
     }
+}
+
+/// A speed scale of a two-link run: its largest joint rate times `length`.
+fn tip_speed(r: &RunResult, length: f64) -> f64 {
+    let rate = ["joint1.rate", "joint2.rate"]
+        .iter()
+        .flat_map(|c| channel(r, c).iter())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    rate * length
 }
 
 fn channel<'a>(r: &'a RunResult, name: &str) -> &'a [f64] {

@@ -181,10 +181,15 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
             self.minv_g_end.copy_from_slice(&cx.newton.delta);
         }
         let held = constraint.is_some();
-        let g_minv_g = dot(&self.g_end, &self.minv_g_end);
+        let g_minv_g = if held {
+            dot(&self.g_end, &self.minv_g_end)
+        } else {
+            0.0
+        };
         let mut nu = 0.0;
         // M(q₁) q̈₁ = −rest (+ ∇g(q₁)ν), by the iteration on the mass matrix.
         let mut converged = false;
+        let mut last = f64::NAN;
         for it in 0..MAX_ITERATIONS {
             if it > 0 {
                 cx.system
@@ -225,6 +230,7 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
             for v in st.qdd1.iter() {
                 amax = amax.max(v.abs());
             }
+            last = big;
             if !big.is_finite() {
                 break;
             }
@@ -234,7 +240,7 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
             }
         }
         if held && !converged {
-            return Err(unprojected("velocity", t0, f64::NAN));
+            return Err(unprojected("velocity", t0, last));
         }
         if let Some(k) = constraint {
             k.set_multiplier(nu);
@@ -256,7 +262,8 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
     }
 }
 
-/// A held step whose projection onto the constraint did not converge.
+/// A held step whose projection onto the constraint did not converge (`residual`: the last gap
+/// error, or the last acceleration update of the velocity projection).
 fn unprojected(level: &str, t: f64, residual: f64) -> FemError {
     FemError::Runaway {
         t,
