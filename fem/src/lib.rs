@@ -68,8 +68,8 @@
 //! ([`run::UNDAMPED_STEPS_PER_PERIOD`]), T₁/100 with a unilateral contact
 //! ([`run::CONTACT_STEPS_PER_PERIOD`]: impacts and held phases) — fitted to divide the output
 //! interval. Central
-//! difference: 2/(κ + √(κ² + ω²)) of the stiffest and of the most damped mode (power
-//! iterations on the linearized K, C, M at t = 0; 2/ω_max undamped); a user step above it is
+//! difference: 2/ω_max of the stiffest mode (power iteration on the linearized K, M at t = 0;
+//! the damping is implicit in its step and does not lower it); a user step above it is
 //! refused, the automatic step is 0.9× it. On request also the implicit midpoint rule
 //! `implicit-midpoint` (one-stage Gauss, second order, no numerical damping, works booked by the
 //! trapezoidal rule: [`method::implicit_midpoint`]) and Bathe's composite method `bathe`

@@ -343,8 +343,7 @@ pub fn prepare(
                 return Err(FemError::StabilityBound {
                     dt,
                     bound,
-                    bound_kind: "central-difference (2/(κ + √(κ² + ω²)) of the binding mode)"
-                        .into(),
+                    bound_kind: crate::method::central_difference::BOUND_KIND.into(),
                     location,
                 });
             }

@@ -44,8 +44,11 @@ impl Driver {
             // stable but strongly non-normal map, and a periodic pattern of full steps plus one
             // short step per output interval composes into an unstable map (measured: spin-up at
             // 0.99 × 2/ω_max, 83 full + 1 short step per 0.01 s, diverged at t ≈ 0.32 s while
-            // ω_max stayed constant to 1e-9). Every step is ≤ h_nominal (up to 1e-9 relative).
-            let n = (span / self.h_nominal * (1.0 - 1e-9)).ceil().max(1.0);
+            // ω_max stayed constant to 1e-9). Every step is ≤ h (up to 1e-9 relative): h_nominal,
+            // or the quarter step of a retried stretch while it grows back.
+            let n = (span / self.h.min(self.h_nominal) * (1.0 - 1e-9))
+                .ceil()
+                .max(1.0);
             span / n
         } else {
             self.h.min(span)

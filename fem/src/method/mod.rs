@@ -9,8 +9,8 @@
 //!
 //! * [`generalized_alpha`]: implicit generalized-α (Chung–Hulbert, Arnold–Brüls form),
 //!   fixed or adaptive steps;
-//! * [`central_difference`]: explicit central difference (velocity-Verlet form) under its
-//!   stability bound 2/(κ + √(κ² + ω²)) (2/ω_max undamped);
+//! * [`central_difference`]: explicit central difference (velocity-Verlet form, the damping
+//!   implicit at the end velocity) under its stability bound 2/ω_max;
 //! * [`energy_midpoint`]: the energy-consistent midpoint (discrete-gradient) scheme;
 //! * [`implicit_midpoint`]: the implicit midpoint rule (one-stage Gauss), fixed or adaptive
 //!   steps.

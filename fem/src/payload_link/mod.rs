@@ -56,8 +56,8 @@
 //! the output times and the motor law's switches, works booked with the midpoint rule,
 //! Kelvin–Voigt per damped field. Methods: `implicit-midpoint` (the default), `generalized-alpha`
 //! (ρ∞ = 0.9 with the axial field, else 1), `energy-midpoint`, `bathe`, and `central-difference`
-//! (its step under the damped bound of [`crate::method::central_difference::stability_bound`]:
-//! with Kelvin–Voigt damping of the kHz axial and torsion modes far below 2/ω_max). Adaptive
+//! (its step under 2/ω_max, [`crate::method::central_difference::stability_bound`]: the
+//! Kelvin–Voigt damping of the kHz axial and torsion modes is implicit in it). Adaptive
 //! steps are refused.
 //! Default mesh 16 elements ([`crate::settings::DEFAULT_ELEMENTS`]); default step of the implicit
 //! methods [`default_step`]: the largest step (fitted to divide the output interval) whose
@@ -739,9 +739,7 @@ pub fn prepare(
                     return Err(FemError::StabilityBound {
                         dt,
                         bound,
-                        bound_kind: "central-difference (2/(κ + √(κ² + ω²)) of the binding \
-                                     mode)"
-                            .into(),
+                        bound_kind: crate::method::central_difference::BOUND_KIND.into(),
                         location: describe_dof(&driver.steps.system.model, dof),
                     });
                 }

@@ -178,9 +178,10 @@ pub fn prepare(scene: &Scene, r: &Rocket, settings: &FemSettings) -> Result<Prep
                 return Err(FemError::StabilityBound {
                     dt,
                     bound: bound.0,
-                    bound_kind: "central-difference (2/(κ + √(κ² + ω²)) of the binding mode, \
-                                 at the run's smallest mass)"
-                        .into(),
+                    bound_kind: format!(
+                        "{}, at the run's smallest mass",
+                        crate::method::central_difference::BOUND_KIND
+                    ),
                     location: describe_dof(&driver.steps.system.model, bound.1),
                 });
             }
