@@ -9,7 +9,8 @@
 //! (`contact-timoshenko-0.35s`: its first impact and micro-bounces, bound by event location);
 //! the forces of one energy-midpoint iteration at q̄ with and without the shared kinematic pass
 //! (`midpoint-forces-at-qbar`); the band LU of the exact augmented matrix against faer's sparse
-//! LU of the same matrix (`augmented-solver`).
+//! LU of the same matrix (`augmented-solver`); explicit central difference on the Kelvin–Voigt
+//! arm at its default step (`central-difference-damped-arm-0.02s`).
 //! Run: `cargo bench -p fem --bench fem_bench -- --quick` (one group: append its name, e.g. `arms`).
 
 use std::hint::black_box;
@@ -181,6 +182,26 @@ fn contact_timoshenko_short(c: &mut Criterion) {
     );
 }
 
+/// Explicit central difference on the Kelvin–Voigt arm (`two-link-free`, 0.02 s at its default
+/// step, 0.9 × 2/ω_max: the damping is implicit at the end velocity, so it does not lower the
+/// bound) for 4 and 16 elements per link: one factorization of M + (h/2)C and a few residual
+/// passes per step.
+fn central_difference_damped_arm(c: &mut Criterion) {
+    let mut g = c.benchmark_group("central-difference-damped-arm-0.02s");
+    g.sample_size(10);
+    let sc = data::load_scene("two-link-free").unwrap();
+    for n in [4, 16] {
+        let mut st = Settings::default();
+        st.discretization.elements = Some(n);
+        st.time.t_end = Some(0.02);
+        st.time.method = Some("central-difference".parse().expect("a method name"));
+        g.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| black_box(FemBackend.simulate(&sc, &st).unwrap()))
+        });
+    }
+    g.finish();
+}
+
 /// The exact Newton matrix of the free two-link arm with foreshortening (residual pass,
 /// augmented assembly, band LU with the border's Schur complement, one solve) for 4–64
 /// elements per link: linear in the elements.
@@ -308,6 +329,7 @@ criterion_group!(
     arms_short,
     contact_short,
     contact_timoshenko_short,
+    central_difference_damped_arm,
     contact_at_converged_switching,
     midpoint_forces
 );
