@@ -3,7 +3,9 @@
 //! stations per link, and the explicit damping (the damped step bound) at 21 stations over
 //! 0.1 s for comparison (×10 for the same simulated time); `two-link-free-undamped`, 1 s at
 //! 21 stations: the velocity form with its time-symmetric corrector pass (one more Γ
-//! evaluation and mass solve per step, the rest kept from the first pass).
+//! evaluation and mass solve per step, the rest kept from the first pass); `barhorst-case1`,
+//! 0.5 s at 21 stations (the drop, the first impacts and the held phases): the contact run's
+//! default, damping implicit with the held tip's force in the kick.
 //! Run: cargo bench -p fdm --bench chain -- --quick
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -71,5 +73,21 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+fn contact(c: &mut Criterion) {
+    let scene = load_scene("barhorst-case1").expect("catalog scene");
+    let mut group = c.benchmark_group("barhorst_case1");
+    group.sample_size(10);
+    let s = settings(21, 0.5);
+    group.bench_function("0.5s_21_stations_implicit_damping", |b| {
+        b.iter(|| {
+            let (out, _) =
+                fdm::runs::two_link_chain_with_contact(&scene, scene.planar_chain().unwrap(), &s)
+                    .expect("run");
+            std::hint::black_box(out.cost.steps)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, contact);
 criterion_main!(benches);

@@ -118,7 +118,8 @@
 //!   taken from the drift velocities v_{j±½} ([`method::velocity_form`]): at the predicted
 //!   velocity the foreshortening couplings would turn the unresolved bending waves into a bias
 //!   growing with the number of stations.
-//!   **Damping implicit** without contact ([`chain::implicit`]): Kelvin–Voigt and the joint
+//!   **Damping implicit** ([`chain::implicit`]; Euler links, with or without the tip
+//!   contact, whose held force the kick carries): Kelvin–Voigt and the joint
 //!   dampers (−Cq̇, C constant) Crank–Nicolson across the velocity form's two kicks,
 //!   (M + ½τC)a = F solved through a banded quasi-definite saddle system (the foreshortening
 //!   rates' multipliers beside their stations, band LDLᵀ) and the same small Schur complement,

@@ -179,6 +179,32 @@ fn dyn_contact_case1_ledger_closes_through_impact_and_sliding() {
 }
 
 #[test]
+fn sys_contact_chain_steps_above_the_damped_bound_with_implicit_damping() {
+    // `barhorst-case1` (Kelvin–Voigt links, joint dampers), 21 stations: the implicit kick, the
+    // held tip's force included, steps at the undamped bound (times the contact runs' accuracy
+    // safety factor) through the impacts and held phases, far above the bound the explicit
+    // damping would impose.
+    use fdm::runs::IMPLICIT_CONTACT_SAFETY;
+    use fdm::system::System;
+    let scene = load_scene("barhorst-case1").unwrap();
+    let mut chain =
+        TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(21)).unwrap();
+    let damped = chain.bound(0.0).sigma;
+    assert!(chain.enable_implicit_damping());
+    let undamped = chain.bound(0.0).sigma;
+    println!("bound: damped {damped:.3e} s, undamped {undamped:.3e} s");
+    assert!(undamped > 4.0 * damped, "{undamped:e} vs {damped:e}");
+    let (r, rep) = run("barhorst-case1", 21, 0.4);
+    assert!(
+        (rep.tau_max - IMPLICIT_CONTACT_SAFETY * undamped).abs() <= 1e-9 * undamped,
+        "largest step {:e}, bound {undamped:e}",
+        rep.tau_max
+    );
+    assert!(r.ledger.relative_closure() < 1e-5);
+    assert!(r.observables.first_non_finite().is_none());
+}
+
+#[test]
 fn dyn_contact_stiff_elbow_rests_on_the_tip_at_the_static_force() {
     let stations = 11;
     // the scene's 10 s: the arm rocks on its sliding tip (hub free, D₁ = 20) and settles

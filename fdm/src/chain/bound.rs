@@ -84,6 +84,18 @@ impl TwoLinkChain {
 
     /// The step bound σ of the chain (the [`System::bound`] of [`TwoLinkChain`]).
     pub(super) fn step_bound(&self) -> Bound {
+        // implicit damping ([`super::implicit`]): the undamped bound (ζ = 0 throughout)
+        self.step_bound_with(if self.implicit_damping() { 0.0 } else { 1.0 })
+    }
+
+    /// The step bound with the damping explicit (the damped bound), whatever the kick: the
+    /// step that resolves the damping's own time scale.
+    pub fn explicit_damping_bound(&self) -> f64 {
+        self.step_bound_with(1.0).sigma
+    }
+
+    /// The step bound, the damping weighed by `explicit` (1: explicit, 0: implicit).
+    fn step_bound_with(&self, explicit: f64) -> Bound {
         // 5.44 per link (σ² = h⁴ρA/(4EI)) with the Kelvin–Voigt factor of the shortest wave
         // (as for the single link); the smaller binds.
         // The measured top frequency of the coupled chain (clamp-rotation modes included),
@@ -116,8 +128,6 @@ impl TwoLinkChain {
             }
             return best;
         }
-        // implicit damping ([`super::implicit`]): the undamped bound (ζ = 0 throughout)
-        let explicit = if self.implicit_damping() { 0.0 } else { 1.0 };
         let zeta = self
             .links
             .iter()

@@ -32,4 +32,6 @@ pub struct ImplicitDamping {
     pub(super) zb: Vec<f64>,
     /// v_{j+1}
     pub(super) vnew: Vec<f64>,
+    /// (M + ½τC)⁻¹Gᵀ of a held tip's constraint row
+    pub(super) damped_g: Vec<f64>,
 }

@@ -23,6 +23,11 @@
 //! `TwoLinkChain::add_damping_forces` by probing (at Q⁻¹e, then Q⁻ᵀ): each full column alone, the band columns in
 //! five interleaved colours (bandwidth 2).
 //!
+//! **Held tip** (restartable steps of a contact run, [`crate::method::velocity_form`]). With A =
+//! M + ½τC, A q̈ = f + Gᵀλ and G q̈ + Ġq̇ = 0 (Ġq̇ at the predicted velocity, as in the explicit
+//! kick): λ = −(G a_free + Ġq̇)/(G A⁻¹Gᵀ), one more banded solve. The drift projections after
+//! the kick keep the metric M (G and M⁻¹Gᵀ from the mass solve).
+//!
 //! **Ledger.** The powers are those of the level velocities (v_{j+1}ᵀCv_{j+1} and the joint
 //! dampers' D θ̇², as in the explicit form), integrated by the driver's trapezoid rule.
 
@@ -38,9 +43,9 @@ use crate::system::{DriftVelocities, System};
 
 impl TwoLinkChain {
     /// Switches the velocity form's closing kick to implicit damping (module docs) when the
-    /// chain has damping, Euler links and no contact; returns whether it did.
+    /// chain has damping and Euler links; returns whether it did.
     pub fn enable_implicit_damping(&mut self) -> bool {
-        if self.timo.is_some() || self.contact.is_some() || !(self.any_kv() || self.any_damper()) {
+        if self.timo.is_some() || !(self.any_kv() || self.any_damper()) {
             return false;
         }
         let n = self.dofs();
@@ -99,6 +104,7 @@ impl TwoLinkChain {
             z: std::array::from_fn(|_| vec![0.0; n]),
             zb: vec![0.0; n],
             vnew: vec![0.0; n],
+            damped_g: vec![0.0; n],
             band,
         }));
         true
@@ -169,7 +175,10 @@ impl TwoLinkChain {
         self.skip_damping = true;
         self.forces(t, q, drift.current, &mut rhs);
         self.skip_damping = false;
-        self.add_inertia_terms(1.0 + drift.w, a, &mut rhs);
+        // (w = −1: the inertia terms at `previous` alone)
+        if drift.w != -1.0 {
+            self.add_inertia_terms(1.0 + drift.w, a, &mut rhs);
+        }
         if drift.w != 0.0 {
             self.frames(q, drift.previous);
             self.add_inertia_terms(-drift.w, a, &mut rhs);
@@ -180,6 +189,9 @@ impl TwoLinkChain {
         self.solve_damped_mass(tau, &rhs, a);
         self.rhs = rhs;
         self.constraint.lambda = 0.0;
+        if self.constraint.constrained {
+            self.hold_tip(q, drift.current, drift.predicted, tau, a);
+        }
         let mut imp = self.implicit.take().expect("implicit damping");
         for i in 0..a.len() {
             imp.vnew[i] = drift.current[i] + 0.5 * tau * a[i];
@@ -187,6 +199,43 @@ impl TwoLinkChain {
         let mut sink = [0.0; 4];
         self.powers_at(t, &imp.vnew, &mut sink);
         self.implicit = Some(imp);
+    }
+
+    /// The held tip's force in the implicit kick (module docs): with A = M + ½τC and the free
+    /// kick's a_free in `a`, A q̈ = f + Gᵀλ, G q̈ + Ġq̇ = 0 (Ġq̇ at the predicted velocity, as
+    /// the explicit kick takes it) ⇒ λ = −(G a_free + Ġq̇)/(G A⁻¹Gᵀ), q̈ = a_free + A⁻¹Gᵀλ.
+    /// Also leaves G and M⁻¹Gᵀ for the velocity projection after the kick, whose metric is M.
+    fn hold_tip(&mut self, q: &[f64], half: &[f64], predicted: &[f64], tau: f64, a: &mut [f64]) {
+        self.frames(q, predicted);
+        let (_, curvature) = self.constraint_solve();
+        let grow = std::mem::take(&mut self.constraint.grow);
+        let mut imp = self.implicit.take().expect("implicit damping");
+        let mut damped_g = std::mem::take(&mut imp.damped_g);
+        self.implicit = Some(imp);
+        self.solve_damped_mass(tau, &grow, &mut damped_g);
+        let gag: f64 = grow.iter().zip(&damped_g).map(|(g, x)| g * x).sum();
+        let ga: f64 = grow.iter().zip(a.iter()).map(|(g, x)| g * x).sum();
+        // a G A⁻¹Gᵀ that is not a positive number (a failed solve) stops the contact driver
+        // through NaN
+        let gv: f64 = grow.iter().zip(half).map(|(g, x)| g * x).sum();
+        let rattle = std::env::var("FV_RATTLE").is_ok();
+        let lam = if gag > 0.0 {
+            if rattle {
+                -(gv + 0.5 * tau * ga) / (0.5 * tau * gag)
+            } else {
+                -(ga + curvature) / gag
+            }
+        } else {
+            f64::NAN
+        };
+        for i in 0..a.len() {
+            a[i] += damped_g[i] * lam;
+        }
+        self.constraint.lambda = lam;
+        self.constraint.grow = grow;
+        if let Some(imp) = self.implicit.as_mut() {
+            imp.damped_g = damped_g;
+        }
     }
 
     /// out = (M + ½τC)⁻¹ rhs at the state of the last `build_columns` (module docs). O(n), no

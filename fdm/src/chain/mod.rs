@@ -49,9 +49,10 @@
 //! of link 1's tip rate with link 2 ([`mass`]): O(n) per solve, no allocation in the step loop.
 //!
 //! **Step.** Velocity form by default (free joints: velocity-dependent inertia forces; damping
-//! on). Without contact the damping (constant C) is implicit in the closing kick ([`implicit`]:
-//! Crank–Nicolson in the damping, banded solve) and the bound is the undamped one below (ζ = 0);
-//! with contact (restartable steps) it is explicit and the bound carries the damping. Without
+//! on). The damping (constant C) is implicit in the closing kick ([`implicit`]: Crank–Nicolson
+//! in the damping, banded solve; with the tip contact's held force and restartable steps too)
+//! and the bound is the undamped one below (ζ = 0); the Timoshenko chain keeps it explicit and
+//! the bound carries the damping. Without
 //! damping the velocity-quadratic inertia terms take the velocity form's time-symmetric corrector
 //! pass: the clamp-rotation inertia J_c + Σm(s^t)² changes with the deflections, and the
 //! extrapolated rule alone lets the ledger drift ([`crate::method::velocity_form`]).

@@ -55,7 +55,7 @@ impl System for TwoLinkChain {
         tau: f64,
         a: &mut [f64],
     ) -> bool {
-        if self.implicit.is_none() || self.constraint.constrained {
+        if self.implicit.is_none() {
             return false;
         }
         self.implicit_kick_solve(t, q, inertia, tau, a);

@@ -43,7 +43,11 @@
 //! **Restartable steps** ([`VelocityForm::predicted`]). With every force at the predicted
 //! velocity a step depends on level j alone, so a step can be re-taken from the same level with
 //! another length (event location: [`crate::chain::contact`]) and the drift positions
-//! q_j + s v_j + ½s² a_j of any length s need no force evaluation.
+//! q_j + s v_j + ½s² a_j of any length s need no force evaluation. A system with implicit
+//! damping takes its implicit kick there too, with the damping at v_{j+½} and the other
+//! velocity-dependent forces at the predicted velocity (both fixed by level j; the inertia
+//! terms at v_{j+½} alone, without the extrapolation from v_{j−½}, would be first order: the
+//! ledger closure of `barhorst-case1`'s free fall halved per halving of the step).
 
 // Index loops run over several parallel level buffers at once.
 #![allow(clippy::needless_range_loop)]
@@ -180,7 +184,17 @@ impl Stepper for VelocityForm {
             self.drift_prev.copy_from_slice(&st.next.v);
             self.have_drift_prev = true;
         } else {
-            sys.accel(t_new, &st.next.q, &st.pred, &mut st.acc_next);
+            // restartable: the implicit kick takes its damping at v_{j+½} and the inertia terms
+            // at the predicted velocity (w = −1 weighs `previous` alone), both fixed by level j
+            let drift = DriftVelocities {
+                current: &st.next.v,
+                previous: &st.pred,
+                w: -1.0,
+                predicted: &st.pred,
+            };
+            if !sys.implicit_kick(t_new, &st.next.q, drift, tau, &mut st.acc_next) {
+                sys.accel(t_new, &st.next.q, &st.pred, &mut st.acc_next);
+            }
         }
         sys.powers(&mut st.p_new);
         for i in 0..st.acc.len() {
