@@ -138,9 +138,15 @@
 //!   (loss booked as `impact`), constrained sliding M q̈ = f + Gᵀλ, Gq̈ + Ġq̇ = 0 with
 //!   position/velocity projection, release located on λ(step length); channels
 //!   `contact1.normal_force`, `contact1.phase`, `contact1.gap`; events `contact-start`,
-//!   `impact`, `release`. With contact the damping stays explicit and the step bound also takes the fastest damping rate κ_max (power
-//!   iteration on −∂a/∂q̇: the joint dampers on the clamp half-cell inertia are strongly
-//!   overdamped, limit τ ≤ 1/κ), and ¼ of the bound for 2000 steps after each velocity jump.
+//!   `impact`, `release`. The damping is implicit through the contact too (A q̈ = f + Gᵀλ with
+//!   A = M + ½τC in the kick, [`chain::implicit`]): the step is 0.45 of the undamped bound
+//!   ([`runs::IMPLICIT_CONTACT_SAFETY`], for the ledger), its first 2000 steps at the explicit
+//!   damping's bound (a preloaded joint released at t = 0), and ¼ of the bound for 2000 steps
+//!   after each velocity jump. The Timoshenko chain keeps its damping explicit; its bound then
+//!   also takes the fastest damping rate κ_max (power iteration on −∂a/∂q̇: the joint dampers on
+//!   the clamp half-cell inertia are strongly overdamped, limit τ ≤ 1/κ).
+//!   Tested (tests/contact.rs) also: the contact run steps far above the explicit damping's
+//!   bound.
 //!   Tested (tests/contact.rs): momentum residual and |Gq̇⁺| at round-off, the ledger, the
 //!   resting force of the stiff elbow against the static equilibrium of the same model.
 //! * **Timoshenko links** ([`chain::timoshenko`]; `barhorst-case1-timoshenko`, `shear` on both

@@ -171,7 +171,8 @@ pub struct DriftVelocities<'a> {
     /// v_{j−½}, the previous step's drift velocity (the first step: `current`, w = 0), or the
     /// estimate of v_{j+3/2} (w = −½)
     pub previous: &'a [f64],
-    /// w = τ_{j+1}/(τ_{j+1} + τ_j) (½ for equal steps) to extrapolate; −½ for the mean
+    /// w = τ_{j+1}/(τ_{j+1} + τ_j) (½ for equal steps) to extrapolate; −½ for the mean; −1
+    /// for `previous` alone (a restartable implicit kick passes the predicted velocity there)
     pub w: f64,
     /// v_pred = v_{j+½} + ½τa_j, the predicted step-end velocity (where
     /// [`System::accel_split`] takes the velocity-dependent forces; an implicit kick may take
