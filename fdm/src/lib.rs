@@ -145,9 +145,8 @@
 //!   after each velocity jump. The Timoshenko chain keeps its damping explicit; its bound then
 //!   also takes the fastest damping rate κ_max (power iteration on −∂a/∂q̇: the joint dampers on
 //!   the clamp half-cell inertia are strongly overdamped, limit τ ≤ 1/κ).
-//!   Tested (tests/contact.rs) also: the contact run steps far above the explicit damping's
-//!   bound.
-//!   Tested (tests/contact.rs): momentum residual and |Gq̇⁺| at round-off, the ledger, the
+//!   Tested (tests/contact.rs): the contact run steps above the explicit damping's bound;
+//!   momentum residual and |Gq̇⁺| at round-off, the ledger, the
 //!   resting force of the stiff elbow against the static equilibrium of the same model.
 //! * **Timoshenko links** ([`chain::timoshenko`]; `barhorst-case1-timoshenko`, `shear` on both
 //!   links, no rotary inertia): v and the section rotation ψ at the stations, U = Σ ½EI

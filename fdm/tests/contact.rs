@@ -193,13 +193,14 @@ fn sys_contact_chain_steps_above_the_damped_bound_with_implicit_damping() {
     assert!(chain.enable_implicit_damping());
     let undamped = chain.bound(0.0).sigma;
     println!("bound: damped {damped:.3e} s, undamped {undamped:.3e} s");
-    assert!(undamped > 4.0 * damped, "{undamped:e} vs {damped:e}");
     let (r, rep) = run("barhorst-case1", 21, 0.4);
     assert!(
         (rep.tau_max - IMPLICIT_CONTACT_SAFETY * undamped).abs() <= 1e-9 * undamped,
         "largest step {:e}, bound {undamped:e}",
         rep.tau_max
     );
+    // beyond the explicit damping's bound, where its kick would diverge
+    assert!(rep.tau_max > damped, "{:e} vs {damped:e}", rep.tau_max);
     assert!(r.ledger.relative_closure() < 1e-5);
     assert!(r.observables.first_non_finite().is_none());
 }

@@ -175,9 +175,10 @@ impl TwoLinkChain {
         self.skip_damping = true;
         self.forces(t, q, drift.current, &mut rhs);
         self.skip_damping = false;
-        // (w = −1: the inertia terms at `previous` alone)
-        if drift.w != -1.0 {
-            self.add_inertia_terms(1.0 + drift.w, a, &mut rhs);
+        // (a zero weight, w = −1: the inertia terms at `previous` alone, no pass at `current`)
+        let w_current = 1.0 + drift.w;
+        if w_current != 0.0 {
+            self.add_inertia_terms(w_current, a, &mut rhs);
         }
         if drift.w != 0.0 {
             self.frames(q, drift.previous);
@@ -190,7 +191,7 @@ impl TwoLinkChain {
         self.rhs = rhs;
         self.constraint.lambda = 0.0;
         if self.constraint.constrained {
-            self.hold_tip(q, drift.current, drift.predicted, tau, a);
+            self.hold_tip(q, drift.predicted, tau, a);
         }
         let mut imp = self.implicit.take().expect("implicit damping");
         for i in 0..a.len() {
@@ -205,7 +206,7 @@ impl TwoLinkChain {
     /// kick's a_free in `a`, A q̈ = f + Gᵀλ, G q̈ + Ġq̇ = 0 (Ġq̇ at the predicted velocity, as
     /// the explicit kick takes it) ⇒ λ = −(G a_free + Ġq̇)/(G A⁻¹Gᵀ), q̈ = a_free + A⁻¹Gᵀλ.
     /// Also leaves G and M⁻¹Gᵀ for the velocity projection after the kick, whose metric is M.
-    fn hold_tip(&mut self, q: &[f64], half: &[f64], predicted: &[f64], tau: f64, a: &mut [f64]) {
+    fn hold_tip(&mut self, q: &[f64], predicted: &[f64], tau: f64, a: &mut [f64]) {
         self.frames(q, predicted);
         let (_, curvature) = self.constraint_solve();
         let grow = std::mem::take(&mut self.constraint.grow);
@@ -217,14 +218,8 @@ impl TwoLinkChain {
         let ga: f64 = grow.iter().zip(a.iter()).map(|(g, x)| g * x).sum();
         // a G A⁻¹Gᵀ that is not a positive number (a failed solve) stops the contact driver
         // through NaN
-        let gv: f64 = grow.iter().zip(half).map(|(g, x)| g * x).sum();
-        let rattle = std::env::var("FV_RATTLE").is_ok();
         let lam = if gag > 0.0 {
-            if rattle {
-                -(gv + 0.5 * tau * ga) / (0.5 * tau * gag)
-            } else {
-                -(ga + curvature) / gag
-            }
+            -(ga + curvature) / gag
         } else {
             f64::NAN
         };
