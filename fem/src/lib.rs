@@ -82,8 +82,8 @@
 //! `implicit-midpoint` (ledger O(h²): [`method::implicit_midpoint`]), `generalized-alpha`
 //! (acceleration history recomputed at every event: [`method::generalized_alpha`]), `bathe`
 //! (the constraint held at both sub-step ends: [`method::bathe`]) and
-//! explicit `central-difference` (positions and velocities projected onto the constraint, no
-//! bilateral wall: [`method::central_difference`]).
+//! explicit `central-difference` (positions and velocities projected onto the constraint, on
+//! the bilateral wall too: [`method::central_difference`]).
 //! Gap g = n̂·(r_tip − p₀), G = n̂ᵀ∂r_tip/∂q
 //! (exact, [`chain::Chain::tip_jacobian`]).
 //! * Detection inside the step: the step is re-solved shortened (Illinois secant on h) until

@@ -28,7 +28,8 @@
 //! steps.
 //!
 //! **Held constraint** g(q) = 0 (a tip held on a surface; no Newton iteration to border, so
-//! by projection, as SHAKE and RATTLE do for velocity Verlet), G = ∇g:
+//! by projection, as SHAKE and RATTLE do for velocity Verlet), G = ∇g (one row; the rows of
+//! the friction wall below):
 //!
 //! ```text
 //! q₁ = qₙ + h q̇ₙ + (h²/2)(q̈ₙ + S⁻¹Gₙᵀμ),           g(q₁) = target   (μ: chord iteration)
@@ -49,14 +50,25 @@
 //! (the ledger closure falls 4× per halved step through impacts and held phases). After every
 //! event (restart) of a run that has held a constraint, q̈ₙ is recomputed for the new phase:
 //! with the event's normal force while held (`start::EventRestart`), without after
-//! a release. The bilateral friction wall (stick–slip phases) is refused.
+//! a release.
+//!
+//! **Friction wall** (bilateral, stick–slip: [`StepConstraint::projection_rows`]). Sliding, the
+//! normal multiplier's force runs along F = G − μsσT (Coulomb friction −μs|λ|T with the sign σ
+//! of λ fixed for the step), so μ and ν act along S⁻¹Fᵀ while the rows stay G: the chord and
+//! the velocity solve use G·S⁻¹Fᵀ. Sticking, the tip is also held at its stick point by
+//! h = t̂_s·(r_tip − p_s) = 0: two rows, 2 × 2 chord and velocity solves. The constraint books
+//! the friction work by the trapezoidal rule, D = ½μsσ(λ₀T(q₀) + νT(q₁))·Δq, λ₀ the start
+//! force (the one q̈ₙ carries plus μ), and the step's normal multiplier as the mean of the
+//! two ([`StepConstraint::commit_projection`]).
 
 use crate::band::BorderedBand;
 use crate::error::FemError;
 use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
-    Capabilities, MethodParams, StepConstraint, StepContext, StepState, Stepper, };
+    Capabilities, MethodParams, ProjectionRows, StepConstraint, StepContext, StepState, Stepper,
+    Works,
+};
 use crate::system::{NewtonCoefficients, System};
 
 /// Iterations of the end-acceleration solve and of the position projection.
@@ -74,11 +86,12 @@ const STALL_TOL: f64 = 1e-9;
 /// Central difference: the buffers of a held constraint's projections and the restart state.
 #[derive(Debug, Clone)]
 pub struct CentralDifference {
-    /// ∇g at the step start and at its end, and M⁻¹ applied to each.
-    g_start: Vec<f64>,
-    g_end: Vec<f64>,
-    minv_g_start: Vec<f64>,
-    minv_g_end: Vec<f64>,
+    /// The held rows at the step start and at its end, and S⁻¹ applied to each row's force
+    /// direction.
+    start: ProjectionRows,
+    end: ProjectionRows,
+    minv_start: [Vec<f64>; 2],
+    minv_end: [Vec<f64>; 2],
     /// The start acceleration of a held step with its projection force (the state's q̈ₙ stays
     /// as it is: a rejected trial restarts from it).
     a_start: Vec<f64>,
@@ -87,6 +100,10 @@ pub struct CentralDifference {
     force: Vec<f64>,
     /// When q̈ₙ is recomputed for the phase (module docs).
     restart: EventRestart,
+    /// The multipliers of the constraint forces q̈ₙ carries (the last accepted step's end
+    /// forces, or a restart's), and the end multipliers of the trial step.
+    carried: [f64; 2],
+    trial_end: [f64; 2],
 }
 
 impl CentralDifference {
@@ -96,7 +113,7 @@ impl CentralDifference {
         adaptive: false,
         prescribed_joints: true,
         held_constraint: true,
-        bilateral_constraint: false,
+        bilateral_constraint: true,
         projects_massless: false,
         variable_mass: true,
     };
@@ -104,13 +121,15 @@ impl CentralDifference {
     /// The method for a system of `n` DOFs.
     pub fn new(n: usize) -> Self {
         CentralDifference {
-            g_start: vec![0.0; n],
-            g_end: vec![0.0; n],
-            minv_g_start: vec![0.0; n],
-            minv_g_end: vec![0.0; n],
+            start: ProjectionRows::new(n),
+            end: ProjectionRows::new(n),
+            minv_start: [vec![0.0; n], vec![0.0; n]],
+            minv_end: [vec![0.0; n], vec![0.0; n]],
             a_start: vec![0.0; n],
             force: vec![0.0; n],
             restart: EventRestart::new(n),
+            carried: [0.0; 2],
+            trial_end: [0.0; 2],
         }
     }
 }
@@ -132,13 +151,16 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
     ) -> Result<Option<f64>, FemError> {
         // After an event (an impact's velocity jump, a release) q̈ₙ is recomputed for the new
         // phase, with the event's normal force while the constraint is held (module docs).
-        self.restart.apply(
+        if self.restart.apply(
             cx,
             constraint.as_deref_mut(),
             h,
             &mut self.force,
             "central-difference",
-        )?;
+        )? {
+            // q̈ₙ now carries the constraint force at its current multiplier, or none.
+            self.carried = [constraint.as_deref().map_or(0.0, |k| k.multiplier()), 0.0];
+        }
         let t0 = cx.state.t;
         let st = &mut *cx.state;
         let n = st.q.len();
@@ -161,55 +183,71 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
         cx.counters.rhs += 1;
         cx.newton.form(cx.system, st, cx.counters, c, t1)?;
         cx.newton.matrix_h = f64::NAN;
+        let mut mu_start = [0.0; 2];
         if let Some(k) = constraint.as_deref_mut() {
-            // SHAKE: the start acceleration gains S⁻¹∇g(q₀)μ so that g(q₁) reaches its target
-            // (the share (h/h_nominal)² of the start gap removed, as in the implicit methods).
-            let g0 = k.gradient(cx.system, t0, &st.q, &mut self.g_start);
-            cx.newton.delta.copy_from_slice(&self.g_start);
-            cx.newton.solve();
-            self.minv_g_start.copy_from_slice(&cx.newton.delta);
+            // SHAKE: the start acceleration gains S⁻¹Fₙᵀμ (Fₙ the rows' force directions at
+            // q₀) so that the rows' values at q₁ reach their targets (the share
+            // (h/h_nominal)² of the start values removed, as in the implicit methods).
+            k.projection_rows(cx.system, t0, &st.q, &mut self.start);
+            let rows = self.start.k;
+            for r in 0..rows {
+                cx.newton.delta.copy_from_slice(&self.start.force[r]);
+                cx.newton.solve();
+                self.minv_start[r].copy_from_slice(&cx.newton.delta);
+            }
             let shortened = (h / cx.h_nominal).min(1.0);
-            let target = g0 * (1.0 - shortened * shortened);
-            let slope = 0.5 * h * h * dot(&self.g_start, &self.minv_g_start);
+            let target = self.start.value.map(|v| v * (1.0 - shortened * shortened));
+            let slope = coupling(0.5 * h * h, &self.start, &self.minv_start);
             let tol = GAP_TOL * cx.length_scale;
-            let mut mu = 0.0;
-            let mut gap = k.value(cx.system, t1, &st.q1);
+            let mut mu = [0.0; 2];
+            let mut off = self.offsets(k, cx.system, t1, &st.q1, target);
             for _ in 0..MAX_ITERATIONS {
-                let off = (gap - target).abs();
-                if off <= tol || off.is_nan() {
+                if within(off, rows, tol) || off.iter().any(|x| x.is_nan()) {
                     break;
                 }
-                let dmu = -(gap - target) / slope;
-                mu += dmu;
-                for i in 0..n {
-                    st.q1[i] += 0.5 * h * h * dmu * self.minv_g_start[i];
+                let dmu = solve_rows(&slope, off, rows);
+                for r in 0..rows {
+                    mu[r] += dmu[r];
+                    for i in 0..n {
+                        st.q1[i] += 0.5 * h * h * dmu[r] * self.minv_start[r][i];
+                    }
                 }
-                gap = k.value(cx.system, t1, &st.q1);
+                off = self.offsets(k, cx.system, t1, &st.q1, target);
             }
-            if (gap - target).abs() > tol || gap.is_nan() {
-                return Err(unprojected("position", t0, gap - target));
+            if !within(off, rows, tol) {
+                let worst = if off[0].abs() >= off[1].abs() || off[0].is_nan() {
+                    off[0]
+                } else {
+                    off[1]
+                };
+                return Err(unprojected("position", t0, worst));
             }
             for i in 0..n {
-                self.a_start[i] = st.qdd[i] + mu * self.minv_g_start[i];
+                let mut a = st.qdd[i];
+                for r in 0..rows {
+                    a += mu[r] * self.minv_start[r][i];
+                }
+                self.a_start[i] = a;
                 st.qd1[i] = st.qd[i] + h * self.a_start[i];
                 st.qdd1[i] = self.a_start[i];
             }
-            // RATTLE: the end force ∇g(q₁)ν with ν such that ∇g(q₁)·q̇₁ = 0.
-            k.gradient(cx.system, t1, &st.q1, &mut self.g_end);
-            cx.newton.delta.copy_from_slice(&self.g_end);
-            cx.newton.solve();
-            self.minv_g_end.copy_from_slice(&cx.newton.delta);
+            // RATTLE: the end forces F₁ᵀν with ν such that the rows' rates ∇c(q₁)·q̇₁ vanish.
+            k.projection_rows(cx.system, t1, &st.q1, &mut self.end);
+            for r in 0..self.end.k {
+                cx.newton.delta.copy_from_slice(&self.end.force[r]);
+                cx.newton.solve();
+                self.minv_end[r].copy_from_slice(&cx.newton.delta);
+            }
+            mu_start = mu;
         }
-        let held = constraint.is_some();
-        let g_minv_g = if held {
-            dot(&self.g_end, &self.minv_g_end)
-        } else {
-            0.0
-        };
-        let mut nu = 0.0;
-        // R(q₁, q̇ₙ₊½ + (h/2)q̈₁, q̈₁) = ∇g(q₁)ν, by Newton on S = M + (h/2)C.
+        let rows = if constraint.is_some() { self.end.k } else { 0 };
+        // ½h ∇c(q₁)·S⁻¹F₁ᵀ: the response of the rows' end rates to the end forces.
+        let rate_coupling = coupling(0.5 * h, &self.end, &self.minv_end);
+        let mut nu = [0.0; 2];
+        // R(q₁, q̇ₙ₊½ + (h/2)q̈₁, q̈₁) = F₁ᵀν, by Newton on S = M + (h/2)C.
         let mut converged = false;
         let mut last = f64::NAN;
+        let held = rows > 0;
         let a0 = if held { &self.a_start } else { &st.qdd };
         for it in 0..MAX_ITERATIONS {
             if it > 0 {
@@ -221,9 +259,9 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
                     .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
                 cx.counters.rhs += 1;
             }
-            if held {
+            for r in 0..rows {
                 for i in 0..n {
-                    cx.newton.res[i] -= nu * self.g_end[i];
+                    cx.newton.res[i] -= nu[r] * self.end.force[r][i];
                 }
             }
             cx.newton.delta.copy_from_slice(&cx.newton.res);
@@ -233,24 +271,31 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
                 st.qdd1[i] -= cx.newton.delta[i];
                 big = big.max(cx.newton.delta[i].abs());
             }
-            let mut floor = 0.0;
+            let mut floor = 0.0f64;
             if held {
-                // ∇g(q₁)·(q̇ₙ₊½ + h/2 q̈₁) = 0 for the updated q̈₁; the round-off of that sum,
-                // divided by ½h ∇gᵀM⁻¹∇g, bounds how far the updates can settle.
-                let (mut normal, mut scale) = (0.0, 0.0);
-                for i in 0..n {
-                    let term = self.g_end[i] * (st.qd[i] + 0.5 * h * (self.a_start[i] + st.qdd1[i]));
-                    normal += term;
-                    scale += term.abs();
+                // ∇c(q₁)·(q̇ₙ₊½ + h/2 q̈₁) = 0 for the updated q̈₁; the round-off of those sums,
+                // divided by the rows' rate coupling, bounds how far the updates can settle.
+                let (mut rate, mut scale) = ([0.0; 2], [0.0; 2]);
+                for r in 0..rows {
+                    for i in 0..n {
+                        let term = self.end.gradient[r][i]
+                            * (st.qd[i] + 0.5 * h * (self.a_start[i] + st.qdd1[i]));
+                        rate[r] += term;
+                        scale[r] += term.abs();
+                    }
                 }
-                let dnu = -normal / (0.5 * h * g_minv_g);
-                nu += dnu;
-                for i in 0..n {
-                    st.qdd1[i] += dnu * self.minv_g_end[i];
+                let dnu = solve_rows(&rate_coupling, rate, rows);
+                for r in 0..rows {
+                    nu[r] += dnu[r];
+                    for i in 0..n {
+                        st.qdd1[i] += dnu[r] * self.minv_end[r][i];
+                    }
+                    let reach = max_abs(&self.minv_end[r]);
+                    big = big.max(dnu[r].abs() * reach);
+                    floor = floor.max(
+                        16.0 * f64::EPSILON * scale[r] / rate_coupling[r][r].abs() * reach,
+                    );
                 }
-                let reach = max_abs(&self.minv_g_end);
-                big = big.max(dnu.abs() * reach);
-                floor = 16.0 * f64::EPSILON * scale / (0.5 * h * g_minv_g) * reach;
             }
             for v in st.qdd1.iter() {
                 amax = amax.max(v.abs());
@@ -272,8 +317,11 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
             return Err(unprojected("velocity", t0, last));
         }
         if let Some(k) = constraint {
-            k.set_multiplier(nu);
+            // The start forces: those q̈ₙ carries plus the position projection's.
+            let start = [self.carried[0] + mu_start[0], self.carried[1] + mu_start[1]];
+            k.commit_projection(cx.system, [t0, t1], [&st.q, &st.q1], start, nu);
         }
+        self.trial_end = nu;
         for i in 0..n {
             st.qd1[i] = st.qd[i] + 0.5 * h * (a0[i] + st.qdd1[i]);
             st.a1[i] = st.qdd1[i];
@@ -285,9 +333,67 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
         true
     }
 
+    /// The accepted step's end forces are what q̈ₙ carries into the next step; the driver
+    /// books the works.
+    fn commit(&mut self, _h: f64, _works: &mut Works) -> bool {
+        self.carried = self.trial_end;
+        false
+    }
+
     fn restart(&mut self) {
         self.restart.request();
     }
+}
+
+impl CentralDifference {
+    /// The held rows' values at q₁ minus their targets: the constraint's value alone for one
+    /// row, else every row's through [`StepConstraint::projection_rows`] (into the end rows,
+    /// which the step re-forms at the converged q₁).
+    fn offsets<S: System + ?Sized>(
+        &mut self,
+        k: &mut (dyn StepConstraint<S> + '_),
+        system: &S,
+        t1: f64,
+        q1: &[f64],
+        target: [f64; 2],
+    ) -> [f64; 2] {
+        if self.start.k == 1 {
+            return [k.value(system, t1, q1) - target[0], 0.0];
+        }
+        k.projection_rows(system, t1, q1, &mut self.end);
+        [self.end.value[0] - target[0], self.end.value[1] - target[1]]
+    }
+}
+
+/// c·∇cᵢ·S⁻¹Fⱼᵀ for the held rows (`minv`: S⁻¹ applied to each row's force direction).
+fn coupling(c: f64, rows: &ProjectionRows, minv: &[Vec<f64>; 2]) -> [[f64; 2]; 2] {
+    let mut a = [[0.0; 2]; 2];
+    for i in 0..rows.k {
+        for j in 0..rows.k {
+            a[i][j] = c * dot(&rows.gradient[i], &minv[j]);
+        }
+    }
+    a
+}
+
+/// −A⁻¹r for the first `k` rows (k ≤ 2; Cramer's rule for two).
+fn solve_rows(a: &[[f64; 2]; 2], r: [f64; 2], k: usize) -> [f64; 2] {
+    match k {
+        1 => [-r[0] / a[0][0], 0.0],
+        2 => {
+            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+            [
+                -(a[1][1] * r[0] - a[0][1] * r[1]) / det,
+                -(a[0][0] * r[1] - a[1][0] * r[0]) / det,
+            ]
+        }
+        _ => [0.0; 2],
+    }
+}
+
+/// Whether the first `k` offsets are within `tol` (false for NaN).
+fn within(off: [f64; 2], k: usize, tol: f64) -> bool {
+    off[..k].iter().all(|x| x.abs() <= tol)
 }
 
 /// A held step whose projection onto the constraint did not converge (`residual`: the last gap

@@ -28,7 +28,8 @@
 //! event; on the bilateral wall the friction work of both sub-steps adds up
 //! ([`StepConstraint::start_sub_step`], [`bathe`] docs). Explicit central difference has no Newton iteration to border: it holds
 //! the unilateral constraint by projection (start force so that g(q₁) is met, end force so
-//! that ∇g(q₁)·q̇₁ = 0; [`central_difference`] docs) and refuses the bilateral wall.
+//! that ∇g(q₁)·q̇₁ = 0; [`central_difference`] docs), on the friction wall with the sliding
+//! friction along the normal force and two rows while the tip sticks.
 //!
 //! Shared machinery: the Newton matrix S = c_a M + c_v C + c_q K and its solver
 //! ([`newton`]), the consistent acceleration of a (re)start ([`start`]), the method–driver
@@ -48,7 +49,7 @@ mod step;
 
 pub use newton::{JacobianKind, NewtonSystem};
 pub use state::{Adaptive, Counters, FixedStepCounters, StepState, Works};
-pub use step::{ConstraintView, StepConstraint, StepContext, Stepper};
+pub use step::{ConstraintView, ProjectionRows, StepConstraint, StepContext, Stepper};
 pub(crate) use step::{HeldConstraint, unconverged, update_tolerance};
 
 use crate::settings::Method;

@@ -104,7 +104,7 @@ impl EventRestart {
     /// At a step start: when a restart is due, q̈ₙ for the phase the step is in, with the held
     /// constraint's force (the event's normal force, [`constrained_acceleration`]; `force`
     /// receives the force applied) or free ([`consistent_acceleration`]). `method` names the
-    /// method in an error.
+    /// method in an error. Returns whether q̈ₙ was recomputed.
     pub fn apply<S: System + ?Sized>(
         &mut self,
         cx: &mut StepContext<'_, S>,
@@ -112,19 +112,20 @@ impl EventRestart {
         h: f64,
         force: &mut [f64],
         method: &str,
-    ) -> Result<(), FemError> {
+    ) -> Result<bool, FemError> {
         self.constrained_before |= constraint.is_some();
         if !(self.pending && self.constrained_before) {
-            return Ok(());
+            return Ok(false);
         }
         self.pending = false;
         let t0 = cx.state.t;
         match constraint {
             Some(k) => {
-                constrained_acceleration(cx, k, t0, &self.zero, &mut self.before, force, method)
+                constrained_acceleration(cx, k, t0, &self.zero, &mut self.before, force, method)?
             }
-            None => consistent_acceleration(cx, h, t0),
+            None => consistent_acceleration(cx, h, t0)?,
         }
+        Ok(true)
     }
 }
 

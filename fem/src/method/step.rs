@@ -144,6 +144,31 @@ impl HeldConstraint {
     }
 }
 
+/// The rows a projection method (central difference: no Newton iteration to border) holds at
+/// a configuration: `k` constraints (1, or 2 for a friction contact's sticking tip) with their
+/// values, gradients and the directions of their multipliers' forces. A force direction differs
+/// from its gradient where the multiplier also drives a non-conservative force (sliding
+/// friction: ∇g − μsσT).
+#[derive(Debug, Clone)]
+pub struct ProjectionRows {
+    pub k: usize,
+    pub value: [f64; 2],
+    pub gradient: [Vec<f64>; 2],
+    pub force: [Vec<f64>; 2],
+}
+
+impl ProjectionRows {
+    /// Rows for a system of `n` DOFs (none held yet).
+    pub fn new(n: usize) -> Self {
+        ProjectionRows {
+            k: 0,
+            value: [0.0; 2],
+            gradient: [vec![0.0; n], vec![0.0; n]],
+            force: [vec![0.0; n], vec![0.0; n]],
+        }
+    }
+}
+
 /// A bilateral constraint held during a step on the system `S` (a tip on a surface,
 /// optionally with friction), seen by a method through its force and its Newton border only.
 pub trait StepConstraint<S: System + ?Sized> {
@@ -152,6 +177,29 @@ pub trait StepConstraint<S: System + ?Sized> {
     /// Constraint value g(q) at (t, q), its gradient ∇g(q) written to `out` (the projections of
     /// a method without a Newton iteration to border: central difference).
     fn gradient(&mut self, system: &S, t: f64, q: &[f64], out: &mut [f64]) -> f64;
+    /// The rows a projection method holds at (t, q) ([`ProjectionRows`]); by default the
+    /// constraint alone, its force along its gradient.
+    fn projection_rows(&mut self, system: &S, t: f64, q: &[f64], rows: &mut ProjectionRows) {
+        rows.k = 1;
+        rows.value[0] = self.gradient(system, t, q, &mut rows.gradient[0]);
+        let (gradient, force) = (&rows.gradient[0], &mut rows.force[0]);
+        force.copy_from_slice(gradient);
+    }
+    /// A projection method's converged step q₀ → q₁: the start and end multipliers of each
+    /// row of [`StepConstraint::projection_rows`] (forces along the rows' force directions at
+    /// q₀ and at q₁). What the constraint books of it (a wall's friction work, by the
+    /// trapezoidal rule as the driver books the other works); by default it keeps the end
+    /// multiplier.
+    fn commit_projection(
+        &mut self,
+        _system: &S,
+        _t: [f64; 2],
+        _q: [&[f64]; 2],
+        _start: [f64; 2],
+        end: [f64; 2],
+    ) {
+        self.set_multiplier(end[0]);
+    }
     /// The multiplier the step starts from (the last accepted step's).
     fn multiplier(&self) -> f64;
     /// Stores the multiplier of a converged step.

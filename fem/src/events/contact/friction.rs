@@ -1,7 +1,9 @@
 //! Bilateral tip contact with Coulomb friction and stick–slip (seed 001, scene
 //! `constrained-arm`) for the midpoint schemes (`energy-midpoint`, the default, whose step the
 //! text below describes; `implicit-midpoint` applies the same terms at its midpoint and books
-//! the other works by the trapezoidal rule, so its ledger closes to O(h²) only).
+//! the other works by the trapezoidal rule, so its ledger closes to O(h²) only; `bathe` holds it
+//! at both sub-step ends; `central-difference` by projection, through the rows and the booking
+//! of `projection_rows` and `commit_projection` here).
 //!
 //! **Constraint.** The tip of the named link stays on the wall ([`crate::events::wall`]) for all time:
 //! g(q) = 0 from t = 0 (the scene starts on the wall, checked), never released, multiplier λ
@@ -89,7 +91,7 @@ use crate::events::contact::Contact;
 use crate::events::mass_solve::MassSolver;
 use crate::events::wall::{Wall, row_along, rows};
 use crate::linalg::dot;
-use crate::method::{ConstraintView, NewtonSystem};
+use crate::method::{ConstraintView, NewtonSystem, ProjectionRows};
 
 /// Slip-velocity tolerance of a located stop, relative to the longest link (per unit time).
 pub const VT_TOL: f64 = 1e-10;
@@ -462,6 +464,81 @@ pub(crate) fn midpoint_terms(
     b.constraint.g1 = gap1;
     b.constraint.h1 = h1;
     if h1.abs() > gap1.abs() { h1 } else { gap1 }
+}
+
+/// The wall's rows for a projection method (central difference), beside the gap row the
+/// caller filled: sliding, the normal multiplier's force gains the friction −μsσT; sticking,
+/// the second row h = t̂_s·(r_tip − p_s) with its gradient as force direction.
+pub(crate) fn projection_rows(
+    c: &mut Contact,
+    chain: &Chain,
+    t: f64,
+    q: &[f64],
+    rows: &mut ProjectionRows,
+) {
+    let link = c.constraint.link;
+    let Some(b) = c.bilateral.as_deref_mut() else {
+        return;
+    };
+    if b.constraint.mu == 0.0 {
+        return;
+    }
+    let r = chain.tip_jacobian(t, link, q, &mut b.constraint.jac);
+    if !b.phase.sticking {
+        let f = b.constraint.wall.frame(r);
+        row_along(f.tangent, &b.constraint.jac, &mut b.constraint.t_row);
+        let k = b.constraint.mu * b.phase.slip_dir * b.phase.sigma;
+        for (x, tr) in rows.force[0].iter_mut().zip(&b.constraint.t_row) {
+            *x -= k * tr;
+        }
+        return;
+    }
+    let ts = b.constraint.stick_tangent;
+    row_along(ts, &b.constraint.jac, &mut rows.gradient[1]);
+    rows.value[1] = ts.dot(&(r - b.constraint.stick_point));
+    let (gradient, force) = (&rows.gradient[1], &mut rows.force[1]);
+    force.copy_from_slice(gradient);
+    rows.k = 2;
+}
+
+/// Books a projection method's converged step q₀ → q₁ on the wall from its start and end
+/// multipliers (forces along the rows of [`projection_rows`] at q₀ and at q₁): the step's
+/// normal multiplier is their mean (the driver's friction-sign check), the stick multiplier
+/// the end one; sliding, the friction work by the trapezoidal rule, as the driver books the
+/// other works, D = ½μsσ(μ₀T(q₀) + ν₀T(q₁))·Δq.
+pub(crate) fn commit_projection(
+    c: &mut Contact,
+    chain: &Chain,
+    [t0, t1]: [f64; 2],
+    [q0, q1]: [&[f64]; 2],
+    start: [f64; 2],
+    end: [f64; 2],
+) {
+    c.constraint.step_lambda = 0.5 * (start[0] + end[0]);
+    let link = c.constraint.link;
+    let Some(b) = c.bilateral.as_deref_mut() else {
+        return;
+    };
+    b.constraint.pending_work = 0.0;
+    if b.constraint.mu == 0.0 {
+        return;
+    }
+    if b.phase.sticking {
+        b.constraint.lt_eval = end[1];
+        return;
+    }
+    let k = b.constraint.mu * b.phase.slip_dir * b.phase.sigma;
+    let mut work = 0.0;
+    for (tq, q, lambda) in [(t0, q0, start[0]), (t1, q1, end[0])] {
+        let r = chain.tip_jacobian(tq, link, q, &mut b.constraint.jac);
+        let f = b.constraint.wall.frame(r);
+        row_along(f.tangent, &b.constraint.jac, &mut b.constraint.t_row);
+        let slide: f64 = (0..q0.len())
+            .map(|i| b.constraint.t_row[i] * (q1[i] - q0[i]))
+            .sum();
+        work += 0.5 * k * lambda * slide;
+    }
+    b.constraint.pending_work = work;
 }
 
 /// Whether the contact is a sticking friction contact (two multipliers in Newton).

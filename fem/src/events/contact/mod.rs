@@ -163,8 +163,7 @@
 //! without rotary inertia and without Kelvin–Voigt damping (above; for a bilateral wall:
 //! without rotary inertia), `implicit-midpoint` or `generalized-alpha` contact on Timoshenko
 //! links without rotary inertia at all (the end rates of the massless rotations:
-//! `crate::run`), the bilateral wall with `central-difference` (its projections hold one
-//! constraint: [`crate::method`]), and contact with adaptive stepping (`time.rtol`).
+//! `crate::run`), and contact with adaptive stepping (`time.rtol`).
 //!
 //! **Layout.** This file: the contact's parts, its construction and the gap with its gradient;
 //! `mass`: the solves with M(q) + μNNᵀ; `force`: the index-1 normal force; `impact`: the impact

@@ -3,7 +3,7 @@
 use super::Contact;
 use crate::chain::{AugmentedLayout, Chain};
 use crate::linalg::dot;
-use crate::method::{ConstraintView, NewtonSystem, StepConstraint};
+use crate::method::{ConstraintView, NewtonSystem, ProjectionRows, StepConstraint};
 
 /// The contact held in a constrained phase, as the method sees it: the force ∇̄g λ with ∇̄g
 /// the Gonzalez discrete gradient of the gap (metric W = M(q̄), as for the potential, so
@@ -16,6 +16,33 @@ impl StepConstraint<Chain> for Contact {
 
     fn gradient(&mut self, chain: &Chain, t: f64, q: &[f64], out: &mut [f64]) -> f64 {
         Contact::gradient(self, chain, t, q, out)
+    }
+
+    /// The gap row; on the bilateral wall also sliding friction's share of the normal
+    /// multiplier's force, or the stick row (`crate::events::contact::friction`).
+    fn projection_rows(&mut self, chain: &Chain, t: f64, q: &[f64], rows: &mut ProjectionRows) {
+        rows.k = 1;
+        rows.value[0] = Contact::gradient(self, chain, t, q, &mut rows.gradient[0]);
+        let (gradient, force) = (&rows.gradient[0], &mut rows.force[0]);
+        force.copy_from_slice(gradient);
+        if self.bilateral.is_some() {
+            crate::events::contact::friction::projection_rows(self, chain, t, q, rows);
+        }
+    }
+
+    fn commit_projection(
+        &mut self,
+        chain: &Chain,
+        t: [f64; 2],
+        q: [&[f64]; 2],
+        start: [f64; 2],
+        end: [f64; 2],
+    ) {
+        if self.bilateral.is_some() {
+            crate::events::contact::friction::commit_projection(self, chain, t, q, start, end);
+        } else {
+            self.set_multiplier(end[0]);
+        }
     }
 
     fn multiplier(&self) -> f64 {
