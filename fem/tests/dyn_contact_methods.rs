@@ -53,6 +53,15 @@ fn switches(r: &RunResult) -> Vec<(&'static str, f64)> {
         .collect()
 }
 
+/// The first stick of a friction run after its start-up switches (t > 0.01 s).
+fn first_stick(r: &RunResult) -> f64 {
+    stick_slips(r)
+        .iter()
+        .find(|e| e.0 && e.1 > 0.01)
+        .expect("a stick after the start")
+        .1
+}
+
 /// Stick–slip switches (sticking, t) of a friction run.
 fn stick_slips(r: &RunResult) -> Vec<(bool, f64)> {
     r.events
@@ -384,13 +393,6 @@ fn dyn_bathe_holds_the_friction_wall_and_books_the_friction_of_both_sub_steps() 
     // finest here.
     let t_end = 0.1;
     let reference = run(&sc, "energy-midpoint", None, 7.8125e-6, t_end);
-    let first_stick = |r: &RunResult| {
-        stick_slips(r)
-            .iter()
-            .find(|e| e.0 && e.1 > 0.01)
-            .expect("a stick after the start")
-            .1
-    };
     let ref_stick = first_stick(&reference);
     let ref_angle = channel(&reference, "joint1.angle");
     let mut angle_error = Vec::new();
@@ -449,13 +451,6 @@ fn dyn_central_difference_holds_the_friction_wall_to_second_order() {
     // elements, set by the axial field), against energy-midpoint at 7.8125e-6 s.
     let t_end = 0.1;
     let reference = run(&sc, "energy-midpoint", None, 7.8125e-6, t_end);
-    let first_stick = |r: &RunResult| {
-        stick_slips(r)
-            .iter()
-            .find(|e| e.0 && e.1 > 0.01)
-            .expect("a stick after the start")
-            .1
-    };
     let ref_stick = first_stick(&reference);
     let ref_angle = channel(&reference, "joint1.angle");
     let friction = |r: &RunResult| {

@@ -167,6 +167,14 @@ impl ProjectionRows {
             force: [vec![0.0; n], vec![0.0; n]],
         }
     }
+
+    /// Holds one row, `gradient[0]` as filled, of value `value`, its force along it.
+    pub fn hold_one(&mut self, value: f64) {
+        self.k = 1;
+        self.value[0] = value;
+        let (gradient, force) = (&self.gradient[0], &mut self.force[0]);
+        force.copy_from_slice(gradient);
+    }
 }
 
 /// A bilateral constraint held during a step on the system `S` (a tip on a surface,
@@ -180,10 +188,8 @@ pub trait StepConstraint<S: System + ?Sized> {
     /// The rows a projection method holds at (t, q) ([`ProjectionRows`]); by default the
     /// constraint alone, its force along its gradient.
     fn projection_rows(&mut self, system: &S, t: f64, q: &[f64], rows: &mut ProjectionRows) {
-        rows.k = 1;
-        rows.value[0] = self.gradient(system, t, q, &mut rows.gradient[0]);
-        let (gradient, force) = (&rows.gradient[0], &mut rows.force[0]);
-        force.copy_from_slice(gradient);
+        let value = self.gradient(system, t, q, &mut rows.gradient[0]);
+        rows.hold_one(value);
     }
     /// A projection method's converged step q₀ → q₁: the start and end multipliers of each
     /// row of [`StepConstraint::projection_rows`] (forces along the rows' force directions at

@@ -21,10 +21,8 @@ impl StepConstraint<Chain> for Contact {
     /// The gap row; on the bilateral wall also sliding friction's share of the normal
     /// multiplier's force, or the stick row (`crate::events::contact::friction`).
     fn projection_rows(&mut self, chain: &Chain, t: f64, q: &[f64], rows: &mut ProjectionRows) {
-        rows.k = 1;
-        rows.value[0] = Contact::gradient(self, chain, t, q, &mut rows.gradient[0]);
-        let (gradient, force) = (&rows.gradient[0], &mut rows.force[0]);
-        force.copy_from_slice(gradient);
+        let gap = Contact::gradient(self, chain, t, q, &mut rows.gradient[0]);
+        rows.hold_one(gap);
         if self.bilateral.is_some() {
             crate::events::contact::friction::projection_rows(self, chain, t, q, rows);
         }
