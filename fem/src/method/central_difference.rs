@@ -64,7 +64,7 @@
 use crate::band::BorderedBand;
 use crate::error::FemError;
 use crate::method::start::EventRestart;
-use crate::linalg::{dot, max_abs};
+use crate::linalg::{dot, max_abs, solve2};
 use crate::method::{
     Capabilities, MethodParams, ProjectionRows, StepConstraint, StepContext, StepState, Stepper,
     Works,
@@ -376,17 +376,11 @@ fn coupling(c: f64, rows: &ProjectionRows, minv: &[Vec<f64>; 2]) -> [[f64; 2]; 2
     a
 }
 
-/// −A⁻¹r for the first `k` rows (k ≤ 2; Cramer's rule for two).
+/// −A⁻¹r for the first `k` rows (k ≤ 2).
 fn solve_rows(a: &[[f64; 2]; 2], r: [f64; 2], k: usize) -> [f64; 2] {
     match k {
         1 => [-r[0] / a[0][0], 0.0],
-        2 => {
-            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-            [
-                -(a[1][1] * r[0] - a[0][1] * r[1]) / det,
-                -(a[0][0] * r[1] - a[1][0] * r[0]) / det,
-            ]
-        }
+        2 => solve2(*a, r).map(|x| -x),
         _ => [0.0; 2],
     }
 }

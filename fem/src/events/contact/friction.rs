@@ -90,7 +90,7 @@ use crate::error::FemError;
 use crate::events::contact::Contact;
 use crate::events::mass_solve::MassSolver;
 use crate::events::wall::{Wall, row_along, rows};
-use crate::linalg::dot;
+use crate::linalg::{dot, solve2};
 use crate::method::{ConstraintView, NewtonSystem, ProjectionRows};
 
 /// Slip-velocity tolerance of a located stop, relative to the longest link (per unit time).
@@ -372,9 +372,7 @@ impl Bilateral {
             ..Forces::default()
         };
         if held {
-            let det = gmg * tmt - gmt * gmt;
-            out.lambda_n = (tmt * rn - gmt * rt) / det;
-            out.lambda_t = (gmg * rt - gmt * rn) / det;
+            [out.lambda_n, out.lambda_t] = solve2([[gmg, gmt], [gmt, tmt]], [rn, rt]);
         } else {
             let m = self.constraint.mu * gmt.abs();
             out.painleve = self.constraint.mu > 0.0 && gmg <= m;
@@ -586,9 +584,7 @@ pub(crate) fn stick_newton_update(
     let a22 = hh * dot(&b.constraint.h_end, &b.constraint.s_inv_h);
     let r1 = b.constraint.g1 - hh * dot(&c.constraint.g_end, &newton.delta);
     let r2 = b.constraint.h1 - hh * dot(&b.constraint.h_end, &newton.delta);
-    let det = a11 * a22 - a12 * a21;
-    let dn = (a22 * r1 - a12 * r2) / det;
-    let dt = (a11 * r2 - a21 * r1) / det;
+    let [dn, dt] = solve2([[a11, a12], [a21, a22]], [r1, r2]);
     for i in 0..n {
         newton.delta[i] += c.constraint.s_inv_g[i] * dn + b.constraint.s_inv_h[i] * dt;
     }
