@@ -317,8 +317,48 @@ fn midpoint_forces(c: &mut Criterion) {
     g.finish();
 }
 
+/// The end-point energies of one energy-midpoint iteration after its mass product M(q₁)q̇₁ on
+/// the arms at their default meshes: the energies' own point walk against the potential on the
+/// mass product's kinematics ([`Chain::potential_at_last_q`]) and T₁ = ½q̇₁ᵀM(q₁)q̇₁ (what the
+/// scheme does; the potentials are equal bit for bit).
+fn midpoint_end_energies(c: &mut Criterion) {
+    use fem::chain::Parts;
+    let mut g = c.benchmark_group("midpoint-end-energies");
+    for name in ["two-link-free-undamped", "barhorst-case1-timoshenko"] {
+        let sc = data::load_scene(name).unwrap();
+        let mut ch = Chain::new(sc.links(), sc.gravity(), 16).unwrap();
+        let nd = ch.ndof;
+        let (mut q, mut v) = (vec![0.0; nd], vec![0.0; nd]);
+        ch.initial_state(&mut q, &mut v);
+        for i in 0..nd {
+            q[i] += 1e-3 * (i as f64).sin();
+            v[i] = 0.1 * (i as f64).cos();
+        }
+        let zero = vec![0.0; nd];
+        let mut mv = vec![0.0; nd];
+        g.bench_function(BenchmarkId::new("mass-product-and-energies", name), |b| {
+            b.iter(|| {
+                ch.residual_parts(1.0, &q, &zero, &v, Parts::INERTIA, &mut mv);
+                black_box((&mv, ch.energies(1.0, &q, &v)));
+            })
+        });
+        g.bench_function(
+            BenchmarkId::new("mass-product-and-potential-at-last-q", name),
+            |b| {
+                b.iter(|| {
+                    ch.residual_parts(1.0, &q, &zero, &v, Parts::INERTIA, &mut mv);
+                    let kinetic = 0.5 * v.iter().zip(&mv).map(|(x, y)| x * y).sum::<f64>();
+                    black_box((kinetic, ch.potential_at_last_q(1.0, &q)));
+                })
+            },
+        );
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    midpoint_end_energies,
     assembly,
     assembly_foreshortening,
     augmented_solver,

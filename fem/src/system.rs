@@ -164,6 +164,16 @@ pub trait System {
     /// springs, gravity; their sum is what the methods use).
     fn energies(&self, t: f64, q: &[f64], qd: &[f64]) -> [f64; 4];
 
+    /// The potential parts (strain, springs, gravity) of [`System::energies`] at (t, q), where
+    /// the last evaluation of the residual or of its groups was at the same q (any time, rates
+    /// and groups): it may reuse that pass's configuration data where they do not depend on
+    /// time. By default the energies at (t, q, q), whose potential parts do not depend on the
+    /// rates.
+    fn potential_at_last_q(&mut self, t: f64, q: &[f64]) -> [f64; 3] {
+        let [_, strain, springs, gravity] = self.energies(t, q, q);
+        [strain, springs, gravity]
+    }
+
     /// Whether M(q) has massless directions (zero rows): the start then treats them as
     /// algebraic ([`crate::method::start`]).
     fn has_massless_dofs(&self) -> bool;

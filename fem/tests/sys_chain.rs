@@ -289,6 +289,63 @@ fn sys_residual_parts_at_last_q_equal_the_full_passes() {
     }
 }
 
+/// The potential on the last kinematic pass (the energy-midpoint iteration's V(q₁) after its
+/// mass product) equals the energies' own walk bit for bit on the chains of
+/// [`sys_residual_parts_at_last_q_equal_the_full_passes`] (a prescribed joint takes the walk);
+/// on chains whose joints are all free (the scheme's domain) ½q̇ᵀ(M q̇) is their kinetic energy
+/// to round-off (with a prescribed joint T also holds the prescribed rotation's share).
+#[test]
+fn sys_potential_at_last_q_equals_the_energies() {
+    use fem::chain::Parts;
+    let mut free_chains = 0;
+    for (name, fs, element) in [
+        ("single-link", true, CUBIC),
+        ("two-link-free", true, QUINTIC),
+        ("barhorst-case1-timoshenko", true, CUBIC),
+        ("rotating-beam-axial", false, CUBIC),
+        ("spin-up", false, CUBIC),
+    ] {
+        let (_, q, qd, _) = setup(name, 3, fs, element);
+        let mut sc = data::load_scene(name).unwrap();
+        sc.planar_chain_mut().unwrap().gravity = Some(data::scene::Gravity {
+            vector: [0.3, -9.0],
+        });
+        for l in sc.planar_chain_mut().unwrap().links.iter_mut() {
+            l.foreshortening = fs && !l.axial;
+            l.tip_mass = Some(0.3);
+            l.joint.stiffness = Some(2.0);
+        }
+        let mut ch = Chain::with_element(sc.links(), sc.gravity(), 3, element).unwrap();
+        let n = ch.ndof;
+        let zero = vec![0.0; n];
+        let mut mv = vec![0.0; n];
+        let t = 0.7;
+        ch.residual_parts(t, &q, &zero, &qd, Parts::INERTIA, &mut mv);
+        let [strain, spring, gravity] = ch.potential_at_last_q(t, &q);
+        let [kinetic, e_strain, e_spring, e_gravity] = ch.energies(t, &q, &qd);
+        assert!(strain != 0.0 && spring != 0.0 && gravity != 0.0, "{name}");
+        assert!(
+            strain == e_strain && spring == e_spring && gravity == e_gravity,
+            "{name}: {:?} vs {:?}",
+            [strain, spring, gravity],
+            [e_strain, e_spring, e_gravity]
+        );
+        if sc.links().iter().any(|l| l.joint.prescribed.is_some()) {
+            continue;
+        }
+        let half_v_mv = 0.5 * qd.iter().zip(&mv).map(|(x, y)| x * y).sum::<f64>();
+        assert!(
+            (half_v_mv - kinetic).abs() <= 1e-13 * kinetic.abs(),
+            "{name}: ½q̇ᵀMq̇ {half_v_mv} vs T {kinetic}"
+        );
+        free_chains += 1;
+    }
+    assert_eq!(
+        free_chains, 3,
+        "the kinetic identity was checked on every free chain"
+    );
+}
+
 #[test]
 fn sys_newton_solve_of_real_chain_matrices_is_backward_stable() {
     // The Newton matrices of the arms at their default meshes, with the coefficients of a

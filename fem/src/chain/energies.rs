@@ -155,6 +155,40 @@ impl Chain {
         [kin, strain, spring, grav]
     }
 
+    /// The potential parts (strain, joint_spring, gravity) at (t, q), on the positions and
+    /// frames of the last kinematic pass, which must have been at q (any time, rates and
+    /// groups): equal to those of [`Chain::energies`] bit for bit (same terms, same order),
+    /// without the point walk. A chain with a prescribed joint (whose frames depend on the
+    /// pass's time) takes the walk at t.
+    pub fn potential_at_last_q(&self, t: f64, q: &[f64]) -> [f64; 3] {
+        if self.links.iter().any(|l| l.joint.prescribed.is_some()) {
+            let [_, strain, spring, gravity] = self.energies(t, q, q);
+            return [strain, spring, gravity];
+        }
+        let g_in = self.gravity;
+        let (mut strain, mut spring, mut grav) = (0.0, 0.0, 0.0);
+        for (li, l) in self.links.iter().enumerate() {
+            let th = q[l.joint.dof];
+            spring += 0.5 * l.joint.stiffness * (th - l.joint.set_point).powi(2);
+            let fr = &self.frames[li];
+            let tb = &l.element.quad;
+            for e in 0..l.n_el {
+                for j in 0..tb.ng {
+                    let m = l.rho_a * tb.wh[j];
+                    let p = self.pos[li][e * tb.ng + j];
+                    grav -= m * g_in.dot(&(fr.r + rot(fr.phi, p)));
+                }
+                let u = [Chain::val(q, l.u_dof[e]), Chain::val(q, l.u_dof[e + 1])];
+                let d = Chain::elem_v(q, &l.elem_dofs(e));
+                l.element
+                    .kind
+                    .add_strain_energy(&l.element, u, &d, &mut strain);
+            }
+            grav -= l.tip_mass * g_in.dot(&(fr.r + rot(fr.phi, fr.p_tip)));
+        }
+        [strain, spring, grav]
+    }
+
     /// Adds `sign`·∂T/∂q(q, x) to `out`, T = ½xᵀM(q)x the kinetic energy at generalized
     /// velocity x (module docs; prescribed joints move at their law's rate at t). O(n), no
     /// allocation.

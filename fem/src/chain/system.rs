@@ -65,6 +65,11 @@ impl System for Chain {
     }
 
     #[inline]
+    fn potential_at_last_q(&mut self, t: f64, q: &[f64]) -> [f64; 3] {
+        Chain::potential_at_last_q(self, t, q)
+    }
+
+    #[inline]
     fn has_massless_dofs(&self) -> bool {
         Chain::has_massless_dofs(self)
     }

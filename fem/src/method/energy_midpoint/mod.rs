@@ -27,10 +27,12 @@
 //!   with a central difference for Ṁ(x)x ([`kinetic_gradient_fd`], 3 inertial passes) is
 //!   its test oracle;
 //! * ∇g(q̄) = ∂T/∂q(q̄, a) − ∂T/∂q(q̄, b), a = v̄, b = ½(v₁ − v₀) (polarization);
-//! * ∇V(q̄) = conservative part; Q = −(non-conservative part); V(q₁) from [`System::energies`].
-//!   Both on the kinematic pass of the metric product M(q̄)Δq
-//!   ([`System::residual_parts_at_last_q`]: positions and frame angles depend on q̄ alone), so
-//!   an iteration makes one kinematic pass at q̄ instead of three.
+//! * ∇V(q̄) = conservative part; Q = −(non-conservative part). Both on the kinematic pass of
+//!   the metric product M(q̄)Δq ([`System::residual_parts_at_last_q`]: positions and frame
+//!   angles depend on q̄ alone), so an iteration makes one kinematic pass at q̄ instead of
+//!   three;
+//! * V(q₁) on the kinematic pass of the momentum M(q₁)v₁ ([`System::potential_at_last_q`]),
+//!   and T₁ = ½v₁ᵀ(M(q₁)v₁) from that momentum, so the end point takes one pass.
 //!
 //! Newton on the mean acceleration a = (v₁ − v₀)/h with the generalized-α matrix machinery at
 //! (q̄, v̄, a): S = M + (h/2)C + (h²/4)K (∂q̄/∂a = h²/4, ∂v̄/∂a = h/2), analytic — the

@@ -123,8 +123,8 @@ impl MidpointWork {
 }
 
 /// Residual passes of [`MidpointWork::momentum_residual`]: M(q₁)v₁, W Δq, ∇V, −Q and the two
-/// kinetic gradients, plus V(q₁) counted as one.
-pub(super) const MOMENTUM_PASSES: usize = 7;
+/// kinetic gradients (V(q₁) reuses the first one's kinematics).
+pub(super) const MOMENTUM_PASSES: usize = 6;
 
 /// What one step keeps fixed over its Newton iteration.
 pub(super) struct StepSetup {
@@ -273,7 +273,9 @@ impl MidpointWork {
             Parts::INERTIA,
             &mut self.mv1,
         );
-        let [k1, s1, sp1, g1] = system.energies(setup.t1, &st.q1, &st.qd1);
+        // V(q₁) on that pass's configuration; T₁ = ½q̇₁ᵀM(q₁)q̇₁ from the momentum just formed.
+        let [s1, sp1, g1] = system.potential_at_last_q(setup.t1, &st.q1);
+        let k1 = 0.5 * dot(&st.qd1, &self.mv1);
         let v1_pot = s1 + sp1 + g1;
         let scale1 = k1.abs() + s1.abs() + sp1.abs() + g1.abs();
         // Metric W = M(q̄) (the kinematic pass at q̄), then the forces at the midpoint on
