@@ -277,6 +277,20 @@ fn augmented_solver(c: &mut Criterion) {
     g.finish();
 }
 
+/// An arm at its default mesh (16 elements per link) in a deformed, moving state: (chain, q, v).
+fn moving_arm(name: &str) -> (Chain, Vec<f64>, Vec<f64>) {
+    let sc = data::load_scene(name).unwrap();
+    let ch = Chain::new(sc.links(), sc.gravity(), 16).unwrap();
+    let nd = ch.ndof;
+    let (mut q, mut v) = (vec![0.0; nd], vec![0.0; nd]);
+    ch.initial_state(&mut q, &mut v);
+    for i in 0..nd {
+        q[i] += 1e-3 * (i as f64).sin();
+        v[i] = 0.1 * (i as f64).cos();
+    }
+    (ch, q, v)
+}
+
 /// The forces of one energy-midpoint iteration at q̄ (metric product M(q̄)Δq, ∇V, −Q) on the
 /// arms at their default meshes: three full passes (kinematic and force pass each) against one
 /// full pass and two force passes on its kinematics ([`Chain::residual_parts_at_last_q`], what
@@ -285,15 +299,8 @@ fn midpoint_forces(c: &mut Criterion) {
     use fem::chain::Parts;
     let mut g = c.benchmark_group("midpoint-forces-at-qbar");
     for name in ["two-link-free-undamped", "barhorst-case1-timoshenko"] {
-        let sc = data::load_scene(name).unwrap();
-        let mut ch = Chain::new(sc.links(), sc.gravity(), 16).unwrap();
+        let (mut ch, q, v) = moving_arm(name);
         let nd = ch.ndof;
-        let (mut q, mut v) = (vec![0.0; nd], vec![0.0; nd]);
-        ch.initial_state(&mut q, &mut v);
-        for i in 0..nd {
-            q[i] += 1e-3 * (i as f64).sin();
-            v[i] = 0.1 * (i as f64).cos();
-        }
         let dq: Vec<f64> = v.iter().map(|x| 5e-4 * x).collect();
         let zero = vec![0.0; nd];
         let (mut w, mut gv, mut mq) = (vec![0.0; nd], vec![0.0; nd], vec![0.0; nd]);
@@ -325,15 +332,8 @@ fn midpoint_end_energies(c: &mut Criterion) {
     use fem::chain::Parts;
     let mut g = c.benchmark_group("midpoint-end-energies");
     for name in ["two-link-free-undamped", "barhorst-case1-timoshenko"] {
-        let sc = data::load_scene(name).unwrap();
-        let mut ch = Chain::new(sc.links(), sc.gravity(), 16).unwrap();
+        let (mut ch, q, v) = moving_arm(name);
         let nd = ch.ndof;
-        let (mut q, mut v) = (vec![0.0; nd], vec![0.0; nd]);
-        ch.initial_state(&mut q, &mut v);
-        for i in 0..nd {
-            q[i] += 1e-3 * (i as f64).sin();
-            v[i] = 0.1 * (i as f64).cos();
-        }
         let zero = vec![0.0; nd];
         let mut mv = vec![0.0; nd];
         g.bench_function(BenchmarkId::new("mass-product-and-energies", name), |b| {
