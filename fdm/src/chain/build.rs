@@ -11,6 +11,7 @@ use super::model::{JointLaw, LinkProps, SplitReuse, TwoLinkChain};
 use super::rates::LinkRates;
 use super::rates::MassFactors;
 use super::schur::MAX_SMALL;
+use super::schur::SmallLu;
 use super::surface::{TipConstraint, TipContact};
 use super::timoshenko::{self, TimoFields};
 use crate::error::FdmError;
@@ -210,6 +211,7 @@ fn mass_factors(inertia: &ChainInertia, nd: usize) -> MassFactors {
         nu: 0,
         z: std::array::from_fn(|_| vec![0.0; nd]),
         z_current: false,
+        small: SmallLu::default(),
         zb: vec![0.0; nd],
         rz: vec![0.0; nd],
         rows: vec![0.0; nd * MAX_SMALL],

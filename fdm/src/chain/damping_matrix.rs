@@ -5,7 +5,7 @@
 // Index loops over band positions read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::schur::{MAX_FULL, MAX_SMALL};
+use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
 use crate::band_ldl::BandLdl;
 
 /// C and the banded factorization of the implicit kick (module docs).
@@ -25,11 +25,18 @@ pub struct ImplicitDamping {
     /// segment multipliers
     pub(super) at_band: Vec<usize>,
     pub(super) at_segment: [Vec<usize>; 2],
-    /// saddle-system scratch: the right-hand sides of a kick by rows
+    /// saddle-system scratch: the right-hand sides of a solve by rows
     pub(super) y: Vec<f64>,
-    /// Z = A⁻¹ of the full columns of M + ½τC and of U, A⁻¹r_B (q indexing, zero on F)
+    /// Z = A⁻¹ of the full columns of M + ½τC and of U, and A⁻¹r_B (q indexing, zero on F)
     pub(super) z: [Vec<f64>; MAX_SMALL],
     pub(super) zb: Vec<f64>,
+    /// the small system of the Schur solve, factored
+    pub(super) small: SmallLu,
+    /// the τ of the factors above, while they are those of the current state (`None` after
+    /// a new state's `build_columns`)
+    pub(super) factored_for: Option<f64>,
+    /// whether the saddle system of those factors did not factor
+    pub(super) failed: bool,
     /// v_{j+1}
     pub(super) vnew: Vec<f64>,
     /// (M + ½τC)⁻¹Gᵀ of a held tip's constraint row

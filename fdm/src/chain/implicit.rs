@@ -25,7 +25,8 @@
 //!
 //! **Held tip** (restartable steps of a contact run, [`crate::method::velocity_form`]). With A =
 //! M + ½τC, A q̈ = f + Gᵀλ and G q̈ + Ġq̇ = 0 (Ġq̇ at the predicted velocity, as in the explicit
-//! kick): λ = −(G a_free + Ġq̇)/(G A⁻¹Gᵀ), one more banded solve. The drift projections after
+//! kick): λ = −(G a_free + Ġq̇)/(G A⁻¹Gᵀ), one more right-hand side on the kick's factors (the
+//! saddle LDLᵀ, Z and the small system are kept per state and τ). The drift projections after
 //! the kick keep the metric M (G and M⁻¹Gᵀ from the mass solve).
 //!
 //! **Ledger.** The powers are those of the level velocities (v_{j+1}ᵀCv_{j+1} and the joint
@@ -35,9 +36,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::damping_matrix::ImplicitDamping;
-use super::mass::schur_finish;
+use super::mass::{schur_matrix, schur_solve};
 use super::model::TwoLinkChain;
-use super::schur::{MAX_FULL, MAX_SMALL};
+use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
 use crate::band_ldl::BandLdl;
 use crate::system::{DriftVelocities, System};
 
@@ -101,6 +102,9 @@ impl TwoLinkChain {
             at_band,
             at_segment,
             y: vec![0.0; size * (MAX_SMALL + 1)],
+            small: SmallLu::default(),
+            factored_for: None,
+            failed: false,
             z: std::array::from_fn(|_| vec![0.0; n]),
             zb: vec![0.0; n],
             vnew: vec![0.0; n],
@@ -234,24 +238,32 @@ impl TwoLinkChain {
     }
 
     /// out = (M + ½τC)⁻¹ rhs at the state of the last `build_columns` (module docs). O(n), no
-    /// allocation. A saddle system that does not factor (masses or damping not positive)
-    /// gives NaN, which stops the run.
+    /// allocation. The first solve at a state and τ factors and sweeps the columns Z with its
+    /// right-hand side; a later one at them (the held tip's column after the kick) reuses the
+    /// factors and sweeps its right-hand side alone. A saddle system that does not factor
+    /// (masses or damping not positive) gives NaN, which stops the run.
     pub fn solve_damped_mass(&mut self, tau: f64, rhs: &[f64], out: &mut [f64]) {
         let mut imp = self.implicit.take().expect("implicit damping");
+        let refactor = imp.factored_for != Some(tau);
+        if refactor {
+            imp.factored_for = Some(tau);
+            imp.failed = !self.factor_saddle(tau, &mut imp);
+        }
+        if imp.failed {
+            out.iter_mut().for_each(|x| *x = f64::NAN);
+            self.implicit = Some(imp);
+            return;
+        }
         let ht = 0.5 * tau;
         let nf = self.nfull();
         let full = self.full();
         let full = &full[..nf];
         let nu = self.factors.nu;
-        let nb = imp.band.len();
         let mut rz = std::mem::take(&mut self.factors.rz);
         rz.copy_from_slice(rhs);
         self.q_to_z_forces(&mut rz);
         let ImplicitDamping {
             band,
-            c0,
-            c1,
-            c2,
             cf,
             saddle,
             at_band,
@@ -259,8 +271,74 @@ impl TwoLinkChain {
             y,
             z,
             zb,
+            small,
             ..
         } = &mut *imp;
+        let col = |c: usize, i: usize| self.cols[c][i] + ht * cf[c][i];
+        // the columns Z = A⁻¹[A_BF U] (a new factor only) and A⁻¹r_B, one sweep by rows over
+        // the saddle factor
+        let ns = nf + nu;
+        let nz = if refactor { ns } else { 0 };
+        let m = nz + 1;
+        let saddle_rows = at_segment[1].last().map_or(0, |p| p + 1);
+        y[..saddle_rows * m].iter_mut().for_each(|v| *v = 0.0);
+        for (&i, &at) in band.iter().zip(at_band.iter()) {
+            let at = at * m;
+            if refactor {
+                for c in 0..nf {
+                    y[at + c] = col(c, i);
+                }
+                for a in 0..nu {
+                    y[at + nf + a] = self.factors.u[a][i];
+                }
+            }
+            y[at + nz] = rz[i];
+        }
+        saddle.solve_rows_in_place(&mut y[..saddle_rows * m], m);
+        for c in 0..nz {
+            z[c].iter_mut().for_each(|v| *v = 0.0);
+        }
+        zb.iter_mut().for_each(|v| *v = 0.0);
+        for (&i, &at) in band.iter().zip(at_band.iter()) {
+            let at = at * m;
+            for c in 0..nz {
+                z[c][i] = y[at + c];
+            }
+            zb[i] = y[at + nz];
+        }
+        if refactor {
+            *small = schur_matrix(self.dofs(), full, col, &z[..ns], &self.factors.u[..nu]);
+        }
+        schur_solve(
+            full,
+            col,
+            small,
+            &z[..ns],
+            &self.factors.u[..nu],
+            zb,
+            &rz,
+            out,
+        );
+        self.implicit = Some(imp);
+        self.factors.rz = rz;
+        self.z_to_q_motion(out);
+    }
+
+    /// Assembles and factors the saddle system of M + ½τC at the state of the last
+    /// `build_columns`; false when it does not factor.
+    fn factor_saddle(&self, tau: f64, imp: &mut ImplicitDamping) -> bool {
+        let ht = 0.5 * tau;
+        let nb = imp.band.len();
+        let ImplicitDamping {
+            band,
+            c0,
+            c1,
+            c2,
+            saddle,
+            at_band,
+            at_segment,
+            ..
+        } = imp;
         saddle.clear();
         for b in 0..nb {
             saddle.add(at_band[b], at_band[b], self.diag_mass(band[b]) + ht * c0[b]);
@@ -294,52 +372,7 @@ impl TwoLinkChain {
             }
             first += r - 1;
         }
-        let saddle_rows = at_segment[1].last().map_or(0, |p| p + 1);
-        if saddle.factor().is_err() {
-            out.iter_mut().for_each(|x| *x = f64::NAN);
-            self.implicit = Some(imp);
-            self.factors.rz = rz;
-            return;
-        }
-        // the columns Z = A⁻¹[A_BF U] and A⁻¹r_B, one sweep by rows over the saddle factor
-        let ns = nf + nu;
-        let m = ns + 1;
-        let col = |c: usize, i: usize| self.cols[c][i] + ht * cf[c][i];
-        y.iter_mut().for_each(|v| *v = 0.0);
-        for b in 0..nb {
-            let (i, at) = (band[b], at_band[b] * m);
-            for c in 0..nf {
-                y[at + c] = col(c, i);
-            }
-            for a in 0..nu {
-                y[at + nf + a] = self.factors.u[a][i];
-            }
-            y[at + ns] = rz[i];
-        }
-        saddle.solve_rows_in_place(&mut y[..saddle_rows * m], m);
-        for c in 0..ns {
-            z[c].iter_mut().for_each(|v| *v = 0.0);
-        }
-        zb.iter_mut().for_each(|v| *v = 0.0);
-        for b in 0..nb {
-            let (i, at) = (band[b], at_band[b] * m);
-            for c in 0..ns {
-                z[c][i] = y[at + c];
-            }
-            zb[i] = y[at + ns];
-        }
-        schur_finish(
-            full,
-            col,
-            &z[..nf + nu],
-            &self.factors.u[..nu],
-            zb,
-            &rz,
-            out,
-        );
-        self.implicit = Some(imp);
-        self.factors.rz = rz;
-        self.z_to_q_motion(out);
+        saddle.factor().is_ok()
     }
 }
 
@@ -351,7 +384,9 @@ mod tests {
     #[test]
     fn elem_implicit_kick_solves_the_damped_mass_system() {
         // (M + ½τC) x = r checked by M x (the chain's own product) and C x (the damping forces
-        // themselves), at a deformed, moving state and a step far above the damped bound
+        // themselves), at a deformed, moving state and a step far above the damped bound: the
+        // first solve at the state (factors and columns), a second right-hand side on the same
+        // factors (the held tip's), and another τ (factored again)
         let scene = data::load_scene("two-link-free").unwrap();
         let mut sys =
             TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9))
@@ -364,21 +399,36 @@ mod tests {
         let v: Vec<f64> = (0..n).map(|i| 0.3 * (1.7 * i as f64).cos()).collect();
         sys.frames(&q, &v);
         sys.build_columns();
-        let rhs: Vec<f64> = (0..n).map(|i| (0.37 * i as f64).cos() + 0.1).collect();
-        let tau = 1e-3;
+        let rhs: [Vec<f64>; 2] = [
+            (0..n).map(|i| (0.37 * i as f64).cos() + 0.1).collect(),
+            (0..n).map(|i| (-0.2 * i as f64).exp() - 0.3).collect(),
+        ];
         let mut x = vec![0.0; n];
-        sys.solve_damped_mass(tau, &rhs, &mut x);
-        let mut mx = vec![0.0; n];
-        sys.mass_mul(&x, &mut mx);
-        let mut cx = vec![0.0; n];
-        sys.add_damping_forces(&x, &mut cx);
-        let scale = rhs.iter().fold(0.0f64, |m, r| m.max(r.abs()));
-        for i in 0..n {
-            let res = mx[i] - 0.5 * tau * cx[i] - rhs[i];
-            assert!(res.abs() < 1e-10 * scale, "row {i}: residual {res:e}");
+        let mut reused = vec![0.0; n];
+        for (tau, r) in [(1e-3, &rhs[0]), (1e-3, &rhs[1]), (4e-3, &rhs[1])] {
+            sys.solve_damped_mass(tau, r, &mut x);
+            let mut mx = vec![0.0; n];
+            sys.mass_mul(&x, &mut mx);
+            let mut cx = vec![0.0; n];
+            sys.add_damping_forces(&x, &mut cx);
+            let scale = r.iter().fold(0.0f64, |m, r| m.max(r.abs()));
+            for i in 0..n {
+                let res = mx[i] - 0.5 * tau * cx[i] - r[i];
+                assert!(
+                    res.abs() < 1e-10 * scale,
+                    "τ {tau}, row {i}: residual {res:e}"
+                );
+            }
+            // C is symmetric and positive semi-definite: xᵀCx = −x·(damping forces) ≥ 0
+            let d: f64 = -(0..n).map(|i| x[i] * cx[i]).sum::<f64>();
+            assert!(d > 0.0, "{d}");
+            if tau == 1e-3 && std::ptr::eq(r, &rhs[1]) {
+                reused.copy_from_slice(&x);
+            }
         }
-        // C is symmetric and positive semi-definite: xᵀCx = −x·(damping forces) ≥ 0
-        let d: f64 = -(0..n).map(|i| x[i] * cx[i]).sum::<f64>();
-        assert!(d > 0.0, "{d}");
+        // the reused factors give the fresh solve's bits
+        sys.build_columns();
+        sys.solve_damped_mass(1e-3, &rhs[1], &mut x);
+        assert_eq!(x, reused);
     }
 }

@@ -12,7 +12,7 @@
 //! f₂ = cos φ G₂ᵀμ + sin φ m₂ what link 2's stations move along it (from
 //! ½Σm₂|ṙ|² ∋ Ṡ Σm₂(σ̇ cos φ + ẇ sin φ)), φ = α₂ − α₁. With y = Uᵀx_R and Z = A⁻¹[M_RF U],
 //! the unknowns (x_F, y) solve a system of at most 7, and x_R = A⁻¹b_R − Z_F x_F − Z_U C y:
-//! O(n) per solve, the A factorizations and Z once per state.
+//! O(n) per solve, the A factorizations, Z and the small system's LU once per state.
 
 // Index loops over the columns of M read like the formulas.
 #![allow(clippy::needless_range_loop)]
@@ -20,7 +20,7 @@
 use super::kinetic::{BE, TH};
 use super::model::TwoLinkChain;
 use super::rates::LinkRates;
-use super::schur::{MAX_FULL, MAX_SMALL, solve_small};
+use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
 use crate::system::System;
 
 impl TwoLinkChain {
@@ -45,6 +45,9 @@ impl TwoLinkChain {
     /// unused slots) are constant, built in `from_planar_chain`. Then the factors of the solve.
     pub(super) fn build_columns(&mut self) {
         self.split_reuse.valid = false;
+        if let Some(imp) = self.implicit.as_mut() {
+            imp.factored_for = None;
+        }
         let n = self.dofs();
         let nd = self.inertia.dofs();
         let euler = self.timo.is_none();
@@ -147,6 +150,15 @@ impl TwoLinkChain {
             }
         }
         self.factors.rows = rows;
+        let fc = &self.factors;
+        let cols = &self.cols;
+        self.factors.small = schur_matrix(
+            self.dofs(),
+            &self.full()[..nf],
+            |c, i| cols[c][i],
+            &fc.z[..ns],
+            &fc.u[..fc.nu],
+        );
         self.factors.z_current = true;
     }
 
@@ -186,9 +198,10 @@ impl TwoLinkChain {
         self.solve_blocks(&mut zb);
         let fc = &self.factors;
         let cols = &self.cols;
-        schur_finish(
+        schur_solve(
             &full[..nf],
             |c, i| cols[c][i],
+            &fc.small,
             &fc.z,
             &fc.u[..fc.nu],
             &zb,
@@ -225,27 +238,22 @@ impl TwoLinkChain {
     }
 }
 
-/// The small system of the Schur solve and the back substitution (module docs): `col(c, i)`
-/// is entry i of full column c of the matrix, `z` its columns' A⁻¹ (the F columns, then U's),
-/// `zb` = A⁻¹b_R (zero on F). Writes the solution into `out`.
-pub(super) fn schur_finish(
+/// The small system of the Schur solve (module docs) of an n × n matrix, factored: `col(c, i)`
+/// is entry i of full column c of the matrix, `z` its columns' A⁻¹ (the F columns, then U's,
+/// zero on F).
+pub(super) fn schur_matrix(
+    n: usize,
     full: &[usize],
     col: impl Fn(usize, usize) -> f64,
     z: &[Vec<f64>],
     u: &[Vec<f64>],
-    zb: &[f64],
-    rhs: &[f64],
-    out: &mut [f64],
-) {
-    let n = rhs.len();
+) -> SmallLu {
     let (nf, nu) = (full.len(), u.len());
     let ns = nf + nu;
     let mut s = [[0.0; MAX_SMALL]; MAX_SMALL];
-    let mut b = [0.0; MAX_SMALL];
     // unknown k: x_F[k] (k < nf) or (Cy)[k − nf]; the y rows read y_a = (Cy)_{1−a}. One pass
-    // over q forms M_FR Z, M_FR A⁻¹b_R, UᵀZ and UᵀA⁻¹b_R (z and zb vanish on F).
+    // over q forms M_FR Z and UᵀZ.
     for r in 0..nf {
-        b[r] = rhs[full[r]];
         for k in 0..nf {
             s[r][k] = col(k, full[r]);
         }
@@ -262,7 +270,6 @@ pub(super) fn schur_finish(
         }
         for r in 0..ns {
             let c = if r < nf { col(r, i) } else { u[r - nf][i] };
-            b[r] -= c * zb[i];
             for (sk, zk) in s[r][..ns].iter_mut().zip(&zi[..ns]) {
                 *sk -= c * zk;
             }
@@ -271,7 +278,41 @@ pub(super) fn schur_finish(
     for a in 0..nu {
         s[nf + a][nf + 1 - a] -= 1.0;
     }
-    let x = solve_small(s, b, ns);
+    SmallLu::factor(s, ns)
+}
+
+/// The Schur solve's right-hand side, its small solve with the factors `small` of
+/// [`schur_matrix`] and the back substitution: `zb` = A⁻¹b_R (zero on F), `rhs` the whole
+/// right-hand side. Writes the solution into `out`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn schur_solve(
+    full: &[usize],
+    col: impl Fn(usize, usize) -> f64,
+    small: &SmallLu,
+    z: &[Vec<f64>],
+    u: &[Vec<f64>],
+    zb: &[f64],
+    rhs: &[f64],
+    out: &mut [f64],
+) {
+    let n = rhs.len();
+    let (nf, nu) = (full.len(), u.len());
+    let ns = nf + nu;
+    let mut b = [0.0; MAX_SMALL];
+    // M_FR A⁻¹b_R and UᵀA⁻¹b_R in one pass over q
+    for r in 0..nf {
+        b[r] = rhs[full[r]];
+    }
+    for i in 0..n {
+        if full.contains(&i) {
+            continue;
+        }
+        for r in 0..ns {
+            let c = if r < nf { col(r, i) } else { u[r - nf][i] };
+            b[r] -= c * zb[i];
+        }
+    }
+    let x = small.solve(b);
     for i in 0..n {
         out[i] = match full.iter().position(|&f| f == i) {
             Some(k) => x[k],

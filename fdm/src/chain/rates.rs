@@ -13,7 +13,7 @@
 //! is one tridiagonal SPD factorization per state and O(r) per solve. [`MassFactors`] holds
 //! both links' blocks with the rest of the mass solve's state-dependent factors.
 
-use super::schur::MAX_SMALL;
+use super::schur::{MAX_SMALL, SmallLu};
 use crate::tridiagonal::TridiagonalLdl;
 
 /// One link's A = D + GᵀNG (module docs) at the state of the last [`Self::set_state`],
@@ -164,6 +164,8 @@ pub struct MassFactors {
     /// Z = A⁻¹[M_RF U] in q indexing (zero on F), computed by the first solve at a state
     pub(super) z: [Vec<f64>; MAX_SMALL],
     pub(super) z_current: bool,
+    /// the factored small system of the Schur solve at that state (valid with `z_current`)
+    pub(super) small: SmallLu,
     /// A⁻¹b_R scratch
     pub(super) zb: Vec<f64>,
     /// the right-hand side in the solve's coordinates z
