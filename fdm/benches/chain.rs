@@ -6,10 +6,23 @@
 //! evaluation and mass solve per step, the rest kept from the first pass); `barhorst-case1`,
 //! 0.5 s at 21 stations (the drop, the first impacts and the held phases): the contact run's
 //! default, damping implicit with the held tip's force in the kick.
+//!
+//! `implicit-kick-saddle`: the kick's linear solve alone — the saddle system the chain assembles
+//! at a deformed, moving state of `two-link-free` (21 / 41 / 81 stations, τ = 1e-5), factored
+//! and solved for the kick's eight right-hand sides — by the hand-written band LDLᵀ the chain
+//! uses (`fdm::band_ldl`), by faer's sparse LU and by faer's sparse LDLᵀ (AMD ordering, no
+//! pivoting, as the band solver), each with its symbolic factorization reused and its storage
+//! allocated once (the contenders a hand-written kernel has to beat).
 //! Run: cargo bench -p fdm --bench chain -- --quick
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use data::load_scene;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
+use faer::sparse::linalg::lu::{LuRef, NumericLu, factorize_symbolic_lu};
+use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
+use faer::{Conj, MatMut, Par, Side};
 use fdm::ValidatedSettings;
 use fdm::chain::TwoLinkChain;
 use fdm::driver::{StepControl, integrate};
@@ -89,5 +102,125 @@ fn contact(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, contact);
+fn implicit_kick_saddle(c: &mut Criterion) {
+    let scene = load_scene("two-link-free").expect("catalog scene");
+    let mut group = c.benchmark_group("implicit-kick-saddle");
+    let m = 8;
+    for stations in [21usize, 41, 81] {
+        let mut chain =
+            TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(stations))
+                .expect("chain");
+        assert!(chain.enable_implicit_damping());
+        let n_q = fdm::system::System::dofs(&chain);
+        let q: Vec<f64> = (0..n_q)
+            .map(|i| 0.3 + 0.02 * (0.9 * i as f64).sin())
+            .collect();
+        let qd: Vec<f64> = (0..n_q).map(|i| 0.3 * (1.7 * i as f64).cos()).collect();
+        let assembled = chain.implicit_kick_saddle(&q, &qd, 1e-5);
+        let n = assembled.n();
+        let rhs: Vec<f64> = (0..n * m).map(|k| (0.37 * k as f64).cos()).collect();
+
+        let mut x = rhs.clone();
+        group.bench_with_input(BenchmarkId::new("band ldl", stations), &stations, |b, _| {
+            b.iter(|| {
+                let mut band = assembled.clone();
+                band.factor().expect("quasi-definite");
+                x.copy_from_slice(&rhs);
+                band.solve_rows_in_place(&mut x, m);
+                std::hint::black_box(x[0])
+            })
+        });
+
+        let triplets: Vec<Triplet<usize, usize, f64>> = assembled
+            .lower_entries()
+            .flat_map(|(i, j, v)| {
+                let mirror = (i != j).then(|| Triplet::new(j, i, v));
+                std::iter::once(Triplet::new(i, j, v)).chain(mirror)
+            })
+            .collect();
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets).unwrap();
+        let symbolic = factorize_symbolic_lu(a.symbolic(), Default::default()).unwrap();
+        let scratch = symbolic
+            .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(m, Par::Seq));
+        let mut mem = MemBuffer::new(scratch);
+        let mut numeric = NumericLu::new();
+        // right-hand sides column by column
+        let rhs_cols: Vec<f64> = (0..n * m).map(|k| rhs[(k % n) * m + k / n]).collect();
+        let mut y = rhs_cols.clone();
+        group.bench_with_input(
+            BenchmarkId::new("faer sparse lu", stations),
+            &stations,
+            |b, _| {
+                b.iter(|| {
+                    let a = SparseColMatRef::new(a.symbolic(), a.val());
+                    symbolic
+                        .factorize_numeric_lu(
+                            &mut numeric,
+                            a,
+                            Par::Seq,
+                            MemStack::new(&mut mem),
+                            Default::default(),
+                        )
+                        .expect("numeric LU");
+                    y.copy_from_slice(&rhs_cols);
+                    let lu = LuRef::new_unchecked(&symbolic, &numeric);
+                    lu.solve_in_place_with_conj(
+                        Conj::No,
+                        MatMut::from_column_major_slice_mut(&mut y, n, m),
+                        Par::Seq,
+                        MemStack::new(&mut mem),
+                    );
+                    std::hint::black_box(y[0])
+                })
+            },
+        );
+
+        // LDLᵀ without pivoting (AMD ordering), as the band solver: the quasi-definite matrix
+        // needs no pivoting in any order
+        let ldlt = factorize_symbolic_cholesky(
+            a.symbolic(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            Default::default(),
+        )
+        .unwrap();
+        let scratch = ldlt
+            .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
+            .or(ldlt.solve_in_place_scratch::<f64>(m, Par::Seq));
+        let mut mem = MemBuffer::new(scratch);
+        let mut l_values = vec![0.0; ldlt.len_val()];
+        group.bench_with_input(
+            BenchmarkId::new("faer sparse ldlt", stations),
+            &stations,
+            |b, _| {
+                b.iter(|| {
+                    let a = SparseColMatRef::new(a.symbolic(), a.val());
+                    let factor = ldlt
+                        .factorize_numeric_ldlt(
+                            &mut l_values,
+                            a,
+                            Side::Lower,
+                            LdltRegularization::default(),
+                            Par::Seq,
+                            MemStack::new(&mut mem),
+                            Default::default(),
+                        )
+                        .expect("numeric LDLᵀ");
+                    y.copy_from_slice(&rhs_cols);
+                    factor.solve_in_place_with_conj(
+                        Conj::No,
+                        MatMut::from_column_major_slice_mut(&mut y, n, m),
+                        Par::Seq,
+                        MemStack::new(&mut mem),
+                    );
+                    std::hint::black_box(y[0])
+                })
+            },
+        );
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench, contact, implicit_kick_saddle);
 criterion_main!(benches);

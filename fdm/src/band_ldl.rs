@@ -34,6 +34,27 @@ impl BandLdl {
         i * (self.k + 1) + self.k - (i - j)
     }
 
+    /// The order n.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The half-bandwidth k.
+    pub fn half_bandwidth(&self) -> usize {
+        self.k
+    }
+
+    /// The nonzero entries (i, j, A[i, j]) with j ≤ i of the matrix as assembled (before
+    /// [`Self::factor`]; after it, those of the factors), row by row.
+    pub fn lower_entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+        (0..self.n).flat_map(move |i| {
+            (i.saturating_sub(self.k)..=i).filter_map(move |j| {
+                let v = self.a[self.at(i, j)];
+                (v != 0.0).then_some((i, j, v))
+            })
+        })
+    }
+
     /// Zeroes the matrix.
     pub fn clear(&mut self) {
         self.a.iter_mut().for_each(|x| *x = 0.0);

@@ -324,9 +324,30 @@ impl TwoLinkChain {
         self.z_to_q_motion(out);
     }
 
+    /// The saddle system of the implicit kick (module docs) at (q, q̇) and step τ, assembled
+    /// and not factored (the kernel's bench and its test against faer read it). Requires
+    /// [`Self::enable_implicit_damping`].
+    pub fn implicit_kick_saddle(&mut self, q: &[f64], qd: &[f64], tau: f64) -> BandLdl {
+        self.frames(q, qd);
+        self.build_columns();
+        let mut imp = self.implicit.take().expect("implicit damping");
+        self.assemble_saddle(tau, &mut imp);
+        imp.factored_for = None;
+        let saddle = imp.saddle.clone();
+        self.implicit = Some(imp);
+        saddle
+    }
+
     /// Assembles and factors the saddle system of M + ½τC at the state of the last
     /// `build_columns`; false when it does not factor.
     fn factor_saddle(&self, tau: f64, imp: &mut ImplicitDamping) -> bool {
+        self.assemble_saddle(tau, imp);
+        imp.saddle.factor().is_ok()
+    }
+
+    /// The saddle system [[D_B + ½τC_BB, Gᵀ], [G, −N⁻¹]] interleaved by station into
+    /// `imp.saddle`.
+    fn assemble_saddle(&self, tau: f64, imp: &mut ImplicitDamping) {
         let ht = 0.5 * tau;
         let nb = imp.band.len();
         let ImplicitDamping {
@@ -372,7 +393,6 @@ impl TwoLinkChain {
             }
             first += r - 1;
         }
-        saddle.factor().is_ok()
     }
 }
 
