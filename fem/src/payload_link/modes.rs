@@ -7,7 +7,7 @@ use data::{FemSettings, ModalResult, ModeShape, Scene};
 use faer::{Mat, c64};
 
 use super::model::{self, Model};
-use super::{build, elements};
+use super::plan::{build, elements};
 use crate::element::beam3d::{PHI, U, V, W};
 use crate::error::FemError;
 

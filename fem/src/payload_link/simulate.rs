@@ -12,9 +12,9 @@ use data::{
 use super::driver::LinkDriver;
 use super::model::Model;
 use super::modes::slot_of;
+use super::plan::{build, elements};
 use super::statics::static_sag;
 use super::step_rule::{default_step, fit};
-use super::{build, elements};
 use crate::band::BorderedBand;
 use crate::driver::fixed_steps::QuarterRetries;
 use crate::element::beam3d::{PHI, V, W};

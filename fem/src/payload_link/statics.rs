@@ -8,7 +8,7 @@ use faer::Mat;
 use faer::prelude::*;
 
 use super::model::Model;
-use super::{build, elements};
+use super::plan::{build, elements};
 use crate::error::FemError;
 
 /// Linear gravity sag K_s d = −f_g (zero without gravity).
