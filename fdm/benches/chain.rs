@@ -132,11 +132,8 @@ fn implicit_kick_saddle(c: &mut Criterion) {
         });
 
         let triplets: Vec<Triplet<usize, usize, f64>> = assembled
-            .lower_entries()
-            .flat_map(|(i, j, v)| {
-                let mirror = (i != j).then(|| Triplet::new(j, i, v));
-                std::iter::once(Triplet::new(i, j, v)).chain(mirror)
-            })
+            .entries()
+            .map(|(i, j, v)| Triplet::new(i, j, v))
             .collect();
         let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets).unwrap();
         let symbolic = factorize_symbolic_lu(a.symbolic(), Default::default()).unwrap();

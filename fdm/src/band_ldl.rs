@@ -44,13 +44,15 @@ impl BandLdl {
         self.k
     }
 
-    /// The nonzero entries (i, j, A[i, j]) with j ≤ i of the matrix as assembled (before
-    /// [`Self::factor`]; after it, those of the factors), row by row.
-    pub fn lower_entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+    /// The nonzero entries (i, j, A[i, j]) of the symmetric matrix as assembled (before
+    /// [`Self::factor`]), both triangles, row by row of the lower one.
+    pub fn entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
         (0..self.n).flat_map(move |i| {
-            (i.saturating_sub(self.k)..=i).filter_map(move |j| {
+            (i.saturating_sub(self.k)..=i).flat_map(move |j| {
                 let v = self.a[self.at(i, j)];
-                (v != 0.0).then_some((i, j, v))
+                let lower = (v != 0.0).then_some((i, j, v));
+                let upper = (v != 0.0 && i != j).then_some((j, i, v));
+                lower.into_iter().chain(upper)
             })
         })
     }

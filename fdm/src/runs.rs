@@ -30,7 +30,9 @@ pub const TIMOSHENKO_CONTACT_SAFETY: f64 = 0.1;
 /// of the catalog's contact scenes at safety 1 lies at the 1e-5 target (`barhorst-case2`, 30 s:
 /// 9.29e-6; `-stiff-elbow`, 10 s: 8.65e-6), at 0.45 a third of it or less (1.94e-6 in 1.45 M
 /// steps, 2.61e-6 in 0.51 M; the explicit damping's bound took 7.65 M and 4.54 M steps).
-/// `time.safety_factor` overrides it.
+/// The error it bounds is the velocity form's energy error of the top modes each impact excites
+/// (O((ωτ)²) of their energy, frozen in by the impact), larger the less those modes are damped
+/// (docs/contact.md, "fdm's step through contact"). `time.safety_factor` overrides it.
 pub const IMPLICIT_CONTACT_SAFETY: f64 = 0.45;
 
 /// Runs the rocket with explicit control over the bound check (tests use `enforce_bound =

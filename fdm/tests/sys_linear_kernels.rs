@@ -31,11 +31,8 @@ fn sys_band_ldl_solves_the_implicit_kick_saddle_as_faer_sparse_lu() {
             let mut band = chain.implicit_kick_saddle(&q, &qd, tau);
             let n = band.n();
             let triplets: Vec<Triplet<usize, usize, f64>> = band
-                .lower_entries()
-                .flat_map(|(i, j, v)| {
-                    let mirror = (i != j).then(|| Triplet::new(j, i, v));
-                    std::iter::once(Triplet::new(i, j, v)).chain(mirror)
-                })
+                .entries()
+                .map(|(i, j, v)| Triplet::new(i, j, v))
                 .collect();
             let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets).unwrap();
             // it is a saddle system: both signs on the diagonal
