@@ -39,11 +39,6 @@ impl BandLdl {
         self.n
     }
 
-    /// The half-bandwidth k.
-    pub fn half_bandwidth(&self) -> usize {
-        self.k
-    }
-
     /// The nonzero entries (i, j, A[i, j]) of the symmetric matrix as assembled (before
     /// [`Self::factor`]), both triangles, row by row of the lower one.
     pub fn entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
