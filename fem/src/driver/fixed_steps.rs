@@ -1,8 +1,8 @@
 //! A [`System`] stepped by a method of the registry in fixed steps that land on the caller's
 //! stop times, for the models without events (the 3-D payload link, the rocket): the method,
 //! its state, Newton system and counters ([`FixedSteps`]), and the retry of a step whose
-//! Newton iteration fails as four quarter steps ([`QuarterRetries`]). Each model's driver
-//! keeps its own works and its own trial step (what it books, where its laws jump).
+//! Newton iteration fails as four quarter steps, the trial step landing on the laws' jumps
+//! ([`QuarterRetries`]). Each model's driver says where its laws jump and books its own works.
 
 use crate::error::FemError;
 use crate::method::{Counters, NewtonSystem, StepContext, StepState, Stepper, start};
@@ -86,16 +86,46 @@ impl<S: System<Augmented = NoAugmentation>> FixedSteps<S> {
     }
 }
 
-/// A model's driver over [`FixedSteps`]: its trial step, and the step with retries.
+/// A model's driver over [`FixedSteps`]: where its laws jump and what it books of a step; the
+/// trial step and the step with retries are the same for every model.
 pub trait QuarterRetries {
     type System: System<Augmented = NoAugmentation>;
 
     /// The stepped system.
     fn steps(&mut self) -> &mut FixedSteps<Self::System>;
 
+    /// Whether a step of length h ending at t₁ ends on a jump of the model's laws (a motor
+    /// law's switch, burn-out): the step then takes the laws' left limit and the method
+    /// restarts after it.
+    fn ends_on_jump(&self, h: f64, t1: f64) -> bool;
+
+    /// Books the works of the solved step of length h (the state holds its start and its
+    /// trial end).
+    fn book(&mut self, h: f64);
+
     /// One step of length h onto t₁, its works booked; false (state unchanged) when its Newton
-    /// iteration did not converge.
-    fn try_step(&mut self, h: f64, t1: f64) -> Result<bool, FemError>;
+    /// iteration did not converge. A step that ends on a jump evaluates the laws as their left
+    /// limit, and the method restarts there from a consistent acceleration
+    /// ([`crate::method::start`]).
+    fn try_step(&mut self, h: f64, t1: f64) -> Result<bool, FemError> {
+        let on_jump = self.ends_on_jump(h, t1);
+        let t_law = if on_jump { t1 - 1e-9 * h } else { t1 };
+        let (stepper, mut cx) = self.steps().parts();
+        if let Some(e) = stepper.step(&mut cx, None, h, t1, t_law)?
+            && e.is_infinite()
+        {
+            return Ok(false);
+        }
+        self.book(h);
+        let steps = self.steps();
+        steps.state.swap_in(t1);
+        steps.counters.steps += 1;
+        if on_jump {
+            steps.consistent_acceleration(h, t1)?;
+            steps.restart();
+        }
+        Ok(true)
+    }
 
     /// One step of length h onto t₁ (the caller snaps t₁ to its stop time). A step whose Newton
     /// iteration fails is retried as four quarter steps (recursively, down to 10⁻⁶ of the

@@ -93,38 +93,24 @@ impl QuarterRetries for LinkDriver {
         &mut self.steps
     }
 
-    /// Books the link's works (module docs); a step that ends on a breakpoint takes the law's
-    /// left limit and restarts the method after it.
-    fn try_step(&mut self, h: f64, t1: f64) -> Result<bool, FemError> {
-        let on_break = self
-            .breakpoints
+    /// On a motor-law breakpoint (within 10⁻¹² of the nominal step, or of 1 s).
+    fn ends_on_jump(&self, _h: f64, t1: f64) -> bool {
+        self.breakpoints
             .iter()
-            .any(|&b| (t1 - b).abs() <= 1e-12 * self.steps.h_nominal.max(1.0));
-        let t_law = if on_break { t1 - 1e-9 * h } else { t1 };
-        let t0 = self.steps.state.t;
-        let (stepper, mut cx) = self.steps.parts();
-        if let Some(e) = stepper.step(&mut cx, None, h, t1, t_law)?
-            && e.is_infinite()
-        {
-            return Ok(false);
-        }
+            .any(|&b| (t1 - b).abs() <= 1e-12 * self.steps.h_nominal.max(1.0))
+    }
+
+    /// The method's own works (not reported), then the link's works (module docs).
+    fn book(&mut self, h: f64) {
         self.steps.commit(h, &mut self.method_works);
         let FixedSteps { system, state, .. } = &mut self.steps;
         system.step_works(
-            t0,
+            state.t,
             h,
             (&state.q, &state.q1),
             (&state.qd, &state.qd1),
             &mut self.scratch,
             &mut self.works,
         );
-        self.steps.state.swap_in(t1);
-        self.steps.counters.steps += 1;
-        if on_break {
-            // Restart from the discontinuity with the new law value.
-            self.steps.consistent_acceleration(h, t1)?;
-            self.steps.restart();
-        }
-        Ok(true)
     }
 }

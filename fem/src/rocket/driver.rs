@@ -90,7 +90,28 @@ impl RocketDriver {
         self.steps.newton.tol = newton_tolerance(&self.steps.system.model, h);
     }
 
-    /// Books the works of the solved step t₀ → t₀ + h (module docs).
+    /// Stored energies at the current state, in the ledger's order: kinetic, strain, gravity,
+    /// discrete springs.
+    pub fn stored(&self) -> [f64; 4] {
+        let st = &self.steps.state;
+        let [kinetic, strain, spring, gravity] = self.steps.system.energies(st.t, &st.q, &st.qd);
+        [kinetic, strain, gravity, spring]
+    }
+}
+
+impl QuarterRetries for RocketDriver {
+    type System = RocketSystem;
+
+    fn steps(&mut self) -> &mut FixedSteps<RocketSystem> {
+        &mut self.steps
+    }
+
+    /// On burn-out (the caller snaps the step to it): thrust, pressure and the mass rate jump.
+    fn ends_on_jump(&self, _h: f64, t1: f64) -> bool {
+        t1 == self.burnout
+    }
+
+    /// The works of the solved step t₀ → t₀ + h (module docs).
     fn book(&mut self, h: f64) {
         let st = &self.steps.state;
         let (t0, tm, t1) = (st.t, st.t + 0.5 * h, st.t + h);
@@ -115,44 +136,6 @@ impl RocketDriver {
         w.coriolis += h * p.coriolis;
         w.damper += h * p.damper;
         w.outflow += kin + pot;
-    }
-
-    /// Stored energies at the current state, in the ledger's order: kinetic, strain, gravity,
-    /// discrete springs.
-    pub fn stored(&self) -> [f64; 4] {
-        let st = &self.steps.state;
-        let [kinetic, strain, spring, gravity] = self.steps.system.energies(st.t, &st.q, &st.qd);
-        [kinetic, strain, gravity, spring]
-    }
-}
-
-impl QuarterRetries for RocketDriver {
-    type System = RocketSystem;
-
-    fn steps(&mut self) -> &mut FixedSteps<RocketSystem> {
-        &mut self.steps
-    }
-
-    /// Books the step's works (module docs); a step that ends on burn-out takes the laws' left
-    /// limit and restarts the method after the jump.
-    fn try_step(&mut self, h: f64, t1: f64) -> Result<bool, FemError> {
-        let at_burnout = t1 == self.burnout;
-        let t_law = if at_burnout { t1 - 1e-9 * h } else { t1 };
-        let (stepper, mut cx) = self.steps.parts();
-        if let Some(e) = stepper.step(&mut cx, None, h, t1, t_law)?
-            && e.is_infinite()
-        {
-            return Ok(false);
-        }
-        self.book(h);
-        self.steps.state.swap_in(t1);
-        self.steps.counters.steps += 1;
-        if at_burnout {
-            // Restart after the jump of the loads and of the mass rate.
-            self.steps.consistent_acceleration(h, t1)?;
-            self.steps.restart();
-        }
-        Ok(true)
     }
 }
 
