@@ -13,12 +13,19 @@
 //! uses (`fdm::band_ldl`), by faer's sparse LU and by faer's sparse LDLᵀ (AMD ordering, no
 //! pivoting, as the band solver), each with its symbolic factorization reused and its storage
 //! allocated once (the contenders a hand-written kernel has to beat).
+//!
+//! `link-rates-tridiagonal`: the tridiagonal solve of a link's foreshortening-rate block
+//! N⁻¹ + GD⁻¹Gᵀ in the chain's mass solve (factor once per state, seven right-hand sides), by
+//! the hand-written LDLᵀ (`fdm::tridiagonal`) and by faer's sparse LLᵀ (AMD ordering, symbolic
+//! factorization reused, storage allocated once), 20 / 40 / 80 segments, the masses of
+//! `two-link-free`'s link 1 and the slopes of a bent link.
 //! Run: cargo bench -p fdm --bench chain -- --quick
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use data::load_scene;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
 use faer::sparse::linalg::lu::{LuRef, NumericLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
@@ -26,6 +33,7 @@ use faer::{Conj, MatMut, Par, Side};
 use fdm::ValidatedSettings;
 use fdm::chain::TwoLinkChain;
 use fdm::driver::{StepControl, integrate};
+use fdm::tridiagonal::TridiagonalLdl;
 
 fn settings(stations: usize, t_end: f64) -> ValidatedSettings {
     let requested = data::FdmSettings {
@@ -219,5 +227,99 @@ fn implicit_kick_saddle(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, contact, implicit_kick_saddle);
+fn link_rates_tridiagonal(c: &mut Criterion) {
+    let mut group = c.benchmark_group("link-rates-tridiagonal");
+    let m = 7;
+    let (length, mass_per_length) = (3.0, 1.764);
+    for r in [20usize, 40, 80] {
+        // N⁻¹ + GD⁻¹Gᵀ (`fdm::chain` rates): station masses d, outboard axial masses w of the
+        // segments, slopes g of a link bent to 1 % of its length
+        let h = length / r as f64;
+        let d: Vec<f64> = (0..r - 1).map(|_| mass_per_length * h).collect();
+        let w: Vec<f64> = (0..r)
+            .map(|seg| mass_per_length * (length - seg as f64 * h))
+            .collect();
+        let g: Vec<f64> = (0..r)
+            .map(|seg| 0.01 * (std::f64::consts::PI * (seg as f64 + 0.5) / r as f64).cos())
+            .collect();
+        let inv_d = |i: usize| if i < r - 1 { 1.0 / d[i] } else { 0.0 };
+        let diag = |a: usize| {
+            let mut t = 1.0 / w[a] + g[a] * g[a] * inv_d(a);
+            if a > 0 {
+                t += 1.0 / w[a - 1] + g[a] * g[a] * inv_d(a - 1);
+            }
+            t
+        };
+        let off = |a: usize| -1.0 / w[a] - g[a + 1] * g[a] * inv_d(a);
+        let rhs: Vec<f64> = (0..r * m).map(|k| (0.37 * k as f64).cos()).collect();
+
+        let mut ldl = TridiagonalLdl::new(r);
+        let mut x = rhs.clone();
+        group.bench_with_input(BenchmarkId::new("tridiagonal ldl", r), &r, |b, _| {
+            b.iter(|| {
+                ldl.factor(diag, off).expect("SPD");
+                x.copy_from_slice(&rhs);
+                ldl.solve_rows_in_place(&mut x, m);
+                std::hint::black_box(x[0])
+            })
+        });
+
+        let mut triplets = Vec::new();
+        for a in 0..r {
+            triplets.push(Triplet::new(a, a, diag(a)));
+            if a + 1 < r {
+                triplets.push(Triplet::new(a + 1, a, off(a)));
+                triplets.push(Triplet::new(a, a + 1, off(a)));
+            }
+        }
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(r, r, &triplets).unwrap();
+        let llt = factorize_symbolic_cholesky(
+            a.symbolic(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            Default::default(),
+        )
+        .unwrap();
+        let scratch = llt
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(llt.solve_in_place_scratch::<f64>(m, Par::Seq));
+        let mut mem = MemBuffer::new(scratch);
+        let mut l_values = vec![0.0; llt.len_val()];
+        let rhs_cols: Vec<f64> = (0..r * m).map(|k| rhs[(k % r) * m + k / r]).collect();
+        let mut y = rhs_cols.clone();
+        group.bench_with_input(BenchmarkId::new("faer sparse llt", r), &r, |b, _| {
+            b.iter(|| {
+                let a = SparseColMatRef::new(a.symbolic(), a.val());
+                let factor = llt
+                    .factorize_numeric_llt(
+                        &mut l_values,
+                        a,
+                        Side::Lower,
+                        LltRegularization::default(),
+                        Par::Seq,
+                        MemStack::new(&mut mem),
+                        Default::default(),
+                    )
+                    .expect("numeric LLᵀ");
+                y.copy_from_slice(&rhs_cols);
+                factor.solve_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(&mut y, r, m),
+                    Par::Seq,
+                    MemStack::new(&mut mem),
+                );
+                std::hint::black_box(y[0])
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    bench,
+    contact,
+    implicit_kick_saddle,
+    link_rates_tridiagonal
+);
 criterion_main!(benches);
