@@ -19,6 +19,11 @@
 //! the hand-written LDLᵀ (`fdm::tridiagonal`) and by faer's sparse LLᵀ (AMD ordering, symbolic
 //! factorization reused, storage allocated once), 20 / 40 / 80 segments, the masses of
 //! `two-link-free`'s link 1 and the slopes of a bent link.
+//!
+//! `small-schur-lu`: the dense small system of the kick's Schur solve (seven unknowns at
+//! `two-link-free`'s state above, 41 stations), factored and solved for one right-hand side by
+//! the hand-written elimination (`fdm::chain::schur::SmallLu`) and by faer's dense LU with
+//! partial pivoting (`lu_in_place`, workspace allocated once, then the two triangular solves).
 //! Run: cargo bench -p fdm --bench chain -- --quick
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -26,12 +31,17 @@ use data::load_scene;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::linalg::lu::partial_pivoting::factor::{lu_in_place, lu_in_place_scratch};
+use faer::linalg::triangular_solve::{
+    solve_unit_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
 use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
 use faer::sparse::linalg::lu::{LuRef, NumericLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
-use faer::{Conj, MatMut, Par, Side};
+use faer::{Conj, Mat, MatMut, Par, Side};
 use fdm::ValidatedSettings;
 use fdm::chain::TwoLinkChain;
+use fdm::chain::schur::{MAX_SMALL, SmallLu};
 use fdm::driver::{StepControl, integrate};
 use fdm::tridiagonal::TridiagonalLdl;
 
@@ -315,11 +325,72 @@ fn link_rates_tridiagonal(c: &mut Criterion) {
     group.finish();
 }
 
+fn small_schur_lu(c: &mut Criterion) {
+    let scene = load_scene("two-link-free").expect("catalog scene");
+    let mut chain =
+        TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(41))
+            .expect("chain");
+    assert!(chain.enable_implicit_damping());
+    let n_q = fdm::system::System::dofs(&chain);
+    let q: Vec<f64> = (0..n_q)
+        .map(|i| 0.3 + 0.02 * (0.9 * i as f64).sin())
+        .collect();
+    let qd: Vec<f64> = (0..n_q).map(|i| 0.3 * (1.7 * i as f64).cos()).collect();
+    let (s, n) = chain.implicit_kick_schur(&q, &qd, 1e-5);
+    let b: [f64; MAX_SMALL] = std::array::from_fn(|i| (0.37 * i as f64).cos());
+    let mut group = c.benchmark_group("small-schur-lu");
+    group.bench_function(BenchmarkId::new("small lu", n), |bench| {
+        bench.iter(|| {
+            let lu = SmallLu::factor(s, n);
+            std::hint::black_box(lu.solve(b)[0])
+        })
+    });
+    let req = lu_in_place_scratch::<usize, f64>(n, n, Par::Seq, Default::default());
+    let mut mem = MemBuffer::new(req);
+    let mut a = Mat::<f64>::zeros(n, n);
+    let (mut perm, mut perm_inv) = (vec![0usize; n], vec![0usize; n]);
+    let mut x = vec![0.0; n];
+    group.bench_function(BenchmarkId::new("faer dense lu", n), |bench| {
+        bench.iter(|| {
+            for j in 0..n {
+                for i in 0..n {
+                    a[(i, j)] = s[i][j];
+                }
+            }
+            lu_in_place(
+                a.as_mut(),
+                &mut perm,
+                &mut perm_inv,
+                Par::Seq,
+                MemStack::new(&mut mem),
+                Default::default(),
+            );
+            for k in 0..n {
+                x[k] = b[perm[k]];
+            }
+            let mut rhs = MatMut::from_column_major_slice_mut(&mut x, n, 1);
+            solve_unit_lower_triangular_in_place(a.as_ref(), rhs.as_mut(), Par::Seq);
+            solve_upper_triangular_in_place(a.as_ref(), rhs, Par::Seq);
+            std::hint::black_box(x[0])
+        })
+    });
+    // both solve the same system (checked once, outside the timing)
+    let mine = SmallLu::factor(s, n).solve(b);
+    for k in 0..n {
+        assert!(
+            (mine[k] - x[k]).abs() <= 1e-9 * mine[k].abs().max(1e-300),
+            "x[{k}]"
+        );
+    }
+    group.finish();
+}
+
 criterion_group!(
     benches,
     bench,
     contact,
     implicit_kick_saddle,
-    link_rates_tridiagonal
+    link_rates_tridiagonal,
+    small_schur_lu
 );
 criterion_main!(benches);

@@ -36,7 +36,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::damping_matrix::ImplicitDamping;
-use super::mass::{schur_matrix, schur_solve};
+use super::mass::{schur_matrix, schur_solve, schur_system};
 use super::model::TwoLinkChain;
 use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
 use crate::band_ldl::BandLdl;
@@ -336,6 +336,32 @@ impl TwoLinkChain {
         let saddle = imp.saddle.clone();
         self.implicit = Some(imp);
         saddle
+    }
+
+    /// The small system of the implicit kick's Schur solve (module docs) at (q, q̇) and step τ
+    /// and its order, not factored (the kernel's bench reads it). Requires
+    /// [`Self::enable_implicit_damping`].
+    pub fn implicit_kick_schur(
+        &mut self,
+        q: &[f64],
+        qd: &[f64],
+        tau: f64,
+    ) -> ([[f64; MAX_SMALL]; MAX_SMALL], usize) {
+        self.frames(q, qd);
+        self.build_columns();
+        // a solve at the state leaves the columns Z
+        let zero = vec![0.0; self.dofs()];
+        let mut x = vec![0.0; self.dofs()];
+        self.solve_damped_mass(tau, &zero, &mut x);
+        let imp = self.implicit.as_ref().expect("implicit damping");
+        let (nf, nu) = (self.nfull(), self.factors.nu);
+        schur_system(
+            self.dofs(),
+            &self.full()[..nf],
+            |c, i| self.cols[c][i] + 0.5 * tau * imp.cf[c][i],
+            &imp.z[..nf + nu],
+            &self.factors.u[..nu],
+        )
     }
 
     /// Assembles and factors the saddle system of M + ½τC at the state of the last

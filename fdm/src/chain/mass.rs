@@ -238,9 +238,8 @@ impl TwoLinkChain {
     }
 }
 
-/// The small system of the Schur solve (module docs) of an n × n matrix, factored: `col(c, i)`
-/// is entry i of full column c of the matrix, `z` its columns' A⁻¹ (the F columns, then U's,
-/// zero on F).
+/// The small system of the Schur solve (module docs) of an n × n matrix, factored
+/// ([`schur_system`]).
 pub(super) fn schur_matrix(
     n: usize,
     full: &[usize],
@@ -248,6 +247,20 @@ pub(super) fn schur_matrix(
     z: &[Vec<f64>],
     u: &[Vec<f64>],
 ) -> SmallLu {
+    let (s, ns) = schur_system(n, full, col, z, u);
+    SmallLu::factor(s, ns)
+}
+
+/// The small system of the Schur solve (module docs) of an n × n matrix and its order:
+/// `col(c, i)` is entry i of full column c of the matrix, `z` its columns' A⁻¹ (the F columns,
+/// then U's, zero on F).
+pub(super) fn schur_system(
+    n: usize,
+    full: &[usize],
+    col: impl Fn(usize, usize) -> f64,
+    z: &[Vec<f64>],
+    u: &[Vec<f64>],
+) -> ([[f64; MAX_SMALL]; MAX_SMALL], usize) {
     let (nf, nu) = (full.len(), u.len());
     let ns = nf + nu;
     let mut s = [[0.0; MAX_SMALL]; MAX_SMALL];
@@ -278,7 +291,7 @@ pub(super) fn schur_matrix(
     for a in 0..nu {
         s[nf + a][nf + 1 - a] -= 1.0;
     }
-    SmallLu::factor(s, ns)
+    (s, ns)
 }
 
 /// The Schur solve's right-hand side, its small solve with the factors `small` of

@@ -102,7 +102,7 @@ mod model;
 pub mod modes;
 mod outputs;
 mod rates;
-mod schur;
+pub mod schur;
 mod surface;
 mod system;
 pub mod timoshenko;

@@ -1,21 +1,22 @@
 //! The dense block of the chain's mass solves: the full columns of M (θ, β, the clamp ghost
-//! slots — ψ₁, ψ₂ in the solve's coordinates — and, with Euler links, link 1's tip ghost y) couple every coordinate, so the solves
-//! eliminate the lumped diagonal and are left with an at most 5×5 Schur complement on those
-//! columns ([`super::mass`], [`super::implicit`]).
+//! slots — ψ₁, ψ₂ in the solve's coordinates — and, with Euler links, link 1's tip ghost y)
+//! couple every coordinate, so the solves eliminate the lumped diagonal and are left with a
+//! small Schur complement on those columns and on the two columns of the links'
+//! foreshortening-rate coupling, at most 7 × 7 ([`super::mass`], [`super::implicit`]).
 
 // Index loops over the rows and columns of the block read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
 /// Largest number of full columns (θ, β, the two ghost slots, y).
-pub(super) const MAX_FULL: usize = 5;
+pub const MAX_FULL: usize = 5;
 /// Largest small system of the mass solve: the full columns and the two columns of the
-/// links' foreshortening-rate coupling ([`super::rates`]).
-pub(super) const MAX_SMALL: usize = MAX_FULL + 2;
+/// links' foreshortening-rate coupling (U of [`super::mass`]).
+pub const MAX_SMALL: usize = MAX_FULL + 2;
 
 /// The LU factors (partial pivoting) of the leading `n`×`n` block of a small system, kept so
 /// that every right-hand side at one state reuses them.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct SmallLu {
+pub struct SmallLu {
     /// U on and above the diagonal; below it, the multiplier of each row at the step that
     /// eliminated it (later row swaps leave it in place, so a solve repeats the elimination)
     lu: [[f64; MAX_SMALL]; MAX_SMALL],
@@ -26,7 +27,7 @@ pub(super) struct SmallLu {
 
 impl SmallLu {
     /// Gaussian elimination with partial pivoting of the leading `n`×`n` block of `a`.
-    pub(super) fn factor(mut a: [[f64; MAX_SMALL]; MAX_SMALL], n: usize) -> Self {
+    pub fn factor(mut a: [[f64; MAX_SMALL]; MAX_SMALL], n: usize) -> Self {
         let mut swap = [0; MAX_SMALL];
         for col in 0..n {
             let piv = (col..n)
@@ -51,7 +52,7 @@ impl SmallLu {
     }
 
     /// x with A x = b.
-    pub(super) fn solve(&self, mut b: [f64; MAX_SMALL]) -> [f64; MAX_SMALL] {
+    pub fn solve(&self, mut b: [f64; MAX_SMALL]) -> [f64; MAX_SMALL] {
         let (a, n) = (&self.lu, self.n);
         for col in 0..n {
             b.swap(col, self.swap[col]);
