@@ -26,7 +26,8 @@
 //! partial pivoting (`lu_in_place`, workspace allocated once, then the two triangular solves).
 //! Run: cargo bench -p fdm --bench chain -- --quick
 
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::measurement::WallTime;
+use criterion::{BenchmarkGroup, BenchmarkId, Criterion, criterion_group, criterion_main};
 use data::load_scene;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -40,8 +41,8 @@ use faer::sparse::linalg::lu::{LuRef, NumericLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMat, SparseColMatRef, Triplet};
 use faer::{Conj, Mat, MatMut, Par, Side};
 use fdm::ValidatedSettings;
-use fdm::chain::TwoLinkChain;
 use fdm::chain::schur::{MAX_SMALL, SmallLu};
+use fdm::chain::{TwoLinkChain, rate_block};
 use fdm::driver::{StepControl, integrate};
 use fdm::tridiagonal::TridiagonalLdl;
 
@@ -120,6 +121,87 @@ fn contact(c: &mut Criterion) {
     group.finish();
 }
 
+/// The sparse symmetric factorizations faer offers, as contenders of the hand-written solvers.
+#[derive(Clone, Copy)]
+enum Cholesky {
+    /// LDLᵀ without pivoting (a quasi-definite matrix needs none in any order)
+    Ldlt,
+    /// LLᵀ (positive definite)
+    Llt,
+}
+
+/// Right-hand sides stored by rows (X[i·m + c]) as faer's column-major storage.
+fn by_columns(rows: &[f64], n: usize, m: usize) -> Vec<f64> {
+    (0..n * m).map(|k| rows[(k % n) * m + k / n]).collect()
+}
+
+/// Benches faer's sparse `kind` factorization of `a` (AMD ordering, symbolic factorization
+/// reused, storage allocated once) plus the solve of the `m` right-hand sides `rows` (by rows).
+fn bench_faer_cholesky(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    id: BenchmarkId,
+    a: &SparseColMat<usize, f64>,
+    rows: &[f64],
+    m: usize,
+    kind: Cholesky,
+) {
+    let n = a.nrows();
+    let symbolic = factorize_symbolic_cholesky(
+        a.symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Amd,
+        Default::default(),
+    )
+    .unwrap();
+    let factor_scratch = match kind {
+        Cholesky::Ldlt => {
+            symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
+        }
+        Cholesky::Llt => {
+            symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+        }
+    };
+    let mut mem =
+        MemBuffer::new(factor_scratch.or(symbolic.solve_in_place_scratch::<f64>(m, Par::Seq)));
+    let mut l_values = vec![0.0; symbolic.len_val()];
+    let cols = by_columns(rows, n, m);
+    let mut y = cols.clone();
+    group.bench_function(id, |b| {
+        b.iter(|| {
+            let a = SparseColMatRef::new(a.symbolic(), a.val());
+            y.copy_from_slice(&cols);
+            let rhs = MatMut::from_column_major_slice_mut(&mut y, n, m);
+            match kind {
+                Cholesky::Ldlt => symbolic
+                    .factorize_numeric_ldlt(
+                        &mut l_values,
+                        a,
+                        Side::Lower,
+                        LdltRegularization::default(),
+                        Par::Seq,
+                        MemStack::new(&mut mem),
+                        Default::default(),
+                    )
+                    .expect("numeric LDLᵀ")
+                    .solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut mem)),
+                Cholesky::Llt => symbolic
+                    .factorize_numeric_llt(
+                        &mut l_values,
+                        a,
+                        Side::Lower,
+                        LltRegularization::default(),
+                        Par::Seq,
+                        MemStack::new(&mut mem),
+                        Default::default(),
+                    )
+                    .expect("numeric LLᵀ")
+                    .solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut mem)),
+            }
+            std::hint::black_box(y[0])
+        })
+    });
+}
+
 fn implicit_kick_saddle(c: &mut Criterion) {
     let scene = load_scene("two-link-free").expect("catalog scene");
     let mut group = c.benchmark_group("implicit-kick-saddle");
@@ -160,8 +242,7 @@ fn implicit_kick_saddle(c: &mut Criterion) {
             .or(symbolic.solve_in_place_scratch::<f64>(m, Par::Seq));
         let mut mem = MemBuffer::new(scratch);
         let mut numeric = NumericLu::new();
-        // right-hand sides column by column
-        let rhs_cols: Vec<f64> = (0..n * m).map(|k| rhs[(k % n) * m + k / n]).collect();
+        let rhs_cols = by_columns(&rhs, n, m);
         let mut y = rhs_cols.clone();
         group.bench_with_input(
             BenchmarkId::new("faer sparse lu", stations),
@@ -191,47 +272,14 @@ fn implicit_kick_saddle(c: &mut Criterion) {
             },
         );
 
-        // LDLᵀ without pivoting (AMD ordering), as the band solver: the quasi-definite matrix
-        // needs no pivoting in any order
-        let ldlt = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            Default::default(),
-        )
-        .unwrap();
-        let scratch = ldlt
-            .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
-            .or(ldlt.solve_in_place_scratch::<f64>(m, Par::Seq));
-        let mut mem = MemBuffer::new(scratch);
-        let mut l_values = vec![0.0; ldlt.len_val()];
-        group.bench_with_input(
+        // LDLᵀ without pivoting, as the band solver
+        bench_faer_cholesky(
+            &mut group,
             BenchmarkId::new("faer sparse ldlt", stations),
-            &stations,
-            |b, _| {
-                b.iter(|| {
-                    let a = SparseColMatRef::new(a.symbolic(), a.val());
-                    let factor = ldlt
-                        .factorize_numeric_ldlt(
-                            &mut l_values,
-                            a,
-                            Side::Lower,
-                            LdltRegularization::default(),
-                            Par::Seq,
-                            MemStack::new(&mut mem),
-                            Default::default(),
-                        )
-                        .expect("numeric LDLᵀ");
-                    y.copy_from_slice(&rhs_cols);
-                    factor.solve_in_place_with_conj(
-                        Conj::No,
-                        MatMut::from_column_major_slice_mut(&mut y, n, m),
-                        Par::Seq,
-                        MemStack::new(&mut mem),
-                    );
-                    std::hint::black_box(y[0])
-                })
-            },
+            &a,
+            &rhs,
+            m,
+            Cholesky::Ldlt,
         );
     }
     group.finish();
@@ -252,15 +300,7 @@ fn link_rates_tridiagonal(c: &mut Criterion) {
         let g: Vec<f64> = (0..r)
             .map(|seg| 0.01 * (std::f64::consts::PI * (seg as f64 + 0.5) / r as f64).cos())
             .collect();
-        let inv_d = |i: usize| if i < r - 1 { 1.0 / d[i] } else { 0.0 };
-        let diag = |a: usize| {
-            let mut t = 1.0 / w[a] + g[a] * g[a] * inv_d(a);
-            if a > 0 {
-                t += 1.0 / w[a - 1] + g[a] * g[a] * inv_d(a - 1);
-            }
-            t
-        };
-        let off = |a: usize| -1.0 / w[a] - g[a + 1] * g[a] * inv_d(a);
+        let (diag, off) = rate_block(&d, &w, &g);
         let rhs: Vec<f64> = (0..r * m).map(|k| (0.37 * k as f64).cos()).collect();
 
         let mut ldl = TridiagonalLdl::new(r);
@@ -283,44 +323,14 @@ fn link_rates_tridiagonal(c: &mut Criterion) {
             }
         }
         let a = SparseColMat::<usize, f64>::try_new_from_triplets(r, r, &triplets).unwrap();
-        let llt = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            Default::default(),
-        )
-        .unwrap();
-        let scratch = llt
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(llt.solve_in_place_scratch::<f64>(m, Par::Seq));
-        let mut mem = MemBuffer::new(scratch);
-        let mut l_values = vec![0.0; llt.len_val()];
-        let rhs_cols: Vec<f64> = (0..r * m).map(|k| rhs[(k % r) * m + k / r]).collect();
-        let mut y = rhs_cols.clone();
-        group.bench_with_input(BenchmarkId::new("faer sparse llt", r), &r, |b, _| {
-            b.iter(|| {
-                let a = SparseColMatRef::new(a.symbolic(), a.val());
-                let factor = llt
-                    .factorize_numeric_llt(
-                        &mut l_values,
-                        a,
-                        Side::Lower,
-                        LltRegularization::default(),
-                        Par::Seq,
-                        MemStack::new(&mut mem),
-                        Default::default(),
-                    )
-                    .expect("numeric LLᵀ");
-                y.copy_from_slice(&rhs_cols);
-                factor.solve_in_place_with_conj(
-                    Conj::No,
-                    MatMut::from_column_major_slice_mut(&mut y, r, m),
-                    Par::Seq,
-                    MemStack::new(&mut mem),
-                );
-                std::hint::black_box(y[0])
-            })
-        });
+        bench_faer_cholesky(
+            &mut group,
+            BenchmarkId::new("faer sparse llt", r),
+            &a,
+            &rhs,
+            m,
+            Cholesky::Llt,
+        );
     }
     group.finish();
 }

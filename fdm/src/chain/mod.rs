@@ -109,3 +109,4 @@ pub mod timoshenko;
 
 pub use build::DEFAULT_STATIONS;
 pub use model::TwoLinkChain;
+pub use rates::rate_block;

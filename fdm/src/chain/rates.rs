@@ -98,17 +98,7 @@ impl LinkRates {
     /// Factors N⁻¹ + GD⁻¹Gᵀ (SPD for positive masses and a finite state; otherwise the
     /// solves give NaN and the run's watch stops it).
     fn factor(&mut self) {
-        let r = self.w.len();
-        let (d, w, g) = (&self.d, &self.w, &self.g);
-        let inv_d = |i: usize| if i < r - 1 { 1.0 / d[i] } else { 0.0 };
-        let diag = |a: usize| {
-            let mut t = 1.0 / w[a] + g[a] * g[a] * inv_d(a);
-            if a > 0 {
-                t += 1.0 / w[a - 1] + g[a] * g[a] * inv_d(a - 1);
-            }
-            t
-        };
-        let off = |a: usize| -1.0 / w[a] - g[a + 1] * g[a] * inv_d(a);
+        let (diag, off) = rate_block(&self.d, &self.w, &self.g);
         self.failed = self.ldl.factor(diag, off).is_err();
         self.factored = true;
     }
@@ -151,6 +141,30 @@ impl LinkRates {
             }
         }
     }
+}
+
+/// The tridiagonal block N⁻¹ + GD⁻¹Gᵀ of a link's foreshortening rates (module docs) from its
+/// station masses `d` (length r − 1), axial masses `w` and segment slopes `g` (length r): its
+/// diagonal and its off-diagonal A_{a,a+1}, as functions of the segment index.
+pub fn rate_block<'a>(
+    d: &'a [f64],
+    w: &'a [f64],
+    g: &'a [f64],
+) -> (
+    impl Fn(usize) -> f64 + Copy + 'a,
+    impl Fn(usize) -> f64 + Copy + 'a,
+) {
+    let r = w.len();
+    let inv_d = move |i: usize| if i < r - 1 { 1.0 / d[i] } else { 0.0 };
+    let diag = move |a: usize| {
+        let mut t = 1.0 / w[a] + g[a] * g[a] * inv_d(a);
+        if a > 0 {
+            t += 1.0 / w[a - 1] + g[a] * g[a] * inv_d(a - 1);
+        }
+        t
+    };
+    let off = move |a: usize| -1.0 / w[a] - g[a + 1] * g[a] * inv_d(a);
+    (diag, off)
 }
 
 /// The state-dependent factors of the mass solve ([`super::mass`] docs), allocated once.
