@@ -1,11 +1,15 @@
-//! The hand-written solver of the chain's implicit kick (`fdm::band_ldl::BandLdl`, LDLᵀ without
-//! pivoting of a quasi-definite band) against faer's sparse LU with partial pivoting, on the
-//! saddle systems the chain assembles at deformed, moving states (its bench:
-//! `cargo bench -p fdm --bench chain -- implicit-kick-saddle`).
+//! The chain's hand-written solvers against faer, on the matrices the chain assembles at
+//! deformed, moving states:
+//! - the implicit kick's (`fdm::band_ldl::BandLdl`, LDLᵀ without pivoting of a quasi-definite
+//!   band) against faer's sparse LU with partial pivoting (bench:
+//!   `cargo bench -p fdm --bench chain -- implicit-kick-saddle`);
+//! - the mass solve's foreshortening-rate blocks (`fdm::tridiagonal::TridiagonalLdl`) against
+//!   faer's sparse Cholesky (bench: `cargo bench -p fdm --bench chain -- link-rates-tridiagonal`).
 
 use faer::prelude::*;
 use faer::sparse::{SparseColMat, Triplet};
 use fdm::chain::TwoLinkChain;
+use fdm::tridiagonal::TridiagonalLdl;
 
 /// The two-link-free chain with `stations` per link, implicit damping on, and a deformed,
 /// moving state (q, q̇) of it.
@@ -54,26 +58,88 @@ fn sys_band_ldl_solves_the_implicit_kick_saddle_as_faer_sparse_lu() {
             band.factor().expect("quasi-definite: the LDLᵀ exists");
             let mut rows: Vec<f64> = (0..n * m).map(|k| rhs[(k / m, k % m)]).collect();
             band.solve_rows_in_place(&mut rows, m);
-            let norm_a = triplets.iter().fold(0.0f64, |s, t| s.max(t.val.abs()));
             for c in 0..m {
-                let x_norm = (0..n).fold(0.0f64, |s, i| s.max(rows[i * m + c].abs()));
-                let b_norm = (0..n).fold(0.0f64, |s, i| s.max(rhs[(i, c)].abs()));
-                // backward error of the band solution, ‖b − A x‖ / (‖A‖‖x‖ + ‖b‖), against n·ε
-                let mut r: Vec<f64> = (0..n).map(|i| rhs[(i, c)]).collect();
-                for t in &triplets {
-                    r[t.row] -= t.val * rows[t.col * m + c];
-                }
-                let backward =
-                    r.iter().fold(0.0f64, |s, v| s.max(v.abs())) / (norm_a * x_norm + b_norm);
+                let x: Vec<f64> = (0..n).map(|i| rows[i * m + c]).collect();
+                let b: Vec<f64> = (0..n).map(|i| rhs[(i, c)]).collect();
+                let x_norm = x.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+                let backward = backward_error(&triplets, &x, &b);
                 assert!(
                     backward < f64::EPSILON * n as f64,
                     "{stations} stations, τ {tau}, column {c}: backward error {backward:e}"
                 );
                 for i in 0..n {
-                    let (x, y) = (rows[i * m + c], reference[(i, c)]);
+                    let y = reference[(i, c)];
                     assert!(
-                        (x - y).abs() <= 1e-11 * x_norm,
-                        "{stations} stations, τ {tau}: x[{i}, {c}] {x:e} against faer's {y:e}"
+                        (x[i] - y).abs() <= 1e-11 * x_norm,
+                        "{stations} stations, τ {tau}: x[{i}, {c}] {:e} against faer's {y:e}",
+                        x[i]
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Backward error ‖b − A x‖∞ / (‖A‖max ‖x‖∞ + ‖b‖∞) of one solution column, held to n·ε.
+fn backward_error(triplets: &[Triplet<usize, usize, f64>], x: &[f64], b: &[f64]) -> f64 {
+    let mut r = b.to_vec();
+    for t in triplets {
+        r[t.row] -= t.val * x[t.col];
+    }
+    let norm = |v: &[f64]| v.iter().fold(0.0f64, |s, e| s.max(e.abs()));
+    let norm_a = triplets.iter().fold(0.0f64, |s, t| s.max(t.val.abs()));
+    norm(&r) / (norm_a * norm(x) + norm(b))
+}
+
+#[test]
+fn sys_tridiagonal_ldl_solves_the_link_rate_blocks_as_faer_sparse_cholesky() {
+    for stations in [11usize, 21, 41, 81] {
+        let (mut chain, q, qd) = chain_at_a_state(stations);
+        for link in 0..2 {
+            let (diag, off) = chain.link_rate_block(&q, &qd, link);
+            let r = diag.len();
+            assert_eq!(off.len(), r - 1);
+            // the deformed state gives the block its slope terms: off-diagonals that differ
+            // from the undeformed −1/W
+            assert!(off.windows(2).any(|p| p[0] != p[1]));
+            let mut triplets = Vec::new();
+            for a in 0..r {
+                triplets.push(Triplet::new(a, a, diag[a]));
+                if a + 1 < r {
+                    triplets.push(Triplet::new(a + 1, a, off[a]));
+                    triplets.push(Triplet::new(a, a + 1, off[a]));
+                }
+            }
+            let a = SparseColMat::<usize, f64>::try_new_from_triplets(r, r, &triplets).unwrap();
+            // the mass solve's seven right-hand sides, stored by rows
+            let m = 7;
+            let rhs = Mat::<f64>::from_fn(r, m, |i, c| {
+                (0.37 * (i + 3 * c) as f64).cos() + if i % (c + 2) == 0 { 1.0 } else { 0.0 }
+            });
+            let reference = a
+                .sp_cholesky(faer::Side::Lower)
+                .expect("SPD: faer's sparse Cholesky exists")
+                .solve(&rhs);
+            let mut ldl = TridiagonalLdl::new(r);
+            ldl.factor(|i| diag[i], |i| off[i])
+                .expect("SPD: the LDLᵀ exists");
+            let mut rows: Vec<f64> = (0..r * m).map(|k| rhs[(k / m, k % m)]).collect();
+            ldl.solve_rows_in_place(&mut rows, m);
+            for c in 0..m {
+                let x: Vec<f64> = (0..r).map(|i| rows[i * m + c]).collect();
+                let b: Vec<f64> = (0..r).map(|i| rhs[(i, c)]).collect();
+                let backward = backward_error(&triplets, &x, &b);
+                assert!(
+                    backward < f64::EPSILON * r as f64,
+                    "{stations} stations, link {link}, column {c}: backward error {backward:e}"
+                );
+                let x_norm = x.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+                for i in 0..r {
+                    let y = reference[(i, c)];
+                    assert!(
+                        (x[i] - y).abs() <= 1e-11 * x_norm,
+                        "{stations} stations, link {link}: x[{i}, {c}] {:e} against faer's {y:e}",
+                        x[i]
                     );
                 }
             }

@@ -30,6 +30,15 @@ impl TwoLinkChain {
         first..self.slots[link]
     }
 
+    /// The tridiagonal block N⁻¹ + GD⁻¹Gᵀ of `link`'s foreshortening rates at (q, q̇), the
+    /// matrix of [`super::rate_block`]: its diagonal (one entry per segment) and off-diagonal
+    /// (the kernel's test against faer reads it).
+    pub fn link_rate_block(&mut self, q: &[f64], qd: &[f64], link: usize) -> (Vec<f64>, Vec<f64>) {
+        self.frames(q, qd);
+        self.build_columns();
+        self.factors.links[link].block()
+    }
+
     /// x_R ← A⁻¹x_R on both links' deflections (F entries untouched).
     fn solve_blocks(&mut self, x: &mut [f64]) {
         for link in 0..2 {

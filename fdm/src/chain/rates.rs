@@ -77,6 +77,14 @@ impl LinkRates {
         &self.g
     }
 
+    /// The tridiagonal N⁻¹ + GD⁻¹Gᵀ at the last [`Self::set_state`]: its diagonal (length r)
+    /// and its off-diagonal A_{a,a+1} (length r − 1).
+    pub fn block(&self) -> (Vec<f64>, Vec<f64>) {
+        let r = self.w.len();
+        let (diag, off) = rate_block(&self.d, &self.w, &self.g);
+        ((0..r).map(diag).collect(), (0..r - 1).map(off).collect())
+    }
+
     /// The state: deflections `u` of the stations with an unknown (length r − 1), the tip's
     /// deflection `tip` (0 in a chord frame, −Lψ in the clamp-tangent frame), segment spacing
     /// `h` and station masses `d`.
