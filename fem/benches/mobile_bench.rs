@@ -25,7 +25,7 @@ fn one_step(c: &mut Criterion) {
         .unwrap();
         let h = p.h;
         g.bench_with_input(BenchmarkId::new("implicit_midpoint", n), &n, |b, _| {
-            b.iter(|| p.stepper.step(black_box(h)).unwrap())
+            b.iter(|| p.run.step(black_box(h)).unwrap())
         });
     }
     g.finish();

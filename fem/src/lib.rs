@@ -156,8 +156,10 @@
 //! Scenes of the `[mobile_manipulator]` family with a `flexible_link` are solved by [`mobile`]:
 //! the platform, turret, rigid links and gripper as rigid bodies on the null space of the
 //! nonholonomic constraints, the flexible link as Hermite-cubic beam elements in two bending
-//! planes (linear floating frame), implicit midpoint in time. It shares the Hermite tables and
-//! Gauss rules with the planar chains, nothing else. Rigid mobile scenes are the reference's.
+//! planes (linear floating frame). The model is a reduced system (q̇ = S(q)ν) stepped by a
+//! method of [`method::reduced`], the implicit midpoint rule. It shares the Hermite tables, Gauss
+//! rules and the dense Cholesky ([`linalg`]) with the planar chains, nothing else. Rigid mobile
+//! scenes are the reference's.
 
 //! ## Problem, method, events
 //! The planar chains' time integration is split three ways. The problem is the discretized
@@ -171,7 +173,9 @@
 //! driver ([`driver`]) locates impacts, releases and stick–slip switches and applies the
 //! resets. The 3-D link and the variable-mass rocket ([`rocket::system`]: M(t)q̈ = F, stepped on
 //! its own driver path [`rocket::driver`], which lands on burn-out) are systems stepped by the same
-//! methods; the mobile manipulator's stepper is its own.
+//! methods. The mobile manipulator is split the same way: a reduced system on its speeds
+//! ([`method::reduced::ReducedSystem`], implemented by [`mobile::MobileSystem`]) stepped by the
+//! reduced methods ([`method::reduced::ReducedStepper`]), driven by [`mobile`].
 //!
 //! ## Layers
 //! Each layer imports only the ones above it:

@@ -10,6 +10,16 @@ pub const MAX_ELEMENTS: usize = 20_000;
 /// The FEM backend's time-integration methods ([`data::FemMethod`]).
 pub use data::FemMethod as Method;
 
+/// The spellings of `methods` for a message: `` `a`, `b` or `c` `` with `conjunction` "or".
+pub fn spelled_list(methods: impl IntoIterator<Item = Method>, conjunction: &str) -> String {
+    let names: Vec<String> = methods.into_iter().map(|m| format!("`{m}`")).collect();
+    match names.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} {conjunction} {last}", rest.join(", ")),
+        None => String::new(),
+    }
+}
+
 /// Elements per link of a planar chain or 3-D link: `elements`, [`DEFAULT_ELEMENTS`] when unset.
 pub fn elements(settings: &data::FemSettings) -> Result<usize, FemError> {
     elements_or(settings, DEFAULT_ELEMENTS)

@@ -6,7 +6,7 @@
 use data::{Backend, Discretization, Scene, Settings};
 use fem::FemBackend;
 use fem::mobile::model::{Model, Workspace};
-use fem::mobile::{self, Inputs, Stepper};
+use fem::mobile::{self, Inputs, Run};
 use nalgebra::{Matrix3, Vector3};
 
 fn scene() -> Scene {
@@ -74,7 +74,7 @@ fn elem_mobile_beam_stiffness_tip_load_exact() {
         let fl = md.flex.as_ref().unwrap();
         let ne = fl.ne;
         for (field, ei) in [(0, fl.ei_out), (1, fl.ei_in)] {
-            let mut k = fem::mobile::step::DenseLlt::new(ne);
+            let mut k = fem::linalg::DenseLlt::new(ne);
             let mut rhs = vec![0.0; ne];
             let p = 3.0;
             rhs[ne - 4 + 2 * field] = p;
@@ -140,6 +140,17 @@ fn sys_mobile_rigid_scene_refused_and_bad_settings() {
         matches!(e, data::BackendError::InvalidSettings { .. }),
         "{e:?}"
     );
+    // a second-order method cannot step the reduced system: refused, naming the one that can
+    let mut st = Settings::default();
+    st.time.method = Some("bathe".parse().expect("a method name"));
+    let e = FemBackend.simulate(&scene(), &st).unwrap_err();
+    match e {
+        data::BackendError::Unsupported(why) => assert!(
+            why.contains("`bathe`") && why.contains("`implicit-midpoint`"),
+            "{why}"
+        ),
+        other => panic!("{other:?}"),
+    }
 }
 
 /// Skew part of Ṙ Rᵀ as a vector.
@@ -326,14 +337,14 @@ fn ee_history(md: Model, h: f64, t_end: f64) -> Vec<Vector3<f64>> {
         arm: mm.arm.as_ref().unwrap().torques.clone(),
     };
     let (q, nu) = mobile::initial_state(&md, mm);
-    let mut st = Stepper::new(md, inputs, q, nu);
-    let bp = st.inputs.breakpoints(t_end);
+    let mut run = Run::new(md, inputs, q, nu, data::FemMethod::ImplicitMidpoint).unwrap();
+    let bp = run.system.inputs.breakpoints(t_end);
     let out = 0.01;
     let mut hist = Vec::new();
     let n_out = (t_end / out).round() as usize;
     for k in 1..=n_out {
-        mobile::advance(&mut st, h, k as f64 * out, &bp).unwrap();
-        hist.push(st.model.end_effector(&st.q));
+        mobile::advance(&mut run, h, k as f64 * out, &bp).unwrap();
+        hist.push(run.system.model.end_effector(&run.state.q));
     }
     hist
 }

@@ -37,12 +37,17 @@
 //! counters a method carries (module `state`: [`StepState`], [`Counters`], [`Works`]). This
 //! file holds only the registry, so the methods depend on `step` and `state`, never on it.
 //!
+//! Systems written on the null space of their velocity constraints (q̇ = S(q)ν, the mobile
+//! manipulator) are not [`crate::system::System`]s; their methods are [`reduced`]'s, behind
+//! its own stepper trait and registry.
+//!
 //! Adding a method: one new file here implementing [`Stepper`] and `From<`[`MethodParams`]`>`,
 //! and its line in the registry at the end of this file (which declares the module and maps the
 //! settings' method to it); in `data`, one row of the method table (`data/src/methods.rs`: its
 //! [`data::Method`] variant, spellings and backends, from which [`data::FemMethod`] follows).
 
 pub mod newton;
+pub mod reduced;
 pub mod start;
 mod state;
 mod step;
@@ -120,16 +125,12 @@ macro_rules! registry {
         /// The spellings of the methods with a capability, in registry order, for messages
         /// (`` `a`, `b` or `c` `` with `conjunction` "or").
         pub fn names_with(conjunction: &str, has: impl Fn(&Capabilities) -> bool) -> String {
-            let names: Vec<String> = [$(Method::$variant),*]
-                .into_iter()
-                .filter(|&m| has(&capabilities(m)))
-                .map(|m| format!("`{m}`"))
-                .collect();
-            match names.split_last() {
-                Some((last, [])) => last.clone(),
-                Some((last, rest)) => format!("{} {conjunction} {last}", rest.join(", ")),
-                None => String::new(),
-            }
+            crate::settings::spelled_list(
+                [$(Method::$variant),*]
+                    .into_iter()
+                    .filter(|&m| has(&capabilities(m))),
+                conjunction,
+            )
         }
     };
 }

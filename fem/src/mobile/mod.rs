@@ -23,9 +23,12 @@
 //! N Hermite-cubic elements ([`crate::element::hermite`]) for v and w, DOFs (v, v′, w, w′) per
 //! node; mass integrals by 4-point Gauss quadrature (exact), stiffness exact. The equations
 //! are written on the null space of the constraints (speeds ν = (φ̇_R, φ̇_L, θ̇₁…θ̇₄, ė)) by
-//! Kane's projection of every mass element's inertial force ([`model`]); time integration by
-//! the implicit midpoint rule with a modified-Newton matrix M̄ + ¼h²K + ½hD refactorized once per
-//! step ([`step`]). No dense finite-difference Jacobian; the step loop does not allocate.
+//! Kane's projection of every mass element's inertial force ([`model`]). The model with its
+//! inputs is a reduced system ([`system::MobileSystem`], [`crate::method::reduced`]): time
+//! integration by a reduced method, the implicit midpoint rule by default (and the one
+//! registered) with a modified-Newton matrix M̄ + ¼h²K + ½hD refactorized once per step
+//! ([`crate::method::reduced::implicit_midpoint`]). No dense finite-difference Jacobian; the
+//! step loop does not allocate.
 //!
 //! ## Defaults and cost
 //! Elements: [`DEFAULT_ELEMENTS`]. Step: min(output interval, T₁/[`STEPS_PER_PERIOD`]) with T₁
@@ -38,7 +41,8 @@
 //! h = 1e-4 s; data/cases/mobile_flex_fem.toml). Modes above ~1/h are not resolved but stay
 //! bounded.
 //! A finer mesh raises |K| and with it the round-off of the elastic forces, so the Newton
-//! iteration also accepts an update that has stalled at that floor ([`step::STALL_TOL`]).
+//! iteration also accepts an update that has stalled at that floor
+//! ([`crate::method::reduced::implicit_midpoint::STALL_TOL`]).
 //!
 //! ## Outputs
 //! The reference's channels (`platform.x`, `platform.y`, `platform.heading`,
@@ -49,7 +53,7 @@
 //! `joint_torque`; dissipation `wheel_friction`, `joint_friction` (the reference's names).
 
 pub mod model;
-pub mod step;
+pub mod system;
 
 use std::time::Instant;
 
@@ -59,10 +63,11 @@ use data::scene::MobileManipulator;
 use data::{DofPlan, EnergyLedger, FemSettings, Observables, RunResult, Scene, StabilityVerdict};
 
 pub use model::Model;
-pub use step::{Inputs, Stepper};
+pub use system::{Inputs, MobileSystem, Works};
 
 use crate::error::FemError;
-use crate::linalg::{dot, max_abs};
+use crate::linalg::{DenseLlt, dot, max_abs};
+use crate::method::reduced::{self, ReducedState, ReducedStepper};
 use crate::settings;
 
 /// Elements on the flexible link when `discretization.elements` is absent.
@@ -169,7 +174,7 @@ pub fn first_flexible_frequency(md: &Model, q: &[f64]) -> Result<f64, FemError> 
         t: 0.0,
         message: format!("fem mobile manipulator: {what} is not positive definite"),
     };
-    let mut rigid = step::DenseLlt::new(nr);
+    let mut rigid = DenseLlt::new(nr);
     rigid
         .factor(&mrr)
         .map_err(|_| singular("the rigid block of the mass matrix"))?;
@@ -185,7 +190,7 @@ pub fn first_flexible_frequency(md: &Model, q: &[f64]) -> Result<f64, FemError> 
             meff[i * ne + j] = mass[(nr + i) * m + nr + j] - mer;
         }
     }
-    let mut k = step::DenseLlt::new(ne);
+    let mut k = DenseLlt::new(ne);
     k.factor(&fl.stiffness)
         .map_err(|_| singular("the elastic stiffness"))?;
     // Power iteration on K⁻¹ M_eff: its largest eigenvalue is 1/ω₁².
@@ -218,15 +223,56 @@ fn fit(target: f64, interval: f64) -> f64 {
     interval / (interval / target).ceil().max(1.0)
 }
 
+/// A run in progress: the system, its state, the method stepping it and the integrated works.
+pub struct Run {
+    pub system: MobileSystem,
+    pub state: ReducedState,
+    pub works: Works,
+    pub method: Box<dyn ReducedStepper<MobileSystem>>,
+}
+
+impl Run {
+    /// The run of `model` driven by `inputs` from (q, ν) at t = 0, stepped by `method`;
+    /// refuses a method that does not step reduced systems.
+    pub fn new(
+        model: Model,
+        inputs: Inputs,
+        q: Vec<f64>,
+        nu: Vec<f64>,
+        method: settings::Method,
+    ) -> Result<Self, FemError> {
+        let system = MobileSystem::new(model, inputs);
+        let method = reduced::stepper(method, &system).ok_or_else(|| {
+            FemError::unsupported(format!(
+                "fem mobile manipulator: method `{method}`; this family is a system on the \
+                 null space of its nonholonomic constraints, stepped by {}",
+                reduced::names("or")
+            ))
+        })?;
+        Ok(Run {
+            system,
+            state: ReducedState { t: 0.0, q, nu },
+            works: Works::default(),
+            method,
+        })
+    }
+
+    /// One step of length h.
+    pub fn step(&mut self, h: f64) -> Result<(), FemError> {
+        self.method
+            .step(&mut self.system, &mut self.state, &mut self.works, h)
+    }
+}
+
 /// A run ready to step.
 pub struct Prepared {
-    pub stepper: Stepper,
+    pub run: Run,
     pub h: f64,
     pub t_end: f64,
     pub output_interval: f64,
 }
 
-/// The stepper, step and output settings of a run of `mm`, the manipulator of `scene`.
+/// The run, step and output settings of `mm`, the manipulator of `scene`.
 pub fn prepare(
     scene: &Scene,
     mm: &MobileManipulator,
@@ -234,15 +280,6 @@ pub fn prepare(
 ) -> Result<Prepared, FemError> {
     check_flexible(mm)?;
     let n_el = elements(settings)?;
-    match settings.method {
-        None | Some(data::FemMethod::ImplicitMidpoint) => {}
-        Some(other) => {
-            return Err(FemError::unsupported(format!(
-                "fem mobile manipulator: method `{other}`; only `implicit-midpoint` is \
-                 implemented for this family"
-            )));
-        }
-    }
     if settings.rtol.is_some() || settings.atol.is_some() {
         return Err(FemError::unsupported(
             "fem mobile manipulator: adaptive steps (`time.rtol`/`time.atol`); use --dt",
@@ -271,8 +308,9 @@ pub fn prepare(
             )
         }
     };
+    let method = settings.method.unwrap_or(data::FemMethod::ImplicitMidpoint);
     Ok(Prepared {
-        stepper: Stepper::new(md, inputs, q, nu),
+        run: Run::new(md, inputs, q, nu, method)?,
         h,
         t_end,
         output_interval: out,
@@ -310,38 +348,43 @@ fn channel_specs(md: &Model) -> Vec<(String, &'static str)> {
     s
 }
 
-fn sample(st: &mut Stepper, buf: &mut Vec<f64>) {
+fn sample(run: &mut Run, buf: &mut Vec<f64>) {
     buf.clear();
-    let t = st.t;
-    let l = st.model.layout;
-    let tau: Vec<f64> = st.torques(t).to_vec();
-    let q = st.q.clone();
+    let Run { system, state, .. } = run;
+    let (q, nu) = (&state.q, &state.nu);
+    let l = system.model.layout;
+    let tau = system.torques(state.t).to_vec();
     if l.platform {
         buf.extend_from_slice(&q[..5]);
         buf.extend_from_slice(&tau[..2]);
     }
     for i in 0..4 {
-        buf.extend([q[l.q_arm + i], st.nu[l.nu_arm + i], tau[l.nu_arm + i]]);
+        buf.extend([q[l.q_arm + i], nu[l.nu_arm + i], tau[l.nu_arm + i]]);
     }
-    buf.extend(st.model.end_effector(&q).iter());
-    if let Some(fl) = &st.model.flex {
+    buf.extend(system.model.end_effector(q).iter());
+    if let Some(fl) = &system.model.flex {
         let tip = fl.tip(&q[l.q_el..]);
         buf.extend([tip[2], tip[0]]);
     }
-    let qd = st.coordinate_rates().to_vec();
-    buf.push(st.model.constraint_residual(&q, &qd));
+    let qd = system.coordinate_rates(q, nu).to_vec();
+    buf.push(system.model.constraint_residual(q, &qd));
 }
 
-fn push_ledger(st: &mut Stepper, ledger: &mut EnergyLedger) {
-    let q = st.q.clone();
-    let qd = st.coordinate_rates().to_vec();
-    let md = &st.model;
+fn push_ledger(run: &mut Run, ledger: &mut EnergyLedger) {
+    let Run {
+        system,
+        state,
+        works: w,
+        ..
+    } = run;
+    let q = &state.q;
+    let qd = system.coordinate_rates(q, &state.nu).to_vec();
+    let md = &system.model;
     let stored = [
-        md.kinetic_energy(&q, &qd),
-        md.gravity_energy(&q),
-        md.strain_energy(&q),
+        md.kinetic_energy(q, &qd),
+        md.gravity_energy(q),
+        md.strain_energy(q),
     ];
-    let w = st.works;
     let (inputs, diss): (Vec<f64>, Vec<f64>) = if md.platform.is_some() {
         (
             vec![w.wheel_torque, w.joint_torque],
@@ -350,9 +393,8 @@ fn push_ledger(st: &mut Stepper, ledger: &mut EnergyLedger) {
     } else {
         (vec![w.joint_torque], vec![w.joint_friction])
     };
-    ledger.push(st.t, &stored, &inputs, &diss);
+    ledger.push(state.t, &stored, &inputs, &diss);
 }
-
 /// The ledger's term names (the reference's, plus strain).
 pub fn ledger_names(md: &Model) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'static str>) {
     let stored = vec![
@@ -376,19 +418,20 @@ pub fn ledger_names(md: &Model) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'
 }
 
 /// Steps from the current state to `t_stop`, landing on every breakpoint on the way.
-pub fn advance(st: &mut Stepper, h: f64, t_stop: f64, breakpoints: &[f64]) -> Result<(), FemError> {
-    while st.t < t_stop - 1e-9 * h {
+pub fn advance(run: &mut Run, h: f64, t_stop: f64, breakpoints: &[f64]) -> Result<(), FemError> {
+    while run.state.t < t_stop - 1e-9 * h {
+        let t = run.state.t;
         let next_break = breakpoints
             .iter()
             .copied()
-            .find(|&b| b > st.t + 1e-9 * h)
+            .find(|&b| b > t + 1e-9 * h)
             .unwrap_or(f64::INFINITY);
         let target = t_stop.min(next_break);
-        let rest = target - st.t;
+        let rest = target - t;
         let hk = if rest < h * (1.0 + 1e-9) { rest } else { h };
-        st.step(hk)?;
-        if (st.t - target).abs() < 1e-9 * h {
-            st.t = target;
+        run.step(hk)?;
+        if (run.state.t - target).abs() < 1e-9 * h {
+            run.state.t = target;
         }
     }
     Ok(())
@@ -402,39 +445,39 @@ pub fn simulate(
 ) -> Result<RunResult, FemError> {
     let start = Instant::now();
     let Prepared {
-        mut stepper,
+        mut run,
         h,
         t_end,
         output_interval,
     } = prepare(scene, mm, settings)?;
-    let specs = channel_specs(&stepper.model);
+    let specs = channel_specs(&run.system.model);
     let mut obs = Observables::with_channels(&specs);
-    let (s, i, d) = ledger_names(&stepper.model);
+    let (s, i, d) = ledger_names(&run.system.model);
     let mut ledger = EnergyLedger::new(&s, &i, &d);
-    let breakpoints = stepper.inputs.breakpoints(t_end);
+    let breakpoints = run.system.inputs.breakpoints(t_end);
     let mut buf = Vec::with_capacity(specs.len());
-    sample(&mut stepper, &mut buf);
+    sample(&mut run, &mut buf);
     obs.push(0.0, &buf);
-    push_ledger(&mut stepper, &mut ledger);
+    push_ledger(&mut run, &mut ledger);
     let n_out = (t_end / output_interval - 1e-9).ceil().max(1.0) as usize;
     let mut verdict = StabilityVerdict::Completed;
     for k in 1..=n_out {
         let t_stop = (k as f64 * output_interval).min(t_end);
-        if let Err(e) = advance(&mut stepper, h, t_stop, &breakpoints) {
+        if let Err(e) = advance(&mut run, h, t_stop, &breakpoints) {
             verdict = StabilityVerdict::Stopped {
                 diagnostic: e.into_stop_diagnostic()?,
             };
             break;
         }
-        sample(&mut stepper, &mut buf);
+        sample(&mut run, &mut buf);
         if buf.iter().any(|v| !v.is_finite()) {
             verdict = StabilityVerdict::Stopped {
-                diagnostic: crate::error::non_finite_state(stepper.t),
+                diagnostic: crate::error::non_finite_state(run.state.t),
             };
             break;
         }
-        obs.push(stepper.t, &buf);
-        push_ledger(&mut stepper, &mut ledger);
+        obs.push(run.state.t, &buf);
+        push_ledger(&mut run, &mut ledger);
     }
     Ok(crate::run::run_result(
         scene,
@@ -442,7 +485,7 @@ pub fn simulate(
         obs,
         ledger,
         Vec::new(),
-        stepper.counters.cost(stepper.model.layout.m, start),
+        run.method.counters().cost(run.system.model.layout.m, start),
         verdict,
     ))
 }
