@@ -1,6 +1,6 @@
 //! 1 s of `single-link-3d` (u, v, w, φ at 21 stations, free base, gravity, implicit
 //! Kelvin–Voigt; ≈ 101 000 steps), single-threaded.
-//! Also faer's sparse Cholesky of the step matrix against the banded Cholesky it replaced
+//! Also faer's sparse Cholesky of the step matrix against a banded Cholesky
 //! (`payload-link-step-matrix`).
 //! Run: cargo bench -p fdm --bench payload_link -- --quick
 

@@ -4,11 +4,15 @@
 //!   band) against faer's sparse LU with partial pivoting (bench:
 //!   `cargo bench -p fdm --bench chain -- implicit-kick-saddle`);
 //! - the mass solve's foreshortening-rate blocks (`fdm::tridiagonal::TridiagonalLdl`) against
-//!   faer's sparse Cholesky (bench: `cargo bench -p fdm --bench chain -- link-rates-tridiagonal`).
+//!   faer's sparse Cholesky (bench: `cargo bench -p fdm --bench chain -- link-rates-tridiagonal`);
+//! - the implicit kick's small Schur system (`fdm::chain::schur::SmallLu`, Gaussian elimination
+//!   with partial pivoting) against faer's dense LU (bench:
+//!   `cargo bench -p fdm --bench chain -- small-schur-lu`).
 
 use faer::prelude::*;
 use faer::sparse::{SparseColMat, Triplet};
 use fdm::chain::TwoLinkChain;
+use fdm::chain::schur::{MAX_SMALL, SmallLu};
 use fdm::tridiagonal::TridiagonalLdl;
 
 /// The two-link-free chain with `stations` per link, implicit damping on, and a deformed,
@@ -139,6 +143,45 @@ fn sys_tridiagonal_ldl_solves_the_link_rate_blocks_as_faer_sparse_cholesky() {
                     assert!(
                         (x[i] - y).abs() <= 1e-11 * x_norm,
                         "{stations} stations, link {link}: x[{i}, {c}] {:e} against faer's {y:e}",
+                        x[i]
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn sys_small_lu_solves_the_implicit_kick_schur_system_as_faer_dense_lu() {
+    for stations in [11usize, 21, 41, 81] {
+        for tau in [1e-5, 1e-3] {
+            let (mut chain, q, qd) = chain_at_a_state(stations);
+            let (s, n) = chain.implicit_kick_schur(&q, &qd, tau);
+            // the full columns θ, β, ψ₁, ψ₂, y and the two foreshortening columns
+            assert_eq!(n, MAX_SMALL);
+            let a = Mat::<f64>::from_fn(n, n, |i, j| s[i][j]);
+            let lu = a.partial_piv_lu();
+            let triplets: Vec<Triplet<usize, usize, f64>> = (0..n)
+                .flat_map(|i| (0..n).map(move |j| Triplet::new(i, j, s[i][j])))
+                .collect();
+            let small = SmallLu::factor(s, n);
+            for c in 0..3 {
+                let b: [f64; MAX_SMALL] = std::array::from_fn(|i| {
+                    (0.37 * (i + 3 * c) as f64).cos() + if i % (c + 2) == 0 { 1.0 } else { 0.0 }
+                });
+                let reference = lu.solve(Mat::<f64>::from_fn(n, 1, |i, _| b[i]));
+                let x = small.solve(b);
+                let backward = backward_error(&triplets, &x[..n], &b[..n]);
+                assert!(
+                    backward < f64::EPSILON * n as f64,
+                    "{stations} stations, τ {tau}, right-hand side {c}: backward error {backward:e}"
+                );
+                let x_norm = x[..n].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for i in 0..n {
+                    let y = reference[(i, 0)];
+                    assert!(
+                        (x[i] - y).abs() <= 1e-11 * x_norm,
+                        "{stations} stations, τ {tau}: x[{i}] {:e} against faer's {y:e}",
                         x[i]
                     );
                 }

@@ -152,7 +152,7 @@
 //! Gauss rules), the bordered-band LU ([`band`]), the dense eigensolver ([`modes`]) and the
 //! methods with the planar chains, nothing else.
 //!
-//! ## Mobile manipulator with a flexible pitch link (seed 004, issue 19)
+//! ## Mobile manipulator with a flexible pitch link (seed 004)
 //! Scenes of the `[mobile_manipulator]` family with a `flexible_link` are solved by [`mobile`]:
 //! the platform, turret, rigid links and gripper as rigid bodies on the null space of the
 //! nonholonomic constraints, the flexible link as Hermite-cubic beam elements in two bending

@@ -51,7 +51,7 @@ pub const UNDAMPED_STEPS_PER_PERIOD: f64 = 320.0;
 /// contact-episode boundaries are what a contact run is read for. On `barhorst-case1` (16
 /// elements, against dt 6.25e-5; T₁ = 30.5 ms) they lie 2.5e-3 s from converged at
 /// [`STEPS_PER_PERIOD`] (dt 5e-4), 1.2e-3 s at 80 steps (3.3e-4), 6.8e-4 s at 100 (2.5e-4),
-/// inside issue 16's 1e-3 s (measurements and the other contact scenes: docs/contact.md,
+/// inside the 1e-3 s a contact study asks for (measurements and the other contact scenes: docs/contact.md,
 /// "fem's default step through contact").
 pub const CONTACT_STEPS_PER_PERIOD: f64 = 100.0;
 

@@ -1,7 +1,7 @@
 //! The mobile manipulator of seed 004 with one flexible pitch link (scene family
 //! `[mobile_manipulator]` with `[mobile_manipulator.flexible_link]`).
 //!
-//! ## Model (the shared continuum model of issue 19 item 3)
+//! ## Model (the continuum model fem and modal share)
 //! Rigid part as in the scene's convention (docs/mobile-manipulator.md): platform with the
 //! no-sideways-slip and per-side rolling constraints, turret θ₁, pitch links θ₂…θ₄, gripper,
 //! viscous joint and wheel friction, gravity, torque schedules. The flexible link j (frame F)

@@ -21,8 +21,7 @@
 //! stiffness in launch axes (constant). The loads' and the mass-to-mass springs' dependence on
 //! the mean axes and the cubic strain term are not in S (their derivative is ~1e-5 of S at the
 //! catalog scenes): a quasi-Newton matrix the methods' iterations converge with at that rate.
-//! With the implicit midpoint rule's coefficients (1, h/2, h²/4) S is half the matrix of the
-//! rocket's former hand-written stepper, 2M(t_m) + ½h²K + hC.
+//! With the implicit midpoint rule's coefficients (1, h/2, h²/4) S = M(t_m) + ¼h²K + ½hC.
 //!
 //! [`Capabilities::variable_mass`]: crate::method::Capabilities::variable_mass
 
