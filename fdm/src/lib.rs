@@ -201,6 +201,7 @@ pub mod driver;
 pub mod error;
 pub mod events;
 pub mod foreshortening;
+pub mod linalg;
 pub mod link;
 pub mod method;
 pub mod output;

@@ -45,7 +45,7 @@ use data::scene::{Gravity, Link, PlanarChain, PrescribedMotion, TorqueLaw};
 use data::{FemElement, FemSettings};
 
 use crate::band::BorderedBand;
-use crate::element::{self, ElementDofs, InteriorField, MeshElement, dotn};
+use crate::element::{self, ElementDofs, InteriorField, MeshElement};
 use crate::error::FemError;
 
 pub use crate::element::{MAXE, NONE};

@@ -5,7 +5,8 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
 use faer::{MatMut, MatRef, Par};
 
-/// Euclidean inner product aᵀb, summed in index order.
+/// Euclidean inner product aᵀb over the shorter of the two, summed in index order.
+#[inline]
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

@@ -50,6 +50,7 @@ use super::kinetic::{BE, TH, seg_energy, seg_grad, seg_rate};
 use super::model::TwoLinkChain;
 use super::surface::TipContact;
 use crate::error::FdmError;
+use crate::linalg::dot;
 use crate::output::Outputs;
 use crate::system::System;
 
@@ -196,7 +197,7 @@ impl TwoLinkChain {
         let grow = std::mem::take(&mut self.constraint.grow);
         let mut mg = std::mem::take(&mut self.constraint.minv_g);
         self.solve_mass(&grow, &mut mg);
-        let gmg: f64 = grow.iter().zip(&mg).map(|(a, b)| a * b).sum();
+        let gmg = dot(&grow, &mg);
         self.constraint.grow = grow;
         self.constraint.minv_g = mg;
         (gmg, self.gap_curvature())
@@ -238,7 +239,7 @@ impl TwoLinkChain {
             let grow = std::mem::take(&mut self.constraint.grow);
             let mut mg = std::mem::take(&mut self.constraint.minv_g);
             self.solve_mass(&grow, &mut mg);
-            let gmg: f64 = grow.iter().zip(&mg).map(|(a, b)| a * b).sum();
+            let gmg = dot(&grow, &mg);
             for i in 0..q.len() {
                 q[i] -= mg[i] * g / gmg;
             }
@@ -252,8 +253,8 @@ impl TwoLinkChain {
     /// returns (|Gq̇| before, kinetic energy removed).
     pub(super) fn remove_normal_velocity(&self, v: &mut [f64]) -> (f64, f64) {
         let c = &self.constraint;
-        let gv: f64 = c.grow.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
-        let gmg: f64 = c.grow.iter().zip(&c.minv_g).map(|(a, b)| a * b).sum();
+        let gv = dot(&c.grow, v);
+        let gmg = dot(&c.grow, &c.minv_g);
         for i in 0..v.len() {
             v[i] -= c.minv_g[i] * gv / gmg;
         }
@@ -279,7 +280,7 @@ impl TwoLinkChain {
         if !(gmg > 0.0 && gmg.is_finite()) {
             return None;
         }
-        let gv: f64 = (0..n).map(|i| self.constraint.grow[i] * v[i]).sum();
+        let gv = dot(&self.constraint.grow[..n], &v[..n]);
         let impulse = -gv / gmg;
         let mut dv = vec![0.0; n];
         for i in 0..n {
@@ -299,7 +300,7 @@ impl TwoLinkChain {
         } else {
             res2.sqrt()
         };
-        let normal_velocity_after: f64 = (0..n).map(|i| self.constraint.grow[i] * v[i]).sum();
+        let normal_velocity_after = dot(&self.constraint.grow[..n], &v[..n]);
         let kinetic_energy_lost = ke_before - self.kinetic_energy(q, v);
 
         Some(Event::Impact {

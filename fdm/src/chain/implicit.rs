@@ -40,6 +40,7 @@ use super::mass::{schur_matrix, schur_solve, schur_system};
 use super::model::TwoLinkChain;
 use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
 use crate::band_ldl::BandLdl;
+use crate::linalg::dot;
 use crate::system::{DriftVelocities, System};
 
 impl TwoLinkChain {
@@ -218,8 +219,8 @@ impl TwoLinkChain {
         let mut damped_g = std::mem::take(&mut imp.damped_g);
         self.implicit = Some(imp);
         self.solve_damped_mass(tau, &grow, &mut damped_g);
-        let gag: f64 = grow.iter().zip(&damped_g).map(|(g, x)| g * x).sum();
-        let ga: f64 = grow.iter().zip(a.iter()).map(|(g, x)| g * x).sum();
+        let gag = dot(&grow, &damped_g);
+        let ga = dot(&grow, a);
         // a G A⁻¹Gᵀ that is not a positive number (a failed solve) stops the contact driver
         // through NaN
         let lam = if gag > 0.0 {

@@ -55,6 +55,7 @@ use data::scene::{LinkField, PayloadLink, PrescribedMotion, TorqueLaw};
 use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
+use crate::linalg::dot;
 use spd::Triplets;
 
 /// Default stations (including the clamped root).
@@ -361,10 +362,6 @@ impl PayloadLinkModel {
             .map(|(f, _, _)| ledger_term::kelvin_voigt_of(*f))
             .collect()
     }
-}
-
-pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 pub mod analysis;

@@ -32,8 +32,9 @@ use std::cell::RefCell;
 use data::channel;
 
 use super::spd::{SpdFactor, Triplets};
-use super::{BaseDrive, PayloadLinkModel, apply, dot};
+use super::{BaseDrive, PayloadLinkModel, apply};
 use crate::error::FdmError;
+use crate::linalg::dot;
 use crate::output::{Outputs, sample_field};
 use crate::system::{Bound, BoundKind, DriftVelocities, System};
 

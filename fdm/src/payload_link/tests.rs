@@ -257,7 +257,7 @@ fn sys_payload_equations_are_lagranges_equations_of_the_kinetic_energy() {
     );
     let ddt = ddt(&|t| momentum(t, None));
     let model_theta =
-        m.m_thth(&q) * thdd + super::dot(&mth, &acc) + m.theta_velocity_terms(&q, &v, rate);
+        m.m_thth(&q) * thdd + crate::linalg::dot(&mth, &acc) + m.theta_velocity_terms(&q, &v, rate);
     assert!(
         (ddt - model_theta).abs() < 1e-9 * ddt.abs(),
         "θ equation: {ddt} vs {model_theta}"

@@ -14,7 +14,8 @@
 //! A(γ)∂T/∂u_{i+1} at its tip. Exact for the quadrature (no difference step).
 
 use super::geometry::{V2, perp, rot, rot_t};
-use super::{Chain, FrameState, LinkModel, MAX_LINKS, MAXE, NONE, dotn};
+use super::{Chain, FrameState, LinkModel, MAX_LINKS, MAXE, NONE};
+use crate::linalg::dot;
 
 impl LinkModel {
     /// Walks the link's material points at configuration `q` and generalized velocity `x`, in
@@ -55,9 +56,9 @@ impl LinkModel {
                     for k in 0..tb.nsg {
                         let dn = &tb.sub_dn[j][k];
                         let wgt = tb.sub_wh[j][k];
-                        let vp = dotn(dn, &d, ne);
+                        let vp = dot(&dn[..ne], &d[..ne]);
                         s -= 0.5 * wgt * vp * vp;
-                        sd -= wgt * vp * dotn(dn, &dd, ne);
+                        sd -= wgt * vp * dot(&dn[..ne], &dd[..ne]);
                     }
                 }
                 if j == tb.ng {
@@ -74,8 +75,8 @@ impl LinkModel {
                 } else {
                     (0.0, 0.0)
                 };
-                let p = V2::new(xa + xi * self.h + ax, dotn(&tb.n[j], &d, ne));
-                let pd = V2::new(axd, dotn(&tb.n[j], &dd, ne));
+                let p = V2::new(xa + xi * self.h + ax, dot(&tb.n[j][..ne], &d[..ne]));
+                let pd = V2::new(axd, dot(&tb.n[j][..ne], &dd[..ne]));
                 point(e, j, p, pd, &dd);
             }
             element_done(e, u, &d);
@@ -126,7 +127,7 @@ impl Chain {
                     grav -= m * g_in.dot(&(r0 + rot(phi, p)));
                     if l.rho_i > 0.0 {
                         // ½ρI(φ̇ + β̇)², β the section angle relative to the frame.
-                        let om = w + dotn(&tb.b[j], dd, ne);
+                        let om = w + dot(&tb.b[j][..ne], &dd[..ne]);
                         kin += 0.5 * l.rho_i * tb.wh[j] * om * om;
                     }
                 },
@@ -269,7 +270,8 @@ impl Chain {
                         for kk in 0..tb.nsg {
                             let dn = &tb.sub_dn[j][kk];
                             let c = -tb.sub_wh[j][kk]
-                                * (tail_s * dotn(dn, &d, ne) + tail_sd * dotn(dn, &dd, ne));
+                                * (tail_s * dot(&dn[..ne], &d[..ne])
+                                    + tail_sd * dot(&dn[..ne], &dd[..ne]));
                             for a in 0..ne {
                                 fe[a] += c * dn[a];
                             }
@@ -323,7 +325,7 @@ impl Chain {
             let fq = l.element.kind.consistent_load(&l.element, q0);
             for e in 0..l.n_el {
                 let dd = Self::elem_v(qd, &l.elem_dofs(e));
-                p += dotn(&fq, &dd, l.ne);
+                p += dot(&fq[..l.ne], &dd[..l.ne]);
             }
         }
         p
@@ -343,7 +345,7 @@ impl Chain {
                 for e in 0..l.n_el {
                     let dd = Self::elem_v(qd, &l.elem_dofs(e));
                     for a in 0..l.ne {
-                        pkv += c * dd[a] * dotn(&l.element.kb[a], &dd, l.ne);
+                        pkv += c * dd[a] * dot(&l.element.kb[a][..l.ne], &dd[..l.ne]);
                     }
                 }
             }

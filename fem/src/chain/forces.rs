@@ -3,7 +3,8 @@
 //! subtree resultants and joint equations).
 
 use super::geometry::{V2, rot, rot_t};
-use super::{Chain, MAXE, NONE, dotn};
+use super::{Chain, MAXE, NONE};
+use crate::linalg::dot;
 use crate::system::Parts;
 
 impl Chain {
@@ -159,7 +160,7 @@ impl Chain {
                     let ddd = Self::elem_v(qdd, &dofs);
                     for g in 0..tb.ng {
                         let b = &tb.b[g];
-                        let mr = l.rho_i * tb.wh[g] * (fr.ddphi + dotn(b, &ddd, ne));
+                        let mr = l.rho_i * tb.wh[g] * (fr.ddphi + dot(&b[..ne], &ddd[..ne]));
                         m_sum += mr;
                         for a in 0..ne {
                             fe[a] += mr * b[a];
@@ -171,7 +172,7 @@ impl Chain {
                         self.tail[li][e * (tb.ng + 1) + j] = tail;
                         for kk in 0..tb.nsg {
                             let dn = &tb.sub_dn[j][kk];
-                            let vp = dotn(dn, &d, ne);
+                            let vp = dot(&dn[..ne], &d[..ne]);
                             let c = -tail * tb.sub_wh[j][kk] * vp;
                             for a in 0..ne {
                                 fe[a] += c * dn[a];
@@ -195,7 +196,7 @@ impl Chain {
                     let dd = Self::elem_v(qd, &dofs);
                     let c = l.kelvin_voigt / l.ei;
                     for a in 0..ne {
-                        fe[a] += c * dotn(&l.element.kb[a], &dd, ne);
+                        fe[a] += c * dot(&l.element.kb[a][..ne], &dd[..ne]);
                     }
                 }
                 for a in 0..ne {

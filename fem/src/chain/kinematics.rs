@@ -3,7 +3,8 @@
 //! that observables and contact read (positions, Jacobian, motion).
 
 use super::geometry::{V2, perp, rot, rot_t};
-use super::{Chain, FrameState, MAX_LINKS, MAXE, NONE, Parts, dotn};
+use super::{Chain, FrameState, MAX_LINKS, MAXE, NONE, Parts};
+use crate::linalg::dot;
 
 impl Chain {
     /// Forward pass: frame and tip kinematics of every link (no forces).
@@ -67,9 +68,9 @@ impl Chain {
                         for k in 0..tb.nsg {
                             let dn = &tb.sub_dn[j][k];
                             let wgt = tb.sub_wh[j][k];
-                            let vp = dotn(dn, &d, ne);
-                            let vpd = dotn(dn, &dd, ne);
-                            let vpdd = dotn(dn, &ddd, ne);
+                            let vp = dot(&dn[..ne], &d[..ne]);
+                            let vpd = dot(&dn[..ne], &dd[..ne]);
+                            let vpdd = dot(&dn[..ne], &ddd[..ne]);
                             s -= 0.5 * wgt * vp * vp;
                             sd -= wgt * vp * vpd;
                             sdd -= wgt * (vpd * vpd + vp * vpdd);
@@ -92,9 +93,9 @@ impl Chain {
                     } else {
                         (0.0, 0.0, 0.0)
                     };
-                    let p = V2::new(xa + xi * l.h + ax, dotn(n, &d, ne));
-                    let pd = V2::new(axd, dotn(n, &dd, ne));
-                    let pdd = V2::new(axdd, dotn(n, &ddd, ne));
+                    let p = V2::new(xa + xi * l.h + ax, dot(&n[..ne], &d[..ne]));
+                    let pd = V2::new(axd, dot(&n[..ne], &dd[..ne]));
+                    let pdd = V2::new(axdd, dot(&n[..ne], &ddd[..ne]));
                     let a =
                         frame_acc + (dw * perp(p)) + ((-w * w) * p + ((2.0 * w) * perp(pd) + pdd));
                     let m = l.rho_a * tb.wh[g];
@@ -183,7 +184,7 @@ impl Chain {
             let d = Self::elem_v(q, &l.elem_dofs(e));
             for j in 0..tb.ng + 1 {
                 for k in 0..tb.nsg {
-                    let vp = dotn(&tb.sub_dn[j][k], &d, l.ne);
+                    let vp = dot(&tb.sub_dn[j][k][..l.ne], &d[..l.ne]);
                     s -= 0.5 * tb.sub_wh[j][k] * vp * vp;
                 }
             }
@@ -197,7 +198,7 @@ impl Chain {
         let e = ((x / l.h).floor() as usize).min(l.n_el - 1);
         let xi = ((x - e as f64 * l.h) / l.h).clamp(0.0, 1.0);
         let d = Self::elem_v(q, &l.elem_dofs(e));
-        dotn(&l.shapes_at(xi).0, &d, l.ne)
+        dot(&l.shapes_at(xi).0[..l.ne], &d[..l.ne])
     }
 
     /// Axial tip displacement u(L) of link `li` (extensible links).
@@ -276,7 +277,7 @@ impl Chain {
                     for j in 0..tb.ng + 1 {
                         for kk in 0..tb.nsg {
                             let dn = &tb.sub_dn[j][kk];
-                            let c = -tb.sub_wh[j][kk] * dotn(dn, &d, ne);
+                            let c = -tb.sub_wh[j][kk] * dot(&dn[..ne], &d[..ne]);
                             for a in 0..ne {
                                 ds[a] += c * dn[a];
                             }

@@ -27,6 +27,7 @@
 use data::scene::Link;
 
 use super::quadrature::gauss01;
+use crate::linalg::dot;
 
 /// Small dense 4×4 matrix of an element (row-major).
 pub type Mat4 = [[f64; 4]; 4];
@@ -201,7 +202,7 @@ pub fn linear_internal_force(
 ) {
     let ne = el.ne;
     for a in 0..ne {
-        fe[a] += dotn(&el.k[a], d, ne);
+        fe[a] += dot(&el.k[a][..ne], &d[..ne]);
     }
     if el.axial {
         let (eps, gr) = membrane(el, u, d);
@@ -265,22 +266,12 @@ pub fn linear_tangent(
 pub fn linear_strain_energy(el: &MeshElement, u: [f64; 2], d: &Row, strain: &mut f64) {
     let ne = el.ne;
     for a in 0..ne {
-        *strain += 0.5 * d[a] * dotn(&el.k[a], d, ne);
+        *strain += 0.5 * d[a] * dot(&el.k[a][..ne], &d[..ne]);
     }
     if el.axial {
         let (eps, _) = membrane(el, u, d);
         *strain += 0.5 * el.ea * el.h * eps * eps;
     }
-}
-
-/// Σ aₖ dₖ over the first `ne` entries (left to right).
-#[inline]
-pub fn dotn(a: &Row, d: &Row, ne: usize) -> f64 {
-    let mut s = 0.0;
-    for k in 0..ne {
-        s += a[k] * d[k];
-    }
-    s
 }
 
 /// Shape functions of one element tabulated at its quadrature points (all elements of a link
@@ -398,7 +389,7 @@ pub fn membrane(el: &MeshElement, u: [f64; 2], d: &Row) -> (f64, [f64; MAXE + 2]
     g[1] = 1.0 / h;
     for k in 0..tb.ng {
         let dn = &tb.dn[k];
-        let vp = dotn(dn, d, ne);
+        let vp = dot(&dn[..ne], &d[..ne]);
         half_int += tb.wh[k] * 0.5 * vp * vp;
         for a in 0..ne {
             g[2 + a] += tb.wh[k] / h * vp * dn[a];

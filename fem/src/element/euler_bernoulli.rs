@@ -16,8 +16,9 @@ use super::contract::{
     Element, ElementDofs, InteriorDof, Local, MAXE, Mat4, MeshElement, NONE, Row, Shapes,
     linear_internal_force, linear_strain_energy, linear_tangent, pad,
 };
-use super::hermite::{dot4, hermite};
+use super::hermite::hermite;
 use super::quadrature::gauss01;
+use crate::linalg::dot;
 
 /// Consistent transverse mass ∫ρA NᵢNⱼ (+ ∫ρI Nᵢ′Nⱼ′ when `rho_i` > 0).
 pub fn mass(rho_a: f64, rho_i: f64, h: f64) -> Mat4 {
@@ -99,7 +100,7 @@ fn membrane(h: f64, d: &VkDofs) -> (f64, VkDofs, [[f64; 4]; 4]) {
     g[1] = 1.0 / h;
     for (xi, wg) in p.iter().zip(w) {
         let s = hermite(*xi, h);
-        let vp = dot4(&s.dn, &dv);
+        let vp = dot(&s.dn, &dv);
         half_int += wg * h * 0.5 * vp * vp;
         for k in 0..4 {
             g[2 + k] += wg * vp * s.dn[k];
@@ -118,7 +119,7 @@ pub fn von_karman_energy(ea: f64, ei: f64, h: f64, d: &VkDofs) -> f64 {
     let dv = [d[2], d[3], d[4], d[5]];
     let mut bend = 0.0;
     for a in 0..4 {
-        bend += 0.5 * dv[a] * dot4(&kb[a], &dv);
+        bend += 0.5 * dv[a] * dot(&kb[a], &dv);
     }
     0.5 * ea * h * eps * eps + bend
 }
@@ -134,7 +135,7 @@ pub fn von_karman_force(ea: f64, ei: f64, h: f64, d: &VkDofs) -> VkDofs {
         f[k] = n * h * g[k];
     }
     for a in 0..4 {
-        f[2 + a] += dot4(&kb[a], &dv);
+        f[2 + a] += dot(&kb[a], &dv);
     }
     f
 }

@@ -35,15 +35,10 @@ pub fn hermite(xi: f64, h: f64) -> HermiteAt {
     HermiteAt { n, dn, ddn }
 }
 
-/// Σ aₖ dₖ for 4-vectors.
-#[inline]
-pub fn dot4(a: &[f64; 4], d: &[f64; 4]) -> f64 {
-    a[0] * d[0] + a[1] * d[1] + a[2] * d[2] + a[3] * d[3]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::dot;
 
     #[test]
     fn elem_hermite_reproduces_cubics_and_derivatives() {
@@ -57,9 +52,9 @@ mod tests {
             let x = xa + xi * h;
             let s = hermite(xi, h);
             // Exact interpolation of a cubic: only round-off remains.
-            assert!((dot4(&s.n, &d) - f(x)).abs() < 1e-14);
-            assert!((dot4(&s.dn, &d) - df(x)).abs() < 1e-13);
-            assert!((dot4(&s.ddn, &d) - ddf(x)).abs() < 1e-12);
+            assert!((dot(&s.n, &d) - f(x)).abs() < 1e-14);
+            assert!((dot(&s.dn, &d) - df(x)).abs() < 1e-13);
+            assert!((dot(&s.ddn, &d) - ddf(x)).abs() < 1e-12);
         }
     }
 }

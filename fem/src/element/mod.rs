@@ -36,7 +36,7 @@ use crate::error::FemError;
 
 pub use contract::{
     Element, ElementDofs, InteriorDof, InteriorField, Local, MAX_GAUSS, MAX_SUB_GAUSS, MAXE, Mat4,
-    MeshElement, NONE, Quadrature, Row, Shapes, dotn, linear_internal_force, linear_strain_energy,
+    MeshElement, NONE, Quadrature, Row, Shapes, linear_internal_force, linear_strain_energy,
     linear_tangent, pad,
 };
 

@@ -7,7 +7,8 @@
 use super::columns::{ColumnAt, Sink, dacc};
 use crate::chain::augmented::AugmentedLayout;
 use crate::chain::geometry::{V2, perp};
-use crate::chain::{LinkModel, MAXE, NONE, dotn};
+use crate::chain::{LinkModel, MAXE, NONE};
+use crate::linalg::dot;
 use crate::system::NewtonCoefficients;
 
 /// Longest expansion of a virtual direction: one auxiliary unknown plus the element's DOFs.
@@ -165,9 +166,9 @@ impl Running {
         for k in 0..tb.nsg {
             let dn = &tb.sub_dn[j][k];
             let w = tb.sub_wh[j][k];
-            let vp = dotn(dn, d, ne);
-            let vpd = dotn(dn, dd, ne);
-            let vpdd = dotn(dn, ddd, ne);
+            let vp = dot(&dn[..ne], &d[..ne]);
+            let vpd = dot(&dn[..ne], &dd[..ne]);
+            let vpdd = dot(&dn[..ne], &ddd[..ne]);
             let coef = [
                 c.c_q * vp,
                 c.c_q * vpd + c.c_v * vp,
