@@ -329,6 +329,88 @@ pub const INVERSE_TORQUE_RESIDUAL: &str = "inverse.torque_residual";
 /// Residual of seed 004's closed-form arm equation (37).
 pub const SEED_EQ37_RESIDUAL: &str = "seed_eq37.residual";
 
+// ---------------------------------------------------------------- frame invariance
+
+/// Whether an observable means the same thing in every backend, whatever floating frame,
+/// shape basis or reference point a backend chooses:
+/// * `linkN.tip_x`, `linkN.tip_y` — inertial tip position;
+/// * `jointN.angle`, `jointN.rate`, `jointN.torque` — joint 1 is the hub angle from the inertial
+///   X axis, joint N > 1 the motor angle between the tip tangent of link N−1 and the root
+///   tangent of link N (scenes.md): rotations of rigid hubs and motors, not of a floating frame;
+///   the torque is the actuator's;
+/// * `contactC.normal_force` — a force on the tip;
+/// * `rocket.X`, `rocket.Y`, `rocket.vX`, `rocket.vY` — inertial mass-centre position and
+///   momentum / mass;
+/// * `energy.NAME` — energy-ledger terms;
+/// * `payload.X`, `payload.Y`, `payload.Z` — the 3-D link's payload position;
+/// * `linkN.tip_w`, `linkN.tip_twist` — the 3-D link's vertical tip deflection and tip twist, in
+///   the base's turning frame, which the clamped root fixes the same way in every backend.
+///
+/// * `rocket.massJ.u`, `rocket.massJ.w`, `rocket.u@K`, `rocket.w@K` — the rocket's elastic
+///   displacements relative to the case's mean axis weighted by its ignition mass
+///   (docs/rocket.md): a function of the deformed shape alone, not of a backend's body frame;
+/// * `ee.x`, `ee.y`, `ee.z`, `platform.x`, `platform.y`, `platform.heading` — the mobile
+///   manipulator's inertial end-effector position and platform pose.
+///
+/// Not invariant: tip deflections and axial displacements in a link's floating frame, field
+/// deflections `linkN.v@K`, and the rocket's attitude `rocket.theta` (each backend's body
+/// axis).
+///
+/// Built on the registry's own names: an indexed channel is recognized by rebuilding it.
+pub fn frame_invariant(name: &str) -> bool {
+    if name.starts_with(crate::cases::ENERGY_PREFIX) {
+        return true;
+    }
+    if [
+        ROCKET_X,
+        ROCKET_Y,
+        ROCKET_VX,
+        ROCKET_VY,
+        PAYLOAD_X,
+        PAYLOAD_Y,
+        PAYLOAD_Z,
+        END_EFFECTOR_X,
+        END_EFFECTOR_Y,
+        END_EFFECTOR_Z,
+        PLATFORM_X,
+        PLATFORM_Y,
+        PLATFORM_HEADING,
+    ]
+    .contains(&name)
+    {
+        return true;
+    }
+    let indexed: [fn(usize) -> String; 12] = [
+        tip_x,
+        tip_y,
+        tip_vertical,
+        tip_twist,
+        joint_angle,
+        joint_rate,
+        joint_torque,
+        contact_normal_force,
+        rocket_axial,
+        rocket_transverse,
+        rocket_mass_axial,
+        rocket_mass_transverse,
+    ];
+    indexed.iter().any(|build| built_by(name, build))
+}
+
+/// Whether `name` is `build(i)` for the index i its first run of digits spells.
+fn built_by(name: &str, build: impl Fn(usize) -> String) -> bool {
+    let Some(start) = name.find(|c: char| c.is_ascii_digit()) else {
+        return false;
+    };
+    let digits = &name[start..];
+    let end = digits
+        .find(|c: char| !c.is_ascii_digit())
+        .unwrap_or(digits.len());
+    digits[..end]
+        .parse::<usize>()
+        .is_ok_and(|i| build(i) == name)
+}
+
 // ---------------------------------------------------------------- integrator monitors
 
 /// Time step in use (variable-step schemes).
@@ -509,6 +591,28 @@ pub mod spec {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn elem_frame_invariance_follows_the_registry_names() {
+        for i in [1, 2, 12] {
+            for name in [tip_x(i), tip_y(i), joint_angle(i), joint_torque(i)] {
+                assert!(frame_invariant(&name), "{name}");
+            }
+            for name in [
+                rocket_axial(i),
+                rocket_mass_transverse(i),
+                contact_normal_force(i),
+            ] {
+                assert!(frame_invariant(&name), "{name}");
+            }
+            for name in [tip_deflection(i), field_deflection(1, i), contact_gap(i)] {
+                assert!(!frame_invariant(&name), "{name}");
+            }
+        }
+        assert!(frame_invariant(END_EFFECTOR_Z) && frame_invariant(ROCKET_VY));
+        assert!(!frame_invariant(ROCKET_THETA) && !frame_invariant("rocket.w@"));
+        assert!(!frame_invariant("joint01.angle") && !frame_invariant("joint1.angles"));
+    }
 
     #[test]
     fn payload_link_channels_omit_the_fields_the_rod_does_not_carry() {

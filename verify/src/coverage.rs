@@ -10,7 +10,7 @@
 //! # Enforced
 //! * **Cross-history**: every pair of backends that run a scene is linked by a chain of rows
 //!   comparing a *whole history* (`history:` or `lowpassF:history:`) of a frame-invariant
-//!   observable ([`frame_invariant`]) between two backends. A chain suffices: agreement of A
+//!   observable ([`data::channel::frame_invariant`]) between two backends. A chain suffices: agreement of A
 //!   with B and of B with C within their tolerances bounds A against C by the sum.
 //! * **Convergence**: every backend that runs a scene has an order, Richardson or monotone row
 //!   on it.
@@ -96,70 +96,6 @@ impl CheckKind {
     }
 }
 
-/// Whether an observable means the same thing in every backend, whatever floating frame,
-/// shape basis or reference point a backend chooses:
-/// * `linkN.tip_x`, `linkN.tip_y` — inertial tip position;
-/// * `jointN.angle`, `jointN.rate`, `jointN.torque` — joint 1 is the hub angle from the inertial
-///   X axis, joint N > 1 the motor angle between the tip tangent of link N−1 and the root
-///   tangent of link N (scenes.md): rotations of rigid hubs and motors, not of a floating frame;
-///   the torque is the actuator's;
-/// * `contactC.normal_force` — a force on the tip;
-/// * `rocket.X`, `rocket.Y`, `rocket.vX`, `rocket.vY` — inertial mass-centre position and
-///   momentum / mass;
-/// * `energy.NAME` — energy-ledger terms;
-/// * `payload.X`, `payload.Y`, `payload.Z` — the 3-D link's payload position;
-/// * `linkN.tip_w`, `linkN.tip_twist` — the 3-D link's vertical tip deflection and tip twist, in
-///   the base's turning frame, which the clamped root fixes the same way in every backend.
-///
-/// * `rocket.massJ.u`, `rocket.massJ.w`, `rocket.u@K`, `rocket.w@K` — the rocket's elastic
-///   displacements relative to the case's mean axis weighted by its ignition mass
-///   (docs/rocket.md): a function of the deformed shape alone, not of a backend's body frame;
-/// * `ee.x`, `ee.y`, `ee.z`, `platform.x`, `platform.y`, `platform.heading` — the mobile
-///   manipulator's inertial end-effector position and platform pose.
-///
-/// Not invariant: tip deflections and axial displacements in a link's floating frame, field
-/// deflections `linkN.v@K`, and the rocket's attitude `rocket.theta` (each backend's body
-/// axis).
-pub fn frame_invariant(channel: &str) -> bool {
-    if channel.starts_with(data::cases::ENERGY_PREFIX) {
-        return true;
-    }
-    if matches!(
-        channel,
-        data::channel::ROCKET_X
-            | data::channel::ROCKET_Y
-            | data::channel::ROCKET_VX
-            | data::channel::ROCKET_VY
-            | data::channel::PAYLOAD_X
-            | data::channel::PAYLOAD_Y
-            | data::channel::PAYLOAD_Z
-            | data::channel::END_EFFECTOR_X
-            | data::channel::END_EFFECTOR_Y
-            | data::channel::END_EFFECTOR_Z
-            | data::channel::PLATFORM_X
-            | data::channel::PLATFORM_Y
-            | data::channel::PLATFORM_HEADING
-    ) {
-        return true;
-    }
-    let indexed = |prefix: &str, suffixes: &[&str]| {
-        channel.strip_prefix(prefix).is_some_and(|rest| {
-            rest.split_once('.').is_some_and(|(n, s)| {
-                !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()) && suffixes.contains(&s)
-            })
-        })
-    };
-    let rocket_station = channel
-        .strip_prefix("rocket.u@")
-        .or_else(|| channel.strip_prefix("rocket.w@"))
-        .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
-    rocket_station
-        || indexed("rocket.mass", &["u", "w"])
-        || indexed("link", &["tip_x", "tip_y", "tip_w", "tip_twist"])
-        || indexed("joint", &["angle", "rate", "torque"])
-        || indexed("contact", &["normal_force"])
-}
-
 /// The check kinds a row performs and, for each, the backends it covers (the row's backend,
 /// and the reference backend for cross rows).
 pub fn row_kinds(case: &Case, scene: &Scene) -> Vec<(CheckKind, Vec<BackendKind>)> {
@@ -212,7 +148,9 @@ pub fn row_kinds(case: &Case, scene: &Scene) -> Vec<(CheckKind, Vec<BackendKind>
         Reference::Backend { backend, .. } => {
             let pair = vec![case.backend, *backend];
             match &q {
-                Some(Quantity::History { channel, .. }) if frame_invariant(channel) => {
+                Some(Quantity::History { channel, .. })
+                    if data::channel::frame_invariant(channel) =>
+                {
                     if channel.starts_with(data::cases::ENERGY_PREFIX) {
                         kinds.push((CheckKind::LedgerTerms, pair.clone()));
                     }

@@ -4,8 +4,9 @@
 
 use data::BackendKind;
 use data::cases::{Case, CaseSettings, Norm, Reference, SuiteName, all_cases, stability_cases};
+use data::channel::frame_invariant;
 use data::coverage::{CoverageException, MissingCheck, coverage_exceptions};
-use verify::coverage::{CheckKind, analyse, analyse_embedded, frame_invariant, row_kinds};
+use verify::coverage::{CheckKind, analyse, analyse_embedded, row_kinds};
 
 fn listing(gaps: &[String]) -> String {
     gaps.join("\n  ")
