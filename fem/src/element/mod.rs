@@ -18,15 +18,14 @@
 //! The elements use only [`contract`] (and the interpolation and quadrature modules); this file
 //! is the registry, which names them.
 //!
-//! A new Euler–Bernoulli element is one new file implementing [`Element`], its `pub mod` line and
-//! its line in [`for_link`], with its row in `data`'s element table ([`data::FemElement`]).
+//! A new Euler–Bernoulli element is one new file implementing [`Element`] and its line in the
+//! registry at the end of this file (which declares its module and maps the settings' choice to
+//! it), with its row in `data`'s element table ([`data::FemElement`]).
 
 pub mod beam3d;
 pub mod contract;
-pub mod euler_bernoulli;
 pub mod hermite;
 pub mod quadrature;
-pub mod quintic;
 pub mod timoshenko;
 
 use data::FemElement;
@@ -48,8 +47,7 @@ const _: () = assert!(MAXE == timoshenko::NDOF && quintic::NDOF <= MAXE);
 /// element, and asking for another element there is refused rather than silently ignored.
 pub fn for_link(link: &Link, choice: Option<FemElement>) -> Result<&'static dyn Element, FemError> {
     match (link.shear, choice.unwrap_or_default()) {
-        (false, FemElement::HermiteCubic) => Ok(&euler_bernoulli::HermiteCubic),
-        (false, FemElement::HermiteQuintic) => Ok(&quintic::HermiteQuintic),
+        (false, choice) => Ok(euler_bernoulli_element(choice)),
         (true, FemElement::HermiteCubic) => Ok(&timoshenko::Timoshenko),
         (true, other) => Err(FemError::InvalidSettings {
             field: "discretization.element".into(),
@@ -60,4 +58,25 @@ pub fn for_link(link: &Link, choice: Option<FemElement>) -> Result<&'static dyn 
             ),
         }),
     }
+}
+
+/// The registry of the Euler–Bernoulli elements: one line per element, `Choice =>
+/// module::Type`, declaring the element's module and mapping the settings' `FemElement::Choice`
+/// to its `Type`.
+macro_rules! registry {
+    ($($choice:ident => $module:ident :: $element:ident,)*) => {
+        $(pub mod $module;)*
+
+        /// The Euler–Bernoulli element of a `discretization.element` choice.
+        fn euler_bernoulli_element(choice: FemElement) -> &'static dyn Element {
+            match choice {
+                $(FemElement::$choice => &$module::$element,)*
+            }
+        }
+    };
+}
+
+registry! {
+    HermiteCubic => euler_bernoulli::HermiteCubic,
+    HermiteQuintic => quintic::HermiteQuintic,
 }
