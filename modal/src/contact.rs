@@ -257,12 +257,6 @@ pub fn check(pc: &PlanarChain) -> Result<(), ModalError> {
     Ok(())
 }
 
-/// Solves the symmetric 2 × 2 system [[a, b], [b, d]] x = r.
-pub fn solve2(a: f64, b: f64, d: f64, r: [f64; 2]) -> [f64; 2] {
-    let det = a * d - b * b;
-    [(d * r[0] - b * r[1]) / det, (a * r[1] - b * r[0]) / det]
-}
-
 /// Root of a scalar function on [a, b] with f(a) > 0 ≥ f(b) (Illinois regula falsi) to the
 /// bracket width `tol`. Returns (t, f(t), final bracket width) with f(t) ≤ 0: the located time
 /// is the first sampled point on the far side of the crossing. An iterate with f = 0 exactly

@@ -10,7 +10,7 @@
 use crate::contact::{ContactState, locate_crossing};
 use crate::error::ModalError;
 use crate::integrate::Stepper;
-use crate::linalg::dot;
+use crate::linalg::{dot, solve2};
 use crate::rhs::ChainRhs;
 
 /// Time tolerance of the contact-start and release events (width of the final bracket).
@@ -454,7 +454,7 @@ fn project(rhs: &mut ChainRhs, t: f64, y: &mut [f64], report: &mut ContactReport
         if c.sticking {
             let gmt = dot(&c.g_row, &c.minv_tt);
             let tmt = dot(&c.t_row, &c.minv_tt);
-            crate::contact::solve2(c.gmg, gmt, tmt, r)
+            solve2(&[c.gmg, gmt, gmt, tmt], r)
         } else {
             [r[0] / c.gmg, 0.0]
         }

@@ -1,5 +1,5 @@
 //! The crate's small dense kernels on preallocated row-major storage (no allocation): dot
-//! product, matrix–vector product, and the Cholesky factorization A = L Lᵀ with its two
+//! product, matrix–vector product, the 2 × 2 solve by Cramer's rule, and the Cholesky factorization A = L Lᵀ with its two
 //! triangular solves, used for the reduced mass matrices solved at every right-hand side
 //! (order ≤ ~150), the Newton matrix M + cD + c²K of the chain and the condensation of the
 //! Timoshenko section rotation.
@@ -15,6 +15,17 @@ pub fn mat_vec(m: &[f64], n: usize, x: &[f64], out: &mut [f64]) {
         let row = &m[i * n..(i + 1) * n];
         out[i] = row.iter().zip(x).map(|(a, b)| a * b).sum();
     }
+}
+
+/// Solves the 2 × 2 system [[s₀, s₁], [s₂, s₃]] x = r (row-major, Cramer's rule): the
+/// contact's two multipliers (symmetric, s₁ = s₂) and the Newton solve's Schur complement of
+/// two constraint rows.
+pub fn solve2(s: &[f64; 4], r: [f64; 2]) -> [f64; 2] {
+    let det = s[0] * s[3] - s[1] * s[2];
+    [
+        (s[3] * r[0] - s[1] * r[1]) / det,
+        (s[0] * r[1] - s[2] * r[0]) / det,
+    ]
 }
 
 /// A pivot of a Cholesky factorization that is not positive and finite: the matrix is not

@@ -23,7 +23,7 @@
 //! period-2 cycles at 24 modes), while S is assembled from the same well-scaled M, D, K that
 //! the model itself factors.
 
-use crate::linalg::{cholesky_factor, cholesky_substitute, dot};
+use crate::linalg::{cholesky_factor, cholesky_substitute, dot, solve2};
 
 /// The linearization of one point and the factorization of one c (see the module docs).
 #[derive(Debug, Clone)]
@@ -133,7 +133,7 @@ impl ChainNewton {
             let mu = if self.rows == 1 {
                 [g[0] / self.schur[0], 0.0]
             } else {
-                solve2_general(&self.schur, g)
+                solve2(&self.schur, g)
             };
             for r in 0..self.rows {
                 let sw = &self.sw[r * nf..(r + 1) * nf];
@@ -150,13 +150,4 @@ impl ChainNewton {
             *v += c * dot(&self.p[r * nf..(r + 1) * nf], xv);
         }
     }
-}
-
-/// Solves the 2 × 2 system [[s0, s1], [s2, s3]] μ = g (Cramer's rule).
-fn solve2_general(s: &[f64; 4], g: [f64; 2]) -> [f64; 2] {
-    let det = s[0] * s[3] - s[1] * s[2];
-    [
-        (s[3] * g[0] - s[1] * g[1]) / det,
-        (s[0] * g[1] - s[2] * g[0]) / det,
-    ]
 }

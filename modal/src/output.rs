@@ -357,7 +357,21 @@ pub(crate) fn stopped(
     StabilityVerdict::Stopped { diagnostic }
 }
 
-/// The stop of a run whose contact events accumulate (Zeno-like chattering).
+/// The stop of a run whose time integration could not continue at `t`, for the reason `why`,
+/// with the run's own `remedy` (the payload link and the mobile manipulator; the chain run
+/// uses [`stopped`]).
+pub(crate) fn integrator_stopped(t: f64, why: &str, remedy: &str) -> StabilityVerdict {
+    StabilityVerdict::Stopped {
+        diagnostic: Diagnostic {
+            t,
+            what: "the integrator could not continue".into(),
+            location: None,
+            why: why.into(),
+            remedy: remedy.into(),
+        },
+    }
+}
+
 /// The stop of a run whose step after a plastic impact at `t` (normal force ≤ 0, so the tip
 /// was left free) went `depth` below the surface: the contact would be taken again at `t` with
 /// zero impulse and the same decision, without end.
@@ -385,6 +399,7 @@ pub(crate) fn unresolved_grazing(t: f64, h: f64, depth: f64, fixed_step: bool) -
     }
 }
 
+/// The stop of a run whose contact events accumulate (Zeno-like chattering).
 pub(crate) fn too_many_events(t: f64, count: usize) -> StabilityVerdict {
     StabilityVerdict::Stopped {
         diagnostic: Diagnostic {

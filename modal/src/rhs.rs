@@ -7,7 +7,7 @@
 
 use crate::contact::ContactState;
 use crate::integrate::OdeRhs;
-use crate::linalg::dot;
+use crate::linalg::{dot, solve2};
 use crate::model::Chain;
 use crate::newton::ChainNewton;
 
@@ -202,7 +202,7 @@ impl ChainRhs {
                     let gmt = dot(&c.g_row, &c.minv_tt);
                     let tmt = dot(&c.t_row, &c.minv_tt);
                     let rhs_t = -(t_qdd + tv[0] * conv[0] + tv[1] * conv[1]);
-                    let [ln, lt] = crate::contact::solve2(c.gmg, gmt, tmt, [rhs_n, rhs_t]);
+                    let [ln, lt] = solve2(&[c.gmg, gmt, gmt, tmt], [rhs_n, rhs_t]);
                     c.lambda = ln;
                     c.lambda_t = lt;
                     for (k, &g) in chain.free.iter().enumerate() {
@@ -306,7 +306,7 @@ fn constrain_column(c: &ContactState, x: &mut [f64]) {
         let tx = dot(&c.t_row, x);
         let gmt = dot(&c.g_row, &c.minv_tt);
         let tmt = dot(&c.t_row, &c.minv_tt);
-        let [a, b] = crate::contact::solve2(c.gmg, gmt, tmt, [gx, tx]);
+        let [a, b] = solve2(&[c.gmg, gmt, gmt, tmt], [gx, tx]);
         for k in 0..x.len() {
             x[k] -= c.minv_gt[k] * a + c.minv_tt[k] * b;
         }

@@ -40,6 +40,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::basis::ShapeSet;
 use crate::basis::quadrature::Quadrature;
 use crate::error::ModalError;
+use crate::linalg::dot;
 
 pub type Vec3 = Vector3<f64>;
 pub type Mat3 = Matrix3<f64>;
@@ -369,8 +370,8 @@ impl MobileModel {
                     .expect("flexible link without coordinates");
                 let nm = self.layout.modes;
                 let tip = |x: &[f64], shapes: &[f64]| -> (f64, f64) {
-                    let v = (0..nm).map(|i| shapes[i] * x[e0 + i]).sum();
-                    let w = (0..nm).map(|i| shapes[i] * x[e0 + nm + i]).sum();
+                    let v = dot(&shapes[..nm], &x[e0..e0 + nm]);
+                    let w = dot(&shapes[..nm], &x[e0 + nm..e0 + 2 * nm]);
                     (v, w)
                 };
                 let (vl, wl) = tip(q, &fl.phi_tip);
@@ -431,8 +432,8 @@ impl MobileModel {
             for g in 0..fl.nodes.len() {
                 let ph = &fl.phi[g * nm..(g + 1) * nm];
                 let field = |x: &[f64]| -> (f64, f64) {
-                    let v = (0..nm).map(|i| ph[i] * x[e0 + i]).sum();
-                    let w = (0..nm).map(|i| ph[i] * x[e0 + nm + i]).sum();
+                    let v = dot(ph, &x[e0..e0 + nm]);
+                    let w = dot(ph, &x[e0 + nm..e0 + 2 * nm]);
                     (v, w)
                 };
                 let (v, w) = field(q);
@@ -558,8 +559,8 @@ impl MobileModel {
         let fl = self.flex.as_ref()?;
         let e0 = self.layout.elastic?;
         let nm = self.layout.modes;
-        let v = (0..nm).map(|i| fl.phi_tip[i] * q[e0 + i]).sum();
-        let w = (0..nm).map(|i| fl.phi_tip[i] * q[e0 + nm + i]).sum();
+        let v = dot(&fl.phi_tip[..nm], &q[e0..e0 + nm]);
+        let w = dot(&fl.phi_tip[..nm], &q[e0 + nm..e0 + 2 * nm]);
         Some((v, w))
     }
 }
@@ -764,10 +765,10 @@ impl MobileModel {
             let nm = l.modes;
             for (dir, ei) in [(0, fl.ei_out), (1, fl.ei_in)] {
                 for i in 0..nm {
-                    let mut s = 0.0;
-                    for j in 0..nm {
-                        s += fl.curvature[i * nm + j] * q[e0 + dir * nm + j];
-                    }
+                    let s = dot(
+                        &fl.curvature[i * nm..(i + 1) * nm],
+                        &q[e0 + dir * nm..e0 + (dir + 1) * nm],
+                    );
                     ws.force[k + dir * nm + i] -= ei * s;
                 }
             }

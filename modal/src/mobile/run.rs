@@ -14,8 +14,7 @@ use std::time::Instant;
 use data::channel::spec;
 use data::scene::MobileManipulator;
 use data::{
-    Diagnostic, EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict,
-    ledger_term,
+    EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict, ledger_term,
 };
 
 use super::model::{MobileModel, Workspace};
@@ -23,12 +22,16 @@ use super::{Inputs, set_up};
 use crate::error::ModalError;
 use crate::integrate::{Build, OdeRhs, Tolerances, method_for};
 use crate::linalg::{cholesky_factor, cholesky_substitute};
+use crate::output::integrator_stopped;
 
 /// Default (rtol, atol): atol in metres and radians (unit-scaled modal coordinates) and joules.
 pub const DEFAULT_TOL: (f64, f64) = (1e-8, 1e-10);
 
 /// Number of work integrals carried in the state.
 pub const N_WORK: usize = 4;
+
+/// The remedy of a stopped run's diagnostic ([`integrator_stopped`]).
+const REMEDY: &str = "tighten or loosen time.rtol/time.atol, or check the scene's parameters";
 
 /// The equations as y' = f(t, y).
 pub struct MobileRhs {
@@ -233,11 +236,15 @@ pub fn simulate(
     'outer: for &target in &breaks {
         while t < target {
             if let Err(e) = stepper.step(&mut rhs, &mut t, &mut y, target) {
-                verdict = stopped(t, &e.to_string());
+                verdict = integrator_stopped(t, &e.to_string(), REMEDY);
                 break 'outer;
             }
             if let Some(tf) = rhs.failure {
-                verdict = stopped(tf, "the reduced mass matrix is not positive definite");
+                verdict = integrator_stopped(
+                    tf,
+                    "the reduced mass matrix is not positive definite",
+                    REMEDY,
+                );
                 break 'outer;
             }
             while next < n_samples && sample_time(next) <= t * (1.0 + 1e-14) {
@@ -247,7 +254,7 @@ pub fn simulate(
                 next += 1;
             }
             if !y.iter().all(|v| v.is_finite()) {
-                verdict = stopped(t, "non-finite state");
+                verdict = integrator_stopped(t, "non-finite state", REMEDY);
                 break 'outer;
             }
         }
@@ -283,18 +290,6 @@ pub fn initial_state(model: &MobileModel, mm: &MobileManipulator, y: &mut [f64])
     if let Some(a0) = l.arm {
         y[a0..a0 + 4].copy_from_slice(&mm.initial.joint_angles);
         y[n + k..n + k + 4].copy_from_slice(&mm.initial.joint_rates);
-    }
-}
-
-fn stopped(t: f64, why: &str) -> StabilityVerdict {
-    StabilityVerdict::Stopped {
-        diagnostic: Diagnostic {
-            t,
-            what: "the integrator could not continue".into(),
-            location: None,
-            why: why.into(),
-            remedy: "tighten or loosen time.rtol/time.atol, or check the scene's parameters".into(),
-        },
     }
 }
 

@@ -10,6 +10,7 @@ use faer::Mat;
 use super::model::LinkModel;
 use super::{set_up, static_sag};
 use crate::error::ModalError;
+use crate::linalg::dot;
 use crate::modes::generalized_eigen;
 
 /// Name of a mode whose kinetic energy sits mostly in a field.
@@ -160,13 +161,12 @@ pub fn statics(
     let wall = Instant::now();
     let s = set_up(scene, link, settings)?;
     let q = static_sag(&s.model)?;
-    let dot = |r: &[f64]| r.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>();
     Ok(StaticResult {
         backend: data::BackendKind::Modal,
         scene: scene.name.clone(),
         settings: data::Settings::from(settings),
-        tip_deflection: dot(&s.model.tip.w),
-        tip_rotation: dot(&s.model.tip.slope_w),
+        tip_deflection: dot(&s.model.tip.w, &q),
+        tip_rotation: dot(&s.model.tip.slope_w, &q),
         cost: Cost {
             wall_time_s: wall.elapsed().as_secs_f64(),
             dofs: s.model.n,

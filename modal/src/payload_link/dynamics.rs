@@ -17,7 +17,7 @@
 //! iteration after the rest.
 
 use crate::integrate::OdeRhs;
-use crate::linalg::{cholesky_factor, cholesky_substitute};
+use crate::linalg::{cholesky_factor, cholesky_substitute, dot};
 
 use super::model::LinkModel;
 
@@ -145,13 +145,10 @@ impl LinkRhs {
         let mut dp = 0.0;
         let mut jq = m.j0;
         for i in 0..n {
-            let (mut gqdd, mut gqd, mut nqd, mut nq) = (0.0, 0.0, 0.0, 0.0);
-            for j in 0..n {
-                gqdd += m.gyro[i * n + j] * qdd[j];
-                gqd += m.gyro[i * n + j] * qd[j];
-                nqd += m.centrifugal[i * n + j] * qd[j];
-                nq += m.centrifugal[i * n + j] * q[j];
-            }
+            let row = i * n..(i + 1) * n;
+            let (gyro, centrifugal) = (&m.gyro[row.clone()], &m.centrifugal[row]);
+            let (gqdd, gqd) = (dot(gyro, qdd), dot(gyro, qd));
+            let (nqd, nq) = (dot(centrifugal, qd), dot(centrifugal, q));
             dp += m.b[i] * qdd[i]
                 + q[i] * gqdd
                 + qd[i] * gqd

@@ -25,6 +25,7 @@ use data::scene::{LinkField, PrescribedMotion, TorqueLaw};
 use nalgebra::{Matrix3, Vector3};
 
 use super::basis::FieldBasis;
+use crate::linalg::dot;
 
 /// One carried field: its coordinates q[offset .. offset + count].
 #[derive(Debug, Clone)]
@@ -143,12 +144,10 @@ impl LinkModel {
         let n = self.n;
         let mut t = 0.0;
         for i in 0..n {
-            let (mut mq, mut gq, mut nq) = (0.0, 0.0, 0.0);
-            for j in 0..n {
-                mq += self.mass[i * n + j] * qd[j];
-                gq += self.gyro[i * n + j] * qd[j];
-                nq += self.centrifugal[i * n + j] * q[j];
-            }
+            let row = i * n..(i + 1) * n;
+            let mq = dot(&self.mass[row.clone()], qd);
+            let gq = dot(&self.gyro[row.clone()], qd);
+            let nq = dot(&self.centrifugal[row], q);
             t += 0.5 * qd[i] * mq
                 + w * (self.b[i] * qd[i] + q[i] * gq)
                 + 0.5 * w * w * (2.0 * self.h[i] * q[i] + q[i] * nq);
@@ -163,9 +162,7 @@ impl LinkModel {
 
     /// f_gᵀ q.
     pub fn gravity_energy(&self, q: &[f64]) -> f64 {
-        self.gravity
-            .as_ref()
-            .map_or(0.0, |f| f.iter().zip(q).map(|(a, b)| a * b).sum())
+        self.gravity.as_ref().map_or(0.0, |f| dot(f, q))
     }
 
     /// Dissipation rate q̇ᵀC_f q̇ of one damped field.
@@ -178,11 +175,7 @@ impl LinkModel {
 pub fn quad_form(a: &[f64], n: usize, x: &[f64]) -> f64 {
     let mut s = 0.0;
     for i in 0..n {
-        let mut r = 0.0;
-        for j in 0..n {
-            r += a[i * n + j] * x[j];
-        }
-        s += x[i] * r;
+        s += x[i] * dot(&a[i * n..(i + 1) * n], x);
     }
     0.5 * s
 }

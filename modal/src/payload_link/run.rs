@@ -6,8 +6,8 @@ use std::time::Instant;
 
 use data::scene::{LinkField, LinkInitialShape, PayloadLink, PrescribedMotion};
 use data::{
-    Diagnostic, EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict,
-    channel, ledger_term,
+    EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict, channel,
+    ledger_term,
 };
 
 use super::dynamics::LinkRhs;
@@ -15,7 +15,9 @@ use super::model::LinkModel;
 use super::{SetUp, set_up, static_sag};
 use crate::error::ModalError;
 use crate::integrate::{Build, OdeRhs, TRAPEZOID, TRBDF2, Tolerances, method_for};
+use crate::linalg::dot;
 use crate::modes::generalized_eigen;
+use crate::output::integrator_stopped;
 
 /// Default (rtol, atol) of the adaptive methods: atol is in metres and radians (coordinates are
 /// unit-scaled assumed modes) and in joules for the work integrals.
@@ -23,6 +25,9 @@ pub const DEFAULT_TOL: (f64, f64) = (1e-7, 1e-10);
 
 /// Fixed steps per period of the lowest elastic mode ([`default_step`]).
 pub const STEPS_PER_PERIOD: f64 = 128.0;
+
+/// The remedy of a stopped run's diagnostic ([`integrator_stopped`]).
+const REMEDY: &str = "loosen time.rtol/time.atol, or check the scene's parameters";
 
 /// The default method: adaptive TR-BDF2 when a Kelvin–Voigt term is on (the damped high Ritz
 /// modes decay and the error test then lets the step grow far beyond their periods:
@@ -120,7 +125,7 @@ pub fn simulate(
     'outer: for &target in &breaks {
         while t < target {
             if let Err(e) = stepper.step(&mut rhs, &mut t, &mut y, target) {
-                verdict = stopped(t, &e.to_string());
+                verdict = integrator_stopped(t, &e.to_string(), REMEDY);
                 break 'outer;
             }
             while next < n_samples && sample_time(next) <= t * (1.0 + 1e-14) {
@@ -130,7 +135,7 @@ pub fn simulate(
                 next += 1;
             }
             if !y.iter().all(|v| v.is_finite()) {
-                verdict = stopped(t, "non-finite state");
+                verdict = integrator_stopped(t, "non-finite state", REMEDY);
                 break 'outer;
             }
         }
@@ -147,18 +152,6 @@ pub fn simulate(
         cost: st.cost(rhs.nd, wall),
         verdict,
     })
-}
-
-fn stopped(t: f64, why: &str) -> StabilityVerdict {
-    StabilityVerdict::Stopped {
-        diagnostic: Diagnostic {
-            t,
-            what: "the integrator could not continue".into(),
-            location: None,
-            why: why.into(),
-            remedy: "loosen time.rtol/time.atol, or check the scene's parameters".into(),
-        },
-    }
 }
 
 /// Sampled observables and the energy ledger.
@@ -220,7 +213,7 @@ impl Output {
         let o = rhs.q0();
         let q = &y[o..o + n];
         let qd = &y[rhs.nd + o..rhs.nd + o + n];
-        let row = |r: &[f64]| r.iter().zip(q).map(|(a, b)| a * b).sum::<f64>();
+        let row = |r: &[f64]| dot(r, q);
         let (u, v, w) = (row(&m.tip.u), row(&m.tip.v), row(&m.tip.w));
         let (sv, sw, phi) = (row(&m.tip.slope_v), row(&m.tip.slope_w), row(&m.tip.phi));
         let c = m.reach - m.length;

@@ -222,7 +222,7 @@ impl Model {
     /// φ = Σ c_p w_p. This frame is the case's mean axis (∫m₀W_k = ∫m₀xW_k = 0), so the case
     /// adds nothing to φ. Also the rate of stretch when given the rates ẇ.
     pub fn coupling_stretch_w(&self, c: &Coupling, w: &[f64]) -> f64 {
-        let phi: f64 = self.mass_tilt.iter().zip(w).map(|(a, b)| a * b).sum();
+        let phi = dot(&self.mass_tilt, w);
         let dx = self.body.masses[c.i].x - self.body.masses[c.j].x;
         w[c.i] - w[c.j] - dx * phi
     }
@@ -313,7 +313,7 @@ impl Workspace {
 }
 
 fn mv(a: &[f64], n: usize, x: &[f64], k: usize) -> f64 {
-    (0..n).map(|l| a[k * n + l] * x[l]).sum()
+    dot(&a[k * n..(k + 1) * n], &x[..n])
 }
 fn mtv(a: &[f64], n: usize, x: &[f64], l: usize) -> f64 {
     (0..n).map(|k| a[k * n + l] * x[k]).sum()

@@ -1,4 +1,4 @@
-//! # The variable-mass flexible rocket by free-free eigenfunctions (seed 003, issue 4)
+//! # The variable-mass flexible rocket by free-free eigenfunctions (seed 003)
 //!
 //! The report's conclusion proposes expanding the case's elastic displacements "in terms of
 //! sets of eigenfunctions corresponding to the associated constant-mass system, thereby

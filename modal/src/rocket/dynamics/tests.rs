@@ -104,7 +104,7 @@ fn elem_strain_gradient_matches_finite_difference() {
         );
     }
     // the coupling term is really there: gradient differs from K q alone
-    let lin: f64 = (0..n).map(|l| model.kb[l] * b[l]).sum();
+    let lin = dot(&model.kb[..n], &b[..n]);
     assert!((g[n] - lin).abs() > 1e-9 * g[n].abs());
 }
 
@@ -126,8 +126,8 @@ fn elem_coupling_tensor_matches_pointwise_quadrature() {
     let mut direct = 0.0;
     for p in 0..t5.points() {
         let ea = basis.mesh.elements[t5.element[p]].ea;
-        let up: f64 = (0..n).map(|k| t5.du[p * n + k] * a[k]).sum();
-        let wp: f64 = (0..n).map(|k| t5.dw[p * n + k] * b[k]).sum();
+        let up = dot(&t5.du[p * n..(p + 1) * n], &a);
+        let wp = dot(&t5.dw[p * n..(p + 1) * n], &b);
         direct += 0.5 * ea * t5.weight[p] * up * wp * wp;
     }
     // two exact quadratures of the same polynomial: round-off only
@@ -163,10 +163,10 @@ fn elem_mass_matrix_matches_kinetic_energy_quadrature() {
         let x = table.x[g];
         let uk = &table.u[g * n..(g + 1) * n];
         let wk = &table.w[g * n..(g + 1) * n];
-        let u: f64 = (0..n).map(|k| uk[k] * q[l.a() + k]).sum();
-        let w: f64 = (0..n).map(|k| wk[k] * q[l.b() + k]).sum();
-        let ud: f64 = (0..n).map(|k| uk[k] * v[l.a() + k]).sum();
-        let wd: f64 = (0..n).map(|k| wk[k] * v[l.b() + k]).sum();
+        let u = dot(uk, &q[l.a()..l.a() + n]);
+        let w = dot(wk, &q[l.b()..l.b() + n]);
+        let ud = dot(uk, &v[l.a()..l.a() + n]);
+        let wd = dot(wk, &v[l.b()..l.b() + n]);
         let px = vx - om * w + ud;
         let py = vy + om * (x + u) + wd;
         kin += 0.5 * m * table.weight[g] * (px * px + py * py);
