@@ -16,7 +16,6 @@
 use data::scene::{Link, PrescribedMotion};
 use faer::Mat;
 
-use crate::element::euler_bernoulli as eb;
 use crate::element::quadrature::gauss01;
 use crate::element::{Element, Local, MAXE};
 use crate::error::FemError;
@@ -176,7 +175,7 @@ impl LinearLink {
             }
             if link.axial {
                 let ea = link.axial_stiffness.unwrap_or(0.0);
-                let (mb, kb) = (eb::bar_mass(rho_a, h), eb::bar_stiffness(ea, h));
+                let (mb, kb) = element.axial_mass_and_stiffness(rho_a, ea, h);
                 let ud = [layout.u(e), layout.u(e + 1)];
                 for i in 0..2 {
                     let Some(a) = ud[i] else { continue };

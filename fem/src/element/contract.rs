@@ -130,6 +130,16 @@ pub trait Element: std::fmt::Debug + Sync {
     /// Linear stiffness: bending ∫EI B′B′ (+ shear ∫κGA(N′ − B)(N′ − B) where the rotation is
     /// independent). With κGA = 0 it is the bending part, on which Kelvin–Voigt acts.
     fn stiffness(&self, ei: f64, kga: f64, h: f64) -> Local;
+    /// Consistent mass and stiffness of the axial field (u₁, u₂) of an extensible link, linear
+    /// in every element (the field [`membrane`] strains). Default: the linear bar.
+    fn axial_mass_and_stiffness(
+        &self,
+        rho_a: f64,
+        ea: f64,
+        h: f64,
+    ) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+        (bar_mass(rho_a, h), bar_stiffness(ea, h))
+    }
     /// Geometric stiffness ∫N(ξ) N′N′ for a given axial force (tension positive), or `None`
     /// when the element does not provide it.
     fn geometric_stiffness(&self, h: f64, axial_force: &dyn Fn(f64) -> f64) -> Option<Local>;
@@ -180,6 +190,18 @@ pub trait Element: std::fmt::Debug + Sync {
         }
         fq
     }
+}
+
+/// Linear bar: consistent mass ρA h/6 [[2, 1], [1, 2]].
+pub fn bar_mass(rho_a: f64, h: f64) -> [[f64; 2]; 2] {
+    let c = rho_a * h / 6.0;
+    [[2.0 * c, c], [c, 2.0 * c]]
+}
+
+/// Linear bar: stiffness EA/h [[1, −1], [−1, 1]].
+pub fn bar_stiffness(ea: f64, h: f64) -> [[f64; 2]; 2] {
+    let c = ea / h;
+    [[c, -c], [-c, c]]
 }
 
 /// Copies an N×N element matrix into the padded local block.
@@ -396,4 +418,19 @@ pub fn membrane(el: &MeshElement, u: [f64; 2], d: &Row) -> (f64, [f64; MAXE + 2]
         }
     }
     ((u[1] - u[0]) / h + half_int / h, g)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn elem_bar_total_mass_and_rigid_mode() {
+        let (rho_a, ea, h) = (2.0, 5.0, 0.3);
+        let m = bar_mass(rho_a, h);
+        let k = bar_stiffness(ea, h);
+        let tot: f64 = m.iter().flatten().sum();
+        assert!((tot - rho_a * h).abs() < 1e-15);
+        assert_eq!(k[0][0] + k[0][1], 0.0);
+    }
 }

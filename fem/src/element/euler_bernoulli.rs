@@ -67,18 +67,6 @@ pub fn geometric_stiffness(h: f64, axial_force: impl Fn(f64) -> f64) -> Mat4 {
     k
 }
 
-/// Linear bar: consistent mass ρA h/6 [[2, 1], [1, 2]].
-pub fn bar_mass(rho_a: f64, h: f64) -> [[f64; 2]; 2] {
-    let c = rho_a * h / 6.0;
-    [[2.0 * c, c], [c, 2.0 * c]]
-}
-
-/// Linear bar: stiffness EA/h [[1, −1], [−1, 1]].
-pub fn bar_stiffness(ea: f64, h: f64) -> [[f64; 2]; 2] {
-    let c = ea / h;
-    [[c, -c], [-c, c]]
-}
-
 /// Von Kármán element DOFs: (u₁, u₂, v₁, v₁′, v₂, v₂′).
 pub type VkDofs = [f64; 6];
 
@@ -412,15 +400,5 @@ mod tests {
                 assert!((kt[i][j] - kt[j][i]).abs() < 1e-12 * kt[0][0].abs());
             }
         }
-    }
-
-    #[test]
-    fn elem_bar_total_mass_and_rigid_mode() {
-        let (rho_a, ea, h) = (2.0, 5.0, 0.3);
-        let m = bar_mass(rho_a, h);
-        let k = bar_stiffness(ea, h);
-        let tot: f64 = m.iter().flatten().sum();
-        assert!((tot - rho_a * h).abs() < 1e-15);
-        assert_eq!(k[0][0] + k[0][1], 0.0);
     }
 }
