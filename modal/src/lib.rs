@@ -87,6 +87,7 @@ pub mod output;
 pub mod payload_link;
 pub mod rhs;
 pub mod rocket;
+pub mod sampled;
 pub mod setup;
 pub mod simulate;
 pub mod statics;

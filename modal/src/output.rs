@@ -357,21 +357,6 @@ pub(crate) fn stopped(
     StabilityVerdict::Stopped { diagnostic }
 }
 
-/// The stop of a run whose time integration could not continue at `t`, for the reason `why`,
-/// with the run's own `remedy` (the payload link and the mobile manipulator; the chain run
-/// uses [`stopped`]).
-pub(crate) fn integrator_stopped(t: f64, why: &str, remedy: &str) -> StabilityVerdict {
-    StabilityVerdict::Stopped {
-        diagnostic: Diagnostic {
-            t,
-            what: "the integrator could not continue".into(),
-            location: None,
-            why: why.into(),
-            remedy: remedy.into(),
-        },
-    }
-}
-
 /// The stop of a run whose step after a plastic impact at `t` (normal force ≤ 0, so the tip
 /// was left free) went `depth` below the surface: the contact would be taken again at `t` with
 /// zero impulse and the same decision, without end.

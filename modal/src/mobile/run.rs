@@ -13,16 +13,14 @@ use std::time::Instant;
 
 use data::channel::spec;
 use data::scene::MobileManipulator;
-use data::{
-    EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict, ledger_term,
-};
+use data::{EnergyLedger, ModalSettings, Observables, RunResult, Scene, ledger_term};
 
 use super::model::{MobileModel, Workspace};
 use super::{Inputs, set_up};
 use crate::error::ModalError;
 use crate::integrate::{Build, OdeRhs, Tolerances, method_for};
 use crate::linalg::{cholesky_factor, cholesky_substitute};
-use crate::output::integrator_stopped;
+use crate::sampled::{Schedule, run_sampled};
 
 /// Default (rtol, atol): atol in metres and radians (unit-scaled modal coordinates) and joules.
 pub const DEFAULT_TOL: (f64, f64) = (1e-8, 1e-10);
@@ -30,7 +28,7 @@ pub const DEFAULT_TOL: (f64, f64) = (1e-8, 1e-10);
 /// Number of work integrals carried in the state.
 pub const N_WORK: usize = 4;
 
-/// The remedy of a stopped run's diagnostic ([`integrator_stopped`]).
+/// The remedy of a stopped run's diagnostic.
 const REMEDY: &str = "tighten or loosen time.rtol/time.atol, or check the scene's parameters";
 
 /// The equations as y' = f(t, y).
@@ -225,41 +223,24 @@ pub fn simulate(
     breaks.push(t_end);
 
     let mut out = Output::new(&rhs.model);
-    let dt_out = scene.simulation.output_interval;
-    let n_samples = (t_end / dt_out - 1e-9).ceil() as usize + 1;
-    let sample_time = |k: usize| (k as f64 * dt_out).min(t_end);
-    let mut ys = vec![0.0; dim];
     out.record(&mut rhs, 0.0, &y);
-    let mut next = 1;
-    let mut t = 0.0;
-    let mut verdict = StabilityVerdict::Completed;
-    'outer: for &target in &breaks {
-        while t < target {
-            if let Err(e) = stepper.step(&mut rhs, &mut t, &mut y, target) {
-                verdict = integrator_stopped(t, &e.to_string(), REMEDY);
-                break 'outer;
-            }
-            if let Some(tf) = rhs.failure {
-                verdict = integrator_stopped(
-                    tf,
-                    "the reduced mass matrix is not positive definite",
-                    REMEDY,
-                );
-                break 'outer;
-            }
-            while next < n_samples && sample_time(next) <= t * (1.0 + 1e-14) {
-                let ts = sample_time(next);
-                stepper.dense(ts, &mut ys);
-                out.record(&mut rhs, ts, &ys);
-                next += 1;
-            }
-            if !y.iter().all(|v| v.is_finite()) {
-                verdict = integrator_stopped(t, "non-finite state", REMEDY);
-                break 'outer;
-            }
-        }
-        stepper.reset();
-    }
+    let schedule = Schedule {
+        breaks: &breaks,
+        output_interval: scene.simulation.output_interval,
+        t_end,
+        remedy: REMEDY,
+    };
+    let verdict = run_sampled(
+        stepper.as_mut(),
+        &mut rhs,
+        &mut y,
+        schedule,
+        |rhs| {
+            rhs.failure
+                .map(|tf| (tf, "the reduced mass matrix is not positive definite"))
+        },
+        |rhs, ts, ys| out.record(rhs, ts, ys),
+    );
     let st = stepper.stats();
     Ok(RunResult {
         backend: data::BackendKind::Modal,

@@ -5,10 +5,7 @@
 use std::time::Instant;
 
 use data::scene::{LinkField, LinkInitialShape, PayloadLink, PrescribedMotion};
-use data::{
-    EnergyLedger, ModalSettings, Observables, RunResult, Scene, StabilityVerdict, channel,
-    ledger_term,
-};
+use data::{EnergyLedger, ModalSettings, Observables, RunResult, Scene, channel, ledger_term};
 
 use super::dynamics::LinkRhs;
 use super::model::LinkModel;
@@ -17,7 +14,7 @@ use crate::error::ModalError;
 use crate::integrate::{Build, OdeRhs, TRAPEZOID, TRBDF2, Tolerances, method_for};
 use crate::linalg::dot;
 use crate::modes::generalized_eigen;
-use crate::output::integrator_stopped;
+use crate::sampled::{Schedule, run_sampled};
 
 /// Default (rtol, atol) of the adaptive methods: atol is in metres and radians (coordinates are
 /// unit-scaled assumed modes) and in joules for the work integrals.
@@ -26,7 +23,7 @@ pub const DEFAULT_TOL: (f64, f64) = (1e-7, 1e-10);
 /// Fixed steps per period of the lowest elastic mode ([`default_step`]).
 pub const STEPS_PER_PERIOD: f64 = 128.0;
 
-/// The remedy of a stopped run's diagnostic ([`integrator_stopped`]).
+/// The remedy of a stopped run's diagnostic.
 const REMEDY: &str = "loosen time.rtol/time.atol, or check the scene's parameters";
 
 /// The default method: adaptive TR-BDF2 when a Kelvin–Voigt term is on (the damped high Ritz
@@ -113,34 +110,22 @@ pub fn simulate(
     breaks.push(t_end);
 
     let mut out = Output::new(&rhs);
-    let dt_out = scene.simulation.output_interval;
-    let n_samples = (t_end / dt_out - 1e-9).ceil() as usize + 1;
-    let sample_time = |k: usize| (k as f64 * dt_out).min(t_end);
-    let mut ys = vec![0.0; dim];
     let mut dy = vec![0.0; dim];
     out.record(&mut rhs, 0.0, &y, &mut dy);
-    let mut next = 1;
-    let mut t = 0.0;
-    let mut verdict = StabilityVerdict::Completed;
-    'outer: for &target in &breaks {
-        while t < target {
-            if let Err(e) = stepper.step(&mut rhs, &mut t, &mut y, target) {
-                verdict = integrator_stopped(t, &e.to_string(), REMEDY);
-                break 'outer;
-            }
-            while next < n_samples && sample_time(next) <= t * (1.0 + 1e-14) {
-                let ts = sample_time(next);
-                stepper.dense(ts, &mut ys);
-                out.record(&mut rhs, ts, &ys, &mut dy);
-                next += 1;
-            }
-            if !y.iter().all(|v| v.is_finite()) {
-                verdict = integrator_stopped(t, "non-finite state", REMEDY);
-                break 'outer;
-            }
-        }
-        stepper.reset();
-    }
+    let schedule = Schedule {
+        breaks: &breaks,
+        output_interval: scene.simulation.output_interval,
+        t_end,
+        remedy: REMEDY,
+    };
+    let verdict = run_sampled(
+        stepper.as_mut(),
+        &mut rhs,
+        &mut y,
+        schedule,
+        |_| None,
+        |rhs, ts, ys| out.record(rhs, ts, ys, &mut dy),
+    );
     let st = stepper.stats();
     Ok(RunResult {
         backend: data::BackendKind::Modal,
