@@ -277,7 +277,7 @@ pub fn statics(
     pc: &PlanarChain,
     s: &ValidatedSettings,
 ) -> Result<StaticResult, FdmError> {
-    if pc.links.len() == 1 && pc.links[0].shear {
+    if matches!(pc.links.as_slice(), [link] if link.shear) {
         return timoshenko_statics(scene, pc, s);
     }
     let clock = std::time::Instant::now();
