@@ -61,6 +61,9 @@ pub struct MobileSystem {
     pub inputs: Inputs,
     ws: Workspace,
     tau: Vec<f64>,
+    /// the time `tau` holds the torques of (NaN: none yet): a step evaluates them once, at its
+    /// midpoint, for all its Newton iterations and its booking
+    tau_time: f64,
     qd: Vec<f64>,
     sdn: Vec<f64>,
 }
@@ -73,6 +76,7 @@ impl MobileSystem {
             inputs,
             ws: Workspace::new(n),
             tau: vec![0.0; m],
+            tau_time: f64::NAN,
             qd: vec![0.0; n],
             sdn: vec![0.0; n],
         }
@@ -80,7 +84,10 @@ impl MobileSystem {
 
     /// The applied torques at time t (ν order).
     pub fn torques(&mut self, t: f64) -> &[f64] {
-        self.inputs.at(&self.model, t, &mut self.tau);
+        if t != self.tau_time {
+            self.inputs.at(&self.model, t, &mut self.tau);
+            self.tau_time = t;
+        }
         &self.tau
     }
 
@@ -127,7 +134,7 @@ impl ReducedSystem for MobileSystem {
     }
 
     fn applied_forces(&mut self, t: f64, nu: &[f64], out: &mut [f64]) {
-        self.inputs.at(&self.model, t, &mut self.tau);
+        self.torques(t);
         self.model.applied(nu, &self.tau, out);
     }
 
@@ -153,7 +160,7 @@ impl ReducedSystem for MobileSystem {
     }
 
     fn book(&mut self, t: f64, nu: &[f64], weight: f64, works: &mut Works) {
-        self.inputs.at(&self.model, t, &mut self.tau);
+        self.torques(t);
         let l = self.model.layout;
         if let Some(p) = &self.model.platform {
             for s in 0..2 {
