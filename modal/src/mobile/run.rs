@@ -20,7 +20,7 @@ use super::{Inputs, set_up};
 use crate::error::ModalError;
 use crate::integrate::{Build, OdeRhs, Tolerances, method_for};
 use crate::linalg::{cholesky_factor, cholesky_substitute};
-use crate::sampled::{Schedule, run_sampled};
+use crate::sampled::{SampledRun, Schedule, run_sampled};
 
 /// Default (rtol, atol): atol in metres and radians (unit-scaled modal coordinates) and joules.
 pub const DEFAULT_TOL: (f64, f64) = (1e-8, 1e-10);
@@ -230,17 +230,7 @@ pub fn simulate(
         t_end,
         remedy: REMEDY,
     };
-    let verdict = run_sampled(
-        stepper.as_mut(),
-        &mut rhs,
-        &mut y,
-        schedule,
-        |rhs| {
-            rhs.failure
-                .map(|tf| (tf, "the reduced mass matrix is not positive definite"))
-        },
-        |rhs, ts, ys| out.record(rhs, ts, ys),
-    );
+    let verdict = run_sampled(stepper.as_mut(), &mut rhs, &mut y, schedule, &mut out);
     let st = stepper.stats();
     Ok(RunResult {
         backend: data::BackendKind::Modal,
@@ -334,6 +324,13 @@ impl Output {
             sdn: vec![0.0; n],
             tau: vec![0.0; l.m.max(6)],
         }
+    }
+}
+
+impl SampledRun<MobileRhs> for Output {
+    fn failure(&self, rhs: &MobileRhs) -> Option<(f64, &'static str)> {
+        rhs.failure
+            .map(|tf| (tf, "the reduced mass matrix is not positive definite"))
     }
 
     fn record(&mut self, rhs: &mut MobileRhs, t: f64, y: &[f64]) {

@@ -14,7 +14,7 @@ use crate::error::ModalError;
 use crate::integrate::{Build, OdeRhs, TRAPEZOID, TRBDF2, Tolerances, method_for};
 use crate::linalg::dot;
 use crate::modes::generalized_eigen;
-use crate::sampled::{Schedule, run_sampled};
+use crate::sampled::{SampledRun, Schedule, run_sampled};
 
 /// Default (rtol, atol) of the adaptive methods: atol is in metres and radians (coordinates are
 /// unit-scaled assumed modes) and in joules for the work integrals.
@@ -110,22 +110,14 @@ pub fn simulate(
     breaks.push(t_end);
 
     let mut out = Output::new(&rhs);
-    let mut dy = vec![0.0; dim];
-    out.record(&mut rhs, 0.0, &y, &mut dy);
+    out.record(&mut rhs, 0.0, &y);
     let schedule = Schedule {
         breaks: &breaks,
         output_interval: scene.simulation.output_interval,
         t_end,
         remedy: REMEDY,
     };
-    let verdict = run_sampled(
-        stepper.as_mut(),
-        &mut rhs,
-        &mut y,
-        schedule,
-        |_| None,
-        |rhs, ts, ys| out.record(rhs, ts, ys, &mut dy),
-    );
+    let verdict = run_sampled(stepper.as_mut(), &mut rhs, &mut y, schedule, &mut out);
     let st = stepper.stats();
     Ok(RunResult {
         backend: data::BackendKind::Modal,
@@ -145,6 +137,8 @@ struct Output {
     ledger: EnergyLedger,
     values: Vec<f64>,
     stored: Vec<f64>,
+    /// The derivative the recording evaluates (it leaves the base state in `LinkRhs`).
+    dy: Vec<f64>,
     has_gravity: bool,
     has_spring: bool,
 }
@@ -184,13 +178,16 @@ impl Output {
             ledger: EnergyLedger::new(&stored, &[input], &diss),
             values: Vec::with_capacity(n_channels),
             stored: Vec::with_capacity(4),
+            dy: vec![0.0; rhs.dim()],
             has_gravity,
             has_spring,
         }
     }
+}
 
-    fn record(&mut self, rhs: &mut LinkRhs, t: f64, y: &[f64], dy: &mut [f64]) {
-        rhs.eval(t, y, dy);
+impl SampledRun<LinkRhs> for Output {
+    fn record(&mut self, rhs: &mut LinkRhs, t: f64, y: &[f64]) {
+        rhs.eval(t, y, &mut self.dy);
         let base = rhs.base_state(t, y);
         let torque = rhs.actuator_torque(t, y);
         let m = &rhs.model;

@@ -1,4 +1,16 @@
-//! Time integration of the reduced rocket, sampling of observables, ledger and balances.
+//! The run of the reduced rocket on the shared sampled driver ([`crate::sampled`]), and the
+//! observables, energy ledger and momentum balance sampled on it.
+//!
+//! The loads have one discontinuity, burn-out, the schedule's one breakpoint when it falls
+//! inside the run: the method lands on it exactly and restarts there, and the right-hand side
+//! is told the phase for each interval (burning up to burn-out, burnt out after it) rather than
+//! deciding by time, so the step that ends at burn-out sees the burning loads at its end point
+//! and the step that starts there sees none.
+//! The rocket's hooks ([`RocketRun`]) add to the driver: a `StepRejected` event for each
+//! accepted step that followed rejected attempts (at most [`MAX_REJECTION_EVENTS`]), a
+//! `StepSizeChange` event at burn-out whose `to` is the first step after the restart, a stop when
+//! an elastic displacement runs away ([`runaway`]), and a step failure diagnostic that names a
+//! lost positive definiteness of the reduced mass matrix.
 
 use std::time::Instant;
 
@@ -15,6 +27,7 @@ use super::config::{self, Method, TimeConfig};
 use super::dynamics::{Model, Phase, StationModes, Workspace, quad, rhs, snapshot};
 use super::error::RocketError;
 use crate::integrate::{Build, IntegrateError, OdeRhs, Stepper, Tolerances};
+use crate::sampled::{SampledRun, Schedule, run_sampled};
 
 /// The ODE right-hand side handed to the integrators.
 struct RocketRhs<'a> {
@@ -327,6 +340,178 @@ fn runaway(model: &Model, y: &[f64]) -> Option<(String, f64)> {
     None
 }
 
+/// The remedy of a run stopped by a non-finite state.
+const NON_FINITE_REMEDY: &str = "check the scene parameters; try time.method = \"tr-bdf2\"";
+
+/// The stop of a run whose elastic displacement ran away at `t` (see [`runaway`]).
+fn runaway_stop(model: &Model, t: f64, y: &[f64]) -> Option<StabilityVerdict> {
+    let (where_, value) = runaway(model, y)?;
+    Some(StabilityVerdict::Stopped {
+        diagnostic: Diagnostic {
+            t,
+            what: "elastic displacement grew without bound".into(),
+            location: Some(where_),
+            why: format!(
+                "value {value:.3e} exceeds {RUNAWAY_FRACTION} × body length: outside the \
+                 small-deflection model (physical instability or integration error)"
+            ),
+            remedy: "tighten time.rtol/time.atol or use time.method = \"tr-bdf2\"; check \
+                     stiffness and spring parameters"
+                .into(),
+        },
+    })
+}
+
+/// The stop of a run whose method could not take a step from `t`; `failed_pivot` is where the
+/// reduced mass matrix lost positive definiteness, if it did (the likely cause).
+fn step_failure(
+    t: f64,
+    error: &IntegrateError,
+    failed_pivot: Option<(f64, usize)>,
+) -> StabilityVerdict {
+    let (what, remedy) = match error {
+        IntegrateError::StepTooSmall { .. } => (
+            "step size underflow",
+            "loosen time.rtol/time.atol or use time.method = \"tr-bdf2\" for stiff cases (many \
+             modes)",
+        ),
+        _ => ("non-finite state", NON_FINITE_REMEDY),
+    };
+    let why = match failed_pivot {
+        Some((tp, p)) => format!(
+            "{error}; reduced mass matrix lost positive definiteness at t = {tp:.6e} (pivot {p})"
+        ),
+        None => error.to_string(),
+    };
+    StabilityVerdict::Stopped {
+        diagnostic: Diagnostic {
+            t,
+            what: what.into(),
+            location: None,
+            why,
+            remedy: remedy.into(),
+        },
+    }
+}
+
+/// Burn-out time, when it falls inside the run (before `t_end`).
+fn burnout_within(model: &Model, t_end: f64) -> Option<f64> {
+    model
+        .body
+        .burn
+        .as_ref()
+        .map(|b| b.burnout_time())
+        .filter(|tb| *tb < t_end)
+}
+
+/// The rocket's part in the sampled run: the samples, the events and the stops of its own.
+struct RocketRun<'a> {
+    model: &'a Model,
+    rec: Recorder<'a>,
+    /// The recorder's own workspace (its phase stays `ByTime`).
+    rec_ws: Workspace,
+    /// Burn-out time when it falls inside the run: `breaks[0]` of the schedule.
+    burnout: Option<f64>,
+    events: Vec<Event>,
+    /// Rejected attempts counted by the method up to the last accepted step.
+    rejected_seen: usize,
+    rejection_events: usize,
+    /// The burn-out event whose `to` waits for the first step after the restart.
+    pending_burnout: Option<usize>,
+}
+
+impl<'a> RocketRun<'a> {
+    fn new(model: &'a Model, rec: Recorder<'a>, burnout: Option<f64>) -> RocketRun<'a> {
+        RocketRun {
+            model,
+            rec,
+            rec_ws: Workspace::new(model.layout),
+            burnout,
+            // room for every event a run can list, so the list does not grow in the step loop
+            events: Vec::with_capacity(MAX_REJECTION_EVENTS + 1),
+            rejected_seen: 0,
+            rejection_events: 0,
+            pending_burnout: None,
+        }
+    }
+
+    /// The phase the right-hand side starts in: burning up to a burn-out inside the run, else
+    /// decided by time (the loads do not switch within the run).
+    fn initial_phase(&self) -> Phase {
+        match self.burnout {
+            Some(_) => Phase::Burning,
+            None => Phase::ByTime,
+        }
+    }
+
+    /// A `StepRejected` event when the last accepted step, which ended at `t`, followed
+    /// rejected attempts (while fewer than [`MAX_REJECTION_EVENTS`] are listed).
+    fn list_rejections(&mut self, stepper: &dyn Stepper, t: f64) {
+        let rejected = stepper.stats().rejected;
+        if rejected > self.rejected_seen && self.rejection_events < MAX_REJECTION_EVENTS {
+            self.rejection_events += 1;
+            self.events.push(Event::StepRejected {
+                t,
+                dt: stepper.last_step(),
+                reason: format!(
+                    "local error above tolerance: {} attempt(s) rejected before this accepted step",
+                    rejected - self.rejected_seen
+                ),
+            });
+        }
+        self.rejected_seen = rejected;
+    }
+
+    /// Fills the burn-out event's `to` with the first step after the restart.
+    fn complete_burnout_event(&mut self, stepper: &dyn Stepper) {
+        if let Some(idx) = self.pending_burnout.take()
+            && let Some(Event::StepSizeChange { to, .. }) = self.events.get_mut(idx)
+        {
+            *to = stepper.last_step();
+        }
+    }
+}
+
+impl<'m> SampledRun<RocketRhs<'m>> for RocketRun<'_> {
+    fn record(&mut self, _rhs: &mut RocketRhs<'m>, t: f64, y: &[f64]) {
+        self.rec.record(&mut self.rec_ws, t, y);
+    }
+
+    fn step_failed(
+        &self,
+        rhs: &RocketRhs<'m>,
+        t: f64,
+        error: &IntegrateError,
+    ) -> Option<StabilityVerdict> {
+        Some(step_failure(t, error, rhs.ws.failed_pivot))
+    }
+
+    fn after_step(&mut self, stepper: &dyn Stepper, t: f64, y: &[f64]) -> Option<StabilityVerdict> {
+        self.list_rejections(stepper, t);
+        self.complete_burnout_event(stepper);
+        runaway_stop(self.model, t, y)
+    }
+
+    /// At burn-out thrust, chamber pressure and internal flow end; the driver has restarted the
+    /// method there, and the event's `to` is filled in with the first step after the restart.
+    fn on_break(&mut self, rhs: &mut RocketRhs<'m>, stepper: &dyn Stepper, index: usize) {
+        let Some(tb) = self.burnout.filter(|_| index == 0) else {
+            return;
+        };
+        rhs.ws.phase = Phase::BurntOut;
+        self.events.push(Event::StepSizeChange {
+            t: tb,
+            from: stepper.last_step(),
+            to: stepper.last_step(),
+            reason: "burn-out: thrust, chamber pressure and internal flow end; integrator \
+                     restarted at the discontinuity"
+                .into(),
+        });
+        self.pending_burnout = Some(self.events.len() - 1);
+    }
+}
+
+/// A run of the rocket `r` of `scene`, with the accounts [`DetailedRun`] adds.
 pub fn simulate_detailed(
     scene: &data::Scene,
     r: &Rocket,
@@ -342,139 +527,29 @@ pub fn simulate_detailed(
     let dim = l.state_len();
 
     let mut y = initial_state(&model);
-
-    let mut f = RocketRhs {
-        model: &model,
-        ws: Workspace::new(l),
-    };
-    let mut rec_ws = Workspace::new(l);
-    let mut rec = Recorder::new(&model, &basis, scene);
     let tol = Tolerances {
         rtol: tc.rtol,
         atol: tc.atol,
     };
     let mut stepper = stepper(tc.method, dim, tol, tc.dt)?;
 
-    // Output grid and the one discontinuity of the loads (burn-out).
-    // the last sample is t_end itself, also when it is not a multiple of the interval
-    let samples = (tc.t_end / tc.output_interval - 1e-9).ceil().max(1.0) as usize;
-    let output_time = |k: usize| (k as f64 * tc.output_interval).min(tc.t_end);
-    let burnout = model
-        .body
-        .burn
-        .as_ref()
-        .map(|b| b.burnout_time())
-        .filter(|tb| *tb < tc.t_end);
-    let mut events = Vec::new();
-    let mut t = 0.0;
-    rec.record(&mut rec_ws, t, &y);
-    let mut next_out = 1;
-    let mut dense_buf = vec![0.0; dim];
-    let mut verdict = StabilityVerdict::Completed;
-    let mut rejected_seen = 0;
-    let mut rejection_events = 0;
-    let mut pending_burnout: Option<usize> = None;
+    let burnout = burnout_within(&model, tc.t_end);
+    let breaks: Vec<f64> = burnout.into_iter().chain([tc.t_end]).collect();
+    let mut run = RocketRun::new(&model, Recorder::new(&model, &basis, scene), burnout);
+    let mut f = RocketRhs {
+        model: &model,
+        ws: Workspace::new(l),
+    };
+    f.ws.phase = run.initial_phase();
+    run.record(&mut f, 0.0, &y);
+    let schedule = Schedule {
+        breaks: &breaks,
+        output_interval: tc.output_interval,
+        t_end: tc.t_end,
+        remedy: NON_FINITE_REMEDY,
+    };
+    let verdict = run_sampled(stepper.as_mut(), &mut f, &mut y, schedule, &mut run);
 
-    'outer: while t < tc.t_end {
-        let t_stop = match burnout {
-            Some(tb) if t < tb => {
-                f.ws.phase = Phase::Burning;
-                tb
-            }
-            Some(_) => {
-                f.ws.phase = Phase::BurntOut;
-                tc.t_end
-            }
-            None => tc.t_end,
-        };
-        if let Err(e) = stepper.step(&mut f, &mut t, &mut y, t_stop) {
-            let (what, why, remedy) = match e {
-                IntegrateError::StepTooSmall { .. } => (
-                    "step size underflow".to_string(),
-                    e.to_string(),
-                    "loosen time.rtol/time.atol or use time.method = \"tr-bdf2\" for stiff \
-                     cases (many modes)"
-                        .to_string(),
-                ),
-                _ => (
-                    "non-finite state".to_string(),
-                    e.to_string(),
-                    "check the scene parameters; try time.method = \"tr-bdf2\"".to_string(),
-                ),
-            };
-            let why = match f.ws.failed_pivot {
-                Some((tp, p)) => format!(
-                    "{why}; reduced mass matrix lost positive definiteness at t = {tp:.6e} (pivot {p})"
-                ),
-                None => why,
-            };
-            verdict = StabilityVerdict::Stopped {
-                diagnostic: Diagnostic {
-                    t,
-                    what,
-                    location: None,
-                    why,
-                    remedy,
-                },
-            };
-            break;
-        }
-        let st = stepper.stats();
-        if st.rejected > rejected_seen && rejection_events < MAX_REJECTION_EVENTS {
-            rejection_events += 1;
-            events.push(Event::StepRejected {
-                t,
-                dt: stepper.last_step(),
-                reason: format!(
-                    "local error above tolerance: {} attempt(s) rejected before this accepted step",
-                    st.rejected - rejected_seen
-                ),
-            });
-        }
-        rejected_seen = st.rejected;
-        if let Some(idx) = pending_burnout.take()
-            && let Some(Event::StepSizeChange { to, .. }) = events.get_mut(idx)
-        {
-            *to = stepper.last_step();
-        }
-        while next_out <= samples && output_time(next_out) <= t * (1.0 + 1e-14) {
-            let to = output_time(next_out);
-            stepper.dense(to, &mut dense_buf);
-            rec.record(&mut rec_ws, to, &dense_buf);
-            next_out += 1;
-        }
-        if let Some((where_, value)) = runaway(&model, &y) {
-            verdict = StabilityVerdict::Stopped {
-                diagnostic: Diagnostic {
-                    t,
-                    what: "elastic displacement grew without bound".into(),
-                    location: Some(where_),
-                    why: format!(
-                        "value {value:.3e} exceeds {RUNAWAY_FRACTION} × body length: outside the \
-                         small-deflection model (physical instability or integration error)"
-                    ),
-                    remedy: "tighten time.rtol/time.atol or use time.method = \"tr-bdf2\"; check \
-                             stiffness and spring parameters"
-                        .into(),
-                },
-            };
-            break 'outer;
-        }
-        if burnout.is_some_and(|tb| t == tb) {
-            // Thrust, chamber pressure and internal flow end: restart the integrator's history.
-            // The event's `to` is filled in with the first step after the restart.
-            stepper.reset();
-            events.push(Event::StepSizeChange {
-                t,
-                from: stepper.last_step(),
-                to: stepper.last_step(),
-                reason: "burn-out: thrust, chamber pressure and internal flow end; integrator \
-                         restarted at the discontinuity"
-                    .into(),
-            });
-            pending_burnout = Some(events.len() - 1);
-        }
-    }
     let st = stepper.stats();
     let cost = st.cost(l.dofs(), wall);
     let hz = |w: &Vec<f64>| w.iter().map(|w| w / (2.0 * std::f64::consts::PI)).collect();
@@ -483,13 +558,13 @@ pub fn simulate_detailed(
             backend: BackendKind::Modal,
             scene: scene.name.clone(),
             settings: data::Settings::from(settings),
-            observables: rec.obs,
-            ledger: rec.ledger,
-            events,
+            observables: run.rec.obs,
+            ledger: run.rec.ledger,
+            events: run.events,
             cost,
             verdict,
         },
-        balance: rec.balance,
+        balance: run.rec.balance,
         initial_shape_residual: model.initial_shape_residual,
         basis_frequencies_hz: (hz(&model.omega_axial), hz(&model.omega_bending)),
     })
