@@ -10,7 +10,7 @@
 use fem::band::BorderedBand;
 use fem::method::central_difference;
 use fem::method::{
-    Adaptive, Counters, NewtonSystem, StepContext, StepState, Stepper, Works, start, stepper,
+    Adaptive, Counters, NewtonSystem, StepContext, StepState, Stepper, Trial, Works, start, stepper,
 };
 use fem::settings::Method;
 use fem::system::{NewtonCoefficients, NoAugmentation, Parts, System};
@@ -282,8 +282,12 @@ fn errors_and_ledger(
     let (mut err, mut q_max) = (0.0f64, 0.0f64);
     for k in 0..steps {
         let t1 = (k + 1) as f64 * h;
-        let estimate = method.step(cx, None, h, t1, t1).expect("a fixed step");
-        assert_eq!(estimate, None, "{kind:?}: Newton converged at step {k}");
+        let trial = method.step(cx, None, h, t1, t1).expect("a fixed step");
+        assert_eq!(
+            trial,
+            Trial::Converged { error: None },
+            "{kind:?}: Newton converged at step {k}"
+        );
         let booked = method.commit(h, &mut works);
         cx.state.swap_in(t1);
         let w = works.applied_load - works.joint_damper;
@@ -319,6 +323,68 @@ fn sys_every_method_steps_a_system_that_is_not_a_chain_at_second_order() {
                 (1.8..=2.2).contains(&order),
                 "{method:?} ρ∞ = {rho}: observed order {order:.3} (errors {errors:?})"
             );
+        }
+    }
+}
+
+#[test]
+fn sys_every_methods_dense_output_is_no_less_accurate_than_its_step() {
+    // One step of length h from (Q0, V0) on the damped, forced oscillator. The continuous
+    // extension meets the step's ends exactly, and inside the step its distance to the exact
+    // solution is of the order of the step's own local error: the interpolant (third order) adds
+    // less than the method (second order) makes, so both fall as h³ under halving.
+    let mut sys = Oscillator::new((0.2, 2e-3));
+    for (method, rho) in [
+        (Method::ImplicitMidpoint, 1.0),
+        (Method::GeneralizedAlpha, 0.8),
+        (Method::EnergyMidpoint, 1.0),
+        (Method::CentralDifference, 1.0),
+        (Method::Bathe, 1.0),
+    ] {
+        let mut previous: Option<(f64, f64)> = None;
+        for h in [4e-3, 2e-3, 1e-3] {
+            let (end_error, inner_error) =
+                with_context(&mut sys, method, rho, h, (Q0, V0), None, |cx, stepper| {
+                    let trial = stepper.step(cx, None, h, h, h).expect("a step");
+                    assert_eq!(trial, Trial::Converged { error: None }, "{method:?}");
+                    let (mut q, mut qd) = ([0.0; 2], [0.0; 2]);
+                    for (theta, q_end, qd_end) in [
+                        (0.0, &cx.state.q, &cx.state.qd),
+                        (1.0, &cx.state.q1, &cx.state.qd1),
+                    ] {
+                        stepper.dense(cx.state, h, theta, &mut q, &mut qd);
+                        for i in 0..2 {
+                            assert!((q[i] - q_end[i]).abs() <= 1e-15 * q_end[i].abs().max(1e-2));
+                            assert!((qd[i] - qd_end[i]).abs() <= 1e-12 * qd_end[i].abs().max(1e-1));
+                        }
+                    }
+                    let exact_end = cx.system.exact(&Q0, &V0, h);
+                    let end_error = (0..2)
+                        .map(|i| (cx.state.q1[i] - exact_end[i]).abs())
+                        .fold(0.0, f64::max);
+                    let mut inner_error = 0.0f64;
+                    for theta in [0.25, 0.5, 0.75] {
+                        stepper.dense(cx.state, h, theta, &mut q, &mut qd);
+                        let exact = cx.system.exact(&Q0, &V0, theta * h);
+                        for i in 0..2 {
+                            inner_error = inner_error.max((q[i] - exact[i]).abs());
+                        }
+                    }
+                    (end_error, inner_error)
+                });
+            assert!(
+                inner_error <= 2.0 * end_error,
+                "{method:?}, h = {h}: inside {inner_error:.3e}, at the end {end_error:.3e}"
+            );
+            if let Some((end_before, inner_before)) = previous {
+                let order = (inner_before / inner_error).log2();
+                assert!(
+                    order >= 2.7,
+                    "{method:?}, h = {h}: inner error order {order:.2} \
+                     ({inner_before:.3e} → {inner_error:.3e}; end {end_before:.3e} → {end_error:.3e})"
+                );
+            }
+            previous = Some((end_error, inner_error));
         }
     }
 }
@@ -402,7 +468,8 @@ fn sys_bathe_steps_its_amplification_map_which_damps_only_the_unresolved() {
             start,
             None,
             |cx, method| {
-                method.step(cx, None, h, h, h).expect("a step");
+                let trial = method.step(cx, None, h, h, h).expect("a step");
+                assert!(matches!(trial, Trial::Converged { .. }), "{trial:?}");
                 (cx.state.q1.clone(), cx.state.qd1.clone())
             },
         );
@@ -467,8 +534,11 @@ fn sys_bathe_error_estimate_is_its_local_error() {
             ([0.0; 2], [0.0; 2]),
             Some(tol),
             |cx, method| {
-                let e = method.step(cx, None, h, h, h).expect("a step");
-                (e.expect("adaptive: an estimate"), cx.state.q1[0])
+                let trial = method.step(cx, None, h, h, h).expect("a step");
+                let Trial::Converged { error: Some(e) } = trial else {
+                    panic!("adaptive: an estimate, got {trial:?}");
+                };
+                (e, cx.state.q1[0])
             },
         );
         let exact = f0 * (h / big_omega - (big_omega * h).sin() / (big_omega * big_omega));
@@ -513,7 +583,8 @@ fn sys_central_difference_keeps_the_undamped_bound_under_damping() {
                 let mut late = 0.0f64;
                 for k in 0..steps {
                     let t1 = (k + 1) as f64 * h;
-                    method.step(cx, None, h, t1, t1).expect("a step");
+                    let trial = method.step(cx, None, h, t1, t1).expect("a step");
+                    assert!(matches!(trial, Trial::Converged { .. }), "{trial:?}");
                     cx.state.swap_in(t1);
                     if k >= 3 * steps / 4 {
                         late = late.max(max_abs(&cx.state.q));

@@ -1,5 +1,6 @@
 //! Unilateral contact events in the driver: the gap and the normal force located inside the
-//! step (Illinois secant on the step length, each value a re-solved shortened step), and the
+//! step (Illinois secant on the step length, each value a re-solved shortened step, an impact's
+//! first point the gap's root on the method's continuous extension of the step), and the
 //! resets applied at the located state (impact map, release, drift projection) by the contact
 //! object [`crate::events::contact::Contact`] (its module docs state the rules).
 
@@ -10,6 +11,7 @@ use crate::error::FemError;
 use crate::events::contact::{
     Contact, FORCE_TOL, GRAZING_FORCE_LIMIT, GRAZING_LOCATION, MAX_EVENTS, REFINE_MIN, TIME_TOL,
 };
+use crate::method::Trial;
 
 /// Secant iterations at most per located event.
 const MAX_SECANT: usize = 80;
@@ -81,7 +83,7 @@ impl Driver {
     fn trial(&mut self, watch: Watch, h: f64) -> Result<f64, FemError> {
         let t1 = self.state.t + h;
         match self.solve(h, t1, t1)? {
-            Some(e) if e.is_infinite() => Err(FemError::Runaway {
+            Trial::NewtonFailed => Err(FemError::Runaway {
                 t: self.state.t,
                 what: format!("Newton failed on a shortened step (h = {h:.3e}) locating an event"),
                 location: Some("contact1".into()),
@@ -92,13 +94,45 @@ impl Driver {
         }
     }
 
+    /// The gap at t₀ + `theta`·h on the method's continuous extension of the trial step of
+    /// length h just solved ([`crate::method::Stepper::dense`]): no step is re-solved.
+    fn dense_gap(&mut self, h: f64, theta: f64) -> f64 {
+        let (q, qd) = (&mut self.dense.0, &mut self.dense.1);
+        self.stepper.dense(&self.state, h, theta, q, qd);
+        let c = self.contact.as_deref().expect("contact run");
+        c.gap_at(&self.chain, self.state.t + theta * h, q)
+    }
+
+    /// Where the gap's root lies on the continuous extension of the trial step of length h just
+    /// solved (gap g0 > 0 at its start a, g1 < 0 at its end h), to the gap tolerance: the first
+    /// point of the impact's location on re-solved steps, which then needs fewer of them. The
+    /// gap is kinematic, and the extension's error is of the order of the step's own (third
+    /// order against the methods' second), so the re-solved gap at the seed lies within about
+    /// the step's local error of zero. The normal force has no such seed: the force at the end
+    /// of a re-solved shorter step is not the force on the extension (the constrained
+    /// trajectory's stiff components respond to the step length), so a release is located on
+    /// re-solved steps from the secant.
+    fn dense_seed(
+        &mut self,
+        (a, g0): (f64, f64),
+        (h, g1): (f64, f64),
+        tol: f64,
+    ) -> Result<f64, FemError> {
+        let located = self.illinois_on_step((a, g0), (h, g1), tol, true, false, None, |s, c| {
+            Ok(s.dense_gap(h, c / h))
+        })?;
+        Ok(located.h)
+    }
+
     /// Illinois secant on the step length for the root of an event function F(h), each value a
     /// re-solved shortened step (`trial`): F(a) = fa > 0, F(b) = fb ≤ 0, F decreasing through
     /// the root. Stops at a trial with −tol ≤ F ≤ 0 (or 0 < F ≤ tol when `accept_positive`),
     /// which is left solved (`Located::exact`), or when the bracket is narrower than
     /// [`TIME_TOL`]·max(t, 1); `b_solved` says whether the last trial solved is b (true on
-    /// entry if F(b) was the last evaluation). A trial whose Newton iteration fails is replaced
-    /// by other points of the bracket (its midpoint, then its quarter points).
+    /// entry if F(b) was the last evaluation); `first`, when given, replaces the first secant
+    /// point (a root estimated without re-solving: [`Driver::dense_seed`]). A trial whose
+    /// Newton iteration fails is replaced by other points of the bracket (its midpoint, then
+    /// its quarter points).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn illinois_on_step(
         &mut self,
@@ -107,6 +141,7 @@ impl Driver {
         tol: f64,
         accept_positive: bool,
         mut b_solved: bool,
+        mut first: Option<f64>,
         mut trial: impl FnMut(&mut Self, f64) -> Result<f64, FemError>,
     ) -> Result<Located, FemError> {
         let mut side = 0i32;
@@ -115,7 +150,7 @@ impl Driver {
                 break;
             }
             let margin = 1e-6 * (b - a);
-            let mut c = b - fb * (b - a) / (fb - fa);
+            let mut c = first.take().unwrap_or(b - fb * (b - a) / (fb - fa));
             if !c.is_finite() {
                 c = 0.5 * (a + b);
             }
@@ -174,8 +209,10 @@ impl Driver {
 
     /// Locates the root of a unilateral event function (gap or normal force) inside the step
     /// [a0, h] (F(a0) = f0 > 0, F(h) = f1 ≤ 0): to |F| ≤ tol (either side for the gap, the
-    /// non-positive side for the force) or a bracket narrower than [`TIME_TOL`]. Leaves the
-    /// accepted trial solved in q₁, q̇₁ and returns (h*, bracket width).
+    /// non-positive side for the force) or a bracket narrower than [`TIME_TOL`]. The gap's
+    /// search starts at its root on the method's continuous extension ([`Driver::dense_seed`]),
+    /// the force's at the secant. Leaves the accepted trial solved in q₁, q̇₁ and returns
+    /// (h*, bracket width).
     fn locate(
         &mut self,
         watch: Watch,
@@ -185,10 +222,15 @@ impl Driver {
         f1: f64,
         tol: f64,
     ) -> Result<(f64, f64), FemError> {
-        let loc =
-            self.illinois_on_step((a0, f0), (h, f1), tol, watch == Watch::Gap, true, |s, c| {
-                s.trial(watch, c)
-            })?;
+        let gap = watch == Watch::Gap;
+        let seed = if gap {
+            Some(self.dense_seed((a0, f0), (h, f1), tol)?)
+        } else {
+            None
+        };
+        let loc = self.illinois_on_step((a0, f0), (h, f1), tol, gap, true, seed, |s, c| {
+            s.trial(watch, c)
+        })?;
         let (width, mut b) = (loc.width, loc.h);
         if loc.exact {
             return Ok((b, width));
@@ -274,17 +316,14 @@ impl Driver {
             self.contact = Some(c);
             res?;
             self.stepper.restart();
-            match self.solve(h, t1, t1)? {
-                Some(e) if e.is_infinite() => {
-                    return Err(FemError::Runaway {
-                        t: t0,
-                        what: "Newton failed on the constrained step of a grazing contact".into(),
-                        location: Some("contact1".into()),
-                        why: "the constrained step did not converge".into(),
-                        remedy: "reduce --dt".into(),
-                    });
-                }
-                _ => {}
+            if self.solve(h, t1, t1)? == Trial::NewtonFailed {
+                return Err(FemError::Runaway {
+                    t: t0,
+                    what: "Newton failed on the constrained step of a grazing contact".into(),
+                    location: Some("contact1".into()),
+                    why: "the constrained step did not converge".into(),
+                    remedy: "reduce --dt".into(),
+                });
             }
         }
         // Constrained: the normal force at the step end decides.

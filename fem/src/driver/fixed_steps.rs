@@ -5,7 +5,7 @@
 //! ([`QuarterRetries`]). Each model's driver says where its laws jump and books its own works.
 
 use crate::error::FemError;
-use crate::method::{Counters, NewtonSystem, StepContext, StepState, Stepper, start};
+use crate::method::{Counters, NewtonSystem, StepContext, StepState, Stepper, Trial, start};
 use crate::settings::Method;
 use crate::system::{NoAugmentation, System};
 
@@ -111,9 +111,7 @@ pub trait QuarterRetries {
         let on_jump = self.ends_on_jump(h, t1);
         let t_law = if on_jump { t1 - 1e-9 * h } else { t1 };
         let (stepper, mut cx) = self.steps().parts();
-        if let Some(e) = stepper.step(&mut cx, None, h, t1, t_law)?
-            && e.is_infinite()
-        {
+        if stepper.step(&mut cx, None, h, t1, t_law)? == Trial::NewtonFailed {
             return Ok(false);
         }
         self.book(h);

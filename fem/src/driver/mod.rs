@@ -12,7 +12,10 @@
 //! * Events: a contact ([`crate::events::contact::Contact`]) is handed to the method as a
 //!   [`crate::method::StepConstraint`] while it is held; after each converged trial the
 //!   driver watches its event functions and locates their roots inside the step by
-//!   re-solving it shorter ([`contact_events`]: impact, release, grazing; [`stick_slip`]:
+//!   re-solving it shorter, so the event state satisfies the method's equations (an
+//!   impact's search starts at the gap's root on the method's dense output,
+//!   [`Stepper::dense`](crate::method::Stepper::dense)) ([`contact_events`]: impact, release,
+//!   grazing; [`stick_slip`]:
 //!   slip stop and breakaway), then applies the reset at the accepted state. Contact runs
 //!   with massless section rotations end every step on their balance
 //!   ([`crate::events::massless`]).

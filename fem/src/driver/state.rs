@@ -8,8 +8,8 @@ use crate::chain::{AugmentedLayout, Chain, NONE};
 use crate::error::FemError;
 use crate::events::contact::Contact;
 use crate::method::{
-    Adaptive, Counters, NewtonSystem, StepContext, StepState, Stepper, Works, central_difference,
-    start,
+    Adaptive, Counters, NewtonSystem, StepContext, StepState, Stepper, Trial, Works,
+    central_difference, start,
 };
 use crate::settings::Method;
 
@@ -76,6 +76,10 @@ pub struct Driver {
     pub contact: Option<Box<Contact>>,
     /// Why the last rejected step was rejected.
     pub last_rejection: Rejection,
+    /// Positions and rates on the method's continuous extension of a trial step, where the
+    /// unilateral contact's events are first located ([`super::contact_events`]); empty
+    /// without that contact.
+    pub(super) dense: (Vec<f64>, Vec<f64>),
 }
 
 impl Driver {
@@ -120,6 +124,7 @@ impl Driver {
             length_scale,
             contact: None,
             last_rejection: Rejection::Newton,
+            dense: (Vec::new(), Vec::new()),
         };
         let st = &mut it.state;
         it.chain.initial_state(&mut st.q, &mut st.qd);
@@ -138,6 +143,8 @@ impl Driver {
     /// the step loop).
     pub fn enable_unilateral_contact(&mut self) -> Result<(), FemError> {
         self.newton.unilateral_contact = true;
+        let n = self.state.q.len();
+        self.dense = (vec![0.0; n], vec![0.0; n]);
         if !crate::method::capabilities(self.method).projects_massless {
             return Ok(());
         }
@@ -189,8 +196,8 @@ impl Driver {
 
     /// Solves the step of length h from the current state with the method (the contact, when
     /// held, as its constraint); a converged step of a contact run with massless sections ends
-    /// on their balance. Returns the method's error estimate (`Some(∞)`: Newton failed).
-    pub(crate) fn solve(&mut self, h: f64, t1: f64, t_law: f64) -> Result<Option<f64>, FemError> {
+    /// on their balance.
+    pub(crate) fn solve(&mut self, h: f64, t1: f64, t_law: f64) -> Result<Trial, FemError> {
         let mut contact = self.contact.take();
         let held = contact
             .as_deref_mut()
@@ -199,18 +206,18 @@ impl Driver {
         let (stepper, mut cx) = self.method_parts();
         let result = stepper.step(&mut cx, held, h, t1, t_law);
         self.contact = contact;
-        match result {
-            Ok(Some(e)) if e.is_infinite() => Ok(Some(e)),
-            Ok(None) => {
+        match result? {
+            Trial::NewtonFailed => Ok(Trial::NewtonFailed),
+            Trial::Converged { error: None } => {
                 self.pending_massless = 0.0;
                 // A converged fixed step (contact runs are fixed-step: run.rs refuses `rtol`).
-                self.end_on_massless_balance(h, t1).map(|()| None)
+                self.end_on_massless_balance(h, t1)?;
+                Ok(Trial::Converged { error: None })
             }
-            Ok(err) => {
+            converged => {
                 self.pending_massless = 0.0;
-                Ok(err)
+                Ok(converged)
             }
-            Err(e) => Err(e),
         }
     }
 

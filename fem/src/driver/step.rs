@@ -8,6 +8,7 @@ use super::contact_events::Post;
 use super::state::{Driver, Rejection, StopReason};
 use crate::error::FemError;
 use crate::events::contact::GRAZING_LOCATION;
+use crate::method::Trial;
 
 impl Driver {
     /// Rejects a fixed step of length `h`: the stretch is retried with a quarter step (grown
@@ -21,6 +22,25 @@ impl Driver {
             self.stepper.restart();
         }
         StopReason::Rejected
+    }
+
+    /// Rejects an adaptive step of length `h` whose scaled error estimate is `err` (∞ for a
+    /// Newton failure): the next trial is shorter by the step-control ratio (at least 0.2).
+    fn retry_shorter(&mut self, h: f64, why: Rejection, err: f64) -> Result<StopReason, FemError> {
+        self.counters.rejected += 1;
+        self.last_rejection = why;
+        let ratio = (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 1.0);
+        self.h = h * ratio;
+        if self.h < 1e-14 * self.stop.abs().max(1.0) {
+            return Err(FemError::Runaway {
+                t: self.state.t,
+                what: "step size underflow".into(),
+                location: None,
+                why: "the error estimate could not be met".into(),
+                remedy: "loosen --rtol or refine the mesh less".into(),
+            });
+        }
+        Ok(StopReason::Rejected)
     }
 
     /// Advances by one step (or rejects one); never steps over the stop time or a breakpoint.
@@ -66,80 +86,67 @@ impl Driver {
         let t1 = self.state.t + h;
         // Laws are evaluated as left limits on a step that ends on a discontinuity.
         let t_law = if on_break { t1 - 1e-9 * h } else { t1 };
-        let result = self.solve(h, t1, t_law);
-        match result {
-            Ok(Some(err)) if self.adaptive.is_none() && err.is_infinite() => {
+        let error = match self.solve(h, t1, t_law)? {
+            Trial::NewtonFailed if self.adaptive.is_none() => {
                 // Fixed step: Newton failed; retry this stretch with quarter steps, then grow back.
                 return Ok(self.retry_quarter_step(h, Rejection::Newton, false));
             }
-            Ok(Some(err)) if self.adaptive.is_some() && err > 1.0 => {
-                self.counters.rejected += 1;
-                self.last_rejection = Rejection::ErrorEstimate;
-                let ratio = (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 1.0);
-                self.h = h * ratio;
-                if self.h < 1e-14 * self.stop.abs().max(1.0) {
-                    return Err(FemError::Runaway {
-                        t: self.state.t,
-                        what: "step size underflow".into(),
-                        location: None,
-                        why: "the error estimate could not be met".into(),
-                        remedy: "loosen --rtol or refine the mesh less".into(),
-                    });
-                }
-                return Ok(StopReason::Rejected);
+            Trial::NewtonFailed => {
+                return self.retry_shorter(h, Rejection::Newton, f64::INFINITY);
             }
-            Ok(err) => {
-                // Contact events are located inside the step: it may be shortened to h_acc.
-                let (h_acc, post) = if self.contact.is_some() {
-                    match self.events_after_trial(h) {
-                        Ok(x) => x,
-                        // A shortened or constrained re-solve did not converge: retry the
-                        // stretch with a quarter step from the (possibly post-impact) start.
-                        Err(FemError::Runaway { ref location, .. })
-                            if h > 1e-6 * self.h_nominal
-                                && location.as_deref() != Some(GRAZING_LOCATION) =>
-                        {
-                            return Ok(self.retry_quarter_step(h, Rejection::Newton, true));
-                        }
-                        Err(e) => return Err(e),
-                    }
-                } else {
-                    (h, Post::None)
-                };
-                if post == Post::Refine {
-                    // The contact phase over this step is undetermined at this length
-                    // (crate::events::contact, grazing): retry the stretch with a quarter step.
-                    return Ok(self.retry_quarter_step(h, Rejection::ContactRefine, true));
-                }
-                let (h, t1, t_law) = if h_acc < h {
-                    on_break = false;
-                    (h_acc, self.state.t + h_acc, self.state.t + h_acc)
-                } else {
-                    (h, t1, t_law)
-                };
-                self.accept(h, t1, t_law);
-                if self.contact.is_some() {
-                    self.events_after_accept(post)?;
-                }
-                if self.adaptive.is_none() {
-                    self.h = (2.0 * self.h).min(self.h_nominal);
-                }
-                if let (Some(e), Some(_)) = (err, self.adaptive) {
-                    let ratio = (0.9 * e.max(1e-10).powf(-1.0 / 3.0)).clamp(0.2, 2.0);
-                    // Do not let a short step that landed on a stop time shrink the next one.
-                    if h >= 0.5 * self.h {
-                        self.h = h * ratio;
-                    } else {
-                        self.h = self.h.max(h * ratio);
-                    }
-                }
-                if on_break {
-                    // Restart from the discontinuity with the new law value.
-                    self.initial_acceleration(self.state.t)?;
-                    self.stepper.restart();
-                }
+            Trial::Converged { error: Some(err) } if self.adaptive.is_some() && err > 1.0 => {
+                return self.retry_shorter(h, Rejection::ErrorEstimate, err);
             }
-            Err(e) => return Err(e),
+            Trial::Converged { error } => error,
+        };
+        // Contact events are located inside the step: it may be shortened to h_acc.
+        let (h_acc, post) = if self.contact.is_some() {
+            match self.events_after_trial(h) {
+                Ok(x) => x,
+                // A shortened or constrained re-solve did not converge: retry the
+                // stretch with a quarter step from the (possibly post-impact) start.
+                Err(FemError::Runaway { ref location, .. })
+                    if h > 1e-6 * self.h_nominal
+                        && location.as_deref() != Some(GRAZING_LOCATION) =>
+                {
+                    return Ok(self.retry_quarter_step(h, Rejection::Newton, true));
+                }
+                Err(e) => return Err(e),
+            }
+        } else {
+            (h, Post::None)
+        };
+        if post == Post::Refine {
+            // The contact phase over this step is undetermined at this length
+            // (crate::events::contact, grazing): retry the stretch with a quarter step.
+            return Ok(self.retry_quarter_step(h, Rejection::ContactRefine, true));
+        }
+        let (h_taken, t_taken, law_taken) = if h_acc < h {
+            on_break = false;
+            (h_acc, self.state.t + h_acc, self.state.t + h_acc)
+        } else {
+            (h, t1, t_law)
+        };
+        self.accept(h_taken, t_taken, law_taken);
+        if self.contact.is_some() {
+            self.events_after_accept(post)?;
+        }
+        if self.adaptive.is_none() {
+            self.h = (2.0 * self.h).min(self.h_nominal);
+        }
+        if let (Some(e), Some(_)) = (error, self.adaptive) {
+            let ratio = (0.9 * e.max(1e-10).powf(-1.0 / 3.0)).clamp(0.2, 2.0);
+            // Do not let a short step that landed on a stop time shrink the next one.
+            if h_taken >= 0.5 * self.h {
+                self.h = h_taken * ratio;
+            } else {
+                self.h = self.h.max(h_taken * ratio);
+            }
+        }
+        if on_break {
+            // Restart from the discontinuity with the new law value.
+            self.initial_acceleration(self.state.t)?;
+            self.stepper.restart();
         }
         self.check_state()?;
         if (self.stop - self.state.t).abs() <= 1e-9 * h {

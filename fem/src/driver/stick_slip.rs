@@ -13,6 +13,7 @@ use crate::events::contact::friction::{
 use crate::events::contact::{Contact, MAX_EVENTS};
 use crate::events::wall::row_along;
 use crate::linalg::dot;
+use crate::method::Trial;
 
 impl Driver {
     fn with_bilateral<R>(
@@ -157,9 +158,7 @@ impl Driver {
     /// Re-solves the current step of length h (phase as set); a Newton failure is an error.
     fn bilateral_solve(&mut self, h: f64) -> Result<(), FemError> {
         let t1 = self.state.t + h;
-        if let Some(e) = self.solve(h, t1, t1)?
-            && e.is_infinite()
-        {
+        if self.solve(h, t1, t1)? == Trial::NewtonFailed {
             return Err(FemError::Runaway {
                 t: self.state.t,
                 what: format!("Newton failed on a friction-contact step (h = {h:.3e})"),
@@ -187,7 +186,7 @@ impl Driver {
         }
         b.phase.sigma = -b.phase.sigma;
         let t1 = self.state.t + h;
-        let failed = matches!(self.solve(h, t1, t1)?, Some(e) if e.is_infinite());
+        let failed = self.solve(h, t1, t1)? == Trial::NewtonFailed;
         let c = self.contact.as_deref_mut().expect("contact");
         let lam2 = c.constraint.step_lambda;
         let sigma = c.bilateral.as_deref().map_or(1.0, |b| b.phase.sigma);
@@ -258,9 +257,10 @@ impl Driver {
         if f_min <= 0.0 {
             return Ok(None);
         }
-        let loc = self.illinois_on_step((h_min, f_min), (h, f1), tol, false, false, |s, c| {
-            s.switch_trial(kind, c)
-        })?;
+        let loc =
+            self.illinois_on_step((h_min, f_min), (h, f1), tol, false, false, None, |s, c| {
+                s.switch_trial(kind, c)
+            })?;
         if !loc.solved {
             self.switch_trial(kind, loc.h)?;
         }

@@ -72,6 +72,7 @@ use crate::error::FemError;
 use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
+    Trial,
     Capabilities, HeldConstraint, MethodParams, StepConstraint, StepContext,
     StepState, Stepper, Works, unconverged, update_tolerance,
 };
@@ -462,7 +463,7 @@ impl<S: System + ?Sized> Stepper<S> for Bathe {
         h: f64,
         t1: f64,
         t_law: f64,
-    ) -> Result<Option<f64>, FemError> {
+    ) -> Result<Trial, FemError> {
         self.restart.apply(
             cx,
             constraint.as_deref_mut(),
@@ -509,14 +510,16 @@ impl<S: System + ?Sized> Stepper<S> for Bathe {
         }
         let st = &mut *cx.state;
         st.a1.copy_from_slice(&st.qdd1);
-        Ok(cx.adaptive.map(|ad| {
+        Ok(Trial::Converged {
+            error: cx.adaptive.map(|ad| {
             let mut err = 0.0f64;
             for i in 0..st.q.len() {
                 let e = h * h / 24.0 * (st.qdd1[i] - st.qdd[i]);
                 err = err.max(e.abs() / (ad.atol + ad.rtol * st.q1[i].abs()));
             }
             err
-        }))
+            }),
+        })
     }
 
     fn restart(&mut self) {

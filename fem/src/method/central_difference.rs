@@ -66,6 +66,7 @@ use crate::error::FemError;
 use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs, solve2};
 use crate::method::{
+    Trial,
     Capabilities, MethodParams, ProjectionRows, StepConstraint, StepContext, StepState, Stepper,
     Works,
 };
@@ -148,7 +149,7 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
         h: f64,
         t1: f64,
         t_law: f64,
-    ) -> Result<Option<f64>, FemError> {
+    ) -> Result<Trial, FemError> {
         // After an event (an impact's velocity jump, a release) q̈ₙ is recomputed for the new
         // phase, with the event's normal force while the constraint is held (module docs).
         if self.restart.apply(
@@ -326,7 +327,7 @@ impl<S: System + ?Sized> Stepper<S> for CentralDifference {
             st.qd1[i] = st.qd[i] + 0.5 * h * (a0[i] + st.qdd1[i]);
             st.a1[i] = st.qdd1[i];
         }
-        Ok(None)
+        Ok(Trial::Converged { error: None })
     }
 
     fn equal_steps(&self) -> bool {

@@ -46,6 +46,7 @@ use crate::error::FemError;
 use crate::method::start::EventRestart;
 use crate::linalg::{dot, max_abs};
 use crate::method::{
+    Trial,
     Capabilities, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, Works,
     unconverged, update_tolerance,
 };
@@ -133,7 +134,7 @@ impl<S: System + ?Sized> Stepper<S> for GeneralizedAlpha {
         h: f64,
         t1: f64,
         t_law: f64,
-    ) -> Result<Option<f64>, FemError> {
+    ) -> Result<Trial, FemError> {
         self.restart.apply(
             cx,
             constraint.as_deref_mut(),
@@ -277,14 +278,16 @@ impl<S: System + ?Sized> Stepper<S> for GeneralizedAlpha {
         if !converged {
             return unconverged(cx.adaptive.is_some(), cx.h_nominal, st.t, h, last, "");
         }
-        Ok(cx.adaptive.map(|ad| {
+        Ok(Trial::Converged {
+            error: cx.adaptive.map(|ad| {
             let mut err = 0.0f64;
             for i in 0..n {
                 let e = h * h * (beta - 1.0 / 6.0) * (st.qdd1[i] - st.qdd[i]);
                 err = err.max(e.abs() / (ad.atol + ad.rtol * st.q1[i].abs()));
             }
             err
-        }))
+            }),
+        })
     }
 
     fn commit(&mut self, _h: f64, _works: &mut Works) -> bool {

@@ -37,6 +37,7 @@
 use crate::error::FemError;
 use crate::linalg::max_abs;
 use crate::method::{
+    Trial,
     Capabilities, HeldConstraint, MethodParams, StepConstraint, StepContext, Stepper, unconverged,
     update_tolerance,
 };
@@ -89,7 +90,7 @@ impl<S: System + ?Sized> Stepper<S> for ImplicitMidpoint {
         h: f64,
         t1: f64,
         t_law: f64,
-    ) -> Result<Option<f64>, FemError> {
+    ) -> Result<Trial, FemError> {
         let st = &mut *cx.state;
         let n = st.q.len();
         let t0 = st.t;
@@ -200,13 +201,15 @@ impl<S: System + ?Sized> Stepper<S> for ImplicitMidpoint {
         cx.system
             .residual(t_law, &st.q1, &st.qd1, &st.qdd1, &mut cx.newton.res);
         cx.counters.rhs += 1;
-        Ok(cx.adaptive.map(|ad| {
+        Ok(Trial::Converged {
+            error: cx.adaptive.map(|ad| {
             let mut err = 0.0f64;
             for i in 0..n {
                 let e = h * h / 12.0 * (st.qdd1[i] - st.qdd[i]);
                 err = err.max(e.abs() / (ad.atol + ad.rtol * st.q1[i].abs()));
             }
             err
-        }))
+            }),
+        })
     }
 }

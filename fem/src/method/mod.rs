@@ -1,9 +1,12 @@
 //! Time-integration methods: one type per method behind the [`Stepper`] trait.
 //!
 //! A method advances R(q, q̇, q̈, t) = 0 of a [`crate::system::System`] over one step of
-//! length h from the state at the step start to a trial end ([`StepState`]); the driver
-//! ([`crate::driver`]) chooses h, accepts or rejects the trial, books the works and handles
-//! events. A method never names a scene family or a contact: a bilateral constraint (a tip
+//! length h from the state at the step start to a trial end ([`StepState`]) and reports how
+//! the attempt ended ([`Trial`]: converged, with its local error estimate when the steps are
+//! adaptive, or a Newton failure); it gives the state inside the step by its continuous
+//! extension ([`Stepper::dense`]). The driver ([`crate::driver`]) chooses h, accepts or rejects
+//! the trial, counts the work ([`Counters`]), books the works and handles events, and reports
+//! why each of its steps returned ([`crate::driver::StopReason`]). A method never names a scene family or a contact: a bilateral constraint (a tip
 //! held on a surface) reaches it only through [`StepConstraint`], which adds the constraint
 //! force and the bordered Newton update to the method's own iteration.
 //!
@@ -54,7 +57,9 @@ mod step;
 
 pub use newton::{JacobianKind, NewtonSystem};
 pub use state::{Adaptive, Counters, FixedStepCounters, StepState, Works};
-pub use step::{ConstraintView, ProjectionRows, StepConstraint, StepContext, Stepper};
+pub use step::{
+    ConstraintView, ProjectionRows, StepConstraint, StepContext, Stepper, Trial, hermite_dense,
+};
 pub(crate) use step::{HeldConstraint, unconverged, update_tolerance};
 
 use crate::settings::Method;

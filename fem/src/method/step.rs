@@ -56,8 +56,8 @@ pub(crate) fn update_tolerance(newton_tol: f64, c_q: f64, h: f64, qdd: &[f64], q
 
 /// A step of length `h` from `t` whose Newton iteration did not converge (`last`: its last
 /// update): retried shorter when it can be (adaptive, or longer than 1e-6 of the nominal
-/// step: `Some(∞)`), else the run stops; `also` extends the remedy with what is specific to
-/// the method.
+/// step: [`Trial::NewtonFailed`]), else the run stops; `also` extends the remedy with what is
+/// specific to the method.
 pub(crate) fn unconverged(
     adaptive: bool,
     h_nominal: f64,
@@ -65,9 +65,9 @@ pub(crate) fn unconverged(
     h: f64,
     last: f64,
     also: &str,
-) -> Result<Option<f64>, FemError> {
+) -> Result<Trial, FemError> {
     if adaptive || h > 1e-6 * h_nominal {
-        return Ok(Some(f64::INFINITY));
+        return Ok(Trial::NewtonFailed);
     }
     Err(FemError::Runaway {
         t,
@@ -76,6 +76,38 @@ pub(crate) fn unconverged(
         why: "the step is too large for the nonlinearity or the solution diverged".into(),
         remedy: format!("reduce --dt or give --rtol for adaptive stepping{also}"),
     })
+}
+
+/// What a method's attempt at one step gives the driver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Trial {
+    /// Newton converged; the trial end is in the step state. `error`: the local error estimate
+    /// scaled by the tolerances (≤ 1 accepts) when the steps are adaptive.
+    Converged { error: Option<f64> },
+    /// Newton did not converge: the driver retries the stretch with a shorter step.
+    NewtonFailed,
+}
+
+/// The cubic Hermite interpolant of a step of length `h` from (q₀, q̇₀) to (q₁, q̇₁) in
+/// `state`, at θ ∈ [0, 1]: positions into `q`, their rates into `qd`.
+pub fn hermite_dense(state: &StepState, h: f64, theta: f64, q: &mut [f64], qd: &mut [f64]) {
+    let (s, s2) = (theta, theta * theta);
+    let (h00, h10, h01, h11) = (
+        1.0 - 3.0 * s2 + 2.0 * s2 * s,
+        s - 2.0 * s2 + s2 * s,
+        3.0 * s2 - 2.0 * s2 * s,
+        s2 * s - s2,
+    );
+    let (d00, d10, d11) = (
+        6.0 * (s2 - s) / h,
+        1.0 - 4.0 * s + 3.0 * s2,
+        3.0 * s2 - 2.0 * s,
+    );
+    for i in 0..q.len() {
+        let (q0, v0, q1, v1) = (state.q[i], state.qd[i], state.q1[i], state.qd1[i]);
+        q[i] = h00 * q0 + h * h10 * v0 + h01 * q1 + h * h11 * v1;
+        qd[i] = d00 * (q0 - q1) + d10 * v0 + d11 * v1;
+    }
 }
 
 /// Work buffers of a held constraint in a method's Newton iteration, and the one operation
@@ -235,9 +267,9 @@ pub trait StepConstraint<S: System + ?Sized> {
 /// One integration method, stepping the system `S`.
 pub trait Stepper<S: System + ?Sized>: std::fmt::Debug {
     /// Solves the step t₀ → t₁ = t₀ + h from `cx.state` into its trial end (laws evaluated at
-    /// `t_law`, = t₁ except as a left limit at a discontinuity). Returns the scaled local error
-    /// estimate when adaptive, `Some(∞)` when Newton failed (the driver retries shorter).
-    /// `constraint`: a held bilateral constraint (methods without that support refuse it).
+    /// `t_law`, = t₁ except as a left limit at a discontinuity). `constraint`: a held bilateral
+    /// constraint (methods without that support refuse it). An error is a stop the driver
+    /// cannot remedy (a singular matrix, a step that cannot be shortened further).
     fn step(
         &mut self,
         cx: &mut StepContext<'_, S>,
@@ -245,7 +277,17 @@ pub trait Stepper<S: System + ?Sized>: std::fmt::Debug {
         h: f64,
         t1: f64,
         t_law: f64,
-    ) -> Result<Option<f64>, FemError>;
+    ) -> Result<Trial, FemError>;
+
+    /// The continuous extension of the trial step of length `h` just solved, at t₀ + θh
+    /// (θ ∈ [0, 1]): positions into `q`, rates into `qd`. The cubic Hermite interpolant of
+    /// the step's end positions and rates ([`hermite_dense`]): third order in the positions,
+    /// second in the rates, one order above the methods' own, so the interpolant's error is
+    /// below the step's. The driver locates events on it before it re-solves the step to the
+    /// event.
+    fn dense(&self, state: &StepState, h: f64, theta: f64, q: &mut [f64], qd: &mut [f64]) {
+        hermite_dense(state, h, theta, q, qd);
+    }
 
     /// Whether every stretch between stop times must be split into equal steps.
     fn equal_steps(&self) -> bool {

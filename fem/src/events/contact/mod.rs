@@ -89,7 +89,8 @@
 //! for where this shows).
 //!
 //! **Events**, located INSIDE the step by re-solving it with a shortened step h* (Illinois
-//! secant on the step length, other bracket points where Newton fails): contact start when
+//! secant on the step length, other bracket points where Newton fails; a contact start's first
+//! point is the gap's root on the method's continuous extension of the step): contact start when
 //! |g(q₁(h*))| ≤ [`GAP_TOL`]·L (L the longest link); release when the index-1 normal force
 //! λ(q₁(h*), q̇₁(h*)) at the end of the shortened step lies in [−[`FORCE_TOL`]·W, 0] (W the
 //! chain's weight, or its mass times 1 length/time² without gravity), or when the bracket is

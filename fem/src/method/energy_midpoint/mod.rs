@@ -102,7 +102,9 @@ mod work;
 pub use gradients::{FD_STEP, kinetic_gradient, kinetic_gradient_fd, mass_product};
 pub use work::MidpointWork;
 
-use crate::method::{Capabilities, MethodParams, StepConstraint, StepContext, Stepper, Works, unconverged};
+use crate::method::{
+    Capabilities, MethodParams, StepConstraint, StepContext, Stepper, Trial, Works, unconverged,
+};
 use crate::system::System;
 use iteration::{Iteration, MAX_ITERATIONS, Verdict};
 use work::{MOMENTUM_PASSES, form_matrix, solve_update};
@@ -154,7 +156,7 @@ impl<S: System + ?Sized> Stepper<S> for EnergyMidpoint {
         h: f64,
         t1: f64,
         t_law: f64,
-    ) -> Result<Option<f64>, FemError> {
+    ) -> Result<Trial, FemError> {
         let w = &mut self.work;
         let robust = cx.newton.unilateral_contact;
         let setup = w.begin(cx, constraint.as_deref(), h, t1);
@@ -226,7 +228,9 @@ impl<S: System + ?Sized> Stepper<S> for EnergyMidpoint {
             );
         }
         w.accept(cx, &setup, robust, t_law);
-        Ok(cx.adaptive.map(|ad| w.error_estimate(cx.state, h, ad)))
+        Ok(Trial::Converged {
+            error: cx.adaptive.map(|ad| w.error_estimate(cx.state, h, ad)),
+        })
     }
 
     fn commit(&mut self, h: f64, works: &mut Works) -> bool {
