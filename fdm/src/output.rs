@@ -1,11 +1,11 @@
 //! Driver outputs: the naming of a model's observables and ledger terms ([`Outputs`]), the
-//! sampling of a run at the output times (`Recorder`: linear interpolation between step
-//! levels, no allocation after construction) and the mapping to `data`'s result types
+//! sampling of a run at the output times (`Recorder`: the state on the method's continuous
+//! extension of the step, the works linear in time; no allocation after construction) and the mapping to `data`'s result types
 //! ([`Outcome`]).
 
 use data::{Cost, EnergyLedger, Event, Observables, StabilityVerdict};
 
-use crate::method::Levels;
+use crate::method::{Levels, Stepper};
 use crate::system::{Bound, System};
 
 /// How a model's state is named and observed: channels, ledger terms, coordinate names.
@@ -55,7 +55,9 @@ impl Outcome {
     }
 }
 
-/// Output recorder: samples at the output times by linear interpolation between levels.
+/// Output recorder: samples the state at the output times on the method's continuous extension
+/// of the step that passes them ([`Stepper::dense`]), the works linearly (the trapezoidal
+/// rule's own interpolation).
 pub(crate) struct Recorder {
     times: Vec<f64>,
     next: usize,
@@ -126,6 +128,7 @@ impl Recorder {
     pub(crate) fn record<S: System + Outputs + ?Sized>(
         &mut self,
         sys: &S,
+        method: &dyn Stepper,
         ta: f64,
         a: &Levels,
         wa: &[f64],
@@ -145,10 +148,7 @@ impl Recorder {
             } else {
                 1.0
             };
-            for i in 0..self.q.len() {
-                self.q[i] = a.q[i] + s * (b.q[i] - a.q[i]);
-                self.v[i] = a.v[i] + s * (b.v[i] - a.v[i]);
-            }
+            method.dense(a, b, s, &mut self.q, &mut self.v);
             for i in 0..self.work.len() {
                 self.work[i] = wa[i] + s * (wb[i] - wa[i]);
             }

@@ -167,7 +167,7 @@ pub fn run<S: Model, E: Events<S>>(
     let clock = Instant::now();
     let factor = method.bound_factor();
     let mut rec = Recorder::new(sys, ctl.t_end, ctl.output_interval);
-    let (mut rs, limit) = RunState::begin(sys, events, q0, v0, ctl, factor, &mut rec)?;
+    let (mut rs, limit) = RunState::begin(sys, &*method, events, q0, v0, ctl, factor, &mut rec)?;
     let watch = WatchSettings {
         mon: sys.monitored(),
         parasitic_threshold: method.parasitic_threshold(),
@@ -236,8 +236,10 @@ struct RunState {
 impl RunState {
     /// The initial level (q0, v0) at t = 0: accelerations, powers, the first step from the
     /// bound and the first sample. Returns the state and the method's limit at t = 0.
+    #[allow(clippy::too_many_arguments)]
     fn begin<S: Model, E: Events<S>>(
         sys: &mut S,
+        method: &dyn Stepper,
         events: &mut E,
         q0: &[f64],
         v0: &[f64],
@@ -266,7 +268,9 @@ impl RunState {
         cost.rhs_evaluations += 1;
         let (tau, limit, _) = choose_step(sys, ctl, factor, t)?;
         events.first_step(tau);
-        rec.record(sys, t, &st.cur, &w_cur, t, &st.cur, &w_cur, tau, limit);
+        rec.record(
+            sys, method, t, &st.cur, &w_cur, t, &st.cur, &w_cur, tau, limit,
+        );
 
         let mon = sys.monitored();
         let peak_v = inf_norm(&st.cur.v[mon.clone()]).max(1e-300);
@@ -306,6 +310,7 @@ impl RunState {
             self.book_work(tau);
             rec.record(
                 sys,
+                &*method,
                 t,
                 &self.st.cur,
                 &self.w_cur,
@@ -467,6 +472,7 @@ impl RunState {
         if tau_eff > 0.0 {
             rec.record(
                 sys,
+                &*method,
                 t,
                 &self.st.cur,
                 &self.w_cur,

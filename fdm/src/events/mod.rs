@@ -37,6 +37,12 @@ impl Retake<'_> {
         take_step(self.method, sys, self.t, self.tau_prev, len, st);
         self.evaluations += 1;
     }
+
+    /// The positions the step of length `len` from level j reaches, into `q`, without a force
+    /// evaluation ([`Stepper::step_positions`]).
+    pub fn positions(&self, st: &StepState, len: f64, q: &mut [f64]) {
+        self.method.step_positions(st, self.tau_prev, len, q);
+    }
 }
 
 /// One step of `method` from t by `tau` with the model's constraint projections: positions

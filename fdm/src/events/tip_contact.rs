@@ -202,17 +202,15 @@ impl Events<TwoLinkChain> for TipContactEvents {
                 },
             });
         }
-        let n = self.trial.len();
         let mut tau_eff = tau;
         if !sys.is_constrained() {
             let g1 = sys.gap(&st.next.q);
             if g1 < 0.0 && self.g_prev > 0.0 {
-                // drift of a step of length s: q + s v + ½ s² a (exact for the velocity form)
-                let (cur, acc, trial) = (&st.cur, &st.acc, &mut self.trial);
+                // the gap at the positions a step of length s reaches (the method's own, no
+                // force evaluation)
+                let trial = &mut self.trial;
                 let gap_at = |s: f64| {
-                    for i in 0..n {
-                        trial[i] = cur.q[i] + s * cur.v[i] + 0.5 * s * s * acc[i];
-                    }
+                    retake.positions(st, s, trial);
                     sys.gap_of(trial)
                 };
                 let (s_e, tol, _) = illinois(

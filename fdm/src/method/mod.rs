@@ -3,7 +3,10 @@
 //! A method advances the levels of a [`StepState`] by one step of a length the driver chose:
 //! [`Stepper::predict`] builds the new level's positions (and the velocities known without a
 //! force evaluation), the driver checks them ([`crate::driver`]: growth of the computational
-//! mode, non-finite states), then [`Stepper::complete`] evaluates the forces at the new level.
+//! mode, non-finite states), then [`Stepper::complete`] evaluates the forces at the new level;
+//! [`Stepper::dense`] gives the state inside a taken step, on which the outputs are sampled,
+//! and [`Stepper::step_positions`] the positions a step of any length would reach, on which an
+//! event is located before the step is re-taken to it.
 //! A method knows nothing of scene families, events or outputs; it reports its stability limit
 //! relative to the model's σ ([`Stepper::bound_factor`]) and what it supports
 //! ([`Capabilities`]), from which a run refuses a model the method cannot step, naming the
@@ -20,6 +23,7 @@
 //! variant is `Option<T>` in `data` (None: the backend's default) and `T` here, checked by the
 //! function of the same name in [`payload`].
 
+pub mod dense;
 pub mod payload;
 
 use crate::error::FdmError;
@@ -112,6 +116,17 @@ pub trait Stepper {
         tau: f64,
         st: &mut StepState,
     );
+    /// The continuous extension of the step from level `a` to level `b` at θ ∈ [0, 1] of it:
+    /// positions into `q`, velocities into `v`. The outputs are sampled on it. By default the
+    /// linear interpolant of the two levels ([`dense::linear`], whose module docs say why not
+    /// a cubic).
+    fn dense(&self, a: &Levels, b: &Levels, theta: f64, q: &mut [f64], v: &mut [f64]) {
+        dense::linear(a, b, theta, q, v);
+    }
+    /// The positions a step of length `s` from level j (previous step `tau_prev`) reaches, into
+    /// `q`: what [`Stepper::predict`] would give, without a force evaluation and without
+    /// touching the levels. An event locates its root on them before it re-takes the step.
+    fn step_positions(&self, st: &StepState, tau_prev: f64, s: f64, q: &mut [f64]);
 }
 
 /// What a method supports; a run refuses a model that needs what its method lacks, naming the

@@ -111,6 +111,14 @@ impl Stepper for TwoStep {
         }
     }
 
+    /// q_{j−1} + (τ_j + s) v_j (level j before its filter).
+    fn step_positions(&self, st: &StepState, tau_prev: f64, s: f64, q: &mut [f64]) {
+        let span = tau_prev + s;
+        for i in 0..q.len() {
+            q[i] = st.prev.q[i] + span * st.cur.v[i];
+        }
+    }
+
     fn predicted_velocity<'a>(&self, st: &'a StepState) -> &'a [f64] {
         &st.next.v
     }
@@ -125,5 +133,38 @@ impl Stepper for TwoStep {
     ) {
         sys.accel(t_new, &st.next.q, &st.next.v, &mut st.acc_next);
         sys.powers(&mut st.p_new);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn elem_step_positions_are_the_positions_the_step_predicts() {
+        let n = 4;
+        let mut st = StepState::new(n, 0);
+        for i in 0..n {
+            let x = i as f64 + 1.0;
+            st.prev.q[i] = 0.1 * x - 1e-3;
+            st.cur.q[i] = 0.1 * x;
+            st.cur.v[i] = 2.0 - 0.7 * x;
+            st.acc[i] = 30.0 * x.sin();
+        }
+        let mut q = vec![0.0; n];
+        for (mut method, tau_prev, s) in [
+            (TwoStep::central_difference(), 1e-4, 1e-4),
+            (TwoStep::central_difference(), 1e-4, 3e-5),
+            (TwoStep::robert_asselin(0.01), 2e-4, 1e-4),
+        ] {
+            method.step_positions(&st, tau_prev, s, &mut q);
+            let mut taken = StepState::new(n, 0);
+            taken.prev.q.copy_from_slice(&st.prev.q);
+            taken.cur.q.copy_from_slice(&st.cur.q);
+            taken.cur.v.copy_from_slice(&st.cur.v);
+            taken.acc.copy_from_slice(&st.acc);
+            method.predict(tau_prev, s, &mut taken);
+            assert_eq!(q, taken.next.q, "τ_prev = {tau_prev}, s = {s}");
+        }
     }
 }

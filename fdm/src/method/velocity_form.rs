@@ -142,6 +142,13 @@ impl Stepper for VelocityForm {
         &st.pred
     }
 
+    /// The drift q_j + s v_j + ½s² a_j (the kick–drift positions, level j alone).
+    fn step_positions(&self, st: &StepState, _tau_prev: f64, s: f64, q: &mut [f64]) {
+        for i in 0..q.len() {
+            q[i] = st.cur.q[i] + s * st.cur.v[i] + 0.5 * s * s * st.acc[i];
+        }
+    }
+
     fn complete(
         &mut self,
         sys: &mut dyn System,
@@ -199,6 +206,41 @@ impl Stepper for VelocityForm {
         sys.powers(&mut st.p_new);
         for i in 0..st.acc.len() {
             st.next.v[i] += 0.5 * tau * st.acc_next[i];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn elem_step_positions_are_the_positions_the_step_predicts() {
+        let n = 5;
+        let mut st = StepState::new(n, 0);
+        for i in 0..n {
+            let x = i as f64 + 1.0;
+            st.cur.q[i] = 0.1 * x;
+            st.cur.v[i] = -0.7 * x + 2.0;
+            st.acc[i] = 30.0 * x.sin();
+        }
+        let mut q = vec![0.0; n];
+        for (mut method, s) in [
+            (VelocityForm::predicted(), 1e-6),
+            (VelocityForm::predicted(), 3.7e-4),
+            (VelocityForm::drift_split(), 2e-2),
+        ] {
+            method.step_positions(&st, 0.0, s, &mut q);
+            method.predict(0.0, s, &mut st);
+            for i in 0..n {
+                let scale = st.cur.q[i].abs() + s * st.cur.v[i].abs() + s * s * st.acc[i].abs();
+                assert!(
+                    (q[i] - st.next.q[i]).abs() <= 4.0 * f64::EPSILON * scale,
+                    "s = {s}, dof {i}: {} against the step's {}",
+                    q[i],
+                    st.next.q[i]
+                );
+            }
         }
     }
 }
