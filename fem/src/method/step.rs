@@ -6,6 +6,7 @@
 
 use super::newton::NewtonSystem;
 use super::state::{Adaptive, Counters, StepState, Works};
+use crate::element::hermite::hermite;
 use crate::error::FemError;
 use crate::linalg::{dot, max_abs};
 use crate::system::{Parts, System};
@@ -91,22 +92,13 @@ pub enum Trial {
 /// The cubic Hermite interpolant of a step of length `h` from (q₀, q̇₀) to (q₁, q̇₁) in
 /// `state`, at θ ∈ [0, 1]: positions into `q`, their rates into `qd`.
 pub fn hermite_dense(state: &StepState, h: f64, theta: f64, q: &mut [f64], qd: &mut [f64]) {
-    let (s, s2) = (theta, theta * theta);
-    let (h00, h10, h01, h11) = (
-        1.0 - 3.0 * s2 + 2.0 * s2 * s,
-        s - 2.0 * s2 + s2 * s,
-        3.0 * s2 - 2.0 * s2 * s,
-        s2 * s - s2,
-    );
-    let (d00, d10, d11) = (
-        6.0 * (s2 - s) / h,
-        1.0 - 4.0 * s + 3.0 * s2,
-        3.0 * s2 - 2.0 * s,
-    );
+    // The element's Hermite cubics on an "element" of length h in time: the basis of
+    // (q₀, q̇₀, q₁, q̇₁) and its time derivative.
+    let basis = hermite(theta, h);
     for i in 0..q.len() {
-        let (q0, v0, q1, v1) = (state.q[i], state.qd[i], state.q1[i], state.qd1[i]);
-        q[i] = h00 * q0 + h * h10 * v0 + h01 * q1 + h * h11 * v1;
-        qd[i] = d00 * (q0 - q1) + d10 * v0 + d11 * v1;
+        let ends = [state.q[i], state.qd[i], state.q1[i], state.qd1[i]];
+        q[i] = dot(&basis.n, &ends);
+        qd[i] = dot(&basis.dn, &ends);
     }
 }
 
