@@ -10,7 +10,7 @@
 use data::scene::{LinkField, PayloadLink};
 use data::{Backend, Discretization, Scene, Settings};
 use fem::FemBackend;
-use fem::element::beam3d::rows_at;
+use fem::element::beam3d::{bending_element, rows_at};
 use fem::element::quadrature::gauss01;
 use fem::payload_link::model::Model;
 use fem::payload_link::system::LinkSystem;
@@ -137,7 +137,7 @@ fn direct_kinetic(l: &PayloadLink, md: &Model, d: &[f64], dd: &[f64], theta_dot:
         let (mut s, mut sd) = (0.0, 0.0);
         for (k, span) in (0..e).map(|k| (k, 1.0)).chain(std::iter::once((e, xi))) {
             for (&z, &wz) in pts.iter().zip(wts) {
-                let r = rows_at(&md.layout, k, h, z * span);
+                let r = rows_at(&md.layout, bending_element(), k, h, z * span);
                 let (vs, ws) = (r.dv.dot(d), r.dw.dot(d));
                 let (vsd, wsd) = (r.dv.dot(dd), r.dw.dot(dd));
                 s += 0.5 * (vs * vs + ws * ws) * wz * span * h;
@@ -151,7 +151,7 @@ fn direct_kinetic(l: &PayloadLink, md: &Model, d: &[f64], dd: &[f64], theta_dot:
         for (&xi, &wq) in pts.iter().zip(wts) {
             let x = (e as f64 + xi) * h;
             let wt = wq * h;
-            let r = rows_at(&md.layout, e, h, xi);
+            let r = rows_at(&md.layout, bending_element(), e, h, xi);
             let (s, sd) = fs(e, xi);
             let p = [x + r.u.dot(d) - s, r.v.dot(d), r.w.dot(d)];
             let pd = [r.u.dot(dd) - sd, r.v.dot(dd), r.w.dot(dd)];

@@ -1,5 +1,9 @@
-//! 3-D beam element of the payload link (seed 002): axial u and torsion φ linear, the two bending
-//! planes v (turning plane) and w (vertical) Hermite cubic ([`super::hermite`]).
+//! 3-D beam element of the payload link (seed 002), composed from the planar element contract:
+//! each bending plane, v (turning plane) and w (vertical), is interpolated by a planar
+//! Euler–Bernoulli [`Element`] of the registry (its deflection, slope and curvature shapes,
+//! [`Element::shapes`]), axial u and torsion φ by the linear bar ([`bar_shapes`]). The nodal
+//! layout carries (v, v′) per node, so the bending element is one whose local DOFs are those
+//! of its two nodes ([`bending_element`]: the Hermite cubic).
 //!
 //! Nodal DOFs, in this order, for the fields the scene carries: u, v, v′, w, w′, φ. Node 0 is the
 //! clamped root (no DOFs); node k ≥ 1 numbers its DOFs from (k − 1)·n_node, so an element couples
@@ -8,9 +12,18 @@
 //! ([`Row`]): the model assembles every operator as sums of weighted outer products of such rows
 //! at Gauss points, and the payload attaches through the tip node's rows.
 
+use data::FemElement;
 use data::scene::LinkField;
 
-use super::hermite::hermite;
+use super::contract::{Element, bar_shapes};
+
+/// The planar element both bending planes use: the registry's Hermite cubic, whose local DOFs
+/// are its two nodes' (v, v′), the nodal layout's (an element with interior DOFs has no place in
+/// it: the family refuses another `discretization.element`,
+/// [`crate::settings::cubic_elements_or`]).
+pub fn bending_element() -> &'static dyn Element {
+    super::euler_bernoulli_element(FemElement::HermiteCubic)
+}
 
 /// Slots of the nodal DOFs.
 pub const U: usize = 0;
@@ -126,12 +139,12 @@ pub struct PointRows {
     pub dphi: Row,
 }
 
-/// Rows of element `e` (nodes e, e + 1) of length `h` at local coordinate ξ ∈ [0, 1].
-pub fn rows_at(layout: &NodeLayout, e: usize, h: f64, xi: f64) -> PointRows {
+/// Rows of element `e` (nodes e, e + 1) of length `h` at local coordinate ξ ∈ [0, 1], both
+/// bending planes interpolated by `bending` ([`bending_element`]).
+pub fn rows_at(layout: &NodeLayout, bending: &dyn Element, e: usize, h: f64, xi: f64) -> PointRows {
     let (a, b) = (e, e + 1);
-    let lin = [1.0 - xi, xi];
-    let dlin = [-1.0 / h, 1.0 / h];
-    let herm = hermite(xi, h);
+    let (lin, dlin) = bar_shapes(xi, h);
+    let shapes = bending.shapes(xi, h);
     let mut p = PointRows::default();
     for (k, node) in [a, b].into_iter().enumerate() {
         let u = layout.dof(node, U);
@@ -145,12 +158,12 @@ pub fn rows_at(layout: &NodeLayout, e: usize, h: f64, xi: f64) -> PointRows {
             (W, W_SLOPE, &mut p.w, &mut p.dw, &mut p.ddw),
         ] {
             let (dv, ds) = (layout.dof(node, slot_value), layout.dof(node, slot_slope));
-            val.push(dv, herm.n[2 * k]);
-            val.push(ds, herm.n[2 * k + 1]);
-            der.push(dv, herm.dn[2 * k]);
-            der.push(ds, herm.dn[2 * k + 1]);
-            sec.push(dv, herm.ddn[2 * k]);
-            sec.push(ds, herm.ddn[2 * k + 1]);
+            val.push(dv, shapes.n[2 * k]);
+            val.push(ds, shapes.n[2 * k + 1]);
+            der.push(dv, shapes.dn[2 * k]);
+            der.push(ds, shapes.dn[2 * k + 1]);
+            sec.push(dv, shapes.db[2 * k]);
+            sec.push(ds, shapes.db[2 * k + 1]);
         }
     }
     p
@@ -176,14 +189,22 @@ mod tests {
     }
 
     #[test]
+    fn elem_bending_element_has_only_nodal_deflection_dofs() {
+        let e = bending_element();
+        assert!(e.interior().is_empty() && !e.independent_rotation());
+        assert_eq!(e.local_dofs(), 4);
+    }
+
+    #[test]
     fn elem_rows_interpolate_nodal_values_and_slopes() {
         let lay = NodeLayout::new(&LinkField::ALL);
         let h = 0.25;
         let n = 2 * lay.per_node;
         let d: Vec<f64> = (0..n).map(|i| 0.1 * (i as f64 + 1.0)).collect();
         // Element 1 (nodes 1, 2) at its ends reproduces the nodal DOFs.
-        let at0 = rows_at(&lay, 1, h, 0.0);
-        let at1 = rows_at(&lay, 1, h, 1.0);
+        let cubic = bending_element();
+        let at0 = rows_at(&lay, cubic, 1, h, 0.0);
+        let at1 = rows_at(&lay, cubic, 1, h, 1.0);
         let get = |node: usize, slot: usize| d[lay.dof(node, slot).unwrap()];
         assert!((at0.v.dot(&d) - get(1, V)).abs() < 1e-15);
         assert!((at0.dv.dot(&d) - get(1, V_SLOPE)).abs() < 1e-14);

@@ -7,8 +7,9 @@
 //! and the section angle β at both end nodes (β = v′ for Euler–Bernoulli, the rotation ψ for
 //! Timoshenko), then its interior DOFs ([`Element::interior`]), which the assembly keeps as
 //! global DOFs numbered just before the element's end node (the band stays narrow). Along the
-//! element the deflection is v(ξ) = Σ Nₐ(ξ) dₐ and the section angle β(ξ) = Σ Bₐ(ξ) dₐ
-//! ([`Element::shapes`]). From these and the section data the element provides the linear
+//! element the deflection is v(ξ) = Σ Nₐ(ξ) dₐ, the section angle β(ξ) = Σ Bₐ(ξ) dₐ and the
+//! curvature β′(ξ) = Σ Bₐ′(ξ) dₐ ([`Element::shapes`]; the 3-D element interpolates its two
+//! bending planes with them, [`super::beam3d`]). From these and the section data the element provides the linear
 //! operators (consistent mass, stiffness, geometric stiffness: modes and statics) and the
 //! nonlinear ones of the floating-frame chain (internal force, tangent and strain energy of the
 //! extensible beam, consistent load). The chain's kinematic and force passes need nothing else:
@@ -69,25 +70,35 @@ pub struct InteriorDof {
     pub at: f64,
 }
 
-/// Shape functions of every local DOF at one point: deflection N, its x-derivative N′ and the
-/// section angle B (B = N′ for Euler–Bernoulli).
+/// Shape functions of every local DOF at one point: deflection N, its x-derivative N′, the
+/// section angle B (B = N′ for Euler–Bernoulli) and its x-derivative B′, the curvature (N″ for
+/// Euler–Bernoulli).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Shapes {
     pub n: Row,
     pub dn: Row,
     pub b: Row,
+    pub db: Row,
 }
 
 impl Shapes {
     /// Shapes of an Euler–Bernoulli element (every local DOF is a deflection DOF; the section
-    /// angle is the slope, B = N′), zero-padded to [`MAXE`].
-    pub fn euler_bernoulli(n: &[f64], dn: &[f64]) -> Self {
+    /// angle is the slope, B = N′, its curvature N″), zero-padded to [`MAXE`].
+    pub fn euler_bernoulli(n: &[f64], dn: &[f64], ddn: &[f64]) -> Self {
         let mut out = Shapes::default();
         out.n[..n.len()].copy_from_slice(n);
         out.dn[..dn.len()].copy_from_slice(dn);
         out.b[..dn.len()].copy_from_slice(dn);
+        out.db[..ddn.len()].copy_from_slice(ddn);
         out
     }
+}
+
+/// The linear interpolation of a bar field (axial u, torsion φ) on an element of length h at
+/// local coordinate ξ: the shape functions of its end values and their x-derivatives (the
+/// interpolation [`bar_mass`] and [`bar_stiffness`] integrate).
+pub fn bar_shapes(xi: f64, h: f64) -> ([f64; 2], [f64; 2]) {
+    ([1.0 - xi, xi], [-1.0 / h, 1.0 / h])
 }
 
 /// Global DOFs of one element: axial u at both ends and the local transverse DOFs

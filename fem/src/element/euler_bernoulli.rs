@@ -179,7 +179,7 @@ impl Element for HermiteCubic {
     }
     fn shapes(&self, xi: f64, h: f64) -> Shapes {
         let s = hermite(xi, h);
-        Shapes::euler_bernoulli(&s.n, &s.dn)
+        Shapes::euler_bernoulli(&s.n, &s.dn, &s.ddn)
     }
     fn translates(&self, _a: usize) -> bool {
         true

@@ -13,7 +13,8 @@
 //!   element (cubic + two C¹ bubbles, O(h⁸) frequencies);
 //! * [`timoshenko`] — [`timoshenko::Timoshenko`]: cubic v and quadratic θ (interior DOFs kept
 //!   global), free of shear locking, O(h⁴) frequencies;
-//! * [`beam3d`] — the 3-D beam element (u, v, w, φ) of the payload link.
+//! * [`beam3d`] — the 3-D beam element (u, v, w, φ) of the payload link, its bending planes
+//!   interpolated by a registry element through [`Element::shapes`].
 //!
 //! The elements use only [`contract`] (and the interpolation and quadrature modules); this file
 //! is the registry, which names them.
@@ -68,7 +69,7 @@ macro_rules! registry {
         $(pub mod $module;)*
 
         /// The Euler–Bernoulli element of a `discretization.element` choice.
-        fn euler_bernoulli_element(choice: FemElement) -> &'static dyn Element {
+        pub(crate) fn euler_bernoulli_element(choice: FemElement) -> &'static dyn Element {
             match choice {
                 $(FemElement::$choice => &$module::$element,)*
             }
@@ -79,4 +80,48 @@ macro_rules! registry {
 registry! {
     HermiteCubic => euler_bernoulli::HermiteCubic,
     HermiteQuintic => quintic::HermiteQuintic,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::element::quadrature::gauss01;
+
+    #[test]
+    fn elem_curvature_shapes_integrate_to_every_elements_bending_stiffness() {
+        // K_bending = ∫EI B′B′ dx: the curvature shapes of `Element::shapes` (which the 3-D
+        // element's bending planes use) against each element's own stiffness at κGA = 0.
+        let (ei, h) = (2.5e3, 0.37);
+        let elements: Vec<&dyn Element> = FemElement::ALL
+            .iter()
+            .map(|&c| euler_bernoulli_element(c))
+            .chain([&timoshenko::Timoshenko as &dyn Element])
+            .collect();
+        for element in elements {
+            let k = element.stiffness(ei, 0.0, h);
+            let (pts, wts) = gauss01(MAX_GAUSS);
+            let ne = element.local_dofs();
+            let mut integrated = [[0.0; MAXE]; MAXE];
+            for (&xi, &w) in pts.iter().zip(wts) {
+                let db = element.shapes(xi, h).db;
+                for a in 0..ne {
+                    for b in 0..ne {
+                        integrated[a][b] += ei * w * h * db[a] * db[b];
+                    }
+                }
+            }
+            let scale = k.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+            for a in 0..ne {
+                for b in 0..ne {
+                    assert!(
+                        (integrated[a][b] - k[a][b]).abs() <= 1e-12 * scale,
+                        "{}: K[{a}][{b}] = {:.6e}, ∫EI B′B′ = {:.6e}",
+                        element.name(),
+                        k[a][b],
+                        integrated[a][b]
+                    );
+                }
+            }
+        }
+    }
 }

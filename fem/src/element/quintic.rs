@@ -144,7 +144,7 @@ impl Element for HermiteQuintic {
     }
     fn shapes(&self, xi: f64, h: f64) -> Shapes {
         let s = shapes(xi, h);
-        Shapes::euler_bernoulli(&s.n, &s.dn)
+        Shapes::euler_bernoulli(&s.n, &s.dn, &s.ddn)
     }
     fn translates(&self, _a: usize) -> bool {
         true

@@ -180,6 +180,7 @@ impl Element for Timoshenko {
             n: s.v,
             dn: s.dv,
             b: s.th,
+            db: s.dth,
         }
     }
     fn translates(&self, a: usize) -> bool {

@@ -260,7 +260,7 @@ impl Model {
             for (&xi, &wq) in pts.iter().zip(wts) {
                 let x = (e as f64 + xi) * h;
                 let wt = wq * h;
-                let r = beam3d::rows_at(&md.layout, e, h, xi);
+                let r = beam3d::rows_at(&md.layout, beam3d::bending_element(), e, h, xi);
                 md.add_translation(rho_a * wt, x, &r.u, &r.v, &r.w);
                 // Foreshortening: −2ρA∫x s dx = −ρA∫½(L² − x²)(v′² + w′²) dx.
                 let cf = -0.5 * rho_a * (len * len - x * x) * wt;
@@ -463,7 +463,7 @@ impl Model {
     pub fn field_at(&self, d: &[f64], slot: usize, x: f64) -> f64 {
         let e = ((x / self.h) as usize).min(self.n_el - 1);
         let xi = (x / self.h - e as f64).clamp(0.0, 1.0);
-        let r = beam3d::rows_at(&self.layout, e, self.h, xi);
+        let r = beam3d::rows_at(&self.layout, beam3d::bending_element(), e, self.h, xi);
         match slot {
             U => r.u.dot(d),
             V => r.v.dot(d),
