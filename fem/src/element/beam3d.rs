@@ -12,7 +12,6 @@
 //! ([`Row`]): the model assembles every operator as sums of weighted outer products of such rows
 //! at Gauss points, and the payload attaches through the tip node's rows.
 
-use data::FemElement;
 use data::scene::LinkField;
 
 use super::contract::{Element, bar_shapes};
@@ -22,7 +21,7 @@ use super::contract::{Element, bar_shapes};
 /// it: the family refuses another `discretization.element`,
 /// [`crate::settings::cubic_elements_or`]).
 pub fn bending_element() -> &'static dyn Element {
-    super::euler_bernoulli_element(FemElement::HermiteCubic)
+    super::hermite_cubic()
 }
 
 /// Slots of the nodal DOFs.

@@ -36,8 +36,8 @@ use crate::error::FemError;
 
 pub use contract::{
     Element, ElementDofs, InteriorDof, InteriorField, Local, MAX_GAUSS, MAX_SUB_GAUSS, MAXE, Mat4,
-    MeshElement, NONE, Quadrature, Row, Shapes, linear_internal_force, linear_strain_energy,
-    linear_tangent, pad,
+    MeshElement, NONE, Quadrature, Row, Shapes, bar_shapes, linear_internal_force,
+    linear_strain_energy, linear_tangent, pad,
 };
 
 // The local arrays are padded to the largest element of the registry.
@@ -59,6 +59,12 @@ pub fn for_link(link: &Link, choice: Option<FemElement>) -> Result<&'static dyn 
             ),
         }),
     }
+}
+
+/// The Hermite-cubic element of the registry: the beams of the families built on cubics only
+/// (the 3-D link, the mobile manipulator's flexible link, the rocket) take their shapes from it.
+pub fn hermite_cubic() -> &'static dyn Element {
+    euler_bernoulli_element(FemElement::HermiteCubic)
 }
 
 /// The registry of the Euler–Bernoulli elements: one line per element, `Choice =>

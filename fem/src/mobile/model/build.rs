@@ -8,7 +8,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::{
     Body, FlexLink, GAUSS, Layout, Model, PlatformModel, positive_semidefinite, residual_inertia,
 };
-use crate::element::hermite::hermite;
+use crate::element::hermite_cubic;
 use crate::element::quadrature::gauss01;
 use crate::error::FemError;
 
@@ -185,7 +185,7 @@ fn flexible_link(
         ei_out: f.bending_stiffness_out_of_plane,
         ne: 4 * elements,
         stiffness: Vec::new(),
-        shapes: std::array::from_fn(|g| hermite(xs[g], le)),
+        shapes: std::array::from_fn(|g| hermite_cubic().shapes(xs[g], le)),
         gauss_xi: std::array::from_fn(|g| xs[g]),
         gauss_w: std::array::from_fn(|g| ws[g] * le),
     };

@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 
 use super::{EY, EZ, FlexLink, Frames, MINUS_EY, Model, Partials, Vec3, revolute, rot_z};
-use crate::element::hermite::HermiteAt;
+use crate::element::Shapes;
 
 impl Model {
     /// Recursive kinematics of F0…F5 at (q, q̇, q̈) (full coordinate rates, any q̇).
@@ -145,7 +145,7 @@ impl Model {
         q: &[f64],
         fl: &FlexLink,
         el: usize,
-        s: &HermiteAt,
+        s: &Shapes,
         p: Vec3,
         out: &mut Partials,
     ) {

@@ -33,8 +33,8 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::element::hermite::{HermiteAt, hermite};
 use crate::element::quadrature::gauss01;
+use crate::element::{Shapes, hermite_cubic};
 
 mod build;
 mod dynamics;
@@ -108,7 +108,7 @@ pub struct FlexLink {
     /// Stiffness K (ne × ne, row-major).
     pub stiffness: Vec<f64>,
     /// Shape functions at the Gauss points of an element (the same on every element).
-    pub shapes: [HermiteAt; GAUSS],
+    pub shapes: [Shapes; GAUSS],
     /// Gauss abscissae (fraction of the element) and weights (times le).
     pub gauss_xi: [f64; GAUSS],
     pub gauss_w: [f64; GAUSS],
@@ -124,7 +124,7 @@ impl FlexLink {
     }
 
     /// v(x) and w(x) (field 0, 1) of element `el` with shape values `n` from the elastic DOFs.
-    fn field_at(&self, e: &[f64], el: usize, n: &[f64; 4]) -> [f64; 2] {
+    fn field_at(&self, e: &[f64], el: usize, n: &[f64]) -> [f64; 2] {
         let mut out = [0.0; 2];
         for (f, o) in out.iter_mut().enumerate() {
             for l in 0..4 {
@@ -149,7 +149,7 @@ impl FlexLink {
         for el in 0..self.elements {
             for (f, ei) in [(0, self.ei_out), (1, self.ei_in)] {
                 for (xi, w) in xs.iter().zip(ws) {
-                    let s = hermite(*xi, self.le);
+                    let s = hermite_cubic().shapes(*xi, self.le);
                     for a in 0..4 {
                         let Some(ga) = Self::dof(el, a, f) else {
                             continue;
@@ -158,7 +158,7 @@ impl FlexLink {
                             let Some(gb) = Self::dof(el, b, f) else {
                                 continue;
                             };
-                            self.stiffness[ga * ne + gb] += ei * w * self.le * s.ddn[a] * s.ddn[b];
+                            self.stiffness[ga * ne + gb] += ei * w * self.le * s.db[a] * s.db[b];
                         }
                     }
                 }

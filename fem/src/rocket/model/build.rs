@@ -8,10 +8,10 @@ use std::collections::BTreeMap;
 use data::scene::Rocket;
 
 use super::{
-    Attached, Coupling, DOFS_PER_NODE, Model, Quad, Triplets, dofs_of, linear, mesh_point,
+    Attached, Coupling, DOFS_PER_NODE, Model, Quad, Triplets, dofs_of, mesh_point, slopes,
 };
-use crate::element::hermite::{HermiteAt, hermite};
 use crate::element::quadrature::gauss01;
+use crate::element::{Shapes, bar_shapes, hermite_cubic};
 use crate::error::FemError;
 
 /// The constant operators before conversion to triplets: the burning stage's unit mass, the
@@ -196,6 +196,7 @@ fn quadrature_points(r: &Rocket, elements: usize, h: f64) -> Vec<Quad> {
                         st.weight_per_length / g
                     },
                     burning: k == 0,
+                    slopes: slopes((x - xa) / h, h),
                 });
             }
         }
@@ -213,10 +214,8 @@ fn integrate_operators(quad: &[Quad], h: f64, l1: f64, n: usize) -> Operators {
     let mut cor_u = vec![0.0; n];
     let mut cor_w = vec![0.0; n];
     for q in quad {
-        let (nu, du) = linear(q.s, h);
-        let HermiteAt {
-            n: hw, ddn: hdd, ..
-        } = hermite(q.s, h);
+        let (nu, du) = bar_shapes(q.s, h);
+        let Shapes { n: hw, db: hdd, .. } = hermite_cubic().shapes(q.s, h);
         let (iu, iw) = dofs_of(q.element);
         let (mass_b, mass_f) = (
             if q.burning { q.weight } else { 0.0 },

@@ -9,7 +9,7 @@
 
 use data::scene::InitialShape;
 
-use crate::element::hermite::hermite;
+use crate::element::{bar_shapes, hermite_cubic};
 
 mod build;
 
@@ -60,6 +60,9 @@ struct Quad {
     fixed_mass: f64,
     burning: bool,
     ei: f64,
+    /// The x-derivatives of the axial (u₁, u₂) and transverse (w₁, w₁′, w₂, w₂′) shape
+    /// functions at the point, tabulated for the force passes.
+    slopes: ([f64; 2], [f64; 4]),
 }
 
 /// Discrete mass on springs (spring to the case at its attachment point).
@@ -172,8 +175,12 @@ impl MeanAxis {
 }
 
 /// Linear shape functions and derivatives on an element of length h at s ∈ [0, 1].
-fn linear(s: f64, h: f64) -> ([f64; 2], [f64; 2]) {
-    ([1.0 - s, s], [-1.0 / h, 1.0 / h])
+/// The x-derivatives of the bar and Hermite-cubic shape functions at local coordinate `s` of an
+/// element of length `h`.
+fn slopes(s: f64, h: f64) -> ([f64; 2], [f64; 4]) {
+    let (_, du) = bar_shapes(s, h);
+    let dn = hermite_cubic().shapes(s, h).dn;
+    (du, [dn[0], dn[1], dn[2], dn[3]])
 }
 
 fn dofs_of(e: usize) -> ([usize; 2], [usize; 4]) {
@@ -186,8 +193,9 @@ fn dofs_of(e: usize) -> ([usize; 2], [usize; 4]) {
 fn mesh_point(x: f64, h: f64, elements: usize) -> Point {
     let el = ((x / h).floor() as usize).min(elements - 1);
     let s = x / h - el as f64;
-    let (nu, _) = linear(s, h);
-    let hw = hermite(s, h).n;
+    let (nu, _) = bar_shapes(s, h);
+    let n = hermite_cubic().shapes(s, h).n;
+    let hw = [n[0], n[1], n[2], n[3]];
     let (iu, iw) = dofs_of(el);
     Point { x, iu, nu, iw, hw }
 }
@@ -306,8 +314,7 @@ impl Model {
 
     fn slopes(&self, qp: &Quad, q: &[f64]) -> (f64, f64) {
         let (iu, iw) = dofs_of(qp.element);
-        let (_, du) = linear(qp.s, self.h);
-        let hd = hermite(qp.s, self.h).dn;
+        let (du, hd) = qp.slopes;
         let up = du[0] * q[iu[0]] + du[1] * q[iu[1]];
         let wp = (0..4).map(|a| hd[a] * q[iw[a]]).sum::<f64>();
         (up, wp)
@@ -319,8 +326,7 @@ impl Model {
         for qp in &self.quad {
             let (up, wp) = self.slopes(qp, q);
             let (iu, iw) = dofs_of(qp.element);
-            let (_, du) = linear(qp.s, self.h);
-            let hd = hermite(qp.s, self.h).dn;
+            let (du, hd) = qp.slopes;
             let fu = qp.weight * 0.5 * qp.ea * wp * wp;
             let fw = qp.weight * qp.ea * up * wp;
             for a in 0..2 {
