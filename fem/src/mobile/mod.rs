@@ -20,7 +20,7 @@
 //! V = Σ m g z + ∫μ g p_z dx + ½∫(EI_out v″² + EI_in w″²) dx, D = ½Σbᵢθ̇ᵢ² + ½b_side(φ̇_R² + φ̇_L²).
 //!
 //! ## Discretization
-//! N Hermite-cubic elements ([`crate::element::hermite`]) for v and w, DOFs (v, v′, w, w′) per
+//! N Hermite-cubic elements ([`crate::element::hermite_cubic`]) for v and w, DOFs (v, v′, w, w′) per
 //! node; mass integrals by 4-point Gauss quadrature (exact), stiffness exact. The equations
 //! are written on the null space of the constraints (speeds ν = (φ̇_R, φ̇_L, θ̇₁…θ̇₄, ė)) by
 //! Kane's projection of every mass element's inertial force ([`model`]). The model with its
