@@ -15,7 +15,7 @@
 //! The linear extension's error, ⅛τ²|ÿ|, is below the methods' own second-order error at the
 //! stability steps fdm takes.
 
-use super::Levels;
+use super::levels::Levels;
 
 /// The state at t_a + θτ on the linear interpolant of the step from level `a` to level `b`:
 /// positions into `q`, velocities into `v`.
