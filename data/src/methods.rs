@@ -137,4 +137,6 @@ method_table! {
     TrBdf2Fixed => "trbdf2-fixed" [] for modal;
     /// modal: trapezoidal rule at a fixed step.
     Trapezoid => "trapezoid" [] for modal;
+    /// modal: exponential Runge–Kutta (ETDRK4) on the linearized oscillators, fixed step.
+    Exponential => "exponential" ["etdrk4"] for modal;
 }

@@ -37,7 +37,9 @@
 //! overdamped Kelvin–Voigt eigenvalues reach −1.4e7 / −4.8e7 / −1.4e8 s⁻¹ at 16 / 20 / 24 modes
 //! per link on `barhorst-case1-tipmass`). TR-BDF2 solves its Newton systems through the
 //! chain's own factored linearization ([`newton`]: Cholesky of M + cD + c²K with the contact
-//! rows, never M⁻¹K) and keeps it across the drift projections of the contact phase. The
+//! rows, never M⁻¹K) and keeps it across the drift projections of the contact phase. Undamped
+//! chains without contact can also be stepped by an exponential integrator that is exact on
+//! the undeformed arm's oscillators ([`integrate::Exponential`], [`pencil`]). The
 //! rocket (seed 003) is in [`rocket`], the 3-D
 //! link with an offset payload (seed 002) in [`payload_link`], the mobile manipulator with a
 //! flexible pitch link (seed 004) in [`mobile`].
@@ -85,6 +87,7 @@ pub mod modes;
 pub mod newton;
 pub mod output;
 pub mod payload_link;
+pub mod pencil;
 pub mod rhs;
 pub mod rocket;
 pub mod sampled;

@@ -12,9 +12,10 @@ use std::time::Instant;
 
 use data::scene::PlanarChain;
 use data::{Cost, ModalResult, ModalSettings, ModeShape, Scene};
-use faer::{Mat, Side};
+use faer::Mat;
 
 use crate::error::ModalError;
+use crate::pencil::{Pencil, PencilError};
 use crate::setup::{Purpose, build_chain_for};
 
 /// Natural frequencies \[Hz\] of `pc`, the chain of `scene`, ascending. A statically unstable
@@ -171,27 +172,20 @@ pub fn rotating_modes(
     modes(scene, &spinning, settings, count)
 }
 
-/// K x = λ M x by Cholesky reduction: ascending λ and M-orthonormal x (columns).
+/// K x = λ M x by Cholesky reduction ([`crate::pencil::Pencil`]): ascending λ and
+/// M-orthonormal x (columns).
 pub fn generalized_eigen(k: &Mat<f64>, m: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>), ModalError> {
-    let llt = m.llt(Side::Lower).map_err(|_| ModalError::Numerical {
-        t: 0.0,
-        message: "reduced mass matrix is not positive definite".into(),
-    })?;
-    let lm = llt.L();
-    let mut t = k.clone();
-    lm.solve_lower_triangular_in_place(&mut t);
-    let mut c = t.transpose().to_owned();
-    lm.solve_lower_triangular_in_place(&mut c);
-    let c = Mat::<f64>::from_fn(c.nrows(), c.ncols(), |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
-    let ev = c
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|_| ModalError::Numerical {
+    let mut pencil = Pencil::new(m.nrows());
+    pencil
+        .solve(k.as_ref(), m.as_ref())
+        .map_err(|e| ModalError::Numerical {
             t: 0.0,
-            message: "eigen-decomposition did not converge".into(),
+            message: match e {
+                PencilError::MassNotPositiveDefinite => {
+                    "reduced mass matrix is not positive definite".into()
+                }
+                PencilError::NoConvergence => "eigen-decomposition did not converge".into(),
+            },
         })?;
-    let s = ev.S().column_vector();
-    let lambda: Vec<f64> = (0..s.nrows()).map(|i| s[i]).collect();
-    let mut x = ev.U().to_owned();
-    lm.transpose().solve_upper_triangular_in_place(&mut x);
-    Ok((lambda, x))
+    Ok((pencil.eigenvalues().to_vec(), pencil.vectors().to_owned()))
 }

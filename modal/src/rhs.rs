@@ -48,6 +48,8 @@ pub struct ChainRhs {
     kv_grad: Vec<f64>,
     /// Factored Newton linear algebra ([`OdeRhs::newton_linearize`]).
     lin: ChainNewton,
+    /// The state of [`OdeRhs::second_order_linearization`]: y with its elastic part zeroed.
+    y_rigid: Vec<f64>,
 }
 
 impl ChainRhs {
@@ -88,6 +90,7 @@ impl ChainRhs {
             rate_grad: vec![(0, 0.0); n + 1],
             kv_grad: vec![0.0; n],
             lin: ChainNewton::new(nf, slots.count),
+            y_rigid: vec![0.0; 2 * nf + slots.count],
             kt: vec![0.0; n * n],
             dt: vec![0.0; n * n],
             col: vec![0.0; nf],
@@ -420,6 +423,54 @@ impl OdeRhs for ChainRhs {
         }
         self.power_rows(t);
         true
+    }
+
+    /// M and the elastic tangent K_t (the joint springs, the bending and shear stiffness) over
+    /// the free coordinates, of the undeformed chain — elastic coordinates and rates zero — at
+    /// the joint angles of y; everything else (the configuration's foreshortening terms,
+    /// centrifugal, gyroscopic and gravity forces, ∂M/∂q) stays in the remainder. A chain in
+    /// its constrained contact phase has no such form (its constraint force is not an
+    /// oscillator).
+    fn second_order_linearization(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        m: &mut Vec<f64>,
+        k: &mut Vec<f64>,
+    ) -> Option<usize> {
+        if self.contact.as_ref().is_some_and(|c| c.constrained) {
+            return None;
+        }
+        // The undeformed arm at the current joint angles: M(q) depends on the elastic coordinates
+        // only through foreshortening, and sampled at the state it would carry the phase of
+        // every ringing mode into the linear part (docs/backends.md).
+        let nf = self.nf();
+        self.y_rigid.copy_from_slice(y);
+        for (k, &g) in self.chain.free.iter().enumerate() {
+            if !self.chain.links.iter().any(|l| l.theta == g) {
+                self.y_rigid[k] = 0.0;
+                self.y_rigid[nf + k] = 0.0;
+            }
+        }
+        let y_rigid = std::mem::take(&mut self.y_rigid);
+        let solved = self.solve(t, &y_rigid);
+        self.y_rigid = y_rigid;
+        if !solved {
+            return None;
+        }
+        let n = self.chain.n;
+        let nf = self.nf();
+        self.chain.elastic_tangent(&mut self.kt, &mut self.dt);
+        let mass = self.chain.mass_matrix();
+        m.resize(nf * nf, 0.0);
+        k.resize(nf * nf, 0.0);
+        for (r, &gr) in self.chain.free.iter().enumerate() {
+            for (c, &gc) in self.chain.free.iter().enumerate() {
+                m[r * nf + c] = mass[gr * n + gc];
+                k[r * nf + c] = self.kt[gr * n + gc];
+            }
+        }
+        Some(nf)
     }
 
     fn newton_factor(&mut self, c: f64) -> bool {

@@ -12,7 +12,9 @@ use data::{ModalSettings, RunResult, Scene, StabilityVerdict};
 use crate::contact::ContactState;
 use crate::error::ModalError;
 use crate::events::{ContactEvents, Halt};
-use crate::integrate::{Build, DOPRI5, MethodInfo, TRBDF2, Tolerances, method_for};
+use crate::integrate::{
+    Build, DOPRI5, MethodInfo, TRBDF2, Tolerances, method_for, names_with, resolving_step,
+};
 use crate::output::{Output, runaway, stopped, too_many_events, unresolved_grazing};
 use crate::setup::build_chain;
 
@@ -134,6 +136,30 @@ pub fn simulate_detailed(
     let wall = Instant::now();
     let chain = build_chain(pc, settings)?;
     let method = method_choice(pc, settings);
+    if method.needs_oscillators {
+        let damped = pc
+            .links
+            .iter()
+            .any(|l| l.kelvin_voigt.is_some_and(|g| g > 0.0));
+        if damped || !pc.contacts.is_empty() {
+            return Err(ModalError::invalid(
+                "time.method",
+                format!(
+                    "`{}` integrates chains without Kelvin–Voigt damping and without a tip \
+                     contact (scene `{}` has {}): its exact part is the undamped oscillators and \
+                     everything else is explicit; use {}",
+                    method.name,
+                    scene.name,
+                    if damped {
+                        "Kelvin–Voigt damping"
+                    } else {
+                        "a contact"
+                    },
+                    names_with("or", |m| !m.needs_oscillators)
+                ),
+            ));
+        }
+    }
     let fixed_step = method.is_fixed_step();
     let default_kelvin_voigt_method = settings.method.is_none() && std::ptr::eq(method, &TRBDF2);
     let (rtol_default, atol_default) = if default_kelvin_voigt_method {
@@ -164,7 +190,21 @@ pub fn simulate_detailed(
     let tol = Tolerances { rtol, atol };
     let mut stepper = match method.build {
         Build::Adaptive(build) => build(dim, tol, settings.dt),
-        Build::Fixed(build) => build(dim, tol, settings.dt.unwrap_or_else(|| default_step(pc))),
+        Build::Fixed(build) => {
+            let h = match settings.dt {
+                Some(h) => h,
+                None if method.needs_oscillators => {
+                    default_step(pc).min(resolving_step(&mut rhs, 0.0, &y).map_err(|e| {
+                        ModalError::Numerical {
+                            t: 0.0,
+                            message: e.to_string(),
+                        }
+                    })?)
+                }
+                None => default_step(pc),
+            };
+            build(dim, tol, h)
+        }
     };
     let mut out = Output::new(&rhs, scene, t_end, dim);
 

@@ -633,3 +633,66 @@ fn dyn_two_link_free_fixed_step_and_default_follow_the_resolved_method() {
     }
     assert!(fixed.cost.steps * 3 < adaptive.cost.steps);
 }
+
+/// The exponential integrator on the undamped arm, whose every mode rings: its whole 0.3 s
+/// joint-angle histories converge at fourth order once the step resolves the remainder's
+/// coupling of the top mode (ω_max·h ≤ 2; the default step is there), to Dormand–Prince's
+/// answer at a tight tolerance.
+#[test]
+fn dyn_exponential_converges_on_the_undamped_arm() {
+    let scene = load_scene("two-link-free-undamped").unwrap();
+    let settings = |method: &str, dt: Option<f64>, rtol: Option<f64>| Settings {
+        time: TimeStepping {
+            t_end: Some(0.3),
+            dt,
+            rtol,
+            atol: rtol.map(|r| r * 1e-3),
+            method: Some(method.parse().expect("a method name")),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let simulate = |s: &Settings| {
+        let r = ModalBackend.simulate(&scene, s).unwrap();
+        assert_eq!(r.verdict, StabilityVerdict::Completed);
+        r
+    };
+    let distance = |a: &RunResult, b: &RunResult| {
+        [1, 2]
+            .iter()
+            .map(|&k| {
+                let ch = channel::joint_angle(k);
+                let x = &a.observables.get(&ch).unwrap().values;
+                let y = &b.observables.get(&ch).unwrap().values;
+                assert_eq!(x.len(), y.len());
+                x.iter()
+                    .zip(y)
+                    .map(|(p, q)| (p - q).abs())
+                    .fold(0.0, f64::max)
+            })
+            .fold(0.0, f64::max)
+    };
+    // ω_max·h ≈ 4, 2, 1, 0.5 (ω_max = 1.58e4 rad/s at the start); measured differences
+    // 3.3e-6, 3.7e-7, 3.0e-8 rad (orders 3.17, 3.61). A fifth rung (h = 1.5625e-5) differs by
+    // 5.7e-9 rad, the round-off floor of the steps' modal transforms in `poly` coordinates.
+    let runs: Vec<RunResult> = [2.5e-4, 1.25e-4, 6.25e-5, 3.125e-5]
+        .iter()
+        .map(|&h| simulate(&settings("exponential", Some(h), None)))
+        .collect();
+    let diffs: Vec<f64> = runs.windows(2).map(|w| distance(&w[0], &w[1])).collect();
+    let orders: Vec<f64> = diffs.windows(2).map(|d| (d[0] / d[1]).log2()).collect();
+    println!("successive differences {diffs:?}, orders {orders:?}");
+    assert!(orders[1] > orders[0], "{orders:?}");
+    assert!(orders[1] > 3.5 && orders[1] < 4.3, "{orders:?}");
+    let reference = simulate(&settings("dopri5", None, Some(1e-10)));
+    let agreement = distance(&runs[3], &reference);
+    println!("finest rung against dopri5 at rtol 1e-10: {agreement:.3e}");
+    assert!(agreement < diffs[2], "{agreement:e} vs {diffs:?}");
+    let default = simulate(&settings("exponential", None, None));
+    let steps = default.cost.steps;
+    println!(
+        "default: {steps} steps, {:.3e} from the finest rung",
+        distance(&default, &runs[3])
+    );
+    assert!((2300..=2500).contains(&steps), "{steps}");
+}

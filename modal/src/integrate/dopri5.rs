@@ -58,6 +58,7 @@ pub const DOPRI5: MethodInfo = MethodInfo {
     method: data::ModalMethod::Dopri5,
     name: "dopri5",
     build: Build::Adaptive(|dim, tol, h_init| Box::new(Dopri5::new(dim, tol, h_init, None))),
+    needs_oscillators: false,
 };
 
 /// Adaptive Dormand–Prince 5(4) integrator (see the module docs).

@@ -11,7 +11,11 @@
 //!   what the step does not resolve) and, on the same Newton machinery, the fixed-step
 //!   trapezoidal rule ([`Sdirk::trapezoidal`], no damping).
 //!
-//! Both keep all work arrays in the struct: a step performs no heap allocation.
+//! * [`Exponential`] — fixed-step exponential Runge–Kutta (ETDRK4) that solves the right-hand
+//!   side's linear oscillators exactly ([`OdeRhs::second_order_linearization`]) and the rest
+//!   explicitly: no numerical dispersion of the modes a step does not resolve.
+//!
+//! All keep their work arrays in the struct: a step performs no heap allocation.
 //!
 //! Every method implements [`Stepper`] (one accepted step, dense output over it, work
 //! counters, restart after a discontinuity) and has a [`MethodInfo`] (its name and how it is
@@ -28,6 +32,7 @@
 //! [`data::ModalMethod`] follows).
 
 pub use dopri5::{DOPRI5, Dopri5};
+pub use exponential::{EXPONENTIAL, Exponential, TOP_FREQUENCY_STEP, resolving_step};
 pub use sdirk::{Sdirk, TRAPEZOID, TRBDF2, TRBDF2_FIXED};
 
 /// Why [`Stepper::step`] returned.
@@ -82,6 +87,9 @@ pub struct MethodInfo {
     /// Its canonical spelling, for messages.
     pub name: &'static str,
     pub build: Build,
+    /// The method integrates the right-hand side's linear oscillators exactly and needs them
+    /// ([`OdeRhs::second_order_linearization`]): models without that form refuse it.
+    pub needs_oscillators: bool,
 }
 
 impl MethodInfo {
@@ -141,6 +149,19 @@ pub fn names_with(conjunction: &str, has: impl Fn(&MethodInfo) -> bool) -> Strin
 registry! {
     dopri5 { Dopri5 => DOPRI5 }
     sdirk { TrBdf2 => TRBDF2, TrBdf2Fixed => TRBDF2_FIXED, Trapezoid => TRAPEZOID }
+    exponential { Exponential => EXPONENTIAL }
+}
+
+/// The refusal of `method` by a model (`model`, for the message) whose right-hand side has
+/// no linear oscillators ([`MethodInfo::needs_oscillators`]); `None` when the method runs.
+pub fn oscillators_refused(method: &MethodInfo, model: &str) -> Option<String> {
+    method.needs_oscillators.then(|| {
+        format!(
+            "`{}` is implemented for the planar link chains, not for {model}; use {}",
+            method.name,
+            names_with("or", |m| !m.needs_oscillators)
+        )
+    })
 }
 
 /// [`StopReason`] of a step that ended at `t` with target `t_stop`.
@@ -179,6 +200,19 @@ pub trait OdeRhs {
     }
     /// x ← (I − c·J)⁻¹ x with the last factorization.
     fn newton_solve(&mut self, _x: &mut [f64]) {}
+    /// For a second-order system y = (q, q̇, …) with q̈ = a(t, y): the mass and stiffness
+    /// matrices M, K (row-major nf × nf, resized here) of the linearization at (t, y), whose
+    /// oscillators q̈ = −M⁻¹K q carry the stiff part of the dynamics. Returns nf, or `None`
+    /// when the system has no such form (the default).
+    fn second_order_linearization(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        _m: &mut Vec<f64>,
+        _k: &mut Vec<f64>,
+    ) -> Option<usize> {
+        None
+    }
 }
 
 /// Mixed error tolerance: component i is scaled by atol + rtol·max(|yᵢ(t)|, |yᵢ(t+h)|).
@@ -238,6 +272,11 @@ pub enum IntegrateError {
     NonFinite { t: f64 },
     #[error("Newton iteration failed to converge at t = {t:.9e} even with the smallest step")]
     NewtonFailed { t: f64 },
+    #[error(
+        "no linear oscillators at t = {t:.9e}: the system has no second-order linearization with a \
+         positive definite mass matrix there (the exponential method needs one)"
+    )]
+    NoLinearization { t: f64 },
 }
 
 /// Weighted RMS norm of `err` with the mixed scale of [`Tolerances`].

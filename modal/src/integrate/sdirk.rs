@@ -133,16 +133,19 @@ pub const TRBDF2: MethodInfo = MethodInfo {
     method: data::ModalMethod::TrBdf2,
     name: "trbdf2",
     build: Build::Adaptive(|dim, tol, h_init| Box::new(Sdirk::new(dim, tol, h_init, None))),
+    needs_oscillators: false,
 };
 pub const TRBDF2_FIXED: MethodInfo = MethodInfo {
     method: data::ModalMethod::TrBdf2Fixed,
     name: "trbdf2-fixed",
     build: Build::Fixed(|dim, tol, h| Box::new(Sdirk::fixed_step(dim, tol, h))),
+    needs_oscillators: false,
 };
 pub const TRAPEZOID: MethodInfo = MethodInfo {
     method: data::ModalMethod::Trapezoid,
     name: "trapezoid",
     build: Build::Fixed(|dim, tol, h| Box::new(Sdirk::trapezoidal(dim, tol, h))),
+    needs_oscillators: false,
 };
 
 /// Implicit adaptive TR-BDF2 integrator (see the module docs).

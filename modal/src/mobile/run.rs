@@ -18,7 +18,7 @@ use data::{EnergyLedger, ModalSettings, Observables, RunResult, Scene, ledger_te
 use super::model::{MobileModel, Workspace};
 use super::{Inputs, set_up};
 use crate::error::ModalError;
-use crate::integrate::{Build, OdeRhs, Tolerances, method_for};
+use crate::integrate::{Build, OdeRhs, Tolerances, method_for, oscillators_refused};
 use crate::linalg::{cholesky_factor, cholesky_substitute};
 use crate::sampled::{SampledRun, Schedule, run_sampled};
 
@@ -189,6 +189,9 @@ pub fn simulate(
     let wall = Instant::now();
     let (model, inputs) = set_up(mm, settings)?;
     let method = method(settings);
+    if let Some(message) = oscillators_refused(method, "the mobile manipulator") {
+        return Err(ModalError::invalid("time.method", message));
+    }
     let rtol = settings.rtol.unwrap_or(DEFAULT_TOL.0);
     let atol = settings.atol.unwrap_or(DEFAULT_TOL.1);
     if !(rtol > 0.0 && atol > 0.0 && rtol < 1.0 && atol.is_finite()) {

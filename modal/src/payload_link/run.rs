@@ -11,7 +11,9 @@ use super::dynamics::LinkRhs;
 use super::model::LinkModel;
 use super::{SetUp, set_up, static_sag};
 use crate::error::ModalError;
-use crate::integrate::{Build, OdeRhs, TRAPEZOID, TRBDF2, Tolerances, method_for};
+use crate::integrate::{
+    Build, OdeRhs, TRAPEZOID, TRBDF2, Tolerances, method_for, oscillators_refused,
+};
 use crate::linalg::dot;
 use crate::modes::generalized_eigen;
 use crate::sampled::{SampledRun, Schedule, run_sampled};
@@ -69,6 +71,9 @@ pub fn simulate(
     let method = settings
         .method
         .map_or_else(|| default_method(&model), method_for);
+    if let Some(message) = oscillators_refused(method, "the 3-D payload link") {
+        return Err(ModalError::invalid("time.method", message));
+    }
     let rtol = settings.rtol.unwrap_or(DEFAULT_TOL.0);
     let atol = settings.atol.unwrap_or(DEFAULT_TOL.1);
     if !(rtol > 0.0 && atol > 0.0 && rtol.is_finite() && atol.is_finite()) {
