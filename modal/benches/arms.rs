@@ -11,6 +11,12 @@
 //! `arm 1 s` runs the first simulated second of the undamped arm only
 //! (`cargo bench -p modal --bench arms -- 'arm 1 s'`).
 //!
+//! The undamped arm with the exponential integrator (`--method exponential`), whose error does
+//! not come from the modes' stiffness: at its default step (2/ω_max, ~8 000 steps per simulated
+//! second; 5.3e-6 rad from the default run's 20 Hz low-passed hub angle over 10 s) and at
+//! h = 2.5e-4 (1.5e-4 rad), in both groups (docs/backends.md, "The exponential method on the
+//! undamped arm"): `cargo bench -p modal --bench arms -- exponential`.
+//!
 //! With contact, the group `contact 3 s converged switching` runs `barhorst-case1` and
 //! `barhorst-case1-timoshenko` (3 s) at the resolution whose contact-episode boundaries lie
 //! within 1e-3 s of the converged ones (10 modes, adaptive TR-BDF2 at rtol 1e-3, atol 1e-5;
@@ -57,6 +63,24 @@ fn arms(c: &mut Criterion) {
             )
         })
     });
+    for dt in [None, Some(2.5e-4)] {
+        let exponential = Settings {
+            time: TimeStepping {
+                method: Some("exponential".parse().expect("a method name")),
+                dt,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let label = if dt.is_some() {
+            "2.5e-4"
+        } else {
+            "default step"
+        };
+        group.bench_function(format!("two-link-free-undamped exponential {label}"), |b| {
+            b.iter(|| black_box(ModalBackend.simulate(&undamped, &exponential).unwrap()))
+        });
+    }
     group.finish();
 }
 
@@ -83,6 +107,12 @@ fn arm_first_second(c: &mut Criterion) {
     group.bench_function("two-link-free-undamped trbdf2-fixed 2.5e-4", |b| {
         b.iter(|| black_box(ModalBackend.simulate(&undamped, &fixed).unwrap()))
     });
+    for (dt, label) in [(None, "default step"), (Some(2.5e-4), "2.5e-4")] {
+        let exponential = over_one_second(Some("exponential"), dt);
+        group.bench_function(format!("two-link-free-undamped exponential {label}"), |b| {
+            b.iter(|| black_box(ModalBackend.simulate(&undamped, &exponential).unwrap()))
+        });
+    }
     group.finish();
 }
 
