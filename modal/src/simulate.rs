@@ -160,6 +160,16 @@ pub fn simulate_detailed(
             ));
         }
     }
+    if method.needs_oscillators && (settings.rtol.is_some() || settings.atol.is_some()) {
+        return Err(ModalError::invalid(
+            "time.rtol/atol",
+            format!(
+                "`{}` takes no tolerance (fixed steps, no Newton iteration); its accuracy is set \
+                 by --dt (default 2/ω_max)",
+                method.name
+            ),
+        ));
+    }
     let fixed_step = method.is_fixed_step();
     let default_kelvin_voigt_method = settings.method.is_none() && std::ptr::eq(method, &TRBDF2);
     let (rtol_default, atol_default) = if default_kelvin_voigt_method {

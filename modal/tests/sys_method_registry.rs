@@ -128,9 +128,19 @@ fn sys_registry_models_without_oscillators_refuse_the_methods_that_need_them() {
             }
         }
     }
-    // An undamped chain without contact runs them.
+    // An undamped chain without contact runs them, and refuses a tolerance for them.
     let scene = load_scene("two-link-free-undamped").unwrap();
     for &&info in &needing {
+        let mut s = Settings::default();
+        s.time.method = Some(info.method.into());
+        s.time.rtol = Some(1e-6);
+        match modal::ModalBackend.simulate(&scene, &s) {
+            Err(BackendError::InvalidSettings { field, message }) => {
+                assert_eq!(field, "time.rtol/atol");
+                assert!(message.contains("--dt"), "{message}");
+            }
+            other => panic!("{info:?} with rtol: {other:?}"),
+        }
         let mut s = Settings::default();
         s.time.method = Some(info.method.into());
         s.time.t_end = Some(1e-2);
