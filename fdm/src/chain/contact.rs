@@ -205,18 +205,14 @@ impl TwoLinkChain {
 
     /// g(q) of full coordinates (uses the kernel scratch `qk`).
     pub fn gap(&mut self, q: &[f64]) -> f64 {
-        let mut qk = std::mem::take(&mut self.qk);
-        self.to_kinetic(q, &mut qk);
-        self.qk = qk;
+        self.set_kinetic_q(q);
         let ct = self.contact.clone().expect("contact");
         self.gap_on(&ct, &self.qk)
     }
 
     /// G = ∂g/∂q at q into `out` (for checks); returns g.
     pub fn gap_gradient(&mut self, q: &[f64], out: &mut [f64]) -> f64 {
-        let mut qk = std::mem::take(&mut self.qk);
-        self.to_kinetic(q, &mut qk);
-        self.qk = qk;
+        self.set_kinetic_q(q);
         let g = self.gap_row();
         out.copy_from_slice(&self.constraint.grow);
         g
@@ -227,9 +223,7 @@ impl TwoLinkChain {
         let tol = GAP_TOLERANCE * (self.links[0].length + self.links[1].length);
         let mut first = None;
         for _ in 0..3 {
-            let mut qk = std::mem::take(&mut self.qk);
-            self.to_kinetic(q, &mut qk);
-            self.qk = qk;
+            self.set_kinetic_q(q);
             let g = self.gap_row();
             first.get_or_insert(g.abs());
             if g.abs() <= tol {

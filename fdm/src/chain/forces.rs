@@ -41,7 +41,7 @@ impl TwoLinkChain {
         self.frames(q, qd);
         out.iter_mut().for_each(|x| *x = 0.0);
         self.inertia
-            .momenta_values(&self.qk, &self.vk, &mut self.points, out);
+            .momenta_at(&self.qk, &self.vk, &mut self.points, out);
         self.kinetic_transpose(out);
         self.add_section_inertias(qd, out);
     }
@@ -183,7 +183,7 @@ impl TwoLinkChain {
     /// n) is overwritten. The section inertias are constant.
     pub(super) fn add_inertia_terms(&mut self, scale: f64, scratch: &mut [f64], rhs: &mut [f64]) {
         self.inertia
-            .inertia_forces(&self.qk, &self.vk, &mut self.points, scratch);
+            .inertia_forces_at(&self.qk, &self.vk, &mut self.points, scratch);
         self.kinetic_transpose(scratch);
         self.add_scaled_inertia(scale, scratch, rhs);
     }

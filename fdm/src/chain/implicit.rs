@@ -186,10 +186,10 @@ impl TwoLinkChain {
             self.add_inertia_terms(w_current, a, &mut rhs);
         }
         if drift.w != 0.0 {
-            self.frames(q, drift.previous);
+            self.frames_velocity(drift.previous);
             self.add_inertia_terms(-drift.w, a, &mut rhs);
         }
-        self.frames(q, drift.current);
+        self.frames_velocity(drift.current);
         self.build_columns();
         self.add_damping_forces(drift.current, &mut rhs);
         self.solve_damped_mass(tau, &rhs, a);

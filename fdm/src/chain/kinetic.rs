@@ -110,6 +110,16 @@ pub fn seg_grad(u: &[f64], h: f64, c: Option<&[f64]>, k: usize) -> f64 {
     d
 }
 
+/// [`seg_grad`] from the slopes `g` already taken (weights `c`).
+#[inline]
+fn seg_grad_at(g: &[f64], c: &[f64], k: usize) -> f64 {
+    let mut d = c[k] * g[k];
+    if k + 1 < g.len() {
+        d -= c[k + 1] * g[k + 1];
+    }
+    d
+}
+
 impl ChainInertia {
     pub fn dofs(&self) -> usize {
         2 + self.r1 + self.r2
@@ -134,8 +144,21 @@ impl ChainInertia {
     }
 }
 
+/// The configuration's part of every product with B or Bᵀ at q: each link's segment slopes g
+/// and running foreshortening s_k = ½h Σ_{seg ≤ k} g_seg² (zero without foreshortening). One
+/// step evaluates B and Bᵀ at one q several times (M's columns, Γ at two drift velocities), and
+/// the slopes' divisions dominated each pass.
+#[derive(Debug, Clone)]
+pub struct Shape {
+    pub g1: Vec<f64>,
+    pub g2: Vec<f64>,
+    pub s1: Vec<f64>,
+    pub s2: Vec<f64>,
+}
+
 /// Per-point scratch of the kinetic energy: velocity components (with their derivative along
-/// q̇, or values only), per-point forces and the outboard sums of the transpose.
+/// q̇, or values only), per-point forces, the outboard sums of the transpose and the
+/// [`Shape`] of the configuration the `_at` products read.
 #[derive(Debug, Clone)]
 pub struct PointScratch {
     pub x: Vec<Dual>,
@@ -146,6 +169,7 @@ pub struct PointScratch {
     pub fy: Vec<f64>,
     pub c1: Vec<f64>,
     pub c2: Vec<f64>,
+    pub shape: Shape,
 }
 
 impl PointScratch {
@@ -160,6 +184,12 @@ impl PointScratch {
             fy: vec![0.0; n],
             c1: vec![0.0; ine.r1],
             c2: vec![0.0; ine.r2],
+            shape: Shape {
+                g1: vec![0.0; ine.r1],
+                g2: vec![0.0; ine.r2],
+                s1: vec![0.0; ine.r1],
+                s2: vec![0.0; ine.r2],
+            },
         }
     }
 }
@@ -225,23 +255,60 @@ impl ChainInertia {
         }
     }
 
+    /// The [`Shape`] of q into `sc.shape`: what the `_at` products read (the slopes and
+    /// foreshortenings [`Self::point_velocities`] and the transpose compute, the same
+    /// operations in the same order, so the values are those bits).
+    pub fn set_shape(&self, q: &[f64], sc: &mut PointScratch) {
+        let sh = &mut sc.shape;
+        for (u, h, fs, g, s) in [
+            (&q[self.iv()], self.h1, self.fs1, &mut sh.g1, &mut sh.s1),
+            (&q[self.iw()], self.h2, self.fs2, &mut sh.g2, &mut sh.s2),
+        ] {
+            let mut acc = 0.0;
+            for k in 0..u.len() {
+                if fs {
+                    let gk = slope(u, k, h);
+                    g[k] = gk;
+                    acc += 0.5 * h * gk.powi(2);
+                } else {
+                    g[k] = 0.0;
+                }
+                s[k] = acc;
+            }
+        }
+    }
+
     /// out = Bᵀ f: the generalized forces of per-point forces (fx, fy) in the link frames.
     pub fn apply_transpose(&self, q: &[f64], sc: &mut PointScratch, out: &mut [f64]) {
+        self.set_shape(q, sc);
+        self.apply_transpose_at(q, sc, out);
+    }
+
+    /// [`Self::apply_transpose`] with the shape of q already in `sc` ([`Self::set_shape`]).
+    pub fn apply_transpose_at(&self, q: &[f64], sc: &mut PointScratch, out: &mut [f64]) {
         let (v, w) = (&q[self.iv()], &q[self.iw()]);
         let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
         let (sn, c) = (q[BE] - q[TH]).sin_cos();
-        let (fx, fy) = (&sc.fx, &sc.fy);
+        let PointScratch {
+            fx,
+            fy,
+            c1,
+            c2,
+            shape,
+            ..
+        } = sc;
+        let (fx, fy) = (&fx[..r1 + 1 + r2], &fy[..r1 + 1 + r2]);
+        let (g1, s1) = (&shape.g1[..r1], &shape.s1[..r1]);
+        let (g2, s2) = (&shape.g2[..r2], &shape.s2[..r2]);
+        let (c1, c2) = (&mut c1[..r1], &mut c2[..r2]);
         let off = 2 + r1;
+        let out = &mut out[..off + r2];
         // link 2: β, the rates ẇ, the outboard sums of −fx for σ̇, the elbow force
         let (mut qb, mut gx, mut gy) = (0.0, fx[r1], fy[r1]);
-        let mut sg = 0.0;
         let mut acc = 0.0;
         for j in 0..r2 {
-            if self.fs2 {
-                sg += 0.5 * h2 * slope(w, j, h2).powi(2);
-            }
             let (a, b) = (fx[r1 + 1 + j], fy[r1 + 1 + j]);
-            qb += -a * w[j] + b * ((j + 1) as f64 * h2 - sg);
+            qb += -a * w[j] + b * ((j + 1) as f64 * h2 - s2[j]);
             out[off + j] = b;
             gx += c * a - sn * b;
             gy += sn * a + c * b;
@@ -249,35 +316,31 @@ impl ChainInertia {
         if self.fs2 {
             for j in (0..r2).rev() {
                 acc -= fx[r1 + 1 + j];
-                sc.c2[j] = acc;
+                c2[j] = acc;
             }
             for j in 0..r2 {
-                out[off + j] += seg_grad(w, h2, Some(&sc.c2), j);
+                out[off + j] += seg_grad_at(g2, c2, j);
             }
         }
         // link 1 with the elbow force at its tip station
         let mut qt = 0.0;
-        let mut s = 0.0;
         for k in 0..r1 {
-            if self.fs1 {
-                s += 0.5 * h1 * slope(v, k, h1).powi(2);
-            }
             let (mut a, mut b) = (fx[k], fy[k]);
             if k == r1 - 1 {
                 a += gx;
                 b += gy;
             }
-            qt += -a * v[k] + b * ((k + 1) as f64 * h1 - s);
+            qt += -a * v[k] + b * ((k + 1) as f64 * h1 - s1[k]);
             out[2 + k] = b;
         }
         if self.fs1 {
             let mut acc = -gx;
             for k in (0..r1).rev() {
                 acc -= fx[k];
-                sc.c1[k] = acc;
+                c1[k] = acc;
             }
             for k in 0..r1 {
-                out[2 + k] += seg_grad(v, h1, Some(&sc.c1), k);
+                out[2 + k] += seg_grad_at(g1, c1, k);
             }
         }
         out[TH] = qt;
@@ -296,26 +359,126 @@ impl ChainInertia {
 
     /// p = ∂T/∂q̇ = M q̇ into the first [`Self::dofs`] entries of `out`.
     pub fn momenta_values(&self, q: &[f64], qd: &[f64], sc: &mut PointScratch, out: &mut [f64]) {
-        self.point_velocities(q, q, qd, &mut sc.xv, &mut sc.yv);
-        for p in 0..self.points() {
-            let m = self.point_mass(p);
-            sc.fx[p] = m * sc.xv[p];
-            sc.fy[p] = m * sc.yv[p];
+        self.set_shape(q, sc);
+        self.momenta_at(q, qd, sc, out);
+    }
+
+    /// [`Self::momenta_values`] with the shape of q already in `sc` ([`Self::set_shape`]):
+    /// [`Self::point_velocities`]' values from the shape's slopes.
+    pub fn momenta_at(&self, q: &[f64], qd: &[f64], sc: &mut PointScratch, out: &mut [f64]) {
+        let (v, vd) = (&q[self.iv()], &qd[self.iv()]);
+        let (w, wd) = (&q[self.iw()], &qd[self.iw()]);
+        let (thd, bed) = (qd[TH], qd[BE]);
+        let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
+        let PointScratch {
+            xv,
+            yv,
+            fx,
+            fy,
+            shape,
+            ..
+        } = &mut *sc;
+        let np = r1 + 1 + r2;
+        let (xs, ys) = (&mut xv[..np], &mut yv[..np]);
+        let (fx, fy) = (&mut fx[..np], &mut fy[..np]);
+        let (g1, s1) = (&shape.g1[..r1], &shape.s1[..r1]);
+        let (g2, s2) = (&shape.g2[..r2], &shape.s2[..r2]);
+        let mut sd = 0.0;
+        for k in 0..r1 {
+            if self.fs1 {
+                sd += g1[k] * (h1 * slope(vd, k, h1));
+            }
+            xs[k] = -(v[k] * thd) - sd;
+            ys[k] = ((k + 1) as f64 * h1 - s1[k]) * thd + vd[k];
         }
-        self.apply_transpose(q, sc, out);
+        let (ex, ey) = (xs[r1 - 1], ys[r1 - 1]);
+        xs[r1] = ex;
+        ys[r1] = ey;
+        let phi = q[BE] - q[TH];
+        let (sn, c) = (phi.sin(), phi.cos());
+        let (xe, ye) = (c * ex + sn * ey, c * ey - sn * ex);
+        let mut sgd = 0.0;
+        for j in 0..r2 {
+            if self.fs2 {
+                sgd += g2[j] * (h2 * slope(wd, j, h2));
+            }
+            xs[r1 + 1 + j] = xe - w[j] * bed - sgd;
+            ys[r1 + 1 + j] = ye + ((j + 1) as f64 * h2 - s2[j]) * bed + wd[j];
+        }
+        for p in 0..np {
+            let m = self.point_mass(p);
+            fx[p] = m * xs[p];
+            fy[p] = m * ys[p];
+        }
+        self.apply_transpose_at(q, sc, out);
         out[TH] += self.hub * qd[TH];
     }
 
     /// out = −Σ m Bᵀ[(∂(Bq̇)/∂q)q̇ + α̇J(X, Y)]: the inertia forces at q̈ = 0 (module docs).
     pub fn inertia_forces(&self, q: &[f64], qd: &[f64], sc: &mut PointScratch, out: &mut [f64]) {
-        self.point_velocities(q, qd, qd, &mut sc.x, &mut sc.y);
-        for p in 0..self.points() {
-            let rate = if p <= self.r1 { qd[TH] } else { qd[BE] };
-            let m = self.point_mass(p);
-            let (x, y) = (sc.x[p], sc.y[p]);
-            sc.fx[p] = -m * (x.du - rate * y.re);
-            sc.fy[p] = -m * (y.du + rate * x.re);
+        self.set_shape(q, sc);
+        self.inertia_forces_at(q, qd, sc, out);
+    }
+
+    /// [`Self::inertia_forces`] with the shape of q already in `sc` ([`Self::set_shape`]):
+    /// [`Self::point_velocities`]' dual pass along q̇ with the values of the slopes from the
+    /// shape and the slope of q̇ (the derivative part and the rate) taken once.
+    pub fn inertia_forces_at(&self, q: &[f64], qd: &[f64], sc: &mut PointScratch, out: &mut [f64]) {
+        let (v, vd) = (&q[self.iv()], &qd[self.iv()]);
+        let (w, wd) = (&q[self.iw()], &qd[self.iw()]);
+        let (thd, bed) = (qd[TH], qd[BE]);
+        let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
+        let PointScratch {
+            x,
+            y,
+            fx,
+            fy,
+            shape,
+            ..
+        } = &mut *sc;
+        let np = r1 + 1 + r2;
+        let (xs, ys) = (&mut x[..np], &mut y[..np]);
+        let (fx, fy) = (&mut fx[..np], &mut fy[..np]);
+        let g1 = &shape.g1[..r1];
+        let g2 = &shape.g2[..r2];
+        let zero = Dual::default();
+        let (mut s, mut sd) = (zero, zero);
+        for k in 0..r1 {
+            if self.fs1 {
+                let gd = slope(vd, k, h1);
+                let g = Dual::new(g1[k], gd);
+                s = s + g * g * (0.5 * h1);
+                sd = sd + g * (h1 * gd);
+            }
+            let vk = Dual::new(v[k], vd[k]);
+            xs[k] = -(vk * thd) - sd;
+            ys[k] = (Dual::constant((k + 1) as f64 * h1) - s) * thd + vd[k];
         }
-        self.apply_transpose(q, sc, out);
+        let (ex, ey) = (xs[r1 - 1], ys[r1 - 1]);
+        xs[r1] = ex;
+        ys[r1] = ey;
+        let phi = Dual::new(q[BE] - q[TH], qd[BE] - qd[TH]);
+        let (sn, c) = (phi.sin(), phi.cos());
+        let (xe, ye) = (c * ex + sn * ey, c * ey - sn * ex);
+        let (mut sg, mut sgd) = (zero, zero);
+        for j in 0..r2 {
+            if self.fs2 {
+                let gd = slope(wd, j, h2);
+                let g = Dual::new(g2[j], gd);
+                sg = sg + g * g * (0.5 * h2);
+                sgd = sgd + g * (h2 * gd);
+            }
+            let wj = Dual::new(w[j], wd[j]);
+            xs[r1 + 1 + j] = xe - wj * bed - sgd;
+            ys[r1 + 1 + j] = ye + (Dual::constant((j + 1) as f64 * h2) - sg) * bed + wd[j];
+        }
+        for p in 0..np {
+            let rate = if p <= r1 { thd } else { bed };
+            let m = self.point_mass(p);
+            let (x, y) = (xs[p], ys[p]);
+            fx[p] = -m * (x.du - rate * y.re);
+            fy[p] = -m * (y.du + rate * x.re);
+        }
+        self.apply_transpose_at(q, sc, out);
     }
 }

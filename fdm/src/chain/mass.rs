@@ -79,7 +79,7 @@ impl TwoLinkChain {
                 }
             }
             self.inertia
-                .momenta_values(&self.qk, &self.unit, &mut self.points, &mut self.cols[c]);
+                .momenta_at(&self.qk, &self.unit, &mut self.points, &mut self.cols[c]);
             self.unit[frame] = 0.0;
             if c >= 2 {
                 self.unit[first..=slot].iter_mut().for_each(|x| *x = 0.0);
@@ -229,7 +229,7 @@ impl TwoLinkChain {
         self.to_kinetic(x, &mut xk);
         out.iter_mut().for_each(|o| *o = 0.0);
         self.inertia
-            .momenta_values(&self.qk, &xk, &mut self.points, out);
+            .momenta_at(&self.qk, &xk, &mut self.points, out);
         self.vd = xk;
         self.kinetic_transpose(out);
         self.add_section_inertias(x, out);

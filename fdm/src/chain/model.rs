@@ -211,16 +211,31 @@ impl TwoLinkChain {
     /// kernel's coordinates ([`Self::to_kinetic`]: the clamp-tangent frames).
     pub(super) fn frames(&mut self, q: &[f64], v: &[f64]) {
         self.qc.copy_from_slice(q);
-        self.vc.copy_from_slice(v);
         for s in self.ghosts() {
             self.qc[s] = 0.0;
+        }
+        self.set_kinetic_q(q);
+        self.frames_velocity(v);
+    }
+
+    /// [`Self::frames`] at the q of the last call: only the velocity copies `vc`, `vk` change.
+    pub(super) fn frames_velocity(&mut self, v: &[f64]) {
+        self.vc.copy_from_slice(v);
+        for s in self.ghosts() {
             self.vc[s] = 0.0;
         }
-        let (mut qk, mut vk) = (std::mem::take(&mut self.qk), std::mem::take(&mut self.vk));
-        self.to_kinetic(q, &mut qk);
+        let mut vk = std::mem::take(&mut self.vk);
         self.to_kinetic(v, &mut vk);
-        self.qk = qk;
         self.vk = vk;
+    }
+
+    /// `qk` ← the kernel's coordinates of q, with their shape in the point scratch (what the
+    /// mass columns, M x and the inertia terms read): every write of `qk` goes through here.
+    pub(super) fn set_kinetic_q(&mut self, q: &[f64]) {
+        let mut qk = std::mem::take(&mut self.qk);
+        self.to_kinetic(q, &mut qk);
+        self.inertia.set_shape(&qk, &mut self.points);
+        self.qk = qk;
     }
 
     /// The frame-angle slot, the first station, the ghost slot and the step of link ℓ.

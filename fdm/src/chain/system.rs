@@ -86,12 +86,17 @@ impl System for TwoLinkChain {
             self.frames(q, v);
             self.forces(t, q, v, &mut rhs);
             self.split_reuse.rest.copy_from_slice(&rhs);
-            self.frames(q, inertia.current);
+            self.frames_velocity(inertia.current);
             self.add_inertia_terms(1.0 + inertia.w, a, &mut rhs);
             self.split_reuse.current_forces.copy_from_slice(a);
         }
         if inertia.w != 0.0 {
-            self.frames(q, inertia.previous);
+            // the reused pass's q equals the first pass's only as numbers (±0)
+            if reuse {
+                self.frames(q, inertia.previous);
+            } else {
+                self.frames_velocity(inertia.previous);
+            }
             self.add_inertia_terms(-inertia.w, a, &mut rhs);
         }
         if !reuse {
