@@ -3,34 +3,88 @@
 //! with P and N⁻¹ positive definite (Vanderbei: the pivots of the first block stay positive,
 //! those of the second negative). O(n·k²) with half-bandwidth k, no allocation after
 //! construction.
+//!
+//! **Envelope.** Row i may start later than i − k (its first column `first[i]`): L has no fill
+//! left of a row's first nonzero, so the factor and the solves skip those columns, and rows
+//! that start at or after a row r (every one) split the matrix into independent diagonal
+//! blocks, solved one at a time. The skipped terms are products with zeros, so the sums that
+//! remain are the full band's in the same order.
 
 // Index loops over the band read like the factorization.
 #![allow(clippy::needless_range_loop)]
 
+use std::ops::Range;
+
 /// Largest half-bandwidth [`BandLdl`] factors (its row scratch lives on the stack).
 pub const MAX_HALF_BANDWIDTH: usize = 16;
 
-/// A = L D Lᵀ with L unit lower triangular of half-bandwidth `k`, stored by rows.
+/// A = L D Lᵀ with L unit lower triangular of half-bandwidth `k` inside an envelope, stored by
+/// rows (and L's columns again for the back substitution).
 #[derive(Debug, Clone, Default)]
 pub struct BandLdl {
     n: usize,
     k: usize,
+    /// first column of row i (≥ i − k): A and L are zero left of it
+    first: Vec<usize>,
+    /// last row whose envelope reaches column j
+    last: Vec<usize>,
+    /// whether no row at or after i reaches left of i (a block starts at i)
+    block_start: Vec<bool>,
     /// row i holds A[i, i−k..=i] before and L[i, i−k..i] (and D at the diagonal) after factor
     a: Vec<f64>,
+    /// after factor: column j of L below the diagonal, L[j+1..=j+k, j] (zero outside the
+    /// envelope)
+    lc: Vec<f64>,
 }
 
 impl BandLdl {
     /// Storage for an n × n matrix of half-bandwidth k, all zero.
     pub fn new(n: usize, k: usize) -> Self {
+        Self::with_envelope((0..n).map(|i| i.saturating_sub(k)).collect())
+    }
+
+    /// Storage for the matrix whose row i has its entries in columns `first[i]..=i` (and
+    /// their symmetric ones), all zero; the half-bandwidth is the widest row's.
+    pub fn with_envelope(first: Vec<usize>) -> Self {
+        let n = first.len();
+        assert!(
+            first.iter().enumerate().all(|(i, &f)| f <= i),
+            "a row starts right of its diagonal"
+        );
+        let k = first
+            .iter()
+            .enumerate()
+            .map(|(i, &f)| i - f)
+            .max()
+            .unwrap_or(0);
+        let mut last: Vec<usize> = (0..n).collect();
+        for (i, &f) in first.iter().enumerate() {
+            for j in f..i {
+                last[j] = last[j].max(i);
+            }
+        }
+        let mut block_start = vec![true; n + 1];
+        let mut reach = n;
+        for i in (0..n).rev() {
+            reach = reach.min(first[i]);
+            block_start[i] = reach >= i;
+        }
         BandLdl {
             n,
             k,
+            first,
+            last,
+            block_start,
             a: vec![0.0; n * (k + 1)],
+            lc: vec![0.0; n * k],
         }
     }
 
     fn at(&self, i: usize, j: usize) -> usize {
-        debug_assert!(j <= i && i - j <= self.k, "({i}, {j}) outside the band");
+        assert!(
+            j <= i && j >= self.first[i],
+            "({i}, {j}) outside the envelope"
+        );
         i * (self.k + 1) + self.k - (i - j)
     }
 
@@ -43,7 +97,7 @@ impl BandLdl {
     /// [`Self::factor`]), both triangles, row by row of the lower one.
     pub fn entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
         (0..self.n).flat_map(move |i| {
-            (i.saturating_sub(self.k)..=i).flat_map(move |j| {
+            (self.first[i]..=i).flat_map(move |j| {
                 let v = self.a[self.at(i, j)];
                 let lower = (v != 0.0).then_some((i, j, v));
                 let upper = (v != 0.0 && i != j).then_some((j, i, v));
@@ -57,15 +111,15 @@ impl BandLdl {
         self.a.iter_mut().for_each(|x| *x = 0.0);
     }
 
-    /// A[i, j] += v for |i − j| ≤ k (the symmetric entry is implied).
+    /// A[i, j] += v inside the envelope (the symmetric entry is implied).
     pub fn add(&mut self, i: usize, j: usize, v: f64) {
         let (i, j) = if i >= j { (i, j) } else { (j, i) };
         let p = self.at(i, j);
         self.a[p] += v;
     }
 
-    /// Factors in place. Err(j): pivot j is zero or not finite. `scratch` holds row j of L
-    /// times D while column j is eliminated.
+    /// Factors in place. Err(j): pivot j is zero or not finite. `ld` holds row j of L times D
+    /// while column j is eliminated.
     pub fn factor(&mut self) -> Result<(), usize> {
         let (n, k, w) = (self.n, self.k, self.k + 1);
         let mut ld = [0.0; MAX_HALF_BANDWIDTH];
@@ -73,59 +127,135 @@ impl BandLdl {
             k <= MAX_HALF_BANDWIDTH,
             "half-bandwidth {k} above {MAX_HALF_BANDWIDTH}"
         );
+        let (a, lc) = (&mut self.a[..n * w], &mut self.lc[..n * k]);
         for j in 0..n {
-            let lo = j.saturating_sub(k);
-            let row_j = j * w + w - 1 - (j - lo);
-            let mut d = self.a[j * w + w - 1];
-            for (t, m) in (lo..j).enumerate() {
-                let l = self.a[row_j + t];
-                ld[t] = l * self.a[m * w + w - 1];
+            let fj = self.first[j];
+            let row_j = j * w + w - 1 - (j - fj);
+            let mut d = a[j * w + w - 1];
+            for (t, m) in (fj..j).enumerate() {
+                let l = a[row_j + t];
+                ld[t] = l * a[m * w + w - 1];
                 d -= l * ld[t];
             }
             if d == 0.0 || !d.is_finite() {
                 return Err(j);
             }
-            self.a[j * w + w - 1] = d;
-            for i in j + 1..(j + k + 1).min(n) {
-                // row i's entries at columns lo_i..j against row j's L·D
-                let lo_i = i - k.min(i);
-                let row_i = i * w + w - 1 - (i - lo_i);
-                let mut s = self.a[row_i + (j - lo_i)];
-                for m in lo_i.max(lo)..j {
-                    s -= self.a[row_i + (m - lo_i)] * ld[m - lo];
+            a[j * w + w - 1] = d;
+            let col = &mut lc[j * k..j * k + k];
+            for i in j + 1..=self.last[j] {
+                let fi = self.first[i];
+                if fi > j {
+                    col[i - j - 1] = 0.0;
+                    continue;
                 }
-                self.a[row_i + (j - lo_i)] = s / d;
+                // row i's entries at columns fi..j against row j's L·D
+                let row_i = i * w + w - 1 - (i - fi);
+                let lo = fi.max(fj);
+                let li = &a[row_i + (lo - fi)..row_i + (j - fi)];
+                let mut s = a[row_i + (j - fi)];
+                for (l, x) in li.iter().zip(&ld[lo - fj..j - fj]) {
+                    s -= l * x;
+                }
+                let l = s / d;
+                a[row_i + (j - fi)] = l;
+                col[i - j - 1] = l;
             }
         }
         Ok(())
     }
 
     /// X ← A⁻¹X for `m` right-hand sides stored by rows (X[i·m + c]): one sweep for all, L
-    /// by rows, D, then Lᵀ with the rows of L read as its columns (contiguous band rows).
+    /// by rows, then D and Lᵀ together, each row of the solution gathered from L's column.
     pub fn solve_rows_in_place(&self, x: &mut [f64], m: usize) {
-        let (n, w) = (self.n, self.k + 1);
-        for i in 0..n {
-            let lo = i.saturating_sub(self.k);
-            let (done, rest) = x.split_at_mut(i * m);
+        self.solve_block_rows_in_place(0..self.n, x, m);
+    }
+
+    /// As [`Self::solve_rows_in_place`] on the diagonal block `rows` alone (`x` holds its
+    /// rows): the block must not couple to the rest ([`Self::is_block`]).
+    pub fn solve_block_rows_in_place(&self, rows: Range<usize>, x: &mut [f64], m: usize) {
+        assert!(
+            self.is_block(rows.clone()),
+            "{rows:?} couples to other rows"
+        );
+        let x = &mut x[..rows.len() * m];
+        match m {
+            1 => self.solve_block::<1>(rows, x.as_chunks_mut().0),
+            2 => self.solve_block::<2>(rows, x.as_chunks_mut().0),
+            3 => self.solve_block::<3>(rows, x.as_chunks_mut().0),
+            4 => self.solve_block::<4>(rows, x.as_chunks_mut().0),
+            5 => self.solve_block::<5>(rows, x.as_chunks_mut().0),
+            6 => self.solve_block::<6>(rows, x.as_chunks_mut().0),
+            7 => self.solve_block::<7>(rows, x.as_chunks_mut().0),
+            8 => self.solve_block::<8>(rows, x.as_chunks_mut().0),
+            _ => self.solve_block_any(rows, x, m),
+        }
+    }
+
+    /// Whether the rows `rows` form a diagonal block that no other row reaches.
+    pub fn is_block(&self, rows: Range<usize>) -> bool {
+        rows.start <= rows.end
+            && rows.end <= self.n
+            && self.block_start[rows.start]
+            && self.block_start[rows.end]
+    }
+
+    /// The solve of one block with `M` right-hand sides per row, each row's in registers.
+    fn solve_block<const M: usize>(&self, rows: Range<usize>, x: &mut [[f64; M]]) {
+        let (w, k, r0) = (self.k + 1, self.k, rows.start);
+        for i in rows.clone() {
+            let fi = self.first[i];
+            let li = &self.a[i * w + w - 1 - (i - fi)..i * w + w - 1];
+            let (done, rest) = x.split_at_mut(i - r0);
+            let mut xi = rest[0];
+            for (l, xj) in li.iter().zip(&done[fi - r0..]) {
+                for c in 0..M {
+                    xi[c] -= l * xj[c];
+                }
+            }
+            rest[0] = xi;
+        }
+        for j in rows.rev() {
+            let d = self.a[j * w + w - 1];
+            let below = self.last[j] - j;
+            let lj = &self.lc[j * k..j * k + below];
+            let (head, tail) = x.split_at_mut(j - r0 + 1);
+            let mut xj = head[j - r0];
+            for c in 0..M {
+                xj[c] /= d;
+            }
+            for (l, xi) in lj.iter().zip(&tail[..below]).rev() {
+                for c in 0..M {
+                    xj[c] -= l * xi[c];
+                }
+            }
+            head[j - r0] = xj;
+        }
+    }
+
+    /// [`Self::solve_block`] for any number of right-hand sides.
+    fn solve_block_any(&self, rows: Range<usize>, x: &mut [f64], m: usize) {
+        let (w, k, r0) = (self.k + 1, self.k, rows.start);
+        for i in rows.clone() {
+            let fi = self.first[i];
+            let li = &self.a[i * w + w - 1 - (i - fi)..i * w + w - 1];
+            let (done, rest) = x.split_at_mut((i - r0) * m);
             let xi = &mut rest[..m];
-            for (t, j) in (lo..i).enumerate() {
-                let l = self.a[i * w + w - 1 - (i - lo) + t];
+            for (t, l) in li.iter().enumerate() {
+                let j = fi - r0 + t;
                 for (v, u) in xi.iter_mut().zip(&done[j * m..j * m + m]) {
                     *v -= l * u;
                 }
             }
         }
-        for i in 0..n {
-            let d = self.a[i * w + w - 1];
-            x[i * m..i * m + m].iter_mut().for_each(|v| *v /= d);
-        }
-        for i in (0..n).rev() {
-            let lo = i.saturating_sub(self.k);
-            let (head, rest) = x.split_at_mut(i * m);
-            let xi = &rest[..m];
-            for (t, j) in (lo..i).enumerate() {
-                let l = self.a[i * w + w - 1 - (i - lo) + t];
-                for (v, u) in head[j * m..j * m + m].iter_mut().zip(xi) {
+        for j in rows.rev() {
+            let d = self.a[j * w + w - 1];
+            let below = self.last[j] - j;
+            let lj = &self.lc[j * k..j * k + below];
+            let (head, tail) = x.split_at_mut((j - r0 + 1) * m);
+            let xj = &mut head[(j - r0) * m..];
+            xj.iter_mut().for_each(|v| *v /= d);
+            for (t, l) in lj.iter().enumerate().rev() {
+                for (v, u) in xj.iter_mut().zip(&tail[t * m..t * m + m]) {
                     *v -= l * u;
                 }
             }
@@ -205,6 +335,65 @@ mod tests {
                 assert!(
                     (x - y[(i, c)]).abs() < 1e-12 * (1.0 + y[(i, c)].abs()),
                     "x[{i}, {c}]"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn elem_band_ldl_envelope_gives_the_full_bands_bits_block_by_block() {
+        // two uncoupled saddle blocks interleaved as the implicit kick's (rows of the first
+        // block start up to 4 left, the multipliers' 3), stored once in their envelope and once
+        // in the full band of half-bandwidth 5: the envelope's factor and solves skip products
+        // with zeros only, so every bit agrees, and each block solves alone
+        let blocks = [0..19, 19..38];
+        let n = 38;
+        let mut first = vec![0; n];
+        let mut entries = Vec::new();
+        for b in &blocks {
+            let (r0, len) = (b.start, b.len());
+            for i in 0..len {
+                let at = r0 + i;
+                let reach = if i % 2 == 0 { 4 } else { 3 };
+                first[at] = r0 + i.saturating_sub(reach);
+                for j in first[at]..at {
+                    let v = ((at * 7 + j * 3) as f64 * 0.31).sin() * 0.2;
+                    entries.push((at, j, v));
+                }
+                let d = if i % 2 == 0 { 4.0 } else { -3.0 };
+                entries.push((at, at, d + 0.1 * (i as f64).cos()));
+            }
+        }
+        let mut envelope = BandLdl::with_envelope(first);
+        let mut full = BandLdl::new(n, 5);
+        for &(i, j, v) in &entries {
+            envelope.add(i, j, v);
+            full.add(j, i, v);
+        }
+        assert!(envelope.is_block(blocks[0].clone()) && envelope.is_block(blocks[1].clone()));
+        assert!(!envelope.is_block(0..20));
+        envelope.factor().unwrap();
+        full.factor().unwrap();
+        for m in [1usize, 3, 7, 8, 11] {
+            let rhs: Vec<f64> = (0..n * m).map(|k| (0.37 * k as f64).cos() + 0.1).collect();
+            let mut x_full = rhs.clone();
+            full.solve_rows_in_place(&mut x_full, m);
+            let mut x_env = rhs.clone();
+            envelope.solve_rows_in_place(&mut x_env, m);
+            let mut x_blocks = rhs.clone();
+            for b in &blocks {
+                envelope.solve_block_rows_in_place(
+                    b.clone(),
+                    &mut x_blocks[b.start * m..b.end * m],
+                    m,
+                );
+            }
+            for k in 0..n * m {
+                assert_eq!(x_env[k].to_bits(), x_full[k].to_bits(), "m {m}, entry {k}");
+                assert_eq!(
+                    x_blocks[k].to_bits(),
+                    x_full[k].to_bits(),
+                    "m {m}, entry {k}"
                 );
             }
         }
