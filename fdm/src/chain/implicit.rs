@@ -92,14 +92,16 @@ impl TwoLinkChain {
                 }
             }
         }
-        let (at_band, at_segment, k) = self.saddle_layout(&band);
+        let (at_band, at_segment) = self.saddle_layout(&band);
         let size = at_segment[1].last().map_or(0, |p| p + 1);
+        let saddle =
+            BandLdl::with_envelope(self.saddle_envelope(size, &at_band, &at_segment, [&c1, &c2]));
         self.implicit = Some(Box::new(ImplicitDamping {
             c0,
             c1,
             c2,
             cf,
-            saddle: BandLdl::new(size, k),
+            saddle,
             at_band,
             at_segment,
             y: vec![0.0; size * (MAX_SMALL + 1)],
@@ -118,8 +120,8 @@ impl TwoLinkChain {
     /// Positions of the saddle system's unknowns, interleaved by station so that it is banded:
     /// per link the deflection of station i, then the multiplier of segment i, and the last
     /// segment's multiplier after the link's last station. Returns the positions of the band
-    /// unknowns, of each link's segment multipliers, and the half-bandwidth.
-    fn saddle_layout(&self, band: &[usize]) -> (Vec<usize>, [Vec<usize>; 2], usize) {
+    /// unknowns and of each link's segment multipliers.
+    fn saddle_layout(&self, band: &[usize]) -> (Vec<usize>, [Vec<usize>; 2]) {
         let mut at_band = vec![0; band.len()];
         let mut at_segment: [Vec<usize>; 2] = [Vec::new(), Vec::new()];
         let mut pos = 0;
@@ -135,30 +137,50 @@ impl TwoLinkChain {
             at_segment[link].push(pos);
             pos += 1;
         }
-        let mut k = 0;
-        for b in 0..band.len() {
-            for d in 1..3 {
-                if b + d < band.len() {
-                    k = k.max(at_band[b + d] - at_band[b]);
-                }
+        (at_band, at_segment)
+    }
+
+    /// The first column of each row of the saddle system: its entries are those
+    /// `assemble_saddle` adds, C's sub-diagonals where they are not zero (C is constant; the
+    /// links' blocks do not couple), G and N⁻¹ always (the slopes change).
+    fn saddle_envelope(
+        &self,
+        size: usize,
+        at_band: &[usize],
+        at_segment: &[Vec<usize>; 2],
+        [c1, c2]: [&[f64]; 2],
+    ) -> Vec<usize> {
+        let mut first: Vec<usize> = (0..size).collect();
+        let mut reach = |i: usize, j: usize| {
+            let (i, j) = (i.max(j), i.min(j));
+            first[i] = first[i].min(j);
+        };
+        let nb = at_band.len();
+        for b in 0..nb {
+            if b + 1 < nb && c1[b] != 0.0 {
+                reach(at_band[b + 1], at_band[b]);
+            }
+            if b + 2 < nb && c2[b] != 0.0 {
+                reach(at_band[b + 2], at_band[b]);
             }
         }
-        let mut first = 0;
-        for (link, segs) in at_segment.iter().enumerate() {
+        let mut start = 0;
+        for segs in at_segment {
             let r = segs.len();
             for seg in 0..r {
-                if seg + 1 < r {
-                    k = k.max(segs[seg + 1] - segs[seg]);
+                if seg < r - 1 {
+                    reach(segs[seg], at_band[start + seg]);
                 }
-                for i in [seg.wrapping_sub(1), seg] {
-                    if i < r - 1 {
-                        k = k.max(segs[seg].abs_diff(at_band[first + i]));
-                    }
+                if seg >= 1 {
+                    reach(segs[seg], at_band[start + seg - 1]);
+                }
+                if seg + 1 < r {
+                    reach(segs[seg + 1], segs[seg]);
                 }
             }
-            first += self.deflections(link).len();
+            start += r - 1;
         }
-        (at_band, at_segment, k)
+        first
     }
 
     /// Whether the damping is implicit (the bound then leaves it out).
@@ -390,10 +412,11 @@ impl TwoLinkChain {
         saddle.clear();
         for b in 0..nb {
             saddle.add(at_band[b], at_band[b], self.diag_mass(band[b]) + ht * c0[b]);
-            if b + 1 < nb {
+            // a zero of C is no entry of the envelope (adding it changed nothing)
+            if b + 1 < nb && c1[b] != 0.0 {
                 saddle.add(at_band[b + 1], at_band[b], ht * c1[b]);
             }
-            if b + 2 < nb {
+            if b + 2 < nb && c2[b] != 0.0 {
                 saddle.add(at_band[b + 2], at_band[b], ht * c2[b]);
             }
         }
