@@ -5,6 +5,8 @@
 // Index loops over band positions read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
+use std::ops::Range;
+
 use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
 use crate::band_ldl::BandLdl;
 
@@ -25,12 +27,11 @@ pub struct ImplicitDamping {
     /// segment multipliers
     pub(super) at_band: Vec<usize>,
     pub(super) at_segment: [Vec<usize>; 2],
-    /// saddle-system scratch: the right-hand sides of a solve by rows
-    pub(super) y: Vec<f64>,
-    /// Z = A⁻¹ of the full columns of M + ½τC and of U, and A⁻¹r_B (q indexing, zero on F)
-    pub(super) z: [Vec<f64>; MAX_SMALL],
-    pub(super) zb: Vec<f64>,
-    /// the small system of the Schur solve, factored
+    /// each link's block of the saddle system and of the kick's solves
+    pub(super) blocks: [KickBlock; 2],
+    /// the small system of the Schur solve as formed (the kernel's bench reads it) and
+    /// factored
+    pub(super) system: [[f64; MAX_SMALL]; MAX_SMALL],
     pub(super) small: SmallLu,
     /// the τ of the factors above, while they are those of the current state (`None` after
     /// a new state's `build_columns`)
@@ -41,4 +42,30 @@ pub struct ImplicitDamping {
     pub(super) vnew: Vec<f64>,
     /// (M + ½τC)⁻¹Gᵀ of a held tip's constraint row
     pub(super) damped_g: Vec<f64>,
+}
+
+/// Largest number of right-hand sides of a block's solve: the small system's columns and the
+/// kick's right-hand side.
+pub const MAX_SOLVED: usize = MAX_SMALL + 1;
+
+/// One link's diagonal block of the saddle system (the links' blocks do not couple) and its
+/// part of the kick's solves: the columns of [A_BF U] that are not zero on the link (the other
+/// link's U column, and a constant full column without entries there, are left out: their
+/// A⁻¹ is zero on it) and the right-hand side, solved together.
+#[derive(Debug, Clone)]
+pub struct KickBlock {
+    /// the block's rows of the saddle system
+    pub(super) rows: Range<usize>,
+    /// the link's band positions
+    pub(super) band: Range<usize>,
+    /// the small system's columns solved on the block, ascending, then the right-hand side:
+    /// `m` in all
+    pub(super) cols: [usize; MAX_SOLVED],
+    pub(super) m: usize,
+    /// the right-hand sides of the block's band rows (band row × m) and the solution of the
+    /// last factoring solve by saddle rows (saddle row × m)
+    pub(super) rhs: Vec<f64>,
+    pub(super) sol: Vec<f64>,
+    /// a later right-hand side's solution (one per saddle row)
+    pub(super) one: Vec<f64>,
 }

@@ -19,9 +19,12 @@
 //! each segment's multiplier sits next to its station: quasi-definite, so its LDLᵀ exists
 //! without pivoting (`crate::band_ldl`), O(n) per kick (G follows the slopes). The rank-2 U
 //! and the full columns close it as in the mass solve: Z = A⁻¹[A_BF U], a system of at most
-//! 7, back substitution; no allocation. C_z itself is read once from
-//! `TwoLinkChain::add_damping_forces` by probing (at Q⁻¹e, then Q⁻ᵀ): each full column alone, the band columns in
-//! five interleaved colours (bandwidth 2).
+//! 7, back substitution; no allocation. The links' blocks of the saddle system do not couple
+//! (C_z has no entry across the elbow), so each is stored in its envelope and solved alone with
+//! the columns that are not zero on it: the other link's U column and a constant full column
+//! without entries there (link 1's tip ghost on link 2) have a zero A⁻¹ on the link. C_z
+//! itself is read once from `TwoLinkChain::add_damping_forces` by probing (at Q⁻¹e, then
+//! Q⁻ᵀ): each full column alone, the band columns in five interleaved colours (bandwidth 2).
 //!
 //! **Held tip** (restartable steps of a contact run, [`crate::method::velocity_form`]). With A =
 //! M + ½τC, A q̈ = f + Gᵀλ and G q̈ + Ġq̇ = 0 (Ġq̇ at the predicted velocity, as in the explicit
@@ -35,8 +38,7 @@
 // Index loops over band positions and full columns read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::damping_matrix::ImplicitDamping;
-use super::mass::{schur_matrix, schur_solve, schur_system};
+use super::damping_matrix::{ImplicitDamping, KickBlock, MAX_SOLVED};
 use super::model::TwoLinkChain;
 use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
 use crate::band_ldl::BandLdl;
@@ -96,6 +98,7 @@ impl TwoLinkChain {
         let size = at_segment[1].last().map_or(0, |p| p + 1);
         let saddle =
             BandLdl::with_envelope(self.saddle_envelope(size, &at_band, &at_segment, [&c1, &c2]));
+        let blocks = self.kick_blocks(&saddle, &band, &at_segment, &cf);
         self.implicit = Some(Box::new(ImplicitDamping {
             c0,
             c1,
@@ -104,12 +107,11 @@ impl TwoLinkChain {
             saddle,
             at_band,
             at_segment,
-            y: vec![0.0; size * (MAX_SMALL + 1)],
+            blocks,
+            system: [[0.0; MAX_SMALL]; MAX_SMALL],
             small: SmallLu::default(),
             factored_for: None,
             failed: false,
-            z: std::array::from_fn(|_| vec![0.0; n]),
-            zb: vec![0.0; n],
             vnew: vec![0.0; n],
             damped_g: vec![0.0; n],
             band,
@@ -138,6 +140,69 @@ impl TwoLinkChain {
             pos += 1;
         }
         (at_band, at_segment)
+    }
+
+    /// Each link's block of the saddle system with the columns of [A_BF U] solved on it (module
+    /// docs): every full column but a constant one without entries on the link (link 1's
+    /// tip-ghost column; θ, β, ψ₁, ψ₂ follow the state), the link's own U column. Links whose
+    /// blocks couple (C across the elbow) are solved as one block with every column.
+    fn kick_blocks(
+        &self,
+        saddle: &BandLdl,
+        band: &[usize],
+        at_segment: &[Vec<usize>; 2],
+        cf: &[Vec<f64>; MAX_FULL],
+    ) -> [KickBlock; 2] {
+        let nf = self.nfull();
+        let nu = if self.inertia.fs1 { 2 } else { 0 };
+        let size = saddle.n();
+        let split = at_segment[0].last().map_or(0, |p| p + 1);
+        let nb1 = self.deflections(0).len();
+        let (rows, bands, links): ([_; 2], [_; 2], [&[usize]; 2]) =
+            if saddle.is_block(0..split) && saddle.is_block(split..size) {
+                (
+                    [0..split, split..size],
+                    [0..nb1, nb1..band.len()],
+                    [&[0], &[1]],
+                )
+            } else {
+                ([0..size, size..size], [0..band.len(), 0..0], [&[0, 1], &[]])
+            };
+        std::array::from_fn(|l| {
+            let on = &band[bands[l].clone()];
+            let mut cols = [0; MAX_SOLVED];
+            let mut m = 0;
+            for c in 0..nf {
+                let constant = c >= 4;
+                if constant
+                    && on
+                        .iter()
+                        .all(|&i| self.cols[c][i] == 0.0 && cf[c][i] == 0.0)
+                {
+                    continue;
+                }
+                cols[m] = c;
+                m += 1;
+            }
+            for &link in links[l] {
+                if link < nu {
+                    cols[m] = nf + link;
+                    m += 1;
+                }
+            }
+            // the right-hand side
+            m += 1;
+            let len = rows[l].len();
+            KickBlock {
+                rows: rows[l].clone(),
+                band: bands[l].clone(),
+                cols,
+                m,
+                rhs: vec![0.0; on.len() * m],
+                sol: vec![0.0; len * m],
+                one: vec![0.0; len],
+            }
+        })
     }
 
     /// The first column of each row of the saddle system: its entries are those
@@ -290,58 +355,90 @@ impl TwoLinkChain {
             cf,
             saddle,
             at_band,
-            at_segment,
-            y,
-            z,
-            zb,
+            blocks,
+            system,
             small,
             ..
         } = &mut *imp;
-        let col = |c: usize, i: usize| self.cols[c][i] + ht * cf[c][i];
-        // the columns Z = A⁻¹[A_BF U] (a new factor only) and A⁻¹r_B, one sweep by rows over
-        // the saddle factor
-        let ns = nf + nu;
-        let nz = if refactor { ns } else { 0 };
-        let m = nz + 1;
-        let saddle_rows = at_segment[1].last().map_or(0, |p| p + 1);
-        y[..saddle_rows * m].iter_mut().for_each(|v| *v = 0.0);
-        for (&i, &at) in band.iter().zip(at_band.iter()) {
-            let at = at * m;
-            if refactor {
-                for c in 0..nf {
-                    y[at + c] = col(c, i);
-                }
-                for a in 0..nu {
-                    y[at + nf + a] = self.factors.u[a][i];
-                }
+        let u = &self.factors.u;
+        let col = |c: usize, i: usize| {
+            if c < nf {
+                self.cols[c][i] + ht * cf[c][i]
+            } else {
+                u[c - nf][i]
             }
-            y[at + nz] = rz[i];
-        }
-        saddle.solve_rows_in_place(&mut y[..saddle_rows * m], m);
-        for c in 0..nz {
-            z[c].iter_mut().for_each(|v| *v = 0.0);
-        }
-        zb.iter_mut().for_each(|v| *v = 0.0);
-        for (&i, &at) in band.iter().zip(at_band.iter()) {
-            let at = at * m;
-            for c in 0..nz {
-                z[c][i] = y[at + c];
-            }
-            zb[i] = y[at + nz];
+        };
+        // the small system's right-hand side b and (a new factor) the system itself: the
+        // columns Z = A⁻¹[A_BF U] and A⁻¹r_B by one sweep per block, then M_FR Z, UᵀZ and
+        // their products with A⁻¹r_B in one pass over the band rows in q order
+        let mut b = [0.0; MAX_SMALL];
+        for r in 0..nf {
+            b[r] = rz[full[r]];
         }
         if refactor {
-            *small = schur_matrix(self.dofs(), full, col, &z[..ns], &self.factors.u[..nu]);
+            let mut s = [[0.0; MAX_SMALL]; MAX_SMALL];
+            for r in 0..nf {
+                for k in 0..nf {
+                    s[r][k] = col(k, full[r]);
+                }
+            }
+            for blk in blocks.iter_mut() {
+                let (m, r0) = (blk.m, blk.rows.start);
+                blk.sol.iter_mut().for_each(|v| *v = 0.0);
+                for (t, p) in blk.band.clone().enumerate() {
+                    let i = band[p];
+                    let row = &mut blk.rhs[t * m..t * m + m];
+                    for a in 0..m - 1 {
+                        row[a] = col(blk.cols[a], i);
+                    }
+                    row[m - 1] = rz[i];
+                    let at = (at_band[p] - r0) * m;
+                    blk.sol[at..at + m].copy_from_slice(row);
+                }
+                saddle.solve_block_rows_in_place(blk.rows.clone(), &mut blk.sol, m);
+                schur_rows(blk, &at_band[blk.band.clone()], &mut s, &mut b);
+            }
+            for a in 0..nu {
+                s[nf + a][nf + 1 - a] -= 1.0;
+            }
+            *system = s;
+            *small = SmallLu::factor(s, nf + nu);
+        } else {
+            for blk in blocks.iter_mut() {
+                let (m, r0) = (blk.m, blk.rows.start);
+                blk.one.iter_mut().for_each(|v| *v = 0.0);
+                for p in blk.band.clone() {
+                    blk.one[at_band[p] - r0] = rz[band[p]];
+                }
+                saddle.solve_block_rows_in_place(blk.rows.clone(), &mut blk.one, 1);
+                for (t, p) in blk.band.clone().enumerate() {
+                    let zb = blk.one[at_band[p] - r0];
+                    for a in 0..m - 1 {
+                        b[blk.cols[a]] -= blk.rhs[t * m + a] * zb;
+                    }
+                }
+            }
         }
-        schur_solve(
-            full,
-            col,
-            small,
-            &z[..ns],
-            &self.factors.u[..nu],
-            zb,
-            &rz,
-            out,
-        );
+        let x = small.solve(b);
+        for blk in blocks.iter() {
+            let (m, r0) = (blk.m, blk.rows.start);
+            for p in blk.band.clone() {
+                let at = at_band[p] - r0;
+                let z = &blk.sol[at * m..at * m + m - 1];
+                let zb = if refactor {
+                    blk.sol[at * m + m - 1]
+                } else {
+                    blk.one[at]
+                };
+                out[band[p]] = zb
+                    - (blk.cols[..m - 1].iter().zip(z))
+                        .map(|(&k, z)| z * x[k])
+                        .sum::<f64>();
+            }
+        }
+        for (k, &f) in full.iter().enumerate() {
+            out[f] = x[k];
+        }
         self.implicit = Some(imp);
         self.factors.rz = rz;
         self.z_to_q_motion(out);
@@ -372,19 +469,12 @@ impl TwoLinkChain {
     ) -> ([[f64; MAX_SMALL]; MAX_SMALL], usize) {
         self.frames(q, qd);
         self.build_columns();
-        // a solve at the state leaves the columns Z
+        // a solve at the state forms it
         let zero = vec![0.0; self.dofs()];
         let mut x = vec![0.0; self.dofs()];
         self.solve_damped_mass(tau, &zero, &mut x);
         let imp = self.implicit.as_ref().expect("implicit damping");
-        let (nf, nu) = (self.nfull(), self.factors.nu);
-        schur_system(
-            self.dofs(),
-            &self.full()[..nf],
-            |c, i| self.cols[c][i] + 0.5 * tau * imp.cf[c][i],
-            &imp.z[..nf + nu],
-            &self.factors.u[..nu],
-        )
+        (imp.system, self.nfull() + self.factors.nu)
     }
 
     /// Assembles and factors the saddle system of M + ½τC at the state of the last
@@ -443,6 +533,62 @@ impl TwoLinkChain {
             }
             first += r - 1;
         }
+    }
+}
+
+/// The small system's products over one block's band rows, in order: s[r][k] −= c_r z_k and
+/// b[r] −= c_r z_b for the block's columns r, k (c the right-hand sides as formed, z their
+/// solutions; the other columns are zero on the block). `at` are the rows' saddle rows.
+fn schur_rows(
+    blk: &KickBlock,
+    at: &[usize],
+    s: &mut [[f64; MAX_SMALL]; MAX_SMALL],
+    b: &mut [f64; MAX_SMALL],
+) {
+    match blk.m {
+        1 => schur_rows_m::<1>(blk, at, s, b),
+        2 => schur_rows_m::<2>(blk, at, s, b),
+        3 => schur_rows_m::<3>(blk, at, s, b),
+        4 => schur_rows_m::<4>(blk, at, s, b),
+        5 => schur_rows_m::<5>(blk, at, s, b),
+        6 => schur_rows_m::<6>(blk, at, s, b),
+        7 => schur_rows_m::<7>(blk, at, s, b),
+        8 => schur_rows_m::<8>(blk, at, s, b),
+        m => unreachable!("{m} right-hand sides"),
+    }
+}
+
+/// [`schur_rows`] with `M` solved columns (the right-hand side last), the block of s and b
+/// held locally.
+fn schur_rows_m<const M: usize>(
+    blk: &KickBlock,
+    at: &[usize],
+    s: &mut [[f64; MAX_SMALL]; MAX_SMALL],
+    b: &mut [f64; MAX_SMALL],
+) {
+    let cols = &blk.cols[..M - 1];
+    let mut acc = [[0.0; M]; M];
+    for (a, &r) in cols.iter().enumerate() {
+        for (k, &c) in cols.iter().enumerate() {
+            acc[a][k] = s[r][c];
+        }
+        acc[a][M - 1] = b[r];
+    }
+    let r0 = blk.rows.start;
+    let (rhs, sol) = (blk.rhs.as_chunks::<M>().0, blk.sol.as_chunks::<M>().0);
+    for (c, &p) in rhs.iter().zip(at) {
+        let z = &sol[p - r0];
+        for a in 0..M - 1 {
+            for k in 0..M {
+                acc[a][k] -= c[a] * z[k];
+            }
+        }
+    }
+    for (a, &r) in cols.iter().enumerate() {
+        for (k, &c) in cols.iter().enumerate() {
+            s[r][c] = acc[a][k];
+        }
+        b[r] = acc[a][M - 1];
     }
 }
 
