@@ -388,12 +388,15 @@ impl TwoLinkChain {
                 for (t, p) in blk.band.clone().enumerate() {
                     let i = band[p];
                     let row = &mut blk.rhs[t * m..t * m + m];
+                    let at = (at_band[p] - r0) * m;
+                    let sol = &mut blk.sol[at..at + m];
                     for a in 0..m - 1 {
-                        row[a] = col(blk.cols[a], i);
+                        let v = col(blk.cols[a], i);
+                        row[a] = v;
+                        sol[a] = v;
                     }
                     row[m - 1] = rz[i];
-                    let at = (at_band[p] - r0) * m;
-                    blk.sol[at..at + m].copy_from_slice(row);
+                    sol[m - 1] = rz[i];
                 }
                 saddle.solve_block_rows_in_place(blk.rows.clone(), &mut blk.sol, m);
                 schur_rows(blk, &at_band[blk.band.clone()], &mut s, &mut b);
