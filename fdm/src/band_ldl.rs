@@ -5,10 +5,12 @@
 //! construction.
 //!
 //! **Envelope.** Row i may start later than i − k (its first column `first[i]`): L has no fill
-//! left of a row's first nonzero, so the factor and the solves skip those columns, and rows
-//! that start at or after a row r (every one) split the matrix into independent diagonal
-//! blocks, solved one at a time. The skipped terms are products with zeros, so the sums that
-//! remain are the full band's in the same order.
+//! left of a row's first nonzero, so the solves skip those columns, and rows that start at or
+//! after a row r (every one) split the matrix into independent diagonal blocks, solved one at a
+//! time. The skipped terms are products with zeros, so the sums that remain are the full
+//! band's in the same order. The factor runs the other way: away from a block's ends its
+//! columns take the full band in straight-line code (zeros included, the same bits), and two
+//! blocks take turns, so that the division that ends each column overlaps the other block's.
 
 // Index loops over the band read like the factorization.
 #![allow(clippy::needless_range_loop)]
@@ -30,6 +32,8 @@ pub struct BandLdl {
     last: Vec<usize>,
     /// whether no row at or after i reaches left of i (a block starts at i)
     block_start: Vec<bool>,
+    /// the independent diagonal blocks in order
+    blocks: Vec<Range<usize>>,
     /// row i holds A[i, i−k..=i] before and L[i, i−k..i] (and D at the diagonal) after factor
     a: Vec<f64>,
     /// after factor: column j of L below the diagonal, L[j+1..=j+k, j] (zero outside the
@@ -69,12 +73,15 @@ impl BandLdl {
             reach = reach.min(first[i]);
             block_start[i] = reach >= i;
         }
+        let starts: Vec<usize> = (0..=n).filter(|&i| block_start[i]).collect();
+        let blocks = starts.windows(2).map(|w| w[0]..w[1]).collect();
         BandLdl {
             n,
             k,
             first,
             last,
             block_start,
+            blocks,
             a: vec![0.0; n * (k + 1)],
             lc: vec![0.0; n * k],
         }
@@ -118,48 +125,120 @@ impl BandLdl {
         self.a[p] += v;
     }
 
-    /// Factors in place. Err(j): pivot j is zero or not finite. `ld` holds row j of L times D
-    /// while column j is eliminated.
+    /// Factors in place. Err(j): pivot j is zero or not finite (the first such of its block).
+    ///
+    /// Every entry outside the envelope is a zero (so is its L: a zero over a finite pivot),
+    /// and subtracting a product with one from a sum that is nonzero or +0 changes nothing.
+    /// The sums are never −0: each starts from an assembled entry (a sum onto +0) and only
+    /// subtracts. So the columns away from a block's ends run over the full band, straight-line
+    /// code for the common half-bandwidths, with the envelope's bits.
     pub fn factor(&mut self) -> Result<(), usize> {
-        let (n, k, w) = (self.n, self.k, self.k + 1);
-        let mut ld = [0.0; MAX_HALF_BANDWIDTH];
         assert!(
-            k <= MAX_HALF_BANDWIDTH,
-            "half-bandwidth {k} above {MAX_HALF_BANDWIDTH}"
+            self.k <= MAX_HALF_BANDWIDTH,
+            "half-bandwidth {} above {MAX_HALF_BANDWIDTH}",
+            self.k
         );
-        let (a, lc) = (&mut self.a[..n * w], &mut self.lc[..n * k]);
-        for j in 0..n {
-            let fj = self.first[j];
-            let row_j = j * w + w - 1 - (j - fj);
-            let mut d = a[j * w + w - 1];
-            for (t, m) in (fj..j).enumerate() {
-                let l = a[row_j + t];
-                ld[t] = l * a[m * w + w - 1];
-                d -= l * ld[t];
-            }
-            if d == 0.0 || !d.is_finite() {
-                return Err(j);
-            }
-            a[j * w + w - 1] = d;
-            let col = &mut lc[j * k..j * k + k];
-            for i in j + 1..=self.last[j] {
-                let fi = self.first[i];
-                if fi > j {
-                    col[i - j - 1] = 0.0;
-                    continue;
+        match self.k {
+            1 => self.factor_band::<1>(),
+            2 => self.factor_band::<2>(),
+            3 => self.factor_band::<3>(),
+            4 => self.factor_band::<4>(),
+            5 => self.factor_band::<5>(),
+            6 => self.factor_band::<6>(),
+            _ => (0..self.n).try_for_each(|j| self.factor_column(j)),
+        }
+    }
+
+    /// [`Self::factor`] with half-bandwidth `K`: each block's columns K from its ends over the
+    /// full band, two blocks in turn (their pivot chains are independent, and each column
+    /// waits for the division that ends the previous one).
+    fn factor_band<const K: usize>(&mut self) -> Result<(), usize> {
+        for pair in (0..self.blocks.len()).step_by(2) {
+            let p = self.blocks[pair].clone();
+            let q = self.blocks.get(pair + 1).cloned().unwrap_or(0..0);
+            // the columns of a block that reach its ends, and its inner ones
+            let inner = |b: &Range<usize>| {
+                if b.len() >= 2 * K {
+                    b.start + K..b.end - K
+                } else {
+                    b.end..b.end
                 }
-                // row i's entries at columns fi..j against row j's L·D
-                let row_i = i * w + w - 1 - (i - fi);
-                let lo = fi.max(fj);
-                let li = &a[row_i + (lo - fi)..row_i + (j - fi)];
-                let mut s = a[row_i + (j - fi)];
-                for (l, x) in li.iter().zip(&ld[lo - fj..j - fj]) {
-                    s -= l * x;
-                }
-                let l = s / d;
-                a[row_i + (j - fi)] = l;
-                col[i - j - 1] = l;
+            };
+            let (ip, iq) = (inner(&p), inner(&q));
+            for j in p.start..ip.start.min(p.end) {
+                self.factor_column(j)?;
             }
+            for j in q.start..iq.start.min(q.end) {
+                self.factor_column(j)?;
+            }
+            let w = K + 1;
+            let (a, lc) = (&mut self.a[..], &mut self.lc[..]);
+            // the pivot chain's last link, L[j, j−1] and D[j−1], stays in registers from the
+            // previous column
+            let chain = |j: usize, a: &[f64]| (a[j * w + K - 1], a[(j - 1) * w + K]);
+            let mut cp = if ip.is_empty() {
+                (0.0, 0.0)
+            } else {
+                chain(ip.start, a)
+            };
+            let mut cq = if iq.is_empty() {
+                (0.0, 0.0)
+            } else {
+                chain(iq.start, a)
+            };
+            for t in 0..ip.len().max(iq.len()) {
+                if t < ip.len() {
+                    band_column::<K>(a, lc, ip.start + t, &mut cp)?;
+                }
+                if t < iq.len() {
+                    band_column::<K>(a, lc, iq.start + t, &mut cq)?;
+                }
+            }
+            for j in ip.end.max(p.start)..p.end {
+                self.factor_column(j)?;
+            }
+            for j in iq.end.max(q.start)..q.end {
+                self.factor_column(j)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Column j of [`Self::factor`] inside the envelope.
+    fn factor_column(&mut self, j: usize) -> Result<(), usize> {
+        let (k, w) = (self.k, self.k + 1);
+        let mut ld = [0.0; MAX_HALF_BANDWIDTH];
+        let a = &mut self.a;
+        let fj = self.first[j];
+        let row_j = j * w + w - 1 - (j - fj);
+        let mut d = a[j * w + w - 1];
+        for (t, m) in (fj..j).enumerate() {
+            let l = a[row_j + t];
+            ld[t] = l * a[m * w + w - 1];
+            d -= l * ld[t];
+        }
+        if d == 0.0 || !d.is_finite() {
+            return Err(j);
+        }
+        a[j * w + w - 1] = d;
+        let col = &mut self.lc[j * k..j * k + k];
+        for i in j + 1..=self.last[j] {
+            let fi = self.first[i];
+            if fi > j {
+                col[i - j - 1] = 0.0;
+                continue;
+            }
+            // row i's entries at columns fi..j against row j's L·D
+            let row_i = i * w + w - 1 - (i - fi);
+            let lo = fi.max(fj);
+            let li = &a[row_i + (lo - fi)..row_i + (j - fi)];
+            let mut s = a[row_i + (j - fi)];
+            for (l, x) in li.iter().zip(&ld[lo - fj..j - fj]) {
+                s -= l * x;
+            }
+            let l = s / d;
+            a[row_i + (j - fi)] = l;
+            col[i - j - 1] = l;
         }
         Ok(())
     }
@@ -263,6 +342,52 @@ impl BandLdl {
     }
 }
 
+/// Column j of [`BandLdl::factor`] over the full band of half-bandwidth `K` (rows `a` of
+/// K + 1 entries, L's columns `lc` of K); `chain` carries L[j, j−1] and D[j−1] in and
+/// L[j+1, j] and D[j] out.
+#[inline(always)]
+fn band_column<const K: usize>(
+    a: &mut [f64],
+    lc: &mut [f64],
+    j: usize,
+    chain: &mut (f64, f64),
+) -> Result<(), usize> {
+    let w = K + 1;
+    let (left, right) = a.split_at_mut(j * w);
+    let (row_j, below) = right.split_at_mut(w);
+    let mut ld = [0.0; K];
+    let mut d = row_j[K];
+    for t in 0..K {
+        let (l, dm) = if t == K - 1 {
+            *chain
+        } else {
+            (row_j[t], left[(j - K + t) * w + K])
+        };
+        ld[t] = l * dm;
+        d -= l * ld[t];
+    }
+    if d == 0.0 || !d.is_finite() {
+        return Err(j);
+    }
+    row_j[K] = d;
+    chain.1 = d;
+    let col = &mut lc[j * K..j * K + K];
+    for r in 1..=K {
+        let row_i = &mut below[(r - 1) * w..r * w];
+        let mut s = row_i[K - r];
+        for t in r..K {
+            s -= row_i[t - r] * ld[t];
+        }
+        let l = s / d;
+        row_i[K - r] = l;
+        col[r - 1] = l;
+        if r == 1 {
+            chain.0 = l;
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -343,9 +468,10 @@ mod tests {
     #[test]
     fn elem_band_ldl_envelope_gives_the_full_bands_bits_block_by_block() {
         // two uncoupled saddle blocks interleaved as the implicit kick's (rows of the first
-        // block start up to 4 left, the multipliers' 3), stored once in their envelope and once
-        // in the full band of half-bandwidth 5: the envelope's factor and solves skip products
-        // with zeros only, so every bit agrees, and each block solves alone
+        // block start up to 4 left, the multipliers' 3), stored in their envelope, in the full
+        // band of half-bandwidth 5 and in one of 7 (no straight-line kernel: column by column
+        // inside the envelope): the three factors and solves differ by products with zeros
+        // only, so every bit agrees, and each block solves alone
         let blocks = [0..19, 19..38];
         let n = 38;
         let mut first = vec![0; n];
@@ -366,18 +492,24 @@ mod tests {
         }
         let mut envelope = BandLdl::with_envelope(first);
         let mut full = BandLdl::new(n, 5);
+        // wider than the straight-line kernels: column by column inside the envelope
+        let mut wide = BandLdl::new(n, 7);
         for &(i, j, v) in &entries {
             envelope.add(i, j, v);
             full.add(j, i, v);
+            wide.add(i, j, v);
         }
         assert!(envelope.is_block(blocks[0].clone()) && envelope.is_block(blocks[1].clone()));
         assert!(!envelope.is_block(0..20));
         envelope.factor().unwrap();
         full.factor().unwrap();
+        wide.factor().unwrap();
         for m in [1usize, 3, 7, 8, 11] {
             let rhs: Vec<f64> = (0..n * m).map(|k| (0.37 * k as f64).cos() + 0.1).collect();
             let mut x_full = rhs.clone();
             full.solve_rows_in_place(&mut x_full, m);
+            let mut x_wide = rhs.clone();
+            wide.solve_rows_in_place(&mut x_wide, m);
             let mut x_env = rhs.clone();
             envelope.solve_rows_in_place(&mut x_env, m);
             let mut x_blocks = rhs.clone();
@@ -390,6 +522,7 @@ mod tests {
             }
             for k in 0..n * m {
                 assert_eq!(x_env[k].to_bits(), x_full[k].to_bits(), "m {m}, entry {k}");
+                assert_eq!(x_wide[k].to_bits(), x_full[k].to_bits(), "m {m}, entry {k}");
                 assert_eq!(
                     x_blocks[k].to_bits(),
                     x_full[k].to_bits(),
