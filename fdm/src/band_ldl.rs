@@ -118,6 +118,18 @@ impl BandLdl {
         self.a.iter_mut().for_each(|x| *x = 0.0);
     }
 
+    /// The entries of `other`, a matrix with the same envelope (as assembled: before its
+    /// factor).
+    pub fn assign(&mut self, other: &BandLdl) {
+        assert!(
+            self.n == other.n && self.k == other.k,
+            "another envelope: order {} and half-bandwidth {}",
+            other.n,
+            other.k
+        );
+        self.a.copy_from_slice(&other.a);
+    }
+
     /// A[i, j] += v inside the envelope (the symmetric entry is implied).
     pub fn add(&mut self, i: usize, j: usize, v: f64) {
         let (i, j) = if i >= j { (i, j) } else { (j, i) };

@@ -23,6 +23,9 @@ pub struct ImplicitDamping {
     pub(super) cf: [Vec<f64>; MAX_FULL],
     /// the saddle system [[D_B + ½τC_BB + ..., Gᵀ], [G, −N⁻¹]] interleaved by station
     pub(super) saddle: BandLdl,
+    /// its entries that do not follow the state (all but G's), at the step `constant_for`
+    pub(super) constant: BandLdl,
+    pub(super) constant_for: Option<f64>,
     /// position in the saddle system of each band position's unknown, and of each link's
     /// segment multipliers
     pub(super) at_band: Vec<usize>,

@@ -21,18 +21,28 @@ impl TwoLinkChain {
     /// single-link energy on u (u_r = 0) with κ₀ = 2u₁/h² replaced by (u₁ + x)/h². Adds −∂/∂u
     /// into f (its tip entry left untouched) and returns (energy, −∂/∂x).
     fn ghost_bending(h: f64, c: f64, u: &[f64], x: f64, f: &mut [f64]) -> (f64, f64) {
+        let g = Self::ghost_bending_forces(h, c, u, x, f);
+        (Self::ghost_bending_energy(h, c, u, x), g)
+    }
+
+    /// [`Self::ghost_bending`]'s forces alone: adds −∂/∂u into f and returns −∂/∂x.
+    fn ghost_bending_forces(h: f64, c: f64, u: &[f64], x: f64, f: &mut [f64]) -> f64 {
         let r = u.len();
         let tip = f[r - 1];
-        let e = FloatingLink::add_bending(h, c, u, f);
+        FloatingLink::add_bending_forces(h, c, u, f);
         f[r - 1] = tip;
         let h3 = h * h * h;
         f[0] += 2.0 * c * u[0] / h3;
         let g = c * (u[0] + x) / (2.0 * h3);
         f[0] -= g;
-        (
-            e - c * u[0] * u[0] / h3 + c * (u[0] + x).powi(2) / (4.0 * h3),
-            -g,
-        )
+        -g
+    }
+
+    /// [`Self::ghost_bending`]'s energy alone.
+    fn ghost_bending_energy(h: f64, c: f64, u: &[f64], x: f64) -> f64 {
+        let e = FloatingLink::bending_energy(h, c, u);
+        let h3 = h * h * h;
+        e - c * u[0] * u[0] / h3 + c * (u[0] + x).powi(2) / (4.0 * h3)
     }
 
     /// Generalized momenta p = M(q) q̇ of the whole chain (Pᵀ of the kernel's momenta in the
@@ -150,21 +160,16 @@ impl TwoLinkChain {
             let u = v[self.inertia.i_tip1() - 1];
             p_kv += 2.0 * Self::tip_bending(self.hs[0], self.links[0].gamma, u, v[y]).0;
         }
-        for (link, (range, f)) in [(iv, &mut self.fv), (iw, &mut self.fw)]
-            .into_iter()
-            .enumerate()
-        {
+        for (link, range) in [iv, iw].into_iter().enumerate() {
             let lp = &self.links[link];
             if lp.gamma == 0.0 {
                 continue;
             }
-            f.iter_mut().for_each(|x| *x = 0.0);
-            let (d2, _) = Self::ghost_bending(
+            let d2 = Self::ghost_bending_energy(
                 self.hs[link],
                 lp.gamma,
                 &self.vc[range],
                 v[self.slots[link]],
-                f,
             );
             p_kv += 2.0 * d2;
         }
@@ -225,7 +230,7 @@ impl TwoLinkChain {
             };
             let lp = &self.links[link];
             let slot = self.slots[link];
-            let (_, gx) = Self::ghost_bending(h, lp.ei, &self.qc[range.clone()], q[slot], f);
+            let gx = Self::ghost_bending_forces(h, lp.ei, &self.qc[range.clone()], q[slot], f);
             let mut fx = gx;
             if lp.gamma != 0.0 && damp {
                 let (d2, gv) =
@@ -301,8 +306,8 @@ impl TwoLinkChain {
             }
             f.iter_mut().for_each(|x| *x = 0.0);
             let slot = self.slots[link];
-            let (_, gv) =
-                Self::ghost_bending(self.hs[link], lp.gamma, &vd[range.clone()], v[slot], f);
+            let gv =
+                Self::ghost_bending_forces(self.hs[link], lp.gamma, &vd[range.clone()], v[slot], f);
             let r = f.len();
             f[r - 1] = gv;
             for (o, x) in out[range].iter_mut().zip(f.iter()) {

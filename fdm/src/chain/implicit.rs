@@ -100,6 +100,8 @@ impl TwoLinkChain {
             BandLdl::with_envelope(self.saddle_envelope(size, &at_band, &at_segment, [&c1, &c2]));
         let blocks = self.kick_blocks(&saddle, &band, &at_segment, &cf);
         self.implicit = Some(Box::new(ImplicitDamping {
+            constant: saddle.clone(),
+            constant_for: None,
             c0,
             c1,
             c2,
@@ -490,33 +492,22 @@ impl TwoLinkChain {
     /// The saddle system [[D_B + ½τC_BB, Gᵀ], [G, −N⁻¹]] interleaved by station into
     /// `imp.saddle`.
     fn assemble_saddle(&self, tau: f64, imp: &mut ImplicitDamping) {
-        let ht = 0.5 * tau;
-        let nb = imp.band.len();
+        if imp.constant_for != Some(tau) {
+            self.assemble_constant(tau, imp);
+            imp.constant_for = Some(tau);
+        }
         let ImplicitDamping {
-            band,
-            c0,
-            c1,
-            c2,
             saddle,
+            constant,
             at_band,
             at_segment,
             ..
         } = imp;
-        saddle.clear();
-        for b in 0..nb {
-            saddle.add(at_band[b], at_band[b], self.diag_mass(band[b]) + ht * c0[b]);
-            // a zero of C is no entry of the envelope (adding it changed nothing)
-            if b + 1 < nb && c1[b] != 0.0 {
-                saddle.add(at_band[b + 1], at_band[b], ht * c1[b]);
-            }
-            if b + 2 < nb && c2[b] != 0.0 {
-                saddle.add(at_band[b + 2], at_band[b], ht * c2[b]);
-            }
-        }
+        // every entry takes one term: the constant ones, then G's onto their zeros
+        saddle.assign(constant);
         let mut first = 0;
         for (link, segs) in at_segment.iter().enumerate() {
-            let rates = &self.factors.links[link];
-            let (g, w) = (rates.slopes(), rates.weights());
+            let g = self.factors.links[link].slopes();
             let r = segs.len();
             for seg in 0..r {
                 if seg < r - 1 {
@@ -525,16 +516,50 @@ impl TwoLinkChain {
                 if seg >= 1 {
                     saddle.add(segs[seg], at_band[first + seg - 1], -g[seg]);
                 }
+            }
+            first += r - 1;
+        }
+    }
+
+    /// The saddle system's entries that do not follow the state, D_B + ½τC_BB and −N⁻¹, into
+    /// `imp.constant`.
+    fn assemble_constant(&self, tau: f64, imp: &mut ImplicitDamping) {
+        let ht = 0.5 * tau;
+        let nb = imp.band.len();
+        let ImplicitDamping {
+            band,
+            c0,
+            c1,
+            c2,
+            constant,
+            at_band,
+            at_segment,
+            ..
+        } = imp;
+        constant.clear();
+        for b in 0..nb {
+            constant.add(at_band[b], at_band[b], self.diag_mass(band[b]) + ht * c0[b]);
+            // a zero of C is no entry of the envelope (adding it changed nothing)
+            if b + 1 < nb && c1[b] != 0.0 {
+                constant.add(at_band[b + 1], at_band[b], ht * c1[b]);
+            }
+            if b + 2 < nb && c2[b] != 0.0 {
+                constant.add(at_band[b + 2], at_band[b], ht * c2[b]);
+            }
+        }
+        for (link, segs) in at_segment.iter().enumerate() {
+            let w = self.factors.links[link].weights();
+            let r = segs.len();
+            for seg in 0..r {
                 let mut nd = 1.0 / w[seg];
                 if seg >= 1 {
                     nd += 1.0 / w[seg - 1];
                 }
-                saddle.add(segs[seg], segs[seg], -nd);
+                constant.add(segs[seg], segs[seg], -nd);
                 if seg + 1 < r {
-                    saddle.add(segs[seg + 1], segs[seg], 1.0 / w[seg]);
+                    constant.add(segs[seg + 1], segs[seg], 1.0 / w[seg]);
                 }
             }
-            first += r - 1;
         }
     }
 }

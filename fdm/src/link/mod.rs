@@ -289,12 +289,17 @@ impl FloatingLink {
 
     /// Adds −∂/∂v of ½ Σ c_i h c κ_i² (c = EI with v, or γ with v̇) into f; returns the energy.
     pub(crate) fn add_bending(h: f64, c: f64, vs: &[f64], f: &mut [f64]) -> f64 {
+        Self::add_bending_forces(h, c, vs, f);
+        Self::bending_energy(h, c, vs)
+    }
+
+    /// [`Self::add_bending`]'s forces alone (the energy costs a division per station).
+    pub(crate) fn add_bending_forces(h: f64, c: f64, vs: &[f64], f: &mut [f64]) {
         let r = vs.len();
         let inv_h3 = 1.0 / (h * h * h);
         // clamped end: κ₀ = 2v₁/h², weight ½
         let m0 = c * 2.0 * vs[0] * inv_h3; // = c κ₀ / h
         f[0] -= m0;
-        let mut e = 0.5 * 0.5 * h * c * (2.0 * vs[0] / (h * h)).powi(2);
         for i in 1..r {
             let k = Self::at(vs, i + 1) - 2.0 * Self::at(vs, i) + Self::at(vs, i - 1);
             let mb = c * k * inv_h3;
@@ -303,9 +308,7 @@ impl FloatingLink {
             }
             f[i - 1] += 2.0 * mb;
             f[i] -= mb;
-            e += 0.5 * h * c * (k / (h * h)).powi(2);
         }
-        e
     }
 
     /// Adds scale · ∂Φ/∂v into f and returns Φ = ½ Σ_seg h W_seg g_seg² (W_seg = Σ_{i > seg} mᵢxᵢ):
