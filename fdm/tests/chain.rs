@@ -7,7 +7,7 @@ use data::{Backend, RunResult, Settings, StabilityVerdict, load_scene};
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
 use fdm::chain::kinetic::ChainInertia;
-use fdm::chain::kinetic::PointScratch;
+use fdm::chain::kinetic::{Lanes, PointScratch};
 use fdm::system::System;
 
 mod common;
@@ -76,6 +76,88 @@ fn chain_kinetic(sys: &TwoLinkChain, sc: &mut PointScratch, q: &[f64], v: &[f64]
     sys.to_kinetic(q, &mut qk);
     sys.to_kinetic(v, &mut vk);
     sys.inertia.kinetic(&qk, &vk, sc)
+}
+
+#[test]
+fn elem_chain_kinetic_lanes_give_each_single_products_bits() {
+    // M q̇ and the inertia forces at several velocities in one pass (a lane each, as the mass
+    // columns and the implicit kick's two drift velocities take them) against one velocity at
+    // a time: the same operations per lane, so the same bits
+    let scene = load_scene("two-link-free").unwrap();
+    let sys =
+        TwoLinkChain::from_planar_chain(&scene, scene.planar_chain().unwrap(), Some(9)).unwrap();
+    let ine = &sys.inertia;
+    let n = sys.dofs();
+    let (q, v) = common::moving_chain_state(n);
+    let mut qk = vec![0.0; n];
+    sys.to_kinetic(&q, &mut qk);
+    let rates: Vec<Vec<f64>> = (0..4)
+        .map(|c| {
+            let mut vk = vec![0.0; n];
+            let vc: Vec<f64> = (0..n)
+                .map(|i| v[i] * (1.0 + 0.3 * c as f64) + 0.01 * ((c + i) as f64).sin())
+                .collect();
+            sys.to_kinetic(&vc, &mut vk);
+            vk
+        })
+        .collect();
+    // the segment slopes of each velocity's deflection rates, link 1's then link 2's
+    let slopes: Vec<Vec<f64>> = rates
+        .iter()
+        .map(|r| {
+            let slope = |u: &[f64], k: usize, h: f64| {
+                let left = if k == 0 { 0.0 } else { u[k - 1] };
+                (u[k] - left) / h
+            };
+            let (a, b) = (&r[ine.iv()], &r[ine.iw()]);
+            (0..ine.r1)
+                .map(|k| slope(a, k, ine.h1))
+                .chain((0..ine.r2).map(|j| slope(b, j, ine.h2)))
+                .collect()
+        })
+        .collect();
+    let mut sc = PointScratch::new(ine);
+    ine.set_shape(&qk, &mut sc);
+    let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    let mut single = vec![vec![0.0; n]; 4];
+    for c in 0..4 {
+        ine.momenta_at(&qk, &rates[c], &mut sc, &mut single[c]);
+    }
+    let mut lanes = Lanes::<4>::new(ine);
+    let mut many = vec![vec![0.0; n]; 4];
+    let [m0, m1, m2, m3] = &mut many[..] else {
+        unreachable!()
+    };
+    ine.momenta_lanes(
+        &qk,
+        &sc.shape,
+        std::array::from_fn(|c| &rates[c][..]),
+        std::array::from_fn(|c| &slopes[c][..]),
+        &mut lanes,
+        [&mut m0[..], &mut m1[..], &mut m2[..], &mut m3[..]],
+    );
+    for c in 0..4 {
+        assert_eq!(bits(&many[c]), bits(&single[c]), "momenta, lane {c}");
+    }
+    let mut single = vec![vec![0.0; n]; 2];
+    for c in 0..2 {
+        ine.inertia_forces_at(&qk, &rates[c], &mut sc, &mut single[c]);
+    }
+    let mut lanes = Lanes::<2>::new(ine);
+    let mut many = vec![vec![0.0; n]; 2];
+    let [f0, f1] = &mut many[..] else {
+        unreachable!()
+    };
+    ine.inertia_forces_lanes(
+        &qk,
+        &sc.shape,
+        [&rates[0][..], &rates[1][..]],
+        &mut lanes,
+        [&mut f0[..], &mut f1[..]],
+    );
+    for c in 0..2 {
+        assert_eq!(bits(&many[c]), bits(&single[c]), "inertia forces, lane {c}");
+    }
 }
 
 #[test]

@@ -5,8 +5,8 @@
 use data::scene::{Link, PlanarChain};
 use data::{DofPlan, Scene};
 
-use super::kinetic::PointScratch;
 use super::kinetic::{BE, ChainInertia, TH};
+use super::kinetic::{Lanes, PointScratch};
 use super::model::{JointLaw, LinkProps, SplitReuse, TwoLinkChain};
 use super::rates::LinkRates;
 use super::rates::MassFactors;
@@ -278,7 +278,12 @@ impl TwoLinkChain {
             obs_points: std::cell::RefCell::new(PointScratch::new(&inertia)),
             factors: mass_factors(&inertia, nd),
             cols: std::array::from_fn(|_| vec![0.0; nd]),
-            unit: vec![0.0; nd],
+            units: std::array::from_fn(|_| vec![0.0; nd]),
+            unit_slopes: std::array::from_fn(|_| vec![0.0; r1 + r2]),
+            column_lanes: Lanes::new(&inertia),
+            vk2: vec![0.0; nd],
+            f2: vec![0.0; nd],
+            inertia_lanes: Lanes::new(&inertia),
             rhs: vec![0.0; nd],
             split_reuse: SplitReuse::new(nd),
             fv: vec![0.0; r1],
@@ -316,6 +321,7 @@ impl TwoLinkChain {
             timo,
         };
         chain.set_ghost_columns();
+        chain.set_unit_rates();
         chain.omega_max = chain.top_frequency();
         chain.kappa_max = chain.top_damping_rate();
         Ok(chain)

@@ -193,6 +193,34 @@ impl TwoLinkChain {
         self.add_scaled_inertia(scale, scratch, rhs);
     }
 
+    /// [`Self::add_inertia_terms`] with `scales[0]` at `vk`, then with `scales[1]` at the
+    /// velocity `other` (the same q): both kernel passes at once. `scratch` (length n) is
+    /// overwritten.
+    pub(super) fn add_inertia_terms_pair(
+        &mut self,
+        scales: [f64; 2],
+        other: &[f64],
+        scratch: &mut [f64],
+        rhs: &mut [f64],
+    ) {
+        let (mut vk2, mut f2) = (std::mem::take(&mut self.vk2), std::mem::take(&mut self.f2));
+        self.to_kinetic(other, &mut vk2);
+        self.inertia.inertia_forces_lanes(
+            &self.qk,
+            &self.points.shape,
+            [&self.vk, &vk2],
+            &mut self.inertia_lanes,
+            [&mut scratch[..], &mut f2[..]],
+        );
+        self.kinetic_transpose_z_lanes(&mut [&mut scratch[..], &mut f2[..]]);
+        self.z_to_q_forces(scratch);
+        self.z_to_q_forces(&mut f2);
+        self.add_scaled_inertia(scales[0], scratch, rhs);
+        self.add_scaled_inertia(scales[1], &f2, rhs);
+        self.vk2 = vk2;
+        self.f2 = f2;
+    }
+
     /// rhs += scale·f for inertia-term forces f on q (the tip ghost moves no mass: not added).
     pub(super) fn add_scaled_inertia(&self, scale: f64, f: &[f64], rhs: &mut [f64]) {
         for i in 0..self.inertia.dofs() {

@@ -271,14 +271,18 @@ impl TwoLinkChain {
         self.skip_damping = false;
         // (a zero weight, w = −1: the inertia terms at `previous` alone, no pass at `current`)
         let w_current = 1.0 + drift.w;
-        if w_current != 0.0 {
-            self.add_inertia_terms(w_current, a, &mut rhs);
+        if w_current != 0.0 && drift.w != 0.0 {
+            self.add_inertia_terms_pair([w_current, -drift.w], drift.previous, a, &mut rhs);
+        } else {
+            if w_current != 0.0 {
+                self.add_inertia_terms(w_current, a, &mut rhs);
+            }
+            if drift.w != 0.0 {
+                self.frames_velocity(drift.previous);
+                self.add_inertia_terms(-drift.w, a, &mut rhs);
+            }
+            self.frames_velocity(drift.current);
         }
-        if drift.w != 0.0 {
-            self.frames_velocity(drift.previous);
-            self.add_inertia_terms(-drift.w, a, &mut rhs);
-        }
-        self.frames_velocity(drift.current);
         self.build_columns();
         self.add_damping_forces(drift.current, &mut rhs);
         self.solve_damped_mass(tau, &rhs, a);

@@ -194,6 +194,29 @@ impl PointScratch {
     }
 }
 
+/// Per-point scratch of `C` products with B or Bᵀ at one configuration taken together (M's
+/// full columns, the inertia terms at two velocities): the per-point forces and the outboard
+/// sums, one lane per product. The products' chains of sums over the stations then overlap.
+#[derive(Debug, Clone)]
+pub struct Lanes<const C: usize> {
+    pub fx: Vec<[f64; C]>,
+    pub fy: Vec<[f64; C]>,
+    pub c1: Vec<[f64; C]>,
+    pub c2: Vec<[f64; C]>,
+}
+
+impl<const C: usize> Lanes<C> {
+    pub fn new(ine: &ChainInertia) -> Self {
+        let n = ine.points();
+        Lanes {
+            fx: vec![[0.0; C]; n],
+            fy: vec![[0.0; C]; n],
+            c1: vec![[0.0; C]; ine.r1],
+            c2: vec![[0.0; C]; ine.r2],
+        }
+    }
+}
+
 impl ChainInertia {
     /// Number of lumped points: link 1's stations, the elbow, link 2's stations.
     pub fn points(&self) -> usize {
@@ -480,5 +503,236 @@ impl ChainInertia {
             fy[p] = -m * (y.du + rate * x.re);
         }
         self.apply_transpose_at(q, sc, out);
+    }
+
+    /// [`Self::momenta_at`] of `C` velocities at once into `out` (its operations per lane):
+    /// `slopes[c]` holds the segment slopes of `qds[c]`'s deflection rates, link 1's then
+    /// link 2's (the divisions [`Self::point_velocities`] takes, here supplied).
+    pub fn momenta_lanes<const C: usize>(
+        &self,
+        q: &[f64],
+        shape: &Shape,
+        qds: [&[f64]; C],
+        slopes: [&[f64]; C],
+        lanes: &mut Lanes<C>,
+        out: [&mut [f64]; C],
+    ) {
+        let (v, w) = (&q[self.iv()], &q[self.iw()]);
+        let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
+        let vd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iv()]);
+        let wd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iw()]);
+        let gd1: [&[f64]; C] = std::array::from_fn(|c| &slopes[c][..r1]);
+        let gd2: [&[f64]; C] = std::array::from_fn(|c| &slopes[c][r1..r1 + r2]);
+        let thd: [f64; C] = std::array::from_fn(|c| qds[c][TH]);
+        let bed: [f64; C] = std::array::from_fn(|c| qds[c][BE]);
+        let np = r1 + 1 + r2;
+        let (fx, fy) = (&mut lanes.fx[..np], &mut lanes.fy[..np]);
+        let (g1, s1) = (&shape.g1[..r1], &shape.s1[..r1]);
+        let (g2, s2) = (&shape.g2[..r2], &shape.s2[..r2]);
+        let mut sd = [0.0; C];
+        let (mut ex, mut ey) = ([0.0; C], [0.0; C]);
+        for k in 0..r1 {
+            let m = self.m1[k];
+            for c in 0..C {
+                if self.fs1 {
+                    sd[c] += g1[k] * (h1 * gd1[c][k]);
+                }
+                ex[c] = -(v[k] * thd[c]) - sd[c];
+                ey[c] = ((k + 1) as f64 * h1 - s1[k]) * thd[c] + vd[c][k];
+                fx[k][c] = m * ex[c];
+                fy[k][c] = m * ey[c];
+            }
+        }
+        let m = self.elbow_mass;
+        for c in 0..C {
+            fx[r1][c] = m * ex[c];
+            fy[r1][c] = m * ey[c];
+        }
+        let phi = q[BE] - q[TH];
+        let (sn, cs) = (phi.sin(), phi.cos());
+        let xe: [f64; C] = std::array::from_fn(|c| cs * ex[c] + sn * ey[c]);
+        let ye: [f64; C] = std::array::from_fn(|c| cs * ey[c] - sn * ex[c]);
+        let mut sgd = [0.0; C];
+        for j in 0..r2 {
+            let m = self.m2[j];
+            for c in 0..C {
+                if self.fs2 {
+                    sgd[c] += g2[j] * (h2 * gd2[c][j]);
+                }
+                let x = xe[c] - w[j] * bed[c] - sgd[c];
+                let y = ye[c] + ((j + 1) as f64 * h2 - s2[j]) * bed[c] + wd[c][j];
+                fx[r1 + 1 + j][c] = m * x;
+                fy[r1 + 1 + j][c] = m * y;
+            }
+        }
+        let mut out = out;
+        self.apply_transpose_lanes(q, shape, lanes, &mut out);
+        for c in 0..C {
+            out[c][TH] += self.hub * thd[c];
+        }
+    }
+
+    /// [`Self::inertia_forces_at`] at `C` velocities at once into `out` (its operations per
+    /// lane).
+    pub fn inertia_forces_lanes<const C: usize>(
+        &self,
+        q: &[f64],
+        shape: &Shape,
+        qds: [&[f64]; C],
+        lanes: &mut Lanes<C>,
+        out: [&mut [f64]; C],
+    ) {
+        let (v, w) = (&q[self.iv()], &q[self.iw()]);
+        let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
+        let vd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iv()]);
+        let wd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iw()]);
+        let thd: [f64; C] = std::array::from_fn(|c| qds[c][TH]);
+        let bed: [f64; C] = std::array::from_fn(|c| qds[c][BE]);
+        let np = r1 + 1 + r2;
+        let (fx, fy) = (&mut lanes.fx[..np], &mut lanes.fy[..np]);
+        let (g1, g2) = (&shape.g1[..r1], &shape.g2[..r2]);
+        let zero = Dual::default();
+        let (mut s, mut sd) = ([zero; C], [zero; C]);
+        let (mut ex, mut ey) = ([zero; C], [zero; C]);
+        for k in 0..r1 {
+            let m = self.m1[k];
+            for c in 0..C {
+                if self.fs1 {
+                    let gd = slope(vd[c], k, h1);
+                    let g = Dual::new(g1[k], gd);
+                    s[c] = s[c] + g * g * (0.5 * h1);
+                    sd[c] = sd[c] + g * (h1 * gd);
+                }
+                let vk = Dual::new(v[k], vd[c][k]);
+                let x = -(vk * thd[c]) - sd[c];
+                let y = (Dual::constant((k + 1) as f64 * h1) - s[c]) * thd[c] + vd[c][k];
+                fx[k][c] = -m * (x.du - thd[c] * y.re);
+                fy[k][c] = -m * (y.du + thd[c] * x.re);
+                (ex[c], ey[c]) = (x, y);
+            }
+        }
+        let m = self.elbow_mass;
+        for c in 0..C {
+            let (x, y) = (ex[c], ey[c]);
+            fx[r1][c] = -m * (x.du - thd[c] * y.re);
+            fy[r1][c] = -m * (y.du + thd[c] * x.re);
+        }
+        let mut xe = [zero; C];
+        let mut ye = [zero; C];
+        for c in 0..C {
+            let phi = Dual::new(q[BE] - q[TH], qds[c][BE] - qds[c][TH]);
+            let (sn, cs) = (phi.sin(), phi.cos());
+            xe[c] = cs * ex[c] + sn * ey[c];
+            ye[c] = cs * ey[c] - sn * ex[c];
+        }
+        let (mut sg, mut sgd) = ([zero; C], [zero; C]);
+        for j in 0..r2 {
+            let m = self.m2[j];
+            for c in 0..C {
+                if self.fs2 {
+                    let gd = slope(wd[c], j, h2);
+                    let g = Dual::new(g2[j], gd);
+                    sg[c] = sg[c] + g * g * (0.5 * h2);
+                    sgd[c] = sgd[c] + g * (h2 * gd);
+                }
+                let wj = Dual::new(w[j], wd[c][j]);
+                let x = xe[c] - wj * bed[c] - sgd[c];
+                let y = ye[c] + (Dual::constant((j + 1) as f64 * h2) - sg[c]) * bed[c] + wd[c][j];
+                fx[r1 + 1 + j][c] = -m * (x.du - bed[c] * y.re);
+                fy[r1 + 1 + j][c] = -m * (y.du + bed[c] * x.re);
+            }
+        }
+        let mut out = out;
+        self.apply_transpose_lanes(q, shape, lanes, &mut out);
+    }
+
+    /// [`Self::apply_transpose_at`] of `C` lanes of per-point forces at once.
+    pub fn apply_transpose_lanes<const C: usize>(
+        &self,
+        q: &[f64],
+        shape: &Shape,
+        lanes: &mut Lanes<C>,
+        out: &mut [&mut [f64]; C],
+    ) {
+        let (v, w) = (&q[self.iv()], &q[self.iw()]);
+        let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
+        let (sn, cs) = (q[BE] - q[TH]).sin_cos();
+        let Lanes { fx, fy, c1, c2 } = lanes;
+        let np = r1 + 1 + r2;
+        let (fx, fy) = (&fx[..np], &fy[..np]);
+        let (g1, s1) = (&shape.g1[..r1], &shape.s1[..r1]);
+        let (g2, s2) = (&shape.g2[..r2], &shape.s2[..r2]);
+        let (c1, c2) = (&mut c1[..r1], &mut c2[..r2]);
+        let off = 2 + r1;
+        let out: [&mut [f64]; C] = out.each_mut().map(|o| &mut o[..off + r2]);
+        // link 2: β, the rates ẇ, the outboard sums of −fx for σ̇, the elbow force
+        let mut qb = [0.0; C];
+        let (mut gx, mut gy) = (fx[r1], fy[r1]);
+        for j in 0..r2 {
+            let (a, b) = (fx[r1 + 1 + j], fy[r1 + 1 + j]);
+            let arm = (j + 1) as f64 * h2 - s2[j];
+            for c in 0..C {
+                qb[c] += -a[c] * w[j] + b[c] * arm;
+                out[c][off + j] = b[c];
+                gx[c] += cs * a[c] - sn * b[c];
+                gy[c] += sn * a[c] + cs * b[c];
+            }
+        }
+        if self.fs2 {
+            let mut acc = [0.0; C];
+            for j in (0..r2).rev() {
+                for c in 0..C {
+                    acc[c] -= fx[r1 + 1 + j][c];
+                }
+                c2[j] = acc;
+            }
+            for j in 0..r2 {
+                for c in 0..C {
+                    let mut d = c2[j][c] * g2[j];
+                    if j + 1 < r2 {
+                        d -= c2[j + 1][c] * g2[j + 1];
+                    }
+                    out[c][off + j] += d;
+                }
+            }
+        }
+        // link 1 with the elbow force at its tip station
+        let mut qt = [0.0; C];
+        for k in 0..r1 {
+            let (mut a, mut b) = (fx[k], fy[k]);
+            if k == r1 - 1 {
+                for c in 0..C {
+                    a[c] += gx[c];
+                    b[c] += gy[c];
+                }
+            }
+            let arm = (k + 1) as f64 * h1 - s1[k];
+            for c in 0..C {
+                qt[c] += -a[c] * v[k] + b[c] * arm;
+                out[c][2 + k] = b[c];
+            }
+        }
+        if self.fs1 {
+            let mut acc: [f64; C] = std::array::from_fn(|c| -gx[c]);
+            for k in (0..r1).rev() {
+                for c in 0..C {
+                    acc[c] -= fx[k][c];
+                }
+                c1[k] = acc;
+            }
+            for k in 0..r1 {
+                for c in 0..C {
+                    let mut d = c1[k][c] * g1[k];
+                    if k + 1 < r1 {
+                        d -= c1[k + 1][c] * g1[k + 1];
+                    }
+                    out[c][2 + k] += d;
+                }
+            }
+        }
+        for c in 0..C {
+            out[c][TH] = qt[c];
+            out[c][BE] = qb[c];
+        }
     }
 }

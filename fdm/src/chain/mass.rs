@@ -17,7 +17,7 @@
 // Index loops over the columns of M read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::kinetic::{BE, TH};
+use super::kinetic::{BE, TH, slope};
 use super::model::TwoLinkChain;
 use super::rates::LinkRates;
 use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
@@ -59,45 +59,68 @@ impl TwoLinkChain {
         }
         let n = self.dofs();
         let nd = self.inertia.dofs();
-        let euler = self.timo.is_none();
-        let ncols = if euler { 4 } else { 2 };
-        for c in 0..ncols {
-            self.cols[c][nd..n].iter_mut().for_each(|x| *x = 0.0);
-            // the kernel's rates at unit ż_c: the frame angle, and for ψ_ℓ also the tangent
-            // frame's deflections −ξ_k (tip −L)
-            let link = c % 2;
-            let (frame, first, slot) = (
-                if link == 0 { TH } else { BE },
-                self.first(link),
-                self.slots[link],
+        let mut cols = std::mem::take(&mut self.cols);
+        if self.timo.is_none() {
+            let [c0, c1, c2, c3, _] = &mut cols;
+            let mut lanes = [&mut c0[..], &mut c1[..], &mut c2[..], &mut c3[..]];
+            for col in lanes.iter_mut() {
+                col[nd..n].iter_mut().for_each(|x| *x = 0.0);
+            }
+            let units = self.units.each_ref().map(|u| &u[..]);
+            let slopes = self.unit_slopes.each_ref().map(|u| &u[..]);
+            self.inertia.momenta_lanes(
+                &self.qk,
+                &self.points.shape,
+                units,
+                slopes,
+                &mut self.column_lanes,
+                lanes.each_mut().map(|c| &mut c[..]),
             );
-            self.unit[frame] = 1.0;
-            if c >= 2 {
-                let h = self.hs[link];
-                for (k, i) in (first..=slot).enumerate() {
-                    self.unit[i] = -((k + 1) as f64) * h;
+            self.kinetic_transpose_z_lanes(&mut lanes);
+            for (c, col) in lanes.into_iter().enumerate() {
+                self.add_clamp_z(c % 2, self.jc[c % 2], col);
+                // θ's column also gets J_t e of link 1's tip section (y's column is fixed)
+                if c == 0 {
+                    self.add_tip(self.jt, col);
                 }
             }
-            self.inertia
-                .momenta_at(&self.qk, &self.unit, &mut self.points, &mut self.cols[c]);
-            self.unit[frame] = 0.0;
-            if c >= 2 {
-                self.unit[first..=slot].iter_mut().for_each(|x| *x = 0.0);
+        } else {
+            for c in 0..2 {
+                let col = &mut cols[c];
+                col[nd..n].iter_mut().for_each(|x| *x = 0.0);
+                self.inertia
+                    .momenta_at(&self.qk, &self.units[c], &mut self.points, col);
+                self.kinetic_transpose_z(col);
+                self.add_clamp(c, self.jc[c], col);
             }
-            let mut col = std::mem::take(&mut self.cols[c]);
-            self.kinetic_transpose_z(&mut col);
-            if euler {
-                self.add_clamp_z(link, self.jc[link], &mut col);
-            } else {
-                self.add_clamp(c, self.jc[c], &mut col);
-            }
-            // θ's column also gets J_t e of link 1's tip section (y's column is fixed)
-            if c == 0 {
-                self.add_tip(self.jt, &mut col);
-            }
-            self.cols[c] = col;
         }
+        self.cols = cols;
         self.factor_blocks();
+    }
+
+    /// The kernel's rates at unit rate of the state-dependent full columns (the frame angle,
+    /// and for ψ_ℓ also the tangent frame's deflections −ξ_k, tip −L) and their slopes.
+    pub(super) fn set_unit_rates(&mut self) {
+        let ine = &self.inertia;
+        for c in 0..4 {
+            let link = c % 2;
+            let (first, slot, h) = (self.first(link), self.slots[link], self.hs[link]);
+            let unit = &mut self.units[c];
+            unit[if link == 0 { TH } else { BE }] = 1.0;
+            if c >= 2 {
+                for (k, i) in (first..=slot).enumerate() {
+                    unit[i] = -((k + 1) as f64) * h;
+                }
+            }
+            let (v, w) = (&unit[ine.iv()], &unit[ine.iw()]);
+            let slopes = &mut self.unit_slopes[c];
+            for k in 0..ine.r1 {
+                slopes[k] = slope(v, k, ine.h1);
+            }
+            for j in 0..ine.r2 {
+                slopes[ine.r1 + j] = slope(w, j, ine.h2);
+            }
+        }
     }
 
     /// A_ℓ and U at `qk` (Z follows with the first solve).

@@ -7,8 +7,8 @@
 use data::scene::TorqueLaw;
 
 use super::damping_matrix::ImplicitDamping;
-use super::kinetic::PointScratch;
 use super::kinetic::{BE, ChainInertia, TH};
+use super::kinetic::{Lanes, PointScratch};
 use super::rates::MassFactors;
 use super::schur::MAX_FULL;
 use super::surface::{TipConstraint, TipContact};
@@ -83,7 +83,17 @@ pub struct TwoLinkChain {
     pub(super) factors: MassFactors,
     /// the full columns of M: θ, β, x₁, x₂ and (Euler) the tip ghost y
     pub(super) cols: [Vec<f64>; MAX_FULL],
-    pub(super) unit: Vec<f64>,
+    /// the kernel's rates at unit rate of each state-dependent full column, and their
+    /// deflection rates' segment slopes (link 1's, then link 2's)
+    pub(super) units: [Vec<f64>; 4],
+    pub(super) unit_slopes: [Vec<f64>; 4],
+    /// the per-point scratch of the columns' products, one lane each
+    pub(super) column_lanes: Lanes<4>,
+    /// the inertia terms at two drift velocities together: the second velocity in the
+    /// kernel's coordinates, its forces and the per-point scratch
+    pub(super) vk2: Vec<f64>,
+    pub(super) f2: Vec<f64>,
+    pub(super) inertia_lanes: Lanes<2>,
     pub(super) rhs: Vec<f64>,
     /// what the velocity form's corrector pass may take from the first pass at the same level
     pub(super) split_reuse: SplitReuse,
@@ -292,6 +302,34 @@ impl TwoLinkChain {
                 psi -= (k + 1) as f64 * h * f[i];
             }
             f[slot] = psi;
+        }
+    }
+
+    /// [`Self::kinetic_transpose_z`] of `C` vectors at once (their sums over the stations
+    /// overlap).
+    pub(super) fn kinetic_transpose_z_lanes<const C: usize>(&self, f: &mut [&mut [f64]; C]) {
+        for s in self.ghosts() {
+            if self.timo.is_some() || Some(s) == self.tip_ghost {
+                for fc in f.iter_mut() {
+                    fc[s] = 0.0;
+                }
+            }
+        }
+        if self.timo.is_some() {
+            return;
+        }
+        for link in 0..2 {
+            let (frame, first, slot, h) = self.link_slots(link);
+            let mut psi: [f64; C] = std::array::from_fn(|c| f[c][frame]);
+            for (k, i) in (first..=slot).enumerate() {
+                let x = (k + 1) as f64 * h;
+                for c in 0..C {
+                    psi[c] -= x * f[c][i];
+                }
+            }
+            for c in 0..C {
+                f[c][slot] = psi[c];
+            }
         }
     }
 
