@@ -391,19 +391,26 @@ impl TwoLinkChain {
             for blk in blocks.iter_mut() {
                 let (m, r0) = (blk.m, blk.rows.start);
                 blk.sol.iter_mut().for_each(|v| *v = 0.0);
-                for (t, p) in blk.band.clone().enumerate() {
-                    let i = band[p];
-                    let row = &mut blk.rhs[t * m..t * m + m];
-                    let at = (at_band[p] - r0) * m;
-                    let sol = &mut blk.sol[at..at + m];
-                    for a in 0..m - 1 {
-                        let v = col(blk.cols[a], i);
-                        row[a] = v;
-                        sol[a] = v;
+                let (rows, at) = (&band[blk.band.clone()], &at_band[blk.band.clone()]);
+                // column by column: each a loop without branches
+                let (rhs, sol) = (&mut blk.rhs[..], &mut blk.sol[..]);
+                let mut put = |a: usize, value: &[f64], damping: Option<&[f64]>| {
+                    for (t, (&i, &p)) in rows.iter().zip(at).enumerate() {
+                        let v = match damping {
+                            Some(cc) => value[i] + ht * cc[i],
+                            None => value[i],
+                        };
+                        rhs[t * m + a] = v;
+                        sol[(p - r0) * m + a] = v;
                     }
-                    row[m - 1] = rz[i];
-                    sol[m - 1] = rz[i];
+                };
+                for a in 0..m - 1 {
+                    match blk.cols[a] {
+                        c if c < nf => put(a, &self.cols[c], Some(&cf[c])),
+                        c => put(a, &u[c - nf], None),
+                    }
                 }
+                put(m - 1, &rz, None);
                 saddle.solve_block_rows_in_place(blk.rows.clone(), &mut blk.sol, m);
                 schur_rows(blk, &at_band[blk.band.clone()], &mut s, &mut b);
             }

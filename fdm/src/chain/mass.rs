@@ -126,13 +126,14 @@ impl TwoLinkChain {
     /// A_ℓ and U at `qk` (Z follows with the first solve).
     fn factor_blocks(&mut self) {
         self.factors.z_current = false;
-        let hs = self.hs;
         for link in 0..2 {
-            let r = self.deflections(link);
-            let start = r.start;
+            let start = self.deflections(link).start;
             let mut rates = std::mem::replace(&mut self.factors.links[link], LinkRates::empty());
-            let tip = self.qk[r.end];
-            rates.set_state(&self.qk[r], tip, hs[link], |i| self.diag_mass(start + i));
+            // the kernel's slopes at `qk` (its shape): the tip's deflection sits in the slot
+            // after the link's deflections
+            let shape = &self.points.shape;
+            let g = if link == 0 { &shape.g1 } else { &shape.g2 };
+            rates.set_state(g, |i| self.diag_mass(start + i));
             self.factors.links[link] = rates;
         }
         let ine = &self.inertia;

@@ -85,21 +85,17 @@ impl LinkRates {
         ((0..r).map(diag).collect(), (0..r - 1).map(off).collect())
     }
 
-    /// The state: deflections `u` of the stations with an unknown (length r − 1), the tip's
-    /// deflection `tip` (0 in a chord frame, −Lψ in the clamp-tangent frame), segment spacing
-    /// `h` and station masses `d`.
-    pub fn set_state(&mut self, u: &[f64], tip: f64, h: f64, d: impl Fn(usize) -> f64) {
+    /// The state: the segment slopes `g` (length r; read only with foreshortening) of the
+    /// stations' deflections, the tip's included (0 in a chord frame, −Lψ in the clamp-tangent
+    /// frame), and station masses `d`.
+    pub fn set_state(&mut self, g: &[f64], d: impl Fn(usize) -> f64) {
         let r = self.w.len();
         for i in 0..r - 1 {
             self.d[i] = d(i);
         }
         self.factored = false;
         if self.foreshortening {
-            for seg in 0..r {
-                let right = if seg < r - 1 { u[seg] } else { tip };
-                let left = if seg == 0 { 0.0 } else { u[seg - 1] };
-                self.g[seg] = (right - left) / h;
-            }
+            self.g.copy_from_slice(&g[..r]);
         }
     }
 
