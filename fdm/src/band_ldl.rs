@@ -435,8 +435,8 @@ impl BandLdl {
 }
 
 /// Column j of [`BandLdl::factor`] over the full band of half-bandwidth `K` (rows `a` of
-/// K + 1 entries, L's columns `lc` of K); `chain` carries L[j, j−1] and D[j−1] in and
-/// L[j+1, j] and D[j] out.
+/// K + 1 entries, L's columns `lc` of K); `chain` carries L(j, j−1) and D(j−1) in and
+/// L(j+1, j) and D(j) out.
 #[inline(always)]
 fn band_column<const K: usize>(
     a: &mut [f64],

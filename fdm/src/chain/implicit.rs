@@ -575,8 +575,8 @@ impl TwoLinkChain {
     }
 }
 
-/// The small system's products over one block's band rows, in order: s[r][k] −= c_r z_k and
-/// b[r] −= c_r z_b for the block's columns r, k (c the right-hand sides as formed, z their
+/// The small system's products over one block's band rows, in order: s(r, k) −= c_r z_k and
+/// b(r) −= c_r z_b for the block's columns r, k (c the right-hand sides as formed, z their
 /// solutions; the other columns are zero on the block). `at` are the rows' saddle rows.
 fn schur_rows(
     blk: &KickBlock,
