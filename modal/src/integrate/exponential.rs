@@ -71,13 +71,25 @@ pub fn resolving_step(f: &mut dyn OdeRhs, t: f64, y: &[f64]) -> Result<f64, Inte
     let nf = f
         .second_order_linearization(t, y, &mut m_rows, &mut k_rows)
         .ok_or(IntegrateError::NoLinearization { t })?;
-    let sym = |a: &[f64]| Mat::<f64>::from_fn(nf, nf, |i, j| 0.5 * (a[i * nf + j] + a[j * nf + i]));
+    let (mut m, mut k) = (Mat::zeros(nf, nf), Mat::zeros(nf, nf));
+    symmetrize(&m_rows, &mut m);
+    symmetrize(&k_rows, &mut k);
     let mut pencil = Pencil::new(nf);
     pencil
-        .solve(sym(&k_rows).as_ref(), sym(&m_rows).as_ref())
+        .solve(k.as_ref(), m.as_ref())
         .map_err(|_| IntegrateError::NoLinearization { t })?;
     let top = pencil.eigenvalues().iter().fold(0.0f64, |a, &l| a.max(l.abs()));
     Ok(TOP_FREQUENCY_STEP / top.sqrt().max(f64::MIN_POSITIVE))
+}
+
+/// out = ½(A + Aᵀ) of the row-major square `rows` (the pencil reads one triangle).
+fn symmetrize(rows: &[f64], out: &mut Mat<f64>) {
+    let n = out.nrows();
+    for i in 0..n {
+        for j in 0..n {
+            out[(i, j)] = 0.5 * (rows[i * n + j] + rows[j * n + i]);
+        }
+    }
 }
 
 /// f(τJ) = a·I + b·J of one mode's block J = [[0, 1], [−λ, 0]].
@@ -269,12 +281,8 @@ impl Exponential {
             .ok_or(IntegrateError::NoLinearization { t })?;
         self.size_for(nf);
         self.stats.jacobian_evals += 1;
-        for i in 0..nf {
-            for j in 0..nf {
-                self.m[(i, j)] = 0.5 * (self.m_rows[i * nf + j] + self.m_rows[j * nf + i]);
-                self.k[(i, j)] = 0.5 * (self.k_rows[i * nf + j] + self.k_rows[j * nf + i]);
-            }
-        }
+        symmetrize(&self.m_rows, &mut self.m);
+        symmetrize(&self.k_rows, &mut self.k);
         self.pencil
             .solve(self.k.as_ref(), self.m.as_ref())
             .map_err(|_| IntegrateError::NoLinearization { t })?;
