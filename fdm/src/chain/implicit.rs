@@ -437,19 +437,19 @@ impl TwoLinkChain {
         }
         let x = small.solve(b);
         for blk in blocks.iter() {
-            let (m, r0) = (blk.m, blk.rows.start);
-            for p in blk.band.clone() {
-                let at = at_band[p] - r0;
-                let z = &blk.sol[at * m..at * m + m - 1];
-                let zb = if refactor {
-                    blk.sol[at * m + m - 1]
-                } else {
-                    blk.one[at]
-                };
-                out[band[p]] = zb
-                    - (blk.cols[..m - 1].iter().zip(z))
-                        .map(|(&k, z)| z * x[k])
-                        .sum::<f64>();
+            let range = blk.band.clone();
+            let (rows, at) = (&band[range.clone()], &at_band[range]);
+            let one = (!refactor).then_some(&blk.one[..]);
+            match blk.m {
+                1 => back_rows::<1>(blk, rows, at, &x, one, out),
+                2 => back_rows::<2>(blk, rows, at, &x, one, out),
+                3 => back_rows::<3>(blk, rows, at, &x, one, out),
+                4 => back_rows::<4>(blk, rows, at, &x, one, out),
+                5 => back_rows::<5>(blk, rows, at, &x, one, out),
+                6 => back_rows::<6>(blk, rows, at, &x, one, out),
+                7 => back_rows::<7>(blk, rows, at, &x, one, out),
+                8 => back_rows::<8>(blk, rows, at, &x, one, out),
+                m => unreachable!("{m} right-hand sides"),
             }
         }
         for (k, &f) in full.iter().enumerate() {
@@ -628,6 +628,30 @@ fn schur_rows_m<const M: usize>(
             s[r][c] = acc[a][k];
         }
         b[r] = acc[a][M - 1];
+    }
+}
+
+/// The back substitution of the Schur solve on one block's band rows (q indices `rows`,
+/// saddle rows `at`): out = A⁻¹r_B − Z x, A⁻¹r_B from the factoring solve's last column or
+/// from `one` (a later right-hand side's solution).
+fn back_rows<const M: usize>(
+    blk: &KickBlock,
+    rows: &[usize],
+    at: &[usize],
+    x: &[f64; MAX_SMALL],
+    one: Option<&[f64]>,
+    out: &mut [f64],
+) {
+    let xs: [f64; M] = std::array::from_fn(|a| if a + 1 < M { x[blk.cols[a]] } else { 0.0 });
+    let r0 = blk.rows.start;
+    let sol = blk.sol.as_chunks::<M>().0;
+    for (&i, &p) in rows.iter().zip(at) {
+        let z = &sol[p - r0];
+        let zb = match one {
+            Some(one) => one[p - r0],
+            None => z[M - 1],
+        };
+        out[i] = zb - (0..M - 1).map(|a| z[a] * xs[a]).sum::<f64>();
     }
 }
 
