@@ -8,10 +8,10 @@
 //! left of a row's first nonzero, and rows that start at or after a row r (every one) split the
 //! matrix into independent diagonal blocks, solved one at a time. The terms left of a row's
 //! first column are products with zeros, so skipping them or not gives the full band's sums
-//! in the same order: near a block's ends the factor and the solves skip them, away from the
-//! ends they take the full band in straight-line code (a constant half-bandwidth, no per-row
-//! bookkeeping), and the factor lets two blocks take turns, so that the division that ends
-//! each column overlaps the other block's.
+//! in the same order: near the ends (the matrix's for the factor, a block's for the solves)
+//! they are skipped, elsewhere the full band runs in straight-line code (a constant
+//! half-bandwidth, no per-row bookkeeping), and the factor lets two blocks take turns, so
+//! that the division that ends each column overlaps the other block's.
 
 // Index loops over the band read like the factorization.
 #![allow(clippy::needless_range_loop)]
@@ -143,8 +143,8 @@ impl BandLdl {
     /// Every entry outside the envelope is a zero (so is its L: a zero over a finite pivot),
     /// and subtracting a product with one from a sum that is nonzero or +0 changes nothing.
     /// The sums are never −0: each starts from an assembled entry (a sum onto +0) and only
-    /// subtracts. So the columns away from a block's ends run over the full band, straight-line
-    /// code for the common half-bandwidths, with the envelope's bits.
+    /// subtracts. So the columns away from the matrix's ends run over the full band,
+    /// straight-line code for the common half-bandwidths, with the envelope's bits.
     pub fn factor(&mut self) -> Result<(), usize> {
         assert!(
             self.k <= MAX_HALF_BANDWIDTH,
@@ -162,20 +162,20 @@ impl BandLdl {
         }
     }
 
-    /// [`Self::factor`] with half-bandwidth `K`: each block's columns K from its ends over the
+    /// [`Self::factor`] with half-bandwidth `K`: the columns K from the matrix's ends over the
     /// full band, two blocks in turn (their pivot chains are independent, and each column
     /// waits for the division that ends the previous one).
     fn factor_band<const K: usize>(&mut self) -> Result<(), usize> {
         for pair in (0..self.blocks.len()).step_by(2) {
             let p = self.blocks[pair].clone();
             let q = self.blocks.get(pair + 1).cloned().unwrap_or(0..0);
-            // the columns of a block that reach its ends, and its inner ones
+            // the columns that reach the matrix's ends, and the others: those of a block's
+            // ends reach into its neighbours only through zeros (outside the envelope), and
+            // a neighbour's entries there are finite whatever its progress
+            let n = self.n;
             let inner = |b: &Range<usize>| {
-                if b.len() >= 2 * K {
-                    b.start + K..b.end - K
-                } else {
-                    b.end..b.end
-                }
+                let (lo, hi) = (b.start.max(K), b.end.min(n.saturating_sub(K)));
+                if lo < hi { lo..hi } else { b.end..b.end }
             };
             let (ip, iq) = (inner(&p), inner(&q));
             for j in p.start..ip.start.min(p.end) {

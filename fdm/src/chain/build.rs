@@ -322,6 +322,7 @@ impl TwoLinkChain {
         };
         chain.set_ghost_columns();
         chain.set_unit_rates();
+        chain.set_station_masses();
         chain.omega_max = chain.top_frequency();
         chain.kappa_max = chain.top_damping_rate();
         Ok(chain)

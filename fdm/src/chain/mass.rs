@@ -98,6 +98,16 @@ impl TwoLinkChain {
         self.factor_blocks();
     }
 
+    /// The rate blocks' station masses (the lumped diagonal of M).
+    pub(super) fn set_station_masses(&mut self) {
+        for link in 0..2 {
+            let start = self.deflections(link).start;
+            let mut rates = std::mem::replace(&mut self.factors.links[link], LinkRates::empty());
+            rates.set_masses(|i| self.diag_mass(start + i));
+            self.factors.links[link] = rates;
+        }
+    }
+
     /// The kernel's rates at unit rate of the state-dependent full columns (the frame angle,
     /// and for ψ_ℓ also the tangent frame's deflections −ξ_k, tip −L) and their slopes.
     pub(super) fn set_unit_rates(&mut self) {
@@ -127,14 +137,11 @@ impl TwoLinkChain {
     fn factor_blocks(&mut self) {
         self.factors.z_current = false;
         for link in 0..2 {
-            let start = self.deflections(link).start;
-            let mut rates = std::mem::replace(&mut self.factors.links[link], LinkRates::empty());
             // the kernel's slopes at `qk` (its shape): the tip's deflection sits in the slot
             // after the link's deflections
             let shape = &self.points.shape;
             let g = if link == 0 { &shape.g1 } else { &shape.g2 };
-            rates.set_state(g, |i| self.diag_mass(start + i));
-            self.factors.links[link] = rates;
+            self.factors.links[link].set_state(g);
         }
         let ine = &self.inertia;
         self.factors.nu = if ine.fs1 { 2 } else { 0 };

@@ -38,7 +38,7 @@ pub struct LinkRates {
 }
 
 impl LinkRates {
-    /// A link of r segments with axial masses `w` (length r); D is set by [`Self::factor`].
+    /// A link of r segments with axial masses `w` (length r); D is set by [`Self::set_masses`].
     pub fn new(w: Vec<f64>, foreshortening: bool) -> Self {
         let r = w.len();
         LinkRates {
@@ -85,14 +85,20 @@ impl LinkRates {
         ((0..r).map(diag).collect(), (0..r - 1).map(off).collect())
     }
 
-    /// The state: the segment slopes `g` (length r; read only with foreshortening) of the
-    /// stations' deflections, the tip's included (0 in a chord frame, −Lψ in the clamp-tangent
-    /// frame), and station masses `d`.
-    pub fn set_state(&mut self, g: &[f64], d: impl Fn(usize) -> f64) {
+    /// The station masses D (length r − 1; constant).
+    pub fn set_masses(&mut self, d: impl Fn(usize) -> f64) {
         let r = self.w.len();
         for i in 0..r - 1 {
             self.d[i] = d(i);
         }
+        self.factored = false;
+    }
+
+    /// The state: the segment slopes `g` (length r; read only with foreshortening) of the
+    /// stations' deflections, the tip's included (0 in a chord frame, −Lψ in the clamp-tangent
+    /// frame).
+    pub fn set_state(&mut self, g: &[f64]) {
+        let r = self.w.len();
         self.factored = false;
         if self.foreshortening {
             self.g.copy_from_slice(&g[..r]);
