@@ -9,10 +9,11 @@
 //!
 //! `implicit-kick-saddle`: the kick's linear solve alone — the saddle system the chain assembles
 //! at a deformed, moving state of `two-link-free` (21 / 41 / 81 stations, τ = 1e-5), factored
-//! and solved for the kick's eight right-hand sides — by the hand-written band LDLᵀ the chain
-//! uses (`fdm::band_ldl`), by faer's sparse LU and by faer's sparse LDLᵀ (AMD ordering, no
-//! pivoting, as the band solver), each with its symbolic factorization reused and its storage
-//! allocated once (the contenders a hand-written kernel has to beat).
+//! and solved for eight right-hand sides over both links' blocks (the kick solves each block
+//! alone, with 7 and 6) — by the hand-written band LDLᵀ the chain uses (`fdm::band_ldl`), by
+//! faer's sparse LU and by faer's sparse LDLᵀ (AMD ordering, no pivoting, as the band solver),
+//! each with its symbolic factorization reused and its storage allocated once (the contenders
+//! a hand-written kernel has to beat).
 //!
 //! `link-rates-tridiagonal`: the tridiagonal solve of a link's foreshortening-rate block
 //! N⁻¹ + GD⁻¹Gᵀ in the chain's mass solve (factor once per state, seven right-hand sides), by
