@@ -6,7 +6,7 @@
 //! nothing of stepping, events or output.
 
 use crate::contact::ContactState;
-use crate::integrate::OdeRhs;
+use crate::integrate::{OdeRhs, Stretch};
 use crate::linalg::{dot, solve2};
 use crate::model::Chain;
 use crate::newton::ChainNewton;
@@ -247,6 +247,7 @@ impl ChainRhs {
     fn power_rows(&mut self, t: f64) {
         let nf = self.nf();
         let s = self.slots;
+        let t_law = self.chain.stretch.input_time(t);
         let p = &mut self.lin.p;
         p.iter_mut().for_each(|v| *v = 0.0);
         let base = 2 * nf;
@@ -260,7 +261,7 @@ impl ChainRhs {
             for &(c, g) in &self.rate_grad[..m] {
                 let k = self.free_of[c];
                 if let (Some(row), Some(law)) = (s.applied, &j.torque) {
-                    p[(row - base) * nf + k] += law.torque(t) * g;
+                    p[(row - base) * nf + k] += law.torque(t_law) * g;
                 }
                 if let Some(row) = s.joint_damper {
                     p[(row - base) * nf + k] += 2.0 * j.damping * rate * g;
@@ -287,7 +288,9 @@ impl ChainRhs {
         if j.prescribed.is_some() {
             self.chain.tau_prescribed[i]
         } else {
-            j.torque.as_ref().map_or(0.0, |l| l.torque(t))
+            j.torque
+                .as_ref()
+                .map_or(0.0, |l| l.torque(self.chain.stretch.input_time(t)))
                 - j.stiffness
                     * (self.chain.joint_angle_with_lag(i, &self.q, &self.qd) - j.set_point)
                 - j.damping * self.chain.joint_rate(i, &self.qd)
@@ -331,6 +334,10 @@ fn constrain_column(c: &ContactState, x: &mut [f64]) {
 impl OdeRhs for ChainRhs {
     fn dim(&self) -> usize {
         2 * self.nf() + self.slots.count
+    }
+
+    fn set_stretch(&mut self, stretch: Stretch) {
+        self.chain.stretch = stretch;
     }
 
     /// Structured Jacobian of y' = (q̇, q̈, powers): ∂q̇/∂q̇ = I; the acceleration rows
@@ -495,10 +502,11 @@ impl OdeRhs for ChainRhs {
         }
         let s = self.slots;
         if let Some(k) = s.applied {
+            let t_law = self.chain.stretch.input_time(t);
             let mut p = 0.0;
             for (i, j) in self.chain.joints.iter().enumerate() {
                 if let (None, Some(law)) = (&j.prescribed, &j.torque) {
-                    p += law.torque(t) * self.chain.joint_rate(i, &self.qd);
+                    p += law.torque(t_law) * self.chain.joint_rate(i, &self.qd);
                 }
             }
             dydt[k] = p;

@@ -22,7 +22,7 @@
 
 use data::{Diagnostic, StabilityVerdict};
 
-use crate::integrate::{IntegrateError, OdeRhs, Stepper};
+use crate::integrate::{IntegrateError, OdeRhs, Stepper, Stretch};
 
 /// When a sampled run samples and restarts.
 #[derive(Debug, Clone, Copy)]
@@ -88,8 +88,12 @@ pub fn run_sampled<R: OdeRhs, S: SampledRun<R>>(
     };
     let mut t = 0.0;
     for (index, &target) in schedule.breaks.iter().enumerate() {
+        let stretch = Stretch {
+            start: t,
+            end: target,
+        };
         while t < target {
-            if let Some(stop) = driver.step(&mut t, y, target) {
+            if let Some(stop) = driver.step(&mut t, y, stretch) {
                 return stop;
             }
         }
@@ -145,10 +149,13 @@ struct Driver<'a, R, S> {
 }
 
 impl<R: OdeRhs, S: SampledRun<R>> Driver<'_, R, S> {
-    /// One accepted step from `t` toward `target` and what follows it (module docs); the
+    /// One accepted step from `t` toward the end of `stretch` and what follows it (module docs); the
     /// verdict when the run stops.
-    fn step(&mut self, t: &mut f64, y: &mut [f64], target: f64) -> Option<StabilityVerdict> {
-        if let Err(e) = self.stepper.step(self.rhs, t, y, target) {
+    fn step(&mut self, t: &mut f64, y: &mut [f64], stretch: Stretch) -> Option<StabilityVerdict> {
+        self.rhs.set_stretch(stretch);
+        let stepped = self.stepper.step(self.rhs, t, y, stretch.end);
+        self.rhs.set_stretch(Stretch::OPEN);
+        if let Err(e) = stepped {
             let own = self.run.step_failed(self.rhs, *t, &e);
             return Some(own.unwrap_or_else(|| self.stopped(*t, &e.to_string())));
         }

@@ -1,6 +1,7 @@
 //! The driver of a chain run: builds the model ([`ChainRhs`]) and the registered integration
 //! method ([`crate::integrate::method_for`]), then steps to each forcing discontinuity and to
-//! t_end; after every accepted step it hands the step to the contact events
+//! t_end (a stage that lands on a discontinuity reads the torque laws' left limits there:
+//! [`crate::integrate::Stretch`]); after every accepted step it hands the step to the contact events
 //! ([`crate::events`]: locate on the dense output, reset, project), takes the samples due
 //! ([`crate::output`]) and checks for runaway growth; it maps the run to a [`RunResult`].
 
@@ -13,7 +14,8 @@ use crate::contact::ContactState;
 use crate::error::ModalError;
 use crate::events::{ContactEvents, Halt};
 use crate::integrate::{
-    Build, DOPRI5, MethodInfo, TRBDF2, Tolerances, method_for, names_with, resolving_step,
+    Build, DOPRI5, MethodInfo, OdeRhs, Stretch, TRBDF2, Tolerances, method_for, names_with,
+    resolving_step,
 };
 use crate::output::{Output, runaway, stopped, too_many_events, unresolved_grazing};
 use crate::setup::build_chain;
@@ -245,9 +247,16 @@ pub fn simulate_detailed(
     }
     contact.arm(&rhs)?;
     'outer: for &target in &breaks {
+        let stretch = Stretch {
+            start: t,
+            end: target,
+        };
         while t < target {
             let t_old = t;
-            if let Err(e) = stepper.step(&mut rhs, &mut t, &mut y, target) {
+            rhs.set_stretch(stretch);
+            let stepped = stepper.step(&mut rhs, &mut t, &mut y, target);
+            rhs.set_stretch(Stretch::OPEN);
+            if let Err(e) = stepped {
                 verdict = stopped(&rhs, t, &e.to_string(), None);
                 break 'outer;
             }

@@ -696,3 +696,56 @@ fn dyn_exponential_converges_on_the_undamped_arm() {
     );
     assert!((2300..=2500).contains(&steps), "{steps}");
 }
+
+/// The fixed-step methods keep their order through the discontinuities of a torque law:
+/// `single-link`'s bang-bang torque jumps at 0.5 s and 1 s, onto which the driver steps. A
+/// stage that lands on a jump reads the law's left limit there ([`modal::integrate::Stretch`]);
+/// read at the jump's own time, a right-continuous law hands the next stretch's torque to the
+/// last stage of the step before it, and the step integrates the jump over part of its
+/// length: an error of order h·Δτ, first order in h. Over 1.2 s (both jumps) the trapezoidal
+/// rule must show order 2 and the exponential method order 4 on the joint angle's whole
+/// history, against Dormand–Prince at rtol 1e-11.
+#[test]
+fn dyn_fixed_step_methods_keep_their_order_through_torque_jumps() {
+    let scene = load_scene("single-link").unwrap();
+    let settings = |method: &str, dt: Option<f64>, rtol: Option<f64>| Settings {
+        time: TimeStepping {
+            t_end: Some(1.2),
+            dt,
+            rtol,
+            atol: rtol.map(|r| r * 1e-3),
+            method: Some(method.parse().expect("a method name")),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let angle = |s: &Settings| {
+        let r = ModalBackend.simulate(&scene, s).unwrap();
+        assert_eq!(r.verdict, StabilityVerdict::Completed);
+        r.observables
+            .get(&channel::joint_angle(1))
+            .unwrap()
+            .values
+            .clone()
+    };
+    let reference = angle(&settings("dopri5", None, Some(1e-11)));
+    let error = |method: &str, h: f64| {
+        let x = angle(&settings(method, Some(h), None));
+        assert_eq!(x.len(), reference.len());
+        x.iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    };
+    for (method, steps, order) in [
+        ("trapezoid", [2e-3, 1e-3, 5e-4], 2.0),
+        ("exponential", [2e-3, 1e-3, 5e-4], 4.0),
+    ] {
+        let errors: Vec<f64> = steps.iter().map(|&h| error(method, h)).collect();
+        let orders: Vec<f64> = errors.windows(2).map(|e| (e[0] / e[1]).log2()).collect();
+        println!("{method}: errors {errors:?}, orders {orders:.2?}");
+        for p in orders {
+            assert!((p - order).abs() < 0.5, "{method}: {p}");
+        }
+    }
+}

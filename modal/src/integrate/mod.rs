@@ -213,6 +213,41 @@ pub trait OdeRhs {
     ) -> Option<usize> {
         None
     }
+    /// The stretch of time the next steps integrate, between two discontinuities of the
+    /// system's piecewise-constant inputs ([`Stretch`]); [`Stretch::OPEN`] outside a step. A
+    /// system without such inputs ignores it (the default).
+    fn set_stretch(&mut self, _stretch: Stretch) {}
+}
+
+/// A stretch [start, end] of time between two discontinuities of piecewise-constant inputs
+/// (torque laws and schedules), onto which the drivers step. A method's last stage lands on
+/// `end`, where a right-continuous law already takes the next stretch's value; that stage must
+/// see this stretch's value (the law's left limit), or the step integrates the jump over a
+/// part of itself and the error becomes first order in h (e.g. `single-link`'s bang-bang
+/// torque with the fixed-step methods).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stretch {
+    pub start: f64,
+    pub end: f64,
+}
+
+impl Stretch {
+    /// No stretch: every input at its own time.
+    pub const OPEN: Stretch = Stretch {
+        start: f64::NEG_INFINITY,
+        end: f64::INFINITY,
+    };
+
+    /// The time at which a piecewise-constant input is read for a stage at `t`: `t` itself,
+    /// or, from `end` on, the stretch's midpoint (the inputs are constant inside the stretch,
+    /// so this is their left limit at `end`, free of the rounding of a time next to `end`).
+    pub fn input_time(&self, t: f64) -> f64 {
+        if t >= self.end {
+            0.5 * (self.start + self.end)
+        } else {
+            t
+        }
+    }
 }
 
 /// Mixed error tolerance: component i is scaled by atol + rtol·max(|yᵢ(t)|, |yᵢ(t+h)|).

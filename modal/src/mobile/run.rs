@@ -18,7 +18,7 @@ use data::{EnergyLedger, ModalSettings, Observables, RunResult, Scene, ledger_te
 use super::model::{MobileModel, Workspace};
 use super::{Inputs, set_up};
 use crate::error::ModalError;
-use crate::integrate::{Build, OdeRhs, Tolerances, method_for, oscillators_refused};
+use crate::integrate::{Build, OdeRhs, Stretch, Tolerances, method_for, oscillators_refused};
 use crate::linalg::{cholesky_factor, cholesky_substitute};
 use crate::sampled::{SampledRun, Schedule, run_sampled};
 
@@ -43,6 +43,9 @@ pub struct MobileRhs {
     col: Vec<f64>,
     /// First non-positive pivot met (the reduced mass matrix lost definiteness).
     pub failure: Option<f64>,
+    /// The stretch between the schedules' discontinuities being integrated: the inputs are
+    /// read at [`Stretch::input_time`].
+    stretch: Stretch,
 }
 
 impl MobileRhs {
@@ -59,6 +62,7 @@ impl MobileRhs {
             unit: vec![0.0; m],
             col: vec![0.0; m],
             failure: None,
+            stretch: Stretch::OPEN,
         }
     }
 
@@ -72,7 +76,7 @@ impl MobileRhs {
     /// Evaluates M_r and the right-hand side at (t, q, ν) and solves for ν̇ into `nud`.
     pub fn accelerations(&mut self, t: f64, q: &[f64], nu: &[f64], nud: &mut [f64]) {
         let m = self.m();
-        self.inputs.at(t, &mut self.tau);
+        self.inputs.at(self.stretch.input_time(t), &mut self.tau);
         self.model.equations(q, nu, &self.tau, &mut self.ws);
         nud[..m].copy_from_slice(&self.ws.force);
         if cholesky_factor(&mut self.ws.mass, m).is_err() {
@@ -87,6 +91,10 @@ impl MobileRhs {
 impl OdeRhs for MobileRhs {
     fn dim(&self) -> usize {
         self.n() + self.m() + N_WORK
+    }
+
+    fn set_stretch(&mut self, stretch: Stretch) {
+        self.stretch = stretch;
     }
 
     fn eval(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
@@ -122,7 +130,7 @@ impl OdeRhs for MobileRhs {
             jac[(pl + 2) * dim + pl + 1] = u * c;
         }
         // Mass matrix at (t, y): factor once, then M⁻¹ times the stiffness and friction columns.
-        self.inputs.at(t, &mut self.tau);
+        self.inputs.at(self.stretch.input_time(t), &mut self.tau);
         self.model.equations(q, nu, &self.tau, &mut self.ws);
         if cholesky_factor(&mut self.ws.mass, m).is_err() {
             return false;

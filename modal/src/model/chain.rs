@@ -19,6 +19,7 @@ use super::body::{BodyScratch, body_terms};
 use super::elbow::Elbow;
 use super::link::{JointModel, LinkModel};
 use super::section::SectionKind;
+use crate::integrate::Stretch;
 use crate::linalg::{cholesky_solve, cholesky_substitute, dot};
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -72,6 +73,9 @@ pub struct Chain {
     /// Per joint: the condensation with the elbow when the joint is free and its parent link
     /// a condensed Timoshenko link ([`super::elbow`]); the joint coordinate is then φ.
     pub elbows: Vec<Option<Elbow>>,
+    /// The stretch between the torque laws' discontinuities being integrated: the laws are
+    /// read at [`Stretch::input_time`].
+    pub(crate) stretch: Stretch,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -127,6 +131,7 @@ impl Chain {
             tau_prescribed: vec![0.0; nj],
             step_load: None,
             elbows: vec![None; nj],
+            stretch: Stretch::OPEN,
         }
     }
 
@@ -267,6 +272,7 @@ impl Chain {
     /// actuator torques of prescribed joints).
     pub fn evaluate(&mut self, t: f64, q: &[f64], qd: &[f64]) {
         let n = self.n;
+        let t_law = self.stretch.input_time(t);
         self.mass.iter_mut().for_each(|v| *v = 0.0);
         match &self.step_load {
             Some(f) => self.force.copy_from_slice(f),
@@ -381,7 +387,7 @@ impl Chain {
                 let (nb, nc) = (e.nb, e.nc);
                 let b = &q[p.b0..p.b0 + nb];
                 let bd = &qd[p.b0..p.b0 + nb];
-                let tau = j.torque.as_ref().map_or(0.0, |law| law.torque(t));
+                let tau = j.torque.as_ref().map_or(0.0, |law| law.torque(t_law));
                 e.condense(b, q[th], tau);
                 let rate = e.rate(bd, qd[th]);
                 let blk = &e.blocks;
@@ -400,7 +406,7 @@ impl Chain {
                 let th = link.theta;
                 let mut tau = -j.stiffness * (q[th] - j.set_point) - j.damping * qd[th];
                 if let Some(law) = &j.torque {
-                    tau += law.torque(t);
+                    tau += law.torque(t_law);
                 }
                 self.force[th] += tau;
             }

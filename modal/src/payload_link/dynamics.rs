@@ -16,7 +16,7 @@
 //! zero: nothing depends on the works, so the simplified Newton iteration settles them one
 //! iteration after the rest.
 
-use crate::integrate::OdeRhs;
+use crate::integrate::{OdeRhs, Stretch};
 use crate::linalg::{cholesky_factor, cholesky_substitute, dot};
 
 use super::model::LinkModel;
@@ -45,6 +45,9 @@ pub struct LinkRhs {
     cols: Vec<f64>,
     scratch: Vec<f64>,
     pub evaluations: usize,
+    /// The stretch between the torque law's discontinuities being integrated: the law is
+    /// read at [`Stretch::input_time`].
+    stretch: Stretch,
 }
 
 /// The quantities of one evaluation the outputs need.
@@ -86,6 +89,7 @@ impl LinkRhs {
             cols: vec![0.0; nd * 2 * nd],
             scratch: vec![0.0; dim],
             evaluations: 0,
+            stretch: Stretch::OPEN,
         })
     }
 
@@ -134,7 +138,7 @@ impl LinkRhs {
     pub fn actuator_torque(&self, t: f64, y: &[f64]) -> f64 {
         let base = &self.model.base;
         if base.free {
-            return base.motor_torque(t);
+            return base.motor_torque(self.stretch.input_time(t));
         }
         let m = &self.model;
         let n = m.n;
@@ -211,7 +215,8 @@ impl LinkRhs {
             self.force[o + i] = f;
         }
         if free {
-            let mut f = m.base.motor_torque(t) - m.base.friction * rate + m.base.spring(theta).0;
+            let mut f = m.base.motor_torque(self.stretch.input_time(t)) - m.base.friction * rate
+                + m.base.spring(theta).0;
             let mut jq = m.j0;
             for i in 0..n {
                 f -= qd[i] * self.gqd[i] + 2.0 * rate * (m.h[i] * qd[i] + q[i] * self.nqd[i]);
@@ -240,6 +245,10 @@ impl LinkRhs {
 impl OdeRhs for LinkRhs {
     fn dim(&self) -> usize {
         2 * self.nd + self.nw
+    }
+
+    fn set_stretch(&mut self, stretch: Stretch) {
+        self.stretch = stretch;
     }
 
     fn eval(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
