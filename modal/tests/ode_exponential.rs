@@ -222,10 +222,48 @@ fn conv_ode_exponential_dense_output_is_second_order_and_meets_the_step_ends() {
     assert!(p > 1.8, "dense output order {p:.2}, errors {errs:?}");
 }
 
+/// [`Nonlinear`] linearized with a stiffness that drifts in time, so that every step
+/// diagonalizes a new pencil (the splitting stays exact: the remainder takes the difference).
+struct Drifting;
+
+impl OdeRhs for Drifting {
+    fn dim(&self) -> usize {
+        5
+    }
+    fn eval(&mut self, t: f64, y: &[f64], d: &mut [f64]) {
+        Nonlinear.eval(t, y, d);
+    }
+    fn second_order_linearization(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        m: &mut Vec<f64>,
+        k: &mut Vec<f64>,
+    ) -> Option<usize> {
+        let nf = Nonlinear.second_order_linearization(t, y, m, k)?;
+        k[0] += 10.0 * t;
+        Some(nf)
+    }
+}
+
+#[test]
+fn ode_exponential_diagonalizes_an_unchanged_linearization_once() {
+    let mut f = Nonlinear;
+    let mut s = Exponential::new(5, 0.01);
+    let (mut t, mut y) = (0.0, Y0);
+    while t < T_END {
+        s.step(&mut f, &mut t, &mut y, T_END).unwrap();
+    }
+    // One diagonalization for the full steps and at most one for a shortened last step.
+    assert!(s.stats().steps >= 100, "{:?}", s.stats());
+    assert!(s.stats().factorizations <= 2, "{:?}", s.stats());
+    assert_eq!(s.stats().jacobian_evals, s.stats().steps);
+}
+
 #[test]
 fn ode_exponential_steps_do_not_allocate() {
     faer::set_global_parallelism(faer::Par::Seq);
-    let mut f = Nonlinear;
+    let mut f = Drifting;
     let mut s = Exponential::new(5, 0.01);
     let (mut t, mut y) = (0.0, Y0);
     let mut out = [0.0; 5];

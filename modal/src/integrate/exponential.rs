@@ -15,7 +15,9 @@
 //! J = [[0, 1], [−λ, 0]], and every function the method needs is f(τJ) = a·I + b·J with
 //! a, b from the scalar f at the eigenvalues ±τ√−λ (cosines and sines for λ > 0, hyperbolic
 //! functions for λ < 0, the power series where |λ|τ² ≤ 1). In those coordinates the
-//! remainder is η = XᵀM_n a + Λ z and has no position part.
+//! remainder is η = XᵀM_n a + Λ z and has no position part. A linearization identical to
+//! the last one, at the same step, keeps its eigenvectors and φ functions (one link on its hub:
+//! the undeformed arm's M and K do not depend on the joint angle).
 //!
 //! **Method.** Cox & Matthews' ETDRK4 (J. Comput. Phys. 176, 2002): stages at t + h/2 (twice)
 //! and t + h,
@@ -185,6 +187,12 @@ pub struct Exponential {
     /// M_n, K_n over the free coordinates: row-major from the right-hand side, then as matrices.
     m_rows: Vec<f64>,
     k_rows: Vec<f64>,
+    /// The rows and the step of the last diagonalization: an identical linearization (a
+    /// chain whose undeformed mass and stiffness do not depend on its joint angles, e.g. one
+    /// link on its hub) keeps its modes and φ functions.
+    m_rows_last: Vec<f64>,
+    k_rows_last: Vec<f64>,
+    h_last_linearized: f64,
     m: Mat<f64>,
     k: Mat<f64>,
     pencil: Pencil,
@@ -224,6 +232,9 @@ impl Exponential {
             stats: StepStats::default(),
             m_rows: Vec::new(),
             k_rows: Vec::new(),
+            m_rows_last: Vec::new(),
+            k_rows_last: Vec::new(),
+            h_last_linearized: f64::NAN,
             m: Mat::zeros(0, 0),
             k: Mat::zeros(0, 0),
             pencil: Pencil::new(0),
@@ -281,6 +292,12 @@ impl Exponential {
             .ok_or(IntegrateError::NoLinearization { t })?;
         self.size_for(nf);
         self.stats.jacobian_evals += 1;
+        if h == self.h_last_linearized
+            && self.m_rows == self.m_rows_last
+            && self.k_rows == self.k_rows_last
+        {
+            return Ok(());
+        }
         symmetrize(&self.m_rows, &mut self.m);
         symmetrize(&self.k_rows, &mut self.k);
         self.pencil
@@ -308,6 +325,9 @@ impl Exponential {
             self.half[j] = [half[0], half[1]];
             self.full[j] = phi_blocks(self.lambda[j], h);
         }
+        self.m_rows_last.clone_from(&self.m_rows);
+        self.k_rows_last.clone_from(&self.k_rows);
+        self.h_last_linearized = h;
         Ok(())
     }
 
@@ -505,6 +525,7 @@ impl Stepper for Exponential {
     fn last_step(&self) -> f64 {
         self.h_last
     }
-    /// Nothing is carried between steps: every step linearizes afresh.
+    /// Nothing is carried between steps but the last diagonalization, which every step checks
+    /// against its own linearization.
     fn reset(&mut self) {}
 }
