@@ -31,15 +31,15 @@
 //! for the exact inextensible kinetic terms) plus a dense N³/3 Cholesky of the small reduced
 //! mass matrix. Prescribed hub motion is
 //! imposed exactly and the torque it needs is reported. Time integration: [`integrate`]
-//! (by default adaptive TR-BDF2 for Kelvin–Voigt-damped chains, with or without contact,
-//! Dormand–Prince 5(4) otherwise, see [`simulate::default_method`]; adaptive TR-BDF2 is also
+//! (by default adaptive TR-BDF2 for Kelvin–Voigt-damped chains, with or without contact, an
+//! exponential integrator exact on the undeformed arm's oscillators for undamped chains
+//! without contact ([`integrate::Exponential`], [`pencil`]), Dormand–Prince 5(4) otherwise,
+//! see [`simulate::default_method`]; adaptive TR-BDF2 is also
 //! the method for other stiff cases: many `poly` modes, whose
 //! overdamped Kelvin–Voigt eigenvalues reach −1.4e7 / −4.8e7 / −1.4e8 s⁻¹ at 16 / 20 / 24 modes
 //! per link on `barhorst-case1-tipmass`). TR-BDF2 solves its Newton systems through the
 //! chain's own factored linearization ([`newton`]: Cholesky of M + cD + c²K with the contact
-//! rows, never M⁻¹K) and keeps it across the drift projections of the contact phase. Undamped
-//! chains without contact can also be stepped by an exponential integrator that is exact on
-//! the undeformed arm's oscillators ([`integrate::Exponential`], [`pencil`]). The
+//! rows, never M⁻¹K) and keeps it across the drift projections of the contact phase. The
 //! rocket (seed 003) is in [`rocket`], the 3-D
 //! link with an offset payload (seed 002) in [`payload_link`], the mobile manipulator with a
 //! flexible pitch link (seed 004) in [`mobile`].

@@ -14,8 +14,8 @@ use crate::contact::ContactState;
 use crate::error::ModalError;
 use crate::events::{ContactEvents, Halt};
 use crate::integrate::{
-    Build, DOPRI5, MethodInfo, OdeRhs, Stretch, TRBDF2, Tolerances, method_for, names_with,
-    resolving_step,
+    Build, DOPRI5, EXPONENTIAL, MethodInfo, OdeRhs, Stretch, TRBDF2, Tolerances, method_for,
+    names_with, resolving_step,
 };
 use crate::output::{Output, runaway, stopped, too_many_events, unresolved_grazing};
 use crate::setup::build_chain;
@@ -55,9 +55,14 @@ pub fn method_choice(pc: &PlanarChain, settings: &ModalSettings) -> Method {
         .map_or_else(|| default_method(pc, settings), method_for)
 }
 
-/// The default method: adaptive TR-BDF2 ([`TRBDF2`], tolerances [`KELVIN_VOIGT_DEFAULT_TOL`],
-/// with a tip contact [`KELVIN_VOIGT_CONTACT_TOL`]) for a chain whose every link carries
-/// Kelvin–Voigt damping, when no tolerance is given; otherwise Dormand–Prince.
+/// The default method, when no tolerance is given (a tolerance given without a method asks
+/// for Dormand–Prince, [`DOPRI5`]):
+/// - every link Kelvin–Voigt-damped, with or without a tip contact: adaptive TR-BDF2
+///   ([`TRBDF2`], tolerances [`KELVIN_VOIGT_DEFAULT_TOL`], with a contact
+///   [`KELVIN_VOIGT_CONTACT_TOL`]);
+/// - no link damped and no contact: the exponential method ([`EXPONENTIAL`]) at
+///   min([`default_step`], 2/ω_max);
+/// - otherwise (a contact on undamped links, some links damped): Dormand–Prince.
 ///
 /// Why: an explicit method is bound by the highest Ritz frequency (ω ~ β²√(EI/ρAL⁴) grows
 /// like the square of the mode number) and, at a tight tolerance, resolves every such mode.
@@ -69,22 +74,25 @@ pub fn method_choice(pc: &PlanarChain, settings: &ModalSettings) -> Method {
 /// name) cannot resolve the initial transient: on `two-link-free` (6 `poly` modes,
 /// h = T₁/128 = 1.05e-3) the term `dissipated:kelvin_voigt` comes out 14 % high at 6 modes
 /// and 12 % high at 8, and the error grows with the mode count. Undamped links keep their
-/// high modes ringing for all time; they keep the explicit method. There the high modes are not
-/// stiff in the sense an implicit method exploits: they oscillate about their quasi-static
-/// state with an amplitude the joint angles feel (the nonlinear coupling keeps re-exciting
-/// them), so an error-controlled step resolves them whatever the method, and a method that
-/// damps or aliases them moves the answer (docs/backends.md has the measurements). A tolerance
-/// given (`rtol`/`atol`) without a method asks for Dormand–Prince.
+/// high modes ringing for all time, and the joint angles feel their phases through the
+/// nonlinear coupling: a method that damps or aliases them moves the answer (docs/backends.md).
+/// The exponential method carries every mode of the undeformed arm exactly at any step and
+/// integrates only the coupling at fourth order, so it converges where the implicit methods do
+/// not and takes ~10× fewer steps than Dormand–Prince, whose step the top mode bounds
+/// (`two-link-free-undamped`, 10 s: 3.6 s instead of 40 s, 5.3e-6 rad apart on the 20 Hz
+/// low-passed hub angle). A contact's constraint force would sit in its explicit remainder,
+/// hence Dormand–Prince there.
 pub fn default_method(pc: &PlanarChain, settings: &ModalSettings) -> Method {
     let tolerance_given = settings.rtol.is_some() || settings.atol.is_some();
-    let all_damped = pc
-        .links
-        .iter()
-        .all(|l| l.kelvin_voigt.is_some_and(|g| g > 0.0));
-    if tolerance_given || !all_damped {
+    let damped = |l: &data::scene::Link| l.kelvin_voigt.is_some_and(|g| g > 0.0);
+    if tolerance_given {
         &DOPRI5
-    } else {
+    } else if pc.links.iter().all(damped) {
         &TRBDF2
+    } else if !pc.links.iter().any(damped) && pc.contacts.is_empty() {
+        &EXPONENTIAL
+    } else {
+        &DOPRI5
     }
 }
 

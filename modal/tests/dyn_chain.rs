@@ -470,8 +470,8 @@ fn dyn_spin_up_axial_converges_to_the_inextensible_model() {
 }
 
 #[test]
-fn sys_default_method_is_adaptive_trbdf2_for_kelvin_voigt_chains_with_or_without_contact() {
-    use modal::integrate::{DOPRI5, TRBDF2};
+fn sys_default_method_per_chain_kelvin_voigt_trbdf2_undamped_exponential_contact_dopri5() {
+    use modal::integrate::{DOPRI5, EXPONENTIAL, TRBDF2};
     use modal::simulate::{STEPS_PER_PERIOD, default_method, default_step};
     let plain = Settings::default();
     let with_rtol = Settings {
@@ -499,11 +499,23 @@ fn sys_default_method_is_adaptive_trbdf2_for_kelvin_voigt_chains_with_or_without
             "{name}"
         );
     }
-    // Undamped links (and a contact scene without Kelvin–Voigt) keep the explicit method.
-    for name in ["two-link-free-undamped", "single-link", "constrained-arm"] {
+    // Undamped chains without contact take the exponential method, unless a tolerance is given;
+    // a contact scene without Kelvin–Voigt keeps the explicit method.
+    for (name, method) in [
+        ("two-link-free-undamped", &EXPONENTIAL),
+        ("single-link", &EXPONENTIAL),
+        ("spin-up", &EXPONENTIAL),
+        ("constrained-arm", &DOPRI5),
+    ] {
         let scene = load_scene(name).unwrap();
+        let chain = scene.planar_chain().unwrap();
         assert_eq!(
-            default_method(scene.planar_chain().unwrap(), &plain.modal().unwrap()),
+            default_method(chain, &plain.modal().unwrap()),
+            method,
+            "{name}"
+        );
+        assert_eq!(
+            default_method(chain, &with_rtol.modal().unwrap()),
             &DOPRI5,
             "{name}"
         );
