@@ -2,7 +2,7 @@
 //! constant linear oscillators at any step, fourth order on a nonlinear one, a continuous
 //! extension that meets both step ends, and no allocation per step.
 
-use modal::integrate::{DOPRI5, Exponential, OdeRhs, Stepper, Tolerances};
+use modal::integrate::{DOPRI5, Exponential, OdeRhs, REFRESH_TOLERANCE, Stepper, Tolerances};
 
 #[path = "support/counting_alloc.rs"]
 mod counting_alloc;
@@ -222,9 +222,11 @@ fn conv_ode_exponential_dense_output_is_second_order_and_meets_the_step_ends() {
     assert!(p > 1.8, "dense output order {p:.2}, errors {errs:?}");
 }
 
-/// [`Nonlinear`] linearized with a stiffness that drifts in time, so that every step
-/// diagonalizes a new pencil (the splitting stays exact: the remainder takes the difference).
-struct Drifting;
+/// [`Nonlinear`] linearized with a stiffness K₀₀ = 900 + rate·t that drifts in time (the
+/// splitting stays exact: the remainder takes the difference).
+struct Drifting {
+    rate: f64,
+}
 
 impl OdeRhs for Drifting {
     fn dim(&self) -> usize {
@@ -241,9 +243,43 @@ impl OdeRhs for Drifting {
         k: &mut Vec<f64>,
     ) -> Option<usize> {
         let nf = Nonlinear.second_order_linearization(t, y, m, k)?;
-        k[0] += 10.0 * t;
+        k[0] += self.rate * t;
         Some(nf)
     }
+}
+
+/// (end state, diagonalizations, steps) of [`Drifting`] at h = 0.01 with the refresh tolerance.
+fn drifting(rate: f64, tolerance: f64) -> ([f64; 5], usize, usize) {
+    let mut f = Drifting { rate };
+    let mut s = Exponential::new(5, 0.01).with_refresh_tolerance(tolerance);
+    let (mut t, mut y) = (0.0, Y0);
+    while t < T_END {
+        s.step(&mut f, &mut t, &mut y, T_END).unwrap();
+    }
+    (y, s.stats().factorizations, s.stats().steps)
+}
+
+#[test]
+fn ode_exponential_refreshes_its_diagonalization_past_the_tolerance() {
+    // K₀₀ moves by rate·h per step against the bound 1e-4·√(K₀₀K₀₀) ≈ 0.09: at rate 100 every
+    // step refreshes; at rate 0.5 every ~18th step does, and the answer stays within a small
+    // fraction of the method's own error (1.5e-4 at h = 0.01 against the reference).
+    let r = reference();
+    let error = |y: [f64; 5]| (0..5).map(|i| (y[i] - r[i]).abs()).fold(0.0, f64::max);
+    let (_, fast, steps) = drifting(100.0, REFRESH_TOLERANCE);
+    assert_eq!(fast, steps);
+    let (every, all, _) = drifting(0.5, 0.0);
+    let (kept, some, steps) = drifting(0.5, REFRESH_TOLERANCE);
+    assert_eq!(all, steps);
+    assert!(some * 10 < steps && some > 2, "{some} of {steps}");
+    let (e_every, e_kept) = (error(every), error(kept));
+    let apart = error_between(every, kept);
+    println!("errors {e_every:.3e} (every step) {e_kept:.3e} (kept), {apart:.3e} apart");
+    assert!(apart < 0.1 * e_every, "{apart:e} vs {e_every:e}");
+}
+
+fn error_between(a: [f64; 5], b: [f64; 5]) -> f64 {
+    (0..5).map(|i| (a[i] - b[i]).abs()).fold(0.0, f64::max)
 }
 
 #[test]
@@ -263,7 +299,7 @@ fn ode_exponential_diagonalizes_an_unchanged_linearization_once() {
 #[test]
 fn ode_exponential_steps_do_not_allocate() {
     faer::set_global_parallelism(faer::Par::Seq);
-    let mut f = Drifting;
+    let mut f = Drifting { rate: 100.0 };
     let mut s = Exponential::new(5, 0.01);
     let (mut t, mut y) = (0.0, Y0);
     let mut out = [0.0; 5];

@@ -32,7 +32,9 @@
 //! [`data::ModalMethod`] follows).
 
 pub use dopri5::{DOPRI5, Dopri5};
-pub use exponential::{EXPONENTIAL, Exponential, TOP_FREQUENCY_STEP, resolving_step};
+pub use exponential::{
+    EXPONENTIAL, Exponential, REFRESH_TOLERANCE, TOP_FREQUENCY_STEP, resolving_step,
+};
 pub use sdirk::{Sdirk, TRAPEZOID, TRBDF2, TRBDF2_FIXED};
 
 /// Why [`Stepper::step`] returned.
