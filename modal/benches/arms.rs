@@ -1,21 +1,18 @@
 //! Criterion benches of the Barhorst arm (issue 16). Without contact, 10 s each, at the default
 //! settings (basis, modes, method and step chosen by the backend) and, for the undamped arm,
-//! at fixed-step TR-BDF2 (h = 2.5e-4). The fixed step is a cost reference, not an equivalent
-//! answer: it damps the ringing high modes, and its 20 Hz low-passed joint angles lie 5.3e-3 rad
-//! (joint 1) and 8.5e-3 rad (joint 2) from Dormand–Prince at rtol 1e-6 over the 10 s (2.1e-3 and
-//! 3.6e-3 rad within the first second, against rtol 1e-8).
+//! at other methods: Dormand–Prince at rtol 1e-8 (the explicit method, bound by the top Ritz
+//! mode: ~1.8e5 steps per simulated second, about a minute a run on an idle 2-core machine, so
+//! its 10 samples take ~10 minutes), the exponential method at h = 2.5e-4 (1.5e-4 rad from
+//! Dormand–Prince on the 20 Hz low-passed hub angle over 10 s), and fixed-step TR-BDF2 at
+//! h = 2.5e-4. The undamped default is the exponential method at its default step (2/ω_max,
+//! ~8 000 steps per simulated second, 6.1e-6 rad from Dormand–Prince; docs/backends.md, "The
+//! exponential method on the undamped arm"). The fixed step is a cost reference, not an
+//! equivalent answer: it damps the ringing high modes, and its 20 Hz low-passed joint angles lie
+//! 5.3e-3 rad (joint 1) and 8.5e-3 rad (joint 2) from Dormand–Prince at rtol 1e-6 over the 10 s
+//! (2.1e-3 and 3.6e-3 rad within the first second, against rtol 1e-8).
 //!
-//! Run: `cargo bench -p modal --bench arms`. The undamped default is the explicit method with
-//! 6 poly modes, ~1.7e5 Dormand–Prince steps per simulated second (clamped-free: 1.0e5), about
-//! a minute a run on an idle 2-core machine: its 10 samples take ~10 minutes. The group
-//! `arm 1 s` runs the first simulated second of the undamped arm only
-//! (`cargo bench -p modal --bench arms -- 'arm 1 s'`).
-//!
-//! The undamped arm with the exponential integrator (`--method exponential`), whose error does
-//! not come from the modes' stiffness: at its default step (2/ω_max, ~8 000 steps per simulated
-//! second; 5.3e-6 rad from the default run's 20 Hz low-passed hub angle over 10 s) and at
-//! h = 2.5e-4 (1.5e-4 rad), in both groups (docs/backends.md, "The exponential method on the
-//! undamped arm"): `cargo bench -p modal --bench arms -- exponential`.
+//! Run: `cargo bench -p modal --bench arms`. The group `arm 1 s` runs the first simulated second
+//! of the undamped arm only (`cargo bench -p modal --bench arms -- 'arm 1 s'`).
 //!
 //! With contact, the group `contact 3 s converged switching` runs `barhorst-case1` and
 //! `barhorst-case1-timoshenko` (3 s) at the resolution whose contact-episode boundaries lie
@@ -63,22 +60,20 @@ fn arms(c: &mut Criterion) {
             )
         })
     });
-    for dt in [None, Some(2.5e-4)] {
-        let exponential = Settings {
+    for (method, dt, label) in [
+        ("dopri5", None, "dopri5"),
+        ("exponential", Some(2.5e-4), "exponential 2.5e-4"),
+    ] {
+        let settings = Settings {
             time: TimeStepping {
-                method: Some("exponential".parse().expect("a method name")),
+                method: Some(method.parse().expect("a method name")),
                 dt,
                 ..Default::default()
             },
             ..Default::default()
         };
-        let label = if dt.is_some() {
-            "2.5e-4"
-        } else {
-            "default step"
-        };
-        group.bench_function(format!("two-link-free-undamped exponential {label}"), |b| {
-            b.iter(|| black_box(ModalBackend.simulate(&undamped, &exponential).unwrap()))
+        group.bench_function(format!("two-link-free-undamped {label}"), |b| {
+            b.iter(|| black_box(ModalBackend.simulate(&undamped, &settings).unwrap()))
         });
     }
     group.finish();
@@ -107,10 +102,13 @@ fn arm_first_second(c: &mut Criterion) {
     group.bench_function("two-link-free-undamped trbdf2-fixed 2.5e-4", |b| {
         b.iter(|| black_box(ModalBackend.simulate(&undamped, &fixed).unwrap()))
     });
-    for (dt, label) in [(None, "default step"), (Some(2.5e-4), "2.5e-4")] {
-        let exponential = over_one_second(Some("exponential"), dt);
-        group.bench_function(format!("two-link-free-undamped exponential {label}"), |b| {
-            b.iter(|| black_box(ModalBackend.simulate(&undamped, &exponential).unwrap()))
+    for (method, dt, label) in [
+        ("dopri5", None, "dopri5"),
+        ("exponential", Some(2.5e-4), "exponential 2.5e-4"),
+    ] {
+        let settings = over_one_second(Some(method), dt);
+        group.bench_function(format!("two-link-free-undamped {label}"), |b| {
+            b.iter(|| black_box(ModalBackend.simulate(&undamped, &settings).unwrap()))
         });
     }
     group.finish();
