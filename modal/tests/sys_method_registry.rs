@@ -105,7 +105,8 @@ fn sys_registry_models_without_oscillators_refuse_the_methods_that_need_them() {
     let others = names_with("or", |m| !m.needs_oscillators);
     let needing: Vec<_> = METHODS.iter().filter(|m| m.needs_oscillators).collect();
     assert!(!needing.is_empty());
-    // Kelvin–Voigt and contact chains, the 3-D payload link and the mobile manipulator.
+    // Kelvin–Voigt and contact chains, the Kelvin–Voigt-damped 3-D payload link and the mobile
+    // manipulator.
     for scene_name in [
         "two-link-free",
         "barhorst-case1",
@@ -128,23 +129,30 @@ fn sys_registry_models_without_oscillators_refuse_the_methods_that_need_them() {
             }
         }
     }
-    // An undamped chain without contact runs them, and refuses a tolerance for them.
-    let scene = load_scene("two-link-free-undamped").unwrap();
-    for &&info in &needing {
-        let mut s = Settings::default();
-        s.time.method = Some(info.method.into());
-        s.time.rtol = Some(1e-6);
-        match modal::ModalBackend.simulate(&scene, &s) {
-            Err(BackendError::InvalidSettings { field, message }) => {
-                assert_eq!(field, "time.rtol/atol");
-                assert!(message.contains("--dt"), "{message}");
+    // An undamped chain without contact and the undamped payload link run them, and refuse a
+    // tolerance for them.
+    for scene_name in ["two-link-free-undamped", "single-link-3d-stiff"] {
+        let scene = load_scene(scene_name).unwrap();
+        for &&info in &needing {
+            let mut s = Settings::default();
+            s.time.method = Some(info.method.into());
+            s.time.rtol = Some(1e-6);
+            match modal::ModalBackend.simulate(&scene, &s) {
+                Err(BackendError::InvalidSettings { field, message }) => {
+                    assert_eq!(field, "time.rtol/atol");
+                    assert!(message.contains("--dt"), "{message}");
+                }
+                other => panic!("{scene_name} {info:?} with rtol: {other:?}"),
             }
-            other => panic!("{info:?} with rtol: {other:?}"),
+            let mut s = Settings::default();
+            s.time.method = Some(info.method.into());
+            s.time.t_end = Some(1e-2);
+            let r = modal::ModalBackend.simulate(&scene, &s).unwrap();
+            assert_eq!(
+                r.verdict,
+                StabilityVerdict::Completed,
+                "{scene_name} {info:?}"
+            );
         }
-        let mut s = Settings::default();
-        s.time.method = Some(info.method.into());
-        s.time.t_end = Some(1e-2);
-        let r = modal::ModalBackend.simulate(&scene, &s).unwrap();
-        assert_eq!(r.verdict, StabilityVerdict::Completed, "{info:?}");
     }
 }

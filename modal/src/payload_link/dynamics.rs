@@ -251,6 +251,41 @@ impl OdeRhs for LinkRhs {
         self.stretch = stretch;
     }
 
+    /// The oscillators of the undeformed link: M = [[J₀, bᵀ], [b, M_qq]] (free base; M_qq
+    /// alone with a prescribed one) and K = diag(K_θ, K_qq). Both are constant, so the
+    /// exponential method diagonalizes them once; the centrifugal softening, the gyroscopic and
+    /// nonlinear inertia terms, gravity and the motor stay in its remainder.
+    fn second_order_linearization(
+        &mut self,
+        _t: f64,
+        _y: &[f64],
+        m: &mut Vec<f64>,
+        k: &mut Vec<f64>,
+    ) -> Option<usize> {
+        let model = &self.model;
+        let (n, nd) = (model.n, self.nd);
+        let o = nd - n;
+        m.clear();
+        m.resize(nd * nd, 0.0);
+        k.clear();
+        k.resize(nd * nd, 0.0);
+        for i in 0..n {
+            for j in 0..n {
+                m[(o + i) * nd + o + j] = model.mass[i * n + j];
+                k[(o + i) * nd + o + j] = model.stiffness[i * n + j];
+            }
+        }
+        if model.base.free {
+            m[0] = model.j0;
+            for i in 0..n {
+                m[1 + i] = model.b[i];
+                m[(1 + i) * nd] = model.b[i];
+            }
+            k[0] = model.base.spring.map_or(0.0, |(ks, _)| ks);
+        }
+        Some(nd)
+    }
+
     fn eval(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
         self.evaluations += 1;
         let nd = self.nd;
