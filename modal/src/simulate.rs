@@ -15,7 +15,7 @@ use crate::error::ModalError;
 use crate::events::{ContactEvents, Halt};
 use crate::integrate::{
     Build, DOPRI5, EXPONENTIAL, MethodInfo, OdeRhs, Stretch, TRBDF2, Tolerances, method_for,
-    names_with, resolving_step,
+    oscillators_disturbed, resolving_step, tolerance_refused,
 };
 use crate::output::{Output, runaway, stopped, too_many_events, unresolved_grazing};
 use crate::setup::build_chain;
@@ -152,33 +152,27 @@ pub fn simulate_detailed(
             .iter()
             .any(|l| l.kelvin_voigt.is_some_and(|g| g > 0.0));
         if damped || !pc.contacts.is_empty() {
+            let has = if damped {
+                "Kelvin–Voigt damping"
+            } else {
+                "a contact"
+            };
             return Err(ModalError::invalid(
                 "time.method",
-                format!(
-                    "`{}` integrates chains without Kelvin–Voigt damping and without a tip \
-                     contact (scene `{}` has {}): its exact part is the undamped oscillators and \
-                     everything else is explicit; use {}",
-                    method.name,
-                    scene.name,
-                    if damped {
-                        "Kelvin–Voigt damping"
-                    } else {
-                        "a contact"
-                    },
-                    names_with("or", |m| !m.needs_oscillators)
+                oscillators_disturbed(
+                    method,
+                    "chains without Kelvin–Voigt damping and without a tip contact",
+                    &scene.name,
+                    has,
                 ),
             ));
         }
-    }
-    if method.needs_oscillators && (settings.rtol.is_some() || settings.atol.is_some()) {
-        return Err(ModalError::invalid(
-            "time.rtol/atol",
-            format!(
-                "`{}` takes no tolerance (fixed steps, no Newton iteration); its accuracy is set \
-                 by --dt (default 2/ω_max)",
-                method.name
-            ),
-        ));
+        if settings.rtol.is_some() || settings.atol.is_some() {
+            return Err(ModalError::invalid(
+                "time.rtol/atol",
+                tolerance_refused(method, "2/ω_max"),
+            ));
+        }
     }
     let fixed_step = method.is_fixed_step();
     let default_kelvin_voigt_method = settings.method.is_none() && std::ptr::eq(method, &TRBDF2);

@@ -646,16 +646,11 @@ fn dyn_two_link_free_fixed_step_and_default_follow_the_resolved_method() {
     assert!(fixed.cost.steps * 3 < adaptive.cost.steps);
 }
 
-/// The exponential integrator on the undamped arm, whose every mode rings: its whole 0.3 s
-/// joint-angle histories converge at fourth order once the step resolves the remainder's
-/// coupling of the top mode (ω_max·h ≤ 2; the default step is there), to Dormand–Prince's
-/// answer at a tight tolerance.
-#[test]
-fn dyn_exponential_converges_on_the_undamped_arm() {
-    let scene = load_scene("two-link-free-undamped").unwrap();
-    let settings = |method: &str, dt: Option<f64>, rtol: Option<f64>| Settings {
+/// The scene's defaults but for the method, t_end, the step and the tolerance (atol rtol/1000).
+fn method_settings(method: &str, t_end: f64, dt: Option<f64>, rtol: Option<f64>) -> Settings {
+    Settings {
         time: TimeStepping {
-            t_end: Some(0.3),
+            t_end: Some(t_end),
             dt,
             rtol,
             atol: rtol.map(|r| r * 1e-3),
@@ -663,7 +658,18 @@ fn dyn_exponential_converges_on_the_undamped_arm() {
             ..Default::default()
         },
         ..Default::default()
-    };
+    }
+}
+
+/// The exponential integrator on the undamped arm, whose every mode rings: its whole 0.3 s
+/// joint-angle histories converge at fourth order once the step resolves the remainder's
+/// coupling of the top mode (ω_max·h ≤ 2; the default step is there), to Dormand–Prince's
+/// answer at a tight tolerance.
+#[test]
+fn dyn_exponential_converges_on_the_undamped_arm() {
+    let scene = load_scene("two-link-free-undamped").unwrap();
+    let settings =
+        |method: &str, dt: Option<f64>, rtol: Option<f64>| method_settings(method, 0.3, dt, rtol);
     let simulate = |s: &Settings| {
         let r = ModalBackend.simulate(&scene, s).unwrap();
         assert_eq!(r.verdict, StabilityVerdict::Completed);
@@ -720,17 +726,8 @@ fn dyn_exponential_converges_on_the_undamped_arm() {
 #[test]
 fn dyn_fixed_step_methods_keep_their_order_through_torque_jumps() {
     let scene = load_scene("single-link").unwrap();
-    let settings = |method: &str, dt: Option<f64>, rtol: Option<f64>| Settings {
-        time: TimeStepping {
-            t_end: Some(1.2),
-            dt,
-            rtol,
-            atol: rtol.map(|r| r * 1e-3),
-            method: Some(method.parse().expect("a method name")),
-            ..Default::default()
-        },
-        ..Default::default()
-    };
+    let settings =
+        |method: &str, dt: Option<f64>, rtol: Option<f64>| method_settings(method, 1.2, dt, rtol);
     let angle = |s: &Settings| {
         let r = ModalBackend.simulate(&scene, s).unwrap();
         assert_eq!(r.verdict, StabilityVerdict::Completed);

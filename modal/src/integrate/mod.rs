@@ -166,6 +166,28 @@ pub fn oscillators_refused(method: &MethodInfo, model: &str) -> Option<String> {
     })
 }
 
+/// Why a method that needs oscillators refuses a model that has them but also a term its
+/// explicit remainder must not carry: `models` is what it integrates ("chains without
+/// Kelvin–Voigt damping and without a tip contact"), `scene` the scene and `has` the term.
+pub fn oscillators_disturbed(method: &MethodInfo, models: &str, scene: &str, has: &str) -> String {
+    format!(
+        "`{}` integrates {models} (scene `{scene}` has {has}): its exact part is the undamped \
+         oscillators and everything else is explicit; use {}",
+        method.name,
+        names_with("or", |m| !m.needs_oscillators)
+    )
+}
+
+/// Why a fixed-step method without a Newton iteration refuses a tolerance; `default_step`
+/// names its default step.
+pub fn tolerance_refused(method: &MethodInfo, default_step: &str) -> String {
+    format!(
+        "`{}` takes no tolerance (fixed steps, no Newton iteration); its accuracy is set by --dt \
+         (default {default_step})",
+        method.name
+    )
+}
+
 /// [`StopReason`] of a step that ended at `t` with target `t_stop`.
 pub(crate) fn stop_reason(t: f64, t_stop: f64) -> StopReason {
     if t >= t_stop {

@@ -11,7 +11,10 @@ use super::dynamics::LinkRhs;
 use super::model::LinkModel;
 use super::{SetUp, set_up, static_sag};
 use crate::error::ModalError;
-use crate::integrate::{Build, EXPONENTIAL, OdeRhs, TRBDF2, Tolerances, method_for, names_with};
+use crate::integrate::{
+    Build, EXPONENTIAL, OdeRhs, TRBDF2, Tolerances, method_for, oscillators_disturbed,
+    tolerance_refused,
+};
 use crate::linalg::dot;
 use crate::modes::generalized_eigen;
 use crate::sampled::{SampledRun, Schedule, run_sampled};
@@ -78,24 +81,18 @@ pub fn simulate(
     if method.needs_oscillators && model.damping.is_some() {
         return Err(ModalError::invalid(
             "time.method",
-            format!(
-                "`{}` integrates the payload link without Kelvin–Voigt damping (scene `{}` has \
-                 it): its exact part is the undamped oscillators and everything else is \
-                 explicit; use {}",
-                method.name,
-                scene.name,
-                names_with("or", |m| !m.needs_oscillators)
+            oscillators_disturbed(
+                method,
+                "the payload link without Kelvin–Voigt damping",
+                &scene.name,
+                "it",
             ),
         ));
     }
     if method.needs_oscillators && (settings.rtol.is_some() || settings.atol.is_some()) {
         return Err(ModalError::invalid(
             "time.rtol/atol",
-            format!(
-                "`{}` takes no tolerance (fixed steps, no Newton iteration); its accuracy is set \
-                 by --dt (default T₁/128)",
-                method.name
-            ),
+            tolerance_refused(method, "T₁/128"),
         ));
     }
     let rtol = settings.rtol.unwrap_or(DEFAULT_TOL.0);
