@@ -173,6 +173,8 @@ fn chain_inertia(pc: &PlanarChain, lumps: [(usize, f64, Vec<f64>); 2]) -> ChainI
         mass2: m2.iter().sum::<f64>() + 0.5 * pc.links[1].mass_per_length * h2,
         q2: (0..r2).map(|j| m2[j] * (j + 1) as f64 * h2).sum(),
         elbow_mass: 0.5 * pc.links[1].mass_per_length * h2,
+        x1: (0..r1).map(|k| (k + 1) as f64 * h1).collect(),
+        x2: (0..r2).map(|j| (j + 1) as f64 * h2).collect(),
         m1,
         m2,
     }

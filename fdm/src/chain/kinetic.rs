@@ -51,6 +51,9 @@ pub struct ChainInertia {
     pub r2: usize,
     pub fs1: bool,
     pub fs2: bool,
+    /// abscissae ξ_k = (k+1)h of stations 1…r (index k ↔ station k+1)
+    pub x1: Vec<f64>,
+    pub x2: Vec<f64>,
     /// masses of stations 1…r (index k ↔ station k+1)
     pub m1: Vec<f64>,
     pub m2: Vec<f64>,
@@ -145,15 +148,16 @@ impl ChainInertia {
 }
 
 /// The configuration's part of every product with B or Bᵀ at q: each link's segment slopes g
-/// and running foreshortening s_k = ½h Σ_{seg ≤ k} g_seg² (zero without foreshortening). One
-/// step evaluates B and Bᵀ at one q several times (M's columns, Γ at two drift velocities), and
-/// the slopes' divisions dominated each pass.
+/// and its points' axial positions x_k − s_k in the link frame, s_k = ½h Σ_{seg ≤ k} g_seg² the
+/// running foreshortening (zero without foreshortening). One step evaluates B and Bᵀ at one q
+/// several times (M's columns, Γ at two drift velocities), and the slopes' divisions dominated
+/// each pass.
 #[derive(Debug, Clone)]
 pub struct Shape {
     pub g1: Vec<f64>,
     pub g2: Vec<f64>,
-    pub s1: Vec<f64>,
-    pub s2: Vec<f64>,
+    pub a1: Vec<f64>,
+    pub a2: Vec<f64>,
 }
 
 /// Per-point scratch of the kinetic energy: velocity components (with their derivative along
@@ -187,8 +191,8 @@ impl PointScratch {
             shape: Shape {
                 g1: vec![0.0; ine.r1],
                 g2: vec![0.0; ine.r2],
-                s1: vec![0.0; ine.r1],
-                s2: vec![0.0; ine.r2],
+                a1: vec![0.0; ine.r1],
+                a2: vec![0.0; ine.r2],
             },
         }
     }
@@ -257,7 +261,7 @@ impl ChainInertia {
             }
             let vk = N::seed(v[k], dv[k]);
             xs[k] = -(vk * thd) - sd;
-            ys[k] = (N::constant((k + 1) as f64 * h1) - s) * thd + vd[k];
+            ys[k] = (N::constant(self.x1[k]) - s) * thd + vd[k];
         }
         let (ex, ey) = (xs[r1 - 1], ys[r1 - 1]);
         xs[r1] = ex;
@@ -274,18 +278,32 @@ impl ChainInertia {
             }
             let wj = N::seed(w[j], dw[j]);
             xs[r1 + 1 + j] = xe - wj * bed - sgd;
-            ys[r1 + 1 + j] = ye + (N::constant((j + 1) as f64 * h2) - sg) * bed + wd[j];
+            ys[r1 + 1 + j] = ye + (N::constant(self.x2[j]) - sg) * bed + wd[j];
         }
     }
 
     /// The [`Shape`] of q into `sc.shape`: what the `_at` products read (the slopes and
-    /// foreshortenings [`Self::point_velocities`] and the transpose compute, the same
+    /// axial positions [`Self::point_velocities`] and the transpose compute, the same
     /// operations in the same order, so the values are those bits).
     pub fn set_shape(&self, q: &[f64], sc: &mut PointScratch) {
         let sh = &mut sc.shape;
-        for (u, h, fs, g, s) in [
-            (&q[self.iv()], self.h1, self.fs1, &mut sh.g1, &mut sh.s1),
-            (&q[self.iw()], self.h2, self.fs2, &mut sh.g2, &mut sh.s2),
+        for (u, x, h, fs, g, a) in [
+            (
+                &q[self.iv()],
+                &self.x1,
+                self.h1,
+                self.fs1,
+                &mut sh.g1,
+                &mut sh.a1,
+            ),
+            (
+                &q[self.iw()],
+                &self.x2,
+                self.h2,
+                self.fs2,
+                &mut sh.g2,
+                &mut sh.a2,
+            ),
         ] {
             let mut acc = 0.0;
             for k in 0..u.len() {
@@ -296,7 +314,7 @@ impl ChainInertia {
                 } else {
                     g[k] = 0.0;
                 }
-                s[k] = acc;
+                a[k] = x[k] - acc;
             }
         }
     }
@@ -310,7 +328,7 @@ impl ChainInertia {
     /// [`Self::apply_transpose`] with the shape of q already in `sc` ([`Self::set_shape`]).
     pub fn apply_transpose_at(&self, q: &[f64], sc: &mut PointScratch, out: &mut [f64]) {
         let (v, w) = (&q[self.iv()], &q[self.iw()]);
-        let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
+        let (r1, r2) = (self.r1, self.r2);
         let (sn, c) = (q[BE] - q[TH]).sin_cos();
         let PointScratch {
             fx,
@@ -321,8 +339,8 @@ impl ChainInertia {
             ..
         } = sc;
         let (fx, fy) = (&fx[..r1 + 1 + r2], &fy[..r1 + 1 + r2]);
-        let (g1, s1) = (&shape.g1[..r1], &shape.s1[..r1]);
-        let (g2, s2) = (&shape.g2[..r2], &shape.s2[..r2]);
+        let (g1, a1) = (&shape.g1[..r1], &shape.a1[..r1]);
+        let (g2, a2) = (&shape.g2[..r2], &shape.a2[..r2]);
         let (c1, c2) = (&mut c1[..r1], &mut c2[..r2]);
         let off = 2 + r1;
         let out = &mut out[..off + r2];
@@ -331,7 +349,7 @@ impl ChainInertia {
         let mut acc = 0.0;
         for j in 0..r2 {
             let (a, b) = (fx[r1 + 1 + j], fy[r1 + 1 + j]);
-            qb += -a * w[j] + b * ((j + 1) as f64 * h2 - s2[j]);
+            qb += -a * w[j] + b * a2[j];
             out[off + j] = b;
             gx += c * a - sn * b;
             gy += sn * a + c * b;
@@ -353,7 +371,7 @@ impl ChainInertia {
                 a += gx;
                 b += gy;
             }
-            qt += -a * v[k] + b * ((k + 1) as f64 * h1 - s1[k]);
+            qt += -a * v[k] + b * a1[k];
             out[2 + k] = b;
         }
         if self.fs1 {
@@ -404,15 +422,15 @@ impl ChainInertia {
         let np = r1 + 1 + r2;
         let (xs, ys) = (&mut xv[..np], &mut yv[..np]);
         let (fx, fy) = (&mut fx[..np], &mut fy[..np]);
-        let (g1, s1) = (&shape.g1[..r1], &shape.s1[..r1]);
-        let (g2, s2) = (&shape.g2[..r2], &shape.s2[..r2]);
+        let (g1, a1) = (&shape.g1[..r1], &shape.a1[..r1]);
+        let (g2, a2) = (&shape.g2[..r2], &shape.a2[..r2]);
         let mut sd = 0.0;
         for k in 0..r1 {
             if self.fs1 {
                 sd += g1[k] * (h1 * slope(vd, k, h1));
             }
             xs[k] = -(v[k] * thd) - sd;
-            ys[k] = ((k + 1) as f64 * h1 - s1[k]) * thd + vd[k];
+            ys[k] = a1[k] * thd + vd[k];
         }
         let (ex, ey) = (xs[r1 - 1], ys[r1 - 1]);
         xs[r1] = ex;
@@ -426,7 +444,7 @@ impl ChainInertia {
                 sgd += g2[j] * (h2 * slope(wd, j, h2));
             }
             xs[r1 + 1 + j] = xe - w[j] * bed - sgd;
-            ys[r1 + 1 + j] = ye + ((j + 1) as f64 * h2 - s2[j]) * bed + wd[j];
+            ys[r1 + 1 + j] = ye + a2[j] * bed + wd[j];
         }
         for p in 0..np {
             let m = self.point_mass(p);
@@ -444,8 +462,9 @@ impl ChainInertia {
     }
 
     /// [`Self::inertia_forces`] with the shape of q already in `sc` ([`Self::set_shape`]):
-    /// [`Self::point_velocities`]' dual pass along q̇ with the values of the slopes from the
-    /// shape and the slope of q̇ (the derivative part and the rate) taken once.
+    /// [`Self::point_velocities`]' dual pass along q̇ with the values of the slopes and of the
+    /// axial positions from the shape and the slope of q̇ (the derivative part and the rate)
+    /// taken once.
     pub fn inertia_forces_at(&self, q: &[f64], qd: &[f64], sc: &mut PointScratch, out: &mut [f64]) {
         let (v, vd) = (&q[self.iv()], &qd[self.iv()]);
         let (w, wd) = (&q[self.iw()], &qd[self.iw()]);
@@ -462,8 +481,8 @@ impl ChainInertia {
         let np = r1 + 1 + r2;
         let (xs, ys) = (&mut x[..np], &mut y[..np]);
         let (fx, fy) = (&mut fx[..np], &mut fy[..np]);
-        let g1 = &shape.g1[..r1];
-        let g2 = &shape.g2[..r2];
+        let (g1, a1) = (&shape.g1[..r1], &shape.a1[..r1]);
+        let (g2, a2) = (&shape.g2[..r2], &shape.a2[..r2]);
         let zero = Dual::default();
         let (mut s, mut sd) = (zero, zero);
         for k in 0..r1 {
@@ -475,7 +494,7 @@ impl ChainInertia {
             }
             let vk = Dual::new(v[k], vd[k]);
             xs[k] = -(vk * thd) - sd;
-            ys[k] = (Dual::constant((k + 1) as f64 * h1) - s) * thd + vd[k];
+            ys[k] = Dual::new(a1[k], 0.0 - s.du) * thd + vd[k];
         }
         let (ex, ey) = (xs[r1 - 1], ys[r1 - 1]);
         xs[r1] = ex;
@@ -493,7 +512,7 @@ impl ChainInertia {
             }
             let wj = Dual::new(w[j], wd[j]);
             xs[r1 + 1 + j] = xe - wj * bed - sgd;
-            ys[r1 + 1 + j] = ye + (Dual::constant((j + 1) as f64 * h2) - sg) * bed + wd[j];
+            ys[r1 + 1 + j] = ye + Dual::new(a2[j], 0.0 - sg.du) * bed + wd[j];
         }
         for p in 0..np {
             let rate = if p <= r1 { thd } else { bed };
@@ -527,8 +546,8 @@ impl ChainInertia {
         let bed: [f64; C] = std::array::from_fn(|c| qds[c][BE]);
         let np = r1 + 1 + r2;
         let (fx, fy) = (&mut lanes.fx[..np], &mut lanes.fy[..np]);
-        let (g1, s1) = (&shape.g1[..r1], &shape.s1[..r1]);
-        let (g2, s2) = (&shape.g2[..r2], &shape.s2[..r2]);
+        let (g1, a1) = (&shape.g1[..r1], &shape.a1[..r1]);
+        let (g2, a2) = (&shape.g2[..r2], &shape.a2[..r2]);
         let mut sd = [0.0; C];
         let (mut ex, mut ey) = ([0.0; C], [0.0; C]);
         for k in 0..r1 {
@@ -538,7 +557,7 @@ impl ChainInertia {
                     sd[c] += g1[k] * (h1 * gd1[c][k]);
                 }
                 ex[c] = -(v[k] * thd[c]) - sd[c];
-                ey[c] = ((k + 1) as f64 * h1 - s1[k]) * thd[c] + vd[c][k];
+                ey[c] = a1[k] * thd[c] + vd[c][k];
                 fx[k][c] = m * ex[c];
                 fy[k][c] = m * ey[c];
             }
@@ -560,7 +579,7 @@ impl ChainInertia {
                     sgd[c] += g2[j] * (h2 * gd2[c][j]);
                 }
                 let x = xe[c] - w[j] * bed[c] - sgd[c];
-                let y = ye[c] + ((j + 1) as f64 * h2 - s2[j]) * bed[c] + wd[c][j];
+                let y = ye[c] + a2[j] * bed[c] + wd[c][j];
                 fx[r1 + 1 + j][c] = m * x;
                 fy[r1 + 1 + j][c] = m * y;
             }
@@ -590,7 +609,8 @@ impl ChainInertia {
         let bed: [f64; C] = std::array::from_fn(|c| qds[c][BE]);
         let np = r1 + 1 + r2;
         let (fx, fy) = (&mut lanes.fx[..np], &mut lanes.fy[..np]);
-        let (g1, g2) = (&shape.g1[..r1], &shape.g2[..r2]);
+        let (g1, a1) = (&shape.g1[..r1], &shape.a1[..r1]);
+        let (g2, a2) = (&shape.g2[..r2], &shape.a2[..r2]);
         let zero = Dual::default();
         let (mut s, mut sd) = ([zero; C], [zero; C]);
         let (mut ex, mut ey) = ([zero; C], [zero; C]);
@@ -605,7 +625,7 @@ impl ChainInertia {
                 }
                 let vk = Dual::new(v[k], vd[c][k]);
                 let x = -(vk * thd[c]) - sd[c];
-                let y = (Dual::constant((k + 1) as f64 * h1) - s[c]) * thd[c] + vd[c][k];
+                let y = Dual::new(a1[k], 0.0 - s[c].du) * thd[c] + vd[c][k];
                 fx[k][c] = -m * (x.du - thd[c] * y.re);
                 fy[k][c] = -m * (y.du + thd[c] * x.re);
                 (ex[c], ey[c]) = (x, y);
@@ -637,7 +657,7 @@ impl ChainInertia {
                 }
                 let wj = Dual::new(w[j], wd[c][j]);
                 let x = xe[c] - wj * bed[c] - sgd[c];
-                let y = ye[c] + (Dual::constant((j + 1) as f64 * h2) - sg[c]) * bed[c] + wd[c][j];
+                let y = ye[c] + Dual::new(a2[j], 0.0 - sg[c].du) * bed[c] + wd[c][j];
                 fx[r1 + 1 + j][c] = -m * (x.du - bed[c] * y.re);
                 fy[r1 + 1 + j][c] = -m * (y.du + bed[c] * x.re);
             }
@@ -655,13 +675,13 @@ impl ChainInertia {
         out: &mut [&mut [f64]; C],
     ) {
         let (v, w) = (&q[self.iv()], &q[self.iw()]);
-        let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
+        let (r1, r2) = (self.r1, self.r2);
         let (sn, cs) = (q[BE] - q[TH]).sin_cos();
         let Lanes { fx, fy, c1, c2 } = lanes;
         let np = r1 + 1 + r2;
         let (fx, fy) = (&fx[..np], &fy[..np]);
-        let (g1, s1) = (&shape.g1[..r1], &shape.s1[..r1]);
-        let (g2, s2) = (&shape.g2[..r2], &shape.s2[..r2]);
+        let (g1, a1) = (&shape.g1[..r1], &shape.a1[..r1]);
+        let (g2, a2) = (&shape.g2[..r2], &shape.a2[..r2]);
         let (c1, c2) = (&mut c1[..r1], &mut c2[..r2]);
         let off = 2 + r1;
         let out: [&mut [f64]; C] = out.each_mut().map(|o| &mut o[..off + r2]);
@@ -670,7 +690,7 @@ impl ChainInertia {
         let (mut gx, mut gy) = (fx[r1], fy[r1]);
         for j in 0..r2 {
             let (a, b) = (fx[r1 + 1 + j], fy[r1 + 1 + j]);
-            let arm = (j + 1) as f64 * h2 - s2[j];
+            let arm = a2[j];
             for c in 0..C {
                 qb[c] += -a[c] * w[j] + b[c] * arm;
                 out[c][off + j] = b[c];
@@ -706,7 +726,7 @@ impl ChainInertia {
                     b[c] += gy[c];
                 }
             }
-            let arm = (k + 1) as f64 * h1 - s1[k];
+            let arm = a1[k];
             for c in 0..C {
                 qt[c] += -a[c] * v[k] + b[c] * arm;
                 out[c][2 + k] = b[c];

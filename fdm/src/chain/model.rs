@@ -254,6 +254,15 @@ impl TwoLinkChain {
         (frame, self.first(link), self.slots[link], self.hs[link])
     }
 
+    /// The abscissae (k+1)h of link ℓ's stations 1…r.
+    fn abscissae(&self, link: usize) -> &[f64] {
+        if link == 0 {
+            &self.inertia.x1
+        } else {
+            &self.inertia.x2
+        }
+    }
+
     /// q (or q̇) → the coordinates of the kinetic kernel ([`super::kinetic`]: frame angles,
     /// deflections of stations 1…r with the tip's in the ghost slot), a constant linear map P.
     /// Euler links: the clamp-tangent frames, α = (chord angle) + ψ, v^t_k = v_k − ξ_kψ (tip
@@ -271,8 +280,8 @@ impl TwoLinkChain {
             let (frame, first, slot, h) = self.link_slots(link);
             let psi = (q[first] - q[slot]) / (2.0 * h);
             out[frame] += psi;
-            for (k, i) in (first..=slot).enumerate() {
-                out[i] -= (k + 1) as f64 * h * psi;
+            for (x, o) in self.abscissae(link).iter().zip(&mut out[first..=slot]) {
+                *o -= x * psi;
             }
         }
     }
@@ -296,10 +305,10 @@ impl TwoLinkChain {
             return;
         }
         for link in 0..2 {
-            let (frame, first, slot, h) = self.link_slots(link);
+            let (frame, first, slot, _) = self.link_slots(link);
             let mut psi = f[frame];
-            for (k, i) in (first..=slot).enumerate() {
-                psi -= (k + 1) as f64 * h * f[i];
+            for (x, fi) in self.abscissae(link).iter().zip(&f[first..=slot]) {
+                psi -= x * fi;
             }
             f[slot] = psi;
         }
@@ -319,10 +328,9 @@ impl TwoLinkChain {
             return;
         }
         for link in 0..2 {
-            let (frame, first, slot, h) = self.link_slots(link);
+            let (frame, first, slot, _) = self.link_slots(link);
             let mut psi: [f64; C] = std::array::from_fn(|c| f[c][frame]);
-            for (k, i) in (first..=slot).enumerate() {
-                let x = (k + 1) as f64 * h;
+            for (&x, i) in self.abscissae(link).iter().zip(first..=slot) {
                 for c in 0..C {
                     psi[c] -= x * f[c][i];
                 }
