@@ -13,7 +13,7 @@
 //! writes no channel of that field ([`payload_link`]), so a check that asks for it fails on the
 //! missing name instead of reading zeros.
 
-use crate::scene::LinkField;
+use crate::scene::{LinkField, MobileManipulator};
 
 /// A channel declaration: name and unit.
 pub type Spec = (String, &'static str);
@@ -328,6 +328,56 @@ pub const FORMULATIONS_RATE_GAP: &str = "formulations.rate_gap";
 pub const INVERSE_TORQUE_RESIDUAL: &str = "inverse.torque_residual";
 /// Residual of seed 004's closed-form arm equation (37).
 pub const SEED_EQ37_RESIDUAL: &str = "seed_eq37.residual";
+
+/// The channels of a mobile-manipulator run of `mm` whose model carries the scene's flexible
+/// link as a beam: with a platform, its pose, the side wheel angles and the side drive torques;
+/// with an arm, joint angle, rate and torque of θ₁…θ₄ and the end-effector position; with a
+/// flexible link, its in-plane and out-of-plane tip deflections; then the constraint drift. A
+/// backend may append its own channels.
+pub fn mobile_manipulator(mm: &MobileManipulator) -> Vec<Spec> {
+    let flexible = mm.flexible_link.as_ref().filter(|_| mm.arm.is_some());
+    mobile_manipulator_with(mm, flexible.map(|f| f.link))
+}
+
+/// The channels of [`mobile_manipulator`] for a rigid model of `mm`, the EI → ∞ limit of a
+/// flexible link (no tip deflections).
+pub fn mobile_manipulator_rigid(mm: &MobileManipulator) -> Vec<Spec> {
+    mobile_manipulator_with(mm, None)
+}
+
+/// The mobile manipulator's channels with the tip deflections of pitch link `flexible`.
+fn mobile_manipulator_with(mm: &MobileManipulator, flexible: Option<usize>) -> Vec<Spec> {
+    let mut c = Vec::new();
+    if mm.platform.is_some() {
+        c.extend([
+            spec::platform_x(),
+            spec::platform_y(),
+            spec::platform_heading(),
+            spec::wheel_right_angle(),
+            spec::wheel_left_angle(),
+            spec::wheel_right_torque(),
+            spec::wheel_left_torque(),
+        ]);
+    }
+    if mm.arm.is_some() {
+        for i in 1..=4 {
+            c.push(spec::arm_joint_angle(i));
+            c.push(spec::arm_joint_rate(i));
+            c.push(spec::arm_joint_torque(i));
+        }
+        c.extend([
+            spec::end_effector_x(),
+            spec::end_effector_y(),
+            spec::end_effector_z(),
+        ]);
+    }
+    if let Some(k) = flexible {
+        c.push(spec::flexible_tip_in_plane(k));
+        c.push(spec::flexible_tip_out_of_plane(k));
+    }
+    c.push(spec::constraint_drift());
+    c
+}
 
 // ---------------------------------------------------------------- frame invariance
 

@@ -66,6 +66,76 @@ pub struct Platform {
     pub drive: TorqueSchedule,
 }
 
+/// The platform as the equations of motion see it: the chassis and all its wheels composed
+/// into one rigid body on the platform frame, plus the two wheel sides (each side's wheels
+/// spin together).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlatformComposite {
+    /// Total mass: chassis plus wheels.
+    pub mass: f64,
+    /// Forward offset of the composite mass centre from the middle-axle centre.
+    pub com_offset: f64,
+    /// Yaw inertia about the vertical axis through the composite mass centre: the chassis's own
+    /// and its parallel-axis term, each wheel's point mass at its axle end (±`half_track`) and
+    /// its diametral inertia.
+    pub yaw_inertia: f64,
+    pub wheel_radius: f64,
+    pub half_track: f64,
+    /// Spin inertia of one side's wheels.
+    pub side_spin_inertia: f64,
+    /// Viscous friction of one side's wheel bearings.
+    pub side_friction: f64,
+}
+
+impl Platform {
+    /// Number of axles (two wheels each).
+    pub fn axles(&self) -> usize {
+        self.wheel_count / 2
+    }
+
+    /// Forward positions of the axles from the middle-axle centre, front to rear: equally
+    /// spaced over the wheelbase, symmetric about that centre (0 for a single axle).
+    pub fn axle_positions(&self) -> Vec<f64> {
+        let axles = self.axles();
+        (0..axles)
+            .map(|k| {
+                if axles == 1 {
+                    0.0
+                } else {
+                    self.wheelbase * (0.5 - k as f64 / (axles - 1) as f64)
+                }
+            })
+            .collect()
+    }
+
+    /// The chassis and wheels composed about their common mass centre, and the wheel sides.
+    pub fn composite(&self) -> PlatformComposite {
+        let wheels_per_side = self.axles() as f64;
+        let mw = self.wheel_mass;
+        let mass = self.chassis_mass + self.wheel_count as f64 * mw;
+        let xs = self.axle_positions();
+        let com_offset = (self.chassis_mass * self.chassis_com_offset
+            + 2.0 * mw * xs.iter().sum::<f64>())
+            / mass;
+        let mut yaw = self.chassis_yaw_inertia
+            + self.chassis_mass * (self.chassis_com_offset - com_offset).powi(2);
+        for &x in &xs {
+            yaw += 2.0
+                * (mw * ((x - com_offset).powi(2) + self.half_track.powi(2))
+                    + self.wheel_diametral_inertia);
+        }
+        PlatformComposite {
+            mass,
+            com_offset,
+            yaw_inertia: yaw,
+            wheel_radius: self.wheel_radius,
+            half_track: self.half_track,
+            side_spin_inertia: wheels_per_side * self.wheel_spin_inertia,
+            side_friction: wheels_per_side * self.wheel_friction,
+        }
+    }
+}
+
 /// A rigid body in its own frame: mass, centre of mass, inertia tensor about the centre of mass.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

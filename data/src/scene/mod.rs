@@ -20,8 +20,8 @@ mod planar;
 mod rocket;
 
 pub use mobile::{
-    Arm, ArmLink, FlexibleLink, InitialState, MobileManipulator, Platform, RigidBody,
-    TorqueSchedule,
+    Arm, ArmLink, FlexibleLink, InitialState, MobileManipulator, Platform, PlatformComposite,
+    RigidBody, TorqueSchedule,
 };
 pub use payload::{
     InitialShape as LinkInitialShape, KelvinVoigt3d, LinkField, Payload, PayloadLink,

@@ -33,7 +33,7 @@ pub(super) fn check_mobile(c: &mut Checker, m: &MobileManipulator) {
         c.non_negative(pb.key("wheelbase"), p.wheelbase);
         c.finite(pb.key("chassis_com_offset"), p.chassis_com_offset);
         c.non_negative(pb.key("wheel_friction"), p.wheel_friction);
-        let axles = p.wheel_count / 2;
+        let axles = p.axles();
         if p.wheel_count < 2 || p.wheel_count % 2 != 0 || p.wheel_count > MAX_WHEELS {
             c.fail(
                 pb.key("wheel_count"),

@@ -57,7 +57,7 @@ pub mod system;
 
 use std::time::Instant;
 
-use data::channel::spec;
+use data::channel;
 use data::results::ledger_term;
 use data::scene::MobileManipulator;
 use data::{DofPlan, EnergyLedger, FemSettings, Observables, RunResult, Scene, StabilityVerdict};
@@ -317,37 +317,6 @@ pub fn prepare(
     })
 }
 
-fn channel_specs(md: &Model) -> Vec<(String, &'static str)> {
-    let mut s = Vec::new();
-    if md.platform.is_some() {
-        s.extend([
-            spec::platform_x(),
-            spec::platform_y(),
-            spec::platform_heading(),
-            spec::wheel_right_angle(),
-            spec::wheel_left_angle(),
-            spec::wheel_right_torque(),
-            spec::wheel_left_torque(),
-        ]);
-    }
-    for i in 1..=4 {
-        s.push(spec::arm_joint_angle(i));
-        s.push(spec::arm_joint_rate(i));
-        s.push(spec::arm_joint_torque(i));
-    }
-    s.extend([
-        spec::end_effector_x(),
-        spec::end_effector_y(),
-        spec::end_effector_z(),
-    ]);
-    if let Some(fl) = &md.flex {
-        s.push(spec::flexible_tip_in_plane(fl.link + 1));
-        s.push(spec::flexible_tip_out_of_plane(fl.link + 1));
-    }
-    s.push(spec::constraint_drift());
-    s
-}
-
 fn sample(run: &mut Run, buf: &mut Vec<f64>) {
     buf.clear();
     let Run { system, state, .. } = run;
@@ -450,7 +419,7 @@ pub fn simulate(
         t_end,
         output_interval,
     } = prepare(scene, mm, settings)?;
-    let specs = channel_specs(&run.system.model);
+    let specs = channel::mobile_manipulator(mm);
     let mut obs = Observables::with_channels(&specs);
     let (s, i, d) = ledger_names(&run.system.model);
     let mut ledger = EnergyLedger::new(&s, &i, &d);

@@ -34,7 +34,7 @@
 //! degree-(N + 1) shapes); the eigenfunction basis gets the composite rule of
 //! [`Quadrature::for_wavenumber`].
 
-use data::scene::{MobileManipulator, RigidBody};
+use data::scene::{MobileManipulator, Platform, PlatformComposite, RigidBody};
 use nalgebra::{Matrix3, Vector3};
 
 use crate::basis::ShapeSet;
@@ -80,18 +80,6 @@ impl Layout {
     pub fn speed_shift(&self) -> usize {
         if self.platform.is_some() { 3 } else { 0 }
     }
-}
-
-/// The platform as the equations use it (composite of chassis and wheels).
-#[derive(Debug, Clone, PartialEq)]
-pub struct PlatformModel {
-    pub mass: f64,
-    pub com_offset: f64,
-    pub yaw_inertia: f64,
-    pub wheel_radius: f64,
-    pub half_track: f64,
-    pub side_spin_inertia: f64,
-    pub side_friction: f64,
 }
 
 /// A rigid body moving with frame `frame` (0 platform … 5 gripper).
@@ -142,7 +130,8 @@ pub enum ShapeChoice {
 pub struct MobileModel {
     pub layout: Layout,
     pub gravity: f64,
-    pub platform: Option<PlatformModel>,
+    /// Chassis and wheels composed ([`Platform::composite`]).
+    pub platform: Option<PlatformComposite>,
     pub ground_pose: [f64; 3],
     pub mount: Vec3,
     pub base_height: f64,
@@ -196,39 +185,7 @@ impl MobileModel {
         modes: usize,
         shapes: ShapeChoice,
     ) -> Result<Self, ModalError> {
-        let platform = m.platform.as_ref().map(|p| {
-            let axles = p.wheel_count / 2;
-            let wheels_per_side = axles as f64;
-            let mw = p.wheel_mass;
-            let mass = p.chassis_mass + p.wheel_count as f64 * mw;
-            let xs: Vec<f64> = (0..axles)
-                .map(|k| {
-                    if axles == 1 {
-                        0.0
-                    } else {
-                        p.wheelbase * (0.5 - k as f64 / (axles - 1) as f64)
-                    }
-                })
-                .collect();
-            let com_offset =
-                (p.chassis_mass * p.chassis_com_offset + 2.0 * mw * xs.iter().sum::<f64>()) / mass;
-            let mut yaw = p.chassis_yaw_inertia
-                + p.chassis_mass * (p.chassis_com_offset - com_offset).powi(2);
-            for &x in &xs {
-                yaw += 2.0
-                    * (mw * ((x - com_offset).powi(2) + p.half_track.powi(2))
-                        + p.wheel_diametral_inertia);
-            }
-            PlatformModel {
-                mass,
-                com_offset,
-                yaw_inertia: yaw,
-                wheel_radius: p.wheel_radius,
-                half_track: p.half_track,
-                side_spin_inertia: wheels_per_side * p.wheel_spin_inertia,
-                side_friction: wheels_per_side * p.wheel_friction,
-            }
-        });
+        let platform = m.platform.as_ref().map(Platform::composite);
         let flexible = m.flexible_link.as_ref().filter(|_| m.arm.is_some());
         let mut n = 0;
         let mut speeds = 0;

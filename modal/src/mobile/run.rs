@@ -11,7 +11,7 @@
 
 use std::time::Instant;
 
-use data::channel::spec;
+use data::channel;
 use data::scene::MobileManipulator;
 use data::{EnergyLedger, ModalSettings, Observables, RunResult, Scene, ledger_term};
 
@@ -233,7 +233,7 @@ pub fn simulate(
     let mut breaks = rhs.inputs.breakpoints(t_end);
     breaks.push(t_end);
 
-    let mut out = Output::new(&rhs.model);
+    let mut out = Output::new(&rhs.model, mm);
     out.record(&mut rhs, 0.0, &y);
     let schedule = Schedule {
         breaks: &breaks,
@@ -287,37 +287,9 @@ struct Output {
 }
 
 impl Output {
-    fn new(model: &MobileModel) -> Self {
+    fn new(model: &MobileModel, mm: &MobileManipulator) -> Self {
         let l = model.layout;
-        let mut specs = Vec::new();
-        if l.platform.is_some() {
-            specs.extend([
-                spec::platform_x(),
-                spec::platform_y(),
-                spec::platform_heading(),
-                spec::wheel_right_angle(),
-                spec::wheel_left_angle(),
-                spec::wheel_right_torque(),
-                spec::wheel_left_torque(),
-            ]);
-        }
-        if l.arm.is_some() {
-            for i in 1..=4 {
-                specs.push(spec::arm_joint_angle(i));
-                specs.push(spec::arm_joint_rate(i));
-                specs.push(spec::arm_joint_torque(i));
-            }
-            specs.extend([
-                spec::end_effector_x(),
-                spec::end_effector_y(),
-                spec::end_effector_z(),
-            ]);
-        }
-        if let Some(fl) = &model.flex {
-            specs.push(spec::flexible_tip_in_plane(fl.link));
-            specs.push(spec::flexible_tip_out_of_plane(fl.link));
-        }
-        specs.push(spec::constraint_drift());
+        let specs = channel::mobile_manipulator(mm);
         let mut stored = vec![ledger_term::KINETIC, ledger_term::GRAVITY];
         if model.flex.is_some() {
             stored.push(ledger_term::STRAIN);

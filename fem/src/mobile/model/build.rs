@@ -5,9 +5,7 @@
 use data::scene::{ArmLink, FlexibleLink, MobileManipulator, Platform, RigidBody};
 use nalgebra::{Matrix3, Vector3};
 
-use super::{
-    Body, FlexLink, GAUSS, Layout, Model, PlatformModel, positive_semidefinite, residual_inertia,
-};
+use super::{Body, FlexLink, GAUSS, Layout, Model, positive_semidefinite, residual_inertia};
 use crate::element::hermite_cubic;
 use crate::element::quadrature::gauss01;
 use crate::error::FemError;
@@ -28,7 +26,7 @@ impl Model {
                 arm.links.len()
             )));
         }
-        let platform = m.platform.as_ref().map(platform_model);
+        let platform = m.platform.as_ref().map(Platform::composite);
         let mut bodies = Vec::new();
         if let Some(p) = &platform {
             bodies.push(Body {
@@ -75,41 +73,6 @@ impl Model {
             flex,
             joint_friction: arm.joint_friction,
         })
-    }
-}
-
-/// The platform as one rigid body on F0: chassis and wheels lumped (mass, centre of mass on
-/// the axis, yaw inertia with the wheels' parallel-axis and diametral terms), each side's
-/// wheels as one spin inertia and one bearing friction.
-fn platform_model(p: &Platform) -> PlatformModel {
-    let axles = p.wheel_count / 2;
-    let mw = p.wheel_mass;
-    let mass = p.chassis_mass + p.wheel_count as f64 * mw;
-    let xs: Vec<f64> = (0..axles)
-        .map(|k| {
-            if axles == 1 {
-                0.0
-            } else {
-                p.wheelbase * (0.5 - k as f64 / (axles - 1) as f64)
-            }
-        })
-        .collect();
-    let com_offset =
-        (p.chassis_mass * p.chassis_com_offset + 2.0 * mw * xs.iter().sum::<f64>()) / mass;
-    let mut yaw =
-        p.chassis_yaw_inertia + p.chassis_mass * (p.chassis_com_offset - com_offset).powi(2);
-    for &x in &xs {
-        yaw += 2.0
-            * (mw * ((x - com_offset).powi(2) + p.half_track.powi(2)) + p.wheel_diametral_inertia);
-    }
-    PlatformModel {
-        mass,
-        com_offset,
-        yaw_inertia: yaw,
-        wheel_radius: p.wheel_radius,
-        half_track: p.half_track,
-        side_spin_inertia: axles as f64 * p.wheel_spin_inertia,
-        side_friction: axles as f64 * p.wheel_friction,
     }
 }
 

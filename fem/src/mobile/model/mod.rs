@@ -31,6 +31,7 @@
 //! `kinematics` the recursive frames and partial velocities, `dynamics` M̄ and M̄ν̇ + b,
 //! `energies` the energies and constraint checks of a state.
 
+use data::scene::PlatformComposite;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::element::quadrature::gauss01;
@@ -65,20 +66,6 @@ pub const GAUSS: usize = 4;
 /// Most partial-velocity columns one mass element can have: 2 platform + 4 joints + 8 beam
 /// DOFs of its element (or the 4 tip DOFs).
 const MAX_COLS: usize = 14;
-
-/// Platform parameters (chassis and wheels composed about the composite mass centre).
-#[derive(Debug, Clone, PartialEq)]
-pub struct PlatformModel {
-    pub mass: f64,
-    pub com_offset: f64,
-    pub yaw_inertia: f64,
-    pub wheel_radius: f64,
-    pub half_track: f64,
-    /// Spin inertia of one side's wheels.
-    pub side_spin_inertia: f64,
-    /// Viscous friction of one side's wheel bearings.
-    pub side_friction: f64,
-}
 
 /// A rigid body moving with frame `frame`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -189,7 +176,8 @@ pub struct Layout {
 pub struct Model {
     pub layout: Layout,
     pub gravity: f64,
-    pub platform: Option<PlatformModel>,
+    /// Chassis and wheels composed ([`data::scene::Platform::composite`]).
+    pub platform: Option<PlatformComposite>,
     /// Fixed pose (x, y, ψ) of F0 without a platform.
     pub ground_pose: [f64; 3],
     pub mount: Vec3,

@@ -26,7 +26,7 @@ pub mod seed;
 
 use std::time::Instant;
 
-use data::channel::spec;
+use data::channel::{self, spec};
 use data::ledger_term;
 use data::scene::MobileManipulator;
 use data::{
@@ -88,32 +88,8 @@ pub fn simulate(
     let model = &reference.model;
     let layout = model.layout;
 
-    let mut specs: Vec<(String, &str)> = Vec::new();
-    if layout.platform.is_some() {
-        specs.extend([
-            spec::platform_x(),
-            spec::platform_y(),
-            spec::platform_heading(),
-            spec::wheel_right_angle(),
-            spec::wheel_left_angle(),
-            spec::wheel_right_torque(),
-            spec::wheel_left_torque(),
-        ]);
-    }
-    if layout.arm.is_some() {
-        for i in 1..=4 {
-            specs.push(spec::arm_joint_angle(i));
-            specs.push(spec::arm_joint_rate(i));
-            specs.push(spec::arm_joint_torque(i));
-        }
-        specs.extend([
-            spec::end_effector_x(),
-            spec::end_effector_y(),
-            spec::end_effector_z(),
-        ]);
-    }
+    let mut specs = channel::mobile_manipulator_rigid(mm);
     specs.extend([
-        spec::constraint_drift(),
         spec::formulations_position_gap(),
         spec::formulations_rate_gap(),
         spec::inverse_torque_residual(),

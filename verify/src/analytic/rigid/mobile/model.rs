@@ -34,7 +34,7 @@
 //! Null-space basis S(q) for ν = (φ̇_R, φ̇_L, θ̇₁…θ̇₄): u = r(φ̇_R + φ̇_L)/2, ψ̇ = r(φ̇_R − φ̇_L)/(2b),
 //! ẋ = u cos ψ, ẏ = u sin ψ, and the identity on the wheel and joint rates, so Sᵀ B = I.
 
-use data::scene::{MobileManipulator, RigidBody};
+use data::scene::{MobileManipulator, Platform, PlatformComposite, RigidBody};
 use nalgebra::{Matrix3, Rotation3, SMatrix, SVector, Vector3};
 
 use crate::analytic::error::{AnalyticError, Result};
@@ -68,24 +68,6 @@ pub struct Layout {
     pub m: usize,
 }
 
-/// Platform parameters as the equations use them.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PlatformModel {
-    /// Total mass (chassis + wheels).
-    pub mass: f64,
-    /// Mass centre forward of P.
-    pub com_offset: f64,
-    /// Yaw inertia about the composite mass centre (chassis, wheels' translation and
-    /// diametral inertia).
-    pub yaw_inertia: f64,
-    pub wheel_radius: f64,
-    pub half_track: f64,
-    /// Spin inertia of one side's wheels.
-    pub side_spin_inertia: f64,
-    /// Viscous friction of one side's wheel bearings.
-    pub side_friction: f64,
-}
-
 /// One arm body attached to a frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Body {
@@ -100,7 +82,8 @@ pub struct Body {
 pub struct Model {
     pub layout: Layout,
     pub gravity: f64,
-    pub platform: Option<PlatformModel>,
+    /// Chassis and wheels composed ([`Platform::composite`]).
+    pub platform: Option<PlatformComposite>,
     /// Fixed pose of F0 when there is no platform: (x, y, ψ).
     pub ground_pose: [f64; 3],
     /// Mount, first-pitch offset and link lengths (frame offsets in the parent frame).
@@ -130,41 +113,7 @@ impl Model {
         // A `[mobile_manipulator.flexible_link]` is ignored: the rigid model is its EI → ∞
         // limit (the backends' beam carries the link's mass m, mass centre L/2 and inertia J
         // exactly, the elastic deflection vanishing as 1/EI).
-        let platform = m.platform.as_ref().map(|p| {
-            let axles = p.wheel_count / 2;
-            let wheels_per_side = axles as f64;
-            let mw = p.wheel_mass;
-            let n_w = p.wheel_count as f64;
-            let mass = p.chassis_mass + n_w * mw;
-            // Axle positions equally spaced over the wheelbase, symmetric about P.
-            let xs: Vec<f64> = (0..axles)
-                .map(|k| {
-                    if axles == 1 {
-                        0.0
-                    } else {
-                        p.wheelbase * (0.5 - k as f64 / (axles - 1) as f64)
-                    }
-                })
-                .collect();
-            let com_offset =
-                (p.chassis_mass * p.chassis_com_offset + 2.0 * mw * xs.iter().sum::<f64>()) / mass;
-            let mut yaw = p.chassis_yaw_inertia
-                + p.chassis_mass * (p.chassis_com_offset - com_offset).powi(2);
-            for &x in &xs {
-                yaw += 2.0
-                    * (mw * ((x - com_offset).powi(2) + p.half_track.powi(2))
-                        + p.wheel_diametral_inertia);
-            }
-            PlatformModel {
-                mass,
-                com_offset,
-                yaw_inertia: yaw,
-                wheel_radius: p.wheel_radius,
-                half_track: p.half_track,
-                side_spin_inertia: wheels_per_side * p.wheel_spin_inertia,
-                side_friction: wheels_per_side * p.wheel_friction,
-            }
-        });
+        let platform = m.platform.as_ref().map(Platform::composite);
         let mut n = 0;
         let pl = platform.as_ref().map(|_| {
             n += 5;
