@@ -156,6 +156,34 @@ impl TorqueLaw {
         }
     }
 
+    /// Torque just before time t, the left limit lim_{s↑t} τ(s): equal to [`Self::torque`]
+    /// except at a breakpoint, where it is the value of the stretch that ends there. A step
+    /// that ends on a jump integrates that stretch and reads its end with this.
+    pub fn torque_before(&self, t: f64) -> f64 {
+        match *self {
+            TorqueLaw::Constant { value, until } => {
+                if until.is_none_or(|u| t <= u) {
+                    value
+                } else {
+                    0.0
+                }
+            }
+            TorqueLaw::BangBang {
+                amplitude,
+                switch,
+                off,
+            } => {
+                if t <= switch {
+                    amplitude
+                } else if t <= off {
+                    -amplitude
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
     /// Times at which the law is discontinuous (integrators should step onto them).
     pub fn breakpoints(&self) -> Vec<f64> {
         match *self {
