@@ -123,7 +123,10 @@ impl Recorder {
         }
     }
 
-    /// Records every output time in (t_a, t_b] (and t_a itself if it is the first sample).
+    /// Records every output time in (t_a, t_b] (and t_a itself if it is the first sample); in
+    /// (t_a, t_b) when the step ends on a jump of an applied law (`on_jump`): a sample at the
+    /// jump belongs to the stretch it opens (the laws are right-continuous) and is taken at the
+    /// start of the next step.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn record<S: System + Outputs + ?Sized>(
         &mut self,
@@ -137,10 +140,12 @@ impl Recorder {
         wb: &[f64],
         tau: f64,
         bound: f64,
+        on_jump: bool,
     ) {
+        let tol = 1e-12 * tb.abs().max(1e-30);
         while self.next < self.times.len() {
             let t = self.times[self.next];
-            if t > tb + 1e-12 * tb.abs().max(1e-30) {
+            if t > tb + tol || (on_jump && t >= tb - tol) {
                 break;
             }
             let s = if tb > ta {

@@ -9,7 +9,7 @@
 //! Kelvin–Voigt or discrete damper acts. The method scales it by its own factor
 //! ([`crate::method::Stepper::bound_factor`]) and the user's safety factor.
 
-use data::scene::LinkField;
+use data::scene::{LinkField, TorqueLaw};
 
 /// Which stability bound is binding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -126,6 +126,20 @@ pub trait System {
     /// Whether any force depends on the velocities through damping or a velocity-coupled
     /// (gyroscopic) term: the two-step scheme's computational mode can then grow.
     fn damped(&self) -> bool;
+    /// Times t > 0 where an applied law jumps (torque switches): the driver steps onto them
+    /// when its method splits its kicks there ([`crate::method::Capabilities::steps_onto_jumps`]).
+    /// Default: none.
+    fn jumps(&self) -> Vec<f64> {
+        Vec::new()
+    }
+    /// While `Some(t_jump)`, the force and power evaluations take the applied laws at their
+    /// value on the stretch that ends at t_jump, their left limit there, whatever time they are
+    /// at: the driver sets it for a step that ends on that jump, every evaluation of which
+    /// (the closing kick, an event's re-taken steps) lies inside the stretch. `None` (the
+    /// default): the laws at the evaluation's time, right-continuous.
+    fn close_stretch_at(&mut self, jump: Option<f64>) {
+        let _ = jump;
+    }
     /// The first link whose transverse tip deflection exceeds its length at q: beyond it the
     /// beam models (linear or small-strain floating frame) no longer describe the link, and
     /// the driver stops the run with a diagnostic. Default: no link to check.
@@ -178,6 +192,28 @@ pub struct DriftVelocities<'a> {
     /// [`System::accel_split`] takes the velocity-dependent forces; an implicit kick may take
     /// the forces other than the implicit damping there)
     pub predicted: &'a [f64],
+}
+
+/// An applied torque law at t, or at the left limit of the jump a closed stretch ends on
+/// ([`System::close_stretch_at`]); 0 without a law.
+pub(crate) fn law_torque(law: Option<&TorqueLaw>, t: f64, closing: Option<f64>) -> f64 {
+    match (law, closing) {
+        (Some(l), Some(jump)) => l.torque_before(jump),
+        (Some(l), None) => l.torque(t),
+        (None, _) => 0.0,
+    }
+}
+
+/// The jump times t > 0 of `laws`, sorted, each once ([`System::jumps`]).
+pub(crate) fn law_jumps<'a>(laws: impl IntoIterator<Item = &'a TorqueLaw>) -> Vec<f64> {
+    let mut jumps: Vec<f64> = laws
+        .into_iter()
+        .flat_map(TorqueLaw::breakpoints)
+        .filter(|t| *t > 0.0)
+        .collect();
+    jumps.sort_by(f64::total_cmp);
+    jumps.dedup();
+    jumps
 }
 
 #[cfg(test)]

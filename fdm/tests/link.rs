@@ -323,3 +323,37 @@ fn dyn_single_link_deflected_beyond_its_length_stops_with_a_diagnostic() {
     assert!(maxabs(tip) <= length, "{}", maxabs(tip));
     assert!(maxabs(tip) > 0.5 * length, "{}", maxabs(tip));
 }
+
+#[test]
+fn dyn_velocity_form_keeps_its_order_through_torque_switches() {
+    // `single-link`'s bang-bang torque jumps at 0.5 s and 1.0 s. A step that passes a jump
+    // takes its impulse wrong by (t_jump − t_mid)·Δτ, first order in the step; the driver
+    // steps onto the jumps instead (closing kick at the left limit, opening kick at the new
+    // value). Steps that do not divide the switch times, so that no rung lands on them by
+    // chance: the hub angle's whole history over both switches must converge at second order.
+    let hub = |dt: f64| {
+        let mut s = Settings::default();
+        s.discretization.stations = Some(21);
+        s.time.dt = Some(dt);
+        s.time.t_end = Some(1.3);
+        let r = run("single-link", |_| {}, &s);
+        assert!(
+            matches!(r.verdict, StabilityVerdict::Completed),
+            "{:?}",
+            r.verdict
+        );
+        r.observables.get("joint1.angle").unwrap().values.clone()
+    };
+    let rungs: Vec<Vec<f64>> = [1.7e-4, 8.5e-5, 4.25e-5].into_iter().map(hub).collect();
+    let peak = maxabs(&rungs[2]);
+    let diff = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            / peak
+    };
+    let (d1, d2) = (diff(&rungs[0], &rungs[1]), diff(&rungs[1], &rungs[2]));
+    let order = (d1 / d2).log2();
+    eprintln!("hub angle: successive differences {d1:.3e}, {d2:.3e} of the peak, order {order:.2}");
+    assert!(order > 1.7, "order {order:.2}");
+}

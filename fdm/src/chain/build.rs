@@ -319,6 +319,7 @@ impl TwoLinkChain {
             },
             implicit: None,
             skip_damping: false,
+            closing: None,
             vd: vec![0.0; nd],
             timo,
         };

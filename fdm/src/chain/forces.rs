@@ -176,7 +176,7 @@ impl TwoLinkChain {
         let (th1d, th2d) = (self.clamp_angle(v, 0), self.elbow(v));
         let j = &self.joints;
         self.power = [
-            j[0].torque(t) * th1d + j[1].torque(t) * th2d,
+            j[0].torque(t, self.closing) * th1d + j[1].torque(t, self.closing) * th2d,
             j[0].damping * th1d * th1d + j[1].damping * th2d * th2d,
             p_kv,
         ];
@@ -288,7 +288,7 @@ impl TwoLinkChain {
         let th2 = self.elbow(q);
         let th2d = self.elbow(v);
         let j = &self.joints;
-        let ext = [j[0].torque(t), j[1].torque(t)];
+        let ext = [j[0].torque(t, self.closing), j[1].torque(t, self.closing)];
         let th1 = self.clamp_angle(q, 0);
         let th1d = self.clamp_angle(v, 0);
         let dj = if damp {

@@ -6,6 +6,8 @@
 
 use data::scene::TorqueLaw;
 
+use crate::system::law_torque;
+
 use super::damping_matrix::ImplicitDamping;
 use super::kinetic::{BE, ChainInertia, TH};
 use super::kinetic::{Lanes, PointScratch};
@@ -29,8 +31,10 @@ pub(super) struct JointLaw {
 }
 
 impl JointLaw {
-    pub(super) fn torque(&self, t: f64) -> f64 {
-        self.law.as_ref().map_or(0.0, |l| l.torque(t))
+    /// The applied torque at t, or on the stretch being closed
+    /// ([`crate::system::System::close_stretch_at`]).
+    pub(super) fn torque(&self, t: f64, closing: Option<f64>) -> f64 {
+        law_torque(self.law.as_ref(), t, closing)
     }
 }
 
@@ -116,6 +120,9 @@ pub struct TwoLinkChain {
     pub(super) implicit: Option<Box<ImplicitDamping>>,
     /// `forces` leaves the damping out (the implicit kick adds it at the drift velocity)
     pub(super) skip_damping: bool,
+    /// the jump the step being closed ends on: the forces and powers take the torque laws'
+    /// left limits there ([`crate::system::System::close_stretch_at`])
+    pub(super) closing: Option<f64>,
     /// scratch of [`Self::add_damping_forces`] and the implicit kick (length n)
     pub(super) vd: Vec<f64>,
     /// Timoshenko links (`shear` on both): the condensed section rotations ([`super::timoshenko`]);

@@ -68,8 +68,10 @@ impl Outputs for TwoLinkChain {
         let [th1d, th2d] = self.joint_rates(v);
         let j = &self.joints;
         // joint torques: applied law + spring + damper at this state
-        let tau1 = j[0].torque(t) - j[0].stiffness * (th1 - j[0].set_point) - j[0].damping * th1d;
-        let tau2 = j[1].torque(t) - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * th2d;
+        let tau1 =
+            j[0].torque(t, None) - j[0].stiffness * (th1 - j[0].set_point) - j[0].damping * th1d;
+        let tau2 =
+            j[1].torque(t, None) - j[1].stiffness * (th2 - j[1].set_point) - j[1].damping * th2d;
         out[0] = th1;
         out[1] = th1d;
         out[2] = tau1;

@@ -5,11 +5,19 @@
 
 use super::model::TwoLinkChain;
 use crate::link::FloatingLink;
-use crate::system::{Bound, DeflectionModel, DriftVelocities, Overextension, System};
+use crate::system::{Bound, DeflectionModel, DriftVelocities, Overextension, System, law_jumps};
 
 impl System for TwoLinkChain {
     fn dofs(&self) -> usize {
         self.inertia.dofs() + usize::from(self.tip_ghost.is_some())
+    }
+
+    fn jumps(&self) -> Vec<f64> {
+        law_jumps(self.joints.iter().filter_map(|j| j.law.as_ref()))
+    }
+
+    fn close_stretch_at(&mut self, jump: Option<f64>) {
+        self.closing = jump;
     }
 
     /// The points' positions depend on the frame angles and, through foreshortening and the

@@ -30,15 +30,17 @@ use data::{Cost, Diagnostic, Event, StabilityVerdict};
 
 use crate::error::FdmError;
 use crate::events::{Events, NoEvents, Retake, finish_step};
-use crate::method::{StepState, Stepper, stepper};
+use crate::method::{StepState, Stepper, capabilities, stepper};
 use crate::output::{Outcome, Outputs, Recorder};
 use crate::settings::{Method, ValidatedSettings};
 use crate::system::{Bound, System};
+use jumps::Jumps;
 use watch::{
     Growth, LEDGER_LOST, LEDGER_SETTLED_STEPS, Watch, growth_diagnostic, ledger_diagnostic,
     overextension_diagnostic,
 };
 
+mod jumps;
 mod watch;
 
 /// How to step.
@@ -175,21 +177,34 @@ pub fn run<S: Model, E: Events<S>>(
     };
     let mut verdict = StabilityVerdict::Completed;
     rs.start_up(sys, method, limit, &mut rec);
+    let mut jumps = Jumps::new(&*sys, ctl.t_end, capabilities(ctl.method).steps_onto_jumps);
 
     while !rec.done() {
         let (tau_next, limit_next) = rs.next_step(sys, ctl, factor)?;
-        let tau_step = match events.step_factor(rs.t) {
+        let tau_bound = match events.step_factor(rs.t) {
             Some(f) if ctl.forced_dt.is_none() => tau_next * f,
             _ => tau_next,
         };
+        let (tau_step, landing) = jumps.toward(rs.t, tau_bound);
+        sys.close_stretch_at(landing);
         method.predict(rs.tau, tau_step, &mut rs.st);
         if let Some(diagnostic) = rs.watch(sys, method, &watch, tau_step, limit_next) {
             verdict = StabilityVerdict::Stopped { diagnostic };
             break;
         }
-        if let Err(stop) = rs.advance(sys, method, events, &watch, tau_step, limit_next, &mut rec) {
-            verdict = stop;
-            break;
+        let advanced = rs.advance(
+            sys, method, events, &watch, tau_step, landing, limit_next, &mut rec,
+        );
+        sys.close_stretch_at(None);
+        match (advanced, landing) {
+            (Err(stop), _) => {
+                verdict = stop;
+                break;
+            }
+            (Ok(true), Some(jump)) => {
+                rs.cost.rhs_evaluations += jumps.open(sys, events, jump, &mut rs.st);
+            }
+            _ => {}
         }
     }
     rs.cost.wall_time_s = clock.elapsed().as_secs_f64();
@@ -269,7 +284,7 @@ impl RunState {
         let (tau, limit, _) = choose_step(sys, ctl, factor, t)?;
         events.first_step(tau);
         rec.record(
-            sys, method, t, &st.cur, &w_cur, t, &st.cur, &w_cur, tau, limit,
+            sys, method, t, &st.cur, &w_cur, t, &st.cur, &w_cur, tau, limit, false,
         );
 
         let mon = sys.monitored();
@@ -319,6 +334,7 @@ impl RunState {
                 &self.w_new,
                 tau,
                 limit,
+                false,
             );
             self.st.rotate();
             std::mem::swap(&mut self.w_cur, &mut self.w_new);
@@ -436,8 +452,9 @@ impl RunState {
 
     /// Completes the step: accelerations at the new level, an event inside the step located
     /// (the step re-taken up to it), the work booked, the sample recorded, the levels rotated,
-    /// and at an event its reset applied (a new history for the watch). `Err` stops the run
-    /// with the events' verdict.
+    /// and at an event its reset applied (a new history for the watch). A step aimed at the
+    /// jump `landing` that no event cut short ends exactly on it (returns true; a sample at the
+    /// jump is left to the stretch it opens). `Err` stops the run with the events' verdict.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn advance<S: Model, E: Events<S>>(
@@ -447,9 +464,10 @@ impl RunState {
         events: &mut E,
         ws: &WatchSettings,
         tau_step: f64,
+        landing: Option<f64>,
         limit_next: f64,
         rec: &mut Recorder,
-    ) -> Result<(), StabilityVerdict> {
+    ) -> Result<bool, StabilityVerdict> {
         let (t, tau) = (self.t, self.tau);
         finish_step(method, sys, t, tau, tau_step, &mut self.st);
         self.cost.rhs_evaluations += 1;
@@ -463,7 +481,8 @@ impl RunState {
         self.cost.rhs_evaluations += retake.evaluations;
         let tau_taken = located?;
         let tau_eff = tau_taken.unwrap_or(tau_step);
-        let t_new = t + tau_eff;
+        let landed = landing.filter(|_| tau_taken.is_none());
+        let t_new = landed.unwrap_or(t + tau_eff);
         if tau_eff > 0.0 {
             events.level_powers(sys, t_new, &self.st.next.v, &mut self.st.p_new);
         }
@@ -481,6 +500,7 @@ impl RunState {
                 &self.w_new,
                 tau_eff,
                 limit_next,
+                landed.is_some(),
             );
             self.cost.steps += 1;
             // a two-step scheme whose computational mode can grow has its own, more specific
@@ -508,6 +528,6 @@ impl RunState {
             self.peak_v = self.peak_v.max(inf_norm(&self.st.cur.v[ws.mon.clone()]));
         }
         events.settled(sys, &self.st.cur);
-        Ok(())
+        Ok(landed.is_some())
     }
 }

@@ -42,7 +42,9 @@ use data::{DofPlan, Scene};
 
 use crate::error::FdmError;
 use crate::foreshortening::Foreshortening;
-use crate::system::{Bound, BoundKind, DeflectionModel, Overextension, System};
+use crate::system::{
+    Bound, BoundKind, DeflectionModel, Overextension, System, law_jumps, law_torque,
+};
 
 mod outputs;
 
@@ -94,6 +96,8 @@ pub struct FloatingLink {
     axial: Vec<f64>,
     power: [f64; 3],
     torque: f64,
+    /// The jump the step being closed ends on ([`System::close_stretch_at`]).
+    closing: Option<f64>,
     /// Hub rate of the latest force evaluation (the bound of a torque-driven hub uses it).
     last_rate: f64,
     /// Hub rate the latest bound was evaluated at (for its description).
@@ -192,6 +196,7 @@ impl FloatingLink {
             f: vec![0.0; r],
             power: [0.0; 3],
             torque: 0.0,
+            closing: None,
         })
     }
 
@@ -376,7 +381,7 @@ impl FloatingLink {
                 damping,
                 set_point,
             } => {
-                let ext = law.as_ref().map_or(0.0, |l| l.torque(t));
+                let ext = law_torque(law.as_ref(), t, self.closing);
                 (ext, -stiffness * (th - set_point), -damping * rate)
             }
             Drive::Prescribed(_) => (0.0, 0.0, 0.0),
@@ -436,6 +441,17 @@ impl FloatingLink {
 impl System for FloatingLink {
     fn dofs(&self) -> usize {
         self.r + self.v0()
+    }
+
+    fn jumps(&self) -> Vec<f64> {
+        match &self.drive {
+            Drive::Torque { law, .. } => law_jumps(law),
+            Drive::Prescribed(_) => Vec::new(),
+        }
+    }
+
+    fn close_stretch_at(&mut self, jump: Option<f64>) {
+        self.closing = jump;
     }
 
     fn overextended(&self, q: &[f64]) -> Option<Overextension> {

@@ -87,6 +87,11 @@ pub struct Capabilities {
     /// linear damping implicit ([`System::implicit_kick`]), so the step stays at the undamped
     /// bound (required by the 3-D payload link; switched on in the two-link chain).
     pub implicit_damping: bool,
+    /// Its kicks split at every level (an opening and a closing half kick), so a step can end
+    /// on a jump of an applied law with the closing kick at the law's left limit and the next
+    /// opening kick at its new value: the driver steps onto the system's jumps
+    /// ([`System::jumps`]).
+    pub steps_onto_jumps: bool,
 }
 
 /// What a method is built from: the validated method (with its payload) and whether the run

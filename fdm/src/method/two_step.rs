@@ -41,11 +41,13 @@ impl TwoStep {
         TwoStep { filter: Some(nu) }
     }
 
-    /// Neither capability: a step needs the level before it (no restart at an event), and its
-    /// damping is explicit.
+    /// No capability: a step needs the level before it (no restart at an event), its damping
+    /// is explicit, and a level's force acts over the half steps on both sides of it at once
+    /// (a jump inside that window is taken at the level's value).
     pub const CAPABILITIES: Capabilities = Capabilities {
         restarts_at_events: false,
         implicit_damping: false,
+        steps_onto_jumps: false,
     };
 }
 

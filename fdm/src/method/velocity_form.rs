@@ -40,6 +40,11 @@
 //! step applies −½τM⁻¹C at v_j (opening kick, explicit) and at v_{j+1} (closing kick): Crank–
 //! Nicolson in the damping, stable for every κτ, and the step stays at the undamped bound.
 //!
+//! **Jumps of applied laws.** The opening and the closing kick at a level are separate, so a
+//! step can end on a torque switch with its closing kick at the law's left limit and the next
+//! opening kick at the new value; the driver lands on the switches (`crate::driver`'s jumps
+//! module) and the scheme keeps its second order through them.
+//!
 //! **Restartable steps** ([`VelocityForm::predicted`]). With every force at the predicted
 //! velocity a step depends on level j alone, so a step can be re-taken from the same level with
 //! another length (event location: [`crate::chain::contact`]) and the drift positions
@@ -88,10 +93,12 @@ impl VelocityForm {
         }
     }
 
-    /// Restartable ([`VelocityForm::predicted`]) and with implicit damping (module docs).
+    /// Restartable ([`VelocityForm::predicted`]), with implicit damping, and onto jumps: the
+    /// closing and the opening kick at a level are separate (module docs).
     pub const CAPABILITIES: Capabilities = Capabilities {
         restarts_at_events: true,
         implicit_damping: true,
+        steps_onto_jumps: true,
     };
 }
 

@@ -36,7 +36,7 @@ use super::{BaseDrive, PayloadLinkModel, apply};
 use crate::error::FdmError;
 use crate::linalg::dot;
 use crate::output::{Outputs, sample_field};
-use crate::system::{Bound, BoundKind, DriftVelocities, System};
+use crate::system::{Bound, BoundKind, DriftVelocities, System, law_jumps, law_torque};
 
 /// The base's state at one force evaluation (what the coordinates do not carry).
 #[derive(Debug, Clone, Copy, Default)]
@@ -83,6 +83,8 @@ pub struct PayloadLinkSystem {
     levels: [BaseLevel; 2],
     /// scratch of the stored energies (`&self`)
     scratch: RefCell<Vec<f64>>,
+    /// the jump the step being closed ends on ([`System::close_stretch_at`])
+    closing: Option<f64>,
 }
 
 impl PayloadLinkSystem {
@@ -115,6 +117,7 @@ impl PayloadLinkSystem {
             power: vec![0.0; inputs.len() + diss.len()],
             levels: [BaseLevel::default(); 2],
             scratch: RefCell::new(vec![0.0; n]),
+            closing: None,
             model,
         })
     }
@@ -168,6 +171,7 @@ impl PayloadLinkSystem {
         a: &mut [f64],
     ) -> BaseLevel {
         let o = self.off;
+        let closing = self.closing;
         let PayloadLinkSystem {
             model: md,
             c,
@@ -208,7 +212,7 @@ impl PayloadLinkSystem {
                 damping,
                 set_point,
             } => {
-                let ext = law.as_ref().map_or(0.0, |l| l.torque(t));
+                let ext = law_torque(law.as_ref(), t, closing);
                 let rhs = ext - damping * rate - stiffness * (th - set_point) - vel;
                 let acc = &mut a[o..];
                 acc.copy_from_slice(f);
@@ -285,6 +289,17 @@ impl PayloadLinkSystem {
 impl System for PayloadLinkSystem {
     fn dofs(&self) -> usize {
         self.model.n + self.off
+    }
+
+    fn jumps(&self) -> Vec<f64> {
+        match &self.model.drive {
+            BaseDrive::Free { law, .. } => law_jumps(law),
+            BaseDrive::Prescribed(_) => Vec::new(),
+        }
+    }
+
+    fn close_stretch_at(&mut self, jump: Option<f64>) {
+        self.closing = jump;
     }
 
     /// The start level: the accelerations with the step matrix and the damping at `v` (module
