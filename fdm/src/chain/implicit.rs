@@ -389,28 +389,30 @@ impl TwoLinkChain {
                 }
             }
             for blk in blocks.iter_mut() {
-                let (m, r0) = (blk.m, blk.rows.start);
-                blk.sol.iter_mut().for_each(|v| *v = 0.0);
-                let (rows, at) = (&band[blk.band.clone()], &at_band[blk.band.clone()]);
-                // column by column: each a loop without branches
-                let (rhs, sol) = (&mut blk.rhs[..], &mut blk.sol[..]);
-                let mut put = |a: usize, value: &[f64], damping: Option<&[f64]>| {
-                    for (t, (&i, &p)) in rows.iter().zip(at).enumerate() {
-                        let v = match damping {
-                            Some(cc) => value[i] + ht * cc[i],
-                            None => value[i],
-                        };
-                        rhs[t * m + a] = v;
-                        sol[(p - r0) * m + a] = v;
-                    }
-                };
+                let m = blk.m;
+                // the block's columns (those of M's full columns take their damping), then
+                // the right-hand side
+                let mut src: [(&[f64], Option<&[f64]>); MAX_SOLVED] = [(&[], None); MAX_SOLVED];
                 for a in 0..m - 1 {
-                    match blk.cols[a] {
-                        c if c < nf => put(a, &self.cols[c], Some(&cf[c])),
-                        c => put(a, &u[c - nf], None),
-                    }
+                    src[a] = match blk.cols[a] {
+                        c if c < nf => (&self.cols[c], Some(&cf[c])),
+                        c => (&u[c - nf], None),
+                    };
                 }
-                put(m - 1, &rz, None);
+                src[m - 1] = (&rz, None);
+                let src = &src[..m];
+                let (rows, at) = (&band[blk.band.clone()], &at_band[blk.band.clone()]);
+                match m {
+                    1 => put_rows::<1>(blk, rows, at, src, ht),
+                    2 => put_rows::<2>(blk, rows, at, src, ht),
+                    3 => put_rows::<3>(blk, rows, at, src, ht),
+                    4 => put_rows::<4>(blk, rows, at, src, ht),
+                    5 => put_rows::<5>(blk, rows, at, src, ht),
+                    6 => put_rows::<6>(blk, rows, at, src, ht),
+                    7 => put_rows::<7>(blk, rows, at, src, ht),
+                    8 => put_rows::<8>(blk, rows, at, src, ht),
+                    m => unreachable!("{m} right-hand sides"),
+                }
                 saddle.solve_block_rows_in_place(blk.rows.clone(), &mut blk.sol, m);
                 schur_rows(blk, &at_band[blk.band.clone()], &mut s, &mut b);
             }
@@ -573,6 +575,40 @@ impl TwoLinkChain {
             }
         }
     }
+}
+
+/// The right-hand sides of one block's factoring solve, row by row: `src[a]` is column a's
+/// values over q (and its damping, taken with weight `ht`), `rows` and `at` the block's band
+/// rows in q and in the saddle system. Into `blk.rhs` by band rows and into `blk.sol` by
+/// saddle rows, the multipliers' rows zero.
+fn put_rows<const M: usize>(
+    blk: &mut KickBlock,
+    rows: &[usize],
+    at: &[usize],
+    src: &[(&[f64], Option<&[f64]>)],
+    ht: f64,
+) {
+    let src: &[_; M] = src.try_into().unwrap();
+    let r0 = blk.rows.start;
+    let (rhs, sol) = (
+        blk.rhs.as_chunks_mut::<M>().0,
+        blk.sol.as_chunks_mut::<M>().0,
+    );
+    let mut next = 0;
+    for ((&i, &p), c) in rows.iter().zip(at).zip(rhs.iter_mut()) {
+        let mut v = [0.0; M];
+        for a in 0..M {
+            v[a] = match src[a] {
+                (value, Some(damping)) => value[i] + ht * damping[i],
+                (value, None) => value[i],
+            };
+        }
+        *c = v;
+        sol[next..p - r0].fill([0.0; M]);
+        sol[p - r0] = v;
+        next = p - r0 + 1;
+    }
+    sol[next..].fill([0.0; M]);
 }
 
 /// The small system's products over one block's band rows, in order: s(r, k) −= c_r z_k and
