@@ -651,13 +651,19 @@ fn schur_rows_m<const M: usize>(
     }
     let r0 = blk.rows.start;
     let (rhs, sol) = (blk.rhs.as_chunks::<M>().0, blk.sol.as_chunks::<M>().0);
-    for (c, &p) in rhs.iter().zip(at) {
-        let z = &sol[p - r0];
-        for a in 0..M - 1 {
-            for k in 0..M {
-                acc[a][k] -= c[a] * z[k];
-            }
+    // two rows of acc at a time, each sum over the band rows in order as one lane of packed
+    // products (all rows at once spill, and the compiler then kept every product scalar)
+    let mut a = 0;
+    while a + 1 < M - 1 {
+        let mut pair: [[f64; 2]; M] = std::array::from_fn(|k| [acc[a][k], acc[a + 1][k]]);
+        schur_pair(&mut pair, a, rhs, sol, at, r0);
+        for k in 0..M {
+            [acc[a][k], acc[a + 1][k]] = pair[k];
         }
+        a += 2;
+    }
+    if a < M - 1 {
+        schur_single(&mut acc[a], a, rhs, sol, at, r0);
     }
     for (a, &r) in cols.iter().enumerate() {
         for (k, &c) in cols.iter().enumerate() {
@@ -665,6 +671,50 @@ fn schur_rows_m<const M: usize>(
         }
         b[r] = acc[a][M - 1];
     }
+}
+
+/// Rows a and a + 1 of [`schur_rows_m`]'s sums, lane by lane: acc[k] −= (c_a, c_{a+1}) z_k
+/// over the band rows (`at` their saddle rows). Out of line: inlined, the compiler left the
+/// products scalar.
+#[inline(never)]
+fn schur_pair<const M: usize>(
+    acc: &mut [[f64; 2]; M],
+    a: usize,
+    rhs: &[[f64; M]],
+    sol: &[[f64; M]],
+    at: &[usize],
+    r0: usize,
+) {
+    let mut sums = *acc;
+    for (c, &p) in rhs.iter().zip(at) {
+        let z = &sol[p - r0];
+        let ca = [c[a], c[a + 1]];
+        for k in 0..M {
+            sums[k][0] -= ca[0] * z[k];
+            sums[k][1] -= ca[1] * z[k];
+        }
+    }
+    *acc = sums;
+}
+
+/// Row a of [`schur_rows_m`]'s sums alone (an odd number of rows): acc −= c_a z.
+#[inline(never)]
+fn schur_single<const M: usize>(
+    acc: &mut [f64; M],
+    a: usize,
+    rhs: &[[f64; M]],
+    sol: &[[f64; M]],
+    at: &[usize],
+    r0: usize,
+) {
+    let mut sums = *acc;
+    for (c, &p) in rhs.iter().zip(at) {
+        let z = &sol[p - r0];
+        for k in 0..M {
+            sums[k] -= c[a] * z[k];
+        }
+    }
+    *acc = sums;
 }
 
 /// The back substitution of the Schur solve on one block's band rows (q indices `rows`,
