@@ -12,6 +12,10 @@
 //! they are skipped, elsewhere the full band runs in straight-line code (a constant
 //! half-bandwidth, no per-row bookkeeping), and the factor lets two blocks take turns, so
 //! that the division that ends each column overlaps the other block's.
+//!
+//! **Out of place.** Each assembled entry is read once, by the column that turns it into L's
+//! (or D's), so the factor may read them from another matrix with the same envelope
+//! ([`BandLdl::factor_from`]): a matrix assembled anew for every factor then needs no copy.
 
 // Index loops over the band read like the factorization.
 #![allow(clippy::needless_range_loop)]
@@ -119,23 +123,23 @@ impl BandLdl {
         self.a.iter_mut().for_each(|x| *x = 0.0);
     }
 
-    /// The entries of `other`, a matrix with the same envelope (as assembled: before its
-    /// factor).
-    pub fn assign(&mut self, other: &BandLdl) {
-        assert!(
-            self.n == other.n && self.k == other.k,
-            "another envelope: order {} and half-bandwidth {}",
-            other.n,
-            other.k
-        );
-        self.a.copy_from_slice(&other.a);
-    }
-
     /// A[i, j] += v inside the envelope (the symmetric entry is implied).
     pub fn add(&mut self, i: usize, j: usize, v: f64) {
         let (i, j) = if i >= j { (i, j) } else { (j, i) };
         let p = self.at(i, j);
         self.a[p] += v;
+    }
+
+    /// Where A[i, j] (inside the envelope; or its symmetric entry) is stored, for
+    /// [`Self::set_at`].
+    pub fn position(&self, i: usize, j: usize) -> usize {
+        let (i, j) = if i >= j { (i, j) } else { (j, i) };
+        self.at(i, j)
+    }
+
+    /// The entry stored at `p` ([`Self::position`]) = v.
+    pub fn set_at(&mut self, p: usize, v: f64) {
+        self.a[p] = v;
     }
 
     /// Factors in place. Err(j): pivot j is zero or not finite (the first such of its block).
@@ -146,26 +150,41 @@ impl BandLdl {
     /// subtracts. So the columns away from the matrix's ends run over the full band,
     /// straight-line code for the common half-bandwidths, with the envelope's bits.
     pub fn factor(&mut self) -> Result<(), usize> {
+        self.factor_with(InPlace)
+    }
+
+    /// [`Self::factor`] of `assembled`, a matrix with the same envelope (as assembled), into
+    /// this one: the same operations on the same entries, so the same bits, and `assembled`
+    /// is left as it is. This matrix's own entries are not read.
+    pub fn factor_from(&mut self, assembled: &BandLdl) -> Result<(), usize> {
+        assert!(
+            self.n == assembled.n && self.k == assembled.k && self.first == assembled.first,
+            "another envelope"
+        );
+        self.factor_with(Other(&assembled.a))
+    }
+
+    fn factor_with<S: Assembled>(&mut self, src: S) -> Result<(), usize> {
         assert!(
             self.k <= MAX_HALF_BANDWIDTH,
             "half-bandwidth {} above {MAX_HALF_BANDWIDTH}",
             self.k
         );
         match self.k {
-            1 => self.factor_band::<1>(),
-            2 => self.factor_band::<2>(),
-            3 => self.factor_band::<3>(),
-            4 => self.factor_band::<4>(),
-            5 => self.factor_band::<5>(),
-            6 => self.factor_band::<6>(),
-            _ => (0..self.n).try_for_each(|j| self.factor_column(j)),
+            1 => self.factor_band::<1, S>(src),
+            2 => self.factor_band::<2, S>(src),
+            3 => self.factor_band::<3, S>(src),
+            4 => self.factor_band::<4, S>(src),
+            5 => self.factor_band::<5, S>(src),
+            6 => self.factor_band::<6, S>(src),
+            _ => (0..self.n).try_for_each(|j| self.factor_column(j, src)),
         }
     }
 
     /// [`Self::factor`] with half-bandwidth `K`: the columns K from the matrix's ends over the
     /// full band, two blocks in turn (their pivot chains are independent, and each column
     /// waits for the division that ends the previous one).
-    fn factor_band<const K: usize>(&mut self) -> Result<(), usize> {
+    fn factor_band<const K: usize, S: Assembled>(&mut self, src: S) -> Result<(), usize> {
         for pair in (0..self.blocks.len()).step_by(2) {
             let p = self.blocks[pair].clone();
             let q = self.blocks.get(pair + 1).cloned().unwrap_or(0..0);
@@ -179,10 +198,10 @@ impl BandLdl {
             };
             let (ip, iq) = (inner(&p), inner(&q));
             for j in p.start..ip.start.min(p.end) {
-                self.factor_column(j)?;
+                self.factor_column(j, src)?;
             }
             for j in q.start..iq.start.min(q.end) {
-                self.factor_column(j)?;
+                self.factor_column(j, src)?;
             }
             let w = K + 1;
             let (a, lc) = (&mut self.a[..], &mut self.lc[..]);
@@ -201,30 +220,30 @@ impl BandLdl {
             };
             for t in 0..ip.len().max(iq.len()) {
                 if t < ip.len() {
-                    band_column::<K>(a, lc, ip.start + t, &mut cp)?;
+                    band_column::<K, S>(a, lc, src, ip.start + t, &mut cp)?;
                 }
                 if t < iq.len() {
-                    band_column::<K>(a, lc, iq.start + t, &mut cq)?;
+                    band_column::<K, S>(a, lc, src, iq.start + t, &mut cq)?;
                 }
             }
             for j in ip.end.max(p.start)..p.end {
-                self.factor_column(j)?;
+                self.factor_column(j, src)?;
             }
             for j in iq.end.max(q.start)..q.end {
-                self.factor_column(j)?;
+                self.factor_column(j, src)?;
             }
         }
         Ok(())
     }
 
     /// Column j of [`Self::factor`] inside the envelope.
-    fn factor_column(&mut self, j: usize) -> Result<(), usize> {
+    fn factor_column<S: Assembled>(&mut self, j: usize, src: S) -> Result<(), usize> {
         let (k, w) = (self.k, self.k + 1);
         let mut ld = [0.0; MAX_HALF_BANDWIDTH];
         let a = &mut self.a;
         let fj = self.first[j];
         let row_j = j * w + w - 1 - (j - fj);
-        let mut d = a[j * w + w - 1];
+        let mut d = src.entry(a, j * w + w - 1);
         for (t, m) in (fj..j).enumerate() {
             let l = a[row_j + t];
             ld[t] = l * a[m * w + w - 1];
@@ -245,7 +264,7 @@ impl BandLdl {
             let row_i = i * w + w - 1 - (i - fi);
             let lo = fi.max(fj);
             let li = &a[row_i + (lo - fi)..row_i + (j - fi)];
-            let mut s = a[row_i + (j - fi)];
+            let mut s = src.entry(a, row_i + (j - fi));
             for (l, x) in li.iter().zip(&ld[lo - fj..j - fj]) {
                 s -= l * x;
             }
@@ -434,21 +453,53 @@ impl BandLdl {
     }
 }
 
+/// Where [`BandLdl::factor`] reads the assembled entries: the matrix being factored or another
+/// with its envelope (the storage positions are the same).
+trait Assembled: Copy {
+    /// The assembled entry at storage position `p` (`a` the matrix being factored).
+    fn entry(self, a: &[f64], p: usize) -> f64;
+}
+
+/// The matrix being factored holds them.
+#[derive(Clone, Copy)]
+struct InPlace;
+
+impl Assembled for InPlace {
+    #[inline(always)]
+    fn entry(self, a: &[f64], p: usize) -> f64 {
+        a[p]
+    }
+}
+
+/// Another matrix's storage holds them.
+#[derive(Clone, Copy)]
+struct Other<'a>(&'a [f64]);
+
+impl Assembled for Other<'_> {
+    #[inline(always)]
+    fn entry(self, _: &[f64], p: usize) -> f64 {
+        self.0[p]
+    }
+}
+
 /// Column j of [`BandLdl::factor`] over the full band of half-bandwidth `K` (rows `a` of
 /// K + 1 entries, L's columns `lc` of K); `chain` carries L(j, j−1) and D(j−1) in and
 /// L(j+1, j) and D(j) out.
 #[inline(always)]
-fn band_column<const K: usize>(
+fn band_column<const K: usize, S: Assembled>(
     a: &mut [f64],
     lc: &mut [f64],
+    src: S,
     j: usize,
     chain: &mut (f64, f64),
 ) -> Result<(), usize> {
     let w = K + 1;
+    let mut d = src.entry(a, j * w + K);
+    let below_at = |r: usize| src.entry(a, (j + r) * w + K - r);
+    let assembled: [f64; K] = std::array::from_fn(|r| below_at(r + 1));
     let (left, right) = a.split_at_mut(j * w);
     let (row_j, below) = right.split_at_mut(w);
     let mut ld = [0.0; K];
-    let mut d = row_j[K];
     for t in 0..K {
         let (l, dm) = if t == K - 1 {
             *chain
@@ -466,7 +517,7 @@ fn band_column<const K: usize>(
     let col = &mut lc[j * K..j * K + K];
     for r in 1..=K {
         let row_i = &mut below[(r - 1) * w..r * w];
-        let mut s = row_i[K - r];
+        let mut s = assembled[r - 1];
         for t in r..K {
             s -= row_i[t - r] * ld[t];
         }
@@ -593,9 +644,23 @@ mod tests {
         }
         assert!(envelope.is_block(blocks[0].clone()) && envelope.is_block(blocks[1].clone()));
         assert!(!envelope.is_block(0..20));
+        // out of place: the same bits, the assembled matrix untouched
+        let assembled = envelope.clone();
+        let kept = assembled.a.clone();
+        let mut from = BandLdl::with_envelope(envelope.first.clone());
+        from.factor_from(&assembled).unwrap();
         envelope.factor().unwrap();
         full.factor().unwrap();
         wide.factor().unwrap();
+        assert_eq!(
+            from.a.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            envelope.a.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        );
+        assert_eq!(
+            from.lc.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            envelope.lc.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        );
+        assert_eq!(assembled.a, kept);
         for m in [1usize, 3, 7, 8, 11] {
             let rhs: Vec<f64> = (0..n * m).map(|k| (0.37 * k as f64).cos() + 0.1).collect();
             let mut x_full = rhs.clone();

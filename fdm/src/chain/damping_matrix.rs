@@ -21,11 +21,18 @@ pub struct ImplicitDamping {
     pub(super) c2: Vec<f64>,
     /// C's full columns over q
     pub(super) cf: [Vec<f64>; MAX_FULL],
-    /// the saddle system [[D_B + ½τC_BB + ..., Gᵀ], [G, −N⁻¹]] interleaved by station
+    /// the factors of the saddle system [[D_B + ½τC_BB + ..., Gᵀ], [G, −N⁻¹]] interleaved
+    /// by station
     pub(super) saddle: BandLdl,
-    /// its entries that do not follow the state (all but G's), at the step `constant_for`
-    pub(super) constant: BandLdl,
+    /// the saddle system as assembled: its entries that do not follow the state (all but
+    /// G's) at the step `constant_for`, and G's of the last assembly (the factor reads it in
+    /// place of a copy)
+    pub(super) assembled: BandLdl,
     pub(super) constant_for: Option<f64>,
+    /// per link, the storage positions in `assembled` of G's entries g_seg (segments
+    /// 0…r − 2) and −g_seg (segments 1…r − 1)
+    pub(super) g_plus: [Vec<usize>; 2],
+    pub(super) g_minus: [Vec<usize>; 2],
     /// position in the saddle system of each band position's unknown, and of each link's
     /// segment multipliers
     pub(super) at_band: Vec<usize>,

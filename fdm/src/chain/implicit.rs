@@ -19,12 +19,14 @@
 //! each segment's multiplier sits next to its station: quasi-definite, so its LDLᵀ exists
 //! without pivoting (`crate::band_ldl`), O(n) per kick (G follows the slopes). The rank-2 U
 //! and the full columns close it as in the mass solve: Z = A⁻¹[A_BF U], a system of at most
-//! 7, back substitution; no allocation. The links' blocks of the saddle system do not couple
-//! (C_z has no entry across the elbow), so each is stored in its envelope and solved alone with
-//! the columns that are not zero on it: the other link's U column and a constant full column
-//! without entries there (link 1's tip ghost on link 2) have a zero A⁻¹ on the link. C_z
-//! itself is read once from `TwoLinkChain::add_damping_forces` by probing (at Q⁻¹e, then
-//! Q⁻ᵀ): each full column alone, the band columns in five interleaved colours (bandwidth 2).
+//! 7, back substitution; no allocation. The saddle system is assembled in a matrix of its own
+//! (the constant entries once per τ, G's per state) and factored out of place from it, without
+//! a copy. The links' blocks of the saddle system do not couple (C_z has no entry across the
+//! elbow), so each is stored in its envelope and solved alone with the columns that are not
+//! zero on it: the other link's U column and a constant full column without entries there
+//! (link 1's tip ghost on link 2) have a zero A⁻¹ on the link. C_z itself is read once from
+//! `TwoLinkChain::add_damping_forces` by probing (at Q⁻¹e, then Q⁻ᵀ): each full column alone,
+//! the band columns in five interleaved colours (bandwidth 2).
 //!
 //! **Held tip** (restartable steps of a contact run, [`crate::method::velocity_form`]). With A =
 //! M + ½τC, A q̈ = f + Gᵀλ and G q̈ + Ġq̇ = 0 (Ġq̇ at the predicted velocity, as in the explicit
@@ -99,9 +101,26 @@ impl TwoLinkChain {
         let saddle =
             BandLdl::with_envelope(self.saddle_envelope(size, &at_band, &at_segment, [&c1, &c2]));
         let blocks = self.kick_blocks(&saddle, &band, &at_segment, &cf);
+        // G's entries in the envelope, found once
+        let (mut g_plus, mut g_minus): ([Vec<usize>; 2], [Vec<usize>; 2]) = Default::default();
+        let mut first = 0;
+        for (link, segs) in at_segment.iter().enumerate() {
+            let r = segs.len();
+            for seg in 0..r {
+                if seg < r - 1 {
+                    g_plus[link].push(saddle.position(segs[seg], at_band[first + seg]));
+                }
+                if seg >= 1 {
+                    g_minus[link].push(saddle.position(segs[seg], at_band[first + seg - 1]));
+                }
+            }
+            first += r - 1;
+        }
         self.implicit = Some(Box::new(ImplicitDamping {
-            constant: saddle.clone(),
+            assembled: saddle.clone(),
             constant_for: None,
+            g_plus,
+            g_minus,
             c0,
             c1,
             c2,
@@ -471,7 +490,7 @@ impl TwoLinkChain {
         let mut imp = self.implicit.take().expect("implicit damping");
         self.assemble_saddle(tau, &mut imp);
         imp.factored_for = None;
-        let saddle = imp.saddle.clone();
+        let saddle = imp.assembled.clone();
         self.implicit = Some(imp);
         saddle
     }
@@ -499,43 +518,37 @@ impl TwoLinkChain {
     /// `build_columns`; false when it does not factor.
     fn factor_saddle(&self, tau: f64, imp: &mut ImplicitDamping) -> bool {
         self.assemble_saddle(tau, imp);
-        imp.saddle.factor().is_ok()
+        imp.saddle.factor_from(&imp.assembled).is_ok()
     }
 
     /// The saddle system [[D_B + ½τC_BB, Gᵀ], [G, −N⁻¹]] interleaved by station into
-    /// `imp.saddle`.
+    /// `imp.assembled`.
     fn assemble_saddle(&self, tau: f64, imp: &mut ImplicitDamping) {
         if imp.constant_for != Some(tau) {
             self.assemble_constant(tau, imp);
             imp.constant_for = Some(tau);
         }
         let ImplicitDamping {
-            saddle,
-            constant,
-            at_band,
-            at_segment,
+            assembled,
+            g_plus,
+            g_minus,
             ..
         } = imp;
-        // every entry takes one term: the constant ones, then G's onto their zeros
-        saddle.assign(constant);
-        let mut first = 0;
-        for (link, segs) in at_segment.iter().enumerate() {
+        // every entry takes one term: the constant ones, and G's onto their zeros, which
+        // the last assembly's G took (the sum 0 + g that adding it to the zero formed)
+        for link in 0..2 {
             let g = self.factors.links[link].slopes();
-            let r = segs.len();
-            for seg in 0..r {
-                if seg < r - 1 {
-                    saddle.add(segs[seg], at_band[first + seg], g[seg]);
-                }
-                if seg >= 1 {
-                    saddle.add(segs[seg], at_band[first + seg - 1], -g[seg]);
-                }
+            for (&p, &g) in g_plus[link].iter().zip(g) {
+                assembled.set_at(p, 0.0 + g);
             }
-            first += r - 1;
+            for (&p, &g) in g_minus[link].iter().zip(&g[1..]) {
+                assembled.set_at(p, 0.0 - g);
+            }
         }
     }
 
     /// The saddle system's entries that do not follow the state, D_B + ½τC_BB and −N⁻¹, into
-    /// `imp.constant`.
+    /// `imp.assembled` (G's entries zero).
     fn assemble_constant(&self, tau: f64, imp: &mut ImplicitDamping) {
         let ht = 0.5 * tau;
         let nb = imp.band.len();
@@ -544,20 +557,20 @@ impl TwoLinkChain {
             c0,
             c1,
             c2,
-            constant,
+            assembled,
             at_band,
             at_segment,
             ..
         } = imp;
-        constant.clear();
+        assembled.clear();
         for b in 0..nb {
-            constant.add(at_band[b], at_band[b], self.diag_mass(band[b]) + ht * c0[b]);
+            assembled.add(at_band[b], at_band[b], self.diag_mass(band[b]) + ht * c0[b]);
             // a zero of C is no entry of the envelope (adding it changed nothing)
             if b + 1 < nb && c1[b] != 0.0 {
-                constant.add(at_band[b + 1], at_band[b], ht * c1[b]);
+                assembled.add(at_band[b + 1], at_band[b], ht * c1[b]);
             }
             if b + 2 < nb && c2[b] != 0.0 {
-                constant.add(at_band[b + 2], at_band[b], ht * c2[b]);
+                assembled.add(at_band[b + 2], at_band[b], ht * c2[b]);
             }
         }
         for (link, segs) in at_segment.iter().enumerate() {
@@ -568,9 +581,9 @@ impl TwoLinkChain {
                 if seg >= 1 {
                     nd += 1.0 / w[seg - 1];
                 }
-                constant.add(segs[seg], segs[seg], -nd);
+                assembled.add(segs[seg], segs[seg], -nd);
                 if seg + 1 < r {
-                    constant.add(segs[seg + 1], segs[seg], 1.0 / w[seg]);
+                    assembled.add(segs[seg + 1], segs[seg], 1.0 / w[seg]);
                 }
             }
         }
@@ -673,7 +686,7 @@ fn schur_rows_m<const M: usize>(
     }
 }
 
-/// Rows a and a + 1 of [`schur_rows_m`]'s sums, lane by lane: acc[k] −= (c_a, c_{a+1}) z_k
+/// Rows a and a + 1 of [`schur_rows_m`]'s sums, lane by lane: acc_k −= (c_a, c_{a+1}) z_k
 /// over the band rows (`at` their saddle rows). Out of line: inlined, the compiler left the
 /// products scalar.
 #[inline(never)]
