@@ -152,6 +152,7 @@ fn elem_chain_kinetic_lanes_give_each_single_products_bits() {
         &qk,
         &sc.shape,
         [&rates[0][..], &rates[1][..]],
+        [&slopes[0][..], &slopes[1][..]],
         &mut lanes,
         [&mut f0[..], &mut f1[..]],
     );

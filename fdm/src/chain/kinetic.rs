@@ -404,6 +404,24 @@ impl ChainInertia {
         self.momenta_at(q, qd, sc, out);
     }
 
+    /// The segment slopes of `qd`'s deflection rates into `out`, link 1's then link 2's (what
+    /// the `_lanes` products take): those of a link without foreshortening are not read, and
+    /// left as they are.
+    pub fn rate_slopes(&self, qd: &[f64], out: &mut [f64]) {
+        let (vd, wd) = (&qd[self.iv()], &qd[self.iw()]);
+        let (r1, r2) = (self.r1, self.r2);
+        if self.fs1 {
+            for k in 0..r1 {
+                out[k] = slope(vd, k, self.h1);
+            }
+        }
+        if self.fs2 {
+            for j in 0..r2 {
+                out[r1 + j] = slope(wd, j, self.h2);
+            }
+        }
+    }
+
     /// [`Self::momenta_values`] with the shape of q already in `sc` ([`Self::set_shape`]):
     /// [`Self::point_velocities`]' values from the shape's slopes.
     pub fn momenta_at(&self, q: &[f64], qd: &[f64], sc: &mut PointScratch, out: &mut [f64]) {
@@ -592,12 +610,14 @@ impl ChainInertia {
     }
 
     /// [`Self::inertia_forces_at`] at `C` velocities at once into `out` (its operations per
-    /// lane).
+    /// lane): `slopes[c]` holds [`Self::rate_slopes`] of `qds[c]` (the divisions
+    /// [`Self::inertia_forces_at`] takes, here supplied).
     pub fn inertia_forces_lanes<const C: usize>(
         &self,
         q: &[f64],
         shape: &Shape,
         qds: [&[f64]; C],
+        slopes: [&[f64]; C],
         lanes: &mut Lanes<C>,
         out: [&mut [f64]; C],
     ) {
@@ -605,6 +625,8 @@ impl ChainInertia {
         let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
         let vd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iv()]);
         let wd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iw()]);
+        let gd1: [&[f64]; C] = std::array::from_fn(|c| &slopes[c][..r1]);
+        let gd2: [&[f64]; C] = std::array::from_fn(|c| &slopes[c][r1..r1 + r2]);
         let thd: [f64; C] = std::array::from_fn(|c| qds[c][TH]);
         let bed: [f64; C] = std::array::from_fn(|c| qds[c][BE]);
         let np = r1 + 1 + r2;
@@ -618,7 +640,7 @@ impl ChainInertia {
             let m = self.m1[k];
             for c in 0..C {
                 if self.fs1 {
-                    let gd = slope(vd[c], k, h1);
+                    let gd = gd1[c][k];
                     let g = Dual::new(g1[k], gd);
                     s[c] = s[c] + g * g * (0.5 * h1);
                     sd[c] = sd[c] + g * (h1 * gd);
@@ -650,7 +672,7 @@ impl ChainInertia {
             let m = self.m2[j];
             for c in 0..C {
                 if self.fs2 {
-                    let gd = slope(wd[c], j, h2);
+                    let gd = gd2[c][j];
                     let g = Dual::new(g2[j], gd);
                     sg[c] = sg[c] + g * g * (0.5 * h2);
                     sgd[c] = sgd[c] + g * (h2 * gd);

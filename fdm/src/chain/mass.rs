@@ -17,7 +17,7 @@
 // Index loops over the columns of M read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::kinetic::{BE, TH, slope};
+use super::kinetic::{BE, TH};
 use super::model::TwoLinkChain;
 use super::rates::LinkRates;
 use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
@@ -122,14 +122,7 @@ impl TwoLinkChain {
                     unit[i] = -((k + 1) as f64) * h;
                 }
             }
-            let (v, w) = (&unit[ine.iv()], &unit[ine.iw()]);
-            let slopes = &mut self.unit_slopes[c];
-            for k in 0..ine.r1 {
-                slopes[k] = slope(v, k, ine.h1);
-            }
-            for j in 0..ine.r2 {
-                slopes[ine.r1 + j] = slope(w, j, ine.h2);
-            }
+            ine.rate_slopes(unit, &mut self.unit_slopes[c]);
         }
     }
 

@@ -98,6 +98,13 @@ pub struct TwoLinkChain {
     pub(super) vk2: Vec<f64>,
     pub(super) f2: Vec<f64>,
     pub(super) inertia_lanes: Lanes<2>,
+    /// the rate slopes of the inertia terms' pair
+    /// ([`super::kinetic::ChainInertia::rate_slopes`]): scratch, then those of the last pair's
+    /// current drift velocity in the kernel's coordinates, `drift_slopes_of` (once
+    /// `drift_slopes_valid`)
+    pub(super) drift_slopes: [Vec<f64>; 2],
+    pub(super) drift_slopes_of: Vec<f64>,
+    pub(super) drift_slopes_valid: bool,
     pub(super) rhs: Vec<f64>,
     /// what the velocity form's corrector pass may take from the first pass at the same level
     pub(super) split_reuse: SplitReuse,
