@@ -7,7 +7,7 @@ use data::{Backend, RunResult, Settings, StabilityVerdict, load_scene};
 use fdm::FdmBackend;
 use fdm::chain::TwoLinkChain;
 use fdm::chain::kinetic::ChainInertia;
-use fdm::chain::kinetic::{Lanes, PointScratch};
+use fdm::chain::kinetic::{Lanes, PointScratch, RateLanes};
 use fdm::system::System;
 
 mod common;
@@ -132,7 +132,7 @@ fn elem_chain_kinetic_lanes_give_each_single_products_bits() {
         &qk,
         &sc.shape,
         std::array::from_fn(|c| &rates[c][..]),
-        std::array::from_fn(|c| &slopes[c][..]),
+        &RateLanes::new(ine, std::array::from_fn(|c| &rates[c][..])),
         &mut lanes,
         [&mut m0[..], &mut m1[..], &mut m2[..], &mut m3[..]],
     );

@@ -6,7 +6,7 @@ use data::scene::{Link, PlanarChain};
 use data::{DofPlan, Scene};
 
 use super::kinetic::{BE, ChainInertia, TH};
-use super::kinetic::{Lanes, PointScratch};
+use super::kinetic::{Lanes, PointScratch, RateLanes};
 use super::model::{JointLaw, LinkProps, SplitReuse, TwoLinkChain};
 use super::rates::LinkRates;
 use super::rates::MassFactors;
@@ -281,7 +281,7 @@ impl TwoLinkChain {
             factors: mass_factors(&inertia, nd),
             cols: std::array::from_fn(|_| vec![0.0; nd]),
             units: std::array::from_fn(|_| vec![0.0; nd]),
-            unit_slopes: std::array::from_fn(|_| vec![0.0; r1 + r2]),
+            unit_lanes: RateLanes::default(),
             column_lanes: Lanes::new(&inertia),
             vk2: vec![0.0; nd],
             f2: vec![0.0; nd],

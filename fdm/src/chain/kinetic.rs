@@ -221,6 +221,35 @@ impl<const C: usize> Lanes<C> {
     }
 }
 
+/// The deflection rates of `C` velocities and their segment slopes
+/// ([`ChainInertia::rate_slopes`]) lane by lane, per station (link 1's, then link 2's): what
+/// [`ChainInertia::momenta_lanes`] reads per station, in one place (read from `C` vectors, the
+/// compiler kept each lane's products scalar).
+#[derive(Debug, Clone, Default)]
+pub struct RateLanes<const C: usize> {
+    pub rates: Vec<[f64; C]>,
+    pub slopes: Vec<[f64; C]>,
+}
+
+impl<const C: usize> RateLanes<C> {
+    pub fn new(ine: &ChainInertia, qds: [&[f64]; C]) -> Self {
+        let n = ine.r1 + ine.r2;
+        let mut lanes = RateLanes {
+            rates: vec![[0.0; C]; n],
+            slopes: vec![[0.0; C]; n],
+        };
+        let mut slopes = vec![0.0; n];
+        for c in 0..C {
+            ine.rate_slopes(qds[c], &mut slopes);
+            for (k, i) in ine.iv().chain(ine.iw()).enumerate() {
+                lanes.rates[k][c] = qds[c][i];
+                lanes.slopes[k][c] = slopes[k];
+            }
+        }
+        lanes
+    }
+}
+
 impl ChainInertia {
     /// Number of lumped points: link 1's stations, the elbow, link 2's stations.
     pub fn points(&self) -> usize {
@@ -543,23 +572,21 @@ impl ChainInertia {
     }
 
     /// [`Self::momenta_at`] of `C` velocities at once into `out` (its operations per lane):
-    /// `slopes[c]` holds the segment slopes of `qds[c]`'s deflection rates, link 1's then
-    /// link 2's (the divisions [`Self::point_velocities`] takes, here supplied).
+    /// `rates` holds their deflection rates and slopes (the divisions
+    /// [`Self::point_velocities`] takes, here supplied), `qds` the frame rates.
     pub fn momenta_lanes<const C: usize>(
         &self,
         q: &[f64],
         shape: &Shape,
         qds: [&[f64]; C],
-        slopes: [&[f64]; C],
+        rates: &RateLanes<C>,
         lanes: &mut Lanes<C>,
         out: [&mut [f64]; C],
     ) {
         let (v, w) = (&q[self.iv()], &q[self.iw()]);
         let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
-        let vd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iv()]);
-        let wd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iw()]);
-        let gd1: [&[f64]; C] = std::array::from_fn(|c| &slopes[c][..r1]);
-        let gd2: [&[f64]; C] = std::array::from_fn(|c| &slopes[c][r1..r1 + r2]);
+        let (vd, wd) = rates.rates[..r1 + r2].split_at(r1);
+        let (gd1, gd2) = rates.slopes[..r1 + r2].split_at(r1);
         let thd: [f64; C] = std::array::from_fn(|c| qds[c][TH]);
         let bed: [f64; C] = std::array::from_fn(|c| qds[c][BE]);
         let np = r1 + 1 + r2;
@@ -570,12 +597,14 @@ impl ChainInertia {
         let (mut ex, mut ey) = ([0.0; C], [0.0; C]);
         for k in 0..r1 {
             let m = self.m1[k];
-            for c in 0..C {
-                if self.fs1 {
-                    sd[c] += g1[k] * (h1 * gd1[c][k]);
+            if self.fs1 {
+                for c in 0..C {
+                    sd[c] += g1[k] * (h1 * gd1[k][c]);
                 }
+            }
+            for c in 0..C {
                 ex[c] = -(v[k] * thd[c]) - sd[c];
-                ey[c] = a1[k] * thd[c] + vd[c][k];
+                ey[c] = a1[k] * thd[c] + vd[k][c];
                 fx[k][c] = m * ex[c];
                 fy[k][c] = m * ey[c];
             }
@@ -592,12 +621,14 @@ impl ChainInertia {
         let mut sgd = [0.0; C];
         for j in 0..r2 {
             let m = self.m2[j];
-            for c in 0..C {
-                if self.fs2 {
-                    sgd[c] += g2[j] * (h2 * gd2[c][j]);
+            if self.fs2 {
+                for c in 0..C {
+                    sgd[c] += g2[j] * (h2 * gd2[j][c]);
                 }
+            }
+            for c in 0..C {
                 let x = xe[c] - w[j] * bed[c] - sgd[c];
-                let y = ye[c] + a2[j] * bed[c] + wd[c][j];
+                let y = ye[c] + a2[j] * bed[c] + wd[j][c];
                 fx[r1 + 1 + j][c] = m * x;
                 fy[r1 + 1 + j][c] = m * y;
             }

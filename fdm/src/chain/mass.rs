@@ -17,7 +17,7 @@
 // Index loops over the columns of M read like the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::kinetic::{BE, TH};
+use super::kinetic::{BE, RateLanes, TH};
 use super::model::TwoLinkChain;
 use super::rates::LinkRates;
 use super::schur::{MAX_FULL, MAX_SMALL, SmallLu};
@@ -67,12 +67,11 @@ impl TwoLinkChain {
                 col[nd..n].iter_mut().for_each(|x| *x = 0.0);
             }
             let units = self.units.each_ref().map(|u| &u[..]);
-            let slopes = self.unit_slopes.each_ref().map(|u| &u[..]);
             self.inertia.momenta_lanes(
                 &self.qk,
                 &self.points.shape,
                 units,
-                slopes,
+                &self.unit_lanes,
                 &mut self.column_lanes,
                 lanes.each_mut().map(|c| &mut c[..]),
             );
@@ -111,7 +110,6 @@ impl TwoLinkChain {
     /// The kernel's rates at unit rate of the state-dependent full columns (the frame angle,
     /// and for ψ_ℓ also the tangent frame's deflections −ξ_k, tip −L) and their slopes.
     pub(super) fn set_unit_rates(&mut self) {
-        let ine = &self.inertia;
         for c in 0..4 {
             let link = c % 2;
             let (first, slot, h) = (self.first(link), self.slots[link], self.hs[link]);
@@ -122,8 +120,8 @@ impl TwoLinkChain {
                     unit[i] = -((k + 1) as f64) * h;
                 }
             }
-            ine.rate_slopes(unit, &mut self.unit_slopes[c]);
         }
+        self.unit_lanes = RateLanes::new(&self.inertia, self.units.each_ref().map(|u| &u[..]));
     }
 
     /// A_ℓ and U at `qk` (Z follows with the first solve).

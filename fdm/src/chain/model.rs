@@ -10,7 +10,7 @@ use crate::system::law_torque;
 
 use super::damping_matrix::ImplicitDamping;
 use super::kinetic::{BE, ChainInertia, TH};
-use super::kinetic::{Lanes, PointScratch};
+use super::kinetic::{Lanes, PointScratch, RateLanes};
 use super::rates::MassFactors;
 use super::schur::MAX_FULL;
 use super::surface::{TipConstraint, TipContact};
@@ -88,9 +88,9 @@ pub struct TwoLinkChain {
     /// the full columns of M: θ, β, x₁, x₂ and (Euler) the tip ghost y
     pub(super) cols: [Vec<f64>; MAX_FULL],
     /// the kernel's rates at unit rate of each state-dependent full column, and their
-    /// deflection rates' segment slopes (link 1's, then link 2's)
+    /// deflection rates with their segment slopes lane by lane
     pub(super) units: [Vec<f64>; 4],
-    pub(super) unit_slopes: [Vec<f64>; 4],
+    pub(super) unit_lanes: RateLanes<4>,
     /// the per-point scratch of the columns' products, one lane each
     pub(super) column_lanes: Lanes<4>,
     /// the inertia terms at two drift velocities together: the second velocity in the
