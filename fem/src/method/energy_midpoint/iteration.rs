@@ -50,6 +50,8 @@ pub(super) struct Iteration {
     pub(super) polish_tol: f64,
     pub(super) last_defect: f64,
     pub(super) iterations: usize,
+    /// The largest contraction θ measured in this solve (0 when none was).
+    pub(super) max_theta: f64,
 }
 
 impl Iteration {
@@ -64,6 +66,7 @@ impl Iteration {
             polish_tol: 0.0,
             last_defect: f64::INFINITY,
             iterations: 0,
+            max_theta: 0.0,
         }
     }
 
@@ -120,6 +123,7 @@ impl Iteration {
         } else {
             0.0
         };
+        self.max_theta = self.max_theta.max(theta);
         let settled = if theta <= 0.5 {
             dq <= tol
         } else {

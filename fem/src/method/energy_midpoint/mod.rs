@@ -44,6 +44,23 @@
 //! iterations that only reduce the energy defect keep it, as it still contracts. Runs without
 //! contact accelerate the iteration (Anderson, depth 3, history restarted with every step
 //! and new matrix; `Anderson`).
+//! The predictor (the first iterate of a step, `MidpointWork::predict`) without a unilateral
+//! contact, once the last three steps were accepted since the last (re)start (every event and
+//! law discontinuity restarts), each with a regular contraction (θ ≤ ½ at every iteration, at
+//! most 8 iterations), and no solve from the step's start has failed:
+//!
+//!   ā_{k+1} = ā_{k−1} + (ā_k − ā_{k−2})·(h_{k+1} + 2h_k + h_{k−1})/(h_k + 2h_{k−1} + h_{k−2}),
+//!
+//! the mean accelerations taken at their step midpoints. It is exact for a mean acceleration
+//! linear in time plus a component that flips sign every step: the midpoint rule maps the
+//! unresolved stiff modes (ωh ≫ 1, undamped or Kelvin–Voigt) to the amplification −1, and
+//! these sawtooth components dominate the step-to-step change of ā on the arms. Constant
+//! extrapolation leaves twice their amplitude in the first iterate, linear extrapolation from
+//! the last two steps four times. Where the contraction is slow (stiff shear under a reused
+//! matrix), a first iterate that close gives a first update within tolerance before θ is
+//! measured, and the iteration would stop short: those stretches keep the previous step's ā.
+//! Otherwise the previous step's ā, zero after a (re)start.
+//! `Predictor::Previous` keeps the previous step's ā throughout (a reference for tests).
 //! Without contact and with a unilateral contact, a step reuses the factorized matrix of an
 //! earlier step (the same step size, with a contact up to `CLOSE_STEP`; formed by this scheme)
 //! for up to `MAX_MATRIX_AGE` steps, while the last step needed at most one
@@ -80,7 +97,9 @@
 //! * the iterate is accepted once the update is within tolerance and the next one is larger
 //!   (round-off noise while the energy defect is being reduced; a new matrix there only added
 //!   noise, and its larger update was taken for divergence);
-//! * the predictor is the previous mean acceleration only if that step was not 10× shorter
+//! * the predictor is the previous mean acceleration, not the extrapolation above (here it
+//!   saves iterations but not run time, which event location, contact forces and matrices
+//!   take, and it reorders micro-bounces), and only if that step was not 10× shorter
 //!   (a located event just before: its mean acceleration is close to the point value, which is
 //!   huge right after an impact);
 //! * constrained steps shortened to locate an event rely on the refresh above instead of a new
@@ -100,7 +119,7 @@ mod iteration;
 mod work;
 
 pub use gradients::{FD_STEP, kinetic_gradient, kinetic_gradient_fd, mass_product};
-pub use work::MidpointWork;
+pub use work::{MidpointWork, Predictor};
 
 use crate::method::{
     Capabilities, MethodParams, StepConstraint, StepContext, Stepper, Trial, Works, unconverged,
@@ -215,6 +234,7 @@ impl<S: System + ?Sized> Stepper<S> for EnergyMidpoint {
         // See the module docs: the linear contraction makes > 3 iterations normal here.
         cx.newton.slow_convergence = !iter.converged || iter.iterations > 8;
         if !iter.converged {
+            w.failed = true;
             let st = &*cx.state;
             // Its energy-defect test can stall at a round-off floor that a shorter step raises
             // (massless sections without Kelvin–Voigt: docs/limits.md).
@@ -227,6 +247,7 @@ impl<S: System + ?Sized> Stepper<S> for EnergyMidpoint {
                 "; if shorter steps fail too, use --method implicit-midpoint or generalized-alpha",
             );
         }
+        w.regular_solve = iter.max_theta <= 0.5 && iter.iterations <= 8;
         w.accept(cx, &setup, robust, t_law);
         Ok(Trial::Converged {
             error: cx.adaptive.map(|ad| w.error_estimate(cx.state, h, ad)),
