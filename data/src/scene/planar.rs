@@ -132,37 +132,23 @@ pub enum TorqueLaw {
 impl TorqueLaw {
     /// Torque at time t.
     pub fn torque(&self, t: f64) -> f64 {
-        match *self {
-            TorqueLaw::Constant { value, until } => {
-                if until.is_none_or(|u| t < u) {
-                    value
-                } else {
-                    0.0
-                }
-            }
-            TorqueLaw::BangBang {
-                amplitude,
-                switch,
-                off,
-            } => {
-                if t < switch {
-                    amplitude
-                } else if t < off {
-                    -amplitude
-                } else {
-                    0.0
-                }
-            }
-        }
+        self.stretch_value(t, false)
     }
 
     /// Torque just before time t, the left limit lim_{s↑t} τ(s): equal to [`Self::torque`]
     /// except at a breakpoint, where it is the value of the stretch that ends there. A step
     /// that ends on a jump integrates that stretch and reads its end with this.
     pub fn torque_before(&self, t: f64) -> f64 {
+        self.stretch_value(t, true)
+    }
+
+    /// The value on the stretch that holds t: the one that starts at t when t is a breakpoint
+    /// (right-continuous), or with `left` the one that ends there.
+    fn stretch_value(&self, t: f64, left: bool) -> f64 {
+        let before = |b: f64| if left { t <= b } else { t < b };
         match *self {
             TorqueLaw::Constant { value, until } => {
-                if until.is_none_or(|u| t <= u) {
+                if until.is_none_or(before) {
                     value
                 } else {
                     0.0
@@ -173,9 +159,9 @@ impl TorqueLaw {
                 switch,
                 off,
             } => {
-                if t <= switch {
+                if before(switch) {
                     amplitude
-                } else if t <= off {
+                } else if before(off) {
                     -amplitude
                 } else {
                     0.0
