@@ -669,14 +669,19 @@ fn schur_rows_m<const M: usize>(
     let mut a = 0;
     while a + 1 < M - 1 {
         let mut pair: [[f64; 2]; M] = std::array::from_fn(|k| [acc[a][k], acc[a + 1][k]]);
-        schur_pair(&mut pair, a, rhs, sol, at, r0);
+        schur_pair(&mut pair, [a, a + 1], rhs, sol, at, r0);
         for k in 0..M {
             [acc[a][k], acc[a + 1][k]] = pair[k];
         }
         a += 2;
     }
     if a < M - 1 {
-        schur_single(&mut acc[a], a, rhs, sol, at, r0);
+        // the last row alone: the pair's second lane repeats it and is dropped
+        let mut pair: [[f64; 2]; M] = std::array::from_fn(|k| [acc[a][k], acc[a][k]]);
+        schur_pair(&mut pair, [a, a], rhs, sol, at, r0);
+        for k in 0..M {
+            acc[a][k] = pair[k][0];
+        }
     }
     for (a, &r) in cols.iter().enumerate() {
         for (k, &c) in cols.iter().enumerate() {
@@ -686,13 +691,13 @@ fn schur_rows_m<const M: usize>(
     }
 }
 
-/// Rows a and a + 1 of [`schur_rows_m`]'s sums, lane by lane: acc_k −= (c_a, c_{a+1}) z_k
+/// Rows `rows` of [`schur_rows_m`]'s sums, lane by lane: acc_k −= (c_{rows₀}, c_{rows₁}) z_k
 /// over the band rows (`at` their saddle rows). Out of line: inlined, the compiler left the
 /// products scalar.
 #[inline(never)]
 fn schur_pair<const M: usize>(
     acc: &mut [[f64; 2]; M],
-    a: usize,
+    rows: [usize; 2],
     rhs: &[[f64; M]],
     sol: &[[f64; M]],
     at: &[usize],
@@ -701,30 +706,10 @@ fn schur_pair<const M: usize>(
     let mut sums = *acc;
     for (c, &p) in rhs.iter().zip(at) {
         let z = &sol[p - r0];
-        let ca = [c[a], c[a + 1]];
+        let ca = [c[rows[0]], c[rows[1]]];
         for k in 0..M {
             sums[k][0] -= ca[0] * z[k];
             sums[k][1] -= ca[1] * z[k];
-        }
-    }
-    *acc = sums;
-}
-
-/// Row a of [`schur_rows_m`]'s sums alone (an odd number of rows): acc −= c_a z.
-#[inline(never)]
-fn schur_single<const M: usize>(
-    acc: &mut [f64; M],
-    a: usize,
-    rhs: &[[f64; M]],
-    sol: &[[f64; M]],
-    at: &[usize],
-    r0: usize,
-) {
-    let mut sums = *acc;
-    for (c, &p) in rhs.iter().zip(at) {
-        let z = &sol[p - r0];
-        for k in 0..M {
-            sums[k] -= c[a] * z[k];
         }
     }
     *acc = sums;
