@@ -144,6 +144,12 @@ fn elem_chain_kinetic_lanes_give_each_single_products_bits() {
         ine.inertia_forces_at(&qk, &rates[c], &mut sc, &mut single[c]);
     }
     let mut lanes = Lanes::<2>::new(ine);
+    let mut drift = RateLanes::<2>::zeroed(ine.r1 + ine.r2);
+    drift.set(
+        ine,
+        [&rates[0][..], &rates[1][..]],
+        [&slopes[0][..], &slopes[1][..]],
+    );
     let mut many = vec![vec![0.0; n]; 2];
     let [f0, f1] = &mut many[..] else {
         unreachable!()
@@ -152,7 +158,7 @@ fn elem_chain_kinetic_lanes_give_each_single_products_bits() {
         &qk,
         &sc.shape,
         [&rates[0][..], &rates[1][..]],
-        [&slopes[0][..], &slopes[1][..]],
+        &drift,
         &mut lanes,
         [&mut f0[..], &mut f1[..]],
     );

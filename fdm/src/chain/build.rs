@@ -286,6 +286,7 @@ impl TwoLinkChain {
             vk2: vec![0.0; nd],
             f2: vec![0.0; nd],
             inertia_lanes: Lanes::new(&inertia),
+            drift_lanes: RateLanes::zeroed(r1 + r2),
             drift_slopes: std::array::from_fn(|_| vec![0.0; r1 + r2]),
             drift_slopes_of: vec![0.0; nd],
             drift_slopes_valid: false,

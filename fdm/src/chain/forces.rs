@@ -217,11 +217,13 @@ impl TwoLinkChain {
         if !same {
             self.inertia.rate_slopes(&vk2, &mut kept);
         }
+        self.drift_lanes
+            .set(&self.inertia, [&self.vk, &vk2], [&fresh, &kept]);
         self.inertia.inertia_forces_lanes(
             &self.qk,
             &self.points.shape,
             [&self.vk, &vk2],
-            [&fresh, &kept],
+            &self.drift_lanes,
             &mut self.inertia_lanes,
             [&mut scratch[..], &mut f2[..]],
         );

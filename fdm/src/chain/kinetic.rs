@@ -248,6 +248,26 @@ impl<const C: usize> RateLanes<C> {
         }
         lanes
     }
+
+    /// Station-by-station lanes of `n` stations, all zero (to be [`Self::set`]).
+    pub fn zeroed(n: usize) -> Self {
+        RateLanes {
+            rates: vec![[0.0; C]; n],
+            slopes: vec![[0.0; C]; n],
+        }
+    }
+
+    /// Interleaves the deflection rates of `qds` and their segment slopes `slopes` (as
+    /// [`ChainInertia::rate_slopes`] gives them) into these lanes, which hold
+    /// `ine.r1 + ine.r2` stations.
+    pub fn set(&mut self, ine: &ChainInertia, qds: [&[f64]; C], slopes: [&[f64]; C]) {
+        let n = ine.r1 + ine.r2;
+        let (rates, slo) = (&mut self.rates[..n], &mut self.slopes[..n]);
+        for (k, i) in ine.iv().chain(ine.iw()).enumerate() {
+            rates[k] = std::array::from_fn(|c| qds[c][i]);
+            slo[k] = std::array::from_fn(|c| slopes[c][k]);
+        }
+    }
 }
 
 impl ChainInertia {
@@ -641,79 +661,82 @@ impl ChainInertia {
     }
 
     /// [`Self::inertia_forces_at`] at `C` velocities at once into `out` (its operations per
-    /// lane): `slopes[c]` holds [`Self::rate_slopes`] of `qds[c]` (the divisions
-    /// [`Self::inertia_forces_at`] takes, here supplied).
+    /// lane): `rates` holds their deflection rates and [`Self::rate_slopes`] lane by lane (the
+    /// divisions [`Self::inertia_forces_at`] takes, here supplied), `qds` the frame rates.
     pub fn inertia_forces_lanes<const C: usize>(
         &self,
         q: &[f64],
         shape: &Shape,
         qds: [&[f64]; C],
-        slopes: [&[f64]; C],
+        rates: &RateLanes<C>,
         lanes: &mut Lanes<C>,
         out: [&mut [f64]; C],
     ) {
         let (v, w) = (&q[self.iv()], &q[self.iw()]);
         let (r1, r2, h1, h2) = (self.r1, self.r2, self.h1, self.h2);
-        let vd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iv()]);
-        let wd: [&[f64]; C] = std::array::from_fn(|c| &qds[c][self.iw()]);
-        let gd1: [&[f64]; C] = std::array::from_fn(|c| &slopes[c][..r1]);
-        let gd2: [&[f64]; C] = std::array::from_fn(|c| &slopes[c][r1..r1 + r2]);
+        let (vd, wd) = rates.rates[..r1 + r2].split_at(r1);
+        let (gd1, gd2) = rates.slopes[..r1 + r2].split_at(r1);
         let thd: [f64; C] = std::array::from_fn(|c| qds[c][TH]);
         let bed: [f64; C] = std::array::from_fn(|c| qds[c][BE]);
         let np = r1 + 1 + r2;
         let (fx, fy) = (&mut lanes.fx[..np], &mut lanes.fy[..np]);
         let (g1, a1) = (&shape.g1[..r1], &shape.a1[..r1]);
         let (g2, a2) = (&shape.g2[..r2], &shape.a2[..r2]);
-        let zero = Dual::default();
-        let (mut s, mut sd) = ([zero; C], [zero; C]);
-        let (mut ex, mut ey) = ([zero; C], [zero; C]);
+        // the dual numbers' parts lane by lane (re, du): s's real part is never read
+        let (mut s_du, mut sd_re, mut sd_du) = ([0.0; C], [0.0; C], [0.0; C]);
+        let (mut ex_re, mut ex_du, mut ey_re, mut ey_du) = ([0.0; C], [0.0; C], [0.0; C], [0.0; C]);
         for k in 0..r1 {
             let m = self.m1[k];
-            for c in 0..C {
-                if self.fs1 {
-                    let gd = gd1[c][k];
-                    let g = Dual::new(g1[k], gd);
-                    s[c] = s[c] + g * g * (0.5 * h1);
-                    sd[c] = sd[c] + g * (h1 * gd);
+            if self.fs1 {
+                for c in 0..C {
+                    let gd = gd1[k][c];
+                    s_du[c] += (g1[k] * gd + gd * g1[k]) * (0.5 * h1);
+                    sd_re[c] += g1[k] * (h1 * gd);
+                    sd_du[c] += gd * (h1 * gd);
                 }
-                let vk = Dual::new(v[k], vd[c][k]);
-                let x = -(vk * thd[c]) - sd[c];
-                let y = Dual::new(a1[k], 0.0 - s[c].du) * thd[c] + vd[c][k];
-                fx[k][c] = -m * (x.du - thd[c] * y.re);
-                fy[k][c] = -m * (y.du + thd[c] * x.re);
-                (ex[c], ey[c]) = (x, y);
             }
+            let vdk = vd[k];
+            ex_re = std::array::from_fn(|c| -(v[k] * thd[c]) - sd_re[c]);
+            ex_du = std::array::from_fn(|c| -(vdk[c] * thd[c]) - sd_du[c]);
+            ey_re = std::array::from_fn(|c| a1[k] * thd[c] + vdk[c]);
+            ey_du = std::array::from_fn(|c| (0.0 - s_du[c]) * thd[c]);
+            fx[k] = std::array::from_fn(|c| -m * (ex_du[c] - thd[c] * ey_re[c]));
+            fy[k] = std::array::from_fn(|c| -m * (ey_du[c] + thd[c] * ex_re[c]));
         }
+        let ex: [Dual; C] = std::array::from_fn(|c| Dual::new(ex_re[c], ex_du[c]));
+        let ey: [Dual; C] = std::array::from_fn(|c| Dual::new(ey_re[c], ey_du[c]));
         let m = self.elbow_mass;
         for c in 0..C {
             let (x, y) = (ex[c], ey[c]);
             fx[r1][c] = -m * (x.du - thd[c] * y.re);
             fy[r1][c] = -m * (y.du + thd[c] * x.re);
         }
-        let mut xe = [zero; C];
-        let mut ye = [zero; C];
+        let (mut xe_re, mut xe_du, mut ye_re, mut ye_du) = ([0.0; C], [0.0; C], [0.0; C], [0.0; C]);
         for c in 0..C {
             let phi = Dual::new(q[BE] - q[TH], qds[c][BE] - qds[c][TH]);
             let (sn, cs) = (phi.sin(), phi.cos());
-            xe[c] = cs * ex[c] + sn * ey[c];
-            ye[c] = cs * ey[c] - sn * ex[c];
+            let xe = cs * ex[c] + sn * ey[c];
+            let ye = cs * ey[c] - sn * ex[c];
+            (xe_re[c], xe_du[c], ye_re[c], ye_du[c]) = (xe.re, xe.du, ye.re, ye.du);
         }
-        let (mut sg, mut sgd) = ([zero; C], [zero; C]);
+        let (mut sg_du, mut sgd_re, mut sgd_du) = ([0.0; C], [0.0; C], [0.0; C]);
         for j in 0..r2 {
             let m = self.m2[j];
-            for c in 0..C {
-                if self.fs2 {
-                    let gd = gd2[c][j];
-                    let g = Dual::new(g2[j], gd);
-                    sg[c] = sg[c] + g * g * (0.5 * h2);
-                    sgd[c] = sgd[c] + g * (h2 * gd);
+            if self.fs2 {
+                for c in 0..C {
+                    let gd = gd2[j][c];
+                    sg_du[c] += (g2[j] * gd + gd * g2[j]) * (0.5 * h2);
+                    sgd_re[c] += g2[j] * (h2 * gd);
+                    sgd_du[c] += gd * (h2 * gd);
                 }
-                let wj = Dual::new(w[j], wd[c][j]);
-                let x = xe[c] - wj * bed[c] - sgd[c];
-                let y = ye[c] + Dual::new(a2[j], 0.0 - sg[c].du) * bed[c] + wd[c][j];
-                fx[r1 + 1 + j][c] = -m * (x.du - bed[c] * y.re);
-                fy[r1 + 1 + j][c] = -m * (y.du + bed[c] * x.re);
             }
+            let wdj = wd[j];
+            let x_re: [f64; C] = std::array::from_fn(|c| xe_re[c] - w[j] * bed[c] - sgd_re[c]);
+            let x_du: [f64; C] = std::array::from_fn(|c| xe_du[c] - wdj[c] * bed[c] - sgd_du[c]);
+            let y_re: [f64; C] = std::array::from_fn(|c| ye_re[c] + a2[j] * bed[c] + wdj[c]);
+            let y_du: [f64; C] = std::array::from_fn(|c| ye_du[c] + (0.0 - sg_du[c]) * bed[c]);
+            fx[r1 + 1 + j] = std::array::from_fn(|c| -m * (x_du[c] - bed[c] * y_re[c]));
+            fy[r1 + 1 + j] = std::array::from_fn(|c| -m * (y_du[c] + bed[c] * x_re[c]));
         }
         let mut out = out;
         self.apply_transpose_lanes(q, shape, lanes, &mut out);

@@ -98,6 +98,8 @@ pub struct TwoLinkChain {
     pub(super) vk2: Vec<f64>,
     pub(super) f2: Vec<f64>,
     pub(super) inertia_lanes: Lanes<2>,
+    /// [`Self::add_inertia_terms_pair`]'s two velocities' rates and slopes, lane by lane.
+    pub(super) drift_lanes: RateLanes<2>,
     /// the rate slopes of the inertia terms' pair
     /// ([`super::kinetic::ChainInertia::rate_slopes`]): scratch, then those of the last pair's
     /// current drift velocity in the kernel's coordinates, `drift_slopes_of` (once
