@@ -7,6 +7,10 @@
 //! is also evaluated at t + τ and the smaller kept (the report evaluates σ with the masses of
 //! the new level, m_{i,j+1}; right for bounds that only shrink, like a burning stage).
 //!
+//! **Jumps.** A method whose kicks split at a level lands on the applied laws' jumps (torque
+//! switches): the step that would pass one ends on it, closed at the laws' left limits, and the
+//! next opens at their new values (`jumps` module).
+//!
 //! **Watch.** Between the method's prediction and its force evaluation the driver checks the
 //! new level: non-finite values, |Δ²v| over the monitored (elastic) coordinates against the
 //! peak |v| (the computational mode of a two-step method grows as a sign-alternating
@@ -189,6 +193,7 @@ pub fn run<S: Model, E: Events<S>>(
         sys.close_stretch_at(landing);
         method.predict(rs.tau, tau_step, &mut rs.st);
         if let Some(diagnostic) = rs.watch(sys, method, &watch, tau_step, limit_next) {
+            sys.close_stretch_at(None);
             verdict = StabilityVerdict::Stopped { diagnostic };
             break;
         }
