@@ -688,12 +688,7 @@ impl ChainInertia {
         for k in 0..r1 {
             let m = self.m1[k];
             if self.fs1 {
-                for c in 0..C {
-                    let gd = gd1[k][c];
-                    s_du[c] += (g1[k] * gd + gd * g1[k]) * (0.5 * h1);
-                    sd_re[c] += g1[k] * (h1 * gd);
-                    sd_du[c] += gd * (h1 * gd);
-                }
+                foreshortening_lanes(g1[k], gd1[k], h1, &mut s_du, &mut sd_re, &mut sd_du);
             }
             let vdk = vd[k];
             ex_re = std::array::from_fn(|c| -(v[k] * thd[c]) - sd_re[c]);
@@ -723,12 +718,7 @@ impl ChainInertia {
         for j in 0..r2 {
             let m = self.m2[j];
             if self.fs2 {
-                for c in 0..C {
-                    let gd = gd2[j][c];
-                    sg_du[c] += (g2[j] * gd + gd * g2[j]) * (0.5 * h2);
-                    sgd_re[c] += g2[j] * (h2 * gd);
-                    sgd_du[c] += gd * (h2 * gd);
-                }
+                foreshortening_lanes(g2[j], gd2[j], h2, &mut sg_du, &mut sgd_re, &mut sgd_du);
             }
             let wdj = wd[j];
             let x_re: [f64; C] = std::array::from_fn(|c| xe_re[c] - w[j] * bed[c] - sgd_re[c]);
@@ -830,5 +820,24 @@ impl ChainInertia {
             out[c][TH] = qt[c];
             out[c][BE] = qb[c];
         }
+    }
+}
+
+/// One segment's terms of the foreshortening sums lane by lane, slope g and slope rates gd
+/// over a segment of length h: the rate part of s = ½h Σ g², and the value and rate parts of
+/// ṡ = h Σ g ġ ([`ChainInertia::inertia_forces_lanes`]).
+#[inline(always)]
+fn foreshortening_lanes<const C: usize>(
+    g: f64,
+    gd: [f64; C],
+    h: f64,
+    s_du: &mut [f64; C],
+    sd_re: &mut [f64; C],
+    sd_du: &mut [f64; C],
+) {
+    for c in 0..C {
+        s_du[c] += (g * gd[c] + gd[c] * g) * (0.5 * h);
+        sd_re[c] += g * (h * gd[c]);
+        sd_du[c] += gd[c] * (h * gd[c]);
     }
 }

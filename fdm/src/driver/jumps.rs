@@ -79,7 +79,6 @@ impl Jumps {
         jump: f64,
         st: &mut StepState,
     ) -> usize {
-        self.next += 1;
         sys.close_stretch_at(Some(jump));
         sys.accel(jump, &st.cur.q, &st.cur.v, &mut self.left);
         sys.powers(&mut self.powers_left);
