@@ -39,6 +39,8 @@
 //! * time: the two-step central difference 5.21/5.24–5.30 with (τ_j + τ_{j+1}) and steps from
 //!   σ² ≤ h² m/EA, σ² ≤ h⁴ m/(4EI) per segment (5.43–5.45), recomputed every step with the
 //!   masses of the new level as stage 1 burns ([`driver`]; the start-up in [`method::two_step`]).
+//!   Burn-out, where thrust, pressure and flow stop, is a jump of the loads: a level lands on
+//!   it and the scheme starts again there ([`method::AtJumps`]).
 //!
 //! **Stability finding.** The report's σ equals 2/ω_max of the discrete operator — the limit of
 //! the *one-step* second-order form. The two-step form 5.21 has roots ξ = iωτ ± √(1 − ω²τ²) and

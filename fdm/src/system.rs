@@ -126,8 +126,8 @@ pub trait System {
     /// Whether any force depends on the velocities through damping or a velocity-coupled
     /// (gyroscopic) term: the two-step scheme's computational mode can then grow.
     fn damped(&self) -> bool;
-    /// Times t > 0 where an applied law jumps (torque switches): the driver steps onto them
-    /// when its method splits its kicks there ([`crate::method::Capabilities::steps_onto_jumps`]).
+    /// Times t > 0 where an applied law jumps (torque switches, burn-out): the driver steps onto
+    /// them ([`crate::method::AtJumps`]).
     /// Default: none.
     fn jumps(&self) -> Vec<f64> {
         Vec::new()

@@ -1,5 +1,5 @@
-//! Steps onto the jumps of the applied laws (torque switches, [`System::jumps`]) for methods
-//! whose kicks split at a level ([`crate::method::Capabilities::steps_onto_jumps`]).
+//! Steps onto the jumps of the applied laws (torque switches, burn-out: [`System::jumps`]);
+//! how the method carries on from there is its [`crate::method::AtJumps`].
 //!
 //! A law that jumps inside a step is read at the step's levels only, so the step takes the
 //! jump's impulse wrong by (t_jump − t_mid)·Δτ: an error first order in the step, which on
@@ -10,6 +10,8 @@
 //! opening kick their new values: the level's acceleration and the ledger's powers there gain
 //! the jump's response a(jump⁺) − a(jump⁻) and P(jump⁺) − P(jump⁻), each pair evaluated at the
 //! landed state, so that everything but the law cancels. Two more force evaluations per jump.
+//! A two-step method then starts again from the landed level
+//! ([`crate::method::AtJumps::Restarts`]: the level's acceleration is the law's new value).
 
 use crate::events::Events;
 use crate::method::StepState;
@@ -27,13 +29,9 @@ pub(super) struct Jumps {
 }
 
 impl Jumps {
-    /// The system's jumps in (0, t_end) when `on` (none otherwise: nothing is allocated).
-    pub(super) fn new<S: System + Outputs + ?Sized>(sys: &S, t_end: f64, on: bool) -> Self {
-        let times: Vec<f64> = if on {
-            sys.jumps().into_iter().filter(|&t| t < t_end).collect()
-        } else {
-            Vec::new()
-        };
+    /// The system's jumps in (0, t_end) (none: nothing is allocated).
+    pub(super) fn new<S: System + Outputs + ?Sized>(sys: &S, t_end: f64) -> Self {
+        let times: Vec<f64> = sys.jumps().into_iter().filter(|&t| t < t_end).collect();
         let (n, np) = if times.is_empty() {
             (0, 0)
         } else {

@@ -7,9 +7,10 @@
 //! is also evaluated at t + τ and the smaller kept (the report evaluates σ with the masses of
 //! the new level, m_{i,j+1}; right for bounds that only shrink, like a burning stage).
 //!
-//! **Jumps.** A method whose kicks split at a level lands on the applied laws' jumps (torque
-//! switches): the step that would pass one ends on it, closed at the laws' left limits, and the
-//! next opens at their new values (`jumps` module).
+//! **Jumps.** Every method lands on the applied laws' jumps (torque switches, burn-out): the
+//! step that would pass one ends on it, closed at the laws' left limits; a one-step method's
+//! next step opens at their new values, a two-step method starts again there (`jumps` module,
+//! [`crate::method::AtJumps`]).
 //!
 //! **Watch.** Between the method's prediction and its force evaluation the driver checks the
 //! new level: non-finite values, |Δ²v| over the monitored (elastic) coordinates against the
@@ -34,7 +35,7 @@ use data::{Cost, Diagnostic, Event, StabilityVerdict};
 
 use crate::error::FdmError;
 use crate::events::{Events, NoEvents, Retake, finish_step};
-use crate::method::{StepState, Stepper, capabilities, stepper};
+use crate::method::{AtJumps, StepState, Stepper, capabilities, stepper};
 use crate::output::{Outcome, Outputs, Recorder};
 use crate::settings::{Method, ValidatedSettings};
 use crate::system::{Bound, System};
@@ -180,8 +181,9 @@ pub fn run<S: Model, E: Events<S>>(
         computational_mode: sys.damped() && method.has_computational_mode(),
     };
     let mut verdict = StabilityVerdict::Completed;
-    rs.start_up(sys, method, limit, &mut rec);
-    let mut jumps = Jumps::new(&*sys, ctl.t_end, capabilities(ctl.method).steps_onto_jumps);
+    rs.start_up(sys, method, rs.tau, limit, &mut rec);
+    let at_jumps = capabilities(ctl.method).at_jumps;
+    let mut jumps = Jumps::new(&*sys, ctl.t_end);
 
     while !rec.done() {
         let (tau_next, limit_next) = rs.next_step(sys, ctl, factor)?;
@@ -207,7 +209,19 @@ pub fn run<S: Model, E: Events<S>>(
                 break;
             }
             (Ok(true), Some(jump)) => {
-                rs.cost.rhs_evaluations += jumps.open(sys, events, jump, &mut rs.st);
+                let mut landed = Some(jump);
+                while let Some(jump) = landed {
+                    rs.cost.rhs_evaluations += jumps.open(sys, events, jump, &mut rs.st);
+                    landed = None;
+                    if at_jumps == AtJumps::Restarts && !rec.done() {
+                        let (tau, limit) = rs.next_step(sys, ctl, factor)?;
+                        let (tau, landing) = jumps.toward(rs.t, tau);
+                        sys.close_stretch_at(landing);
+                        rs.start_up(sys, method, tau, limit, &mut rec);
+                        sys.close_stretch_at(None);
+                        landed = landing;
+                    }
+                }
             }
             _ => {}
         }
@@ -314,17 +328,20 @@ impl RunState {
         Ok((rs, limit))
     }
 
-    /// Start-up: a second level for the two-step forms (nothing for one-step methods).
+    /// Start-up by a step of `tau`: a second level for the two-step forms (nothing for
+    /// one-step methods), at t = 0 and at the jumps they restart at.
     fn start_up<S: Model>(
         &mut self,
         sys: &mut S,
         method: &mut dyn Stepper,
+        tau: f64,
         limit: f64,
         rec: &mut Recorder,
     ) {
-        let (t, tau) = (self.t, self.tau);
+        let t = self.t;
         let start_evaluations = method.start(sys, t, tau, &mut self.st);
         if start_evaluations > 0 {
+            self.tau = tau;
             self.cost.rhs_evaluations += start_evaluations;
             let t_new = t + tau;
             self.book_work(tau);

@@ -43,9 +43,10 @@ pub trait Stepper {
     /// Largest |Δ²v| / peak |v| a resolved physical mode can show at the method's limit, plus
     /// margin: above it the driver reports a growing computational mode.
     fn parasitic_threshold(&self) -> f64;
-    /// Start-up from level j = 0 (`cur`, `acc`, `p_cur` set): a method that needs a second
-    /// level builds it as a step of length `tau` into `next`, `acc_next`, `p_new` and returns
-    /// the number of force evaluations it made; 0 when no start-up step is needed.
+    /// Start-up from level j (`cur`, `acc`, `p_cur` set; t = 0, or a jump the method restarts
+    /// at, [`AtJumps::Restarts`]): a method that needs a second level builds it as a step of
+    /// length `tau` into `next`, `acc_next`, `p_new` and returns the number of force
+    /// evaluations it made; 0 when no start-up step is needed.
     fn start(&mut self, sys: &mut dyn System, t: f64, tau: f64, st: &mut StepState) -> usize;
     /// First half of the step from t_j (previous step `tau_prev`) by `tau`: the new level's
     /// positions in `next.q`; may update level j itself (a filter).
@@ -87,11 +88,22 @@ pub struct Capabilities {
     /// linear damping implicit ([`System::implicit_kick`]), so the step stays at the undamped
     /// bound (required by the 3-D payload link; switched on in the two-link chain).
     pub implicit_damping: bool,
-    /// Its kicks split at every level (an opening and a closing half kick), so a step can end
-    /// on a jump of an applied law with the closing kick at the law's left limit and the next
-    /// opening kick at its new value: the driver steps onto the system's jumps
-    /// ([`System::jumps`]).
-    pub steps_onto_jumps: bool,
+    /// How a step meets a jump of an applied law ([`System::jumps`]).
+    pub at_jumps: AtJumps,
+}
+
+/// How a method takes a jump of an applied law (a torque switch, a burn-out): every method
+/// lands a step on it (a jump inside a step, read at the step's levels, costs an error first
+/// order in the step) and differs in how it carries on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AtJumps {
+    /// The kicks split at every level (an opening and a closing half kick): a step ends on the
+    /// jump with the closing kick at the law's left limit, and the next opening kick takes its
+    /// new value (the driver's `Jumps::open`).
+    SplitsKicks,
+    /// A step ends on the jump, reading the law before it, and the method starts again from
+    /// the landed level with the law's new value ([`Stepper::start`]).
+    Restarts,
 }
 
 /// What a method is built from: the validated method (with its payload) and whether the run

@@ -21,7 +21,7 @@
 // Index loops run over several parallel level buffers at once.
 #![allow(clippy::needless_range_loop)]
 
-use super::{Capabilities, Method, MethodParams, StepState, Stepper};
+use super::{AtJumps, Capabilities, Method, MethodParams, StepState, Stepper};
 use crate::system::System;
 
 /// The two-step central difference, with the Robert–Asselin coefficient ν if filtered.
@@ -41,13 +41,14 @@ impl TwoStep {
         TwoStep { filter: Some(nu) }
     }
 
-    /// No capability: a step needs the level before it (no restart at an event), its damping
-    /// is explicit, and a level's force acts over the half steps on both sides of it at once
-    /// (a jump inside that window is taken at the level's value).
+    /// A step needs the level before it (no restart at an event) and its damping is explicit.
+    /// A level's force acts over the half steps on both sides of it at once, so the scheme
+    /// meets a jump of an applied law by landing a level on it and starting again there: the
+    /// landing step's force lies before the jump, the start-up step's after it.
     pub const CAPABILITIES: Capabilities = Capabilities {
         restarts_at_events: false,
         implicit_damping: false,
-        steps_onto_jumps: false,
+        at_jumps: AtJumps::Restarts,
     };
 }
 

@@ -57,7 +57,7 @@
 // Index loops run over several parallel level buffers at once.
 #![allow(clippy::needless_range_loop)]
 
-use super::{Capabilities, MethodParams, StepState, Stepper};
+use super::{AtJumps, Capabilities, MethodParams, StepState, Stepper};
 use crate::system::{DriftVelocities, System};
 
 /// The velocity form; where the velocity-quadratic inertia terms are evaluated.
@@ -98,7 +98,7 @@ impl VelocityForm {
     pub const CAPABILITIES: Capabilities = Capabilities {
         restarts_at_events: true,
         implicit_damping: true,
-        steps_onto_jumps: true,
+        at_jumps: AtJumps::SplitsKicks,
     };
 }
 

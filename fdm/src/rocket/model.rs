@@ -250,9 +250,10 @@ impl RocketModel {
         self.st_fixed_mass[i] + self.st_burn_len[i] * m1
     }
 
-    /// Mass flow leaving through the nozzle, ṁ_total = ∫₀^{L₁} ṁ dx = m_f(0) v_e (5.18).
-    pub fn mass_flow(&self, t: f64) -> f64 {
-        if self.burning(t) {
+    /// Mass flow leaving through the nozzle while the stage burns, ṁ_total = ∫₀^{L₁} ṁ dx =
+    /// m_f(0) v_e (5.18); 0 after burn-out.
+    pub fn mass_flow(&self, burning: bool) -> f64 {
+        if burning {
             self.burn_rate * self.st_burn_len.iter().sum::<f64>()
         } else {
             0.0

@@ -50,6 +50,9 @@ pub struct RocketSystem {
     lumped: Vec<f64>,
     /// Powers at the last accel: thrust, pressure, coriolis_flow | discrete_damper, mass_outflow.
     power: [f64; 5],
+    /// Whether the evaluations close the burn: the step ends on burn-out, and the loads keep
+    /// their values on the burning stretch ([`System::close_stretch_at`]).
+    closing_burn: bool,
 }
 
 pub const IX: usize = 0;
@@ -69,6 +72,7 @@ impl RocketSystem {
             gw: vec![0.0; nm],
             lumped: vec![0.0; n],
             power: [0.0; 5],
+            closing_burn: false,
         }
     }
 
@@ -176,7 +180,7 @@ impl System for RocketSystem {
         let (mp, mq) = (&v[mur.clone()], &v[mwr.clone()]);
         let (gx, gy) = self.gravity(th);
         let m1 = m.m1(t);
-        let burning = m.burning(t);
+        let burning = self.closing_burn || m.burning(t);
 
         // --- forces on stations and discrete masses (body components) ---
         self.fu.iter_mut().for_each(|f| *f = 0.0);
@@ -204,7 +208,7 @@ impl System for RocketSystem {
             let alpha = axis.slope.atan();
             let alpha_rate = axis_rate.slope / (1.0 + axis.slope * axis.slope);
             let (ac, as_) = (alpha.cos(), alpha.sin());
-            let flow = m.mass_flow(t);
+            let flow = m.mass_flow(burning);
             let thrust = flow * m.exhaust_velocity;
             let (tx, ty) = (
                 thrust * (m.gamma + alpha).cos(),
@@ -441,6 +445,21 @@ impl System for RocketSystem {
 
     fn damped(&self) -> bool {
         self.model.damped()
+    }
+
+    /// Burn-out, where thrust, chamber pressure, the jet's Coriolis force and the mass flow
+    /// switch off (the mass per length keeps its value, with a kink).
+    fn jumps(&self) -> Vec<f64> {
+        let burnout = self.model.burnout_time();
+        if burnout.is_finite() && burnout > 0.0 {
+            vec![burnout]
+        } else {
+            Vec::new()
+        }
+    }
+
+    fn close_stretch_at(&mut self, jump: Option<f64>) {
+        self.closing_burn = jump.is_some();
     }
 }
 
