@@ -573,3 +573,42 @@ fn cli_flags_for_several_backends_reach_only_the_backends_that_read_them() {
         "modal with --elements set for fem"
     );
 }
+
+#[test]
+fn cli_a_study_refuses_a_time_after_the_runs_end_before_running() {
+    // `rocket` ends at 0.1 s: every rung would fail alike, so the quantity is refused as bad
+    // input (exit 2) naming the end and the flag that moves it, for converge and recommend,
+    // and with --t-end the refusal names that end instead.
+    for (args, names) in [
+        (
+            &[
+                "converge",
+                "rocket",
+                "--quantity",
+                "rocket.vY@0.2",
+                "--backend",
+                "fdm",
+            ][..],
+            "0.1 s (the scene's t_end)",
+        ),
+        (
+            &[
+                "recommend",
+                "rocket",
+                "--quantity",
+                "rocket.vY@0.2",
+                "--tol",
+                "1e-3",
+                "--backend",
+                "fdm",
+                "--t-end",
+                "0.15",
+            ][..],
+            "0.15 s (--t-end)",
+        ),
+    ] {
+        let (code, out, err) = flexverify(args);
+        assert_eq!(code, 2, "{args:?}: {out}{err}");
+        assert!(err.contains(names) && err.contains("--t-end 0.2"), "{err}");
+    }
+}

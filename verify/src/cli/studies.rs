@@ -12,7 +12,7 @@ use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
 use crate::progress::Progress;
 use crate::shard::{ConvergeShardFile, MeasuredRung, Shard};
 use crate::study::ladder::{Refine, rung_specs};
-use crate::study::measure::{RungMeasurement, measure_rung, parse_quantity};
+use crate::study::measure::{RungMeasurement, measure_rung, parse_study_quantity};
 use crate::study::summary::Study;
 use crate::study::{run, table};
 use crate::suite::run_cache::RunCache;
@@ -67,9 +67,9 @@ pub fn converge_shard(
         ));
     };
     let scene = load_scene(scene_arg)?;
-    let q = parse_quantity(&scene, quantity)?;
     let kinds = opts.kinds();
     let base = checked_settings(opts, &kinds)?;
+    let q = parse_study_quantity(&scene, quantity, &base)?;
     let flat: Vec<(BackendKind, usize, Settings)> = rung_specs(&scene, refine, &kinds, &base)
         .into_iter()
         .flat_map(|(kind, spec)| {

@@ -59,3 +59,32 @@ pub fn parse_quantity(scene: &Scene, quantity: &str) -> Result<Quantity, Error> 
         reason: reason.to_string(),
     })
 }
+
+/// The quantity of a study whose runs take the settings `base`: [`parse_quantity`], and a
+/// value at a time must lie within the runs (`base`'s t_end, else the scene's). Refused here,
+/// before any rung runs, every rung would fail alike.
+pub fn parse_study_quantity(
+    scene: &Scene,
+    quantity: &str,
+    base: &Settings,
+) -> Result<Quantity, Error> {
+    let q = parse_quantity(scene, quantity)?;
+    let t_end = base.time.t_end.unwrap_or(scene.simulation.t_end);
+    if let Quantity::At { t, .. } = &q
+        && *t > t_end * (1.0 + 1e-12)
+    {
+        let source = if base.time.t_end.is_some() {
+            "--t-end"
+        } else {
+            "the scene's t_end"
+        };
+        return Err(Error::InvalidQuantity {
+            quantity: quantity.to_string(),
+            reason: format!(
+                "t = {t} lies after the runs' end, {t_end} s ({source}); ask for a time within \
+                 the runs or pass --t-end {t}"
+            ),
+        });
+    }
+    Ok(q)
+}

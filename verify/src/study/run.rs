@@ -6,7 +6,7 @@
 use data::{BackendKind, Scene, Settings};
 
 use super::ladder::{Refine, rung_specs};
-use super::measure::{RungMeasurement, measure_rung, parse_quantity};
+use super::measure::{RungMeasurement, measure_rung, parse_study_quantity};
 use super::summary::{CAPPED, Rung, Study, summarize, summarize_ladder};
 use crate::error::Error;
 use crate::progress::Progress;
@@ -23,7 +23,7 @@ pub fn run_study(
     rung_budget_s: Option<f64>,
     progress: &dyn Progress,
 ) -> Result<Study, Error> {
-    let q = parse_quantity(scene, quantity)?;
+    let q = parse_study_quantity(scene, quantity, base)?;
     let cache = RunCache::default();
     let measured = |kind: BackendKind, _rung: usize, settings: &Settings| {
         measure_rung(&cache, scene, kind, settings, &q)
@@ -54,13 +54,14 @@ pub fn study_from_rungs(
     progress: &dyn Progress,
     measured: &dyn Fn(BackendKind, usize, &Settings) -> RungMeasurement,
 ) -> Result<Study, Error> {
-    let q = parse_quantity(scene, quantity)?;
+    let q = parse_study_quantity(scene, quantity, base)?;
     let mut ladders = Vec::new();
     let specs = rung_specs(scene, refine, kinds, base);
     progress.begin(specs.iter().map(|(_, s)| s.len()).sum(), "rungs");
     for (kind, rungs_spec) in specs {
         let mut rungs: Vec<Rung> = Vec::new();
         let mut note = None;
+        let mut skipped = None;
         let rungs_total = rungs_spec.len();
         for (rung_index, (settings, h, label)) in rungs_spec.into_iter().enumerate() {
             progress.start(&format!("{} {quantity}: {kind} {label}", scene.name));
@@ -92,6 +93,7 @@ pub fn study_from_rungs(
                     // Coarse rungs may be rejected (too few elements for the scene); only a
                     // failure after a success ends the ladder.
                     if rungs.is_empty() && !e.contains("unsupported") {
+                        skipped = Some(e);
                         continue;
                     }
                     note = Some(e);
@@ -110,6 +112,10 @@ pub fn study_from_rungs(
                 last.discretization, last.wall_time_s
             ));
         }
+        if rungs.is_empty() && note.is_none() {
+            // no rung measured: the last rejection says why
+            note = skipped;
+        }
         ladders.push(summarize_ladder(kind, rungs, note));
     }
     let study = summarize(scene, &q, quantity, refine, ladders);
@@ -127,7 +133,7 @@ pub fn converge(
     base: &Settings,
     progress: &dyn Progress,
 ) -> Result<Study, Error> {
-    let q = parse_quantity(scene, quantity)?;
+    let q = parse_study_quantity(scene, quantity, base)?;
     let cache = RunCache::default();
     let measured = |kind: BackendKind, _rung: usize, settings: &Settings| {
         measure_rung(&cache, scene, kind, settings, &q)
@@ -159,4 +165,34 @@ pub fn converge_from_rungs(
         });
     }
     Ok(study)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::Silent;
+
+    #[test]
+    fn sys_a_ladder_whose_every_rung_fails_says_why() {
+        // Coarse rungs may be rejected and skipped; when no rung measures the quantity, the
+        // last rejection is the ladder's note, so the refusal is not empty.
+        let scene = data::load_scene("cantilever").unwrap();
+        let why = "fdm: the run stopped at t = 1e-3: diverged";
+        let failing =
+            |_: BackendKind, _: usize, _: &Settings| -> RungMeasurement { Err(why.to_string()) };
+        let err = converge_from_rungs(
+            &scene,
+            "tip_deflection@0.01",
+            Refine::Space,
+            &[BackendKind::Fdm],
+            &Settings::default(),
+            &Silent,
+            &failing,
+        )
+        .unwrap_err();
+        assert!(
+            matches!(&err, Error::QuantityNotProduced { notes, .. } if notes == &[why]),
+            "{err}"
+        );
+    }
 }
