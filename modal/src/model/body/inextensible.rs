@@ -92,41 +92,17 @@ pub(super) fn exact_inextensible_terms(
     let na = it.na;
     let d = h.len();
     let ib = 3 + na;
-    // C_ij = Σ_k b_k Q_ij,k· for i ≤ j, mirrored to C_ji.
-    for i in 0..n {
-        for j in i..n {
-            let row = &it.q4[(i * n + j) * nn..(i * n + j + 1) * nn];
-            let cij = &mut s.cq[(i * n + j) * n..(i * n + j + 1) * n];
-            cij.iter_mut().for_each(|v| *v = 0.0);
-            for (bk, qk) in b.iter().zip(row.chunks_exact(n)) {
-                for (c, q) in cij.iter_mut().zip(qk) {
-                    *c += bk * q;
-                }
-            }
-        }
-        for j in 0..i {
-            let (lo, hi) = s.cq.split_at_mut((i * n + j) * n);
-            hi[..n].copy_from_slice(&lo[(j * n + i) * n..(j * n + i + 1) * n]);
-        }
-    }
-    // A_j· = Σ_i b_i C_ij·;  Eq b = Σ_{i≤j} (2 − δ_ij) ḃ_iḃ_j C_ij.
-    s.amat.iter_mut().for_each(|v| *v = 0.0);
-    s.eqb.iter_mut().for_each(|v| *v = 0.0);
-    for i in 0..n {
-        let bi = b[i];
-        for j in 0..n {
-            let cij = &s.cq[(i * n + j) * n..(i * n + j + 1) * n];
-            for (a, c) in s.amat[j * n..(j + 1) * n].iter_mut().zip(cij) {
-                *a += bi * c;
-            }
-            if j >= i {
-                let wgt = if i == j { 1.0 } else { 2.0 };
-                let e = wgt * bd[i] * bd[j];
-                for (v, c) in s.eqb.iter_mut().zip(cij) {
-                    *v += e * c;
-                }
-            }
-        }
+    // C_ij = Σ_k b_k Q_ij,k· for i ≤ j (C_ji = C_ij), then A_j· = Σ_i b_i C_ij· and
+    // Eq b = Σ_{i≤j} (2 − δ_ij) ḃ_iḃ_j C_ij.
+    match n {
+        4 => quartic_contractions::<4>(&it.q4, b, bd, s),
+        5 => quartic_contractions::<5>(&it.q4, b, bd, s),
+        6 => quartic_contractions::<6>(&it.q4, b, bd, s),
+        7 => quartic_contractions::<7>(&it.q4, b, bd, s),
+        8 => quartic_contractions::<8>(&it.q4, b, bd, s),
+        10 => quartic_contractions::<10>(&it.q4, b, bd, s),
+        12 => quartic_contractions::<12>(&it.q4, b, bd, s),
+        _ => quartic_contractions_any(&it.q4, n, b, bd, s),
     }
     mat_vec(&s.amat, n, b, &mut s.ab);
     // D_m· = R_m b, E_m· = R_m ḃ (R_m symmetric n × n).
@@ -163,5 +139,145 @@ pub(super) fn exact_inextensible_terms(
     h[2] += h_om;
     for p in 0..n {
         h[ib + p] += 2.0 * om * (s.t1[p] - s.zv[p]) + s.eqb[p] - 0.5 * om * om * s.ab[p];
+    }
+}
+
+/// The contractions of Q with b of [`exact_inextensible_terms`] for any order n: C_ij for
+/// i ≤ j mirrored to C_ji (`s.cq`), A (`s.amat`) and Eq b (`s.eqb`).
+fn quartic_contractions_any(q4: &[f64], n: usize, b: &[f64], bd: &[f64], s: &mut BodyScratch) {
+    let nn = n * n;
+    for i in 0..n {
+        for j in i..n {
+            let row = &q4[(i * n + j) * nn..(i * n + j + 1) * nn];
+            let cij = &mut s.cq[(i * n + j) * n..(i * n + j + 1) * n];
+            cij.iter_mut().for_each(|v| *v = 0.0);
+            for (bk, qk) in b.iter().zip(row.chunks_exact(n)) {
+                for (c, q) in cij.iter_mut().zip(qk) {
+                    *c += bk * q;
+                }
+            }
+        }
+        for j in 0..i {
+            let (lo, hi) = s.cq.split_at_mut((i * n + j) * n);
+            hi[..n].copy_from_slice(&lo[(j * n + i) * n..(j * n + i + 1) * n]);
+        }
+    }
+    s.amat.iter_mut().for_each(|v| *v = 0.0);
+    s.eqb.iter_mut().for_each(|v| *v = 0.0);
+    for i in 0..n {
+        let bi = b[i];
+        for j in 0..n {
+            let cij = &s.cq[(i * n + j) * n..(i * n + j + 1) * n];
+            for (a, c) in s.amat[j * n..(j + 1) * n].iter_mut().zip(cij) {
+                *a += bi * c;
+            }
+            if j >= i {
+                let wgt = if i == j { 1.0 } else { 2.0 };
+                let e = wgt * bd[i] * bd[j];
+                for (v, c) in s.eqb.iter_mut().zip(cij) {
+                    *v += e * c;
+                }
+            }
+        }
+    }
+}
+
+/// [`quartic_contractions_any`] with the order N known: every sum accumulates in registers
+/// (the general loop loads and stores C_ij for every k), each from zero and in the general
+/// loop's order, so with its bits; C is read by its upper triangle instead of being
+/// mirrored. This contraction is the largest single cost of a modal evaluation with
+/// foreshortening (docs/performance.md).
+#[inline]
+fn quartic_contractions<const N: usize>(q4: &[f64], b: &[f64], bd: &[f64], s: &mut BodyScratch) {
+    let b: &[f64; N] = b.try_into().expect("b of order N");
+    let bd: &[f64; N] = bd.try_into().expect("ḃ of order N");
+    let cq = &mut s.cq[..N * N * N];
+    for i in 0..N {
+        for j in i..N {
+            let row = &q4[(i * N + j) * N * N..(i * N + j + 1) * N * N];
+            let mut c = [0.0; N];
+            for (bk, qk) in b.iter().zip(row.chunks_exact(N)) {
+                let qk: &[f64; N] = qk.try_into().expect("rows of N");
+                for l in 0..N {
+                    c[l] += bk * qk[l];
+                }
+            }
+            cq[(i * N + j) * N..(i * N + j + 1) * N].copy_from_slice(&c);
+        }
+    }
+    let cq = &s.cq[..N * N * N];
+    let upper = |i: usize, j: usize| -> &[f64; N] {
+        let (p, q) = if i <= j { (i, j) } else { (j, i) };
+        cq[(p * N + q) * N..(p * N + q + 1) * N]
+            .try_into()
+            .expect("rows of N")
+    };
+    for j in 0..N {
+        let mut a = [0.0; N];
+        for i in 0..N {
+            let c = upper(i, j);
+            for l in 0..N {
+                a[l] += b[i] * c[l];
+            }
+        }
+        s.amat[j * N..(j + 1) * N].copy_from_slice(&a);
+    }
+    let mut e = [0.0; N];
+    for i in 0..N {
+        for j in i..N {
+            let wgt = if i == j { 1.0 } else { 2.0 };
+            let x = wgt * bd[i] * bd[j];
+            let c = upper(i, j);
+            for l in 0..N {
+                e[l] += x * c[l];
+            }
+        }
+    }
+    s.eqb[..N].copy_from_slice(&e);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn elem_quartic_contractions_of_known_order_keep_the_general_bits() {
+        // Any Q (the functions rely on no symmetry of it) and state: the registers' version
+        // must give C's upper triangle, A and Eq b bit for bit.
+        for n in [4, 5, 6, 7, 8, 10, 12] {
+            let mut x = 0.377_f64;
+            let mut next = || {
+                x = (x * 3.9 * (1.0 - x)).clamp(1e-3, 1.0 - 1e-3);
+                x - 0.5
+            };
+            let q4: Vec<f64> = (0..n * n * n * n).map(|_| next()).collect();
+            let b: Vec<f64> = (0..n).map(|_| next()).collect();
+            let bd: Vec<f64> = (0..n).map(|_| 10.0 * next()).collect();
+            let mut general = BodyScratch::new(2, n, 0);
+            let mut known = BodyScratch::new(2, n, 0);
+            quartic_contractions_any(&q4, n, &b, &bd, &mut general);
+            match n {
+                4 => quartic_contractions::<4>(&q4, &b, &bd, &mut known),
+                5 => quartic_contractions::<5>(&q4, &b, &bd, &mut known),
+                6 => quartic_contractions::<6>(&q4, &b, &bd, &mut known),
+                7 => quartic_contractions::<7>(&q4, &b, &bd, &mut known),
+                8 => quartic_contractions::<8>(&q4, &b, &bd, &mut known),
+                10 => quartic_contractions::<10>(&q4, &b, &bd, &mut known),
+                _ => quartic_contractions::<12>(&q4, &b, &bd, &mut known),
+            }
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&general.amat), bits(&known.amat), "A, n = {n}");
+            assert_eq!(bits(&general.eqb), bits(&known.eqb), "Eq b, n = {n}");
+            for i in 0..n {
+                for j in i..n {
+                    let r = (i * n + j) * n..(i * n + j + 1) * n;
+                    assert_eq!(
+                        bits(&general.cq[r.clone()]),
+                        bits(&known.cq[r]),
+                        "C_{i}{j}, n = {n}"
+                    );
+                }
+            }
+        }
     }
 }
