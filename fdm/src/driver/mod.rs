@@ -181,9 +181,19 @@ pub fn run<S: Model, E: Events<S>>(
         computational_mode: sys.damped() && method.has_computational_mode(),
     };
     let mut verdict = StabilityVerdict::Completed;
-    rs.start_up(sys, method, rs.tau, limit, &mut rec);
     let at_jumps = capabilities(ctl.method).at_jumps;
     let mut jumps = Jumps::new(&*sys, ctl.t_end);
+    let first = rs.tau;
+    rs.start_onto_jumps(
+        sys,
+        method,
+        events,
+        &mut jumps,
+        ctl,
+        factor,
+        (first, limit),
+        &mut rec,
+    )?;
 
     while !rec.done() {
         let (tau_next, limit_next) = rs.next_step(sys, ctl, factor)?;
@@ -209,18 +219,12 @@ pub fn run<S: Model, E: Events<S>>(
                 break;
             }
             (Ok(true), Some(jump)) => {
-                let mut landed = Some(jump);
-                while let Some(jump) = landed {
-                    rs.cost.rhs_evaluations += jumps.open(sys, events, jump, &mut rs.st);
-                    landed = None;
-                    if at_jumps == AtJumps::Restarts && !rec.done() {
-                        let (tau, limit) = rs.next_step(sys, ctl, factor)?;
-                        let (tau, landing) = jumps.toward(rs.t, tau);
-                        sys.close_stretch_at(landing);
-                        rs.start_up(sys, method, tau, limit, &mut rec);
-                        sys.close_stretch_at(None);
-                        landed = landing;
-                    }
+                rs.cost.rhs_evaluations += jumps.open(sys, events, jump, &mut rs.st);
+                if at_jumps == AtJumps::Restarts && !rec.done() {
+                    let step = rs.next_step(sys, ctl, factor)?;
+                    rs.start_onto_jumps(
+                        sys, method, events, &mut jumps, ctl, factor, step, &mut rec,
+                    )?;
                 }
             }
             _ => {}
@@ -328,22 +332,57 @@ impl RunState {
         Ok((rs, limit))
     }
 
-    /// Start-up by a step of `tau`: a second level for the two-step forms (nothing for
-    /// one-step methods), at t = 0 and at the jumps they restart at.
+    /// The start-up of a method that needs a second level (nothing for one-step methods), at
+    /// t = 0 and at the jumps it restarts at ([`AtJumps::Restarts`]): a step of `step`'s
+    /// length (and method limit), shortened onto a jump it would pass, which is then opened
+    /// and started from again.
+    #[allow(clippy::too_many_arguments)]
+    fn start_onto_jumps<S: Model, E: Events<S>>(
+        &mut self,
+        sys: &mut S,
+        method: &mut dyn Stepper,
+        events: &mut E,
+        jumps: &mut Jumps,
+        ctl: &StepControl,
+        factor: f64,
+        mut step: (f64, f64),
+        rec: &mut Recorder,
+    ) -> Result<(), FdmError> {
+        loop {
+            let (tau, landing) = jumps.toward(self.t, step.0);
+            sys.close_stretch_at(landing);
+            let stepped = self.start_up(sys, method, tau, landing, step.1, rec);
+            sys.close_stretch_at(None);
+            match landing {
+                Some(jump) if stepped => {
+                    self.cost.rhs_evaluations += jumps.open(sys, events, jump, &mut self.st);
+                    if rec.done() {
+                        return Ok(());
+                    }
+                    step = self.next_step(sys, ctl, factor)?;
+                }
+                _ => return Ok(()),
+            }
+        }
+    }
+
+    /// The start-up step of `tau` from the current level (ending on `landing` when it lands on
+    /// a jump); false for a method that needs none.
     fn start_up<S: Model>(
         &mut self,
         sys: &mut S,
         method: &mut dyn Stepper,
         tau: f64,
+        landing: Option<f64>,
         limit: f64,
         rec: &mut Recorder,
-    ) {
+    ) -> bool {
         let t = self.t;
         let start_evaluations = method.start(sys, t, tau, &mut self.st);
         if start_evaluations > 0 {
             self.tau = tau;
             self.cost.rhs_evaluations += start_evaluations;
-            let t_new = t + tau;
+            let t_new = landing.unwrap_or(t + tau);
             self.book_work(tau);
             rec.record(
                 sys,
@@ -356,12 +395,15 @@ impl RunState {
                 &self.w_new,
                 tau,
                 limit,
-                false,
+                landing.is_some(),
             );
             self.st.rotate();
             std::mem::swap(&mut self.w_cur, &mut self.w_new);
             self.t = t_new;
             self.cost.steps += 1;
+            true
+        } else {
+            false
         }
     }
 
