@@ -422,6 +422,58 @@ impl Chain {
         self.massless_directions_with(false)
     }
 
+    /// The almost massless directions that turn a child link's frame through its parent's tip
+    /// section: for a Timoshenko child on a free joint without hub inertia whose parent is a
+    /// Timoshenko link without rotary or tip inertia, ψ(L) of the parent by α with the child's
+    /// field counter-rotated, v = −αx and every ψ by −α. At v = 0 this moves no material point
+    /// (the child frame turns, its centre line and sections stay); otherwise it moves the child's
+    /// points by α·s(x) (the foreshortening), a mass ∫ρA s² orders of magnitude below the
+    /// link's. Unlike the same turn through the child's joint angle
+    /// ([`Chain::massless_directions`]), it leaves θ unchanged, so no joint damper acts on it;
+    /// its stiffness is the shear and bending of the parent's tip and the child's root element.
+    pub fn child_frame_directions(&self) -> Vec<Vec<(usize, f64)>> {
+        let mut dirs = Vec::new();
+        for li in 1..self.links.len() {
+            let (p, l) = (&self.links[li - 1], &self.links[li]);
+            let kind = l.element.kind;
+            if !p.element.kind.independent_rotation()
+                || p.rho_i > 0.0
+                || p.tip_inertia > 0.0
+                || l.joint.dof == NONE
+                || l.hub_inertia > 0.0
+                || !kind.independent_rotation()
+            {
+                continue;
+            }
+            let interior = kind.interior();
+            let ni = interior.len();
+            let mut d = vec![(p.r_dof[p.n_el], 1.0)];
+            for k in 1..=l.n_el {
+                if l.v_dof[k] != NONE {
+                    d.push((l.v_dof[k], -(k as f64) * l.h));
+                }
+            }
+            for e in 0..l.n_el {
+                for (k, idof) in interior.iter().enumerate() {
+                    let coefficient = match idof.field {
+                        InteriorField::Deflection => -(e as f64 + idof.at) * l.h,
+                        InteriorField::Rotation => -1.0,
+                        // A rigid counter-rotation has no bubble content.
+                        InteriorField::Bubble => continue,
+                    };
+                    d.push((l.int_dof[ni * e + k], coefficient));
+                }
+            }
+            for k in 1..=l.n_el {
+                if l.r_dof[k] != NONE {
+                    d.push((l.r_dof[k], -1.0));
+                }
+            }
+            dirs.push(d);
+        }
+        dirs
+    }
+
     fn massless_directions_with(&self, frames: bool) -> Vec<Vec<(usize, f64)>> {
         let mut dirs = Vec::new();
         for (li, l) in self.links.iter().enumerate() {

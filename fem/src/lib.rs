@@ -34,7 +34,13 @@
 //! frame against v = −αx when the hub has no inertia): their equations are static balances
 //! (a DAE). The run starts from a state that satisfies them (`Chain::settle_massless`: the ψ
 //! carry e.g. the next joint's spring moment from t = 0), the initial acceleration treats them
-//! as algebraic ([`method::start`]), and central difference refuses such links.
+//! as algebraic ([`method::start`]), and central difference refuses such links. The step end
+//! rates along them are not determined by a midpoint step (M N = 0): energy-midpoint ends every
+//! step on their balances ([`events::massless`]) — with a unilateral contact the damped ones
+//! (Kelvin–Voigt required), without contact, where some are undamped, the algebraic balance
+//! ∂V/∂ψ = 0 with rates from its time derivative, also along the almost massless turn of a
+//! child frame through its parent's tip section, which no damper reaches
+//! ([`chain::Chain::child_frame_directions`]).
 //!
 //! ## Time integration
 //! Default for chains whose joints are all free (torque/spring driven: `single-link`,

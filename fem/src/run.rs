@@ -491,12 +491,7 @@ fn ledger_terms(integ: &Driver) -> (Vec<&'static str>, Vec<&'static str>, Vec<&'
     if chain.links.iter().any(|l| l.kelvin_voigt > 0.0) {
         diss.push(ledger_term::KELVIN_VOIGT);
     }
-    if integ
-        .contact
-        .as_deref()
-        .and_then(|c| c.solve.massless.as_ref())
-        .is_some_and(|m| m.project)
-    {
+    if integ.massless.as_ref().is_some_and(|m| m.project) {
         diss.push(ledger_term::NUMERICAL_MASSLESS);
     }
     match integ.contact.as_deref().map(|c| c.bilateral.as_deref()) {

@@ -454,7 +454,7 @@ fn sys_refined_normal_force_matches_a_fresh_factorization() {
         let mut held = Contact::from_planar_chain(&sc.name, sc.planar_chain().unwrap(), &chain)
             .unwrap()
             .unwrap();
-        held.state_force(&mut chain, 0.0, &q0, &qd).unwrap();
+        held.state_force(&mut chain, None, 0.0, &q0, &qd).unwrap();
         // One step's motion (0.5 ms at a few rad/s), then a configuration far away.
         for (k, size) in [(1, 1e-3), (2, 1e-3), (3, 0.2)] {
             let q: Vec<f64> = q0
@@ -462,12 +462,12 @@ fn sys_refined_normal_force_matches_a_fresh_factorization() {
                 .enumerate()
                 .map(|(i, v)| v + size * k as f64 * ((i as f64 * 2.3).sin() + 0.5))
                 .collect();
-            let (lam, gmg, _) = held.state_force(&mut chain, 0.0, &q, &qd).unwrap();
+            let (lam, gmg, _) = held.state_force(&mut chain, None, 0.0, &q, &qd).unwrap();
             let mut fresh =
                 Contact::from_planar_chain(&sc.name, sc.planar_chain().unwrap(), &chain)
                     .unwrap()
                     .unwrap();
-            let (lam_f, gmg_f, _) = fresh.state_force(&mut chain, 0.0, &q, &qd).unwrap();
+            let (lam_f, gmg_f, _) = fresh.state_force(&mut chain, None, 0.0, &q, &qd).unwrap();
             // Force scale: the weight of the two links (ρA = 1.764 slug/ft, 5 ft, g = 32.2).
             let weight = 1.764 * 5.0 * 32.2;
             assert!(

@@ -67,7 +67,13 @@ impl Driver {
         let out = match watch {
             Watch::Gap => Ok(c.gap_at(&self.chain, t1, &self.state.q1)),
             Watch::Force => c
-                .state_force(&mut self.chain, t1, &self.state.q1, &self.state.qd1)
+                .state_force(
+                    &mut self.chain,
+                    self.massless.as_mut(),
+                    t1,
+                    &self.state.q1,
+                    &self.state.qd1,
+                )
                 .map(|(l, _, passes)| {
                     self.counters.rhs += passes;
                     c.phase.lambda = l;
@@ -301,12 +307,24 @@ impl Driver {
                     time_tolerance: 0.0,
                 });
             }
-            let res = c.impact(&mut self.chain, t0, &self.state.q, &mut self.state.qd);
+            let res = c.impact(
+                &mut self.chain,
+                self.massless.as_mut(),
+                t0,
+                &self.state.q,
+                &mut self.state.qd,
+            );
             let res = res.and_then(|e| {
                 if let Some(e) = e {
                     c.push(e);
                 }
-                c.state_force(&mut self.chain, t0, &self.state.q, &self.state.qd)
+                c.state_force(
+                    &mut self.chain,
+                    self.massless.as_mut(),
+                    t0,
+                    &self.state.q,
+                    &self.state.qd,
+                )
             });
             c.phase.constrained = true;
             if let Ok((l, _, _)) = res {
@@ -396,6 +414,7 @@ impl Driver {
                 let inward_only = post != Post::None;
                 let (loss, passes) = c.project(
                     &mut self.chain,
+                    self.massless.as_mut(),
                     t,
                     &self.state.q,
                     &mut self.state.qd,
@@ -428,11 +447,22 @@ impl Driver {
                     contact: 1,
                     time_tolerance,
                 });
-                if let Some(e) = c.impact(&mut self.chain, t, &self.state.q, &mut self.state.qd)? {
+                if let Some(e) = c.impact(
+                    &mut self.chain,
+                    self.massless.as_mut(),
+                    t,
+                    &self.state.q,
+                    &mut self.state.qd,
+                )? {
                     c.push(e);
                 }
-                let (l, _, passes) =
-                    c.state_force(&mut self.chain, t, &self.state.q, &self.state.qd)?;
+                let (l, _, passes) = c.state_force(
+                    &mut self.chain,
+                    self.massless.as_mut(),
+                    t,
+                    &self.state.q,
+                    &self.state.qd,
+                )?;
                 self.counters.rhs += passes;
                 if l > 0.0 {
                     c.phase.constrained = true;

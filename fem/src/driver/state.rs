@@ -7,6 +7,7 @@
 use crate::chain::{AugmentedLayout, Chain, NONE};
 use crate::error::FemError;
 use crate::events::contact::Contact;
+use crate::events::massless::Massless;
 use crate::method::{
     Adaptive, Counters, NewtonSystem, StepContext, StepState, Stepper, Trial, Works,
     central_difference, start,
@@ -74,6 +75,12 @@ pub struct Driver {
     /// The scene's tip contact (energy-midpoint or implicit-midpoint; None without contact,
     /// nothing allocated).
     pub contact: Option<Box<Contact>>,
+    /// The chain's exactly massless directions and their balances (Timoshenko links without
+    /// rotary inertia; None otherwise, nothing allocated): the steps end on those balances when
+    /// its `project` is set ([`crate::events::massless`]: the algebraic ones in runs without
+    /// contact, the damped ones with a unilateral contact, whose impact map and normal force
+    /// keep the rates consistent with them).
+    pub massless: Option<Massless>,
     /// Why the last rejected step was rejected.
     pub last_rejection: Rejection,
     /// Positions and rates on the method's continuous extension of a trial step, where the
@@ -123,6 +130,7 @@ impl Driver {
             pending_massless: 0.0,
             length_scale,
             contact: None,
+            massless: None,
             last_rejection: Rejection::Newton,
             dense: (Vec::new(), Vec::new()),
         };
@@ -131,13 +139,26 @@ impl Driver {
         // The unsettled rest configuration (v = 0) is kept in q1 for the initial acceleration.
         st.q1.copy_from_slice(&st.q);
         it.chain.settle_massless(0.0, &mut st.q, &st.qd)?;
+        // Undamped massless sections: every step ends on their algebraic balance, from
+        // consistent rates at the start on (crate::events::massless). A unilateral contact
+        // replaces this with the damped balances (`enable_unilateral_contact`).
+        if crate::method::capabilities(method).projects_massless
+            && let Some(mut ml) = Massless::algebraic(&it.chain)
+        {
+            it.counters.rhs += ml.form(&mut it.chain, 0.0, &st.q);
+            if ml.damped(&mut it.chain, 0.0, &st.q) {
+                ml.project = true;
+                it.counters.rhs += ml.make_consistent(&mut it.chain, 0.0, &st.q, &mut st.qd)?;
+            }
+            it.massless = Some(ml);
+        }
         it.initial_acceleration(0.0)?;
         Ok(it)
     }
 
     /// Switches on the stepping of the scene's unilateral tip contact (set in `self.contact`;
-    /// energy-midpoint): the contact's massless directions (if any, with Kelvin–Voigt) are
-    /// projected onto their balance and given consistent rates after every step
+    /// energy-midpoint): the chain's massless directions (if any, with Kelvin–Voigt) are
+    /// projected onto their damped balance and given consistent rates after every step
     /// ([`crate::events::massless`]), and the Newton matrix and iteration are those of
     /// [`NewtonSystem::unilateral_contact`]. Forms the operators here (nothing is allocated in
     /// the step loop).
@@ -145,14 +166,11 @@ impl Driver {
         self.newton.unilateral_contact = true;
         let n = self.state.q.len();
         self.dense = (vec![0.0; n], vec![0.0; n]);
+        self.massless = Massless::new(&self.chain);
         if !crate::method::capabilities(self.method).projects_massless {
             return Ok(());
         }
-        let Some(ml) = self
-            .contact
-            .as_deref_mut()
-            .and_then(|c| c.solve.massless.as_mut())
-        else {
+        let Some(ml) = self.massless.as_mut() else {
             return Ok(());
         };
         let st = &mut self.state;
@@ -195,8 +213,8 @@ impl Driver {
     }
 
     /// Solves the step of length h from the current state with the method (the contact, when
-    /// held, as its constraint); a converged step of a contact run with massless sections ends
-    /// on their balance.
+    /// held, as its constraint); a converged step of a run whose massless sections are
+    /// projected ends on their balance.
     pub(crate) fn solve(&mut self, h: f64, t1: f64, t_law: f64) -> Result<Trial, FemError> {
         let mut contact = self.contact.take();
         let held = contact
@@ -208,36 +226,27 @@ impl Driver {
         self.contact = contact;
         match result? {
             Trial::NewtonFailed => Ok(Trial::NewtonFailed),
-            Trial::Converged { error: None } => {
-                self.pending_massless = 0.0;
-                // A converged fixed step (contact runs are fixed-step: run.rs refuses `rtol`).
-                self.end_on_massless_balance(h, t1)?;
-                Ok(Trial::Converged { error: None })
-            }
             converged => {
                 self.pending_massless = 0.0;
+                self.end_on_massless_balance(h, t1)?;
                 Ok(converged)
             }
         }
     }
 
-    /// Contact runs with massless section rotations ([`crate::events::massless`]): the end
+    /// Runs with projected massless section rotations ([`crate::events::massless`]): the end
     /// positions projected onto their balance (strain energy removed booked), the end rates,
     /// which the step does not determine, set from the balances, and the mean acceleration
     /// with them.
     fn end_on_massless_balance(&mut self, h: f64, t1: f64) -> Result<(), FemError> {
-        let Some(ml) = self
-            .contact
-            .as_deref_mut()
-            .and_then(|c| c.solve.massless.as_mut())
-            .filter(|m| m.project)
-        else {
+        let Some(ml) = self.massless.as_mut().filter(|m| m.project) else {
             return Ok(());
         };
         let st = &mut self.state;
         let (removed, p) = ml.project_balance(&mut self.chain, t1, &mut st.q1);
-        self.pending_massless = removed;
-        self.counters.rhs += p + ml.make_consistent(&mut self.chain, t1, &st.q1, &mut st.qd1)?;
+        let (kinetic, pr) = ml.end_rates(&mut self.chain, t1, &st.q1, &mut st.qd1)?;
+        self.pending_massless = removed + kinetic;
+        self.counters.rhs += p + pr;
         for i in 0..st.q1.len() {
             st.qdd1[i] = (st.qd1[i] - st.qd[i]) / h;
         }

@@ -5,31 +5,35 @@
 use super::{Contact, REFINE_MARGIN, REFINE_TOL};
 use crate::chain::Chain;
 use crate::error::FemError;
+use crate::events::massless::Massless;
 use crate::linalg::{dot, max_abs};
 
-impl Contact {
-    /// Makes `qd` consistent with the massless balances Nᵀ R(q, q̇, 0) = 0 by changing it along
-    /// N only (no kinetic energy, no tip velocity changes: M N = 0, G N = 0); see
-    /// [`Massless::make_consistent`](crate::events::massless::Massless::make_consistent).
-    /// Returns the residual passes used. No-op without massless directions.
-    pub fn make_consistent(
-        &mut self,
-        chain: &mut Chain,
-        t: f64,
-        q: &[f64],
-        qd: &mut [f64],
-    ) -> Result<usize, FemError> {
-        match self.solve.massless.as_mut() {
-            Some(ml) => ml.make_consistent(chain, t, q, qd),
-            None => Ok(0),
-        }
+/// Makes `qd` consistent with the massless balances Nᵀ R(q, q̇, 0) = 0 by changing it along N
+/// only (no kinetic energy, no tip velocity changes: M N = 0, G N = 0); see
+/// [`Massless::make_consistent`]. Returns the residual passes used. No-op without massless
+/// directions (`massless` None).
+pub(super) fn make_consistent(
+    massless: Option<&mut Massless>,
+    chain: &mut Chain,
+    t: f64,
+    q: &[f64],
+    qd: &mut [f64],
+) -> Result<usize, FemError> {
+    match massless {
+        Some(ml) => ml.make_consistent(chain, t, q, qd),
+        None => Ok(0),
     }
+}
 
-    /// Normal force of the constrained dynamics at (q, q̇) (module docs); also sets G (in
-    /// `g_end`), M⁻¹Gᵀ, the gap and the normal velocity. Returns (λ, G M⁻¹Gᵀ, passes).
+impl Contact {
+    /// Normal force of the constrained dynamics at (q, q̇) (module docs), the chain's exactly
+    /// massless directions `massless` (if any) at rates consistent with their balances; also
+    /// sets G (in `g_end`), M⁻¹Gᵀ, the gap and the normal velocity. Returns (λ, G M⁻¹Gᵀ,
+    /// passes).
     pub fn state_force(
         &mut self,
         chain: &mut Chain,
+        massless: Option<&mut Massless>,
         t: f64,
         q: &[f64],
         qd: &[f64],
@@ -37,16 +41,18 @@ impl Contact {
         let mut g_row = std::mem::take(&mut self.constraint.g_end);
         self.phase.gap = self.gradient(chain, t, q, &mut g_row);
         let mut qd_c = std::mem::take(&mut self.solve.qd_c);
-        let out = self.state_force_with(chain, t, q, qd, &g_row, &mut qd_c);
+        let out = self.state_force_with(chain, massless, t, q, qd, &g_row, &mut qd_c);
         self.constraint.g_end = g_row;
         self.solve.qd_c = qd_c;
         out
     }
 
     /// [`Contact::state_force`] with G in `g_row`; `qd_c` receives the consistent velocity.
+    #[allow(clippy::too_many_arguments)]
     fn state_force_with(
         &mut self,
         chain: &mut Chain,
+        mut massless: Option<&mut Massless>,
         t: f64,
         q: &[f64],
         qd: &[f64],
@@ -72,7 +78,7 @@ impl Contact {
             for i in 0..qd_c.len() {
                 qd_c[i] -= self.solve.minv_gt[i] * vn / gmg;
             }
-            n += self.make_consistent(chain, t, q, qd_c)?;
+            n += make_consistent(massless.as_deref_mut(), chain, t, q, qd_c)?;
             // R(q, q̇, 0): everything but the inertia of q̈; G M⁻¹R = (M⁻¹Gᵀ)ᵀR (M symmetric).
             chain.residual(t, q, qd_c, &self.solve.zero, &mut self.solve.tmp);
             let [_, _, a] = chain.tip_motion(t, self.constraint.link, q, qd_c, &self.solve.zero);

@@ -4,16 +4,21 @@
 use data::Event;
 
 use super::Contact;
+use super::force::make_consistent;
 use crate::chain::{Chain, Parts};
 use crate::error::FemError;
+use crate::events::massless::Massless;
 use crate::linalg::dot;
 
 impl Contact {
-    /// Perfectly plastic impact at (q, q̇⁻) (module docs): updates `qd` to q̇⁺ and returns the
-    /// event (None when the tip does not move into the surface, G q̇⁻ ≥ 0).
+    /// Perfectly plastic impact at (q, q̇⁻) (module docs), the chain's exactly massless
+    /// directions `massless` (if any) at rates consistent with their balances before and after:
+    /// updates `qd` to q̇⁺ and returns the event (None when the tip does not move into the
+    /// surface, G q̇⁻ ≥ 0).
     pub fn impact(
         &mut self,
         chain: &mut Chain,
+        mut massless: Option<&mut Massless>,
         t: f64,
         q: &[f64],
         qd: &mut [f64],
@@ -21,7 +26,7 @@ impl Contact {
         let n = chain.ndof;
         // Massless directions (module docs): q̇⁻ consistent with their balances first (changes
         // neither the kinetic energy nor G q̇).
-        self.make_consistent(chain, t, q, qd)?;
+        make_consistent(massless.as_deref_mut(), chain, t, q, qd)?;
         let mut g_row = std::mem::take(&mut self.constraint.g_end);
         self.phase.gap = self.gradient(chain, t, q, &mut g_row);
         let v_before = dot(&g_row, qd);
@@ -48,7 +53,7 @@ impl Contact {
         }
         // The massless balances hold after the jump too: Nᵀ C Δq̇ = 0 fixes its N-component
         // (zero kinetic energy, no mass product, no normal velocity).
-        self.make_consistent(chain, t, q, qd)?;
+        make_consistent(massless, chain, t, q, qd)?;
         // Independent mass product of the velocity jump (not the factorized matrix). The jump
         // is the increment applied, M⁻¹GᵀΛ: the difference of the stored velocities would add
         // their rounding (|q̇|·1e-16), which dominates for grazing impacts with tiny Λ.
@@ -111,10 +116,12 @@ impl Contact {
     /// Plastic projection of the velocity onto G q̇ = 0 (q̇ ← q̇ − M⁻¹Gᵀ(G q̇)/(G M⁻¹Gᵀ)),
     /// only when `inward_only` is false or G q̇ < 0; returns the kinetic energy it removes,
     /// ½(G q̇)²/(G M⁻¹Gᵀ) ≥ 0, and the residual passes of the mass factorization. Records the
-    /// gap and the drift G q̇ before the projection.
+    /// gap and the drift G q̇ before the projection. The rates along `massless` are made
+    /// consistent with their balances after it.
     pub(crate) fn project(
         &mut self,
         chain: &mut Chain,
+        massless: Option<&mut Massless>,
         t: f64,
         q: &[f64],
         qd: &mut [f64],
@@ -139,7 +146,7 @@ impl Contact {
             for i in 0..qd.len() {
                 qd[i] -= self.solve.minv_gt[i] * vn / gmg;
             }
-            self.make_consistent(chain, t, q, qd)?;
+            make_consistent(massless, chain, t, q, qd)?;
             loss = ke0 - chain.energies(t, q, qd)[0];
         }
         self.phase.normal_velocity = dot(&g_row, qd);

@@ -76,7 +76,7 @@ impl Contact {
         let mut passes = 0;
         let mu = self.solve.mass_scale;
         let stale = !fresh
-            && self.solve.massless.is_none()
+            && !chain.has_massless_dofs()
             && self.solve.mass.factored()
             && !self.solve.refactor_next
             && !self.solve.mass.is_at(t, q, mu);

@@ -60,8 +60,9 @@
 //! (ψ(L) + θ carries the child). Their equations of motion carry no inertia:
 //! Nᵀ(∂V/∂q + C q̇ − Q) = 0 with C the constant damping (Kelvin–Voigt on ψ′, joint dampers).
 //! With Kelvin–Voigt, NᵀCN is regular and these balances fix the N-component of q̇ from q and
-//! the rest of q̇ ([`Contact::make_consistent`]; exact in one solve since they are affine in
-//! q̇); positions do not jump at an impact, so these balances hold on both sides and the jump
+//! the rest of q̇ ([`Massless::make_consistent`](crate::events::massless::Massless::make_consistent),
+//! owned by the driver and handed to the impact map and the normal force; exact in one solve
+//! since they are affine in q̇); positions do not jump at an impact, so these balances hold on both sides and the jump
 //! satisfies Nᵀ C Δq̇ = 0 while the massive block obeys M Δq̇ = GᵀΛ. The energy-midpoint step
 //! solves these rows at the midpoint (∂V/∂ψ(q̄) + C v̄ = 0, an implicit-midpoint rule for a
 //! first-order equation), which does not damp a deviation from the balance (it flips sign every
@@ -183,7 +184,6 @@ use data::scene::{PlanarChain, Surface};
 use crate::chain::{Chain, MAX_LINKS, V2};
 use crate::error::FemError;
 use crate::events::mass_solve::MassSolver;
-use crate::events::massless::Massless;
 
 /// Gap tolerance of a located contact start, relative to the longest link.
 pub const GAP_TOL: f64 = 1e-10;
@@ -294,15 +294,11 @@ pub struct ContactRecord {
     pub n_events: usize,
 }
 
-/// Scratch of the solves with the mass matrix: M(q) + μNNᵀ factorized, the massless balances
-/// and the work vectors of the index-1 force, the impact map and the velocity projection.
+/// Scratch of the solves with the mass matrix: M(q) + μNNᵀ factorized and the work vectors of the index-1 force, the impact map and the velocity projection.
 #[derive(Debug, Clone)]
 pub(crate) struct ConstrainedSolve {
     /// M(q) + μNNᵀ, sparse ([`crate::events::mass_solve`]).
     mass: MassSolver,
-    /// Exactly massless directions N (Timoshenko sections without rotary inertia, see
-    /// [`crate::events::massless`]; None otherwise).
-    pub(crate) massless: Option<Massless>,
     /// All massless directions of [`Chain::massless_directions`] (the exact ones and the
     /// frame directions of mass O(s²)): the regularization M + μ N Nᵀ, by DOF.
     reg_dirs: Vec<Vec<(usize, f64)>>,
@@ -366,7 +362,6 @@ impl Contact {
         let weight = mass * if g > 0.0 { g } else { 1.0 };
         let n = chain.ndof;
         let z = vec![0.0; n];
-        let massless = Massless::new(chain);
         let reg_dirs = chain.massless_directions();
         Ok(Some(Contact {
             constraint: TipConstraint {
@@ -400,7 +395,6 @@ impl Contact {
             },
             solve: ConstrainedSolve {
                 mass: MassSolver::new(chain, &reg_dirs),
-                massless,
                 reg_dirs,
                 mass_scale: 0.0,
                 qd_c: z.clone(),
