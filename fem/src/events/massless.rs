@@ -327,21 +327,18 @@ impl Massless {
         let mut lu = DenseLu::new(na);
         let mut col = vec![0.0; na];
         for l in 0..na {
-            for (sign, out) in [(1.0, &mut self.tmp), (-1.0, &mut self.tmp2)] {
-                for &(i, c) in &self.alg[l] {
+            let dir = &self.alg[l];
+            let place = |sign: f64, qp: &mut [f64]| {
+                for &(i, c) in dir {
                     qp[i] = q[i] + sign * DELTA * c;
                 }
-                chain.residual_parts(t, qp, &self.zero, &self.zero, Parts::CONSERVATIVE, out);
-            }
-            for &(i, _) in &self.alg[l] {
+            };
+            let grads = (&mut self.tmp, &mut self.tmp2);
+            stiffness_along(
+                chain, t, &self.alg, &self.zero, qp, grads, DELTA, place, &mut col,
+            );
+            for &(i, _) in dir {
                 qp[i] = q[i];
-            }
-            for (k, d) in self.alg.iter().enumerate() {
-                col[k] = d
-                    .iter()
-                    .map(|&(i, c)| c * (self.tmp[i] - self.tmp2[i]))
-                    .sum::<f64>()
-                    / (2.0 * DELTA);
             }
             lu.set_column(l, &col);
         }
@@ -477,26 +474,14 @@ impl Massless {
             return 0;
         }
         let s = DELTA / big;
-        for (sign, out) in [(1.0, &mut self.tmp), (-1.0, &mut self.tmp2)] {
-            for (i, x) in self.qp.iter_mut().enumerate() {
+        let place = |sign: f64, qp: &mut [f64]| {
+            for (i, x) in qp.iter_mut().enumerate() {
                 *x = q[i] + sign * s * qd[i];
             }
-            chain.residual_parts(
-                t,
-                &self.qp,
-                &self.zero,
-                &self.zero,
-                Parts::CONSERVATIVE,
-                out,
-            );
-        }
-        for (k, d) in self.alg.iter().enumerate() {
-            self.za[k] = d
-                .iter()
-                .map(|&(i, c)| c * (self.tmp[i] - self.tmp2[i]))
-                .sum::<f64>()
-                / (2.0 * s);
-        }
+        };
+        let grads = (&mut self.tmp, &mut self.tmp2);
+        let (alg, zero, qp) = (&self.alg, &self.zero, &mut self.qp);
+        stiffness_along(chain, t, alg, zero, qp, grads, s, place, &mut self.za);
         ka.solve_in_place(&mut self.za);
         for (k, d) in self.alg.iter().enumerate() {
             for &(i, c) in d {
@@ -504,6 +489,34 @@ impl Massless {
             }
         }
         2
+    }
+}
+
+/// The stiffness along a direction d by a central difference of ∇V, projected on each
+/// algebraic direction N_k: out_k = N_kᵀ[∇V(q + δd) − ∇V(q − δd)]/(2δ), `place(±1, qp)`
+/// putting q ± δd in `qp`. Two residual passes.
+#[allow(clippy::too_many_arguments)]
+fn stiffness_along(
+    chain: &mut Chain,
+    t: f64,
+    alg: &[Vec<(usize, f64)>],
+    zero: &[f64],
+    qp: &mut [f64],
+    (plus, minus): (&mut Vec<f64>, &mut Vec<f64>),
+    delta: f64,
+    place: impl Fn(f64, &mut [f64]),
+    out: &mut [f64],
+) {
+    for (sign, grad) in [(1.0, &mut *plus), (-1.0, &mut *minus)] {
+        place(sign, qp);
+        chain.residual_parts(t, qp, zero, zero, Parts::CONSERVATIVE, grad);
+    }
+    for (o, d) in out.iter_mut().zip(alg) {
+        *o = d
+            .iter()
+            .map(|&(i, c)| c * (plus[i] - minus[i]))
+            .sum::<f64>()
+            / (2.0 * delta);
     }
 }
 
