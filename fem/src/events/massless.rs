@@ -244,33 +244,17 @@ impl Massless {
         let np = self.proj.len();
         let mut passes = 0;
         // K_ψψ column by column: ∇V(q + δe_j) − ∇V(q − δe_j) over 2δ, rows ψ.
-        let delta = DELTA;
         let mut qp = q.to_vec();
         let mut kpp = DenseLu::new(np);
         let mut col = vec![0.0; np.max(nz)];
+        let rows: Vec<Vec<(usize, f64)>> = self.proj.iter().map(|&i| vec![(i, 1.0)]).collect();
         for (l, &j) in self.proj.iter().enumerate() {
-            qp[j] = q[j] + delta;
-            chain.residual_parts(
-                t,
-                &qp,
-                &self.zero,
-                &self.zero,
-                Parts::CONSERVATIVE,
-                &mut self.tmp,
-            );
-            qp[j] = q[j] - delta;
-            chain.residual_parts(
-                t,
-                &qp,
-                &self.zero,
-                &self.zero,
-                Parts::CONSERVATIVE,
-                &mut self.tmp2,
+            let place = |sign: f64, qp: &mut [f64]| qp[j] = q[j] + sign * DELTA;
+            let grads = (&mut self.tmp, &mut self.tmp2);
+            stiffness_along(
+                chain, t, &rows, &self.zero, &mut qp, grads, DELTA, place, &mut col,
             );
             qp[j] = q[j];
-            for (k, &i) in self.proj.iter().enumerate() {
-                col[k] = (self.tmp[i] - self.tmp2[i]) / (2.0 * delta);
-            }
             kpp.set_column(l, &col[..np]);
         }
         passes += 2 * np;
@@ -493,13 +477,13 @@ impl Massless {
 }
 
 /// The stiffness along a direction d by a central difference of ∇V, projected on each
-/// algebraic direction N_k: out_k = N_kᵀ[∇V(q + δd) − ∇V(q − δd)]/(2δ), `place(±1, qp)`
+/// direction N_k of `rows`: out_k = N_kᵀ[∇V(q + δd) − ∇V(q − δd)]/(2δ), `place(±1, qp)`
 /// putting q ± δd in `qp`. Two residual passes.
 #[allow(clippy::too_many_arguments)]
 fn stiffness_along(
     chain: &mut Chain,
     t: f64,
-    alg: &[Vec<(usize, f64)>],
+    rows: &[Vec<(usize, f64)>],
     zero: &[f64],
     qp: &mut [f64],
     (plus, minus): (&mut Vec<f64>, &mut Vec<f64>),
@@ -511,7 +495,7 @@ fn stiffness_along(
         place(sign, qp);
         chain.residual_parts(t, qp, zero, zero, Parts::CONSERVATIVE, grad);
     }
-    for (o, d) in out.iter_mut().zip(alg) {
+    for (o, d) in out.iter_mut().zip(rows) {
         *o = d
             .iter()
             .map(|&(i, c)| c * (plus[i] - minus[i]))
