@@ -131,6 +131,28 @@ pub struct LinkModel {
 }
 
 impl LinkModel {
+    /// The deflection DOFs of this link's field turned rigidly by −1 rad about its root, with
+    /// their coefficients: v = −x at the nodes (root excluded), then at the elements' interior
+    /// deflection points, element by element.
+    fn counter_rotated_deflections(&self) -> Vec<(usize, f64)> {
+        let interior = self.element.kind.interior();
+        let ni = interior.len();
+        let mut d = Vec::new();
+        for k in 1..=self.n_el {
+            if self.v_dof[k] != NONE {
+                d.push((self.v_dof[k], -(k as f64) * self.h));
+            }
+        }
+        for e in 0..self.n_el {
+            for (k, idof) in interior.iter().enumerate() {
+                if idof.field == InteriorField::Deflection {
+                    d.push((self.int_dof[ni * e + k], -(e as f64 + idof.at) * self.h));
+                }
+            }
+        }
+        d
+    }
+
     /// Element-interior DOFs per element.
     fn n_interior(&self) -> usize {
         self.ne - 4
@@ -448,20 +470,14 @@ impl Chain {
             let interior = kind.interior();
             let ni = interior.len();
             let mut d = vec![(p.r_dof[p.n_el], 1.0)];
-            for k in 1..=l.n_el {
-                if l.v_dof[k] != NONE {
-                    d.push((l.v_dof[k], -(k as f64) * l.h));
-                }
-            }
+            d.extend(l.counter_rotated_deflections());
+            // every section turns back with the field (a rigid counter-rotation has no bubble
+            // content)
             for e in 0..l.n_el {
                 for (k, idof) in interior.iter().enumerate() {
-                    let coefficient = match idof.field {
-                        InteriorField::Deflection => -(e as f64 + idof.at) * l.h,
-                        InteriorField::Rotation => -1.0,
-                        // A rigid counter-rotation has no bubble content.
-                        InteriorField::Bubble => continue,
-                    };
-                    d.push((l.int_dof[ni * e + k], coefficient));
+                    if idof.field == InteriorField::Rotation {
+                        d.push((l.int_dof[ni * e + k], -1.0));
+                    }
                 }
             }
             for k in 1..=l.n_el {
@@ -506,18 +522,7 @@ impl Chain {
             }
             if frames && l.joint.dof != NONE && l.hub_inertia == 0.0 {
                 let mut d = vec![(l.joint.dof, 1.0)];
-                for k in 1..=l.n_el {
-                    if l.v_dof[k] != NONE {
-                        d.push((l.v_dof[k], -(k as f64) * l.h));
-                    }
-                }
-                for e in 0..l.n_el {
-                    for (k, idof) in interior.iter().enumerate() {
-                        if idof.field == InteriorField::Deflection {
-                            d.push((l.int_dof[ni * e + k], -(e as f64 + idof.at) * l.h));
-                        }
-                    }
-                }
+                d.extend(l.counter_rotated_deflections());
                 if tip != NONE {
                     d.push((tip, -1.0));
                 }
