@@ -26,6 +26,11 @@ pub struct Timing {
 }
 
 impl Timing {
+    /// The timing of one run, not repeated.
+    pub fn once(seconds: f64) -> Timing {
+        timing_of(&mut [seconds])
+    }
+
     /// (median − min) / min: how far a typical repeat is from the fastest. The maximum is
     /// reported beside it but not used: on a shared machine one preempted repeat makes it
     /// arbitrarily large.
@@ -89,7 +94,7 @@ pub fn time_rung(
     run: impl FnMut() -> Option<f64>,
 ) -> Option<Timing> {
     if first > MAX_SPENT_S {
-        return Some(timing_of(&mut [first]));
+        return Some(Timing::once(first));
     }
     match first_run {
         FirstRun::Alone => repeat_after(vec![first], run),

@@ -8,8 +8,9 @@ use verify::Error;
 use verify::output::TERMINAL_WIDTH;
 use verify::progress::{Progress, Silent};
 use verify::study::ladder::{Refine, rung_specs};
+use verify::study::measure::Timed;
 use verify::study::recommend::recommend;
-use verify::study::run::converge;
+use verify::study::run::{converge, run_study};
 use verify::suite::evaluate::Status;
 use verify::suite::{Suite, report, run_cases, run_cases_with_progress};
 
@@ -101,6 +102,51 @@ fn lib_bad_requests_are_typed_errors() {
             assert!(error > 1e-30);
         }
         other => panic!("expected ToleranceNotMet, got {other:?}"),
+    }
+}
+
+#[test]
+fn lib_recommend_repeats_the_timings_of_its_picks_only() {
+    // The choice across backends compares the picks' minimum wall times and spreads, so the
+    // picks are timed with repeats; the other rungs keep their one run's time.
+    let scene = load_scene("cantilever").unwrap();
+    let kinds = [BackendKind::Fem, BackendKind::Modal];
+    let settings = Settings::default();
+    let r = recommend(
+        &scene,
+        "freq1",
+        1e-4,
+        Refine::Space,
+        &kinds,
+        &settings,
+        None,
+        &Silent,
+    )
+    .unwrap();
+    assert_eq!(r.runners_up.len(), 1, "{r:?}");
+    for pick in std::iter::once(&r.rung).chain(&r.runners_up) {
+        assert!(
+            pick.timing.repeats >= verify::work::MIN_REPEATS,
+            "{} {}: {:?}",
+            pick.backend,
+            pick.discretization,
+            pick.timing
+        );
+        assert_eq!(pick.wall_time_s, pick.timing.min_s);
+    }
+    let once = run_study(
+        &scene,
+        "freq1",
+        Refine::Space,
+        &kinds,
+        &settings,
+        None,
+        Timed::Once,
+        &Silent,
+    )
+    .unwrap();
+    for rung in once.ladders.iter().flat_map(|l| &l.rungs) {
+        assert_eq!(rung.timing.repeats, 1, "{}", rung.discretization);
     }
 }
 

@@ -12,7 +12,7 @@ use crate::output::{Format, TERMINAL_WIDTH, write_atomic};
 use crate::progress::Progress;
 use crate::shard::{ConvergeShardFile, MeasuredRung, Shard};
 use crate::study::ladder::{Refine, rung_specs};
-use crate::study::measure::{RungMeasurement, measure_rung, parse_study_quantity};
+use crate::study::measure::{RungMeasurement, Timed, measure_rung, parse_study_quantity};
 use crate::study::summary::Study;
 use crate::study::{run, table};
 use crate::suite::run_cache::RunCache;
@@ -87,7 +87,7 @@ pub fn converge_shard(
         .map(|position| {
             let (kind, rung, settings) = &flat[position];
             bar.start(&format!("{} {quantity}: {kind} rung {rung}", scene.name));
-            let measurement = measure_rung(&cache, &scene, *kind, settings, &q);
+            let measurement = measure_rung(&cache, &scene, *kind, settings, &q, Timed::Repeated);
             bar.advance();
             MeasuredRung {
                 position,

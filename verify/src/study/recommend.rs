@@ -3,6 +3,8 @@
 //! counter, so the pick inside a ladder never depends on the timer); across backends, the pick
 //! with the smallest minimum wall time, unless the timings cannot separate them (the
 //! runner-up's minimum within the winner's spread), in which case the one with fewer DOFs wins.
+//! Only those picks' timings decide, so only the picks are timed with repeats; every other rung
+//! keeps its one run's time (which also decides the rung budget).
 //!
 //! With a rung budget a ladder stops after its first rung dearer than the budget (the
 //! full suite's rule, [`super::run::study_from_rungs`]); when no measured rung meets the
@@ -12,8 +14,9 @@ use data::{BackendKind, Scene, Settings};
 use serde::Serialize;
 
 use super::ladder::Refine;
+use super::measure::{Timed, parse_study_quantity, retime};
 use super::run::run_study;
-use super::summary::Rung;
+use super::summary::{Ladder, Rung};
 use crate::error::Error;
 use crate::output::wrap;
 use crate::progress::Progress;
@@ -62,13 +65,14 @@ pub fn recommend(
     rung_budget_s: Option<f64>,
     progress: &dyn Progress,
 ) -> Result<Recommendation, Error> {
-    let study = run_study(
+    let mut study = run_study(
         scene,
         quantity,
         refine,
         kinds,
         base,
         rung_budget_s,
+        Timed::Once,
         progress,
     )?;
     let capped: Vec<String> = study
@@ -98,27 +102,33 @@ pub fn recommend(
     }
     // Each rung with its ladder's reference (the study's, or its own estimate when the
     // models disagree by less than the tolerance).
-    let meets = |r: &&Rung| r.error.is_some_and(|e| e <= tol);
     let meeting = study
         .ladders
         .iter()
-        .flat_map(|l| l.rungs.iter().filter(meets))
+        .flat_map(|l| l.rungs.iter().filter(|r| meets(r, tol)))
         .count();
-    // Per ladder, the rung meeting the tolerance with the least work (first on ties).
-    let mut picks: Vec<(&Rung, f64)> = study
+    let picked: Vec<(usize, usize, f64)> = study
         .ladders
         .iter()
-        .filter_map(|l| {
+        .enumerate()
+        .filter_map(|(i, l)| {
             let reference = study.reference.or(l.estimate.map(|e| e.value))?;
-            let counters: Vec<Counters> = l.rungs.iter().map(|r| r.counters).collect();
-            let (_, work) = work_counter_of(&counters);
-            let pick = l
-                .rungs
-                .iter()
-                .filter(meets)
-                .min_by_key(|r| work(&r.counters))?;
-            Some((pick, reference))
+            Some((i, least_work_meeting(l, tol)?, reference))
         })
+        .collect();
+    let q = parse_study_quantity(scene, quantity, base)?;
+    for &(ladder, rung, _) in &picked {
+        let r = &mut study.ladders[ladder].rungs[rung];
+        // A repeat of a run that succeeded fails only if the machine does (out of memory):
+        // then the one run's timing stands, and its `repeats` = 1 says so.
+        if let Some(timing) = retime(scene, r.backend, &r.settings, &q, r.timing.min_s) {
+            r.timing = timing;
+            r.wall_time_s = timing.min_s;
+        }
+    }
+    let mut picks: Vec<(&Rung, f64)> = picked
+        .iter()
+        .map(|&(ladder, rung, reference)| (&study.ladders[ladder].rungs[rung], reference))
         .collect();
     // Across backends: fastest minimum wall time, unless the timings cannot tell the picks
     // apart (within the fastest's spread): then fewer DOFs, then backend order.
@@ -191,6 +201,22 @@ pub fn recommend(
         meeting,
         measured: study.ladders.iter().map(|l| l.rungs.len()).sum(),
     })
+}
+
+fn meets(r: &Rung, tol: f64) -> bool {
+    r.error.is_some_and(|e| e <= tol)
+}
+
+/// The ladder's rung meeting the tolerance with the least work (first on ties), by index.
+fn least_work_meeting(l: &Ladder, tol: f64) -> Option<usize> {
+    let counters: Vec<Counters> = l.rungs.iter().map(|r| r.counters).collect();
+    let (_, work) = work_counter_of(&counters);
+    l.rungs
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| meets(r, tol))
+        .min_by_key(|(_, r)| work(&r.counters))
+        .map(|(i, _)| i)
 }
 
 /// The command-line options that reproduce the settings of a rung (the refined parameter and

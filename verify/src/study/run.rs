@@ -6,14 +6,15 @@
 use data::{BackendKind, Scene, Settings};
 
 use super::ladder::{Refine, rung_specs};
-use super::measure::{RungMeasurement, measure_rung, parse_study_quantity};
+use super::measure::{RungMeasurement, Timed, measure_rung, parse_study_quantity};
 use super::summary::{CAPPED, Rung, Study, summarize, summarize_ladder};
 use crate::error::Error;
 use crate::progress::Progress;
 use crate::suite::run_cache::RunCache;
 
 /// Runs the ladders and fills errors against the best available reference, reporting each
-/// rung to `progress`.
+/// rung to `progress`; each rung timed as `timed` says.
+#[allow(clippy::too_many_arguments)]
 pub fn run_study(
     scene: &Scene,
     quantity: &str,
@@ -21,12 +22,13 @@ pub fn run_study(
     kinds: &[BackendKind],
     base: &Settings,
     rung_budget_s: Option<f64>,
+    timed: Timed,
     progress: &dyn Progress,
 ) -> Result<Study, Error> {
     let q = parse_study_quantity(scene, quantity, base)?;
     let cache = RunCache::default();
     let measured = |kind: BackendKind, _rung: usize, settings: &Settings| {
-        measure_rung(&cache, scene, kind, settings, &q)
+        measure_rung(&cache, scene, kind, settings, &q, timed)
     };
     study_from_rungs(
         scene,
@@ -136,7 +138,7 @@ pub fn converge(
     let q = parse_study_quantity(scene, quantity, base)?;
     let cache = RunCache::default();
     let measured = |kind: BackendKind, _rung: usize, settings: &Settings| {
-        measure_rung(&cache, scene, kind, settings, &q)
+        measure_rung(&cache, scene, kind, settings, &q, Timed::Repeated)
     };
     converge_from_rungs(scene, quantity, refine, kinds, base, progress, &measured)
 }

@@ -7,6 +7,7 @@ use data::{BackendKind, Scene, Settings};
 use serde::{Deserialize, Serialize};
 
 use super::ladder::Refine;
+use super::measure::Timed;
 use super::run::run_study;
 use super::summary::Study;
 use super::table::write_study;
@@ -88,6 +89,7 @@ pub fn run_ladders(
             &BackendKind::ALL,
             &Settings::default(),
             Some(FULL_RUNG_BUDGET_S),
+            Timed::Repeated,
             progress,
         )?;
         if let Some(dir) = out {
