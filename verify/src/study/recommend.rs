@@ -117,15 +117,22 @@ pub fn recommend(
         })
         .collect();
     let q = parse_study_quantity(scene, quantity, base)?;
+    progress.begin(picked.len(), "timings");
     for &(ladder, rung, _) in &picked {
         let r = &mut study.ladders[ladder].rungs[rung];
+        progress.start(&format!(
+            "{} {quantity}: timing {} {}",
+            scene.name, r.backend, r.discretization
+        ));
         // A repeat of a run that succeeded fails only if the machine does (out of memory):
         // then the one run's timing stands, and its `repeats` = 1 says so.
         if let Some(timing) = retime(scene, r.backend, &r.settings, &q, r.timing.min_s) {
             r.timing = timing;
             r.wall_time_s = timing.min_s;
         }
+        progress.advance();
     }
+    progress.finish();
     let mut picks: Vec<(&Rung, f64)> = picked
         .iter()
         .map(|&(ladder, rung, reference)| (&study.ladders[ladder].rungs[rung], reference))
