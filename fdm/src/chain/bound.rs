@@ -10,11 +10,22 @@ use crate::system::{Bound, BoundKind, System, damped_step_factor};
 
 impl TwoLinkChain {
     /// Highest ω of the chain linearized about its initial state at rest: power iteration on
-    /// −∂a/∂q (columns by forward differences of the accelerations). Once per run, O(n²).
-    pub(super) fn top_frequency(&mut self) -> f64 {
+    /// −∂a/∂q (columns by forward differences of the accelerations), and the bound site of
+    /// that mode: a ghost's rotation mode when its ghost is the mode's largest component, else
+    /// the coupled chain's. Once per run, O(n²).
+    pub(super) fn top_frequency(&mut self) -> (f64, usize) {
         let (q0, _) = self.initial_state();
         let rest = vec![0.0; self.dofs()];
-        self.top_frequency_at(0.0, &q0, &rest)
+        let (omega2, largest) = self.top_eigen(0.0, &q0, &rest, false);
+        let site = if let Some(k) = self.slots.iter().position(|&s| s == largest) {
+            3 + k
+        } else if self.tip_ghost == Some(largest) {
+            TIP_SITE
+        } else {
+            2
+        };
+        // power iteration approaches the top eigenvalue from below: 2 % margin on ω
+        (1.02 * omega2.sqrt(), site)
     }
 
     /// Fastest damping rate κ_max (largest |eigenvalue| of −∂a/∂q̇) at the initial state at
@@ -23,20 +34,19 @@ impl TwoLinkChain {
     pub(super) fn top_damping_rate(&mut self) -> f64 {
         let (q0, _) = self.initial_state();
         let rest = vec![0.0; self.dofs()];
-        1.02 * self.top_eigen(0.0, &q0, &rest, true)
-    }
-
-    /// Highest ω of the chain linearized in q about (q, q̇) (in the current contact phase):
-    /// power iteration on −∂a/∂q. O(n²) with n + 1 force evaluations; allocates.
-    pub(super) fn top_frequency_at(&mut self, t: f64, q0: &[f64], v: &[f64]) -> f64 {
-        // power iteration approaches the top eigenvalue from below: 2 % margin on ω
-        1.02 * self.top_eigen(t, q0, v, false).sqrt()
+        1.02 * self.top_eigen(0.0, &q0, &rest, true).0
     }
 
     /// Largest |eigenvalue| of −∂a/∂q (`wrt_v` false: ω²_max) or −∂a/∂q̇ (`wrt_v` true: the
     /// fastest damping rate κ = c/m) at (q, q̇), by power iteration on a forward-difference
-    /// Jacobian (no margin).
-    pub(super) fn top_eigen(&mut self, t: f64, q0: &[f64], v0: &[f64], wrt_v: bool) -> f64 {
+    /// Jacobian (no margin), and the coordinate of its vector's largest component.
+    pub(super) fn top_eigen(
+        &mut self,
+        t: f64,
+        q0: &[f64],
+        v0: &[f64],
+        wrt_v: bool,
+    ) -> (f64, usize) {
         let n = self.dofs();
         let (q0, v) = (q0, v0);
         let lambda = self.constraint.lambda;
@@ -79,7 +89,8 @@ impl TwoLinkChain {
                 x[i] = y[i] / lam;
             }
         }
-        lam.max(0.0)
+        let largest = (0..n).fold(0, |m, i| if x[i].abs() > x[m].abs() { i } else { m });
+        (lam.max(0.0), largest)
     }
 
     /// The step bound σ of the chain (the [`System::bound`] of [`TwoLinkChain`]).
@@ -114,7 +125,7 @@ impl TwoLinkChain {
             let mut best = Bound {
                 sigma: 0.9 * 2.0 / self.omega_max * damped_step_factor(zeta),
                 kind: BoundKind::Transverse,
-                site: 2,
+                site: self.omega_max_site,
             };
             for (k, lp) in self.links.iter().enumerate() {
                 let s = t.shear_bound(k, lp.rho_a);
@@ -136,7 +147,7 @@ impl TwoLinkChain {
         let mut best = Bound {
             sigma: 0.9 * 2.0 / self.omega_max * damped_step_factor(zeta),
             kind: BoundKind::Transverse,
-            site: 2,
+            site: self.omega_max_site,
         };
         // The clamp-rotation modes (ghost x against J_c/(4h²), stiffness EI/(2h³) + K/(4h²))
         // also carry the joint damper D/(4h²): ζ = c/(2√(k m)) can be large at tiny J_c.

@@ -297,6 +297,7 @@ impl TwoLinkChain {
             power: [0.0; 3],
             torques: [0.0; 2],
             omega_max: 0.0,
+            omega_max_site: 2,
             kappa_max: 0.0,
             jc,
             tip_ghost,
@@ -330,7 +331,7 @@ impl TwoLinkChain {
         chain.set_ghost_columns();
         chain.set_unit_rates();
         chain.set_station_masses();
-        chain.omega_max = chain.top_frequency();
+        (chain.omega_max, chain.omega_max_site) = chain.top_frequency();
         chain.kappa_max = chain.top_damping_rate();
         Ok(chain)
     }

@@ -57,6 +57,9 @@ pub struct TwoLinkChain {
     pub(super) field_stations: usize,
     /// highest angular frequency of the linearized chain at t = 0 (power iteration)
     pub omega_max: f64,
+    /// bound site of that mode (a clamp's or the tip's rotation mode, else the coupled
+    /// chain's; `Outputs::describe`)
+    pub(super) omega_max_site: usize,
     /// fastest damping rate of the linearized chain at t = 0 (power iteration on −∂a/∂q̇)
     pub kappa_max: f64,
     /// clamp half-cell rotary inertias ρA h³/24 of links 1 and 2
