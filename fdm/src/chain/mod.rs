@@ -60,11 +60,11 @@
 //! (once per run, O(n²); the bound names a clamp's or link 1's tip rotation mode when that
 //! ghost is the top mode's largest component — on the catalog's arms link 2's clamp, its ghost
 //! against J_c stiffened by the curvature term's 2EI/h: ω² ≈ 48EI/(ρAh⁴), √3 above the
-//! bending waves' (4/h²)√(EI/ρA)), with ζ = max(Kelvin–Voigt ζ of that frequency, κ_max/(2ω_max)) —
-//! κ_max the fastest damping rate, a power iteration on −∂a/∂q̇ (the joint dampers act on the
-//! clamp half-cell inertia: overdamped modes, velocity-form limit τ → 1/κ) — and the
-//! clamp-rotation modes and link 1's tip-rotation mode with their joint-damper ratios. Gravity: V_g of the lumped masses
-//! ([`TwoLinkChain`]'s `gravity_potential`). Tip contact: [`contact`]. Observables: joint angles/rates (clamp angles),
+//! bending waves' (4/h²)√(EI/ρA)), with ζ = max(Kelvin–Voigt ζ of that frequency,
+//! κ_max/(2ω_max)) — κ_max the fastest damping rate, a power iteration on −∂a/∂q̇ (the joint
+//! dampers act on the clamp half-cell inertia: overdamped modes, velocity-form limit τ → 1/κ)
+//! — and the clamp-rotation modes and link 1's tip-rotation mode with their joint-damper
+//! ratios. Gravity: V_g of the lumped masses ([`TwoLinkChain`]'s `gravity_potential`). Tip contact: [`contact`]. Observables: joint angles/rates (clamp angles),
 //! torques = law + spring + damper, tip positions, and deflections in the clamp-tangent frame
 //! (the kernel's v^t).
 //!
