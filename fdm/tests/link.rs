@@ -384,3 +384,72 @@ fn dyn_two_step_keeps_its_order_through_torque_switches() {
         order_through_torque_switches(Some(data::Method::Report), [8.5e-5, 4.25e-5, 2.125e-5]);
     assert!(order > 1.9, "order {order:.2}");
 }
+
+#[test]
+fn dyn_a_sample_between_levels_closes_the_ledger_as_the_levels_do() {
+    // single-link from rest under its torque law: a run that ends inside its first step samples
+    // the end between the levels t = 0 and τ. The stored energies there are those of the dense
+    // state (growing like s²), so the works must be the integral of the interpolated power,
+    // not the linear interpolant of the works (which left a residual of (1 − s) of the energy
+    // that flowed: closure 0.90 at s = 0.1). The sample must close as the level after it does.
+    let at = |t_end: f64| {
+        let mut s = Settings::default();
+        s.time.t_end = Some(t_end);
+        run("single-link", |_| {}, &s)
+    };
+    let first = at(1e-9);
+    let tau = first
+        .observables
+        .channels
+        .iter()
+        .find(|c| c.name == "step_size")
+        .expect("step_size channel")
+        .values[0];
+    let level = at(tau).ledger.relative_closure();
+    for s in [0.1, 0.5, 0.9] {
+        let between = at(s * tau).ledger.relative_closure();
+        assert!(
+            between <= 1.5 * level,
+            "s = {s}: closure {between:e} against {level:e} at the level"
+        );
+    }
+}
+
+#[test]
+fn dyn_a_run_ending_on_a_torque_switch_lands_on_it() {
+    // single-link's bang-bang law switches at t_s: a run ending there lands its last step on
+    // the switch like any other (a step past it would read the new law's power at its far
+    // level, and the end sample would take a torque the law never has between ±amplitude).
+    // The end sample is the level at the switch: the law's value on the stretch it opens, and
+    // the ledger closes there as on the levels before it.
+    let scene = load_scene("single-link").unwrap();
+    let law = scene.planar_chain().unwrap().links[0]
+        .joint
+        .torque
+        .clone()
+        .expect("single-link has a torque law");
+    let switch = law.breakpoints()[0];
+    let mut s = Settings::default();
+    s.time.t_end = Some(switch);
+    let out = run("single-link", |_| {}, &s);
+    let torque = &out
+        .observables
+        .channels
+        .iter()
+        .find(|c| c.name == "joint1.torque")
+        .expect("joint1.torque")
+        .values;
+    let (t, last) = (
+        *out.observables.time.last().unwrap(),
+        *torque.last().unwrap(),
+    );
+    assert_eq!(t, switch);
+    assert_eq!(last, law.torque(switch), "torque at the switch {last}");
+    let n = out.ledger.time.len();
+    let before = (0..n - 1).fold(0.0f64, |m, k| m.max(out.ledger.residual(k).abs()));
+    let end = out.ledger.residual(n - 1).abs();
+    assert!(
+        end <= 1.5 * before,
+        "end residual {end:e} against {before:e} before it"
+    );
+}

@@ -29,9 +29,11 @@ pub(super) struct Jumps {
 }
 
 impl Jumps {
-    /// The system's jumps in (0, t_end) (none: nothing is allocated).
-    pub(super) fn new<S: System + Outputs + ?Sized>(sys: &S, t_end: f64) -> Self {
-        let times: Vec<f64> = sys.jumps().into_iter().filter(|&t| t < t_end).collect();
+    /// The system's jumps (none: nothing is allocated). Those at or after the run's end are
+    /// kept too: the last step must not pass one either, since the samples it records up to
+    /// the end are read on it (a step past a jump takes the new law's power at its far level).
+    pub(super) fn new<S: System + Outputs + ?Sized>(sys: &S) -> Self {
+        let times: Vec<f64> = sys.jumps();
         let (n, np) = if times.is_empty() {
             (0, 0)
         } else {

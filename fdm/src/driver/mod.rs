@@ -36,7 +36,7 @@ use data::{Cost, Diagnostic, Event, StabilityVerdict};
 use crate::error::FdmError;
 use crate::events::{Events, NoEvents, Retake, finish_step};
 use crate::method::{AtJumps, StepState, Stepper, capabilities, stepper};
-use crate::output::{Outcome, Outputs, Recorder};
+use crate::output::{LevelRecord, Outcome, Outputs, Recorder};
 use crate::settings::{Method, ValidatedSettings};
 use crate::system::{Bound, System};
 use jumps::Jumps;
@@ -182,7 +182,7 @@ pub fn run<S: Model, E: Events<S>>(
     };
     let mut verdict = StabilityVerdict::Completed;
     let at_jumps = capabilities(ctl.method).at_jumps;
-    let mut jumps = Jumps::new(&*sys, ctl.t_end);
+    let mut jumps = Jumps::new(&*sys);
     let first = rs.tau;
     rs.start_onto_jumps(
         sys,
@@ -306,9 +306,13 @@ impl RunState {
         cost.rhs_evaluations += 1;
         let (tau, limit, _) = choose_step(sys, ctl, factor, t)?;
         events.first_step(tau);
-        rec.record(
-            sys, method, t, &st.cur, &w_cur, t, &st.cur, &w_cur, tau, limit, false,
-        );
+        let level = LevelRecord {
+            t,
+            state: &st.cur,
+            work: &w_cur,
+            power: &st.p_cur,
+        };
+        rec.record(sys, method, level, level, tau, limit, false);
 
         let mon = sys.monitored();
         let peak_v = inf_norm(&st.cur.v[mon.clone()]).max(1e-300);
@@ -387,12 +391,8 @@ impl RunState {
             rec.record(
                 sys,
                 &*method,
-                t,
-                &self.st.cur,
-                &self.w_cur,
-                t_new,
-                &self.st.next,
-                &self.w_new,
+                self.level(t),
+                self.next_level(t_new),
                 tau,
                 limit,
                 landing.is_some(),
@@ -404,6 +404,26 @@ impl RunState {
             true
         } else {
             false
+        }
+    }
+
+    /// The current level at time t, as the recorder reads it.
+    fn level(&self, t: f64) -> LevelRecord<'_> {
+        LevelRecord {
+            t,
+            state: &self.st.cur,
+            work: &self.w_cur,
+            power: &self.st.p_cur,
+        }
+    }
+
+    /// The new level at time t, as the recorder reads it.
+    fn next_level(&self, t: f64) -> LevelRecord<'_> {
+        LevelRecord {
+            t,
+            state: &self.st.next,
+            work: &self.w_new,
+            power: &self.st.p_new,
         }
     }
 
@@ -556,12 +576,8 @@ impl RunState {
             rec.record(
                 sys,
                 &*method,
-                t,
-                &self.st.cur,
-                &self.w_cur,
-                t_new,
-                &self.st.next,
-                &self.w_new,
+                self.level(t),
+                self.next_level(t_new),
                 tau_eff,
                 limit_next,
                 landed.is_some(),
