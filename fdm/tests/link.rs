@@ -400,10 +400,8 @@ fn dyn_a_sample_between_levels_closes_the_ledger_as_the_levels_do() {
     let first = at(1e-9);
     let tau = first
         .observables
-        .channels
-        .iter()
-        .find(|c| c.name == "step_size")
-        .expect("step_size channel")
+        .get("step_size")
+        .expect("step_size")
         .values[0];
     let level = at(tau).ledger.relative_closure();
     for s in [0.1, 0.5, 0.9] {
@@ -434,9 +432,7 @@ fn dyn_a_run_ending_on_a_torque_switch_lands_on_it() {
     let out = run("single-link", |_| {}, &s);
     let torque = &out
         .observables
-        .channels
-        .iter()
-        .find(|c| c.name == "joint1.torque")
+        .get("joint1.torque")
         .expect("joint1.torque")
         .values;
     let (t, last) = (
