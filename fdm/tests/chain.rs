@@ -545,16 +545,18 @@ fn sys_chain_step_bound_names_the_clamp_rotation_mode_that_sets_it() {
     // The chain's fastest mode is link 2's clamp rotation (its ghost against the clamp
     // section's O(h³) rotary inertia, √3 above the bending waves' limit (4/h²)√(EI/ρA): chain
     // docs), so a step above the bound is refused naming that mode, not the chain at large.
+    let stations = 21;
     let scene = load_scene("two-link-free").unwrap();
     let links = &scene.planar_chain().unwrap().links;
-    let h2 = links[1].length / 20.0;
+    let h2 = links[1].length / (stations - 1) as f64;
     let interior =
         (4.0 / (h2 * h2)) * (links[1].bending_stiffness / links[1].mass_per_length).sqrt();
-    let tau = common::channel(&run("two-link-free", |_| {}, &with(21, 0.01)), "step_size")[0];
+    let run_at = with(stations, 0.01);
+    let tau = common::channel(&run("two-link-free", |_| {}, &run_at), "step_size")[0];
     // 0.9 · 2/ω_max with ω_max 1.02 × the power iteration's: the top mode lies above 1.5 ×
     // the interior's limit
     assert!(0.9 * 2.0 / 1.02 / tau > 1.5 * interior, "step {tau:e}");
-    let mut s = with(21, 0.01);
+    let mut s = run_at;
     s.time.dt = Some(1.2 * tau);
     match FdmBackend.simulate(&scene, &s) {
         Err(data::BackendError::StabilityBound { location, .. }) => {

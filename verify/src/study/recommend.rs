@@ -100,13 +100,14 @@ pub fn recommend(
             why: study.reference_label + &crate::error::capped_sentence(&capped),
         });
     }
-    // Each rung with its ladder's reference (the study's, or its own estimate when the
-    // models disagree by less than the tolerance).
     let meeting = study
         .ladders
         .iter()
         .flat_map(|l| l.rungs.iter().filter(|r| meets(r, tol)))
         .count();
+    // Per ladder (by index), its least-work rung meeting the tolerance and its reference (the
+    // study's, or the ladder's own estimate when the models disagree by less than the
+    // tolerance).
     let picked: Vec<(usize, usize, f64)> = study
         .ladders
         .iter()
