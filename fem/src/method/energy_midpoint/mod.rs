@@ -62,10 +62,11 @@
 //! Otherwise the previous step's ā, zero after a (re)start.
 //! `Predictor::Previous` keeps the previous step's ā throughout (a reference for tests).
 //! Without contact and with a unilateral contact, a step reuses the factorized matrix of an
-//! earlier step (the same step size, with a contact up to `CLOSE_STEP`; formed by this scheme)
-//! for up to `MAX_MATRIX_AGE` steps, while the last step needed at most one
-//! iteration more than the last step with a fresh matrix: over a step S changes by O(h), far
-//! less than the mismatch of the undifferentiated terms that already sets the contraction.
+//! earlier step (the same step size up to round-off, `SAME_STEP`; with a contact up to
+//! `CLOSE_STEP`; formed by this scheme) for up to `MAX_MATRIX_AGE` steps, while the last step
+//! needed at most one iteration more than the last step with a fresh matrix: over a step S
+//! changes by O(h), far less than the mismatch of the undifferentiated terms that already sets
+//! the contraction.
 //! With a unilateral contact the free and the constrained phases alike reuse it (the
 //! constraint borders S through its Schur complement, S itself is the same); every contact
 //! event restarts the scheme with a fresh matrix, and the trials of an event location, which
