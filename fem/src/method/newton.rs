@@ -42,6 +42,9 @@ pub struct NewtonSystem<A> {
     /// Step size the current matrix was formed with, and whether it must be refreshed.
     pub matrix_h: f64,
     pub slow_convergence: bool,
+    /// Matrices formed so far: identifies the factorization that [`NewtonSystem::solve`] uses
+    /// (solves with it may be kept while it is the same).
+    pub formed: u64,
     /// Residual at the trial point (input of [`NewtonSystem::form`]).
     pub res: Vec<f64>,
     /// Right-hand side and solution of [`NewtonSystem::solve`].
@@ -71,6 +74,7 @@ impl<A: Augmentation> NewtonSystem<A> {
             },
             augmented,
             matrix_h: f64::NAN,
+            formed: 0,
             slow_convergence: true,
             res: vec![0.0; n],
             delta: vec![0.0; n],
@@ -113,6 +117,7 @@ impl<A: Augmentation> NewtonSystem<A> {
     ) -> Result<(), FemError> {
         counters.jacobians += 1;
         counters.factorizations += 1;
+        self.formed += 1;
         match self.augmented.as_mut() {
             None => {
                 system.newton_matrix(&st.q1, c, &mut self.matrix);

@@ -261,6 +261,10 @@ pub struct TipConstraint {
     pub(crate) g_bar: Vec<f64>,
     pub(crate) g_end: Vec<f64>,
     pub(crate) s_inv_g: Vec<f64>,
+    /// The Newton matrix (`NewtonSystem::formed`) `s_inv_g` was solved with, and the Newton
+    /// iteration of the current iterate within its step.
+    pub(crate) s_inv_g_of: Option<u64>,
+    pub(crate) iteration: usize,
 }
 
 /// State of the plastic impact law: phase, index-1 normal force, gap and normal velocity at the
@@ -381,6 +385,8 @@ impl Contact {
                 g_bar: z.clone(),
                 g_end: z.clone(),
                 s_inv_g: z.clone(),
+                s_inv_g_of: None,
+                iteration: 0,
             },
             phase: ImpactPhase {
                 constrained: false,

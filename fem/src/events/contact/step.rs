@@ -66,6 +66,7 @@ impl StepConstraint<Chain> for Contact {
         let n = res.len();
         let [_, t_mid, t1] = v.t;
         let (lambda, denom, g0) = (v.lambda, v.denom, v.g0);
+        c.constraint.iteration = v.it;
         // Constraint force ∇̄g λ with ∇̄g the discrete gradient of the gap in the same
         // metric: Δqᵀ∇̄g = g(q₁) − g(q₀), so the constraint does no work.
         let mut g_mid = std::mem::take(&mut c.constraint.g_mid);
@@ -107,9 +108,15 @@ impl StepConstraint<Chain> for Contact {
         let n = res.len();
         // Bordered Newton on (a, λ): S δa − ∇̄g δλ = F, (∂q₁/∂a) ∇g(q₁)·δa = g(q₁) − target,
         // by the Schur complement with two solves of S.
-        newton.delta.copy_from_slice(&c.constraint.g_bar);
-        newton.solve();
-        c.constraint.s_inv_g.copy_from_slice(&newton.delta);
+        // S⁻¹∇̄g of the step's first iterate serves its later iterates while S is the same
+        // factorization: ∇̄g moves by O(update) between them, and a quasi-Newton update
+        // only changes the path, not the solution (the residual and the gap are exact).
+        if c.constraint.iteration == 0 || c.constraint.s_inv_g_of != Some(newton.formed) {
+            newton.delta.copy_from_slice(&c.constraint.g_bar);
+            newton.solve();
+            c.constraint.s_inv_g.copy_from_slice(&newton.delta);
+            c.constraint.s_inv_g_of = Some(newton.formed);
+        }
         newton.delta.copy_from_slice(res);
         newton.solve();
         let cx = dq1_da * dot(&c.constraint.g_end, &newton.delta);
