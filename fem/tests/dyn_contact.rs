@@ -484,20 +484,31 @@ fn sys_refined_normal_force_matches_a_fresh_factorization() {
 
 #[test]
 fn dyn_fine_euler_bernoulli_mesh_stops_at_an_undetermined_grazing_release_with_its_remedy() {
-    // At 48 elements per link and dt 5e-4 the release that ends `barhorst-case1`'s fifth
-    // contact episode (t ≈ 1.81 s) stays undetermined down to the shortest step: the
-    // constrained normal force pulls while the free motion, carrying the fine mesh's tip modes,
-    // enters the surface. The run stops there; the diagnostic names the Euler–Bernoulli cause
-    // and remedy, not the Timoshenko one (its chain has no massless directions). At this step
-    // the release ending the long sliding phase (t ≈ 0.93 s) is undetermined or not with 64,
-    // 72, 80 or 96 elements as round-off falls; the one at 1.81 s stops 48 and 64 elements
-    // alike. At the contact default 2.5e-4 the default mesh resolves both releases.
+    // On fine Euler–Bernoulli meshes at dt 5e-4 the releases of `barhorst-case1` can stay
+    // undetermined down to the shortest step: the constrained normal force pulls while the free
+    // motion, carrying the fine mesh's tip modes, enters the surface. The run stops there; the
+    // diagnostic names the Euler–Bernoulli cause and remedy, not the Timoshenko one (its chain
+    // has no massless directions). Which release does so, if any, turns on round-off: the one
+    // ending the long sliding phase (t ≈ 0.93 s) or the fifth episode (t ≈ 1.81 s) stopped 64
+    // elements, 48 elements or neither as the order of floating-point operations changed. So
+    // the meshes are tried in turn until one stops, and every run must either complete or stop
+    // so.
     let sc = scene("barhorst-case1");
-    let mut st = settings(Some(48), Some(2.0));
-    st.time.dt = Some(5e-4);
-    let r = FemBackend.simulate(&sc, &st).unwrap();
-    let StabilityVerdict::Stopped { diagnostic } = &r.verdict else {
-        panic!("{:?}", r.verdict);
+    let mut stopped = None;
+    for elements in [64, 48, 72] {
+        let mut st = settings(Some(elements), Some(2.0));
+        st.time.dt = Some(5e-4);
+        let r = FemBackend.simulate(&sc, &st).unwrap();
+        match r.verdict {
+            StabilityVerdict::Completed => continue,
+            StabilityVerdict::Stopped { diagnostic } => {
+                stopped = Some(diagnostic);
+                break;
+            }
+        }
+    }
+    let Some(diagnostic) = stopped else {
+        panic!("no mesh of 64, 48, 72 elements met an undetermined grazing release");
     };
     assert!(
         diagnostic.what.starts_with("grazing contact undetermined"),

@@ -3,7 +3,7 @@
 //! that observables and contact read (positions, Jacobian, motion).
 
 use super::geometry::{V2, perp, rot, rot_t};
-use super::{Chain, FrameState, MAX_LINKS, MAXE, NONE, Parts};
+use super::{Chain, FrameState, MAX_LINKS, NONE, Parts};
 use crate::linalg::dot;
 
 impl Chain {
@@ -179,14 +179,12 @@ impl Chain {
     pub fn foreshortening_at_tip(&self, li: usize, q: &[f64]) -> f64 {
         let l = &self.links[li];
         let tb = &l.element.quad;
+        let ne = l.ne;
         let mut s = 0.0;
         for e in 0..l.n_el {
             let d = Self::elem_v(q, &l.elem_dofs(e));
-            for j in 0..tb.ng + 1 {
-                for k in 0..tb.nsg {
-                    let vp = dot(&tb.sub_dn[j][k][..l.ne], &d[..l.ne]);
-                    s -= 0.5 * tb.sub_wh[j][k] * vp * vp;
-                }
+            for a in 0..ne {
+                s -= 0.5 * d[a] * dot(&tb.slope_gram[a][..ne], &d[..ne]);
             }
         }
         s
@@ -273,18 +271,9 @@ impl Chain {
                     let dofs = l.elem_dofs(e);
                     let d = Self::elem_v(q, &dofs);
                     let ne = l.ne;
-                    let mut ds = [0.0; MAXE];
-                    for j in 0..tb.ng + 1 {
-                        for kk in 0..tb.nsg {
-                            let dn = &tb.sub_dn[j][kk];
-                            let c = -tb.sub_wh[j][kk] * dot(&dn[..ne], &d[..ne]);
-                            for a in 0..ne {
-                                ds[a] += c * dn[a];
-                            }
-                        }
-                    }
                     for a in 0..ne {
-                        put(jac, dofs[a], ds[a] * ex);
+                        let ds = -dot(&tb.slope_gram[a][..ne], &d[..ne]);
+                        put(jac, dofs[a], ds * ex);
                     }
                 }
             }

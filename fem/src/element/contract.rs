@@ -325,6 +325,10 @@ pub struct Quadrature {
     /// Sub-interval points (ng + 1 sub-intervals × nsg): weight·h and N′.
     pub sub_wh: [[f64; MAX_SUB_GAUSS]; MAX_GAUSS + 1],
     pub sub_dn: [[Row; MAX_SUB_GAUSS]; MAX_GAUSS + 1],
+    /// Σ weight·h·N′N′ᵀ over every sub-interval point: the element's ∫v′² = dᵀG d by the
+    /// sub-interval quadrature, so the foreshortening at an element's end and its gradient are
+    /// one small matrix product each.
+    pub slope_gram: Local,
 }
 
 impl Quadrature {
@@ -344,6 +348,7 @@ impl Quadrature {
             b: [[0.0; MAXE]; MAX_GAUSS],
             sub_wh: [[0.0; MAX_SUB_GAUSS]; MAX_GAUSS + 1],
             sub_dn: [[[0.0; MAXE]; MAX_SUB_GAUSS]; MAX_GAUSS + 1],
+            slope_gram: [[0.0; MAXE]; MAXE],
         };
         for g in 0..ng {
             let s = element.shapes(p[g], h);
@@ -360,6 +365,12 @@ impl Quadrature {
                 let xi = a + (b - a) * ps[k];
                 t.sub_wh[j][k] = ws[k] * (b - a) * h;
                 t.sub_dn[j][k] = element.shapes(xi, h).dn;
+                let (w, dn) = (t.sub_wh[j][k], t.sub_dn[j][k]);
+                for (row, &da) in t.slope_gram.iter_mut().zip(&dn) {
+                    for (g, &db) in row.iter_mut().zip(&dn) {
+                        *g += w * da * db;
+                    }
+                }
             }
         }
         t
