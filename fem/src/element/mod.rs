@@ -94,6 +94,58 @@ mod tests {
     use crate::element::quadrature::gauss01;
 
     #[test]
+    fn elem_slope_gram_is_the_integral_of_the_slope_shapes() {
+        // Quadrature::slope_gram (the foreshortening's ∫v′² = dᵀG d over an element, summed
+        // over the sub-interval points) against ∫N′N′ᵀ by the highest Gauss rule and, where the
+        // element has one, its geometric stiffness at unit axial force.
+        let h = 0.37;
+        let elements: Vec<&dyn Element> = FemElement::ALL
+            .iter()
+            .map(|&c| euler_bernoulli_element(c))
+            .chain([&timoshenko::Timoshenko as &dyn Element])
+            .collect();
+        for element in elements {
+            let gram = Quadrature::new(element, h).slope_gram;
+            let ne = element.local_dofs();
+            let (pts, wts) = gauss01(MAX_GAUSS);
+            let mut integrated = [[0.0; MAXE]; MAXE];
+            for (&xi, &w) in pts.iter().zip(wts) {
+                let dn = element.shapes(xi, h).dn;
+                for a in 0..ne {
+                    for b in 0..ne {
+                        integrated[a][b] += w * h * dn[a] * dn[b];
+                    }
+                }
+            }
+            let geometric = element.geometric_stiffness(h, &|_| 1.0);
+            let scale = integrated
+                .iter()
+                .flatten()
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+            for a in 0..ne {
+                for b in 0..ne {
+                    assert!(
+                        (gram[a][b] - integrated[a][b]).abs() <= 1e-12 * scale,
+                        "{}: G[{a}][{b}] = {:.6e}, ∫N′N′ = {:.6e}",
+                        element.name(),
+                        gram[a][b],
+                        integrated[a][b]
+                    );
+                    if let Some(kg) = geometric {
+                        assert!(
+                            (gram[a][b] - kg[a][b]).abs() <= 1e-12 * scale,
+                            "{}: G[{a}][{b}] = {:.6e}, K_g = {:.6e}",
+                            element.name(),
+                            gram[a][b],
+                            kg[a][b]
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn elem_curvature_shapes_integrate_to_every_elements_bending_stiffness() {
         // K_bending = ∫EI B′B′ dx: the curvature shapes of `Element::shapes` (which the 3-D
         // element's bending planes use) against each element's own stiffness at κGA = 0.
