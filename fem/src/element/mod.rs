@@ -93,54 +93,61 @@ mod tests {
     use super::*;
     use crate::element::quadrature::gauss01;
 
+    /// Every element of the registry and the Timoshenko element.
+    fn every_element() -> Vec<&'static dyn Element> {
+        FemElement::ALL
+            .iter()
+            .map(|&c| euler_bernoulli_element(c))
+            .chain([&timoshenko::Timoshenko as &dyn Element])
+            .collect()
+    }
+
+    /// ∫ s sᵀ dx over an element of length h by the highest Gauss rule, s = `shape` of the
+    /// element's shapes.
+    fn gauss_gram(element: &dyn Element, h: f64, shape: impl Fn(&Shapes) -> Row) -> Local {
+        let (pts, wts) = gauss01(MAX_GAUSS);
+        let ne = element.local_dofs();
+        let mut integrated = [[0.0; MAXE]; MAXE];
+        for (&xi, &w) in pts.iter().zip(wts) {
+            let s = shape(&element.shapes(xi, h));
+            for a in 0..ne {
+                for b in 0..ne {
+                    integrated[a][b] += w * h * s[a] * s[b];
+                }
+            }
+        }
+        integrated
+    }
+
+    /// Asserts `got` = `want` entry by entry on the element's DOFs, to 1e-12 of `want`'s largest
+    /// entry.
+    fn assert_local_eq(element: &dyn Element, what: &str, got: &Local, want: &Local) {
+        let ne = element.local_dofs();
+        let scale = want.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        for a in 0..ne {
+            for b in 0..ne {
+                assert!(
+                    (got[a][b] - want[a][b]).abs() <= 1e-12 * scale,
+                    "{} {what}[{a}][{b}]: {:.6e} against {:.6e}",
+                    element.name(),
+                    got[a][b],
+                    want[a][b]
+                );
+            }
+        }
+    }
+
     #[test]
     fn elem_slope_gram_is_the_integral_of_the_slope_shapes() {
         // Quadrature::slope_gram (the foreshortening's ∫v′² = dᵀG d over an element, summed
         // over the sub-interval points) against ∫N′N′ᵀ by the highest Gauss rule and, where the
         // element has one, its geometric stiffness at unit axial force.
         let h = 0.37;
-        let elements: Vec<&dyn Element> = FemElement::ALL
-            .iter()
-            .map(|&c| euler_bernoulli_element(c))
-            .chain([&timoshenko::Timoshenko as &dyn Element])
-            .collect();
-        for element in elements {
+        for element in every_element() {
             let gram = Quadrature::new(element, h).slope_gram;
-            let ne = element.local_dofs();
-            let (pts, wts) = gauss01(MAX_GAUSS);
-            let mut integrated = [[0.0; MAXE]; MAXE];
-            for (&xi, &w) in pts.iter().zip(wts) {
-                let dn = element.shapes(xi, h).dn;
-                for a in 0..ne {
-                    for b in 0..ne {
-                        integrated[a][b] += w * h * dn[a] * dn[b];
-                    }
-                }
-            }
-            let geometric = element.geometric_stiffness(h, &|_| 1.0);
-            let scale = integrated
-                .iter()
-                .flatten()
-                .fold(0.0f64, |m, x| m.max(x.abs()));
-            for a in 0..ne {
-                for b in 0..ne {
-                    assert!(
-                        (gram[a][b] - integrated[a][b]).abs() <= 1e-12 * scale,
-                        "{}: G[{a}][{b}] = {:.6e}, ∫N′N′ = {:.6e}",
-                        element.name(),
-                        gram[a][b],
-                        integrated[a][b]
-                    );
-                    if let Some(kg) = geometric {
-                        assert!(
-                            (gram[a][b] - kg[a][b]).abs() <= 1e-12 * scale,
-                            "{}: G[{a}][{b}] = {:.6e}, K_g = {:.6e}",
-                            element.name(),
-                            gram[a][b],
-                            kg[a][b]
-                        );
-                    }
-                }
+            assert_local_eq(element, "G", &gram, &gauss_gram(element, h, |s| s.dn));
+            if let Some(kg) = element.geometric_stiffness(h, &|_| 1.0) {
+                assert_local_eq(element, "G (K_g)", &gram, &kg);
             }
         }
     }
@@ -150,36 +157,11 @@ mod tests {
         // K_bending = ∫EI B′B′ dx: the curvature shapes of `Element::shapes` (which the 3-D
         // element's bending planes use) against each element's own stiffness at κGA = 0.
         let (ei, h) = (2.5e3, 0.37);
-        let elements: Vec<&dyn Element> = FemElement::ALL
-            .iter()
-            .map(|&c| euler_bernoulli_element(c))
-            .chain([&timoshenko::Timoshenko as &dyn Element])
-            .collect();
-        for element in elements {
+        for element in every_element() {
             let k = element.stiffness(ei, 0.0, h);
-            let (pts, wts) = gauss01(MAX_GAUSS);
-            let ne = element.local_dofs();
-            let mut integrated = [[0.0; MAXE]; MAXE];
-            for (&xi, &w) in pts.iter().zip(wts) {
-                let db = element.shapes(xi, h).db;
-                for a in 0..ne {
-                    for b in 0..ne {
-                        integrated[a][b] += ei * w * h * db[a] * db[b];
-                    }
-                }
-            }
-            let scale = k.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-            for a in 0..ne {
-                for b in 0..ne {
-                    assert!(
-                        (integrated[a][b] - k[a][b]).abs() <= 1e-12 * scale,
-                        "{}: K[{a}][{b}] = {:.6e}, ∫EI B′B′ = {:.6e}",
-                        element.name(),
-                        k[a][b],
-                        integrated[a][b]
-                    );
-                }
-            }
+            let mut integrated = gauss_gram(element, h, |s| s.db);
+            integrated.iter_mut().flatten().for_each(|x| *x *= ei);
+            assert_local_eq(element, "∫EI B′B′ (K)", &integrated, &k);
         }
     }
 }
