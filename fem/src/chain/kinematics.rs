@@ -177,14 +177,29 @@ impl Chain {
 
     /// s(L) = −½∫v′² of link `li`.
     pub fn foreshortening_at_tip(&self, li: usize, q: &[f64]) -> f64 {
+        self.tip_foreshortening_with_gradient(li, q, |_, _| {})
+    }
+
+    /// s(L) of link `li`, handing each term of its gradient ∂s(L)/∂d = −∫v′N′ (element DOF,
+    /// value; a node's DOF once per element that holds it) to `gradient` on the way: each
+    /// element's slope Gram product G d gives both.
+    fn tip_foreshortening_with_gradient(
+        &self,
+        li: usize,
+        q: &[f64],
+        mut gradient: impl FnMut(usize, f64),
+    ) -> f64 {
         let l = &self.links[li];
         let tb = &l.element.quad;
         let ne = l.ne;
         let mut s = 0.0;
         for e in 0..l.n_el {
-            let d = Self::elem_v(q, &l.elem_dofs(e));
+            let dofs = l.elem_dofs(e);
+            let d = Self::elem_v(q, &dofs);
             for a in 0..ne {
-                s -= 0.5 * d[a] * dot(&tb.slope_gram[a][..ne], &d[..ne]);
+                let gd = dot(&tb.slope_gram[a][..ne], &d[..ne]);
+                s -= 0.5 * d[a] * gd;
+                gradient(dofs[a], -gd);
             }
         }
         s
@@ -221,6 +236,12 @@ impl Chain {
     pub fn tip_jacobian(&self, t: f64, li: usize, q: &[f64], jac: &mut [f64]) -> V2 {
         let n = self.ndof;
         jac[..2 * n].iter_mut().for_each(|x| *x = 0.0);
+        let put = |jac: &mut [f64], dof: usize, c: V2| {
+            if dof != NONE {
+                jac[dof] += c[0];
+                jac[n + dof] += c[1];
+            }
+        };
         let mut origin = [V2::zeros(); MAX_LINKS];
         let mut angle = [0.0; MAX_LINKS];
         let mut parent: Option<(f64, V2)> = None;
@@ -239,7 +260,10 @@ impl Chain {
             let ax = if l.axial {
                 Self::val(q, l.u_dof[m])
             } else if l.foreshortening {
-                self.foreshortening_at_tip(k, q)
+                // The tip moves along the link's x axis by s(L): its column for every
+                // transverse DOF, from the same products as s(L).
+                let ex = rot(phi, V2::new(1.0, 0.0));
+                self.tip_foreshortening_with_gradient(k, q, |dof, ds| put(jac, dof, ds * ex))
             } else {
                 0.0
             };
@@ -248,12 +272,6 @@ impl Chain {
             angle[k] = phi;
             parent = Some((phi + Self::val(q, l.r_dof[m]), r));
         }
-        let put = |jac: &mut [f64], dof: usize, c: V2| {
-            if dof != NONE {
-                jac[dof] += c[0];
-                jac[n + dof] += c[1];
-            }
-        };
         for k in 0..=li {
             let l = &self.links[k];
             let m = l.n_el;
@@ -262,20 +280,8 @@ impl Chain {
                 put(jac, l.r_dof[m], perp(r - origin[k + 1]));
             }
             put(jac, l.v_dof[m], rot(angle[k], V2::new(0.0, 1.0)));
-            let ex = rot(angle[k], V2::new(1.0, 0.0));
             if l.axial {
-                put(jac, l.u_dof[m], ex);
-            } else if l.foreshortening {
-                let tb = &l.element.quad;
-                for e in 0..l.n_el {
-                    let dofs = l.elem_dofs(e);
-                    let d = Self::elem_v(q, &dofs);
-                    let ne = l.ne;
-                    for a in 0..ne {
-                        let ds = -dot(&tb.slope_gram[a][..ne], &d[..ne]);
-                        put(jac, dofs[a], ds * ex);
-                    }
-                }
+                put(jac, l.u_dof[m], rot(angle[k], V2::new(1.0, 0.0)));
             }
         }
         r

@@ -174,15 +174,14 @@ pub fn recommend(
         });
     };
     // Ending the re-run at the quantity's time makes its final value the quantity.
-    let parsed = Quantity::parse(quantity, scene);
-    let until = match parsed {
-        Ok(Quantity::At { t, .. }) => Some(t),
+    let until = match q {
+        Quantity::At { t, .. } => Some(t),
         _ => None,
     };
     let flags = rerun_flags(&r.settings, until);
-    let what = match parsed {
-        Ok(Quantity::Frequency { .. }) => "modes",
-        Ok(Quantity::StaticTip) => "statics",
+    let what = match q {
+        Quantity::Frequency { .. } => "modes",
+        Quantity::StaticTip => "statics",
         _ => "run",
     };
     Ok(Recommendation {
