@@ -1,4 +1,4 @@
-//! The library's error type: every way a verification, study or stability request can fail
+//! The library's error type: every way a verification, study, stability or comparison request can fail
 //! before it produces results. A failed *check* is not an error — it is an [`Outcome`] or a
 //! [`Verdict`] with its status — and neither is a run that stopped early (its result carries
 //! the diagnostic).
@@ -67,6 +67,23 @@ pub enum Error {
         scene: String,
         tolerance: f64,
         sentence: String,
+    },
+    /// A run result to compare could not be read: a missing or unreadable file, a file that is
+    /// not a run result, or a folder holding none or several.
+    #[error("{}: {reason}", path.display())]
+    RunFile {
+        path: std::path::PathBuf,
+        reason: String,
+    },
+    /// Two run results that cannot be compared (different scenes, a run without output).
+    #[error("cannot compare the runs: {reason}")]
+    RunsNotComparable { reason: String },
+    /// An option of a request is out of its range or names something that does not exist.
+    #[error("{option}: {reason}")]
+    InvalidOption {
+        /// The option's field name in the library's request (e.g. `min_flight`).
+        option: &'static str,
+        reason: String,
     },
     /// A result file could not be written.
     #[error("cannot write output: {0}")]

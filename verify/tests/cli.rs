@@ -612,3 +612,203 @@ fn cli_a_study_refuses_a_time_after_the_runs_end_before_running() {
         assert!(err.contains(names) && err.contains("--t-end 0.2"), "{err}");
     }
 }
+
+/// A fresh folder for one test's run outputs.
+fn out_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("flexverify-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// `flexverify run SCENE ARGS… --out DIR`, which must succeed.
+fn run_into(dir: &std::path::Path, scene: &str, args: &[&str]) {
+    let mut all = vec!["run", scene];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["--format", "json", "--out", dir.to_str().unwrap()]);
+    let (code, _, err) = flexverify(&all);
+    assert_eq!(code, 0, "{all:?}: {err}");
+}
+
+#[test]
+fn cli_compare_histories_of_two_steps_and_of_a_run_with_itself() {
+    let (coarse, fine) = (out_dir("compare-coarse"), out_dir("compare-fine"));
+    run_into(
+        &coarse,
+        "single-link",
+        &["--backend", "fem", "--t-end", "0.05", "--dt", "1e-3"],
+    );
+    run_into(
+        &fine,
+        "single-link",
+        &["--backend", "fem", "--t-end", "0.05", "--dt", "5e-4"],
+    );
+    let result: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(coarse.join("single-link-fem.json")).unwrap(),
+    )
+    .unwrap();
+    let channels: Vec<&str> = result["observables"]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+
+    let c = flexverify_json(&[
+        "compare",
+        coarse.to_str().unwrap(),
+        fine.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    let rows = c["histories"].as_array().unwrap();
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|h| h["channel"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, channels, "one history per channel");
+    for h in rows {
+        let d = h["max_abs_diff"].as_f64().unwrap();
+        assert!(d.is_finite() && d >= 0.0, "{h}");
+    }
+    assert!(
+        rows.iter()
+            .any(|h| h["max_abs_diff"].as_f64().unwrap() > 0.0),
+        "halving the step changed nothing: {c}"
+    );
+    assert!(c["episodes"].is_null(), "single-link has no contact: {c}");
+    assert_eq!(c["run"]["settings"]["time"]["dt"].as_f64(), Some(1e-3));
+
+    // The result file named directly, against its own folder.
+    let same = flexverify_json(&[
+        "compare",
+        coarse.join("single-link-fem.json").to_str().unwrap(),
+        coarse.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    for h in same["histories"].as_array().unwrap() {
+        assert_eq!(h["max_abs_diff"].as_f64(), Some(0.0), "{h}");
+    }
+    let (code, csv, err) = flexverify(&[
+        "compare",
+        coarse.to_str().unwrap(),
+        fine.to_str().unwrap(),
+        "--format",
+        "csv",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        csv.lines().next(),
+        Some("kind,name,run,reference,abs_diff,relative")
+    );
+    assert_eq!(
+        csv.lines().filter(|l| l.starts_with("history,")).count(),
+        channels.len()
+    );
+    for dir in [coarse, fine] {
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}
+
+#[test]
+fn cli_compare_contact_episodes_of_two_backends_and_of_a_run_with_itself() {
+    let (fem, modal) = (out_dir("compare-fem"), out_dir("compare-modal"));
+    run_into(
+        &fem,
+        "barhorst-case1",
+        &["--backend", "fem", "--elements", "4", "--t-end", "0.35"],
+    );
+    run_into(
+        &modal,
+        "barhorst-case1",
+        &["--backend", "modal", "--t-end", "0.35"],
+    );
+    let (fem, modal) = (fem.to_str().unwrap(), modal.to_str().unwrap());
+    let cross = flexverify_json(&["compare", fem, modal, "--format", "json"]);
+    let episodes = &cross["episodes"];
+    assert!(
+        episodes.is_object(),
+        "a contact scene has episodes: {cross}"
+    );
+    assert!(!episodes["run"].as_array().unwrap().is_empty(), "{cross}");
+    assert_eq!(
+        (
+            cross["run"]["backend"].as_str(),
+            cross["reference"]["backend"].as_str()
+        ),
+        (Some("fem"), Some("modal"))
+    );
+
+    let same = flexverify_json(&["compare", fem, fem, "--format", "json"]);
+    let episodes = &same["episodes"];
+    assert!(!episodes["pairs"].as_array().unwrap().is_empty(), "{same}");
+    assert_eq!(
+        episodes["largest"]["abs_diff"].as_f64(),
+        Some(0.0),
+        "{same}"
+    );
+
+    // The default table: the episodes section, the largest difference, 120 columns.
+    let (code, out, err) = flexverify(&["compare", fem, modal]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("contact episodes"), "{out}");
+    assert!(
+        out.contains("largest boundary difference") || out.contains("not paired"),
+        "{out}"
+    );
+    for line in out
+        .lines()
+        .filter(|l| !l.contains(fem) && !l.contains(modal))
+    {
+        assert!(line.chars().count() <= 120, "{line}");
+    }
+    for dir in [fem, modal] {
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}
+
+#[test]
+fn cli_compare_bad_input_exits_2_with_one_clear_message() {
+    let (pair, other) = (out_dir("compare-pair"), out_dir("compare-other"));
+    run_into(
+        &pair,
+        "single-link",
+        &["--backend", "fem,modal", "--t-end", "0.02"],
+    );
+    run_into(&other, "spin-up", &["--backend", "fem", "--t-end", "0.02"]);
+    let fem = pair.join("single-link-fem.json");
+    let missing = pair.join("no-such-run.json");
+    let (pair_s, other_s) = (pair.to_str().unwrap(), other.to_str().unwrap());
+    let (fem_s, missing_s) = (fem.to_str().unwrap(), missing.to_str().unwrap());
+    let cases: [(&[&str], &[&str]); 5] = [
+        (&["compare", missing_s, fem_s], &[missing_s]),
+        (
+            &["compare", pair_s, fem_s],
+            &["single-link-fem.json", "single-link-modal.json", "name one"],
+        ),
+        (
+            &["compare", fem_s, other_s],
+            &["`single-link`", "`spin-up`"],
+        ),
+        (
+            &["compare", fem_s, fem_s, "--min-flight", "0"],
+            &["--min-flight"],
+        ),
+        (
+            &["compare", fem_s, fem_s, "--channel", "nope"],
+            &["`nope`", "joint1.angle"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let (code, out, err) = flexverify(args);
+        assert_eq!(code, 2, "{args:?}: {out}{err}");
+        assert!(out.is_empty(), "{args:?}: {out}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        for needle in needles {
+            assert!(err.contains(needle), "{args:?}: no `{needle}` in {err}");
+        }
+    }
+    for dir in [pair, other] {
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}

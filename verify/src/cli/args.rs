@@ -59,6 +59,27 @@ pub enum Command {
         #[command(flatten)]
         opts: CommonOpts,
     },
+    /// Compare two run outputs of one scene: contact-episode boundaries and whole histories.
+    Compare {
+        /// The run: a result JSON written by `run --out`, or the --out folder holding it.
+        run: std::path::PathBuf,
+        /// The reference it is measured against (same scene, any backend), given the same way.
+        reference: std::path::PathBuf,
+        /// Free flights shorter than this (seconds) merge two contact phases into one episode.
+        #[arg(long, allow_hyphen_values = true, value_parser = positive_f64,
+              default_value_t = crate::compare::DEFAULT_MIN_FLIGHT)]
+        min_flight: f64,
+        /// Compare only this history (repeatable): an observable channel, or a ledger term
+        /// energy.NAME.
+        #[arg(long)]
+        channel: Vec<String>,
+        /// Low-pass both histories at this cut-off (Hz; zero-phase Butterworth on one uniform
+        /// grid) before comparing them.
+        #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
+        lowpass: Option<f64>,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+    },
     /// Run the verification suite (checks declared as data in data/cases/).
     Verify {
         #[arg(long, value_enum, default_value_t = Suite::Quick)]

@@ -4,7 +4,7 @@ use data::{BackendError, BackendKind, Model, Scene, Settings, StabilityVerdict, 
 
 use super::CliError;
 use super::args::{Cli, Command, CommonOpts, checked_settings};
-use super::stdout::{out, outln};
+use super::stdout::{out, outln, print_json};
 use crate::output::{
     Column, Format, SWITCHING_HEADER, TERMINAL_WIDTH, csv_table, fitted_table, ledger_csv,
     observables_csv, switching_rows, text_table, wrap, write_atomic,
@@ -18,6 +18,21 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
         Command::Modes { scene, count, opts } => modes(&scene, count as usize, &opts),
         Command::Statics { scene, opts } => statics(&scene, &opts),
         Command::Run { scene, opts } => run(&scene, &opts),
+        Command::Compare {
+            run,
+            reference,
+            min_flight,
+            channel,
+            lowpass,
+            format,
+        } => {
+            let opts = crate::compare::CompareOptions {
+                min_flight,
+                channels: channel,
+                lowpass_hz: lowpass,
+            };
+            super::compare::compare(&run, &reference, &opts, format)
+        }
         Command::Verify {
             suite,
             filter,
@@ -62,13 +77,6 @@ pub fn dispatch(cli: Cli) -> Result<(), CliError> {
 /// Ledger closure above which `run` warns that the answer is not time-converged: an
 /// integrator at a sensible step closes the ledger to 1e-4 or better on every catalog scene.
 const LEDGER_WARNING: f64 = 1e-3;
-
-fn print_json<T: serde::Serialize>(value: &T) -> Result<(), CliError> {
-    let text = serde_json::to_string_pretty(value)
-        .map_err(|e| CliError::Output(format!("error: cannot serialize result: {e}")))?;
-    outln!("{text}");
-    Ok(())
-}
 
 fn scenes(format: Format) -> Result<(), CliError> {
     let mut rows = Vec::new();

@@ -59,9 +59,12 @@ impl From<crate::Error> for CliError {
             E::InvalidQuantity { reason, .. } => {
                 CliError::Input(format!("error: --quantity: {reason}"))
             }
-            E::Scene(_) | E::Cases(_) | E::NoCaseMatches { .. } => {
-                CliError::Input(format!("error: {e}"))
-            }
+            E::Scene(_)
+            | E::Cases(_)
+            | E::NoCaseMatches { .. }
+            | E::RunFile { .. }
+            | E::RunsNotComparable { .. }
+            | E::InvalidOption { .. } => CliError::Input(format!("error: {e}")),
             E::QuantityNotProduced { .. } => CliError::Unsupported(format!("unsupported: {e}")),
             E::NoReference { .. } | E::ToleranceNotMet { .. } | E::ModelsDisagree { .. } => {
                 CliError::Failed(e.to_string())

@@ -10,6 +10,7 @@
 pub mod args;
 mod checks;
 mod commands;
+mod compare;
 mod error;
 mod progress;
 mod stdout;

@@ -40,3 +40,11 @@ macro_rules! outln {
 }
 
 pub(crate) use {out, outln};
+
+/// `value` as pretty JSON on standard output.
+pub(crate) fn print_json<T: serde::Serialize>(value: &T) -> Result<(), super::CliError> {
+    let text = serde_json::to_string_pretty(value)
+        .map_err(|e| super::CliError::Output(format!("error: cannot serialize result: {e}")))?;
+    outln!("{text}");
+    Ok(())
+}
