@@ -528,6 +528,41 @@ fn dyn_fine_euler_bernoulli_mesh_stops_at_an_undetermined_grazing_release_with_i
 }
 
 #[test]
+fn dyn_coarse_timoshenko_meshes_stop_at_an_unresolved_contact_phase_with_the_mesh_remedy() {
+    // Timoshenko links without rotary inertia carry almost massless frame modes; below about 8
+    // elements per link the chattering arm of `barhorst-case1-timoshenko` meets a contact phase
+    // that no step resolves: at 4 elements (dt 1.25e-4) a release stays undetermined down to the
+    // shortest step (t ≈ 1.81 s), at 6 elements a grazing stretch ends in an impact and a release
+    // after which Newton fails at every step length (t ≈ 2.02 s). Either stop must name the
+    // contact and the mesh remedy, never the method's generic "reduce --dt"; which of the two
+    // meshes stops, if both, turns on round-off, so every run must complete or stop so, and one
+    // must stop.
+    let sc = scene("barhorst-case1-timoshenko");
+    let mut stops = Vec::new();
+    for elements in [4, 6] {
+        let mut st = settings(Some(elements), Some(2.05));
+        st.time.dt = Some(1.25e-4);
+        let r = FemBackend.simulate(&sc, &st).unwrap();
+        if let StabilityVerdict::Stopped { diagnostic } = r.verdict {
+            assert_eq!(
+                diagnostic.location.as_deref(),
+                Some("contact1 (grazing)"),
+                "{elements} elements: {diagnostic:?}"
+            );
+            assert!(
+                diagnostic.remedy.contains("8 elements") && diagnostic.why.contains("massless"),
+                "{elements} elements: {diagnostic:?}"
+            );
+            stops.push(elements);
+        }
+    }
+    assert!(
+        !stops.is_empty(),
+        "neither 4 nor 6 elements met an unresolved contact phase"
+    );
+}
+
+#[test]
 fn sys_a_unilateral_contact_takes_the_contact_step_rule() {
     // A chain with a unilateral contact steps at T₁/100 (fem::run::CONTACT_STEPS_PER_PERIOD, T₁
     // the first pinned-free period of the stiffest link on its free joint), fitted to divide the

@@ -86,7 +86,10 @@ impl Driver {
         let t1 = self.state.t + h;
         // Laws are evaluated as left limits on a step that ends on a discontinuity.
         let t_law = if on_break { t1 - 1e-9 * h } else { t1 };
-        let error = match self.solve(h, t1, t_law)? {
+        let solved = self
+            .solve(h, t1, t_law)
+            .map_err(|e| self.unresolved_contact_phase(e, h));
+        let error = match solved? {
             Trial::NewtonFailed if self.adaptive.is_none() => {
                 // Fixed step: Newton failed; retry this stretch with quarter steps, then grow back.
                 return Ok(self.retry_quarter_step(h, Rejection::Newton, false));

@@ -132,7 +132,9 @@
 //! at that instant: that release is withdrawn — the tip did not leave by more than the gap
 //! tolerance), and a constrained step whose force is still not positive releases the tip at
 //! its end; the event reports that force and the step as `time_tolerance`. Beyond
-//! [`GRAZING_FORCE_LIMIT`]·W the run stops with a diagnostic instead. A release is reported
+//! [`GRAZING_FORCE_LIMIT`]·W the run stops with a diagnostic instead; so does a step that the
+//! Newton iteration fails at every length down to its shortest (the driver's
+//! `unresolved_contact_phase`: same location, cause and remedy). A release is reported
 //! once the free motion after it has been stepped, so that a withdrawn one never appears.
 //! Every event advances time; [`MAX_EVENTS`] bounds a Zeno-like accumulation. The normal force
 //! after an impact oscillates at the unresolved mesh frequencies, and the tip makes
