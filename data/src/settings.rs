@@ -471,6 +471,30 @@ pub fn backends_text(backends: &[BackendKind]) -> String {
 }
 
 impl Settings {
+    /// The command-line options that reproduce these settings, each field as set (`--elements
+    /// 4`, `--dt 0.0005`; unset fields, the backends' defaults, are left out), in the order of
+    /// the `run` command's help.
+    pub fn command_line(&self) -> Vec<(SettingField, String)> {
+        use SettingField as F;
+        let (d, t) = (&self.discretization, &self.time);
+        [
+            (F::Elements, d.elements.map(|n| n.to_string())),
+            (F::Element, d.element.map(|e| e.name().to_string())),
+            (F::Stations, d.stations.map(|n| n.to_string())),
+            (F::Modes, d.modes.map(|n| n.to_string())),
+            (F::Basis, d.basis.map(|b| b.name().to_string())),
+            (F::Method, t.method.map(|m| m.name().to_string())),
+            (F::Dt, t.dt.map(|v| v.to_string())),
+            (F::Rtol, t.rtol.map(|v| v.to_string())),
+            (F::Atol, t.atol.map(|v| v.to_string())),
+            (F::SafetyFactor, t.safety_factor.map(|v| v.to_string())),
+            (F::TEnd, t.t_end.map(|v| v.to_string())),
+        ]
+        .into_iter()
+        .filter_map(|(field, value)| value.map(|v| (field, format!("{} {v}", field.flag()))))
+        .collect()
+    }
+
     /// Whether `backend` reads `field` as set here: the field is one the backend reads and,
     /// for the method, one the backend implements ([`Method::backends`]).
     pub fn read_by(&self, field: SettingField, backend: BackendKind) -> bool {

@@ -207,3 +207,33 @@ fn sys_resolution_accessor_sets_each_backends_own_field() {
     );
     assert_eq!(Settings::resolution_field(BackendKind::Reference), None);
 }
+
+#[test]
+fn sys_command_line_gives_each_set_field_once_with_its_flag() {
+    let mut s = Settings::default();
+    assert!(s.command_line().is_empty(), "defaults need no flag");
+    s.discretization.elements = Some(4);
+    s.time.dt = Some(5e-4);
+    s.time.t_end = Some(2.0);
+    s.time.method = Some("implicit-midpoint".parse().unwrap());
+    let fields: Vec<SettingField> = s.command_line().into_iter().map(|(f, _)| f).collect();
+    let flags: Vec<String> = s.command_line().into_iter().map(|(_, f)| f).collect();
+    assert_eq!(
+        fields,
+        [
+            SettingField::Elements,
+            SettingField::Method,
+            SettingField::Dt,
+            SettingField::TEnd
+        ]
+    );
+    assert_eq!(
+        flags,
+        [
+            "--elements 4",
+            "--method implicit-midpoint",
+            "--dt 0.0005",
+            "--t-end 2"
+        ]
+    );
+}

@@ -66,24 +66,7 @@ fn named_by_flag(e: crate::Error) -> CliError {
 
 /// The flags that reproduce a run's settings (`run … --elements 4 --t-end 0.35`).
 fn settings_flags(s: &Settings) -> String {
-    use data::SettingField as F;
-    let (d, t) = (&s.discretization, &s.time);
-    let flags: Vec<String> = [
-        (F::Elements, d.elements.map(|n| n.to_string())),
-        (F::Element, d.element.map(|e| e.name().to_string())),
-        (F::Stations, d.stations.map(|n| n.to_string())),
-        (F::Modes, d.modes.map(|n| n.to_string())),
-        (F::Basis, d.basis.map(|b| b.name().to_string())),
-        (F::Dt, t.dt.map(|v| v.to_string())),
-        (F::TEnd, t.t_end.map(|v| v.to_string())),
-        (F::Method, t.method.map(|m| m.name())),
-        (F::Rtol, t.rtol.map(|v| v.to_string())),
-        (F::Atol, t.atol.map(|v| v.to_string())),
-        (F::SafetyFactor, t.safety_factor.map(|v| v.to_string())),
-    ]
-    .into_iter()
-    .filter_map(|(field, value)| value.map(|v| format!("{} {v}", field.flag())))
-    .collect();
+    let flags: Vec<String> = s.command_line().into_iter().map(|(_, f)| f).collect();
     if flags.is_empty() {
         "(defaults)".into()
     } else {

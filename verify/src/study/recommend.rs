@@ -229,26 +229,12 @@ fn least_work_meeting(l: &Ladder, tol: f64) -> Option<usize> {
 /// The command-line options that reproduce the settings of a rung (the refined parameter and
 /// every option the study was given), ending at `until` when the quantity is a value at a time.
 fn rerun_flags(s: &Settings, until: Option<f64>) -> String {
-    let d = &s.discretization;
-    let t = &s.time;
-    let mut flags = String::new();
-    let mut add = |name: &str, value: Option<String>| {
-        if let Some(v) = value {
-            flags += &format!(" --{name} {v}");
-        }
-    };
-    add("elements", d.elements.map(|v| v.to_string()));
-    add("element", d.element.map(|v| v.name().to_string()));
-    add("stations", d.stations.map(|v| v.to_string()));
-    add("modes", d.modes.map(|v| v.to_string()));
-    add("basis", d.basis.map(|v| v.name().to_string()));
-    add("method", t.method.map(|v| v.name()));
-    add("dt", t.dt.map(|v| v.to_string()));
-    add("rtol", t.rtol.map(|v| v.to_string()));
-    add("atol", t.atol.map(|v| v.to_string()));
-    add("safety-factor", t.safety_factor.map(|v| v.to_string()));
-    add("t-end", until.or(t.t_end).map(|v| v.to_string()));
-    flags
+    let mut s = s.clone();
+    s.time.t_end = until.or(s.time.t_end);
+    s.command_line()
+        .into_iter()
+        .map(|(_, flag)| format!(" {flag}"))
+        .collect()
 }
 
 impl Recommendation {
