@@ -472,8 +472,8 @@ pub fn backends_text(backends: &[BackendKind]) -> String {
 
 impl Settings {
     /// The command-line options that reproduce these settings, each field as set (`--elements
-    /// 4`, `--dt 0.0005`; unset fields, the backends' defaults, are left out), in the order of
-    /// the `run` command's help.
+    /// 4`, `--dt 0.0005`; unset fields, the backends' defaults, are left out): the
+    /// discretization first, then the time stepping, the end time last.
     pub fn command_line(&self) -> Vec<(SettingField, String)> {
         use SettingField as F;
         let (d, t) = (&self.discretization, &self.time);
