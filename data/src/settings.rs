@@ -474,7 +474,7 @@ impl Settings {
     /// The command-line options that reproduce these settings, each field as set (`--elements
     /// 4`, `--dt 0.0005`; unset fields, the backends' defaults, are left out): the
     /// discretization first, then the time stepping, the end time last.
-    pub fn command_line(&self) -> Vec<(SettingField, String)> {
+    pub fn command_line(&self) -> Vec<String> {
         use SettingField as F;
         let (d, t) = (&self.discretization, &self.time);
         [
@@ -491,7 +491,7 @@ impl Settings {
             (F::TEnd, t.t_end.map(|v| v.to_string())),
         ]
         .into_iter()
-        .filter_map(|(field, value)| value.map(|v| (field, format!("{} {v}", field.flag()))))
+        .filter_map(|(field, value)| value.map(|v| format!("{} {v}", field.flag())))
         .collect()
     }
 

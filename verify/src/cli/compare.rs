@@ -66,7 +66,7 @@ fn named_by_flag(e: crate::Error) -> CliError {
 
 /// The flags that reproduce a run's settings (`run … --elements 4 --t-end 0.35`).
 fn settings_flags(s: &Settings) -> String {
-    let flags: Vec<String> = s.command_line().into_iter().map(|(_, f)| f).collect();
+    let flags = s.command_line();
     if flags.is_empty() {
         "(defaults)".into()
     } else {

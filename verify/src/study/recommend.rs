@@ -233,7 +233,7 @@ fn rerun_flags(s: &Settings, until: Option<f64>) -> String {
     s.time.t_end = until.or(s.time.t_end);
     s.command_line()
         .into_iter()
-        .map(|(_, flag)| format!(" {flag}"))
+        .map(|flag| format!(" {flag}"))
         .collect()
 }
 
