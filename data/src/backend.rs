@@ -73,6 +73,40 @@ impl BackendError {
     }
 }
 
+/// The scene as a run samples it: with `output_interval` (a run's override, the settings'
+/// `time.output_interval`) in place of the scene's own, borrowed unchanged when there is none.
+/// `t_end` is the run's end-time override, for the sample count. Refused (naming the field):
+/// an interval that is not a finite number > 0, or one that stores more than
+/// [`crate::validate::limits::MAX_OUTPUT_SAMPLES`] samples up to the run's end.
+pub fn sampled_as(
+    scene: &Scene,
+    output_interval: Option<f64>,
+    t_end: Option<f64>,
+) -> Result<std::borrow::Cow<'_, Scene>, BackendError> {
+    use crate::validate::limits::MAX_OUTPUT_SAMPLES;
+    let Some(interval) = output_interval else {
+        return Ok(std::borrow::Cow::Borrowed(scene));
+    };
+    let refuse = |message: String| BackendError::InvalidSettings {
+        field: "time.output_interval".into(),
+        message,
+    };
+    if !(interval.is_finite() && interval > 0.0) {
+        return Err(refuse(format!("{interval} must be a finite number > 0")));
+    }
+    let t_end = t_end.unwrap_or(scene.simulation.t_end);
+    let samples = t_end / interval;
+    if samples > MAX_OUTPUT_SAMPLES {
+        return Err(refuse(format!(
+            "t_end / output_interval = {t_end} / {interval} = {samples:.3e} samples is above the \
+             limit {MAX_OUTPUT_SAMPLES:.0e}; give a larger output interval"
+        )));
+    }
+    let mut sampled = scene.clone();
+    sampled.simulation.output_interval = interval;
+    Ok(std::borrow::Cow::Owned(sampled))
+}
+
 /// A discretization of scenes: finite elements, finite differences or assumed modes.
 ///
 /// The methods take the user-facing [`Settings`] (and `dof_plan` its [`Discretization`]) so

@@ -44,6 +44,8 @@ pub struct FemSettings {
     pub dt: Option<f64>,
     /// Overrides the scene's end time.
     pub t_end: Option<f64>,
+    /// Overrides the scene's output interval ([`crate::sampled_as`]).
+    pub output_interval: Option<f64>,
     /// Relative / absolute tolerances of the adaptive step control.
     pub rtol: Option<f64>,
     pub atol: Option<f64>,
@@ -61,6 +63,8 @@ pub struct FdmSettings {
     pub dt: Option<f64>,
     /// Overrides the scene's end time.
     pub t_end: Option<f64>,
+    /// Overrides the scene's output interval ([`crate::sampled_as`]).
+    pub output_interval: Option<f64>,
     /// Multiplier (≤ 1) of the stability bound when the backend picks the step.
     pub safety_factor: Option<f64>,
 }
@@ -76,6 +80,8 @@ pub struct ModalSettings {
     pub dt: Option<f64>,
     /// Overrides the scene's end time.
     pub t_end: Option<f64>,
+    /// Overrides the scene's output interval ([`crate::sampled_as`]).
+    pub output_interval: Option<f64>,
     /// Relative / absolute tolerances of the adaptive methods.
     pub rtol: Option<f64>,
     pub atol: Option<f64>,
@@ -87,6 +93,8 @@ pub struct ModalSettings {
 pub struct ReferenceSettings {
     /// Overrides the scene's end time.
     pub t_end: Option<f64>,
+    /// Overrides the scene's output interval ([`crate::sampled_as`]).
+    pub output_interval: Option<f64>,
     /// Relative / absolute tolerances of the step control.
     pub rtol: Option<f64>,
     pub atol: Option<f64>,
@@ -121,6 +129,7 @@ impl SettingField {
             SettingField::Basis => "discretization.basis",
             SettingField::Dt => "time.dt",
             SettingField::TEnd => "time.t_end",
+            SettingField::OutputInterval => "time.output_interval",
             SettingField::Method => "time.method",
             SettingField::Rtol => "time.rtol",
             SettingField::Atol => "time.atol",
@@ -165,6 +174,7 @@ impl Settings {
             method: t.method.and_then(Method::fem),
             dt: t.dt,
             t_end: t.t_end,
+            output_interval: t.output_interval,
             rtol: t.rtol,
             atol: t.atol,
             safety_factor: t.safety_factor,
@@ -180,6 +190,7 @@ impl Settings {
             method: t.method.and_then(Method::fdm),
             dt: t.dt,
             t_end: t.t_end,
+            output_interval: t.output_interval,
             safety_factor: t.safety_factor,
         })
     }
@@ -194,6 +205,7 @@ impl Settings {
             method: t.method.and_then(Method::modal),
             dt: t.dt,
             t_end: t.t_end,
+            output_interval: t.output_interval,
             rtol: t.rtol,
             atol: t.atol,
         })
@@ -205,6 +217,7 @@ impl Settings {
         let t = &self.time;
         Ok(ReferenceSettings {
             t_end: t.t_end,
+            output_interval: t.output_interval,
             rtol: t.rtol,
             atol: t.atol,
         })
@@ -247,6 +260,7 @@ impl From<&FemSettings> for Settings {
             time: TimeStepping {
                 dt: s.dt,
                 t_end: s.t_end,
+                output_interval: s.output_interval,
                 method: s.method.map(Method::from),
                 rtol: s.rtol,
                 atol: s.atol,
@@ -266,6 +280,7 @@ impl From<&FdmSettings> for Settings {
             time: TimeStepping {
                 dt: s.dt,
                 t_end: s.t_end,
+                output_interval: s.output_interval,
                 method: s.method.map(Method::from),
                 safety_factor: s.safety_factor,
                 ..TimeStepping::default()
@@ -285,6 +300,7 @@ impl From<&ModalSettings> for Settings {
             time: TimeStepping {
                 dt: s.dt,
                 t_end: s.t_end,
+                output_interval: s.output_interval,
                 method: s.method.map(Method::from),
                 rtol: s.rtol,
                 atol: s.atol,
@@ -300,6 +316,7 @@ impl From<&ReferenceSettings> for Settings {
             discretization: Discretization::default(),
             time: TimeStepping {
                 t_end: s.t_end,
+                output_interval: s.output_interval,
                 rtol: s.rtol,
                 atol: s.atol,
                 ..TimeStepping::default()
@@ -324,6 +341,7 @@ mod tests {
             time: TimeStepping {
                 dt: Some(1e-3),
                 t_end: Some(0.5),
+                output_interval: Some(1e-3),
                 method: None,
                 rtol: Some(1e-6),
                 atol: Some(1e-8),

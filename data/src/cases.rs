@@ -74,6 +74,9 @@ pub struct CaseSettings {
     pub dt: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub t_end: Option<f64>,
+    /// Overrides the scene's output interval (rows that low-pass a ringing history).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_interval: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub method: Option<crate::Method>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -97,6 +100,7 @@ impl CaseSettings {
             time: crate::TimeStepping {
                 dt: self.dt,
                 t_end: self.t_end,
+                output_interval: self.output_interval,
                 method: self.method,
                 rtol: self.rtol,
                 atol: self.atol,

@@ -27,7 +27,7 @@ pub mod scene;
 pub mod settings;
 pub mod validate;
 
-pub use backend::{Backend, BackendError, DofGroup, DofPlan};
+pub use backend::{Backend, BackendError, DofGroup, DofPlan, sampled_as};
 pub use backend_settings::{
     FdmMethod, FdmSettings, FemMethod, FemSettings, ModalMethod, ModalSettings, ReferenceSettings,
     SettingsRefusal,

@@ -307,6 +307,11 @@ pub struct TimeStepping {
     pub dt: Option<f64>,
     /// Overrides the scene's end time.
     pub t_end: Option<f64>,
+    /// Overrides the scene's output interval (the spacing of the stored samples); a run's
+    /// samples are then its histories, so a low-passed history is only as good as this
+    /// spacing resolves the signal (`verify::suite::filter`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_interval: Option<f64>,
     /// Integration method (None: the backend's default for the scene). Each backend implements
     /// some of the [`Method`]s ([`Method::backends`]).
     pub method: Option<Method>,
@@ -336,6 +341,7 @@ pub enum SettingField {
     Basis,
     Dt,
     TEnd,
+    OutputInterval,
     Method,
     Rtol,
     Atol,
@@ -343,7 +349,7 @@ pub enum SettingField {
 }
 
 impl SettingField {
-    pub const ALL: [SettingField; 11] = [
+    pub const ALL: [SettingField; 12] = [
         SettingField::Elements,
         SettingField::Element,
         SettingField::Stations,
@@ -351,6 +357,7 @@ impl SettingField {
         SettingField::Basis,
         SettingField::Dt,
         SettingField::TEnd,
+        SettingField::OutputInterval,
         SettingField::Method,
         SettingField::Rtol,
         SettingField::Atol,
@@ -367,6 +374,7 @@ impl SettingField {
             SettingField::Basis => "basis",
             SettingField::Dt => "dt",
             SettingField::TEnd => "t_end",
+            SettingField::OutputInterval => "output_interval",
             SettingField::Method => "method",
             SettingField::Rtol => "rtol",
             SettingField::Atol => "atol",
@@ -384,6 +392,7 @@ impl SettingField {
             SettingField::Basis => "--basis",
             SettingField::Dt => "--dt",
             SettingField::TEnd => "--t-end",
+            SettingField::OutputInterval => "--output-interval",
             SettingField::Method => "--method",
             SettingField::Rtol => "--rtol",
             SettingField::Atol => "--atol",
@@ -395,7 +404,7 @@ impl SettingField {
     /// (dt, rtol, atol) and the explicit scheme's safety factor; fdm: stations, dt and the
     /// safety factor of its stability-bound step; modal: modes, basis, dt and the adaptive
     /// tolerances; verify's rigid reference: only the end time and its Dormand–Prince
-    /// tolerances.
+    /// tolerances. Every backend reads the end time and the output interval.
     pub fn readers(self) -> &'static [BackendKind] {
         use BackendKind::{Fdm, Fem, Modal, Reference};
         match self {
@@ -403,7 +412,7 @@ impl SettingField {
             SettingField::Stations => &[Fdm],
             SettingField::Modes | SettingField::Basis => &[Modal],
             SettingField::Dt | SettingField::Method => &[Fem, Fdm, Modal],
-            SettingField::TEnd => &[Fem, Fdm, Modal, Reference],
+            SettingField::TEnd | SettingField::OutputInterval => &[Fem, Fdm, Modal, Reference],
             SettingField::Rtol | SettingField::Atol => &[Fem, Modal, Reference],
             SettingField::SafetyFactor => &[Fem, Fdm],
         }
@@ -429,6 +438,7 @@ impl SettingField {
             SettingField::Basis => d.basis.is_some(),
             SettingField::Dt => t.dt.is_some(),
             SettingField::TEnd => t.t_end.is_some(),
+            SettingField::OutputInterval => t.output_interval.is_some(),
             SettingField::Method => t.method.is_some(),
             SettingField::Rtol => t.rtol.is_some(),
             SettingField::Atol => t.atol.is_some(),
@@ -446,6 +456,7 @@ impl SettingField {
             SettingField::Basis => d.basis = None,
             SettingField::Dt => t.dt = None,
             SettingField::TEnd => t.t_end = None,
+            SettingField::OutputInterval => t.output_interval = None,
             SettingField::Method => t.method = None,
             SettingField::Rtol => t.rtol = None,
             SettingField::Atol => t.atol = None,
@@ -473,7 +484,7 @@ pub fn backends_text(backends: &[BackendKind]) -> String {
 impl Settings {
     /// The command-line options that reproduce these settings, each field as set (`--elements
     /// 4`, `--dt 0.0005`; unset fields, the backends' defaults, are left out): the
-    /// discretization first, then the time stepping, the end time last.
+    /// discretization first, then the time stepping and the output interval, the end time last.
     pub fn command_line(&self) -> Vec<String> {
         use SettingField as F;
         let (d, t) = (&self.discretization, &self.time);
@@ -488,6 +499,7 @@ impl Settings {
             (F::Rtol, t.rtol.map(|v| v.to_string())),
             (F::Atol, t.atol.map(|v| v.to_string())),
             (F::SafetyFactor, t.safety_factor.map(|v| v.to_string())),
+            (F::OutputInterval, t.output_interval.map(|v| v.to_string())),
             (F::TEnd, t.t_end.map(|v| v.to_string())),
         ]
         .into_iter()

@@ -152,6 +152,7 @@ fn every_field_set() -> Settings {
     d.basis = Some(data::Basis::Poly);
     t.dt = Some(1e-3);
     t.t_end = Some(0.5);
+    t.output_interval = Some(1e-3);
     t.method = Some(data::Method::Trapezoid);
     t.rtol = Some(1e-6);
     t.atol = Some(1e-9);
@@ -225,5 +226,42 @@ fn sys_command_line_gives_each_set_field_once_with_its_flag() {
             "--dt 0.0005",
             "--t-end 2"
         ]
+    );
+}
+
+#[test]
+fn sys_output_interval_replaces_the_scenes_and_refuses_what_cannot_be_stored() {
+    use std::borrow::Cow;
+    let scene = data::load_scene("single-link").unwrap();
+    assert!(matches!(
+        data::sampled_as(&scene, None, None),
+        Ok(Cow::Borrowed(_))
+    ));
+    let fine = data::sampled_as(&scene, Some(1e-4), None).unwrap();
+    assert_eq!(fine.simulation.output_interval, 1e-4);
+    let mut back = fine.into_owned();
+    back.simulation.output_interval = scene.simulation.output_interval;
+    assert_eq!(back, scene, "only the output interval changes");
+
+    let refused =
+        |interval: f64, t_end: Option<f64>| match data::sampled_as(&scene, Some(interval), t_end) {
+            Err(data::BackendError::InvalidSettings { field, message }) => {
+                assert_eq!(field, "time.output_interval");
+                message
+            }
+            other => panic!("{interval} (t_end {t_end:?}) was not refused: {other:?}"),
+        };
+    for bad in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+        assert!(refused(bad, None).contains("finite number > 0"));
+    }
+    // The sample count is counted to the run's end: the end-time override moves the limit.
+    let limit = data::validate::limits::MAX_OUTPUT_SAMPLES;
+    assert!(data::sampled_as(&scene, Some(1.0), Some(limit)).is_ok());
+    let message = refused(1.0, Some(2.0 * limit));
+    assert!(message.contains("above the limit"), "{message}");
+    let message = refused(scene.simulation.t_end / (2.0 * limit), None);
+    assert!(
+        message.contains("give a larger output interval"),
+        "{message}"
     );
 }

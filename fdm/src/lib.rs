@@ -323,7 +323,9 @@ impl Backend for FdmBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
-        let s = ValidatedSettings::from_settings(&settings.fdm()?)?;
+        let requested = settings.fdm()?;
+        let scene = &*data::sampled_as(scene, requested.output_interval, requested.t_end)?;
+        let s = ValidatedSettings::from_settings(&requested)?;
         Ok(match &scene.model {
             Model::PlanarChain(pc) => match ChainModel::of(pc) {
                 ChainModel::Cantilever => return Err(beam::simulate_unsupported(scene).into()),

@@ -371,6 +371,7 @@ impl Backend for FemBackend {
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
         let settings = &settings.fem()?;
+        let scene = &*data::sampled_as(scene, settings.output_interval, settings.t_end)?;
         match &scene.model {
             Model::PlanarChain(pc) => Ok(run::simulate(scene, pc, settings)?),
             Model::PayloadLink(l) => Ok(payload_link::simulate(scene, l, settings)?),

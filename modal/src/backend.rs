@@ -58,6 +58,7 @@ impl Backend for ModalBackend {
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
         let settings = &settings.modal()?;
+        let scene = &*data::sampled_as(scene, settings.output_interval, settings.t_end)?;
         match &scene.model {
             Model::PlanarChain(pc) => Ok(simulate::simulate(scene, pc, settings)?),
             Model::Rocket(r) => rocket::simulate(scene, r, settings),

@@ -729,13 +729,21 @@ mod tests {
         assert_eq!(c.histories.len(), 1);
         assert!(c.only_in_run.is_empty());
 
-        // Low-passed far above the content, the difference stays close to the raw one.
+        // Low-passed far above the content, the difference stays close to the raw one over
+        // the compared interior, which ends one cut-off period (0.05 s, rounded up to whole run
+        // samples of 2·STEP) before t = 1.
         let filtered = CompareOptions {
             lowpass_hz: Some(20.0),
             ..only_x
         };
         let c = compare_runs(&run, &reference, &filtered).unwrap();
-        assert!((c.histories[0].max_abs_diff - expected).abs() < 1e-2 * expected);
+        let interior_end = 1.0 - (1.0 / (20.0 * 2.0 * STEP)).ceil() * 2.0 * STEP;
+        let expected = a * interior_end * interior_end;
+        assert!(
+            (c.histories[0].max_abs_diff - expected).abs() < 1e-2 * expected,
+            "{} against {expected}",
+            c.histories[0].max_abs_diff
+        );
     }
 
     #[test]

@@ -53,6 +53,8 @@ impl Backend for ReferenceBackend {
     }
 
     fn simulate(&self, scene: &Scene, settings: &Settings) -> Result<RunResult, BackendError> {
+        let time = &settings.time;
+        let scene = &*data::sampled_as(scene, time.output_interval, time.t_end)?;
         match &scene.model {
             Model::MobileManipulator(mm) => mobile::simulate(scene, mm, settings),
             Model::PlanarChain(_) | Model::Rocket(_) | Model::PayloadLink(_) => {

@@ -812,3 +812,49 @@ fn cli_compare_bad_input_exits_2_with_one_clear_message() {
         std::fs::remove_dir_all(dir).unwrap();
     }
 }
+
+#[test]
+fn cli_output_interval_sets_every_backends_samples_and_refuses_a_bad_value() {
+    let dir = out_dir("output-interval");
+    run_into(
+        &dir,
+        "single-link",
+        &["--t-end", "0.02", "--output-interval", "0.005"],
+    );
+    for backend in ["fem", "fdm", "modal"] {
+        let file = dir.join(format!("single-link-{backend}.json"));
+        let result: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+        let times: Vec<f64> = result["observables"]["time"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t.as_f64().unwrap())
+            .collect();
+        let expected = [0.0, 0.005, 0.01, 0.015, 0.02];
+        assert_eq!(times.len(), expected.len(), "{backend}: {times:?}");
+        for (t, e) in times.iter().zip(expected) {
+            assert!((t - e).abs() < 1e-12, "{backend}: {times:?}");
+        }
+        assert_eq!(
+            result["settings"]["time"]["output_interval"], 0.005,
+            "{backend}"
+        );
+    }
+    let (code, _, err) = flexverify(&["run", "single-link", "--output-interval", "0"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--output-interval"), "{err}");
+    let (code, _, err) = flexverify(&[
+        "run",
+        "single-link",
+        "--backend",
+        "fem",
+        "--output-interval",
+        "1e-9",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("time.output_interval") && err.contains("above the limit"),
+        "{err}"
+    );
+}

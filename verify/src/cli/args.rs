@@ -276,6 +276,11 @@ pub struct CommonOpts {
     /// End time (overrides the scene).
     #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
     pub t_end: Option<f64>,
+    /// Interval between stored output samples (overrides the scene). A low-passed history
+    /// (`lowpassF:`, `compare --lowpass`) needs samples that resolve the signal: undamped
+    /// links ring at high frequency, and coarse samples alias that ringing into the pass band.
+    #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
+    pub output_interval: Option<f64>,
     /// Integration method (backend-specific; the help lists each backend's from the method
     /// table, `method_help`).
     #[arg(long, value_parser = parse_method, help = method_help())]
@@ -352,6 +357,7 @@ impl CommonOpts {
             time: data::TimeStepping {
                 dt: self.dt,
                 t_end: self.t_end,
+                output_interval: self.output_interval,
                 method: self.method,
                 rtol: self.rtol,
                 atol: self.atol,

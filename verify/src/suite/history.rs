@@ -15,14 +15,15 @@
 //! evaluated at those times). With a low-pass cut-off f_c both
 //! histories are first interpolated onto one uniform grid of as many samples as `a` has over
 //! a's span, then filtered by the zero-phase Butterworth of [`super::filter`], and compared on
-//! that grid.
+//! that grid without one cut-off period at each end ([`super::filter::interior`]: the filtered
+//! ends pass through the raw end samples).
 
 use std::borrow::Cow;
 
 use data::RunResult;
 use data::cases::ENERGY_PREFIX;
 
-use super::filter::{lowpass_zero_phase, resample_uniform};
+use super::filter::{interior, lowpass_zero_phase, resample_uniform};
 
 /// (times, values) of a channel or ledger term of a run.
 pub fn series<'a>(r: &'a RunResult, channel: &str) -> Option<(&'a [f64], Cow<'a, [f64]>)> {
@@ -117,17 +118,20 @@ fn compare_series(
         return Err("the two histories do not overlap in time".into());
     }
     let inside = ta.iter().filter(|t| **t >= t0 && **t <= t1).count().max(3);
-    let on_grid = |t: &[f64], v: &[f64]| -> Result<Vec<f64>, String> {
+    let on_grid = |t: &[f64], v: &[f64]| -> Result<(Vec<f64>, std::ops::Range<usize>), String> {
         let (ts, vs): (Vec<f64>, Vec<f64>) = span_points(t, v, t0, t1).into_iter().unzip();
         let (dt, _, uniform) = resample_uniform(&ts, &vs, inside).map_err(|e| e.to_string())?;
-        lowpass_zero_phase(&uniform, dt, fc).map_err(|e| e.to_string())
+        let filtered = lowpass_zero_phase(&uniform, dt, fc).map_err(|e| e.to_string())?;
+        let keep = interior(filtered.len(), dt, fc).map_err(|e| e.to_string())?;
+        Ok((filtered, keep))
     };
-    let fa = on_grid(ta, va)?;
-    let fb = on_grid(tb, vb)?;
-    let max_abs_diff = fa
+    let (fa, keep) = on_grid(ta, va)?;
+    let (fb, _) = on_grid(tb, vb)?;
+    let max_abs_diff = fa[keep.clone()]
         .iter()
-        .zip(&fb)
+        .zip(&fb[keep])
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    // The scale is the whole filtered reference: its ends are values of the history too.
     let reference_peak = fb.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     Ok(HistoryDeviation {
         max_abs_diff,
@@ -172,11 +176,18 @@ pub fn common_samples(
             let (dt, _, uniform) =
                 resample_uniform(&pts_t, &pts_v, inside).map_err(|e| e.to_string())?;
             match lowpass_hz {
-                Some(fc) => lowpass_zero_phase(&uniform, dt, fc).map_err(|e| e.to_string()),
+                Some(fc) => low_passed_interior(&uniform, dt, fc),
                 None => Ok(uniform),
             }
         })
         .collect()
+}
+
+/// Uniform samples low-passed at `fc`, without their ends ([`interior`]).
+fn low_passed_interior(uniform: &[f64], dt: f64, fc: f64) -> Result<Vec<f64>, String> {
+    let filtered = lowpass_zero_phase(uniform, dt, fc).map_err(|e| e.to_string())?;
+    let keep = interior(filtered.len(), dt, fc).map_err(|e| e.to_string())?;
+    Ok(filtered[keep].to_vec())
 }
 
 /// The samples of (t, v) inside [t0, t1] with the span ends interpolated in, sorted by time,
