@@ -30,11 +30,13 @@ pub const STEPS_PER_PERIOD: f64 = 40.0;
 /// nothing dissipates the flexible motion (no joint damper, no Kelvin–Voigt, no contact): this
 /// many steps per first pinned-free period of its most flexible link. Without dissipation every
 /// excited mode rings for the whole run and the second-order schemes' phase error, (ωh)²/12 of
-/// each period, accumulates instead of decaying. With foreshortening the modes the step does
-/// not resolve feed the joint angles through the nonlinear coupling, and a moderately finer step
-/// does not converge: on `two-link-free-undamped` (16 elements, joint-1 angle low-passed at
-/// 20 Hz, against h = 1.47e-4 s) h = 7.1e-4 s differs by 3.7e-3 rad and h = 2.1e-4 s (3.4 times
-/// the cost) still by 3.1e-3; such chains keep the 40-step rule.
+/// each period, accumulates instead of decaying. Chains with foreshortening keep the 40-step
+/// rule; on `two-link-free-undamped` (16 elements, joint-1 angle low-passed at 20 Hz on samples
+/// every 2e-4 s, which resolve the links' ringing) the step's error falls at order 1.5: h =
+/// 2e-4 / 1e-4 / 5e-5 s differ by 2.3e-4 then 8.0e-5 of the peak (data/cases/two_link_rows.toml).
+/// (Sampled at the scene's 0.01 s, the ringing aliases into the 20 Hz band, and h = 7.1e-4 and
+/// 2.1e-4 s both lay ~3e-3 rad from h = 1.47e-4 s, which once read as a step that does not
+/// converge.)
 /// Measured against `flexverify run single-link --backend modal --modes 12 --rtol 1e-10 --atol
 /// 1e-12` (16 elements, hub angle, max over 3 s): 2.6e-2 rad at 40 steps per stiffest-link
 /// period, 7.4e-4 at 320 (h = 3.85e-4 s; modal's own default: 5.8e-4); on
