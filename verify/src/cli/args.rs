@@ -74,7 +74,9 @@ pub enum Command {
         #[arg(long)]
         channel: Vec<String>,
         /// Low-pass both histories at this cut-off (Hz; zero-phase Butterworth on one uniform
-        /// grid) before comparing them.
+        /// grid) before comparing them, without one cut-off period at each end (the filtered
+        /// ends pass through the raw end samples). Runs that ring above their samples' Nyquist
+        /// frequency need a finer `run --output-interval` first.
         #[arg(long, allow_hyphen_values = true, value_parser = positive_f64)]
         lowpass: Option<f64>,
         #[arg(long, value_enum, default_value_t = Format::Table)]
