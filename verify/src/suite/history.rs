@@ -121,9 +121,7 @@ fn compare_series(
     let on_grid = |t: &[f64], v: &[f64]| -> Result<(Vec<f64>, std::ops::Range<usize>), String> {
         let (ts, vs): (Vec<f64>, Vec<f64>) = span_points(t, v, t0, t1).into_iter().unzip();
         let (dt, _, uniform) = resample_uniform(&ts, &vs, inside).map_err(|e| e.to_string())?;
-        let filtered = lowpass_zero_phase(&uniform, dt, fc).map_err(|e| e.to_string())?;
-        let keep = interior(filtered.len(), dt, fc).map_err(|e| e.to_string())?;
-        Ok((filtered, keep))
+        low_passed(&uniform, dt, fc)
     };
     let (fa, keep) = on_grid(ta, va)?;
     let (fb, _) = on_grid(tb, vb)?;
@@ -176,18 +174,23 @@ pub fn common_samples(
             let (dt, _, uniform) =
                 resample_uniform(&pts_t, &pts_v, inside).map_err(|e| e.to_string())?;
             match lowpass_hz {
-                Some(fc) => low_passed_interior(&uniform, dt, fc),
+                Some(fc) => low_passed(&uniform, dt, fc).map(|(f, keep)| f[keep].to_vec()),
                 None => Ok(uniform),
             }
         })
         .collect()
 }
 
-/// Uniform samples low-passed at `fc`, without their ends ([`interior`]).
-fn low_passed_interior(uniform: &[f64], dt: f64, fc: f64) -> Result<Vec<f64>, String> {
+/// Uniform samples low-passed at `fc`, and the range of them that comparisons use (all but
+/// the ends, [`interior`]).
+fn low_passed(
+    uniform: &[f64],
+    dt: f64,
+    fc: f64,
+) -> Result<(Vec<f64>, std::ops::Range<usize>), String> {
     let filtered = lowpass_zero_phase(uniform, dt, fc).map_err(|e| e.to_string())?;
     let keep = interior(filtered.len(), dt, fc).map_err(|e| e.to_string())?;
-    Ok(filtered[keep].to_vec())
+    Ok((filtered, keep))
 }
 
 /// The samples of (t, v) inside [t0, t1] with the span ends interpolated in, sorted by time,
