@@ -75,36 +75,53 @@ impl BackendError {
 
 /// The scene as a run samples it: with `output_interval` (a run's override, the settings'
 /// `time.output_interval`) in place of the scene's own, borrowed unchanged when there is none.
-/// `t_end` is the run's end-time override, for the sample count. Refused (naming the field):
-/// an interval that is not a finite number > 0, or one that stores more than
-/// [`crate::validate::limits::MAX_OUTPUT_SAMPLES`] samples up to the run's end.
+/// `t_end` is the run's end-time override. The scene file's limit on the number of samples
+/// ([`crate::validate::limits::MAX_OUTPUT_SAMPLES`]) holds for the run too: a count above it,
+/// to the run's end at the run's spacing, is refused naming the override that raised it
+/// (`time.output_interval`, else `time.t_end`), as is an interval that is not a finite
+/// number > 0. An invalid end time is left to the backends' own checks.
 pub fn sampled_as(
     scene: &Scene,
     output_interval: Option<f64>,
     t_end: Option<f64>,
 ) -> Result<std::borrow::Cow<'_, Scene>, BackendError> {
-    use crate::validate::limits::MAX_OUTPUT_SAMPLES;
-    let Some(interval) = output_interval else {
-        return Ok(std::borrow::Cow::Borrowed(scene));
-    };
-    let refuse = |message: String| BackendError::InvalidSettings {
-        field: "time.output_interval".into(),
+    use crate::validate::limits::{MAX_OUTPUT_SAMPLES, excess_output_samples};
+    let refuse = |field: &str, message: String| BackendError::InvalidSettings {
+        field: field.into(),
         message,
     };
-    if !(interval.is_finite() && interval > 0.0) {
-        return Err(refuse(format!("{interval} must be a finite number > 0")));
+    if let Some(interval) = output_interval
+        && !(interval.is_finite() && interval > 0.0)
+    {
+        return Err(refuse(
+            "time.output_interval",
+            format!("{interval} must be a finite number > 0"),
+        ));
     }
-    let t_end = t_end.unwrap_or(scene.simulation.t_end);
-    let samples = t_end / interval;
-    if samples > MAX_OUTPUT_SAMPLES {
-        return Err(refuse(format!(
-            "t_end / output_interval = {t_end} / {interval} = {samples:.3e} samples is above the \
-             limit {MAX_OUTPUT_SAMPLES:.0e}; give a larger output interval"
-        )));
+    let interval = output_interval.unwrap_or(scene.simulation.output_interval);
+    let end = t_end.unwrap_or(scene.simulation.t_end);
+    if let Some(samples) = excess_output_samples(end, interval) {
+        let field = match output_interval {
+            Some(_) => "time.output_interval",
+            None => "time.t_end",
+        };
+        return Err(refuse(
+            field,
+            format!(
+                "t_end / output_interval = {end} / {interval} = {samples:.3e} samples is above \
+                 the limit {MAX_OUTPUT_SAMPLES:.0e}; give a larger output interval or an earlier \
+                 end time"
+            ),
+        ));
     }
-    let mut sampled = scene.clone();
-    sampled.simulation.output_interval = interval;
-    Ok(std::borrow::Cow::Owned(sampled))
+    Ok(match output_interval {
+        None => std::borrow::Cow::Borrowed(scene),
+        Some(interval) => {
+            let mut sampled = scene.clone();
+            sampled.simulation.output_interval = interval;
+            std::borrow::Cow::Owned(sampled)
+        }
+    })
 }
 
 /// A discretization of scenes: finite elements, finite differences or assumed modes.

@@ -264,4 +264,18 @@ fn sys_output_interval_replaces_the_scenes_and_refuses_what_cannot_be_stored() {
         message.contains("give a larger output interval"),
         "{message}"
     );
+    // An end-time override alone is held to the same limit, at the scene's spacing.
+    let far = 2.0 * limit * scene.simulation.output_interval;
+    match data::sampled_as(&scene, None, Some(far)) {
+        Err(data::BackendError::InvalidSettings { field, message }) => {
+            assert_eq!(field, "time.t_end");
+            assert!(message.contains("above the limit"), "{message}");
+        }
+        other => panic!("t_end {far} was not refused: {other:?}"),
+    }
+    let near = 0.5 * limit * scene.simulation.output_interval;
+    assert!(matches!(
+        data::sampled_as(&scene, None, Some(near)),
+        Ok(Cow::Borrowed(_))
+    ));
 }

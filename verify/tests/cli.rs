@@ -857,4 +857,11 @@ fn cli_output_interval_sets_every_backends_samples_and_refuses_a_bad_value() {
         err.contains("time.output_interval") && err.contains("above the limit"),
         "{err}"
     );
+    // An end time whose samples the scene's spacing cannot store is refused before running.
+    let (code, _, err) = flexverify(&["run", "single-link", "--backend", "fem", "--t-end", "1e9"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("time.t_end") && err.contains("above the limit"),
+        "{err}"
+    );
 }

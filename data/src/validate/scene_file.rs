@@ -1,7 +1,7 @@
 //! Checks of the scene file as a whole, before it converts into a scene.
 
 use super::issue::{Checker, Issue};
-use super::limits::{MAX_FIELD_STATIONS, MAX_OUTPUT_SAMPLES};
+use super::limits::{MAX_FIELD_STATIONS, MAX_OUTPUT_SAMPLES, excess_output_samples};
 use crate::locate::FieldPath;
 use crate::scene::SceneFile;
 
@@ -35,15 +35,13 @@ pub fn check_file(scene: &SceneFile) -> Vec<Issue> {
     let sim = root.key("simulation");
     c.positive(sim.key("t_end"), scene.simulation.t_end);
     c.positive(sim.key("output_interval"), scene.simulation.output_interval);
-    if scene.simulation.t_end.is_finite()
-        && scene.simulation.output_interval > 0.0
-        && scene.simulation.t_end / scene.simulation.output_interval > MAX_OUTPUT_SAMPLES
+    if let Some(samples) =
+        excess_output_samples(scene.simulation.t_end, scene.simulation.output_interval)
     {
         c.fail(
             sim.key("output_interval"),
             format!(
-                "t_end / output_interval = {:.3e} output samples is above the limit {MAX_OUTPUT_SAMPLES:.0e}",
-                scene.simulation.t_end / scene.simulation.output_interval
+                "t_end / output_interval = {samples:.3e} output samples is above the limit {MAX_OUTPUT_SAMPLES:.0e}"
             ),
             "a larger output_interval",
         );
