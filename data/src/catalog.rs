@@ -26,6 +26,7 @@ catalog!(
     "single-link",
     "two-link-free",
     "two-link-free-undamped",
+    "two-link-free-undamped-swing",
     "barhorst-case1",
     "barhorst-case2",
     "barhorst-case1-tipmass",

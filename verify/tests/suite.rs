@@ -275,17 +275,52 @@ fn conv_history_richardson_is_closer_than_the_rung_spacing_and_can_fail() {
 }
 
 #[test]
-fn prop_history_rung_sizes_follow_the_refined_parameter() {
-    use verify::suite::evaluate::history_rung_sizes;
+fn prop_ladder_rung_sizes_follow_the_refined_parameter() {
+    use verify::suite::evaluate::ladder_rung_sizes;
     let s = |elements: usize, dt: f64| CaseSettings {
         elements: Some(elements),
         dt: Some(dt),
         ..Default::default()
     };
     // A space ladder at one pinned step is sized by the elements, a time ladder by dt.
-    let space = history_rung_sizes(&[s(4, 2.5e-4), s(8, 2.5e-4), s(16, 2.5e-4)]).unwrap();
+    let space = ladder_rung_sizes(&[s(4, 2.5e-4), s(8, 2.5e-4), s(16, 2.5e-4)]).unwrap();
     assert_eq!(space, vec![0.25, 0.125, 0.0625]);
-    let time = history_rung_sizes(&[s(8, 1e-3), s(8, 5e-4), s(8, 2.5e-4)]).unwrap();
+    let time = ladder_rung_sizes(&[s(8, 1e-3), s(8, 5e-4), s(8, 2.5e-4)]).unwrap();
     assert_eq!(time, vec![1e-3, 5e-4, 2.5e-4]);
-    assert!(history_rung_sizes(&[s(8, 1e-3), s(8, 1e-3)]).is_err());
+    assert!(ladder_rung_sizes(&[s(8, 1e-3), s(8, 1e-3)]).is_err());
+}
+
+#[test]
+fn conv_point_value_space_ladder_at_one_pinned_step_is_sized_by_its_elements() {
+    // A ladder that pins dt on every rung refines the mesh: its rungs are sized 1/elements,
+    // as a history ladder's are. Sized by the pinned dt, every rung had one size and no
+    // order could be fitted.
+    let cache = RunCache::default();
+    let rung = |elements: usize| CaseSettings {
+        elements: Some(elements),
+        dt: Some(1e-3),
+        t_end: Some(0.3),
+        ..Default::default()
+    };
+    let case = Case {
+        id: "point-space-ladder".into(),
+        check: "convergence: observed order in space".into(),
+        scene: "two-link-free".into(),
+        overrides: Default::default(),
+        backend: BackendKind::Fem,
+        settings: rung(8),
+        quantity: "joint1.angle@0.3".into(),
+        reference: Reference::Order {
+            order: 4.0,
+            against: None,
+            ladder: [2, 4, 8].map(rung).to_vec(),
+        },
+        norm: Norm::Absolute,
+        tolerance: 10.0,
+        why: "Hermite cubics at one step: the mesh's order".into(),
+        suite: SuiteName::Full,
+    };
+    let o = evaluate(&case, &cache);
+    assert_ne!(o.status, Status::Error, "{}", o.message);
+    assert!(o.value.is_some_and(f64::is_finite), "{:?}", o.value);
 }

@@ -105,20 +105,6 @@ pub fn measure(
     }
 }
 
-/// Step size of a ladder rung for order fits.
-pub fn rung_size(s: &CaseSettings) -> Option<f64> {
-    if let Some(dt) = s.dt {
-        return Some(dt);
-    }
-    if let Some(e) = s.elements {
-        return Some(1.0 / e as f64);
-    }
-    if let Some(n) = s.stations {
-        return Some(1.0 / (n.max(2) - 1) as f64);
-    }
-    s.modes.map(|m| 1.0 / m as f64)
-}
-
 /// Measures the quantity on every rung of a ladder: (h of each rung, values, total wall time).
 /// `h` is empty when a rung sets no refinement parameter and `need_h` is false.
 fn measure_ladder(
@@ -129,12 +115,14 @@ fn measure_ladder(
     q: &Quantity,
     need_h: bool,
 ) -> Result<(Vec<f64>, Vec<f64>, f64), String> {
-    let (mut h, mut v, mut wall) = (Vec::new(), Vec::new(), 0.0);
+    let h = if need_h {
+        ladder_rung_sizes(ladder)?
+    } else {
+        Vec::new()
+    };
+    let (mut v, mut wall) = (Vec::new(), 0.0);
     for rung in ladder {
         let (val, _, w) = measure(cache, scene, kind, &rung.to_settings(), q)?;
-        if need_h {
-            h.push(rung_size(rung).ok_or("a ladder rung sets no refinement parameter")?);
-        }
         v.push(val);
         wall += w;
     }
@@ -414,11 +402,11 @@ fn evaluate_inner(case: &Case, cache: &RunCache, out: &mut Outcome) -> Result<()
 /// One way to size a ladder rung (None when the rung leaves that parameter unset).
 type RungSize = fn(&CaseSettings) -> Option<f64>;
 
-/// Rung sizes of a history ladder from the parameter its rungs refine: dt when it changes
-/// along the ladder, otherwise 1/elements, 1/(stations − 1) or 1/modes. A space ladder may so
-/// pin one step on every rung (the time error of a whole history does not cancel between
-/// meshes as a point value's may).
-pub fn history_rung_sizes(ladder: &[CaseSettings]) -> Result<Vec<f64>, String> {
+/// Rung sizes of a ladder from the parameter its rungs refine: dt when it changes along the
+/// ladder, otherwise 1/elements, 1/(stations − 1) or 1/modes. A space ladder may so pin one
+/// step on every rung (the time error of a whole history does not cancel between meshes as a
+/// point value's may).
+pub fn ladder_rung_sizes(ladder: &[CaseSettings]) -> Result<Vec<f64>, String> {
     let pick: [RungSize; 4] = [
         |s| s.dt,
         |s| s.elements.map(|e| 1.0 / e as f64),
@@ -461,7 +449,7 @@ fn history_ladder(
         Reference::Richardson { richardson } => richardson,
         _ => return Err("a history ladder needs an `order` or `richardson` reference".into()),
     };
-    let h = history_rung_sizes(ladder)?;
+    let h = ladder_rung_sizes(ladder)?;
     let mut runs = Vec::with_capacity(ladder.len() + 1);
     if matches!(case.reference, Reference::Richardson { .. }) {
         runs.push(run(&case.settings)?);

@@ -4,7 +4,7 @@
 //! A point value of an undamped flexible arm does not converge regularly: the elastic vibration
 //! rings at every resolved frequency and the sign of the difference between rungs changes from
 //! one output time to the next. The history as a whole (low-passed or raw) can still converge,
-//! and that is what these checks measure. Rung k (size h_k, from `super::evaluate::history_rung_sizes`)
+//! and that is what these checks measure. Rung k (size h_k, from `super::evaluate::ladder_rung_sizes`)
 //! gives the samples H_k(t) on one common grid ([`super::history::common_samples`]).
 //!
 //! # Observed order

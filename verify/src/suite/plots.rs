@@ -10,7 +10,7 @@ use std::path::Path;
 use data::cases::{Case, CaseSettings, Reference, scene_with_overrides};
 use data::{RunResult, Scene, load_scene};
 
-use super::evaluate::{Outcome, rung_size};
+use super::evaluate::{Outcome, ladder_rung_sizes};
 use super::order::richardson;
 use super::quantity::Quantity;
 use super::reference::analytic_value;
@@ -260,13 +260,13 @@ fn draw_ladder(
     order: f64,
 ) -> bool {
     // Each rung once more, sequentially: value, cost counters and repeated timings.
+    let Ok(sizes) = ladder_rung_sizes(ladder) else {
+        return false;
+    };
     let mut rungs = Vec::new();
-    for rung in ladder {
+    for (rung, &h) in ladder.iter().zip(&sizes) {
         let s = rung.to_settings();
-        let (Some(h), Ok((value, _, _))) = (
-            rung_size(rung),
-            super::evaluate::measure(cache, scene, case.backend, &s, q),
-        ) else {
+        let Ok((value, _, _)) = super::evaluate::measure(cache, scene, case.backend, &s, q) else {
             continue;
         };
         let cached = cache.get(scene, case.backend, &s, q.analysis(), q.modes_needed());
