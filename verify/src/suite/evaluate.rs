@@ -106,7 +106,7 @@ pub fn measure(
 }
 
 /// Measures the quantity on every rung of a ladder: (h of each rung, values, total wall time).
-/// `h` is empty when a rung sets no refinement parameter and `need_h` is false.
+/// `h` ([`ladder_rung_sizes`]) is computed only when `need_h` is set, and is empty otherwise.
 fn measure_ladder(
     cache: &RunCache,
     scene: &Scene,
