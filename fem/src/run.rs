@@ -33,10 +33,9 @@ pub const STEPS_PER_PERIOD: f64 = 40.0;
 /// each period, accumulates instead of decaying. Chains with foreshortening keep the 40-step
 /// rule; on `two-link-free-undamped` (16 elements, joint-1 angle low-passed at 20 Hz on samples
 /// every 2e-4 s, which resolve the links' ringing) the step's error falls at order 1.5: h =
-/// 2e-4 / 1e-4 / 5e-5 s differ by 2.3e-4 then 8.0e-5 of the peak (data/cases/two_link_rows.toml).
-/// (Sampled at the scene's 0.01 s, the ringing aliases into the 20 Hz band, and h = 7.1e-4 and
-/// 2.1e-4 s both lay ~3e-3 rad from h = 1.47e-4 s, which once read as a step that does not
-/// converge.)
+/// 2e-4 / 1e-4 / 5e-5 s differ by 2.3e-4 then 8.0e-5 of the peak (data/cases/two_link_rows.toml;
+/// at the scene's 0.01 s samples the ringing aliases into the 20 Hz band and hides this).
+/// Over the first 2.5 s, h = 2.5e-5 s lies 3.0e-5 of the peak from h = 5e-6 s.
 /// Measured against `flexverify run single-link --backend modal --modes 12 --rtol 1e-10 --atol
 /// 1e-12` (16 elements, hub angle, max over 3 s): 2.6e-2 rad at 40 steps per stiffest-link
 /// period, 7.4e-4 at 320 (h = 3.85e-4 s; modal's own default: 5.8e-4); on
